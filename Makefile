@@ -1,0 +1,109 @@
+# lamprig — the only entry point. See README.md.
+#
+#   make deps    install missing Debian packages (idempotent, silent when all present)
+#   make         build build/bin/lamprig and the tools (build/bin/lamprig-*)
+#   make test    build with -Werror + ASan + UBSan and run every test binary
+#   make run     render the default candle scene headless
+#   make bench   speed and error figures
+#   make clean
+#
+# Sources are found by wildcard: every .c under render/ hal/ calib/ and firmware/ (except
+# firmware/main.c) goes into the library; tools/NAME/*.c builds build/bin/lamprig-NAME;
+# tests/test_NAME.c (plus tests/support/*.c) builds one test binary per area.
+
+PUBLIC_TARGETS := all build test run bench
+
+ifndef LAMPRIG_INNER
+# Outer make: install dependencies first, then re-enter with pkg-config available.
+.PHONY: $(PUBLIC_TARGETS) deps clean
+$(PUBLIC_TARGETS): deps
+	@$(MAKE) --no-print-directory LAMPRIG_INNER=1 $@
+deps:
+	@sh tools/deps.sh
+clean:
+	rm -rf build
+%: deps
+	@$(MAKE) --no-print-directory LAMPRIG_INNER=1 $@
+else
+
+CC      ?= cc
+CXX     ?= c++
+PKGS    := egl glesv2 gbm libdrm libgpiod hidapi-libusb libusb-1.0 libmodbus libpng cairo lcms2
+PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS))
+PKG_LIBS   := $(shell pkg-config --libs $(PKGS))
+CV_CFLAGS  := $(shell pkg-config --cflags opencv4)
+# Only the OpenCV modules calib/ uses (the full list costs seconds per link).
+CV_LIBS    := -lopencv_mcc -lopencv_structured_light -lopencv_calib3d -lopencv_features2d \
+              -lopencv_videoio -lopencv_imgcodecs -lopencv_photo -lopencv_imgproc -lopencv_flann -lopencv_core
+CMOCKA_LIBS := $(shell pkg-config --libs cmocka)
+
+WARN    := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wno-unused-parameter
+COMMON  := -std=c11 -D_GNU_SOURCE -I. $(PKG_CFLAGS) -MMD -MP
+REL_CFLAGS  := $(COMMON) $(WARN) -O2 -g
+TEST_CFLAGS := $(COMMON) $(WARN) -Werror -O1 -g -fno-omit-frame-pointer \
+               -fsanitize=address,undefined -fno-sanitize-recover=undefined
+CXXFLAGS_REL  := -std=c++17 -I. $(CV_CFLAGS) -O2 -g -MMD -MP -Wall -Wextra
+CXXFLAGS_TEST := -std=c++17 -I. $(CV_CFLAGS) -O1 -g -MMD -MP -Wall -Wextra -Werror \
+                 -fsanitize=address,undefined -fno-sanitize-recover=undefined
+LDLIBS  := -Wl,--as-needed $(PKG_LIBS) $(CV_LIBS) -lm -lpthread
+
+LIB_C   := $(sort $(filter-out firmware/main.c, \
+             $(wildcard render/*.c render/*/*.c render/*/*/*.c hal/*.c hal/*/*.c \
+                        calib/*.c calib/*/*.c firmware/*.c firmware/*/*.c)))
+LIB_CXX := $(sort $(wildcard calib/*.cpp calib/*/*.cpp))
+TOOLS   := $(sort $(patsubst tools/%/,%,$(dir $(wildcard tools/*/*.c))))
+TESTS   := $(sort $(patsubst tests/%.c,%,$(wildcard tests/test_*.c)))
+SUPPORT := $(sort $(wildcard tests/support/*.c))
+
+REL_OBJ  := $(LIB_C:%.c=build/obj/rel/%.o) $(LIB_CXX:%.cpp=build/obj/rel/%.o)
+TEST_OBJ := $(LIB_C:%.c=build/obj/asan/%.o) $(LIB_CXX:%.cpp=build/obj/asan/%.o)
+
+.PHONY: all build test run bench
+all build: build/bin/lamprig $(TOOLS:%=build/bin/lamprig-%)
+
+build/obj/rel/%.o: %.c
+	@mkdir -p $(@D)
+	$(CC) $(REL_CFLAGS) -c $< -o $@
+build/obj/rel/%.o: %.cpp
+	@mkdir -p $(@D)
+	$(CXX) $(CXXFLAGS_REL) -c $< -o $@
+build/obj/asan/%.o: %.c
+	@mkdir -p $(@D)
+	$(CC) $(TEST_CFLAGS) -c $< -o $@
+build/obj/asan/%.o: %.cpp
+	@mkdir -p $(@D)
+	$(CXX) $(CXXFLAGS_TEST) -c $< -o $@
+
+build/lib/liblamprig.a: $(REL_OBJ)
+	@mkdir -p $(@D)
+	rm -f $@ && ar rcs $@ $^
+build/lib/liblamprig-asan.a: $(TEST_OBJ)
+	@mkdir -p $(@D)
+	rm -f $@ && ar rcs $@ $^
+
+# C++ (the OpenCV shim) is linked with the C++ driver.
+build/bin/lamprig: build/obj/rel/firmware/main.o build/lib/liblamprig.a
+	@mkdir -p $(@D)
+	$(CXX) -o $@ $^ $(LDLIBS)
+
+.SECONDEXPANSION:
+build/bin/lamprig-%: $$(patsubst %.c,build/obj/rel/%.o,$$(wildcard tools/$$*/*.c)) build/lib/liblamprig.a
+	@mkdir -p $(@D)
+	$(CXX) -o $@ $^ $(LDLIBS)
+
+build/test/test_%: build/obj/asan/tests/test_%.o $(SUPPORT:%.c=build/obj/asan/%.o) build/lib/liblamprig-asan.a
+	@mkdir -p $(@D)
+	$(CXX) -fsanitize=address,undefined -o $@ $^ $(LDLIBS) $(CMOCKA_LIBS)
+
+test: $(TESTS:%=build/test/%) build/bin/lamprig $(TOOLS:%=build/bin/lamprig-%)
+	@sh tests/run.sh $(TESTS:%=build/test/%)
+
+run: build/bin/lamprig
+	./build/bin/lamprig render --scene configs/scenes/candle.json --out build/out/candle.png \
+	    --stats build/out/candle-stats.json
+
+bench: build/bin/lamprig $(TOOLS:%=build/bin/lamprig-%)
+	./build/bin/lamprig-bench
+
+-include $(shell find build/obj -name '*.d' 2>/dev/null)
+endif

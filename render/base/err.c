@@ -1,0 +1,59 @@
+#include "render/base/err.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+int lr_err_set(lr_err *e, int code, const char *fmt, ...)
+{
+    if (e) {
+        va_list ap;
+        va_start(ap, fmt);
+        e->code = code;
+        vsnprintf(e->msg, sizeof e->msg, fmt, ap);
+        va_end(ap);
+    }
+    return code;
+}
+
+int lr_err_prefix(lr_err *e, const char *fmt, ...)
+{
+    if (!e)
+        return LR_OK;
+    char prefix[LR_ERR_MSG_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(prefix, sizeof prefix, fmt, ap);
+    va_end(ap);
+    char joined[LR_ERR_MSG_MAX];
+    /* Truncation is acceptable here: the message stays a readable prefix of the whole. */
+    int n = snprintf(joined, sizeof joined, "%s: %s", prefix, e->msg);
+    (void)n;
+    memcpy(e->msg, joined, sizeof e->msg);
+    return e->code;
+}
+
+void lr_err_clear(lr_err *e)
+{
+    if (e) {
+        e->code = LR_OK;
+        e->msg[0] = '\0';
+    }
+}
+
+const char *lr_status_str(int code)
+{
+    switch (code) {
+    case LR_OK: return "ok";
+    case LR_EINVAL: return "invalid argument";
+    case LR_EPARSE: return "parse error";
+    case LR_EIO: return "i/o error";
+    case LR_ENOMEM: return "out of memory";
+    case LR_ENODEV: return "no such device";
+    case LR_EUNSUPPORTED: return "unsupported";
+    case LR_EGL: return "GL error";
+    case LR_ETIMEOUT: return "timeout";
+    case LR_EPROTO: return "protocol error";
+    default: return "unknown error";
+    }
+}
