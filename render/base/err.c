@@ -25,11 +25,19 @@ int lr_err_prefix(lr_err *e, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(prefix, sizeof prefix, fmt, ap);
     va_end(ap);
-    char joined[LR_ERR_MSG_MAX];
-    /* Truncation is acceptable here: the message stays a readable prefix of the whole. */
-    int n = snprintf(joined, sizeof joined, "%s: %s", prefix, e->msg);
-    (void)n;
-    memcpy(e->msg, joined, sizeof e->msg);
+    /* Shift the message right and write "prefix: " in front; truncate the tail if needed. */
+    size_t cap = sizeof e->msg - 1;
+    size_t plen = strlen(prefix);
+    if (plen + 2 > cap)
+        plen = cap - 2;
+    size_t mlen = strlen(e->msg);
+    if (plen + 2 + mlen > cap)
+        mlen = cap - plen - 2;
+    memmove(e->msg + plen + 2, e->msg, mlen);
+    e->msg[plen + 2 + mlen] = '\0';
+    memcpy(e->msg, prefix, plen);
+    e->msg[plen] = ':';
+    e->msg[plen + 1] = ' ';
     return e->code;
 }
 
