@@ -38,12 +38,13 @@ CV_LIBS    := -lopencv_mcc -lopencv_structured_light -lopencv_calib3d -lopencv_f
 CMOCKA_LIBS := $(shell pkg-config --libs cmocka)
 
 WARN    := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wno-unused-parameter
-COMMON  := -std=c11 -D_GNU_SOURCE -I. $(PKG_CFLAGS) -MMD -MP
+# Where presets are found when no --configs/LAMPRIG_CONFIGS is given (see render/base/paths.h).
+COMMON  := -std=c11 -D_GNU_SOURCE -I. $(PKG_CFLAGS) -MMD -MP -DLR_SOURCE_CONFIGS='"$(CURDIR)/configs"'
 REL_CFLAGS  := $(COMMON) $(WARN) -O2 -g
 TEST_CFLAGS := $(COMMON) $(WARN) -Werror -O1 -g -fno-omit-frame-pointer \
                -fsanitize=address,undefined -fno-sanitize-recover=undefined
-CXXFLAGS_REL  := -std=c++17 -I. $(CV_CFLAGS) -O2 -g -MMD -MP -Wall -Wextra
-CXXFLAGS_TEST := -std=c++17 -I. $(CV_CFLAGS) -O1 -g -MMD -MP -Wall -Wextra -Werror \
+CXXFLAGS_REL  := -std=c++17 -I. -DLR_SOURCE_CONFIGS='"$(CURDIR)/configs"' $(CV_CFLAGS) -O2 -g -MMD -MP -Wall -Wextra
+CXXFLAGS_TEST := -std=c++17 -I. -DLR_SOURCE_CONFIGS='"$(CURDIR)/configs"' $(CV_CFLAGS) -O1 -g -MMD -MP -Wall -Wextra -Werror \
                  -fsanitize=address,undefined -fno-sanitize-recover=undefined
 LDLIBS  := -Wl,--as-needed $(PKG_LIBS) $(CV_LIBS) -lm -lpthread
 
@@ -61,39 +62,51 @@ TEST_OBJ := $(LIB_C:%.c=build/obj/asan/%.o) $(LIB_CXX:%.cpp=build/obj/asan/%.o)
 .PHONY: all build test run bench
 all build: build/bin/lamprig $(TOOLS:%=build/bin/lamprig-%)
 
+V ?= 0
+Q := $(if $(filter 1,$(V)),,@)
+
 build/obj/rel/%.o: %.c
 	@mkdir -p $(@D)
-	$(CC) $(REL_CFLAGS) -c $< -o $@
+	@echo "  CC      $<"
+	$(Q)$(CC) $(REL_CFLAGS) -c $< -o $@
 build/obj/rel/%.o: %.cpp
 	@mkdir -p $(@D)
-	$(CXX) $(CXXFLAGS_REL) -c $< -o $@
+	@echo "  CXX     $<"
+	$(Q)$(CXX) $(CXXFLAGS_REL) -c $< -o $@
 build/obj/asan/%.o: %.c
 	@mkdir -p $(@D)
-	$(CC) $(TEST_CFLAGS) -c $< -o $@
+	@echo "  CC-SAN  $<"
+	$(Q)$(CC) $(TEST_CFLAGS) -c $< -o $@
 build/obj/asan/%.o: %.cpp
 	@mkdir -p $(@D)
-	$(CXX) $(CXXFLAGS_TEST) -c $< -o $@
+	@echo "  CXX-SAN $<"
+	$(Q)$(CXX) $(CXXFLAGS_TEST) -c $< -o $@
 
 build/lib/liblamprig.a: $(REL_OBJ)
 	@mkdir -p $(@D)
-	rm -f $@ && ar rcs $@ $^
+	@echo "  AR      $@"
+	$(Q)rm -f $@ && ar rcs $@ $^
 build/lib/liblamprig-asan.a: $(TEST_OBJ)
 	@mkdir -p $(@D)
-	rm -f $@ && ar rcs $@ $^
+	@echo "  AR      $@"
+	$(Q)rm -f $@ && ar rcs $@ $^
 
 # C++ (the OpenCV shim) is linked with the C++ driver.
 build/bin/lamprig: build/obj/rel/firmware/main.o build/lib/liblamprig.a
 	@mkdir -p $(@D)
-	$(CXX) -o $@ $^ $(LDLIBS)
+	@echo "  LD      $@"
+	$(Q)$(CXX) -o $@ $^ $(LDLIBS)
 
 .SECONDEXPANSION:
 build/bin/lamprig-%: $$(patsubst %.c,build/obj/rel/%.o,$$(wildcard tools/$$*/*.c)) build/lib/liblamprig.a
 	@mkdir -p $(@D)
-	$(CXX) -o $@ $^ $(LDLIBS)
+	@echo "  LD      $@"
+	$(Q)$(CXX) -o $@ $^ $(LDLIBS)
 
 build/test/test_%: build/obj/asan/tests/test_%.o $(SUPPORT:%.c=build/obj/asan/%.o) build/lib/liblamprig-asan.a
 	@mkdir -p $(@D)
-	$(CXX) -fsanitize=address,undefined -o $@ $^ $(LDLIBS) $(CMOCKA_LIBS)
+	@echo "  LD-SAN  $@"
+	$(Q)$(CXX) -fsanitize=address,undefined -o $@ $^ $(LDLIBS) $(CMOCKA_LIBS)
 
 test: $(TESTS:%=build/test/%) build/bin/lamprig $(TOOLS:%=build/bin/lamprig-%)
 	@sh tests/run.sh $(TESTS:%=build/test/%)

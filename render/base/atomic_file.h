@@ -1,0 +1,25 @@
+/* lamprig — atomic file replacement: write a temp file in the same directory, fsync, rename.
+ * A crash or a failed write leaves the previous file intact (calibrations, presets, images). */
+#ifndef LR_ATOMIC_FILE_H
+#define LR_ATOMIC_FILE_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#include "render/base/err.h"
+
+typedef struct lr_atomic_file lr_atomic_file;
+
+/* Opens a temp file beside `path` for writing; write through lr_atomic_file_stream(). */
+int lr_atomic_file_open(const char *path, lr_atomic_file **out, lr_err *e);
+FILE *lr_atomic_file_stream(lr_atomic_file *f);
+/* Flushes, fsyncs and renames over `path`. Always frees f; on failure the temp is removed
+ * and the old file is untouched. */
+int lr_atomic_file_commit(lr_atomic_file *f, lr_err *e);
+/* Discards the temp file (on an error path); frees f. */
+void lr_atomic_file_abort(lr_atomic_file *f);
+
+/* Whole-buffer convenience. */
+int lr_atomic_write(const char *path, const void *data, size_t len, lr_err *e);
+
+#endif

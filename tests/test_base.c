@@ -1,0 +1,100 @@
+/* Base utilities: error messages and atomic file replacement. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "render/base/atomic_file.h"
+#include "render/base/err.h"
+
+static void test_err_prefix(void **state)
+{
+    (void)state;
+    lr_err e = {0};
+    assert_int_equal(lr_err_set(&e, LR_EINVAL, "field '%s' must be >= 0", "eta"), LR_EINVAL);
+    assert_int_equal(lr_err_prefix(&e, "%s:%d", "wax.json", 7), LR_EINVAL);
+    assert_string_equal(e.msg, "wax.json:7: field 'eta' must be >= 0");
+    /* An overlong prefix truncates but keeps the string terminated and the code. */
+    char big[2 * LR_ERR_MSG_MAX];
+    memset(big, 'p', sizeof big - 1);
+    big[sizeof big - 1] = '\0';
+    assert_int_equal(lr_err_prefix(&e, "%s", big), LR_EINVAL);
+    assert_int_equal(strlen(e.msg), LR_ERR_MSG_MAX - 1);
+    assert_int_equal(lr_err_set(NULL, LR_EIO, "ignored"), LR_EIO);
+    assert_string_equal(lr_status_str(LR_ENODEV), "no such device");
+}
+
+static char *slurp(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    char *buf = calloc(1, 4096);
+    size_t n = fread(buf, 1, 4095, f);
+    buf[n] = '\0';
+    fclose(f);
+    return buf;
+}
+
+static int count_entries(const char *dir)
+{
+    DIR *d = opendir(dir);
+    int n = 0;
+    struct dirent *de;
+    while ((de = readdir(d)))
+        if (de->d_name[0] != '.')
+            n++;
+    closedir(d);
+    return n;
+}
+
+static void test_atomic_replace_and_failure_keeps_old(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/lamprig-atomic-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char path[256];
+    snprintf(path, sizeof path, "%s/calib.json", dir);
+    lr_err e = {0};
+    assert_int_equal(lr_atomic_write(path, "old", 3, &e), LR_OK);
+    /* A writer that fails half-way (abort) leaves the old content and no temp file. */
+    lr_atomic_file *f;
+    assert_int_equal(lr_atomic_file_open(path, &f, &e), LR_OK);
+    fputs("half-written new content", lr_atomic_file_stream(f));
+    lr_atomic_file_abort(f);
+    char *s = slurp(path);
+    assert_string_equal(s, "old");
+    free(s);
+    assert_int_equal(count_entries(dir), 1);
+    /* A committed writer replaces it whole. */
+    assert_int_equal(lr_atomic_file_open(path, &f, &e), LR_OK);
+    fputs("new", lr_atomic_file_stream(f));
+    assert_int_equal(lr_atomic_file_commit(f, &e), LR_OK);
+    s = slurp(path);
+    assert_string_equal(s, "new");
+    free(s);
+    assert_int_equal(count_entries(dir), 1);
+    /* Unwritable destination: a clear error naming the path. */
+    char bad[300];
+    snprintf(bad, sizeof bad, "%s/no-such-dir/x.json", dir);
+    assert_int_equal(lr_atomic_write(bad, "x", 1, &e), LR_EIO);
+    assert_non_null(strstr(e.msg, bad));
+    unlink(path);
+    rmdir(dir);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_err_prefix),
+        cmocka_unit_test(test_atomic_replace_and_failure_keeps_old),
+    };
+    return cmocka_run_group_tests_name("base", tests, NULL, NULL);
+}
