@@ -33,8 +33,8 @@ void lrb_cpu_name(char *buf, size_t len);
 
 /* Rate measurement: calls body(ctx, n) (which must perform n evaluations and return a value
  * depending on all of them), choosing n so that one run lasts about min_run_s of thread CPU
- * time, then times `runs` runs after one warm-up. Fills evaluations/s of each run into rates[] (runs <= 32) and returns
- * the median. */
+ * time, then times `runs` runs after one warm-up. Fills evaluations/s of each run into
+ * rates[] (runs <= 32) and returns the median. */
 typedef double (*lrb_body)(void *ctx, long n);
 double lrb_measure_rate(lrb_body body, void *ctx, double min_run_s, int runs, double *rates);
 

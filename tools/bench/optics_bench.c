@@ -50,8 +50,11 @@ static void make_inputs(ctx *x)
         g->xi = lr_v3_add(lr_v3(0.0, 0.0, -R), lr_v3_scale(ni, R));
         double ct = 0.05 + 0.95 * uniform01(&seed), ph = 2.0 * M_PI * uniform01(&seed);
         double st = sqrt(1.0 - ct * ct);
-        /* light direction in n_i's hemisphere (n_i is close to z here; tilt around it) */
-        g->wi = lr_v3_normalize(lr_v3_add(lr_v3(st * cos(ph), st * sin(ph), 0.0), lr_v3_scale(ni, ct)));
+        /* light direction in n_i's hemisphere, cos_i in [0.05, 1] */
+        lr_vec3 t1 = lr_v3_normalize(lr_v3_cross(ni, lr_v3(1.0, 0.0, 0.0)));
+        lr_vec3 t2 = lr_v3_cross(ni, t1);
+        g->wi = lr_v3_add(lr_v3_add(lr_v3_scale(t1, st * cos(ph)), lr_v3_scale(t2, st * sin(ph))),
+                          lr_v3_scale(ni, ct));
         g->r = r;
     }
 }
