@@ -8,7 +8,7 @@
 #include "render/base/err.h"
 
 /* A state line: device prefix + an lr_err message + "; retrying with backoff". */
-#define LR_DEV_LINE_MAX (LR_ERR_MSG_MAX + 2 * LR_EVENT_NAME_MAX + 64)
+#define LR_DEV_LINE_MAX (LR_ERR_MSG_MAX + 4 * LR_EVENT_NAME_MAX + 64)
 
 typedef struct lr_dev_ops {
     const char *kind;

@@ -81,7 +81,7 @@ static void button_events(lr_event *out, int *n, uint16_t old, uint16_t now, con
     for (int i = 0; i < nbits; i++) {
         uint16_t m = (uint16_t)(1u << bits[i]);
         if ((old ^ now) & m) {
-            char name[16];
+            char name[LR_EVENT_NAME_MAX];
             snprintf(name, sizeof name, "button%d", i + 1);
             put(out, n, name, (now & m) ? LR_EV_PRESS : LR_EV_RELEASE, (now & m) ? 1 : 0);
         }

@@ -304,7 +304,8 @@ static void handle_response(lr_modbus *m, int64_t now_ns)
     uint8_t rsp[MODBUS_MAX_ADU_LENGTH];
     int n = modbus_receive_confirmation(m->ctx, rsp);
     m->phase = IDLE;
-    m->earliest_send = now_ns + m->gap_ns;
+    /* The bus silence counts from the end of the answer, which is now, not dispatch start. */
+    m->earliest_send = m->gap_ns ? lr_now_ns() + m->gap_ns : now_ns;
     channel *ch = req_channel(m);
     if (n < 0) {
         int err = errno;
