@@ -60,11 +60,14 @@ static void opened(lr_dev *d)
 {
     char line[LR_DEV_LINE_MAX];
     unsigned attempts = d->backoff.failures;
+    char what[sizeof d->ident + 2] = "";
+    if (d->ident[0])
+        snprintf(what, sizeof what, "%s: ", d->ident);
     if (attempts && d->started)
-        snprintf(line, sizeof line, "%s: open (after %u failed attempt%s)", d->prefix, attempts,
-                 attempts == 1 ? "" : "s");
+        snprintf(line, sizeof line, "%s: %sopen (after %u failed attempt%s)", d->prefix, what,
+                 attempts, attempts == 1 ? "" : "s");
     else
-        snprintf(line, sizeof line, "%s: open", d->prefix);
+        snprintf(line, sizeof line, "%s: %sopen", d->prefix, what);
     lr_backoff_reset(&d->backoff);
     d->retry_at = LR_NO_DEADLINE;
     lr_dev_fds_changed(d);

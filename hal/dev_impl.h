@@ -29,6 +29,8 @@ struct lr_dev {
     const lr_dev_ops *ops;
     char name[LR_EVENT_NAME_MAX];
     char prefix[2 * LR_EVENT_NAME_MAX]; /* "gpio" or "gpio knobs": starts every log line */
+    char ident[320];  /* what is opened ("gpiochip0", "tcp://10.0.0.5:502"): named in the
+                       * "open" line; set by the back end, may stay empty */
     lr_event_sink sink;
     lr_log log;
     lr_dev_state state;

@@ -371,6 +371,7 @@ static int configure(lr_gpio *g, const lr_gpio_desc *desc, lr_err *e)
     if (strlen(chip) >= sizeof g->chip_name)
         return lr_err_set(e, LR_EINVAL, "%s: chip name too long", pf);
     strcpy(g->chip_name, chip);
+    snprintf(g->base.ident, sizeof g->base.ident, "%s", chip);
     snprintf(g->consumer, sizeof g->consumer, "%s",
              desc->consumer && desc->consumer[0] ? desc->consumer : "lamprig");
     switch (desc->bias) {

@@ -167,6 +167,7 @@ int lr_hid_create(const lr_hid_desc *desc, lr_hid **out, lr_err *e)
     if (rc == LR_OK) {
         snprintf(h->ident, sizeof h->ident, "%04x:%04x (%s%s%s)", h->vid, h->pid,
                  lr_hid_proto_name(h->pdesc.proto), h->serial[0] ? ", serial " : "", h->serial);
+        snprintf(h->base.ident, sizeof h->base.ident, "%s", h->ident);
         h->poll_ns = (int64_t)(desc->poll_ms ? desc->poll_ms : 8) * 1000000;
         rc = lr_dev_start(&h->base, desc->dev.required, lr_now_ns(), e);
     }

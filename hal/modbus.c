@@ -20,6 +20,7 @@
 typedef struct channel {
     char what[96];   /* "input 'dimmer' (unit 1, holding register 0)" */
     bool failing;    /* an error was logged; the next success logs the recovery */
+    char last[256];  /* the problem last logged: the same one again is only counted */
 } channel;
 
 typedef struct input {
@@ -79,20 +80,21 @@ static channel *req_channel(lr_modbus *m)
     return m->req == REQ_WRITE ? &m->out.ch : &m->in[m->req_input].ch;
 }
 
-/* Logs a channel problem once, until the channel works again. */
+/* Logs a channel problem once, until the channel works again or fails differently. */
 static void ch_fail(lr_modbus *m, channel *ch, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 static void ch_fail(lr_modbus *m, channel *ch, const char *fmt, ...)
 {
-    if (ch->failing)
-        return;
-    ch->failing = true;
-    char msg[256];
+    char msg[sizeof ch->last];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    lr_dev_log(&m->base, LR_LOG_WARN, "%s: %s: %s (counted; further ones not logged)",
+    if (ch->failing && strcmp(msg, ch->last) == 0)
+        return;
+    ch->failing = true;
+    memcpy(ch->last, msg, sizeof msg);
+    lr_dev_log(&m->base, LR_LOG_WARN, "%s: %s: %s (counted; repeats not logged)",
                m->url_text, ch->what, msg);
 }
 
@@ -101,6 +103,7 @@ static void ch_ok(lr_modbus *m, channel *ch)
     if (!ch->failing)
         return;
     ch->failing = false;
+    ch->last[0] = '\0';
     lr_dev_log(&m->base, LR_LOG_INFO, "%s: %s: answering again", m->url_text, ch->what);
 }
 
@@ -482,6 +485,7 @@ static int configure(lr_modbus *m, const lr_modbus_desc *desc, lr_err *e)
     if (rc != LR_OK)
         return lr_err_prefix(e, "%s", pf);
     lr_modbus_url_format(&m->url, m->url_text, sizeof m->url_text);
+    snprintf(m->base.ident, sizeof m->base.ident, "%s", m->url_text);
     if (desc->n_inputs < 0 || desc->n_inputs > MAX_INPUTS || (desc->n_inputs && !desc->inputs))
         return lr_err_set(e, LR_EINVAL, "%s: n_inputs %d is not 0..%d", pf, desc->n_inputs,
                           MAX_INPUTS);

@@ -344,6 +344,8 @@ int lr_sim_create(const lr_sim_desc *desc, lr_sim **out, lr_err *e)
         free(s);
         return rc;
     }
+    snprintf(s->base.ident, sizeof s->base.ident, "%s (%d events%s)",
+             desc->path ? desc->path : "script", s->script->n, desc->loop ? ", looping" : "");
     s->loop = desc->loop;
     s->start_ns = desc->start_ns ? desc->start_ns : lr_now_ns();
     lr_dev_start(&s->base, false, s->start_ns, e);
