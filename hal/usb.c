@@ -175,7 +175,11 @@ static void open_reader(watch *w, int64_t now_ns)
         what = "find an interrupt IN endpoint on the interface";
         rc = find_in_endpoint(w, &ep, &maxp);
     }
-    if (rc == 0) {
+    if (rc == 0 && w->tr) {
+        /* A transfer whose cancellation never completed is still owned by libusb. */
+        what = "start reading (the previous transfer is still pending)";
+        rc = LIBUSB_ERROR_BUSY;
+    } else if (rc == 0) {
         what = "start reading";
         if (maxp <= 0 || maxp > (int)sizeof w->buf)
             maxp = (int)sizeof w->buf;
@@ -258,7 +262,11 @@ static void process_news(lr_usb *u, int64_t now_ns)
 {
     for (int i = 0; i < u->nq; i++) {
         news *nw = &u->q[i];
-        for (int k = 0; k < u->n; k++) {
+        /* Watches with the same VID:PID each registered a callback: one arrival, one owner. */
+        bool taken = false;
+        for (int k = 0; k < u->n; k++)
+            taken |= nw->arrived && u->w[k].dev == nw->dev;
+        for (int k = 0; k < u->n && !taken; k++) {
             watch *w = &u->w[k];
             if (nw->arrived && !w->dev && matches(w, nw->dev)) {
                 arrived(w, nw->dev, now_ns);

@@ -230,6 +230,62 @@ static void consumer_bitmap_reports(void **state)
     assert_non_null(strstr(e.msg, "bitmap layout needs cc_bitmap"));
 }
 
+static uint32_t rnd(uint32_t *x)
+{
+    *x ^= *x << 13;
+    *x ^= *x >> 17;
+    *x ^= *x << 5;
+    return *x;
+}
+
+static void garbage_never_breaks_a_parser(void **state)
+{
+    (void)state;
+    /* Random reports of 0..80 bytes into every parser: only LR_OK or LR_EPROTO, bounded event
+     * counts, values inside each control's range, and every garbage report counted. */
+    const lr_hid_parser_desc descs[] = {
+        {.proto = LR_HID_POWERMATE},
+        {.proto = LR_HID_SHUTTLEXPRESS},
+        {.proto = LR_HID_SHUTTLEPRO},
+        {.proto = LR_HID_CONSUMER, .report_id = 1},
+        {.proto = LR_HID_CONSUMER, .cc_layout = LR_HID_CC_BITMAP, .cc_bitmap = {0xe9, 0xea, 0xe2}},
+    };
+    uint32_t x = 2463534242u;
+    for (size_t k = 0; k < sizeof descs / sizeof descs[0]; k++) {
+        lr_hid_parser p;
+        assert_int_equal(lr_hid_parser_init(&p, &descs[k], NULL), LR_OK);
+        int garbage = 0;
+        for (int i = 0; i < 20000; i++) {
+            uint8_t buf[80];
+            size_t len = rnd(&x) % (sizeof buf + 1);
+            for (size_t j = 0; j < len; j++)
+                buf[j] = (uint8_t)rnd(&x);
+            if (descs[k].report_id && len && (rnd(&x) & 1))
+                buf[0] = descs[k].report_id; /* mostly our report, sometimes another */
+            parsed r = P(&p, buf, len);
+            assert_true(r.rc == LR_OK || r.rc == LR_EPROTO);
+            assert_true(r.n >= 0 && r.n <= LR_HID_MAX_EVENTS);
+            if (r.rc != LR_OK) {
+                garbage++;
+                assert_int_equal(r.n, 0);
+                assert_true(strlen(r.e.msg) > 0);
+            }
+            for (int j = 0; j < r.n; j++) {
+                const lr_event *ev = &r.ev[j];
+                assert_true(ev->control[0] != '\0');
+                if (ev->kind == LR_EV_DELTA)
+                    assert_true(ev->value >= -128 && ev->value <= 127 && ev->value != 0);
+                else if (ev->kind == LR_EV_ABSOLUTE)
+                    assert_true(ev->value >= -1 && ev->value <= 1);
+                else
+                    assert_float_equal(ev->value, ev->kind == LR_EV_PRESS ? 1 : 0, 0);
+            }
+        }
+        assert_int_equal(garbage, (int)(p.short_reports + p.bad_values));
+        assert_true(garbage > 0);
+    }
+}
+
 static void proto_by_ids(void **state)
 {
     (void)state;
@@ -287,6 +343,7 @@ int main(void)
         cmocka_unit_test(shuttlepro_buttons),
         cmocka_unit_test(consumer_array_reports),
         cmocka_unit_test(consumer_bitmap_reports),
+        cmocka_unit_test(garbage_never_breaks_a_parser),
         cmocka_unit_test(proto_by_ids),
         cmocka_unit_test(hid_device_missing),
     };

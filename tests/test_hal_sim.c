@@ -98,6 +98,50 @@ static void bad_lines_name_file_and_line(void **state)
     }
 }
 
+static void garbage_scripts(void **state)
+{
+    (void)state;
+    /* Random lines built from script-like tokens and junk: parsed or rejected with file:line,
+     * never anything else. */
+    static const char *const tok[] = {"0", "0.5", "1e3", "-1", "nan", "knob1", "a/b", "/",
+                                      "delta", "absolute", "press", "release", "end", "+3",
+                                      "#", "\t", "x\x01y", "99999999999", "", "1.5e-9"};
+    uint32_t x = 88172645u;
+    int ok = 0, bad = 0;
+    for (int i = 0; i < 3000; i++) {
+        char text[512] = "";
+        int lines = 1 + (int)(x % 4);
+        for (int l = 0; l < lines; l++) {
+            int ntok = (int)((x >> 8) % 6);
+            for (int t = 0; t < ntok; t++) {
+                x ^= x << 13;
+                x ^= x >> 17;
+                x ^= x << 5;
+                strcat(text, tok[x % (sizeof tok / sizeof tok[0])]);
+                strcat(text, " ");
+            }
+            strcat(text, "\n");
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+        }
+        lr_sim_script *s = NULL;
+        lr_err e = {0};
+        int rc = lr_sim_script_parse(text, "fuzz.sim", &s, &e);
+        if (rc == LR_OK) {
+            ok++;
+            assert_non_null(s);
+            lr_sim_script_destroy(s);
+        } else {
+            bad++;
+            assert_int_equal(rc, LR_EPARSE);
+            assert_null(s);
+            assert_memory_equal(e.msg, "fuzz.sim:", 9);
+        }
+    }
+    assert_true(ok > 0 && bad > 0);
+}
+
 static void load_file_errors(void **state)
 {
     (void)state;
@@ -250,6 +294,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(script_parses),
         cmocka_unit_test(bad_lines_name_file_and_line),
+        cmocka_unit_test(garbage_scripts),
         cmocka_unit_test(load_file_errors),
         cmocka_unit_test(playback_by_deadlines),
         cmocka_unit_test(playback_loops),
