@@ -162,6 +162,10 @@ static int find_in_endpoint(watch *w, uint8_t *ep, int *maxp)
 static void open_reader(watch *w, int64_t now_ns)
 {
     const char *what = "open";
+    if (w->tr && !w->transfer_active) {
+        libusb_free_transfer(w->tr); /* its late cancellation has completed meanwhile */
+        w->tr = NULL;
+    }
     int rc = libusb_open(w->dev, &w->h);
     if (rc == 0) {
         what = "claim interface";
