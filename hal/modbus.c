@@ -1,0 +1,636 @@
+/* Modbus master back end: see hal/modbus.h for the loop design. */
+#include "hal/modbus.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <modbus.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include "hal/dev_impl.h"
+
+#define MAX_INPUTS 16
+#define MS 1000000LL
+
+typedef struct channel {
+    char what[96];   /* "input 'dimmer' (unit 1, holding register 0)" */
+    bool failing;    /* an error was logged; the next success logs the recovery */
+    char last[256];  /* the problem last logged: the same one again is only counted */
+} channel;
+
+typedef struct input {
+    char control[LR_EVENT_NAME_MAX];
+    int unit, addr;
+    lr_modbus_reg_type type;
+    int raw_min, raw_max;
+    int last_raw;
+    bool have; /* last_raw valid since the last (re)connect */
+    channel ch;
+} input;
+
+typedef struct output {
+    bool enabled;
+    int unit, addr;
+    int raw_min, raw_max;
+    bool multiple;
+    int want;     /* raw value to be written, -1 none yet */
+    int acked;    /* raw value the driver acknowledged, -1 none */
+    int rejected; /* raw value answered with an exception: not resent until the level changes */
+    channel ch;
+} output;
+
+enum { IDLE, WAIT };
+enum { REQ_READ, REQ_WRITE };
+
+struct lr_modbus {
+    lr_dev base;
+    lr_modbus_url url;
+    char url_text[LR_MODBUS_HOST_MAX + 64];
+    modbus_t *ctx;
+    int fd;
+    input in[MAX_INPUTS];
+    int n_in;
+    output out;
+    int64_t poll_ns, timeout_ns;
+    int byte_timeout_ms;
+    int max_timeouts;
+    int64_t gap_ns; /* RTU: silence owed to the bus between frames (3.5 characters) */
+    /* the transaction in flight */
+    int phase;
+    int req;       /* REQ_READ / REQ_WRITE */
+    int req_input; /* for REQ_READ */
+    int req_raw;   /* for REQ_WRITE */
+    int req_unit, req_func, req_addr;
+    int64_t deadline;
+    int64_t earliest_send;
+    /* polling */
+    int next_input;
+    int64_t next_cycle;
+    int consecutive_timeouts;
+    lr_modbus_counters c;
+};
+
+static channel *req_channel(lr_modbus *m)
+{
+    return m->req == REQ_WRITE ? &m->out.ch : &m->in[m->req_input].ch;
+}
+
+/* Logs a channel problem once, until the channel works again or fails differently. */
+static void ch_fail(lr_modbus *m, channel *ch, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static void ch_fail(lr_modbus *m, channel *ch, const char *fmt, ...)
+{
+    char msg[sizeof ch->last];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    if (ch->failing && strcmp(msg, ch->last) == 0)
+        return;
+    ch->failing = true;
+    memcpy(ch->last, msg, sizeof msg);
+    lr_dev_log(&m->base, LR_LOG_WARN, "%s: %s: %s (counted; repeats not logged)",
+               m->url_text, ch->what, msg);
+}
+
+static void ch_ok(lr_modbus *m, channel *ch)
+{
+    if (!ch->failing)
+        return;
+    ch->failing = false;
+    ch->last[0] = '\0';
+    lr_dev_log(&m->base, LR_LOG_INFO, "%s: %s: answering again", m->url_text, ch->what);
+}
+
+static const char *exception_name(int code)
+{
+    switch (code) {
+    case 1: return "illegal function";
+    case 2: return "illegal data address";
+    case 3: return "illegal data value";
+    case 4: return "server device failure";
+    case 5: return "acknowledge";
+    case 6: return "server device busy";
+    case 8: return "memory parity error";
+    case 10: return "gateway path unavailable";
+    case 11: return "gateway target device failed to respond";
+    }
+    return "unknown exception";
+}
+
+static bool errno_means_missing(int err)
+{
+    return err == ENOENT || err == ENODEV || err == ENXIO || err == ECONNREFUSED ||
+           err == EHOSTUNREACH || err == ENETUNREACH || err == EHOSTDOWN;
+}
+
+static void mb_close(lr_dev *d)
+{
+    lr_modbus *m = (lr_modbus *)d;
+    if (m->ctx) {
+        modbus_close(m->ctx);
+        modbus_free(m->ctx);
+    }
+    m->ctx = NULL;
+    m->fd = -1;
+    m->phase = IDLE;
+}
+
+static int mb_open(lr_dev *d, int64_t now_ns, lr_err *e)
+{
+    lr_modbus *m = (lr_modbus *)d;
+    const lr_modbus_url *u = &m->url;
+    errno = 0;
+    if (u->transport == LR_MODBUS_TCP) {
+        char port[16];
+        snprintf(port, sizeof port, "%d", u->port);
+        m->ctx = modbus_new_tcp_pi(u->host, port);
+    } else {
+        m->ctx = modbus_new_rtu(u->device, u->baud, u->parity, u->data_bits, u->stop_bits);
+    }
+    if (!m->ctx)
+        return lr_err_set(e, LR_EINVAL, "%s: cannot set up libmodbus: %s", m->url_text,
+                          modbus_strerror(errno));
+    uint32_t to_us = (uint32_t)(m->timeout_ns / 1000);
+    uint32_t bt_us = (uint32_t)m->byte_timeout_ms * 1000u;
+    modbus_set_error_recovery(m->ctx, MODBUS_ERROR_RECOVERY_NONE);
+    modbus_set_response_timeout(m->ctx, to_us / 1000000u, to_us % 1000000u);
+    modbus_set_byte_timeout(m->ctx, bt_us / 1000000u, bt_us % 1000000u);
+    if (modbus_connect(m->ctx) == -1) {
+        int err = errno;
+        int code = errno_means_missing(err) ? LR_ENODEV : LR_EIO;
+        const char *why = err == EINPROGRESS ? "connect timed out" : modbus_strerror(err);
+        modbus_free(m->ctx);
+        m->ctx = NULL;
+        return lr_err_set(e, code, "%s: cannot connect: %s", m->url_text, why);
+    }
+    if (u->transport == LR_MODBUS_RTU && u->rs485 &&
+        modbus_rtu_set_serial_mode(m->ctx, MODBUS_RTU_RS485) == -1) {
+        int err = errno;
+        mb_close(d);
+        return lr_err_set(e, LR_EUNSUPPORTED,
+                          "%s: rs485=1 but the port refuses RS-485 mode (TIOCSRS485): %s",
+                          m->url_text, modbus_strerror(err));
+    }
+    m->fd = modbus_get_socket(m->ctx);
+    int fl = fcntl(m->fd, F_GETFL);
+    if (fl >= 0)
+        fcntl(m->fd, F_SETFL, fl | O_NONBLOCK);
+    if (u->transport == LR_MODBUS_RTU)
+        modbus_flush(m->ctx); /* bytes left from before we opened the port */
+    m->phase = IDLE;
+    m->next_input = 0;
+    m->next_cycle = now_ns;
+    m->earliest_send = now_ns;
+    m->consecutive_timeouts = 0;
+    /* After a reconnect: report every input again and resend the level (the driver may have
+     * restarted with its own default). */
+    for (int i = 0; i < m->n_in; i++)
+        m->in[i].have = false;
+    m->out.acked = -1;
+    m->out.rejected = -1;
+    m->c.connects++;
+    return LR_OK;
+}
+
+static bool send_request(lr_modbus *m, int64_t now_ns, uint8_t *raw, int len)
+{
+    if (m->url.transport == LR_MODBUS_RTU)
+        modbus_set_slave(m->ctx, raw[0]); /* libmodbus drops RTU answers from other units */
+    m->req_unit = raw[0];
+    m->req_func = raw[1];
+    m->req_addr = raw[2] << 8 | raw[3];
+    if (modbus_send_raw_request(m->ctx, raw, len) == -1) {
+        int err = errno;
+        m->c.io_errors++;
+        lr_dev_lost(&m->base, LR_EIO, now_ns, "%s: send failed: %s", m->url_text,
+                    modbus_strerror(err));
+        return false;
+    }
+    m->c.requests++;
+    m->phase = WAIT;
+    m->deadline = now_ns + m->timeout_ns;
+    return true;
+}
+
+static bool send_read(lr_modbus *m, int i, int64_t now_ns)
+{
+    const input *in = &m->in[i];
+    uint8_t raw[6] = {(uint8_t)in->unit,
+                      in->type == LR_MODBUS_INPUT ? MODBUS_FC_READ_INPUT_REGISTERS
+                                                  : MODBUS_FC_READ_HOLDING_REGISTERS,
+                      (uint8_t)(in->addr >> 8), (uint8_t)in->addr, 0, 1};
+    m->req = REQ_READ;
+    m->req_input = i;
+    return send_request(m, now_ns, raw, 6);
+}
+
+static bool send_write(lr_modbus *m, int64_t now_ns)
+{
+    const output *o = &m->out;
+    uint8_t raw[9];
+    int len;
+    raw[0] = (uint8_t)o->unit;
+    raw[2] = (uint8_t)(o->addr >> 8);
+    raw[3] = (uint8_t)o->addr;
+    if (o->multiple) {
+        raw[1] = MODBUS_FC_WRITE_MULTIPLE_REGISTERS;
+        raw[4] = 0;
+        raw[5] = 1; /* quantity */
+        raw[6] = 2; /* byte count */
+        raw[7] = (uint8_t)(o->want >> 8);
+        raw[8] = (uint8_t)o->want;
+        len = 9;
+    } else {
+        raw[1] = MODBUS_FC_WRITE_SINGLE_REGISTER;
+        raw[4] = (uint8_t)(o->want >> 8);
+        raw[5] = (uint8_t)o->want;
+        len = 6;
+    }
+    m->req = REQ_WRITE;
+    m->req_raw = o->want;
+    return send_request(m, now_ns, raw, len);
+}
+
+static bool write_pending(const lr_modbus *m)
+{
+    const output *o = &m->out;
+    return o->enabled && o->want >= 0 && o->want != o->acked && o->want != o->rejected;
+}
+
+/* Starts the next request when the link is idle: a pending level first (the lamp is what the
+ * designer looks at), then the next input of the current poll cycle. */
+static void start_next(lr_modbus *m, int64_t now_ns)
+{
+    if (m->phase != IDLE || now_ns < m->earliest_send)
+        return;
+    if (write_pending(m)) {
+        send_write(m, now_ns);
+        return;
+    }
+    if (m->n_in == 0)
+        return;
+    if (m->next_input == 0) {
+        if (now_ns < m->next_cycle)
+            return;
+        /* A late loop does not cause a burst of catch-up polls. */
+        m->next_cycle = m->next_cycle + m->poll_ns > now_ns ? m->next_cycle + m->poll_ns
+                                                            : now_ns + m->poll_ns;
+    }
+    int i = m->next_input;
+    m->next_input = (i + 1) % m->n_in;
+    send_read(m, i, now_ns);
+}
+
+static void handle_timeout(lr_modbus *m, int64_t now_ns)
+{
+    m->phase = IDLE;
+    m->c.timeouts++;
+    m->consecutive_timeouts++;
+    ch_fail(m, req_channel(m), "no answer within %lld ms", (long long)(m->timeout_ns / MS));
+    if (m->consecutive_timeouts >= m->max_timeouts) {
+        lr_dev_lost(&m->base, LR_ETIMEOUT, now_ns, "%s: no answer to %d requests in a row",
+                    m->url_text, m->consecutive_timeouts);
+        return;
+    }
+    /* A late answer must not be taken for the next one. */
+    modbus_flush(m->ctx);
+}
+
+static void handle_response(lr_modbus *m, int64_t now_ns)
+{
+    uint8_t rsp[MODBUS_MAX_ADU_LENGTH];
+    int n = modbus_receive_confirmation(m->ctx, rsp);
+    m->phase = IDLE;
+    /* The bus silence counts from the end of the answer, which is now, not dispatch start. */
+    m->earliest_send = m->gap_ns ? lr_now_ns() + m->gap_ns : now_ns;
+    channel *ch = req_channel(m);
+    if (n < 0) {
+        int err = errno;
+        if (err == EMBBADCRC) {
+            m->c.crc_errors++;
+            ch_fail(m, ch, "answer with a bad CRC");
+            modbus_flush(m->ctx);
+        } else if (err == ETIMEDOUT) {
+            /* The frame started but stopped before its end. */
+            handle_timeout(m, now_ns);
+        } else if (err == EMBBADDATA) {
+            m->c.bad_responses++;
+            ch_fail(m, ch, "malformed answer");
+            modbus_flush(m->ctx);
+        } else {
+            m->c.io_errors++;
+            lr_dev_lost(&m->base, LR_EIO, now_ns, "%s: %s", m->url_text,
+                        err == ECONNRESET ? "connection closed by the server"
+                                          : modbus_strerror(err));
+        }
+        return;
+    }
+    int h = modbus_get_header_length(m->ctx);
+    if (n == 0 || n < h + 2) {
+        /* RTU: libmodbus returns 0 for a frame from another unit. */
+        m->c.bad_responses++;
+        ch_fail(m, ch, "answer from another unit or truncated");
+        return;
+    }
+    m->consecutive_timeouts = 0;
+    int unit = rsp[h - 1], func = rsp[h];
+    if (unit != m->req_unit) {
+        m->c.bad_responses++;
+        ch_fail(m, ch, "answer from unit %d", unit);
+        return;
+    }
+    if (func == (m->req_func | 0x80)) {
+        int code = rsp[h + 1];
+        m->c.exceptions++;
+        m->c.last_exception = (uint64_t)code;
+        ch_fail(m, ch, "exception %d (%s)", code, exception_name(code));
+        if (m->req == REQ_WRITE)
+            m->out.rejected = m->req_raw;
+        return;
+    }
+    if (func != m->req_func) {
+        m->c.bad_responses++;
+        ch_fail(m, ch, "answer to function %d, asked %d", func, m->req_func);
+        modbus_flush(m->ctx);
+        return;
+    }
+    if (m->req == REQ_READ) {
+        if (n < h + 4 || rsp[h + 1] != 2) {
+            m->c.bad_responses++;
+            ch_fail(m, ch, "read answer with %d data bytes, expected 2", rsp[h + 1]);
+            return;
+        }
+        input *in = &m->in[m->req_input];
+        int raw = rsp[h + 2] << 8 | rsp[h + 3];
+        m->c.responses++;
+        ch_ok(m, ch);
+        if (!in->have || raw != in->last_raw) {
+            in->have = true;
+            in->last_raw = raw;
+            double v = (double)(raw - in->raw_min) / (double)(in->raw_max - in->raw_min);
+            v = v < 0 ? 0 : v > 1 ? 1 : v;
+            lr_dev_emit(&m->base, NULL, in->control, LR_EV_ABSOLUTE, v, now_ns);
+        }
+        return;
+    }
+    /* Write echo: FC 6 echoes address and value, FC 16 address and quantity. */
+    int echo_addr = n >= h + 5 ? (rsp[h + 1] << 8 | rsp[h + 2]) : -1;
+    int echo_val = n >= h + 5 ? (rsp[h + 3] << 8 | rsp[h + 4]) : -1;
+    int expect_val = m->out.multiple ? 1 : m->req_raw;
+    if (echo_addr != m->req_addr || echo_val != expect_val) {
+        m->c.bad_responses++;
+        ch_fail(m, ch, "write echo does not match the request");
+        return;
+    }
+    m->c.responses++;
+    m->c.writes++;
+    m->out.acked = m->req_raw;
+    ch_ok(m, ch);
+}
+
+static void mb_dispatch(lr_dev *d, int64_t now_ns)
+{
+    lr_modbus *m = (lr_modbus *)d;
+    struct pollfd p = {.fd = m->fd, .events = POLLIN};
+    if (poll(&p, 1, 0) < 0)
+        p.revents = 0;
+    if (m->phase == WAIT) {
+        if (p.revents & (POLLIN | POLLHUP | POLLERR))
+            handle_response(m, now_ns);
+        else if (now_ns >= m->deadline)
+            handle_timeout(m, now_ns);
+    } else if (p.revents & (POLLHUP | POLLERR)) {
+        m->c.io_errors++;
+        lr_dev_lost(d, LR_EIO, now_ns, "%s: connection lost", m->url_text);
+    } else if (p.revents & POLLIN) {
+        /* Nothing was asked: end of connection, or stray bytes on the bus. */
+        char c;
+        if (m->url.transport == LR_MODBUS_TCP && recv(m->fd, &c, 1, MSG_PEEK | MSG_DONTWAIT) == 0) {
+            m->c.io_errors++;
+            lr_dev_lost(d, LR_EIO, now_ns, "%s: connection closed by the server", m->url_text);
+        } else {
+            m->c.bad_responses++;
+            modbus_flush(m->ctx);
+        }
+    }
+    if (d->state == LR_DEV_OPEN)
+        start_next(m, now_ns);
+}
+
+static int mb_pollfds(lr_dev *d, struct pollfd *fds, int max)
+{
+    lr_modbus *m = (lr_modbus *)d;
+    if (max > 0)
+        fds[0] = (struct pollfd){.fd = m->fd, .events = POLLIN};
+    return 1;
+}
+
+static int64_t mb_next_deadline(lr_dev *d)
+{
+    lr_modbus *m = (lr_modbus *)d;
+    if (m->phase == WAIT)
+        return m->deadline;
+    if (write_pending(m) || (m->n_in && m->next_input != 0))
+        return m->earliest_send;
+    if (m->n_in == 0)
+        return LR_NO_DEADLINE;
+    return m->next_cycle > m->earliest_send ? m->next_cycle : m->earliest_send;
+}
+
+static void mb_destroy(lr_dev *d) { free(d); }
+
+static const lr_dev_ops MODBUS_OPS = {
+    .kind = "modbus",
+    .open = mb_open,
+    .close = mb_close,
+    .pollfds = mb_pollfds,
+    .dispatch = mb_dispatch,
+    .next_deadline = mb_next_deadline,
+    .destroy = mb_destroy,
+};
+
+/* Validates unit, register/base and raw range of one channel; fills unit/addr. */
+static int check_channel(lr_modbus *m, const char *field, int unit, int reg, int base,
+                         int raw_min, int raw_max, int *unit_out, int *addr_out, lr_err *e)
+{
+    const char *pf = m->base.prefix;
+    int u = unit ? unit : 1;
+    int umax = m->url.transport == LR_MODBUS_TCP ? 255 : 247;
+    if (u < 1 || u > umax)
+        return lr_err_set(e, LR_EINVAL, "%s: %s.unit %d is not 1..%d", pf, field, unit, umax);
+    if (base != 0 && base != 1)
+        return lr_err_set(e, LR_EINVAL, "%s: %s.base %d is not 0 or 1", pf, field, base);
+    int addr = reg - base;
+    if (addr < 0 || addr > 65535)
+        return lr_err_set(e, LR_EINVAL, "%s: %s.reg %d is not %d..%d (base %d)", pf, field, reg,
+                          base, 65535 + base, base);
+    if (raw_min < 0 || raw_max > 65535 || raw_min >= raw_max)
+        return lr_err_set(e, LR_EINVAL, "%s: %s: raw range %d..%d is not within 0..65535 and "
+                          "increasing", pf, field, raw_min, raw_max);
+    *unit_out = u;
+    *addr_out = addr;
+    return LR_OK;
+}
+
+static int configure(lr_modbus *m, const lr_modbus_desc *desc, lr_err *e)
+{
+    const char *pf = m->base.prefix;
+    int rc = lr_modbus_url_parse(desc->url, &m->url, e);
+    if (rc != LR_OK)
+        return lr_err_prefix(e, "%s", pf);
+    lr_modbus_url_format(&m->url, m->url_text, sizeof m->url_text);
+    snprintf(m->base.ident, sizeof m->base.ident, "%s", m->url_text);
+    if (desc->n_inputs < 0 || desc->n_inputs > MAX_INPUTS || (desc->n_inputs && !desc->inputs))
+        return lr_err_set(e, LR_EINVAL, "%s: n_inputs %d is not 0..%d", pf, desc->n_inputs,
+                          MAX_INPUTS);
+    if (desc->n_inputs == 0 && !desc->output.enabled)
+        return lr_err_set(e, LR_EINVAL, "%s: neither inputs nor an output configured", pf);
+    char field[32];
+    for (int i = 0; i < desc->n_inputs; i++) {
+        const lr_modbus_input *c = &desc->inputs[i];
+        input *in = &m->in[i];
+        snprintf(field, sizeof field, "inputs[%d]", i);
+        const char *ctl = c->control && c->control[0] ? c->control : "dimmer";
+        if (strlen(ctl) >= LR_EVENT_NAME_MAX)
+            return lr_err_set(e, LR_EINVAL, "%s: %s.control '%s' too long", pf, field, ctl);
+        for (int k = 0; k < i; k++)
+            if (strcmp(m->in[k].control, ctl) == 0)
+                return lr_err_set(e, LR_EINVAL, "%s: %s.control '%s' used twice", pf, field, ctl);
+        if (c->type != LR_MODBUS_HOLDING && c->type != LR_MODBUS_INPUT)
+            return lr_err_set(e, LR_EINVAL, "%s: %s.type %d unknown", pf, field, (int)c->type);
+        in->raw_min = c->raw_min;
+        in->raw_max = c->raw_max ? c->raw_max : 1000;
+        rc = check_channel(m, field, c->unit, c->reg, c->base, in->raw_min, in->raw_max,
+                           &in->unit, &in->addr, e);
+        if (rc != LR_OK)
+            return rc;
+        strcpy(in->control, ctl);
+        in->type = c->type;
+        snprintf(in->ch.what, sizeof in->ch.what, "input '%s' (unit %d, %s register %d)", ctl,
+                 in->unit, c->type == LR_MODBUS_INPUT ? "input" : "holding", in->addr);
+        m->n_in = i + 1;
+    }
+    output *o = &m->out;
+    o->want = o->acked = o->rejected = -1;
+    if (desc->output.enabled) {
+        const lr_modbus_output *c = &desc->output;
+        o->enabled = true;
+        o->raw_min = c->raw_min;
+        o->raw_max = c->raw_max ? c->raw_max : 255;
+        o->multiple = c->multiple;
+        rc = check_channel(m, "output", c->unit, c->reg, c->base, o->raw_min, o->raw_max,
+                           &o->unit, &o->addr, e);
+        if (rc != LR_OK)
+            return rc;
+        snprintf(o->ch.what, sizeof o->ch.what, "lamp driver (unit %d, holding register %d)",
+                 o->unit, o->addr);
+    }
+    if (desc->poll_ms < 0 || desc->poll_ms > 60000 || desc->timeout_ms < 0 ||
+        desc->timeout_ms > 10000 || desc->byte_timeout_ms < 0 || desc->byte_timeout_ms > 10000 ||
+        desc->max_timeouts < 0 || desc->max_timeouts > 1000)
+        return lr_err_set(e, LR_EINVAL,
+                          "%s: poll_ms %d / timeout_ms %d / byte_timeout_ms %d / max_timeouts %d "
+                          "out of range",
+                          pf, desc->poll_ms, desc->timeout_ms, desc->byte_timeout_ms,
+                          desc->max_timeouts);
+    m->poll_ns = (desc->poll_ms ? desc->poll_ms : 50) * MS;
+    m->timeout_ns = (desc->timeout_ms ? desc->timeout_ms : 100) * MS;
+    m->byte_timeout_ms = desc->byte_timeout_ms ? desc->byte_timeout_ms : 50;
+    m->max_timeouts = desc->max_timeouts ? desc->max_timeouts : 3;
+    if (m->url.transport == LR_MODBUS_RTU) {
+        /* Modbus over serial line v1.02, 2.5.1.1: 3.5 character times of silence between
+         * frames, fixed at 1.75 ms above 19200 baud. A character is 11 bits on the wire. */
+        int64_t t35 = (int64_t)(3.5 * 11 * 1e9 / m->url.baud);
+        m->gap_ns = m->url.baud > 19200 ? 1750000 : t35;
+    }
+    return LR_OK;
+}
+
+int lr_modbus_create(const lr_modbus_desc *desc, lr_modbus **out, lr_err *e)
+{
+    *out = NULL;
+    lr_modbus *m = calloc(1, sizeof *m);
+    if (!m)
+        return lr_err_set(e, LR_ENOMEM, "modbus: out of memory");
+    m->fd = -1;
+    int rc = lr_dev_init(&m->base, &MODBUS_OPS, &desc->dev, e);
+    if (rc == LR_OK)
+        rc = configure(m, desc, e);
+    if (rc == LR_OK)
+        rc = lr_dev_start(&m->base, desc->dev.required, lr_now_ns(), e);
+    if (rc != LR_OK) {
+        mb_close(&m->base);
+        free(m);
+        return rc;
+    }
+    *out = m;
+    return LR_OK;
+}
+
+void lr_modbus_destroy(lr_modbus *m)
+{
+    if (m)
+        lr_dev_destroy(&m->base);
+}
+
+lr_dev *lr_modbus_dev(lr_modbus *m) { return &m->base; }
+
+int lr_modbus_write_level(lr_modbus *m, double level01)
+{
+    output *o = &m->out;
+    if (!o->enabled)
+        return LR_EUNSUPPORTED;
+    if (isnan(level01))
+        return LR_EINVAL;
+    double l = level01 < 0 ? 0 : level01 > 1 ? 1 : level01;
+    o->want = (int)lround(o->raw_min + l * (o->raw_max - o->raw_min));
+    /* Send now when the link is idle: the lamp follows the knob without waiting for a poll. */
+    if (m->base.state == LR_DEV_OPEN && m->phase == IDLE)
+        start_next(m, lr_now_ns());
+    return LR_OK;
+}
+
+int lr_modbus_output_raw(const lr_modbus *m) { return m->out.want; }
+
+bool lr_modbus_output_synced(const lr_modbus *m)
+{
+    return m->out.enabled && m->out.want >= 0 && m->out.acked == m->out.want;
+}
+
+int lr_modbus_flush(lr_modbus *m, int timeout_ms, lr_err *e)
+{
+    int64_t now = lr_now_ns();
+    int64_t end = now + (int64_t)timeout_ms * MS;
+    lr_dev_retry_now(&m->base, now);
+    while (!lr_modbus_output_synced(m)) {
+        if (!m->out.enabled || m->out.want < 0)
+            return LR_OK;
+        if (m->out.want == m->out.rejected)
+            return lr_err_set(e, LR_EPROTO, "%s: %s: %s rejected the level (raw %d)",
+                              m->base.prefix, m->url_text, m->out.ch.what, m->out.want);
+        now = lr_now_ns();
+        if (now >= end)
+            break;
+        int64_t t = lr_dev_next_deadline(&m->base);
+        if (t > end)
+            t = end;
+        int wait_ms = t <= now ? 0 : (int)((t - now + MS - 1) / MS);
+        struct pollfd p;
+        int n = lr_dev_pollfds(&m->base, &p, 1);
+        poll(&p, (nfds_t)n, wait_ms);
+        lr_dev_dispatch(&m->base, lr_now_ns());
+    }
+    if (lr_modbus_output_synced(m))
+        return LR_OK;
+    return lr_err_set(e, m->base.state == LR_DEV_OPEN ? LR_ETIMEOUT : LR_ENODEV,
+                      "%s: %s: level (raw %d) not acknowledged within %d ms (%s)", m->base.prefix,
+                      m->url_text, m->out.want, timeout_ms, lr_dev_state_name(m->base.state));
+}
+
+void lr_modbus_get_counters(const lr_modbus *m, lr_modbus_counters *out) { *out = m->c; }

@@ -1,0 +1,740 @@
+/* hal/: Modbus master against a real libmodbus server (modbus_reply over a modbus_mapping_t)
+ * running in a thread: on 127.0.0.1 (free port) and over RTU on a pseudo-terminal pair. The
+ * server is the dimmer panel (unit 1) and the lamp driver (unit 2) of configs/rig/modbus-demo.
+ * Also the endpoint URL parser. No timed assertions: the loop runs until a condition holds,
+ * with generous guards against hangs. */
+#include <arpa/inet.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <modbus.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <pthread.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "hal/modbus.h"
+#include "tests/support/hal_test.h"
+
+/* ---- URL parsing ---- */
+
+static void url_good(void **state)
+{
+    (void)state;
+    lr_modbus_url u;
+    lr_err e = {0};
+    char buf[300];
+    assert_int_equal(lr_modbus_url_parse("tcp://192.168.1.20:1502", &u, &e), LR_OK);
+    assert_int_equal(u.transport, LR_MODBUS_TCP);
+    assert_string_equal(u.host, "192.168.1.20");
+    assert_int_equal(u.port, 1502);
+    assert_int_equal(lr_modbus_url_parse("tcp://panel.local", &u, &e), LR_OK);
+    assert_string_equal(u.host, "panel.local");
+    assert_int_equal(u.port, 502);
+    assert_int_equal(lr_modbus_url_parse("tcp://[::1]:5020/", &u, &e), LR_OK);
+    assert_string_equal(u.host, "::1");
+    assert_int_equal(u.port, 5020);
+    lr_modbus_url_format(&u, buf, sizeof buf);
+    assert_string_equal(buf, "tcp://[::1]:5020");
+
+    assert_int_equal(lr_modbus_url_parse("rtu:/dev/ttyUSB0", &u, &e), LR_OK);
+    assert_int_equal(u.transport, LR_MODBUS_RTU);
+    assert_string_equal(u.device, "/dev/ttyUSB0");
+    assert_int_equal(u.baud, 19200);
+    assert_int_equal(u.parity, 'E');
+    assert_int_equal(u.data_bits, 8);
+    assert_int_equal(u.stop_bits, 1);
+    assert_false(u.rs485);
+    assert_int_equal(
+        lr_modbus_url_parse("rtu:///dev/ttyAMA0?baud=9600&parity=n&data=8&stop=2&rs485=1", &u, &e),
+        LR_OK);
+    assert_string_equal(u.device, "/dev/ttyAMA0");
+    assert_int_equal(u.baud, 9600);
+    assert_int_equal(u.parity, 'N');
+    assert_int_equal(u.stop_bits, 2);
+    assert_true(u.rs485);
+    lr_modbus_url_format(&u, buf, sizeof buf);
+    assert_string_equal(buf, "rtu:/dev/ttyAMA0?baud=9600&parity=N&data=8&stop=2&rs485=1");
+}
+
+static void url_bad(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *url, *msg;
+    } cases[] = {
+        {"", "modbus URL is empty (tcp://HOST:PORT or rtu:DEVICE?...)"},
+        {"udp://x:1", "modbus URL 'udp://x:1': unknown scheme (expected tcp://HOST:PORT or "
+                      "rtu:DEVICE?baud=...&parity=N|E|O&data=8&stop=1)"},
+        {"tcp://:502", "modbus URL 'tcp://:502': missing host (tcp://HOST:PORT)"},
+        {"tcp://h:0", "modbus URL 'tcp://h:0': port '0' is not 1..65535"},
+        {"tcp://h:70000", "modbus URL 'tcp://h:70000': port '70000' is not 1..65535"},
+        {"tcp://h:50x", "modbus URL 'tcp://h:50x': port '50x' is not 1..65535"},
+        {"tcp://h:502/unit/1", "modbus URL 'tcp://h:502/unit/1': unexpected '/unit/1' after "
+                               "host:port"},
+        {"tcp://[::1:502", "modbus URL 'tcp://[::1:502': missing ']' after IPv6 address"},
+        {"rtu:", "modbus URL 'rtu:': missing device (rtu:DEVICE?baud=...)"},
+        {"rtu:/dev/ttyS0?baud=12345", "modbus URL 'rtu:/dev/ttyS0?baud=12345': baud '12345' is "
+                                      "not a standard rate (1200..921600)"},
+        {"rtu:/dev/ttyS0?parity=X", "modbus URL 'rtu:/dev/ttyS0?parity=X': parity 'X' is not N, "
+                                    "E or O"},
+        {"rtu:/dev/ttyS0?data=9", "modbus URL 'rtu:/dev/ttyS0?data=9': data bits '9' is not 5..8"},
+        {"rtu:/dev/ttyS0?stop=3", "modbus URL 'rtu:/dev/ttyS0?stop=3': stop bits '3' is not 1 "
+                                  "or 2"},
+        {"rtu:/dev/ttyS0?speed=9600", "modbus URL 'rtu:/dev/ttyS0?speed=9600': unknown option "
+                                      "'speed' (baud, parity, data, stop, rs485)"},
+        {"rtu:/dev/ttyS0?baud", "modbus URL 'rtu:/dev/ttyS0?baud': option 'baud' is not "
+                                "key=value"},
+        {"rtu:/dev/ttyS0?baud=9600&baud=19200", "modbus URL 'rtu:/dev/ttyS0?baud=9600&baud="
+                                                "19200': option 'baud' given twice"},
+        {"rtu:/dev/ttyS0?baud=9600&", "modbus URL 'rtu:/dev/ttyS0?baud=9600&': trailing '&'"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        lr_modbus_url u;
+        lr_err e = {0};
+        assert_int_equal(lr_modbus_url_parse(cases[i].url, &u, &e), LR_EPARSE);
+        assert_string_equal(e.msg, cases[i].msg);
+    }
+}
+
+/* ---- the server: panel = unit 1, lamp driver = unit 2, 10 holding registers each ---- */
+
+typedef struct server {
+    bool rtu;
+    int port;
+    int listen_fd;
+    int pty_master, pty_keep; /* rtu: the bus end, and a slave fd that keeps it from hanging up */
+    char pty_path[64];
+    int stop[2];
+    pthread_t th;
+    bool running;
+    pthread_mutex_t mu;
+    modbus_mapping_t *panel, *driver;
+    int silent;       /* answer nothing */
+    int corrupt;      /* rtu: damage the CRC of this many replies */
+    int answered;
+} server;
+
+static int reg(server *s, modbus_mapping_t *map, int i)
+{
+    pthread_mutex_lock(&s->mu);
+    int v = map->tab_registers[i];
+    pthread_mutex_unlock(&s->mu);
+    return v;
+}
+
+static void set_reg(server *s, modbus_mapping_t *map, int i, int v)
+{
+    pthread_mutex_lock(&s->mu);
+    map->tab_registers[i] = (uint16_t)v;
+    pthread_mutex_unlock(&s->mu);
+}
+
+static void set_flag(server *s, int *flag, int v)
+{
+    pthread_mutex_lock(&s->mu);
+    *flag = v;
+    pthread_mutex_unlock(&s->mu);
+}
+
+/* Answers one request with libmodbus's own server logic (modbus_reply). For RTU the reply goes
+ * through a pipe first so that the test can damage its CRC. */
+static void serve(server *s, modbus_t *ctx, const uint8_t *q, int len, int capture[2])
+{
+    int unit = q[modbus_get_header_length(ctx) - 1];
+    pthread_mutex_lock(&s->mu);
+    modbus_mapping_t *map = unit == 1 ? s->panel : unit == 2 ? s->driver : NULL;
+    if (map && !s->silent) {
+        if (!s->rtu) {
+            modbus_reply(ctx, q, len, map);
+        } else {
+            modbus_set_socket(ctx, capture[1]);
+            int n = modbus_reply(ctx, q, len, map);
+            uint8_t rsp[MODBUS_RTU_MAX_ADU_LENGTH];
+            if (n > 0 && read(capture[0], rsp, (size_t)n) == n) {
+                if (s->corrupt > 0) {
+                    rsp[n - 1] ^= 0x5a;
+                    s->corrupt--;
+                }
+                if (write(s->pty_master, rsp, (size_t)n) != n)
+                    n = -1;
+            }
+        }
+        s->answered++;
+    }
+    pthread_mutex_unlock(&s->mu);
+}
+
+static void *tcp_thread(void *arg)
+{
+    server *s = arg;
+    modbus_t *ctx = modbus_new_tcp("127.0.0.1", s->port);
+    int clients[8], nc = 0;
+    for (;;) {
+        struct pollfd p[10] = {{s->stop[0], POLLIN, 0}, {s->listen_fd, POLLIN, 0}};
+        for (int i = 0; i < nc; i++)
+            p[2 + i] = (struct pollfd){clients[i], POLLIN, 0};
+        if (poll(p, (nfds_t)(2 + nc), -1) < 0)
+            continue;
+        if (p[0].revents)
+            break;
+        if (p[1].revents & POLLIN) {
+            int c = accept(s->listen_fd, NULL, NULL);
+            if (c >= 0 && nc < 8)
+                clients[nc++] = c;
+            else if (c >= 0)
+                close(c);
+        }
+        for (int i = 0; i < nc; i++) {
+            if (!p[2 + i].revents)
+                continue;
+            uint8_t q[MODBUS_TCP_MAX_ADU_LENGTH];
+            modbus_set_socket(ctx, clients[i]);
+            int rc = modbus_receive(ctx, q);
+            if (rc > 0) {
+                serve(s, ctx, q, rc, NULL);
+            } else if (rc < 0) {
+                close(clients[i]);
+                clients[i] = clients[--nc];
+                break; /* p[] no longer matches clients[]: poll again */
+            }
+        }
+    }
+    for (int i = 0; i < nc; i++)
+        close(clients[i]);
+    modbus_set_socket(ctx, -1);
+    modbus_free(ctx);
+    return NULL;
+}
+
+/* Bytes of an RTU request by function code (with CRC); 0 = need more; -1 = unknown. */
+static int rtu_frame_len(const uint8_t *b, int n)
+{
+    if (n < 2)
+        return 0;
+    switch (b[1]) {
+    case MODBUS_FC_READ_HOLDING_REGISTERS:
+    case MODBUS_FC_READ_INPUT_REGISTERS:
+    case MODBUS_FC_WRITE_SINGLE_REGISTER: return 8;
+    case MODBUS_FC_WRITE_MULTIPLE_REGISTERS: return n < 7 ? 0 : 9 + b[6];
+    }
+    return -1;
+}
+
+static void *rtu_thread(void *arg)
+{
+    server *s = arg;
+    modbus_t *ctx = modbus_new_rtu(s->pty_path, 19200, 'E', 8, 1);
+    int capture[2];
+    if (pipe(capture) != 0)
+        return NULL;
+    uint8_t buf[512];
+    int len = 0;
+    for (;;) {
+        struct pollfd p[2] = {{s->stop[0], POLLIN, 0}, {s->pty_master, POLLIN, 0}};
+        if (poll(p, 2, -1) < 0)
+            continue;
+        if (p[0].revents)
+            break;
+        if (!(p[1].revents & POLLIN))
+            continue;
+        ssize_t n = read(s->pty_master, buf + len, sizeof buf - (size_t)len);
+        if (n <= 0)
+            continue;
+        len += (int)n;
+        /* Framing by length is enough for a test bus with one master. */
+        for (;;) {
+            int fl = rtu_frame_len(buf, len);
+            if (fl < 0) {
+                len = 0;
+                break;
+            }
+            if (fl == 0 || len < fl)
+                break;
+            serve(s, ctx, buf, fl, capture);
+            memmove(buf, buf + fl, (size_t)(len - fl));
+            len -= fl;
+        }
+    }
+    close(capture[0]);
+    close(capture[1]);
+    modbus_set_socket(ctx, -1);
+    modbus_free(ctx);
+    return NULL;
+}
+
+static void server_init(server *s, bool rtu)
+{
+    memset(s, 0, sizeof *s);
+    s->rtu = rtu;
+    s->listen_fd = s->pty_master = s->pty_keep = -1;
+    pthread_mutex_init(&s->mu, NULL);
+    s->panel = modbus_mapping_new(0, 0, 10, 0);
+    s->driver = modbus_mapping_new(0, 0, 10, 0);
+    assert_non_null(s->panel);
+    assert_non_null(s->driver);
+    if (rtu) {
+        s->pty_master = posix_openpt(O_RDWR | O_NOCTTY);
+        assert_true(s->pty_master >= 0);
+        assert_int_equal(grantpt(s->pty_master), 0);
+        assert_int_equal(unlockpt(s->pty_master), 0);
+        assert_int_equal(ptsname_r(s->pty_master, s->pty_path, sizeof s->pty_path), 0);
+        s->pty_keep = open(s->pty_path, O_RDWR | O_NOCTTY);
+        assert_true(s->pty_keep >= 0);
+    }
+}
+
+/* Starts (or restarts, on the same port) the server thread. */
+static void server_start(server *s)
+{
+    assert_int_equal(pipe(s->stop), 0);
+    if (!s->rtu) {
+        s->listen_fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+        assert_true(s->listen_fd >= 0);
+        int one = 1;
+        setsockopt(s->listen_fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+        struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)s->port)};
+        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        assert_int_equal(bind(s->listen_fd, (struct sockaddr *)&a, sizeof a), 0);
+        socklen_t al = sizeof a;
+        assert_int_equal(getsockname(s->listen_fd, (struct sockaddr *)&a, &al), 0);
+        s->port = ntohs(a.sin_port); /* 0 at first start: the kernel picked a free port */
+        assert_int_equal(listen(s->listen_fd, 8), 0);
+    }
+    assert_int_equal(pthread_create(&s->th, NULL, s->rtu ? rtu_thread : tcp_thread, s), 0);
+    s->running = true;
+}
+
+/* Kills the server: its thread closes every connection and the listening socket. */
+static void server_stop(server *s)
+{
+    if (!s->running)
+        return;
+    assert_int_equal(write(s->stop[1], "x", 1), 1);
+    pthread_join(s->th, NULL);
+    close(s->stop[0]);
+    close(s->stop[1]);
+    if (s->listen_fd >= 0)
+        close(s->listen_fd);
+    s->listen_fd = -1;
+    s->running = false;
+}
+
+static void server_free(server *s)
+{
+    server_stop(s);
+    if (s->pty_keep >= 0)
+        close(s->pty_keep);
+    if (s->pty_master >= 0)
+        close(s->pty_master);
+    modbus_mapping_free(s->panel);
+    modbus_mapping_free(s->driver);
+    pthread_mutex_destroy(&s->mu);
+}
+
+/* ---- loop conditions ---- */
+
+typedef struct cond {
+    lr_modbus *m;
+    lr_event_ring *ring;
+    server *s;
+    int n;        /* ring events wanted, or a counter threshold */
+    int want;     /* driver register value */
+} cond;
+
+static bool has_events(void *u)
+{
+    cond *c = u;
+    return (int)lr_event_ring_count(c->ring) >= c->n;
+}
+
+static bool driver_has(void *u)
+{
+    cond *c = u;
+    return lr_modbus_output_synced(c->m) && reg(c->s, c->s->driver, 0) == c->want;
+}
+
+static bool link_down(void *u)
+{
+    return lr_dev_get_state(lr_modbus_dev(((cond *)u)->m)) != LR_DEV_OPEN;
+}
+
+static bool failures_reached(void *u)
+{
+    cond *c = u;
+    return (int)lr_dev_failures(lr_modbus_dev(c->m)) >= c->n;
+}
+
+static bool exceptions_reached(void *u)
+{
+    cond *c = u;
+    lr_modbus_counters k;
+    lr_modbus_get_counters(c->m, &k);
+    return (int)k.exceptions >= c->n && lr_event_ring_count(c->ring) >= 1;
+}
+
+static bool crc_errors_reached(void *u)
+{
+    cond *c = u;
+    lr_modbus_counters k;
+    lr_modbus_get_counters(c->m, &k);
+    return (int)k.crc_errors >= c->n;
+}
+
+static bool run(lr_modbus *m, lr_test_pred p, cond *c)
+{
+    lr_dev *d = lr_modbus_dev(m);
+    return lr_test_run(&d, 1, 20000, p, c);
+}
+
+static lr_event pop(lr_event_ring *ring)
+{
+    lr_event ev;
+    memset(&ev, 0, sizeof ev);
+    assert_true(lr_event_ring_pop(ring, &ev));
+    return ev;
+}
+
+/* Drains the ring; returns the last event. */
+static lr_event last(lr_event_ring *ring)
+{
+    lr_event ev = pop(ring);
+    lr_event more;
+    while (lr_event_ring_pop(ring, &more))
+        ev = more;
+    return ev;
+}
+
+static const lr_modbus_input PANEL = {.control = "dimmer", .unit = 1, .reg = 0, .raw_max = 1000};
+
+/* ---- TCP ---- */
+
+static void tcp_panel_driver_and_reconnect(void **state)
+{
+    (void)state;
+    server s;
+    server_init(&s, false);
+    set_reg(&s, s.panel, 0, 500);
+    server_start(&s);
+
+    lr_event_ring *ring;
+    assert_int_equal(lr_event_ring_create(0, &ring, NULL), LR_OK);
+    lr_test_log log = {0};
+    char url[64];
+    snprintf(url, sizeof url, "tcp://127.0.0.1:%d", s.port);
+    lr_modbus_desc desc = {
+        .dev = {.sink = lr_event_ring_sink(ring), .log = {lr_test_log_fn, &log},
+                .retry_min_ms = 20, .retry_max_ms = 200},
+        .url = url,
+        .inputs = &PANEL, .n_inputs = 1,
+        .output = {.enabled = true, .unit = 2, .reg = 0, .raw_max = 255},
+        .poll_ms = 10, .timeout_ms = 1000,
+    };
+    lr_modbus *m = NULL;
+    lr_err e = {0};
+    assert_int_equal(lr_modbus_create(&desc, &m, &e), LR_OK);
+    lr_dev *d = lr_modbus_dev(m);
+    assert_int_equal(lr_dev_get_state(d), LR_DEV_OPEN);
+    struct pollfd pfd;
+    assert_int_equal(lr_dev_pollfds(d, &pfd, 1), 1);
+
+    /* The panel's position is reported once after connecting: 500 of 0..1000. */
+    cond c = {.m = m, .ring = ring, .s = &s, .n = 1};
+    assert_true(run(m, has_events, &c));
+    lr_event ev = pop(ring);
+    assert_string_equal(ev.source, "modbus");
+    assert_string_equal(ev.control, "dimmer");
+    assert_int_equal(ev.kind, LR_EV_ABSOLUTE);
+    assert_float_equal(ev.value, 0.5, 1e-12);
+
+    /* A change on the panel becomes exactly one event with the new value. */
+    set_reg(&s, s.panel, 0, 250);
+    assert_true(run(m, has_events, &c));
+    ev = pop(ring);
+    assert_float_equal(ev.value, 0.25, 1e-12);
+    assert_int_equal(lr_event_ring_count(ring), 0);
+
+    /* Level writes land in the driver's register, scaled to 0..255 and rounded. */
+    assert_int_equal(lr_modbus_write_level(m, 0.5), LR_OK);
+    assert_int_equal(lr_modbus_output_raw(m), 128);
+    c.want = 128;
+    assert_true(run(m, driver_has, &c));
+    assert_int_equal(lr_modbus_write_level(m, 2.0), LR_OK); /* clamped */
+    c.want = 255;
+    assert_true(run(m, driver_has, &c));
+    assert_int_equal(lr_modbus_write_level(m, NAN), LR_EINVAL);
+    assert_int_equal(lr_modbus_write_level(m, 0.2), LR_OK);
+    assert_int_equal(lr_modbus_flush(m, 10000, &e), LR_OK); /* the shutdown path */
+    assert_int_equal(reg(&s, s.driver, 0), 51);
+    assert_int_equal(reg(&s, s.panel, 0), 250); /* the panel was not written */
+
+    lr_modbus_counters k;
+    lr_modbus_get_counters(m, &k);
+    assert_int_equal(k.connects, 1);
+    assert_int_equal(k.writes, 3);
+    assert_int_equal(k.exceptions + k.timeouts + k.crc_errors + k.bad_responses + k.io_errors, 0);
+
+    /* The server dies: the link drops, one line is logged, reconnects back off silently. */
+    server_stop(&s);
+    assert_true(run(m, link_down, &c));
+    int lines_after_loss = lr_test_log_count(&log, "retrying with backoff");
+    c.n = 4;
+    assert_true(run(m, failures_reached, &c));
+    assert_int_equal(lr_dev_get_state(d), LR_DEV_MISSING);
+    assert_non_null(strstr(lr_dev_status(d), "cannot connect: Connection refused"));
+    assert_int_equal(lr_test_log_count(&log, "retrying with backoff"), lines_after_loss + 1);
+    assert_int_equal(lines_after_loss, 1);
+    assert_int_equal(lr_dev_pollfds(d, &pfd, 1), 0);
+    lr_modbus_get_counters(m, &k);
+    assert_true(k.io_errors >= 1);
+
+    /* It comes back (same port) with a moved dimmer and a driver that restarted at 0: the
+     * master reconnects, reports the new position and resends the level. */
+    set_reg(&s, s.panel, 0, 900);
+    set_reg(&s, s.driver, 0, 0);
+    server_start(&s);
+    c.n = 1;
+    lr_event_ring_pop(ring, &ev);
+    assert_true(run(m, has_events, &c));
+    ev = last(ring);
+    assert_float_equal(ev.value, 0.9, 1e-12);
+    c.want = 51;
+    assert_true(run(m, driver_has, &c));
+    lr_modbus_get_counters(m, &k);
+    assert_int_equal(k.connects, 2);
+    assert_int_equal(lr_test_log_count(&log, ": open (after 4 failed attempts)"), 1);
+
+    lr_modbus_destroy(m);
+    server_free(&s);
+    lr_event_ring_destroy(ring);
+}
+
+static void tcp_exceptions_are_counted_not_fatal(void **state)
+{
+    (void)state;
+    server s;
+    server_init(&s, false);
+    set_reg(&s, s.panel, 0, 1000);
+    server_start(&s);
+    lr_event_ring *ring;
+    assert_int_equal(lr_event_ring_create(0, &ring, NULL), LR_OK);
+    lr_test_log log = {0};
+    char url[64];
+    snprintf(url, sizeof url, "tcp://127.0.0.1:%d", s.port);
+    /* Register 50 does not exist on the panel (10 registers): illegal data address. */
+    lr_modbus_input in[2] = {PANEL, {.control = "fader", .unit = 1, .reg = 50}};
+    lr_modbus_desc desc = {
+        .dev = {.name = "panel", .sink = lr_event_ring_sink(ring), .log = {lr_test_log_fn, &log}},
+        .url = url, .inputs = in, .n_inputs = 2,
+        .output = {.enabled = true, .unit = 2, .reg = 20},
+        .poll_ms = 5, .timeout_ms = 1000,
+    };
+    lr_modbus *m = NULL;
+    lr_err e = {0};
+    assert_int_equal(lr_modbus_create(&desc, &m, &e), LR_OK);
+    assert_int_equal(lr_modbus_write_level(m, 1.0), LR_OK);
+    cond c = {.m = m, .ring = ring, .s = &s, .n = 5};
+    assert_true(run(m, exceptions_reached, &c));
+    lr_event ev = last(ring);
+    assert_string_equal(ev.source, "panel");
+    assert_string_equal(ev.control, "dimmer");
+    assert_float_equal(ev.value, 1.0, 0);
+    assert_int_equal(lr_dev_get_state(lr_modbus_dev(m)), LR_DEV_OPEN);
+    lr_modbus_counters k;
+    lr_modbus_get_counters(m, &k);
+    assert_int_equal(k.last_exception, 2);
+    assert_int_equal(k.connects, 1);
+    assert_true(k.responses >= 1);
+    /* Logged once per channel, not once per poll. */
+    assert_int_equal(lr_test_log_count(&log, "input 'fader' (unit 1, holding register 50): "
+                                             "exception 2 (illegal data address)"),
+                     1);
+    assert_int_equal(lr_test_log_count(&log, "lamp driver (unit 2, holding register 20): "
+                                             "exception 2 (illegal data address)"),
+                     1);
+    /* The rejected level is not resent every cycle, and flush says why it cannot land. */
+    assert_false(lr_modbus_output_synced(m));
+    assert_int_equal(lr_modbus_flush(m, 1000, &e), LR_EPROTO);
+    assert_non_null(strstr(e.msg, "rejected the level (raw 255)"));
+    lr_modbus_destroy(m);
+    server_free(&s);
+    lr_event_ring_destroy(ring);
+}
+
+static void tcp_timeouts_drop_and_restore_the_link(void **state)
+{
+    (void)state;
+    server s;
+    server_init(&s, false);
+    set_reg(&s, s.panel, 0, 100);
+    s.silent = 1;
+    server_start(&s);
+    lr_event_ring *ring;
+    assert_int_equal(lr_event_ring_create(0, &ring, NULL), LR_OK);
+    lr_test_log log = {0};
+    char url[64];
+    snprintf(url, sizeof url, "tcp://127.0.0.1:%d", s.port);
+    lr_modbus_desc desc = {
+        .dev = {.sink = lr_event_ring_sink(ring), .log = {lr_test_log_fn, &log},
+                .retry_min_ms = 10, .retry_max_ms = 50},
+        .url = url, .inputs = &PANEL, .n_inputs = 1,
+        .poll_ms = 5, .timeout_ms = 30, .max_timeouts = 3,
+    };
+    lr_modbus *m = NULL;
+    assert_int_equal(lr_modbus_create(&desc, &m, NULL), LR_OK);
+    cond c = {.m = m, .ring = ring, .s = &s, .n = 1};
+    /* The server accepts the connection but never answers. */
+    assert_true(run(m, link_down, &c));
+    lr_dev *d = lr_modbus_dev(m);
+    assert_int_equal(lr_dev_get_state(d), LR_DEV_RETRYING);
+    assert_non_null(strstr(lr_dev_status(d), "no answer to 3 requests in a row"));
+    lr_modbus_counters k;
+    lr_modbus_get_counters(m, &k);
+    assert_int_equal(k.timeouts, 3);
+    assert_int_equal(lr_test_log_count(&log, "no answer within 30 ms"), 1);
+    assert_int_equal(lr_event_ring_count(ring), 0);
+    /* It answers again: reconnected, and the value arrives. */
+    set_flag(&s, &s.silent, 0);
+    assert_true(run(m, has_events, &c));
+    assert_float_equal(pop(ring).value, 0.1, 1e-12);
+    lr_modbus_get_counters(m, &k);
+    assert_true(k.connects >= 2);
+    lr_modbus_destroy(m);
+    server_free(&s);
+    lr_event_ring_destroy(ring);
+}
+
+static void config_errors(void **state)
+{
+    (void)state;
+    lr_event_ring *ring;
+    assert_int_equal(lr_event_ring_create(0, &ring, NULL), LR_OK);
+    lr_modbus_input in = {.unit = 1, .reg = 0, .base = 1};
+    lr_modbus_desc desc = {.dev = {.sink = lr_event_ring_sink(ring)},
+                           .url = "tcp://127.0.0.1:1", .inputs = &in, .n_inputs = 1};
+    lr_modbus *m = NULL;
+    lr_err e = {0};
+    assert_int_equal(lr_modbus_create(&desc, &m, &e), LR_EINVAL);
+    assert_string_equal(e.msg, "modbus: inputs[0].reg 0 is not 1..65536 (base 1)");
+    in.base = 0;
+    in.unit = 248;
+    desc.url = "rtu:/dev/ttyUSB0";
+    assert_int_equal(lr_modbus_create(&desc, &m, &e), LR_EINVAL);
+    assert_string_equal(e.msg, "modbus: inputs[0].unit 248 is not 1..247");
+    in.unit = 1;
+    in.raw_min = 500;
+    in.raw_max = 100;
+    assert_int_equal(lr_modbus_create(&desc, &m, &e), LR_EINVAL);
+    assert_string_equal(e.msg, "modbus: inputs[0]: raw range 500..100 is not within 0..65535 "
+                               "and increasing");
+    desc.url = "tcp:/oops";
+    assert_int_equal(lr_modbus_create(&desc, &m, &e), LR_EPARSE);
+    assert_non_null(strstr(e.msg, "modbus: modbus URL 'tcp:/oops': unknown scheme"));
+    desc.url = "tcp://127.0.0.1:1";
+    desc.n_inputs = 0;
+    assert_int_equal(lr_modbus_create(&desc, &m, &e), LR_EINVAL);
+    assert_string_equal(e.msg, "modbus: neither inputs nor an output configured");
+    /* Nothing listens on port 1: required fails, optional retries. */
+    desc.n_inputs = 1;
+    in.raw_min = 0;
+    in.raw_max = 0;
+    desc.dev.required = true;
+    assert_int_equal(lr_modbus_create(&desc, &m, &e), LR_ENODEV);
+    assert_string_equal(e.msg, "modbus: tcp://127.0.0.1:1: cannot connect: Connection refused");
+    lr_event_ring_destroy(ring);
+}
+
+/* ---- RTU over a pseudo-terminal pair ---- */
+
+static void rtu_over_pty(void **state)
+{
+    (void)state;
+    server s;
+    server_init(&s, true);
+    set_reg(&s, s.panel, 0, 300);
+    server_start(&s);
+    lr_event_ring *ring;
+    assert_int_equal(lr_event_ring_create(0, &ring, NULL), LR_OK);
+    lr_test_log log = {0};
+    char url[128];
+    snprintf(url, sizeof url, "rtu:%s?baud=19200&parity=E&data=8&stop=1", s.pty_path);
+    /* Panel registers numbered from 1 in its manual: register 1 is address 0. */
+    lr_modbus_input in[2] = {{.control = "dimmer", .unit = 1, .reg = 1, .base = 1},
+                             {.control = "fader", .unit = 1, .reg = 51, .base = 1}};
+    lr_modbus_desc desc = {
+        .dev = {.sink = lr_event_ring_sink(ring), .log = {lr_test_log_fn, &log}},
+        .url = url, .inputs = in, .n_inputs = 2,
+        .output = {.enabled = true, .unit = 2, .reg = 0, .raw_max = 255, .multiple = true},
+        .poll_ms = 10, .timeout_ms = 1000,
+    };
+    lr_modbus *m = NULL;
+    lr_err e = {0};
+    assert_int_equal(lr_modbus_create(&desc, &m, &e), LR_OK);
+    assert_int_equal(lr_dev_get_state(lr_modbus_dev(m)), LR_DEV_OPEN);
+    cond c = {.m = m, .ring = ring, .s = &s, .n = 1};
+    assert_true(run(m, has_events, &c));
+    lr_event ev = pop(ring);
+    assert_string_equal(ev.control, "dimmer");
+    assert_float_equal(ev.value, 0.3, 1e-12);
+
+    /* Write with FC 16; the level lands scaled. */
+    assert_int_equal(lr_modbus_write_level(m, 1.0), LR_OK);
+    c.want = 255;
+    assert_true(run(m, driver_has, &c));
+
+    /* Damaged CRCs are counted and the link carries on. */
+    set_flag(&s, &s.corrupt, 2);
+    c.n = 2;
+    assert_true(run(m, crc_errors_reached, &c));
+    set_reg(&s, s.panel, 0, 700);
+    c.n = 1;
+    assert_true(run(m, has_events, &c));
+    assert_float_equal(last(ring).value, 0.7, 1e-12);
+    lr_modbus_counters k;
+    lr_modbus_get_counters(m, &k);
+    assert_int_equal(k.crc_errors, 2);
+    assert_true(k.exceptions >= 1); /* the fader at register 51 */
+    assert_int_equal(k.last_exception, 2);
+    assert_int_equal(k.connects, 1);
+    assert_int_equal(lr_dev_get_state(lr_modbus_dev(m)), LR_DEV_OPEN);
+    assert_true(lr_test_log_count(&log, "answer with a bad CRC") >= 1);
+    lr_modbus_destroy(m);
+
+    /* RS-485 mode needs the TIOCSRS485 ioctl, which a pty refuses: a clear error. */
+    snprintf(url, sizeof url, "rtu:%s?rs485=1", s.pty_path);
+    desc.dev.required = true;
+    assert_int_equal(lr_modbus_create(&desc, &m, &e), LR_EUNSUPPORTED);
+    assert_non_null(strstr(e.msg, "rs485=1 but the port refuses RS-485 mode (TIOCSRS485)"));
+
+    /* A missing serial port. */
+    desc.url = "rtu:/dev/ttyLAMPRIG-none";
+    assert_int_equal(lr_modbus_create(&desc, &m, &e), LR_ENODEV);
+    assert_non_null(strstr(e.msg, "modbus: rtu:/dev/ttyLAMPRIG-none?baud=19200&parity=E&data=8&"
+                                  "stop=1: cannot connect: No such file or directory"));
+    server_free(&s);
+    lr_event_ring_destroy(ring);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(url_good),
+        cmocka_unit_test(url_bad),
+        cmocka_unit_test(tcp_panel_driver_and_reconnect),
+        cmocka_unit_test(tcp_exceptions_are_counted_not_fatal),
+        cmocka_unit_test(tcp_timeouts_drop_and_restore_the_link),
+        cmocka_unit_test(config_errors),
+        cmocka_unit_test(rtu_over_pty),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
