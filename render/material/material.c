@@ -56,7 +56,7 @@ static int get_coeffs(const lr_json *j, lr_jnode node, const char *field, double
         return rc;
     for (int i = 0; i < 3; i++) {
         if (v[i] < 0.0) {
-            char sub[160];
+            char sub[300];
             snprintf(sub, sizeof sub, "%s[%d]", field, i);
             return lr_json_fail(j, lr_json_at(j, node, i), sub, e, LR_EINVAL,
                                 "must be >= 0 (mm^-1), got %g", v[i]);
@@ -99,7 +99,7 @@ static int get_scale(const lr_json *j, lr_jnode node, const char *field, double 
 static int load_base(const lr_json *j, lr_jnode node, const char *field, const char *base_dir,
                      chain *ch, lr_medium *out, lr_err *e)
 {
-    char name[LR_MATERIAL_NAME_MAX + 8];
+    char name[LR_MATERIAL_NAME_MAX];
     int rc = lr_json_string(j, node, field, name, sizeof name, e);
     if (rc)
         return rc;
@@ -109,7 +109,7 @@ static int load_base(const lr_json *j, lr_jnode node, const char *field, const c
                             "or leading '.')",
                             name);
     char path[PATH_MAX];
-    char leaf[LR_MATERIAL_NAME_MAX + 8];
+    char leaf[LR_MATERIAL_NAME_MAX + 16];
     snprintf(leaf, sizeof leaf, "%s.json", name);
     if (lr_path_join(path, sizeof path, base_dir, leaf, NULL) != 0)
         return lr_json_fail(j, node, field, e, LR_EINVAL, "path of preset '%s' too long", name);
@@ -358,7 +358,7 @@ int lr_material_find(const char *name, lr_material *out, lr_err *e)
                           "material '%s': not a preset name (letters, digits, '_', '-', '.'; "
                           "no '/' or leading '.')",
                           name ? name : "(null)");
-    char dir[PATH_MAX], path[PATH_MAX], leaf[LR_MATERIAL_NAME_MAX + 8];
+    char dir[PATH_MAX], path[PATH_MAX], leaf[LR_MATERIAL_NAME_MAX + 16];
     int rc = presets_dir(dir, sizeof dir, e);
     if (rc)
         return rc;
