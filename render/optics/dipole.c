@@ -5,10 +5,11 @@
 #include <math.h>
 
 /* One source's term z (sigma_tr d + 1) e^{-sigma_tr d} / d^3 with d = sqrt(r^2 + z^2).
- * hypot avoids overflow for large r; when d^3 overflows the term correctly becomes 0. */
+ * z <= 1e10 mm (medium validation), so r^2 + z^2 can only overflow for huge r, where hypot
+ * (3x slower) takes over; when d^3 overflows the term correctly becomes 0. */
 static double source_term(double sigma_tr, double z, double r)
 {
-    double d = hypot(r, z);
+    double d = r < 1e150 ? sqrt(r * r + z * z) : hypot(r, z);
     double s = sigma_tr * d;
     return z * (s + 1.0) * exp(-s) / (d * d * d);
 }

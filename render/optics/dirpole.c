@@ -94,7 +94,8 @@ void lr_dirpole_sd(const lr_coeffs *c, lr_vec3 xi, lr_vec3 ni, lr_vec3 wi, lr_ve
             dr = sqrt(D * mu0 * (D * mu0 + 2.0 * q) + r * r);
         } else {
             /* [14]: d_r^2 = 1 / (3 sigma_t)^2 + r^2 when the refracted ray leaves through n_o. */
-            dr = hypot(1.0 / (3.0 * c->sigma_t[j]), r);
+            double z = 1.0 / (3.0 * c->sigma_t[j]);
+            dr = sqrt(z * z + r * r);
         }
         if (dr < floor_d)
             dr = floor_d;

@@ -34,7 +34,8 @@ int lr_medium_validate(const lr_medium *m, lr_err *e)
     }
     if (!isfinite(m->eta) || m->eta < LR_ETA_MIN || m->eta > LR_ETA_MAX)
         return lr_err_set(e, LR_EINVAL,
-                          "medium: eta = %g: must be in [%g, %g], where the diffuse Fresnel fits hold",
+                          "medium: eta = %g: must be in [%g, %g], where the diffuse Fresnel "
+                          "fits hold",
                           m->eta, LR_ETA_MIN, LR_ETA_MAX);
     if (!isfinite(m->g) || m->g <= -1.0 || m->g >= 1.0)
         return lr_err_set(e, LR_EINVAL, "medium: g = %g: must be in (-1, 1)", m->g);

@@ -112,8 +112,11 @@ void lr_dipole_rd_total(const lr_coeffs *c, double out[3]);
  * Clamped to >= 0 as in [14]. n_i, w_i, n_o must be unit vectors. Where [14]'s modified
  * tangent-plane normal n_i* = x^ x (n_i x x) / |n_i x x| is undefined (x_o == x_i, or x_o - x_i
  * parallel to n_i, e.g. straight through a thin shell) it falls back to n_i. A refracted w_i
- * under total internal reflection (eta < 1) is taken as grazing. Finite for every finite
- * input, including albedo' == 0 (de = Inf) and albedo' == 1 (sigma_tr = 0). */
+ * under total internal reflection (eta < 1) is taken as grazing; a w_i below the surface
+ * (w_i . n_i < 0) goes through the same formulas (lr_dirpole_sd_fresnel gives 0 for it).
+ * Finite for every finite input, including albedo' == 0 (de = Inf) and albedo' == 1
+ * (sigma_tr = 0). Note: the published S_d has no albedo' factor, so unlike R_d it tends to a
+ * nonzero limit (the real source alone) as albedo' -> 0. */
 void lr_dirpole_sd(const lr_coeffs *c, lr_vec3 xi, lr_vec3 ni, lr_vec3 wi, lr_vec3 xo,
                    lr_vec3 no, double out[3]);
 /* The same times the incident boundary transmission F_t(w_i) = 1 - R(w_i . n_i, eta) (the
@@ -133,7 +136,8 @@ int lr_dirpole_sd_checked(const lr_coeffs *c, lr_vec3 xi, lr_vec3 ni, lr_vec3 wi
  * sigma_tr -> 0 (albedo -> 1) stays finite: r_max = INFINITY gives Eq. 12 exactly, and
  * sigma_tr == 0 gives the uniform density on [0, r_max]. xi in [0, 1). Preconditions (see
  * lr_exp_radius_validate): sigma_tr finite >= 0, r_max > 0, r_max finite when sigma_tr == 0;
- * otherwise NaN is returned. Density p(r) = sigma_tr e^{-sigma_tr r} / (1 - e^{-sigma_tr r_max}). */
+ * otherwise NaN is returned.
+ * Density p(r) = sigma_tr e^{-sigma_tr r} / (1 - e^{-sigma_tr r_max}). */
 double lr_exp_radius_sample(double sigma_tr, double r_max, double xi);
 /* Its density p(r) (0 outside [0, r_max]); the joint density of Eq. 11 is p(r) / (2 pi). */
 double lr_exp_radius_pdf(double sigma_tr, double r_max, double r);

@@ -47,10 +47,11 @@ double lr_exp_radius_pdf(double sigma_tr, double r_max, double r)
 int lr_exp_radius_validate(double sigma_tr, double r_max, lr_err *e)
 {
     if (!isfinite(sigma_tr) || sigma_tr < 0.0)
-        return lr_err_set(e, LR_EINVAL, "exp radius: sigma_tr = %g: must be finite and >= 0 (mm^-1)",
-                          sigma_tr);
+        return lr_err_set(e, LR_EINVAL,
+                          "exp radius: sigma_tr = %g: must be finite and >= 0 (mm^-1)", sigma_tr);
     if (isnan(r_max) || r_max <= 0.0)
-        return lr_err_set(e, LR_EINVAL, "exp radius: r_max = %g: must be > 0 (mm) or INFINITY", r_max);
+        return lr_err_set(e, LR_EINVAL, "exp radius: r_max = %g: must be > 0 (mm) or INFINITY",
+                          r_max);
     if (sigma_tr == 0.0 && isinf(r_max))
         return lr_err_set(e, LR_EINVAL,
                           "exp radius: r_max = inf with sigma_tr = 0: no density; truncate r_max");

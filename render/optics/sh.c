@@ -29,7 +29,7 @@ void lr_sh9_basis(lr_vec3 d, double out[9])
 double lr_sh9_irradiance(const double coeffs[9], lr_vec3 n)
 {
     /* Funk-Hecke: convolving with the clamped cosine max(0, n.w) scales band l by A_l:
-     * A_0 = pi, A_1 = 2 pi / 3, A_2 = pi / 4 (Ramamoorthi & Hanrahan 2001, Eq. 8-9). */
+     * A_0 = pi, A_1 = 2 pi / 3, A_2 = pi / 4 (Ramamoorthi & Hanrahan 2001). */
     static const double A[9] = {M_PI,
                                 2.0 * M_PI / 3.0, 2.0 * M_PI / 3.0, 2.0 * M_PI / 3.0,
                                 M_PI / 4.0, M_PI / 4.0, M_PI / 4.0, M_PI / 4.0, M_PI / 4.0};
