@@ -1,0 +1,67 @@
+/* lamprig — the renderer: seed 003's passes over a scene, scheduled by what changed.
+ *
+ * This is the one interface the CLI (`lamprig render`), the firmware's main loop, the bench and
+ * the calibration comparison runs use. The estimators each pass computes are fixed in
+ * render/passes/PIPELINE.md; render/cpu/ is their CPU twin.
+ *
+ * Scheduling (DESIGN.md's table): the caller changes the scene with lr_scene_set(), which
+ * returns LR_DIRTY_* flags, and hands them to lr_renderer_invalidate(). The next
+ * lr_renderer_frame() runs only the passes lr_dirty_passes() names: a dimmer change re-runs
+ * composition alone (transport is linear in intensity); a camera change composition alone; a
+ * material change the radiosity maps, VPLs and composition; light or geometry changes
+ * everything. With nothing dirty, frames keep accumulating radiosity samples until
+ * `render.frames` have been accumulated, then lr_renderer_needs_frame() turns false and the
+ * caller only re-presents.
+ */
+#ifndef LR_RENDERER_H
+#define LR_RENDERER_H
+
+#include <stdbool.h>
+
+#include "render/base/err.h"
+#include "render/gl/gl.h"
+#include "render/scene/dirty.h"
+#include "render/scene/scene.h"
+
+typedef struct lr_renderer lr_renderer;
+
+typedef struct lr_renderer_desc {
+    lr_gl *gl;             /* current context; the renderer does not own it */
+    lr_scene *scene;       /* read at every frame; owned by the caller */
+    int width, height;     /* output image; 0 = 640 x 480 */
+    bool no_vpl;           /* skip emergent light (pass 4) */
+    unsigned seed;         /* base of the per-texel/map/frame sample seeds; 0 = 1 */
+} lr_renderer_desc;
+
+enum { LR_PASS_COUNT = 4 }; /* gbuffer, radiosity, vpl, compose (render/scene/dirty.h) */
+
+typedef struct lr_frame_stats {
+    int index;                   /* frames rendered since create */
+    unsigned passes;             /* LR_PASS_* bits that ran this frame */
+    double ms[LR_PASS_COUNT];    /* per pass, GPU time when timer queries exist, else CPU+finish */
+    double total_ms;
+    int samples;                 /* radiosity frames accumulated in the maps after this frame */
+    bool converged;              /* samples reached render.frames */
+} lr_frame_stats;
+
+int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *e);
+void lr_renderer_destroy(lr_renderer *r);
+
+/* Marks what changed (LR_DIRTY_* bits from lr_scene_set). */
+void lr_renderer_invalidate(lr_renderer *r, unsigned dirty);
+/* True while something is dirty or accumulation has not converged. */
+bool lr_renderer_needs_frame(const lr_renderer *r);
+/* Runs the passes that are due and leaves the image in the renderer's output target. */
+int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e);
+
+/* Linear RGB radiance of the last frame, width*height*3 floats, rows bottom to top (PFM order). */
+int lr_renderer_read_hdr(lr_renderer *r, float *rgb, lr_err *e);
+/* Tone-mapped sRGB, width*height*4 bytes, rows top to bottom (PNG order). */
+int lr_renderer_read_rgba8(lr_renderer *r, unsigned char *rgba, lr_err *e);
+/* Draws the last frame to the context's default framebuffer (projector) and presents it. */
+int lr_renderer_present(lr_renderer *r, lr_err *e);
+
+/* "gbuffer", "radiosity", "vpl", "compose" for bit index 0..3. */
+const char *lr_pass_name(int index);
+
+#endif
