@@ -205,7 +205,7 @@ int lr_fb_create(lr_gl *gl, const lr_fb_desc *d, lr_fb **out, lr_err *e)
     const char *label = d->label ? d->label : "framebuffer";
     int w = 0, h = 0, n = 0, rc;
     for (; n < LR_FB_MAX_COLOR && d->color[n].tex; n++) {
-        char field[16];
+        char field[24];
         snprintf(field, sizeof field, "color[%d]", n);
         if ((rc = check_attachment(gl, label, field, &d->color[n], false, &w, &h, e)))
             return rc;

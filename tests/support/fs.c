@@ -1,5 +1,4 @@
 /* lamprig tests — scratch directories and files. */
-#define _XOPEN_SOURCE 700
 #include "tests/support/fs.h"
 
 #include <ftw.h>
