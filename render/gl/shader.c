@@ -486,9 +486,12 @@ int lr_program_create(const lr_program_desc *d, lr_program **out, lr_err *e)
         if (!ok) {
             char *log = info_log(prog, true);
             /* One line: driver logs are multi-line. */
-            for (char *c = log; c && *c; c++)
-                if (*c == '\n')
-                    *c = ' ';
+            size_t n = log ? strlen(log) : 0;
+            for (size_t i = 0; i < n; i++)
+                if (log[i] == '\n')
+                    log[i] = ' ';
+            while (n && log[n - 1] == ' ')
+                log[--n] = '\0';
             rc = lr_err_set(e, LR_EGL, "link %s%s%s: %s", names[0], count > 1 ? " + " : "",
                             count > 1 ? names[1] : "", log ? log : "");
             free(log);
