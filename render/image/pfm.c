@@ -120,24 +120,28 @@ int lr_image_read_pfm(const char *path, lr_image *out, lr_err *e)
     }
     pos = token(d, n, pos, ws, sizeof ws);
     pos = token(d, n, pos, hs, sizeof hs);
+    if (pos >= n) {
+        rc = lr_err_set(e, LR_EPARSE, "%s: truncated PFM header", path);
+        goto done;
+    }
     if (parse_int(ws, &w) || parse_int(hs, &h)) {
         rc = lr_err_set(e, LR_EPARSE, "%s: bad PFM size \"%s %s\" (1..%d)", path, ws, hs,
                         LR_IMAGE_MAX_SIDE);
         goto done;
     }
     pos = token(d, n, pos, ss, sizeof ss);
+    /* Exactly one whitespace character separates the header from the data. */
+    if (pos >= n) {
+        rc = lr_err_set(e, LR_EPARSE, "%s: truncated PFM header", path);
+        goto done;
+    }
     char *end;
     double scale = strtod(ss, &end);
     if (end == ss || *end || !isfinite(scale) || scale == 0.0) {
         rc = lr_err_set(e, LR_EPARSE, "%s: bad PFM scale \"%s\"", path, ss);
         goto done;
     }
-    /* Exactly one whitespace character separates the header from the data. */
-    if (pos >= n || !(d[pos] == '\n' || d[pos] == ' ' || d[pos] == '\r' || d[pos] == '\t')) {
-        rc = lr_err_set(e, LR_EPARSE, "%s: truncated PFM header", path);
-        goto done;
-    }
-    pos++;
+    pos++; /* the token stopped at a whitespace character, which ends the header */
     size_t want = (size_t)w * (size_t)h * (size_t)channels * 4, have = n - pos;
     if (have < want) {
         rc = lr_err_set(e, LR_EPARSE, "%s: truncated: %zu of %zu pixel bytes", path, have, want);

@@ -2,6 +2,7 @@
  * error handling inside libpng and reports failures as a message in the png_image. */
 #include "render/image/image.h"
 
+#include <errno.h>
 #include <math.h>
 #include <png.h>
 #include <stdlib.h>
@@ -44,52 +45,53 @@ int lr_image_write_png(const char *path, const lr_image *img, const lr_tonemap *
     return lr_atomic_commit(af, e);
 }
 
-int lr_image_read_png(const char *path, lr_image *out, lr_err *e)
+/* Decodes an open PNG into out; pi is released by the caller. */
+static int decode(const char *path, FILE *f, png_image *pi, lr_image *out, lr_err *e)
 {
-    out->width = out->height = 0;
-    out->rgb = NULL;
-    png_image pi;
-    memset(&pi, 0, sizeof pi);
-    pi.version = PNG_IMAGE_VERSION;
-    if (!png_image_begin_read_from_file(&pi, path)) {
-        /* libpng says "Not a PNG file", "Read Error", "IHDR: CRC error" ...; the system error
-         * (missing file) comes through as its message too. */
-        int rc = lr_err_set(e, LR_EPARSE, "%s: not a readable PNG: %s", path, pi.message);
-        png_image_free(&pi);
-        return rc;
-    }
-    if (pi.width < 1 || pi.height < 1 || pi.width > LR_IMAGE_MAX_SIDE || pi.height > LR_IMAGE_MAX_SIDE) {
-        int rc = lr_err_set(e, LR_EPARSE, "%s: PNG size %ux%u outside 1..%d", path,
-                            (unsigned)pi.width, (unsigned)pi.height, LR_IMAGE_MAX_SIDE);
-        png_image_free(&pi);
-        return rc;
-    }
-    pi.format = PNG_FORMAT_RGB;
-    size_t n = PNG_IMAGE_SIZE(pi);
+    if (!png_image_begin_read_from_stdio(pi, f))
+        /* libpng says "Not a PNG file", "Read Error", "IHDR: CRC error" ... */
+        return lr_err_set(e, LR_EPARSE, "%s: not a readable PNG: %s", path, pi->message);
+    if (pi->width < 1 || pi->height < 1 || pi->width > LR_IMAGE_MAX_SIDE ||
+        pi->height > LR_IMAGE_MAX_SIDE)
+        return lr_err_set(e, LR_EPARSE, "%s: PNG size %ux%u outside 1..%d", path,
+                          (unsigned)pi->width, (unsigned)pi->height, LR_IMAGE_MAX_SIDE);
+    pi->format = PNG_FORMAT_RGB;
+    size_t n = PNG_IMAGE_SIZE(*pi);
     unsigned char *px = malloc(n);
-    if (!px) {
-        png_image_free(&pi);
-        return lr_err_set(e, LR_ENOMEM, "%s: %ux%u pixels", path, (unsigned)pi.width,
-                          (unsigned)pi.height);
-    }
+    if (!px)
+        return lr_err_set(e, LR_ENOMEM, "%s: %ux%u pixels", path, (unsigned)pi->width,
+                          (unsigned)pi->height);
     png_color black = {0, 0, 0};
-    if (!png_image_finish_read(&pi, &black, px, 0, NULL)) {
-        int rc = lr_err_set(e, LR_EPARSE, "%s: corrupt or truncated PNG: %s", path, pi.message);
-        png_image_free(&pi);
-        free(px);
-        return rc;
-    }
-    int rc = lr_image_alloc(out, (int)pi.width, (int)pi.height, e);
+    int rc = LR_OK;
+    if (!png_image_finish_read(pi, &black, px, 0, NULL))
+        rc = lr_err_set(e, LR_EPARSE, "%s: corrupt or truncated PNG: %s", path, pi->message);
+    else if ((rc = lr_image_alloc(out, (int)pi->width, (int)pi->height, e)) != LR_OK)
+        lr_err_prefix(e, "%s", path);
     if (rc == LR_OK) {
-        /* 256-entry table: exact same decode for every pixel, and no powf per channel. */
+        /* 256-entry table: the same decode for every pixel, and no powf per channel. */
         float lut[256];
         for (int i = 0; i < 256; i++)
             lut[i] = lr_srgb_decode((float)i / 255.0f);
         for (size_t i = 0; i < n; i++)
             out->rgb[i] = lut[px[i]];
-    } else {
-        lr_err_prefix(e, "%s", path);
     }
     free(px);
+    return rc;
+}
+
+int lr_image_read_png(const char *path, lr_image *out, lr_err *e)
+{
+    out->width = out->height = 0;
+    out->rgb = NULL;
+    /* Opened here so a missing file is an I/O error in errno's words, not a PNG error. */
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return lr_err_set(e, LR_EIO, "%s: %s", path, strerror(errno));
+    png_image pi;
+    memset(&pi, 0, sizeof pi);
+    pi.version = PNG_IMAGE_VERSION;
+    int rc = decode(path, f, &pi, out, e);
+    png_image_free(&pi);
+    fclose(f);
     return rc;
 }
