@@ -3,13 +3,14 @@
 #include "render/gl/shader.h"
 
 #include <ctype.h>
-#include <errno.h>
 #include <limits.h>
 #include <stdarg.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "render/base/file.h"
 
 #define MAX_INCLUDE_DEPTH 16
 
@@ -87,39 +88,6 @@ static int append_line(lr_shader_source *s, const char *str, size_t n, int file,
 static int prelude_line(lr_shader_source *s, const char *str, lr_err *e)
 {
     return append_line(s, str, strlen(str), -1, s->nlines + 1, e);
-}
-
-static int read_all(const char *path, char **data, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return -1;
-    size_t cap = 4096, n = 0;
-    char *buf = malloc(cap);
-    while (buf) {
-        n += fread(buf + n, 1, cap - n - 1, f);
-        if (n < cap - 1)
-            break;
-        char *t = realloc(buf, cap * 2);
-        if (!t) {
-            free(buf);
-            buf = NULL;
-            break;
-        }
-        buf = t;
-        cap *= 2;
-    }
-    int err = ferror(f) ? errno : 0;
-    fclose(f);
-    if (!buf || err) {
-        free(buf);
-        errno = buf ? err : ENOMEM;
-        return -1;
-    }
-    buf[n] = '\0';
-    *data = buf;
-    *len = n;
-    return 0;
 }
 
 /* Registers path; returns its index, or -2 when the same file (by realpath) was pasted
@@ -203,12 +171,9 @@ static int load_file(lr_shader_source *s, const char *path, const char *from, in
     char *data;
     size_t len;
     char real[PATH_MAX];
-    if (read_all(path, &data, &len) != 0) {
-        if (from)
-            return lr_err_set(e, LR_EIO, "%s:%d: cannot open include %s: %s", from, from_line,
-                              path, strerror(errno));
-        return lr_err_set(e, LR_EIO, "%s: cannot read shader: %s", path, strerror(errno));
-    }
+    int rc = lr_file_read(path, &data, &len, e);
+    if (rc)
+        return from ? lr_err_prefix(e, "%s:%d: cannot open include", from, from_line) : rc;
     if (!realpath(path, real))
         snprintf(real, sizeof real, "%s", path);
     int file = add_file(s, path, real);
@@ -225,7 +190,6 @@ static int load_file(lr_shader_source *s, const char *path, const char *from, in
         return lr_err_set(e, LR_EPARSE, "%s:%d: includes nested deeper than %d", from, from_line,
                           MAX_INCLUDE_DEPTH);
     }
-    int rc = LR_OK;
     const char *p = data, *end = data + len;
     for (int line = 1; rc == LR_OK && p < end; line++) {
         const char *nl = memchr(p, '\n', (size_t)(end - p));

@@ -42,7 +42,7 @@ typedef struct lr_shader_source lr_shader_source;
 
 /* Reads `path`, resolves its includes and prepends the header and `defines` (NULL-terminated
  * list of "NAME" or "NAME VALUE"; NULL for none). Errors: LR_EIO (file or include cannot be
- * read: "dir/a.frag:3: cannot open include dir/b.glsl: No such file or directory"),
+ * read: "dir/a.frag:3: cannot open include: dir/b.glsl: No such file or directory"),
  * LR_EPARSE (a #version line in a file, a malformed #include, a newline in a define). */
 int lr_shader_source_load(const char *path, lr_shader_stage stage, const char *const *defines,
                           lr_shader_source **out, lr_err *e);

@@ -4,14 +4,15 @@
 #include "render/image/image.h"
 
 #include <errno.h>
-#include <stdbool.h>
 #include <math.h>
+#include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "render/base/atomic_file.h"
+#include "render/base/file.h"
 
 int lr_image_write_pfm(const char *path, const lr_image *img, lr_err *e)
 {
@@ -67,47 +68,14 @@ static int parse_int(const char *s, int *v)
     return 0;
 }
 
-static int read_file(const char *path, unsigned char **data, size_t *len, lr_err *e)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return lr_err_set(e, LR_EIO, "%s: %s", path, strerror(errno));
-    unsigned char *buf = NULL;
-    size_t n = 0, cap = 0;
-    for (;;) {
-        if (n == cap) {
-            cap = cap ? cap * 2 : 1 << 16;
-            unsigned char *t = realloc(buf, cap);
-            if (!t) {
-                free(buf);
-                fclose(f);
-                return lr_err_set(e, LR_ENOMEM, "%s", path);
-            }
-            buf = t;
-        }
-        size_t k = fread(buf + n, 1, cap - n, f);
-        n += k;
-        if (k == 0)
-            break;
-    }
-    int err = ferror(f);
-    fclose(f);
-    if (err) {
-        free(buf);
-        return lr_err_set(e, LR_EIO, "%s: read error", path);
-    }
-    *data = buf;
-    *len = n;
-    return LR_OK;
-}
-
 int lr_image_read_pfm(const char *path, lr_image *out, lr_err *e)
 {
     out->width = out->height = 0;
     out->rgb = NULL;
-    unsigned char *d = NULL;
+    char *text = NULL;
     size_t n = 0;
-    int rc = read_file(path, &d, &n, e);
+    int rc = lr_file_read(path, &text, &n, e);
+    const unsigned char *d = (const unsigned char *)text;
     if (rc)
         return rc;
     char magic[8], ws[16], hs[16], ss[32];
@@ -173,6 +141,6 @@ int lr_image_read_pfm(const char *path, lr_image *out, lr_err *e)
         }
     }
 done:
-    free(d);
+    free(text);
     return rc;
 }
