@@ -8,6 +8,7 @@
 
 #include <GLES3/gl31.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "render/gl/gl.h"
@@ -201,5 +202,7 @@ int main(void)
         cmocka_unit_test(caps_extension_names_match_whole),
         cmocka_unit_test(caps_desktop_gl_is_rejected),
     };
+    if (getenv("LR_TEST_FILTER")) /* e.g. LR_TEST_FILTER='cube*' to run one test */
+        cmocka_set_test_filter(getenv("LR_TEST_FILTER"));
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -353,5 +353,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(compute_shader_and_bad_desc, setup, teardown),
         cmocka_unit_test_setup_teardown(project_shaders_compile, setup, teardown),
     };
+    if (getenv("LR_TEST_FILTER")) /* e.g. LR_TEST_FILTER='cube*' to run one test */
+        cmocka_set_test_filter(getenv("LR_TEST_FILTER"));
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -388,5 +388,7 @@ int main(void)
         T(writes_replace_atomically_and_leave_no_temp),
         T(gl_readback_is_flipped),
     };
+    if (getenv("LR_TEST_FILTER")) /* e.g. LR_TEST_FILTER='cube*' to run one test */
+        cmocka_set_test_filter(getenv("LR_TEST_FILTER"));
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
