@@ -48,7 +48,7 @@ static void surfaceless_context_is_gles31_with_caps(void **state)
     assert_int_equal(c->texture_float_linear, driver_has("GL_OES_texture_float_linear"));
     assert_int_equal(c->timer_query, driver_has("GL_EXT_disjoint_timer_query"));
     assert_int_equal(c->float_blend, driver_has("GL_EXT_float_blend"));
-    /* GLES 3.1 minimums (GLES 3.1 spec, table 20.40 ff.). */
+    /* The minimum values GLES 3.1 requires of every implementation. */
     assert_true(c->max_texture_size >= 2048);
     assert_true(c->max_cube_map_size >= 2048);
     assert_true(c->max_array_layers >= 256);

@@ -19,8 +19,8 @@ int lr_gl_caps_parse(const char *version, const char *const *exts, int n_exts, l
                      lr_err *e)
 {
     int major = 0, minor = 0;
-    /* GLES mandates "OpenGL ES N.M vendor-specific" (GLES 3.2 spec, 6.1.6). Anything else is
-     * desktop GL or a broken driver; neither is what the passes are written for. */
+    /* GLES mandates a GL_VERSION of the form "OpenGL ES N.M vendor-specific". Anything else
+     * is desktop GL or a broken driver; neither is what the passes are written for. */
     if (!version || sscanf(version, "OpenGL ES %d.%d", &major, &minor) != 2)
         return lr_err_set(e, LR_EUNSUPPORTED, "GL: not an OpenGL ES context (GL_VERSION \"%s\")",
                           version ? version : "(null)");
@@ -29,8 +29,8 @@ int lr_gl_caps_parse(const char *version, const char *const *exts, int n_exts, l
     c->minor = minor;
     bool es32 = major > 3 || (major == 3 && minor >= 2);
 
-    /* GLES 3.2 made EXT_color_buffer_float core (GLES 3.2 spec, table 8.13 marks the 16F/32F
-     * formats colour-renderable), so a 3.2 driver need not list it. */
+    /* GLES 3.2 absorbed EXT_color_buffer_float (its 16F/32F formats are colour-renderable in
+     * core), so a 3.2 driver need not list the extension. */
     c->color_buffer_float = es32 || has(exts, n_exts, "GL_EXT_color_buffer_float");
     c->color_buffer_half_float =
         c->color_buffer_float || has(exts, n_exts, "GL_EXT_color_buffer_half_float");

@@ -293,8 +293,8 @@ int lr_fb_read(lr_fb *fb, int index, int x, int y, int w, int h, float *rgba, lr
     glReadBuffer(GL_COLOR_ATTACHMENT0 + (GLenum)index);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     if (formats[fb->color_format[index]].is_float) {
-        /* RGBA/FLOAT is the one combination GLES guarantees for float colour buffers
-         * (GLES 3.2 spec 16.1.2, EXT_color_buffer_float), whatever their channel count. */
+        /* RGBA/FLOAT is the combination GLES guarantees for reading float colour buffers
+         * (EXT_color_buffer_float; glReadPixels in GLES 3.x), whatever their channel count. */
         glReadPixels(x, y, w, h, GL_RGBA, GL_FLOAT, rgba);
     } else {
         size_t n = (size_t)w * (size_t)h * 4;
