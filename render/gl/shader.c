@@ -29,8 +29,8 @@ struct lr_shader_source {
 
 /* Every precision a pass could trip over: float/int default to highp only in vertex and
  * compute shaders, and sampler3D/2DArray/shadow samplers have no default in fragment shaders
- * at all (GLSL ES 3.10, "Default Precision Qualifiers"). highp samplers also keep float textures full precision on
- * GPUs that default sampler2D to lowp. */
+ * at all (GLSL ES 3.10, "Default Precision Qualifiers"). highp samplers also keep float
+ * textures at full precision on GPUs that default sampler2D to lowp. */
 static const char *const precision_lines[] = {
     "precision highp float;",
     "precision highp int;",
