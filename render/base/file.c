@@ -1,0 +1,48 @@
+/* lamprig — whole-file reads. */
+#include "render/base/file.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+int lr_file_read(const char *path, char **data, size_t *len, lr_err *e)
+{
+    *data = NULL;
+    *len = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return lr_err_set(e, LR_EIO, "%s: %s", path, strerror(errno));
+    /* Grow as we go rather than trusting a size from fstat: pipes and /proc report 0. */
+    char *buf = NULL;
+    size_t n = 0, cap = 0;
+    int err = 0;
+    for (;;) {
+        if (cap - n < 2) {
+            size_t ncap = cap ? 2 * cap : 1 << 14;
+            char *t = realloc(buf, ncap);
+            if (!t) {
+                err = ENOMEM;
+                break;
+            }
+            buf = t;
+            cap = ncap;
+        }
+        size_t k = fread(buf + n, 1, cap - n - 1, f);
+        n += k;
+        if (k == 0) {
+            if (ferror(f))
+                err = errno ? errno : EIO;
+            break;
+        }
+    }
+    fclose(f);
+    if (err) {
+        free(buf);
+        return lr_err_set(e, err == ENOMEM ? LR_ENOMEM : LR_EIO, "%s: %s", path, strerror(err));
+    }
+    buf[n] = '\0';
+    *data = buf;
+    *len = n;
+    return LR_OK;
+}

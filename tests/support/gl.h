@@ -1,0 +1,18 @@
+/* lamprig tests — a headless GL context for tests that need the driver. */
+#ifndef LR_TEST_GL_H
+#define LR_TEST_GL_H
+
+#include "render/gl/gl.h"
+
+/* Creates a surfaceless context (lr_gl_create with the defaults) and pins the driver
+ * libraries in memory (lr_test_pin_libraries). On failure prints the message to stderr and
+ * returns the error code; for cmocka setup functions. */
+int lr_test_gl_create(lr_gl **out);
+
+/* Marks every shared library loaded so far RTLD_NODELETE. Mesa dlcloses its driver at
+ * eglTerminate; leaks inside the driver would then be reported from "<unknown module>" and
+ * tests/lsan.supp could not name them. Pinned, they keep their library name and stay
+ * suppressed, while leaks in our own code are reported as ever. */
+void lr_test_pin_libraries(void);
+
+#endif
