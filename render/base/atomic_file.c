@@ -32,7 +32,7 @@ int lr_atomic_file_open(const char *path, lr_atomic_file **out, lr_err *e)
         free(f->tmp);
         free(f->path);
         free(f);
-        return lr_err_set(e, LR_EIO, "%s: cannot create temp file: %s", path, strerror(err));
+        return lr_err_set(e, LR_EIO, "%s: cannot create a temporary file beside it: %s", path, strerror(err));
     }
     /* mkstemp makes 0600; saved files are ordinary data files. */
     (void)fchmod(fd, 0644);
