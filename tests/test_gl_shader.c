@@ -128,7 +128,7 @@ static void loader_errors_name_file_and_line(void **state)
 
     char *m = lr_test_write(f->dir, "m.frag", "\n\n#include \"nope.glsl\"\n", (size_t)-1);
     assert_int_equal(lr_shader_source_load(m, LR_STAGE_FRAGMENT, NULL, &src, &e), LR_EIO);
-    snprintf(want, sizeof want, "%s:3: cannot open include: %s/nope.glsl: No such file or directory",
+    snprintf(want, sizeof want, "%s:3: include: %s/nope.glsl: cannot open: No such file or directory",
              m, f->dir);
     assert_string_equal(e.msg, want);
 
@@ -143,7 +143,7 @@ static void loader_errors_name_file_and_line(void **state)
 
     assert_int_equal(lr_shader_source_load("/nonexistent/x.frag", LR_STAGE_FRAGMENT, NULL, &src, &e),
                      LR_EIO);
-    assert_string_equal(e.msg, "/nonexistent/x.frag: No such file or directory");
+    assert_string_equal(e.msg, "/nonexistent/x.frag: cannot open: No such file or directory");
     free(v);
     free(m);
     free(b);

@@ -174,7 +174,7 @@ static void pfm_bad_files_are_rejected_by_name(void **state)
     lr_image back = {0};
     lr_err e = {0};
     assert_int_equal(lr_image_read_pfm("/nonexistent/x.pfm", &back, &e), LR_EIO);
-    assert_string_equal(e.msg, "/nonexistent/x.pfm: No such file or directory");
+    assert_string_equal(e.msg, "/nonexistent/x.pfm: cannot open: No such file or directory");
     free(longer);
     free(d);
     free(good);
@@ -312,7 +312,7 @@ static void png_bad_files_are_rejected_by_name(void **state)
     assert_int_equal(strncmp(e.msg, prefix, strlen(prefix)), 0);
 
     assert_int_equal(lr_image_read_png("/nonexistent/y.png", &back, &e), LR_EIO);
-    assert_string_equal(e.msg, "/nonexistent/y.png: No such file or directory");
+    assert_string_equal(e.msg, "/nonexistent/y.png: cannot open: No such file or directory");
     free(trunc);
     free(crc);
     free(text);

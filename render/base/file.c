@@ -12,7 +12,7 @@ int lr_file_read(const char *path, char **data, size_t *len, lr_err *e)
     *len = 0;
     FILE *f = fopen(path, "rb");
     if (!f)
-        return lr_err_set(e, LR_EIO, "%s: %s", path, strerror(errno));
+        return lr_err_set(e, LR_EIO, "%s: cannot open: %s", path, strerror(errno));
     /* Grow as we go rather than trusting a size from fstat: pipes and /proc report 0. */
     char *buf = NULL;
     size_t n = 0, cap = 0;

@@ -1,4 +1,5 @@
 #include "render/base/json.h"
+#include "render/base/file.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -139,36 +140,12 @@ int lr_json_parse(const char *text, size_t len, const char *name, lr_json **out,
 int lr_json_load(const char *path, lr_json **out, lr_err *e)
 {
     *out = NULL;
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return lr_err_set(e, LR_EIO, "%s: cannot open: %s", path, strerror(errno));
     char *buf = NULL;
-    size_t len = 0, cap = 0;
-    for (;;) {
-        if (len == cap) {
-            cap = cap ? cap * 2 : 4096;
-            if (cap > LR_JSON_MAX_BYTES + 1)
-                cap = LR_JSON_MAX_BYTES + 1;
-            char *nb = realloc(buf, cap);
-            if (!nb) {
-                free(buf);
-                fclose(f);
-                return lr_err_set(e, LR_ENOMEM, "%s: out of memory", path);
-            }
-            buf = nb;
-        }
-        size_t got = fread(buf + len, 1, cap - len, f);
-        len += got;
-        if (got == 0 || len > LR_JSON_MAX_BYTES)
-            break;
-    }
-    int rerr = ferror(f);
-    fclose(f);
-    if (rerr) {
-        free(buf);
-        return lr_err_set(e, LR_EIO, "%s: read error", path);
-    }
-    int rc = lr_json_parse(buf ? buf : "", len, path, out, e);
+    size_t len = 0;
+    int rc = lr_file_read(path, &buf, &len, e);
+    if (rc)
+        return rc;
+    rc = lr_json_parse(buf, len, path, out, e);
     free(buf);
     return rc;
 }

@@ -173,7 +173,7 @@ static int load_file(lr_shader_source *s, const char *path, const char *from, in
     char real[PATH_MAX];
     int rc = lr_file_read(path, &data, &len, e);
     if (rc)
-        return from ? lr_err_prefix(e, "%s:%d: cannot open include", from, from_line) : rc;
+        return from ? lr_err_prefix(e, "%s:%d: include", from, from_line) : rc;
     if (!realpath(path, real))
         snprintf(real, sizeof real, "%s", path);
     int file = add_file(s, path, real);

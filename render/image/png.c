@@ -86,7 +86,7 @@ int lr_image_read_png(const char *path, lr_image *out, lr_err *e)
     /* Opened here so a missing file is an I/O error in errno's words, not a PNG error. */
     FILE *f = fopen(path, "rb");
     if (!f)
-        return lr_err_set(e, LR_EIO, "%s: %s", path, strerror(errno));
+        return lr_err_set(e, LR_EIO, "%s: cannot open: %s", path, strerror(errno));
     png_image pi;
     memset(&pi, 0, sizeof pi);
     pi.version = PNG_IMAGE_VERSION;
