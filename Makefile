@@ -97,6 +97,8 @@ build/bin/lamprig: build/obj/rel/firmware/main.o build/lib/liblamprig.a
 	@echo "  LD      $@"
 	$(Q)$(CXX) -o $@ $^ $(LDLIBS)
 
+# Keep test objects: without this make deletes them as intermediates and rebuilds each time.
+.SECONDARY:
 .SECONDEXPANSION:
 # No '%' inside the prerequisite functions: make would substitute the stem into them.
 build/bin/lamprig-%: $$(addprefix build/obj/rel/,$$(addsuffix .o,$$(basename $$(wildcard tools/$$*/*.c)))) build/lib/liblamprig.a
