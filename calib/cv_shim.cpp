@@ -40,6 +40,16 @@ int fail_current(lr_err *e, const char *what)
     }
 }
 
+// cv::imread of a missing file logs a warning on stderr before returning nothing: check
+// first so the caller's message is the only one.
+cv::Mat read_gray(const char *path)
+{
+    struct stat st;
+    if (stat(path, &st) != 0)
+        return cv::Mat();
+    return cv::imread(path, cv::IMREAD_GRAYSCALE);
+}
+
 int cv_depth(int depth)
 {
     return depth == 1 ? CV_8U : depth == 2 ? CV_16U : CV_32F;
@@ -409,14 +419,14 @@ int lr_cv_graycode_decode(int pw, int ph, const char *const *patterns, int npatt
                               "%s: %d pattern captures, but a %dx%d projector needs %d", stage,
                               npatterns, pw, ph, n);
         int total = n + 2;
-        cv::Mat w = cv::imread(white, cv::IMREAD_GRAYSCALE);
+        cv::Mat w = read_gray(white);
         if (w.empty())
-            return lr_err_set(e, LR_EIO, "%s: cannot read image", white);
+            return lr_err_set(e, LR_EIO, "%s: missing or not an image", white);
         lr_progress_report(progress, stage, 1, total);
         current = black;
-        cv::Mat b = cv::imread(black, cv::IMREAD_GRAYSCALE);
+        cv::Mat b = read_gray(black);
         if (b.empty())
-            return lr_err_set(e, LR_EIO, "%s: cannot read image", black);
+            return lr_err_set(e, LR_EIO, "%s: missing or not an image", black);
         if (b.size() != w.size())
             return lr_err_set(e, LR_EINVAL, "%s: %dx%d, but %s is %dx%d", black, b.cols, b.rows,
                               white, w.cols, w.rows);
@@ -424,9 +434,9 @@ int lr_cv_graycode_decode(int pw, int ph, const char *const *patterns, int npatt
         std::vector<cv::Mat> imgs((size_t)n);
         for (int i = 0; i < n; i++) {
             current = patterns[i];
-            imgs[(size_t)i] = cv::imread(patterns[i], cv::IMREAD_GRAYSCALE);
+            imgs[(size_t)i] = read_gray(patterns[i]);
             if (imgs[(size_t)i].empty())
-                return lr_err_set(e, LR_EIO, "%s: cannot read image", patterns[i]);
+                return lr_err_set(e, LR_EIO, "%s: missing or not an image", patterns[i]);
             if (imgs[(size_t)i].size() != w.size())
                 return lr_err_set(e, LR_EINVAL, "%s: %dx%d, but %s is %dx%d", patterns[i],
                                   imgs[(size_t)i].cols, imgs[(size_t)i].rows, white, w.cols,
