@@ -93,7 +93,7 @@ static int write_frame(void *ctx, int index, const lr_img *frame, const char *na
     char path[4096];
     if (snprintf(path, sizeof path, "%s/%s", w->dir, name) >= (int)sizeof path)
         return lr_err_set(e, LR_EINVAL, "%s: path too long", w->dir);
-    int rc = lr_img_write(path, frame, e);
+    int rc = lr_img_write_frame(path, frame, e);
     lr_progress_report(w->progress, "write patterns", index + 1, w->total);
     return rc;
 }

@@ -1,5 +1,8 @@
 #include "calib/image.h"
 
+#include <errno.h>
+#include <stdbool.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -33,18 +36,43 @@ int lr_img_read(const char *path, enum lr_img_read_mode mode, lr_img *out, lr_er
     return lr_cv_imread(path, (int)mode, out, e);
 }
 
-int lr_img_write(const char *path, const lr_img *img, lr_err *e)
+static int encode(const char *path, const lr_img *img, void **buf, size_t *len, lr_err *e)
 {
     const char *dot = strrchr(path, '.');
     const char *slash = strrchr(path, '/');
     if (!dot || (slash && dot < slash))
         return lr_err_set(e, LR_EINVAL, "%s: no file extension to choose the format", path);
+    int rc = lr_cv_imencode(dot, img, buf, len, e);
+    return rc ? lr_err_prefix(e, "%s", path) : LR_OK;
+}
+
+int lr_img_write(const char *path, const lr_img *img, lr_err *e)
+{
     void *buf;
     size_t len;
-    int rc = lr_cv_imencode(dot, img, &buf, &len, e);
+    int rc = encode(path, img, &buf, &len, e);
     if (rc)
-        return lr_err_prefix(e, "%s", path);
+        return rc;
     rc = lr_atomic_write(path, buf, len, e);
+    free(buf);
+    return rc;
+}
+
+int lr_img_write_frame(const char *path, const lr_img *img, lr_err *e)
+{
+    void *buf;
+    size_t len;
+    int rc = encode(path, img, &buf, &len, e);
+    if (rc)
+        return rc;
+    FILE *f = fopen(path, "wb");
+    if (!f) {
+        rc = lr_err_set(e, LR_EIO, "%s: cannot write: %s", path, strerror(errno));
+    } else {
+        bool bad = fwrite(buf, 1, len, f) != len;
+        if (fclose(f) != 0 || bad)
+            rc = lr_err_set(e, LR_EIO, "%s: write failed: %s", path, strerror(errno));
+    }
     free(buf);
     return rc;
 }

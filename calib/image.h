@@ -32,9 +32,13 @@ void lr_img_free(lr_img *img);
 
 /* Reads any format OpenCV decodes (PNG, JPEG, TIFF, PNM, ...). Errors name the path. */
 int lr_img_read(const char *path, enum lr_img_read_mode mode, lr_img *out, lr_err *e);
-/* Writes atomically; the format follows the extension (.png for 8/16-bit, .hdr or .exr
- * for float where OpenCV supports it). */
+/* Writes atomically and durably (temp + fsync + rename); the format follows the extension
+ * (.png for 8/16-bit, .hdr for float). For results worth keeping (maps, HDR images). */
 int lr_img_write(const char *path, const lr_img *img, lr_err *e);
+/* Plain write without fsync, for bulk frames that can be regenerated or recaptured
+ * (pattern sequences, captures: 40+ files a pose, where an fsync each costs seconds on an
+ * SD card). A crash can leave a truncated file, which decoding then reports by name. */
+int lr_img_write_frame(const char *path, const lr_img *img, lr_err *e);
 
 /* Sample (x, y, c) scaled to [0, 1] for integer depths (v / 255 or v / 65535), as is for
  * float. No bounds check. */

@@ -1,6 +1,7 @@
 #include "calib/intrinsics.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <string.h>
 
 #include "calib/calfile.h"
@@ -56,8 +57,12 @@ int lr_intrinsics_undistort(const lr_intrinsics *k, const double uv[2], double x
         double dy = k->dist[2] * (r2 + 2 * y * y) + 2 * k->dist[3] * x * y;
         if (!(radial > 0.1))
             break;
-        x = (xd - dx) / radial;
-        y = (yd - dy) / radial;
+        double nx = (xd - dx) / radial, ny = (yd - dy) / radial;
+        bool done = fabs(nx - x) < 1e-15 && fabs(ny - y) < 1e-15;
+        x = nx;
+        y = ny;
+        if (done)
+            break;
     }
     double cx, cy;
     distort(k->dist, x, y, &cx, &cy);
