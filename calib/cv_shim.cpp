@@ -520,32 +520,6 @@ int lr_cv_debevec_response(const lr_img *imgs, const double *times, int n, int s
     }
 }
 
-int lr_cv_merge_debevec(const lr_img *imgs, const double *times, int n,
-                        const double *response, lr_img *out, lr_err *e)
-{
-    *out = lr_img{};
-    try {
-        std::vector<cv::Mat> m;
-        std::vector<float> t;
-        for (int i = 0; i < n; i++) {
-            if (imgs[i].channels != 3 || imgs[i].depth != 1)
-                return lr_err_set(e, LR_EINVAL, "exposure %d: need 8-bit RGB", i);
-            m.push_back(wrap(&imgs[i]));
-            t.push_back((float)times[i]);
-        }
-        cv::Mat resp(256, 1, CV_32FC3);
-        for (int c = 0; c < 3; c++)
-            for (int z = 0; z < 256; z++)
-                resp.at<cv::Vec3f>(z, 0)[c] = (float)response[c * 256 + z];
-        cv::Ptr<cv::MergeDebevec> merge = cv::createMergeDebevec();
-        cv::Mat hdr;
-        merge->process(m, hdr, t, resp);
-        return to_img(hdr, out, e);
-    } catch (...) {
-        return fail_current(e, "MergeDebevec");
-    }
-}
-
 int lr_cv_detect_colorchecker(const lr_img *photo, double *rgb, lr_err *e)
 {
     try {
@@ -553,6 +527,18 @@ int lr_cv_detect_colorchecker(const lr_img *photo, double *rgb, lr_err *e)
             return lr_err_set(e, LR_EINVAL, "ColorChecker detection needs an 8-bit RGB photo");
         cv::Mat bgr;
         cv::cvtColor(wrap(photo), bgr, cv::COLOR_RGB2BGR);
+        // mcc converts to Lab on several threads at once, and OpenCV 4.6 builds its Lab
+        // lookup tables lazily without a lock: every thread that loses the race leaks its
+        // copy (megabytes, reported by LeakSanitizer). Building them here first, on one
+        // thread, leaves nothing to race for.
+        {
+            cv::Mat px8(1, 1, CV_8UC3, cv::Scalar(0, 0, 0)), px32(1, 1, CV_32FC3, cv::Scalar(0, 0, 0));
+            cv::Mat lab;
+            cv::cvtColor(px8, lab, cv::COLOR_BGR2Lab);
+            cv::cvtColor(px32, lab, cv::COLOR_BGR2Lab);
+            cv::cvtColor(px8, lab, cv::COLOR_RGB2Lab);
+            cv::cvtColor(px32, lab, cv::COLOR_RGB2Lab);
+        }
         cv::Ptr<cv::mcc::CCheckerDetector> det = cv::mcc::CCheckerDetector::create();
         if (!det->process(bgr, cv::mcc::MCC24, 1))
             return lr_err_set(e, LR_EINVAL, "no ColorChecker (24 patches) found");

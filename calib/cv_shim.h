@@ -123,11 +123,6 @@ int lr_cv_graycode_decode(int pw, int ph, const char *const *patterns, int npatt
 int lr_cv_debevec_response(const lr_img *imgs, const double *times, int n, int samples,
                            double lambda, double *response, lr_err *e);
 
-/* HDR merge (cv::MergeDebevec) with a response as above: out is a float RGB image of
- * relative radiance. */
-int lr_cv_merge_debevec(const lr_img *imgs, const double *times, int n,
-                        const double *response, lr_img *out, lr_err *e);
-
 /* ColorChecker Classic (24 patches) detection with cv::mcc::CCheckerDetector in an RGB
  * 8-bit photo. rgb[24*3]: mean RGB per patch in [0, 1] (the photo's encoding, not
  * linearised), in the chart's reading order (dark skin first, black last). */
