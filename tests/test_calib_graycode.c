@@ -14,6 +14,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "calib/capture.h"
 #include "calib/cv_shim.h"
 #include "calib/graycode.h"
 #include "tests/support/calib_sim.h"
@@ -287,12 +288,56 @@ static void test_sequence_files(void **state)
     free(dir);
 }
 
+static int never_shown(void *ctx, int index, const lr_img *frame, const char *name, lr_err *e)
+{
+    (void)index;
+    (void)frame;
+    (void)name;
+    (void)e;
+    (*(int *)ctx)++;
+    return LR_OK;
+}
+
+static void test_live_capture_without_camera(void **state)
+{
+    (void)state;
+    /* No camera on this machine: the capture fails before anything is shown or written,
+     * with a message naming the device. */
+    char *dir = sim_tempdir("gc_live");
+    char out[512];
+    snprintf(out, sizeof out, "%s/pose_01", dir);
+    int shown = 0;
+    lr_capture_desc d = {.device = "/dev/video_lamprig_absent", .show = never_shown,
+                         .show_ctx = &shown};
+    lr_err e = {0};
+    assert_int_equal(lr_capture_run(&d, lr_gc_run_sequence, 1280, 720, out, &e), LR_ENODEV);
+    assert_non_null(strstr(e.msg, "/dev/video_lamprig_absent"));
+    assert_non_null(strstr(e.msg, "no such camera device"));
+    /* A device node that is not a camera (a character device V4L2 cannot open). */
+    d.device = "/dev/null";
+    assert_int_equal(lr_capture_run(&d, lr_gc_run_sequence, 1280, 720, out, &e), LR_ENODEV);
+    assert_non_null(strstr(e.msg, "/dev/null: cannot open as a V4L2 camera"));
+    /* A regular file is refused without asking OpenCV. */
+    snprintf(out, sizeof out, "%s/not_a_device", dir);
+    FILE *f = fopen(out, "w");
+    fclose(f);
+    d.device = out;
+    assert_int_equal(lr_capture_run(&d, lr_gc_run_sequence, 1280, 720, dir, &e), LR_ENODEV);
+    assert_non_null(strstr(e.msg, "not a V4L2 character device"));
+    assert_int_equal(shown, 0);
+    snprintf(out, sizeof out, "%s/pose_01", dir);
+    assert_int_not_equal(access(out, F_OK), 0);
+    sim_rmdir(dir);
+    free(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sequence_files),
         cmocka_unit_test(test_sharp_roundtrip),
         cmocka_unit_test(test_blurred_roundtrip),
+        cmocka_unit_test(test_live_capture_without_camera),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
