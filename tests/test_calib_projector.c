@@ -16,7 +16,9 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "calib/camcal.h"
 #include "calib/procam.h"
+#include "firmware/cli.h"
 #include "tests/support/calib_sim.h"
 #include "tests/support/near.h"
 
@@ -246,16 +248,22 @@ static void check_result(const lr_procam *p, double f_tol, double c_tol, double 
 static void test_projector_with_camera_file(void **state)
 {
     (void)state;
-    lr_procam_desc d = {
-        .captures = session,
-        .board = {9, 6, 30.0, LR_BOARD_CHESSBOARD},
-        .camera = &CAM,
-    };
-    lr_procam p;
+    /* Through the CLI, as on the rig: a camera calibration file, the session folder, the
+     * result file. */
+    char campath[512], out[512];
+    snprintf(campath, sizeof campath, "%s/camera.json", session);
+    snprintf(out, sizeof out, "%s/projector.json", session);
+    lr_camcal cam = {.k = CAM, .rms = 0.05, .board = {9, 6, 30.0, LR_BOARD_CHESSBOARD},
+                     .subpix_window = 11};
     lr_err e = {0};
-    int rc = lr_procam_run(&d, &p, &e);
+    assert_int_equal(lr_camcal_save(campath, &cam, &e), LR_OK);
+    char *argv[] = {"lamprig", "calib", "projector", "calibrate", "--captures", session,
+                    "--board", "9x6", "--square", "30", "--camera", campath, "--out", out, NULL};
+    assert_int_equal(lr_cli_main(14, argv), LR_EXIT_OK);
+    lr_procam p;
+    int rc = lr_procam_load(out, &p, &e);
     if (rc)
-        fail_msg("procam: %s", e.msg);
+        fail_msg("load: %s", e.msg);
     /* Tolerances: projector corners come out of local homographies to ~0.05 px (graycode
      * test) and camera corners from 2x2-supersampled edges to ~0.05 px; seven poses of 54
      * corners pin the projector's focal length to a few tenths of a pixel (measured 0.1 px)
@@ -266,23 +274,32 @@ static void test_projector_with_camera_file(void **state)
      * at f = 380; measured 0.15 deg). */
     check_result(&p, 1.5, 2.0, 2.0, 0.3);
     assert_true(p.camera_from_file);
-
-    /* The result file round-trips; the projector pose in a world frame composes. */
-    char path[512];
-    snprintf(path, sizeof path, "%s/projector.json", session);
-    assert_int_equal(lr_procam_save(path, &p, &e), LR_OK);
-    lr_procam back;
-    rc = lr_procam_load(path, &back, &e);
-    if (rc)
-        fail_msg("load: %s", e.msg);
-    assert_true(back.proj.fx == p.proj.fx && back.T[2] == p.T[2] && back.R[4] == p.R[4]);
-    assert_int_equal(back.nposes, NPOSES);
-    assert_string_equal(back.poses[2].name, p.poses[2].name);
+    assert_true(p.cam_rms == 0.05);
+    assert_true(p.cam.fx == CAM.fx);
+    assert_string_equal(p.poses[2].name + strlen(p.poses[2].name) - 7, "pose_03");
+    /* The projector pose in a world frame composes with the camera's. */
     double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, Z[3] = {0, 0, 0}, Rp[9], Tp[3];
-    lr_procam_projector_pose(&back, I, Z, Rp, Tp);
+    lr_procam_projector_pose(&p, I, Z, Rp, Tp);
     for (int i = 0; i < 9; i++)
         assert_near(Rp[i], p.R[i], 1e-15);
-    lr_procam_free(&back);
+
+    /* decode of one pose through the CLI, with the map written. */
+    char pose[512], map[512];
+    snprintf(pose, sizeof pose, "%s/pose_01", session);
+    snprintf(map, sizeof map, "%s/map.png", session);
+    char *argv2[] = {"lamprig", "calib", "projector", "decode", "--captures", pose, "--map", map,
+                     NULL};
+    assert_int_equal(lr_cli_main(8, argv2), LR_EXIT_OK);
+    lr_gc_map *m;
+    assert_int_equal(lr_gc_map_load(map, 320, 240, &m, &e), LR_OK);
+    /* The board's white squares and margin decode; its black squares (12 % albedo, 30 DN
+     * white-black) fall under the 40 DN shadow threshold. Roughly half the frame is board. */
+    assert_true(lr_gc_map_count(m, LR_GC_VALID) > 640 * 480 / 5);
+    assert_true(lr_gc_map_count(m, LR_GC_SHADOW) > 0);
+    lr_gc_map_destroy(m);
+    unlink(map);
+    unlink(out);
+    unlink(campath);
     lr_procam_free(&p);
 }
 

@@ -18,6 +18,7 @@
 #include "calib/colormatrix.h"
 #include "calib/isotonic.h"
 #include "calib/projresp.h"
+#include "firmware/cli.h"
 #include "tests/support/calib_sim.h"
 #include "tests/support/near.h"
 
@@ -459,6 +460,23 @@ static void test_colorchecker(void **state)
     assert_int_equal(lr_colormatrix_fit(lin, truth, 24, &m, &e), LR_OK);
     for (int i = 0; i < 9; i++)
         assert_near(m.m[i], i % 4 == 0 ? 1.0 : 0.0, 0.03);
+    /* The same through the CLI, from a JPEG as a camera would deliver it (JPEG shifts patch
+     * means by a DN or two: 0.05 on the matrix). */
+    char *dir = sim_tempdir("checker");
+    char jpg[512], out[512];
+    snprintf(jpg, sizeof jpg, "%s/chart.jpg", dir);
+    snprintf(out, sizeof out, "%s/color.json", dir);
+    assert_int_equal(lr_img_write(jpg, &photo, &e), LR_OK);
+    char *argv[] = {"lamprig", "calib", "color", "--checker", jpg, "--out", out, NULL};
+    assert_int_equal(lr_cli_main(7, argv), LR_EXIT_OK);
+    lr_colormatrix back;
+    assert_int_equal(lr_colormatrix_load(out, &back, &e), LR_OK);
+    assert_string_equal(back.source, "colorchecker");
+    assert_int_equal(back.patches, 24);
+    for (int i = 0; i < 9; i++)
+        assert_near(back.m[i], i % 4 == 0 ? 1.0 : 0.0, 0.05);
+    sim_rmdir(dir);
+    free(dir);
     lr_img_free(&photo);
 
     /* A photo without a chart: a clear error. */
@@ -469,6 +487,62 @@ static void test_colorchecker(void **state)
     lr_img_free(&photo);
 }
 
+static void test_cli_camera_response(void **state)
+{
+    (void)state;
+    /* The CLI path: PNG stack on disk, times as fractions, response file and HDR image. */
+    lr_img imgs[NEXP];
+    double times[NEXP];
+    double *radiance = malloc(sizeof *radiance * SW * SH * 3);
+    exposure_stack(imgs, times, radiance);
+    char *dir = sim_tempdir("camresp_cli");
+    char path[512], glob[512], out[512], hdr[512];
+    lr_err e = {0};
+    for (int k = 0; k < NEXP; k++) {
+        snprintf(path, sizeof path, "%s/exp%d.png", dir, k);
+        assert_int_equal(lr_img_write(path, &imgs[k], &e), LR_OK);
+        lr_img_free(&imgs[k]);
+    }
+    snprintf(glob, sizeof glob, "%s/exp*.png", dir);
+    snprintf(out, sizeof out, "%s/camera_response.json", dir);
+    snprintf(hdr, sizeof hdr, "%s/merged.hdr", dir);
+    /* 4^k / 256: 1/256, 1/64, 1/16, 1/4, 1, 4 */
+    char *argv[] = {"lamprig", "calib", "camera-response", "--images", glob,
+                    "--times", "1/256,1/64,1/16,1/4,1,4", "--out", out, "--hdr", hdr, NULL};
+    assert_int_equal(lr_cli_main(11, argv), LR_EXIT_OK);
+    lr_camresp r;
+    assert_int_equal(lr_camresp_load(out, &r, &e), LR_OK);
+    double truth = lr_srgb_to_linear(64 / 255.0) / lr_srgb_to_linear(128 / 255.0);
+    assert_near(r.curve[1][64] / truth, 1.0, 0.06); /* as test_camera_response */
+    lr_img back;
+    assert_int_equal(lr_img_read(hdr, LR_IMG_AS_IS, &back, &e), LR_OK);
+    assert_int_equal(back.depth, 4);
+    assert_int_equal(back.channels, 3);
+    assert_int_equal(back.w, SW);
+    /* Radiance .hdr keeps 8-bit mantissas: ratios between pixels to ~1 %, plus the merge's
+     * own error (~2 % RMS): a bright and a dark pixel keep their ratio to 10 %. */
+    int a = 0, b = 0;
+    for (int i = 0; i < SW * SH * 3; i++) {
+        if (radiance[i] > radiance[a] && radiance[i] < 0.5)
+            a = i;
+        if (radiance[i] < radiance[b] && radiance[i] > 0.01)
+            b = i;
+    }
+    double ra = lr_img_get(&back, (a / 3) % SW, (a / 3) / SW, a % 3);
+    double rb = lr_img_get(&back, (b / 3) % SW, (b / 3) / SW, b % 3);
+    assert_near_rel(ra / rb, radiance[a] / radiance[b], 0.10);
+    lr_img_free(&back);
+    /* Count mismatch between images and times: a usage error, nothing written. */
+    unlink(out);
+    char *bad[] = {"lamprig", "calib", "camera-response", "--images", glob,
+                   "--times", "1/256,1/64", "--out", out, NULL};
+    assert_int_equal(lr_cli_main(9, bad), LR_EXIT_USAGE);
+    assert_int_not_equal(access(out, F_OK), 0);
+    free(radiance);
+    sim_rmdir(dir);
+    free(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -477,6 +551,7 @@ int main(void)
         cmocka_unit_test(test_projector_response_noisy_monotone),
         cmocka_unit_test(test_color_matrix_pairs),
         cmocka_unit_test(test_colorchecker),
+        cmocka_unit_test(test_cli_camera_response),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
