@@ -3,9 +3,12 @@
 
 #include <stddef.h>
 
+#include "firmware/cmd_calib.h"
 #include "firmware/cmd_optics.h"
 
 const lr_command lr_commands[] = {
     {"optics", lr_optics_summary, lr_optics_usage, lr_cmd_optics},
+    {"calib", "calibrate camera, projector and radiometry; check calibration files",
+     lr_cmd_calib_usage, lr_cmd_calib},
     {NULL, NULL, NULL, NULL},
 };

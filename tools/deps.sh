@@ -3,10 +3,13 @@
 # Idempotent and silent when everything is present (`make deps` calls it before every build).
 set -eu
 
+# opencv-doc ships OpenCV's sample chessboard photos and OpenCV's own calibration of them
+# (examples/data/left*.jpg, left_intrinsics.yml): tests/test_calib_camera.c checks against them.
 PKGS="build-essential pkg-config
 libgpiod-dev libhidapi-dev libusb-1.0-0-dev libmodbus-dev
 libegl-dev libgles-dev libgbm-dev libdrm-dev libegl-mesa0 libgl1-mesa-dri libgbm1
 libopencv-dev libopencv-contrib-dev
+opencv-doc
 libpng-dev libcairo2-dev liblcms2-dev libjsmn-dev libcmocka-dev"
 
 missing=""

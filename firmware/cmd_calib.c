@@ -1,0 +1,772 @@
+/* `lamprig calib ...`: argument parsing and reporting around calib/. Every result is computed
+ * in full before its file is written, and written atomically after validation, so a failed
+ * run leaves the previous calibration untouched (exit status 1, one-line reason on stderr). */
+#include "firmware/cmd_calib.h"
+
+#include <glob.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "calib/camcal.h"
+#include "calib/camresp.h"
+#include "calib/capture.h"
+#include "calib/calfile.h"
+#include "calib/colormatrix.h"
+#include "calib/graycode.h"
+#include "calib/procam.h"
+#include "calib/projresp.h"
+#include "firmware/cli.h"
+
+const char lr_cmd_calib_usage[] =
+    "usage: lamprig calib SUBCOMMAND [OPTIONS]\n"
+    "\n"
+    "  camera --images GLOB --board COLSxROWS --square MM --out FILE.json\n"
+    "         [--pattern chessboard|circles|acircles] [--fix-aspect] [--drop-outliers]\n"
+    "         [--subpix-window N|auto] [--outlier-factor F] [--min-views N]\n"
+    "      camera intrinsics from photos of a board; outlier views are named\n"
+    "  projector patterns --proj WxH --out DIR\n"
+    "      write the Gray-code sequence (white, black, pattern_NN.png) for the projector\n"
+    "  projector capture --device /dev/videoN --proj WxH --out DIR\n"
+    "         --display file:PATH|prompt:PATTERN_DIR [--camera-size WxH] [--settle-ms N]\n"
+    "      show the sequence and capture it live (one pose: run once per board pose)\n"
+    "  projector decode --captures DIR [--proj WxH] [--contrast N] [--shadow N] [--map OUT.png]\n"
+    "      decode one capture folder per camera pixel and report what decoded\n"
+    "  projector calibrate --captures DIR --board COLSxROWS --square MM --out FILE.json\n"
+    "         [--proj WxH] [--camera CAMERA.json] [--pattern P] [--fix-aspect]\n"
+    "         [--contrast N] [--shadow N] [--window N] [--subpix-window N|auto]\n"
+    "      projector intrinsics and projector-camera extrinsics from pose folders in DIR\n"
+    "  camera-response --images GLOB --times T1,T2,... --out FILE.json [--hdr OUT.hdr]\n"
+    "         [--samples N] [--lambda L]\n"
+    "      camera response (Debevec) from an exposure stack (times in s, 1/30 allowed,\n"
+    "      in the order GLOB sorts), optionally the merged HDR image\n"
+    "  projector-response patterns --proj WxH --out DIR [--steps N]\n"
+    "  projector-response capture --device /dev/videoN --proj WxH --out DIR\n"
+    "         --display file:PATH|prompt:PATTERN_DIR [--camera-size WxH] [--settle-ms N]\n"
+    "      show the 17 default flat levels per channel and capture them live\n"
+    "  projector-response fit --captures DIR --out FILE.json [--camera-response FILE.json]\n"
+    "      per-channel projector response (black subtracted) from flat-level captures\n"
+    "  color --pairs PAIRS.json --out FILE.json\n"
+    "  color --checker PHOTO --out FILE.json [--camera-response FILE.json]\n"
+    "      3x3 colour matrix, camera linear RGB -> linear sRGB\n"
+    "  check FILE...\n"
+    "      load and validate calibration files of any kind, print a summary\n"
+    "\n"
+    "Exit status: 0 success, 1 failure (the output file is left as it was), 2 bad arguments.";
+
+/* ---- arguments ------------------------------------------------------------------------ */
+
+typedef struct opt {
+    const char *name;
+    const char **value; /* option with an argument */
+    bool *flag;         /* option without */
+} opt;
+
+static int usage_error(const char *cmd, const char *fmt, const char *arg)
+{
+    fprintf(stderr, "lamprig calib %s: ", cmd);
+    fprintf(stderr, fmt, arg);
+    fprintf(stderr, " (see `lamprig help calib`)\n");
+    return LR_EXIT_USAGE;
+}
+
+/* Parses argv[first..] against opts; positional arguments are refused unless pos != NULL
+ * (then collected there, at most maxpos). */
+static int parse(const char *cmd, int argc, char **argv, int first, const opt *opts,
+                 const char **pos, int maxpos, int *npos)
+{
+    if (npos)
+        *npos = 0;
+    for (int i = first; i < argc; i++) {
+        const char *a = argv[i];
+        if (strncmp(a, "--", 2) != 0) {
+            if (!pos || *npos >= maxpos)
+                return usage_error(cmd, "unexpected argument '%s'", a);
+            pos[(*npos)++] = a;
+            continue;
+        }
+        const opt *o = NULL;
+        for (const opt *p = opts; p->name; p++)
+            if (strcmp(p->name, a + 2) == 0)
+                o = p;
+        if (!o)
+            return usage_error(cmd, "unknown option '%s'", a);
+        if (o->flag) {
+            *o->flag = true;
+        } else {
+            if (i + 1 >= argc)
+                return usage_error(cmd, "option '%s' needs a value", a);
+            *o->value = argv[++i];
+        }
+    }
+    return LR_EXIT_OK;
+}
+
+static int need(const char *cmd, const char *value, const char *name)
+{
+    return value ? LR_EXIT_OK : usage_error(cmd, "missing --%s", name);
+}
+
+static bool parse_wxh(const char *s, int *w, int *h)
+{
+    int a, b, n = 0;
+    if (!s || sscanf(s, "%dx%d%n", &a, &b, &n) != 2 || s[n] != '\0' || a <= 0 || b <= 0)
+        return false;
+    *w = a;
+    *h = b;
+    return true;
+}
+
+static bool parse_int(const char *s, int lo, int hi, int *out)
+{
+    char *end;
+    long v = s ? strtol(s, &end, 10) : 0;
+    if (!s || *s == '\0' || *end != '\0' || v < lo || v > hi)
+        return false;
+    *out = (int)v;
+    return true;
+}
+
+static bool parse_double(const char *s, double lo, double hi, double *out)
+{
+    char *end;
+    double v = s ? strtod(s, &end) : 0;
+    if (!s || *s == '\0' || *end != '\0' || !(v >= lo && v <= hi))
+        return false;
+    *out = v;
+    return true;
+}
+
+/* "1/30,0.5,2" */
+static int parse_times(const char *s, double *t, int cap)
+{
+    int n = 0;
+    while (*s) {
+        if (n >= cap)
+            return -1;
+        char *end;
+        double a = strtod(s, &end);
+        if (end == s)
+            return -1;
+        if (*end == '/') {
+            const char *d = end + 1;
+            double b = strtod(d, &end);
+            if (end == d || !(b > 0))
+                return -1;
+            a /= b;
+        }
+        if (!(a > 0) || !isfinite(a))
+            return -1;
+        t[n++] = a;
+        if (*end == ',')
+            end++;
+        else if (*end != '\0')
+            return -1;
+        s = end;
+    }
+    return n;
+}
+
+static int parse_board(const char *cmd, const char *size, const char *square, const char *pattern,
+                       lr_board *b)
+{
+    lr_err e = {0};
+    if (lr_board_parse_size(size, &b->cols, &b->rows, &e))
+        return usage_error(cmd, "%s", e.msg);
+    if (!parse_double(square, 1e-3, 1e4, &b->square_mm))
+        return usage_error(cmd, "--square '%s': expected millimetres > 0", square);
+    b->pattern = LR_BOARD_CHESSBOARD;
+    if (pattern && lr_board_parse_pattern(pattern, &b->pattern, &e))
+        return usage_error(cmd, "%s", e.msg);
+    if (lr_board_check(b, &e))
+        return usage_error(cmd, "%s", e.msg);
+    return LR_EXIT_OK;
+}
+
+static int parse_subpix(const char *cmd, const char *s, int *out)
+{
+    *out = 0;
+    if (!s)
+        return LR_EXIT_OK;
+    if (strcmp(s, "auto") == 0) {
+        *out = LR_SUBPIX_AUTO;
+        return LR_EXIT_OK;
+    }
+    if (!parse_int(s, 1, 100, out))
+        return usage_error(cmd, "--subpix-window '%s': expected 1..100 or auto", s);
+    return LR_EXIT_OK;
+}
+
+static int fail(const char *cmd, const lr_err *e)
+{
+    fprintf(stderr, "lamprig calib %s: %s\n", cmd, e->msg);
+    return LR_EXIT_FAIL;
+}
+
+/* Sorted glob matches; an error when nothing matches. */
+static int expand(const char *cmd, const char *pattern, glob_t *g)
+{
+    int rc = glob(pattern, 0, NULL, g);
+    if (rc != 0 || g->gl_pathc == 0) {
+        if (rc == 0)
+            globfree(g);
+        fprintf(stderr, "lamprig calib %s: no files match '%s'\n", cmd, pattern);
+        return LR_EXIT_FAIL;
+    }
+    return LR_EXIT_OK;
+}
+
+/* ---- progress ------------------------------------------------------------------------- */
+
+typedef struct progress_state {
+    char stage[256];
+    int last_decile;
+} progress_state;
+
+/* One line per stage and per tenth of it: readable in a log, alive on a terminal. */
+static void print_progress(void *ctx, const char *stage, int done, int total)
+{
+    progress_state *p = ctx;
+    int decile = total > 0 ? (int)((long)done * 10 / total) : 10;
+    if (strncmp(p->stage, stage, sizeof p->stage - 1) != 0) {
+        snprintf(p->stage, sizeof p->stage, "%s", stage);
+        p->last_decile = -1;
+    }
+    if (decile == p->last_decile)
+        return;
+    p->last_decile = decile;
+    fprintf(stderr, "  %s: %d/%d\n", stage, done, total);
+}
+
+/* ---- camera --------------------------------------------------------------------------- */
+
+static int cmd_camera(int argc, char **argv)
+{
+    const char *images = NULL, *size = NULL, *square = NULL, *pattern = NULL, *out = NULL;
+    const char *subpix = NULL, *factor = NULL, *min_views = NULL;
+    bool fix_aspect = false, drop = false;
+    const opt opts[] = {{"images", &images, NULL},      {"board", &size, NULL},
+                        {"square", &square, NULL},      {"pattern", &pattern, NULL},
+                        {"out", &out, NULL},            {"fix-aspect", NULL, &fix_aspect},
+                        {"drop-outliers", NULL, &drop}, {"subpix-window", &subpix, NULL},
+                        {"outlier-factor", &factor, NULL}, {"min-views", &min_views, NULL},
+                        {NULL, NULL, NULL}};
+    const char *cmd = "camera";
+    int rc = parse(cmd, argc, argv, 2, opts, NULL, 0, NULL);
+    if (rc || (rc = need(cmd, images, "images")) || (rc = need(cmd, size, "board")) ||
+        (rc = need(cmd, square, "square")) || (rc = need(cmd, out, "out")))
+        return rc;
+    lr_camcal_desc d = {.fix_aspect = fix_aspect, .drop_outliers = drop};
+    if ((rc = parse_board(cmd, size, square, pattern, &d.board)) ||
+        (rc = parse_subpix(cmd, subpix, &d.subpix_window)))
+        return rc;
+    if (factor && !parse_double(factor, 1.0, 1e3, &d.outlier_factor))
+        return usage_error(cmd, "--outlier-factor '%s': expected a number >= 1", factor);
+    if (min_views && !parse_int(min_views, 1, 10000, &d.min_views))
+        return usage_error(cmd, "--min-views '%s': expected a count >= 1", min_views);
+    glob_t g;
+    if ((rc = expand(cmd, images, &g)))
+        return rc;
+    progress_state ps = {{0}, -1};
+    lr_progress progress = {print_progress, &ps};
+    d.images = (const char *const *)g.gl_pathv;
+    d.nimages = (int)g.gl_pathc;
+    d.progress = &progress;
+    lr_camcal c;
+    lr_err e = {0};
+    if (lr_camcal_run(&d, &c, &e)) {
+        globfree(&g);
+        return fail(cmd, &e);
+    }
+    globfree(&g);
+    for (int i = 0; i < c.nrejected; i++)
+        fprintf(stderr, "skipped %s: %s\n", c.rejected[i].image, c.rejected[i].reason);
+    double med = lr_camcal_median_error(&c);
+    for (int i = 0; i < c.nviews; i++)
+        if (c.views[i].outlier)
+            fprintf(stderr, "outlier view %s: error %.3f px, median %.3f px%s\n",
+                    c.views[i].image, c.views[i].error, med,
+                    c.views[i].used ? " (kept; --drop-outliers refits without it)" : " (dropped)");
+    rc = lr_camcal_save(out, &c, &e);
+    if (rc) {
+        lr_camcal_free(&c);
+        return fail(cmd, &e);
+    }
+    int used = 0;
+    for (int i = 0; i < c.nviews; i++)
+        used += c.views[i].used;
+    printf("camera %dx%d: fx %.3f fy %.3f cx %.3f cy %.3f  k1 %.5f k2 %.5f  rms %.4f px, %d "
+           "views -> %s\n",
+           c.k.width, c.k.height, c.k.fx, c.k.fy, c.k.cx, c.k.cy, c.k.dist[0], c.k.dist[1], c.rms,
+           used, out);
+    lr_camcal_free(&c);
+    return LR_EXIT_OK;
+}
+
+/* ---- projector ------------------------------------------------------------------------ */
+
+typedef struct display {
+    lr_gc_show_fn show;
+    void *ctx;
+} display;
+
+static int parse_display(const char *cmd, const char *s, display *d)
+{
+    if (!s)
+        return usage_error(cmd, "%s",
+                           "missing --display: the firmware's projector output is not wired "
+                           "in yet; use file:PATH (an external viewer shows PATH) or "
+                           "prompt:PATTERN_DIR (you show each pattern, then press Enter)");
+    if (strncmp(s, "file:", 5) == 0 && s[5]) {
+        *d = (display){lr_capture_show_file, (void *)(s + 5)};
+        return LR_EXIT_OK;
+    }
+    if (strncmp(s, "prompt:", 7) == 0 && s[7]) {
+        *d = (display){lr_capture_show_prompt, (void *)(s + 7)};
+        return LR_EXIT_OK;
+    }
+    return usage_error(cmd, "--display '%s': expected file:PATH or prompt:PATTERN_DIR", s);
+}
+
+static int cmd_projector_patterns(int argc, char **argv)
+{
+    const char *proj = NULL, *out = NULL, *cmd = "projector patterns";
+    const opt opts[] = {{"proj", &proj, NULL}, {"out", &out, NULL}, {NULL, NULL, NULL}};
+    int rc = parse(cmd, argc, argv, 3, opts, NULL, 0, NULL);
+    int pw, ph;
+    if (rc || (rc = need(cmd, proj, "proj")) || (rc = need(cmd, out, "out")))
+        return rc;
+    if (!parse_wxh(proj, &pw, &ph))
+        return usage_error(cmd, "--proj '%s': expected WIDTHxHEIGHT", proj);
+    progress_state ps = {{0}, -1};
+    lr_progress progress = {print_progress, &ps};
+    lr_err e = {0};
+    if (lr_gc_write_patterns(out, pw, ph, &progress, &e))
+        return fail(cmd, &e);
+    int n = 0;
+    lr_gc_frame_count(pw, ph, &n, &e);
+    printf("%d frames for a %dx%d projector -> %s/\n", n, pw, ph, out);
+    return LR_EXIT_OK;
+}
+
+static int capture_common(const char *cmd, int argc, char **argv, bool graycode)
+{
+    const char *device = NULL, *proj = NULL, *out = NULL, *disp = NULL, *csize = NULL;
+    const char *settle = NULL;
+    const opt opts[] = {{"device", &device, NULL},     {"proj", &proj, NULL},
+                        {"out", &out, NULL},           {"display", &disp, NULL},
+                        {"camera-size", &csize, NULL}, {"settle-ms", &settle, NULL},
+                        {NULL, NULL, NULL}};
+    int rc = parse(cmd, argc, argv, 3, opts, NULL, 0, NULL);
+    if (rc || (rc = need(cmd, device, "device")) || (rc = need(cmd, proj, "proj")) ||
+        (rc = need(cmd, out, "out")))
+        return rc;
+    int pw, ph;
+    if (!parse_wxh(proj, &pw, &ph))
+        return usage_error(cmd, "--proj '%s': expected WIDTHxHEIGHT", proj);
+    display disp_cb;
+    if ((rc = parse_display(cmd, disp, &disp_cb)))
+        return rc;
+    lr_capture_desc d = {.device = device, .show = disp_cb.show, .show_ctx = disp_cb.ctx};
+    if (csize && !parse_wxh(csize, &d.width, &d.height))
+        return usage_error(cmd, "--camera-size '%s': expected WIDTHxHEIGHT", csize);
+    if (settle && !parse_int(settle, 1, 60000, &d.settle_ms))
+        return usage_error(cmd, "--settle-ms '%s': expected 1..60000", settle);
+    progress_state ps = {{0}, -1};
+    lr_progress progress = {print_progress, &ps};
+    d.progress = &progress;
+    lr_err e = {0};
+    rc = lr_capture_run(&d, graycode ? lr_gc_run_sequence : lr_projresp_run_sequence, pw, ph, out,
+                        &e);
+    if (rc)
+        return fail(cmd, &e);
+    printf("captured -> %s/\n", out);
+    return LR_EXIT_OK;
+}
+
+static int cmd_projector_decode(int argc, char **argv)
+{
+    const char *dir = NULL, *proj = NULL, *contrast = NULL, *shadow = NULL, *map = NULL;
+    const char *cmd = "projector decode";
+    const opt opts[] = {{"captures", &dir, NULL}, {"proj", &proj, NULL},
+                        {"contrast", &contrast, NULL}, {"shadow", &shadow, NULL},
+                        {"map", &map, NULL},      {NULL, NULL, NULL}};
+    int rc = parse(cmd, argc, argv, 3, opts, NULL, 0, NULL);
+    if (rc || (rc = need(cmd, dir, "captures")))
+        return rc;
+    int pw = 0, ph = 0;
+    lr_gc_params params = {0};
+    if (proj && !parse_wxh(proj, &pw, &ph))
+        return usage_error(cmd, "--proj '%s': expected WIDTHxHEIGHT", proj);
+    if (contrast && !parse_int(contrast, 1, 255, &params.contrast))
+        return usage_error(cmd, "--contrast '%s': expected 1..255", contrast);
+    if (shadow && !parse_int(shadow, 1, 255, &params.shadow))
+        return usage_error(cmd, "--shadow '%s': expected 1..255", shadow);
+    progress_state ps = {{0}, -1};
+    lr_progress progress = {print_progress, &ps};
+    lr_gc_map *m;
+    lr_err e = {0};
+    if (lr_gc_decode_dir(dir, pw, ph, &params, &progress, &m, &e))
+        return fail(cmd, &e);
+    long total = (long)lr_gc_map_width(m) * lr_gc_map_height(m);
+    printf("%s: %dx%d camera pixels:", dir, lr_gc_map_width(m), lr_gc_map_height(m));
+    for (int s = LR_GC_VALID; s <= LR_GC_OUT_OF_RANGE; s++) {
+        long n = lr_gc_map_count(m, s);
+        printf(" %s %ld (%.1f %%)%s", lr_gc_status_name(s), n, 100.0 * n / total,
+               s < LR_GC_OUT_OF_RANGE ? "," : "\n");
+    }
+    if (map) {
+        if (lr_gc_map_save(m, map, &e)) {
+            lr_gc_map_destroy(m);
+            return fail(cmd, &e);
+        }
+        printf("map (R = projector x, G = y, B = status) -> %s\n", map);
+    }
+    lr_gc_map_destroy(m);
+    return LR_EXIT_OK;
+}
+
+static int cmd_projector_calibrate(int argc, char **argv)
+{
+    const char *dir = NULL, *proj = NULL, *size = NULL, *square = NULL, *pattern = NULL;
+    const char *camera = NULL, *contrast = NULL, *shadow = NULL, *window = NULL, *out = NULL;
+    const char *subpix = NULL;
+    bool fix_aspect = false;
+    const char *cmd = "projector calibrate";
+    const opt opts[] = {{"captures", &dir, NULL},   {"proj", &proj, NULL},
+                        {"board", &size, NULL},     {"square", &square, NULL},
+                        {"pattern", &pattern, NULL}, {"camera", &camera, NULL},
+                        {"contrast", &contrast, NULL}, {"shadow", &shadow, NULL},
+                        {"window", &window, NULL},  {"out", &out, NULL},
+                        {"subpix-window", &subpix, NULL}, {"fix-aspect", NULL, &fix_aspect},
+                        {NULL, NULL, NULL}};
+    int rc = parse(cmd, argc, argv, 3, opts, NULL, 0, NULL);
+    if (rc || (rc = need(cmd, dir, "captures")) || (rc = need(cmd, size, "board")) ||
+        (rc = need(cmd, square, "square")) || (rc = need(cmd, out, "out")))
+        return rc;
+    lr_procam_desc d = {.captures = dir, .proj_fix_aspect = fix_aspect};
+    if ((rc = parse_board(cmd, size, square, pattern, &d.board)) ||
+        (rc = parse_subpix(cmd, subpix, &d.subpix_window)))
+        return rc;
+    if (proj && !parse_wxh(proj, &d.proj_w, &d.proj_h))
+        return usage_error(cmd, "--proj '%s': expected WIDTHxHEIGHT", proj);
+    if (contrast && !parse_int(contrast, 1, 255, &d.decode.contrast))
+        return usage_error(cmd, "--contrast '%s': expected 1..255", contrast);
+    if (shadow && !parse_int(shadow, 1, 255, &d.decode.shadow))
+        return usage_error(cmd, "--shadow '%s': expected 1..255", shadow);
+    if (window && !parse_int(window, 2, 500, &d.local.half_window))
+        return usage_error(cmd, "--window '%s': expected a half-size of 2..500 px", window);
+    lr_err e = {0};
+    lr_camcal cam;
+    if (camera) {
+        if (lr_camcal_load(camera, &cam, &e))
+            return fail(cmd, &e);
+        d.camera = &cam.k;
+        d.camera_rms = cam.rms;
+    }
+    progress_state ps = {{0}, -1};
+    lr_progress progress = {print_progress, &ps};
+    d.progress = &progress;
+    lr_procam p;
+    rc = lr_procam_run(&d, &p, &e);
+    if (camera)
+        lr_camcal_free(&cam);
+    if (rc)
+        return fail(cmd, &e);
+    for (int i = 0; i < p.nrejected; i++)
+        fprintf(stderr, "skipped pose %s: %s\n", p.rejected[i].name, p.rejected[i].reason);
+    if (lr_procam_save(out, &p, &e)) {
+        lr_procam_free(&p);
+        return fail(cmd, &e);
+    }
+    printf("projector %dx%d: fx %.3f fy %.3f cx %.3f cy %.3f  rms %.4f px\n", p.proj.width,
+           p.proj.height, p.proj.fx, p.proj.fy, p.proj.cx, p.proj.cy, p.proj_rms);
+    printf("projector from camera: T (%.2f, %.2f, %.2f) mm, baseline %.2f mm, stereo rms %.4f "
+           "px, %d poses -> %s\n",
+           p.T[0], p.T[1], p.T[2], sqrt(p.T[0] * p.T[0] + p.T[1] * p.T[1] + p.T[2] * p.T[2]),
+           p.rms, p.nposes, out);
+    lr_procam_free(&p);
+    return LR_EXIT_OK;
+}
+
+static int cmd_projector(int argc, char **argv)
+{
+    const char *sub = argc > 2 ? argv[2] : "";
+    if (!strcmp(sub, "patterns"))
+        return cmd_projector_patterns(argc, argv);
+    if (!strcmp(sub, "capture"))
+        return capture_common("projector capture", argc, argv, true);
+    if (!strcmp(sub, "decode"))
+        return cmd_projector_decode(argc, argv);
+    if (!strcmp(sub, "calibrate"))
+        return cmd_projector_calibrate(argc, argv);
+    return usage_error("projector", "expected patterns, capture, decode or calibrate, got '%s'",
+                       sub);
+}
+
+/* ---- radiometry ----------------------------------------------------------------------- */
+
+static int cmd_camera_response(int argc, char **argv)
+{
+    const char *images = NULL, *times = NULL, *out = NULL, *hdr = NULL, *samples = NULL;
+    const char *lambda = NULL, *cmd = "camera-response";
+    const opt opts[] = {{"images", &images, NULL}, {"times", &times, NULL},
+                        {"out", &out, NULL},       {"hdr", &hdr, NULL},
+                        {"samples", &samples, NULL}, {"lambda", &lambda, NULL},
+                        {NULL, NULL, NULL}};
+    int rc = parse(cmd, argc, argv, 2, opts, NULL, 0, NULL);
+    if (rc || (rc = need(cmd, images, "images")) || (rc = need(cmd, times, "times")) ||
+        (rc = need(cmd, out, "out")))
+        return rc;
+    double t[LR_CAMRESP_MAX_STACK];
+    int nt = parse_times(times, t, LR_CAMRESP_MAX_STACK);
+    if (nt < 2)
+        return usage_error(cmd, "--times '%s': expected 2 or more exposure times, e.g. "
+                                "1/30,1/8,0.5", times);
+    lr_camresp_desc d = {0};
+    if (samples && !parse_int(samples, 10, 100000, &d.samples))
+        return usage_error(cmd, "--samples '%s': expected 10..100000", samples);
+    if (lambda && !parse_double(lambda, 1e-6, 1e6, &d.lambda))
+        return usage_error(cmd, "--lambda '%s': expected a positive number", lambda);
+    glob_t g;
+    if ((rc = expand(cmd, images, &g)))
+        return rc;
+    lr_err e = {0};
+    if ((int)g.gl_pathc != nt) {
+        fprintf(stderr, "lamprig calib %s: %zu images match '%s' but %d times are given\n", cmd,
+                g.gl_pathc, images, nt);
+        globfree(&g);
+        return LR_EXIT_USAGE;
+    }
+    lr_img imgs[LR_CAMRESP_MAX_STACK];
+    int loaded = 0;
+    rc = LR_EXIT_OK;
+    for (; loaded < nt; loaded++)
+        if (lr_img_read(g.gl_pathv[loaded], LR_IMG_RGB8, &imgs[loaded], &e)) {
+            rc = fail(cmd, &e);
+            break;
+        }
+    lr_camresp r;
+    lr_img merged = {0};
+    if (!rc) {
+        d.images = imgs;
+        d.times = t;
+        d.n = nt;
+        if (lr_camresp_fit(&d, &r, &e) ||
+            (hdr && (lr_camresp_merge(&r, imgs, t, nt, &merged, &e) ||
+                     lr_img_write(hdr, &merged, &e))) ||
+            lr_camresp_save(out, &r, &e))
+            rc = fail(cmd, &e);
+    }
+    for (int i = 0; i < loaded; i++)
+        lr_img_free(&imgs[i]);
+    lr_img_free(&merged);
+    globfree(&g);
+    if (!rc)
+        printf("camera response from %d exposures: value 64 -> %.4f, 192 -> %.4f (green, "
+               "relative to 128) -> %s%s%s\n",
+               nt, r.curve[1][64], r.curve[1][192], out, hdr ? ", HDR -> " : "", hdr ? hdr : "");
+    return rc;
+}
+
+static int cmd_projector_response(int argc, char **argv)
+{
+    const char *sub = argc > 2 ? argv[2] : "";
+    if (!strcmp(sub, "capture"))
+        return capture_common("projector-response capture", argc, argv, false);
+    if (!strcmp(sub, "patterns")) {
+        const char *proj = NULL, *out = NULL, *steps = NULL, *cmd = "projector-response patterns";
+        const opt opts[] = {{"proj", &proj, NULL}, {"out", &out, NULL}, {"steps", &steps, NULL},
+                            {NULL, NULL, NULL}};
+        int rc = parse(cmd, argc, argv, 3, opts, NULL, 0, NULL);
+        int pw, ph, n = 0;
+        if (rc || (rc = need(cmd, proj, "proj")) || (rc = need(cmd, out, "out")))
+            return rc;
+        if (!parse_wxh(proj, &pw, &ph))
+            return usage_error(cmd, "--proj '%s': expected WIDTHxHEIGHT", proj);
+        if (steps && !parse_int(steps, 3, 256, &n))
+            return usage_error(cmd, "--steps '%s': expected 3..256", steps);
+        lr_err e = {0};
+        if (lr_projresp_write_patterns(out, pw, ph, n, &e))
+            return fail(cmd, &e);
+        printf("flat frames (r_/g_/b_LLL.png) -> %s/\n", out);
+        return LR_EXIT_OK;
+    }
+    if (!strcmp(sub, "fit")) {
+        const char *dir = NULL, *out = NULL, *camresp = NULL, *cmd = "projector-response fit";
+        const opt opts[] = {{"captures", &dir, NULL}, {"out", &out, NULL},
+                            {"camera-response", &camresp, NULL}, {NULL, NULL, NULL}};
+        int rc = parse(cmd, argc, argv, 3, opts, NULL, 0, NULL);
+        if (rc || (rc = need(cmd, dir, "captures")) || (rc = need(cmd, out, "out")))
+            return rc;
+        lr_err e = {0};
+        lr_camresp cam;
+        if (camresp && lr_camresp_load(camresp, &cam, &e))
+            return fail(cmd, &e);
+        lr_projresp *r = malloc(sizeof *r);
+        if (!r) {
+            lr_err_set(&e, LR_ENOMEM, "out of memory");
+            return fail(cmd, &e);
+        }
+        rc = LR_EXIT_OK;
+        if (lr_projresp_measure(dir, camresp ? &cam : NULL, r, &e) ||
+            lr_projresp_save(out, r, &e))
+            rc = fail(cmd, &e);
+        else
+            printf("projector response from %d levels: gamma r %.3f g %.3f b %.3f, black %.4f "
+                   "%.4f %.4f of white -> %s\n",
+                   r->nlevels, r->gamma[0], r->gamma[1], r->gamma[2], r->black[0], r->black[1],
+                   r->black[2], out);
+        free(r);
+        return rc;
+    }
+    return usage_error("projector-response", "expected patterns, capture or fit, got '%s'", sub);
+}
+
+static int cmd_color(int argc, char **argv)
+{
+    const char *pairs = NULL, *checker = NULL, *camresp = NULL, *out = NULL, *cmd = "color";
+    const opt opts[] = {{"pairs", &pairs, NULL}, {"checker", &checker, NULL},
+                        {"camera-response", &camresp, NULL}, {"out", &out, NULL},
+                        {NULL, NULL, NULL}};
+    int rc = parse(cmd, argc, argv, 2, opts, NULL, 0, NULL);
+    if (rc || (rc = need(cmd, out, "out")))
+        return rc;
+    if (!pairs == !checker)
+        return usage_error(cmd, "%s", "give exactly one of --pairs FILE or --checker PHOTO");
+    lr_err e = {0};
+    lr_colormatrix m;
+    if (pairs) {
+        double *c, *r;
+        int n;
+        if (lr_colorpairs_load(pairs, &c, &r, &n, &e))
+            return fail(cmd, &e);
+        rc = lr_colormatrix_fit(c, r, n, &m, &e);
+        free(c);
+        free(r);
+        if (rc)
+            return fail(cmd, &e);
+    } else {
+        lr_camresp cam;
+        if (camresp && lr_camresp_load(camresp, &cam, &e))
+            return fail(cmd, &e);
+        lr_img photo;
+        if (lr_img_read(checker, LR_IMG_RGB8, &photo, &e))
+            return fail(cmd, &e);
+        double measured[72], ref[72];
+        rc = lr_colorchecker_measure(&photo, camresp ? &cam : NULL, measured, &e);
+        lr_img_free(&photo);
+        if (rc) {
+            lr_err_prefix(&e, "%s", checker);
+            return fail(cmd, &e);
+        }
+        lr_colorchecker_linear(ref);
+        if (lr_colormatrix_fit(measured, ref, 24, &m, &e))
+            return fail(cmd, &e);
+        snprintf(m.source, sizeof m.source, "colorchecker");
+    }
+    if (lr_colormatrix_save(out, &m, &e))
+        return fail(cmd, &e);
+    printf("colour matrix from %d patches (%s): rms %.4f, worst %.4f -> %s\n", m.patches, m.source,
+           m.rms, m.max_err, out);
+    for (int r = 0; r < 3; r++)
+        printf("  [%9.5f %9.5f %9.5f]\n", m.m[3 * r], m.m[3 * r + 1], m.m[3 * r + 2]);
+    return LR_EXIT_OK;
+}
+
+/* ---- check ---------------------------------------------------------------------------- */
+
+static int check_one(const char *path)
+{
+    char kind[64];
+    lr_err e = {0};
+    if (lr_calfile_peek_kind(path, kind, sizeof kind, &e)) {
+        fprintf(stderr, "%s\n", e.msg);
+        return LR_EXIT_FAIL;
+    }
+    int rc = LR_OK;
+    if (!strcmp(kind, LR_CAMCAL_KIND)) {
+        lr_camcal c;
+        if (!(rc = lr_camcal_load(path, &c, &e))) {
+            printf("%s: camera %dx%d, fx %.3f fy %.3f cx %.3f cy %.3f, rms %.4f px, %d views\n",
+                   path, c.k.width, c.k.height, c.k.fx, c.k.fy, c.k.cx, c.k.cy, c.rms, c.nviews);
+            lr_camcal_free(&c);
+        }
+    } else if (!strcmp(kind, LR_PROCAM_KIND)) {
+        lr_procam p;
+        if (!(rc = lr_procam_load(path, &p, &e))) {
+            printf("%s: projector %dx%d fx %.3f fy %.3f cx %.3f cy %.3f; camera %dx%d; "
+                   "T (%.2f, %.2f, %.2f) mm; stereo rms %.4f px\n",
+                   path, p.proj.width, p.proj.height, p.proj.fx, p.proj.fy, p.proj.cx, p.proj.cy,
+                   p.cam.width, p.cam.height, p.T[0], p.T[1], p.T[2], p.rms);
+            lr_procam_free(&p);
+        }
+    } else if (!strcmp(kind, LR_CAMRESP_KIND)) {
+        lr_camresp r;
+        if (!(rc = lr_camresp_load(path, &r, &e)))
+            printf("%s: camera response, %d exposures\n", path, r.images);
+    } else if (!strcmp(kind, LR_PROJRESP_KIND)) {
+        lr_projresp *r = malloc(sizeof *r);
+        if (!r)
+            rc = lr_err_set(&e, LR_ENOMEM, "out of memory");
+        else if (!(rc = lr_projresp_load(path, r, &e)))
+            printf("%s: projector response, %d levels, gamma %.3f %.3f %.3f\n", path, r->nlevels,
+                   r->gamma[0], r->gamma[1], r->gamma[2]);
+        free(r);
+    } else if (!strcmp(kind, LR_COLORMATRIX_KIND)) {
+        lr_colormatrix m;
+        if (!(rc = lr_colormatrix_load(path, &m, &e)))
+            printf("%s: colour matrix from %d patches, rms %.4f\n", path, m.patches, m.rms);
+    } else if (!strcmp(kind, LR_GC_SEQUENCE_KIND)) {
+        char dir[4096];
+        snprintf(dir, sizeof dir, "%s", path);
+        char *slash = strrchr(dir, '/');
+        if (slash)
+            *slash = '\0';
+        else
+            snprintf(dir, sizeof dir, ".");
+        int pw, ph;
+        if (!(rc = lr_gc_read_sequence(dir, &pw, &ph, &e)))
+            printf("%s: Gray-code sequence for a %dx%d projector\n", path, pw, ph);
+    } else {
+        fprintf(stderr, "%s: unknown kind '%s'\n", path, kind);
+        return LR_EXIT_FAIL;
+    }
+    if (rc) {
+        fprintf(stderr, "%s\n", e.msg);
+        return LR_EXIT_FAIL;
+    }
+    return LR_EXIT_OK;
+}
+
+static int cmd_check(int argc, char **argv)
+{
+    if (argc < 3)
+        return usage_error("check", "%s", "expected one or more calibration files");
+    int rc = LR_EXIT_OK;
+    for (int i = 2; i < argc; i++)
+        if (check_one(argv[i]) != LR_EXIT_OK)
+            rc = LR_EXIT_FAIL;
+    return rc;
+}
+
+int lr_cmd_calib(int argc, char **argv)
+{
+    const char *sub = argc > 1 ? argv[1] : "";
+    if (!strcmp(sub, "camera"))
+        return cmd_camera(argc, argv);
+    if (!strcmp(sub, "projector"))
+        return cmd_projector(argc, argv);
+    if (!strcmp(sub, "camera-response"))
+        return cmd_camera_response(argc, argv);
+    if (!strcmp(sub, "projector-response"))
+        return cmd_projector_response(argc, argv);
+    if (!strcmp(sub, "color"))
+        return cmd_color(argc, argv);
+    if (!strcmp(sub, "check"))
+        return cmd_check(argc, argv);
+    fprintf(stderr, "%s\n", lr_cmd_calib_usage);
+    return LR_EXIT_USAGE;
+}
