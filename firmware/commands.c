@@ -4,8 +4,10 @@
 #include <stddef.h>
 
 #include "firmware/cmd_optics.h"
+#include "firmware/cmd_run.h"
 
 const lr_command lr_commands[] = {
     {"optics", lr_optics_summary, lr_optics_usage, lr_cmd_optics},
+    {"run", lr_run_summary, lr_run_usage, lr_cmd_run},
     {NULL, NULL, NULL, NULL},
 };
