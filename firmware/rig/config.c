@@ -526,7 +526,9 @@ static int binding(ctx *x, lr_jnode o, const char *where, lr_rig_binding *b)
     int rc = keys(x, o, where, b_keys);
     if (rc)
         return rc;
-    b->line = lr_json_line(x->j, o);
+    b->line = b->line_param = b->line_range = lr_json_line(x->j, o);
+    if (lr_json_get(x->j, o, "param") != LR_JNONE)
+        b->line_param = lr_json_line(x->j, lr_json_get(x->j, o, "param"));
     char f[192];
     char control[2 * LR_RIG_NAME_MAX + 2];
     if ((rc = get_str(x, o, where, "control", true, control, sizeof control)) ||
@@ -574,6 +576,7 @@ static int binding(ctx *x, lr_jnode o, const char *where, lr_rig_binding *b)
                                 "expected an array of 1..%d values", LR_RIG_MAX_VALUES);
         for (int i = 0; i < n; i++) {
             lr_jnode v = lr_json_at(x->j, values, i);
+            b->line_values[i] = lr_json_line(x->j, v);
             char vf[224];
             snprintf(vf, sizeof vf, "%s[%d]", f, i);
             if (lr_json_type(x->j, v) == LR_JSON_ARRAY && !scene) {
@@ -624,6 +627,8 @@ static int binding(ctx *x, lr_jnode o, const char *where, lr_rig_binding *b)
         field_name(f, sizeof f, where, "colors");
         return lr_json_fail(x->j, colors, f, x->e, LR_EPARSE, "give 'range' or 'colors', not both");
     }
+    if (range != LR_JNONE || colors != LR_JNONE)
+        b->line_range = lr_json_line(x->j, range != LR_JNONE ? range : colors);
     if (range != LR_JNONE) {
         field_name(f, sizeof f, where, "range");
         if ((rc = lr_json_numbers(x->j, range, f, b->range, 2, x->e)))

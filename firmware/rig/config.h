@@ -145,7 +145,8 @@ typedef struct lr_rig_binding {
     char source[LR_RIG_NAME_MAX];  /* "" = any */
     char control[LR_RIG_NAME_MAX];
     char param[128];
-    int line;
+    int line;        /* of the binding; of its "param", "range"/"colors", each value: */
+    int line_param, line_range, line_values[LR_RIG_MAX_VALUES];
     lr_binding_kind kind;
     /* level */
     bool is_color;

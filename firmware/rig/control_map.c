@@ -59,11 +59,11 @@ static void value_of(const lr_rig_binding *b, double y, double out[3])
     }
 }
 
-static int param_fail(const lr_rig_config *cfg, int i, const char *field, lr_err *e,
+static int param_fail(const lr_rig_config *cfg, int i, int line, const char *field, lr_err *e,
                       const char *msg)
 {
-    return lr_err_set(e, LR_EPARSE, "%s:%d: field 'controls[%d].%s': %s", cfg->path,
-                      cfg->bindings[i].line, i, field, msg);
+    return lr_err_set(e, LR_EPARSE, "%s:%d: field 'controls[%d].%s': %s", cfg->path, line, i,
+                      field, msg);
 }
 
 static void format_value(double v[3], bool vector, char *buf, size_t cap)
@@ -94,7 +94,8 @@ static int check_values(const lr_rig_config *cfg, lr_control_map *m, lr_err *e)
                     char msg[LR_ERR_MSG_MAX];
                     snprintf(msg, sizeof msg, "the scene rejects %s = %s: %.300s",
                              end ? "the upper end" : "the lower end", text, le.msg);
-                    rc = param_fail(cfg, i, b->is_color ? "colors" : "range", e, msg);
+                    rc = param_fail(cfg, i, b->line_range, b->is_color ? "colors" : "range", e,
+                                    msg);
                 }
             }
         } else if (strcmp(b->param, "scene") == 0) {
@@ -103,7 +104,7 @@ static int check_values(const lr_rig_config *cfg, lr_control_map *m, lr_err *e)
                 if (lr_scene_load(b->values[k], NULL, &other, &le)) {
                     char f[32];
                     snprintf(f, sizeof f, "values[%d]", k);
-                    rc = param_fail(cfg, i, f, e, le.msg);
+                    rc = param_fail(cfg, i, b->line_values[k], f, e, le.msg);
                 }
                 lr_scene_destroy(other);
             }
@@ -112,7 +113,7 @@ static int check_values(const lr_rig_config *cfg, lr_control_map *m, lr_err *e)
                 if (lr_scene_set(scratch, b->param, b->values[k], NULL, &le)) {
                     char f[32];
                     snprintf(f, sizeof f, "values[%d]", k);
-                    rc = param_fail(cfg, i, f, e, le.msg);
+                    rc = param_fail(cfg, i, b->line_values[k], f, e, le.msg);
                 }
         }
     }
@@ -144,7 +145,7 @@ int lr_control_map_create(const lr_rig_config *cfg, lr_scene *scene, bool check,
         char cur[256];
         lr_err le = {0};
         if (lr_scene_get(scene, b->param, cur, sizeof cur, &le)) {
-            rc = param_fail(cfg, i, "param", e, le.msg);
+            rc = param_fail(cfg, i, b->line_param, "param", e, le.msg);
             break;
         }
         if (b->kind == LR_BIND_CYCLE) {
