@@ -63,6 +63,7 @@ struct lr_rig {
     double lamp_written; /* -1: nothing written */
     uint64_t frames, events, reloads, reload_failures;
     unsigned frame_errors;
+    bool fading; /* a fade was running at the last apply: apply once more after it ends */
 };
 
 static void set_free(rigset *s)
@@ -254,6 +255,7 @@ static void apply(lr_rig *r, int64_t now)
     double level;
     if (lr_control_map_lamp_level(r->set.map, now, &level))
         write_lamp(r, level);
+    r->fading = lr_control_map_fading(r->set.map, now);
 }
 
 static void switch_scene(lr_rig *r, const char *path)
@@ -345,7 +347,8 @@ static void frame(lr_rig *r, int64_t now)
 
 static bool frame_wanted(lr_rig *r, int64_t now)
 {
-    return lr_rig_view_needs_frame(r->view) || lr_control_map_fading(r->set.map, now);
+    (void)now;
+    return lr_rig_view_needs_frame(r->view) || r->fading;
 }
 
 static void write_stats(lr_rig *r, int64_t now)
@@ -607,7 +610,7 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
         const char *sw = lr_control_map_scene_request(r->set.map);
         if (sw)
             switch_scene(r, sw);
-        if (any || sw || lr_control_map_fading(r->set.map, now))
+        if (any || sw || r->fading)
             apply(r, now);
         if (frame_wanted(r, now) && now >= r->next_frame_ns &&
             !(r->kms && lr_gl_flip_pending(r->gl)))
