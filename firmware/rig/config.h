@@ -4,6 +4,9 @@
  *
  * {
  *   "scene":    "PATH"                 scene file; relative paths resolve against this file
+ *   "scene_set": {"render.K": 4, "light.color": [1, 0.6, 0.3], ...}   scene parameters set
+ *                                      after every load of the scene (the rig's render budget:
+ *                                      a small GPU needs smaller maps than the scene file's)
  *   "devices":  [ DEVICE, ... ]        zero or more (names unique)
  *   "controls": [ BINDING, ... ] | "PATH"   the control map, inline or a file holding
  *                                      {"controls": [ ... ]} (configs/controls/NAME.json)
@@ -65,6 +68,7 @@
 #define LR_RIG_MAX_BINDINGS 32
 #define LR_RIG_MAX_VALUES 32
 #define LR_RIG_MAX_ITEMS 16 /* inputs, encoders, buttons, watches per device */
+#define LR_RIG_MAX_SETS 32
 
 typedef enum lr_rig_dev_type {
     LR_RIG_DEV_SIM = 0,
@@ -173,6 +177,11 @@ typedef enum lr_rig_output_mode {
 typedef struct lr_rig_config {
     char path[LR_RIG_PATH_MAX];  /* the file it came from */
     char scene[LR_RIG_PATH_MAX]; /* resolved */
+    struct {
+        char key[128], value[256];
+        int line;
+    } sets[LR_RIG_MAX_SETS];
+    int n_sets;
     lr_rig_device devices[LR_RIG_MAX_DEVICES];
     int n_devices;
     lr_rig_binding bindings[LR_RIG_MAX_BINDINGS];
@@ -198,6 +207,10 @@ int lr_rig_config_load(const char *path, lr_rig_config **out, lr_err *e);
 /* The same from text; name is used in messages and as the base of relative paths. */
 int lr_rig_config_parse(const char *text, const char *name, lr_rig_config **out, lr_err *e);
 void lr_rig_config_destroy(lr_rig_config *c);
+
+/* Applies "scene_set" to a freshly loaded scene; errors name the config file, line and field. */
+struct lr_scene;
+int lr_rig_config_apply_sets(const lr_rig_config *c, struct lr_scene *scene, lr_err *e);
 
 /* The modbus device the lamp driver is on, -1 when none. */
 int lr_rig_config_lamp_device(const lr_rig_config *c);

@@ -81,6 +81,10 @@ static int check_values(const lr_rig_config *cfg, lr_control_map *m, lr_err *e)
     lr_err le = {0};
     if (lr_scene_load(cfg->scene, NULL, &scratch, &le))
         return lr_err_set(e, le.code, "%s", le.msg);
+    if (lr_rig_config_apply_sets(cfg, scratch, e)) {
+        lr_scene_destroy(scratch);
+        return LR_EPARSE;
+    }
     int rc = LR_OK;
     for (int i = 0; i < m->n && !rc; i++) {
         const lr_rig_binding *b = &cfg->bindings[i];

@@ -206,6 +206,8 @@ static int set_build(lr_rig *r, rigset *s, lr_err *e)
     if (!rc)
         rc = lr_scene_load(s->cfg->scene, &warn, &s->scene, e);
     if (!rc)
+        rc = lr_rig_config_apply_sets(s->cfg, s->scene, e);
+    if (!rc)
         rc = lr_control_map_create(s->cfg, s->scene, true, lr_now_ns(), &s->map, e);
     for (int i = 0; !rc && i < s->cfg->n_devices; i++)
         rc = create_device(r, s, &s->cfg->devices[i], e);
@@ -260,12 +262,14 @@ static void apply(lr_rig *r, int64_t now)
 
 static void switch_scene(lr_rig *r, const char *path)
 {
-    lr_scene *scene;
+    lr_scene *scene = NULL;
     lr_err e = {0};
     lr_warn_sink warn = {scene_warn, r};
-    if (lr_scene_load(path, &warn, &scene, &e)) {
+    if (lr_scene_load(path, &warn, &scene, &e) ||
+        lr_rig_config_apply_sets(r->set.cfg, scene, &e)) {
         lr_log_write(&r->log, LR_LOG_ERROR, "scene switch: %s; keeping %s", e.msg,
                      lr_scene_path(r->set.scene));
+        lr_scene_destroy(scene);
         return;
     }
     lr_rig_view *view;
@@ -666,6 +670,7 @@ void lr_rig_get_info(const lr_rig *r, lr_rig_info *out)
     out->lamp_level = r->lamp_written;
     out->output = r->kms ? "kms" : "headless";
     out->view = r->view ? lr_rig_view_name(r->view) : "";
+    out->idle = r->view && !frame_wanted((lr_rig *)r, lr_now_ns());
 }
 
 struct lr_scene *lr_rig_scene(lr_rig *r) { return r->set.scene; }

@@ -49,6 +49,7 @@ typedef struct lr_rig_info {
     double lamp_level;        /* last level written to the lamp driver, -1 none */
     const char *output;       /* "headless" or "kms" */
     const char *view;         /* "passes" or "preview" */
+    bool idle;                /* no frame wanted: converged, no fade running */
 } lr_rig_info;
 
 int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e);

@@ -5,7 +5,7 @@
 #include <string.h>
 
 /* Default first. */
-static const lr_rig_view_ops *const views[] = {&lr_rig_view_preview};
+static const lr_rig_view_ops *const views[] = {&lr_rig_view_passes, &lr_rig_view_preview};
 #define N_VIEWS ((int)(sizeof views / sizeof views[0]))
 
 struct lr_rig_view {
@@ -14,7 +14,7 @@ struct lr_rig_view {
     int width, height;
 };
 
-const char *lr_rig_view_names(void) { return "preview"; }
+const char *lr_rig_view_names(void) { return "passes, preview"; }
 
 static const lr_rig_view_ops *find(const char *name)
 {

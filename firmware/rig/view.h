@@ -2,7 +2,8 @@
  * shape of render/renderer.h (invalidate by dirty flags, needs_frame, frame with stats,
  * RGBA8 readback, present), so the loop schedules frames the same way whichever is built in.
  *
- *   "passes"   render/renderer.h, seed 003's passes (when the renderer is linked in)
+ *   "passes"   render/renderer.h, seed 003's passes (the default; needs GL, surfaceless
+ *              headless)
  *   "preview"  a CPU stand-in: a glow whose colour is the sum of the lights' intensity times
  *              colour (relative to the lights when the view was created, tone-mapped
  *              1 - exp(-x)), so a frame's brightness follows the dimmer; converged after
@@ -29,7 +30,7 @@ typedef struct lr_rig_view_desc {
     int width, height;
 } lr_rig_view_desc;
 
-/* Comma-separated names of the back ends built in, default first ("preview"). */
+/* Comma-separated names of the back ends built in, default first ("passes, preview"). */
 const char *lr_rig_view_names(void);
 /* Whether a back end needs a GL context even headless. */
 bool lr_rig_view_needs_gl(const char *name);
@@ -58,6 +59,7 @@ typedef struct lr_rig_view_ops {
     int (*present)(void *impl, lr_err *e);
 } lr_rig_view_ops;
 
+extern const lr_rig_view_ops lr_rig_view_passes;
 extern const lr_rig_view_ops lr_rig_view_preview;
 
 #endif
