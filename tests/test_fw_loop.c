@@ -128,6 +128,50 @@ static void test_sim_in_process(void **state)
     lr_test_rmtree(dir);
 }
 
+/* Devices missing at start (no GPIO chip, no HID knob, no USB device here): each is logged
+ * once (not once per retry) and retried, and the rig runs on the sim script meanwhile. */
+static void test_missing_devices_keep_running(void **state)
+{
+    (void)state;
+    char *dir = lr_test_tmpdir();
+    char text[2048];
+    snprintf(text, sizeof text,
+             "{\"scene\": \"%s/scenes/candle.json\",\n"
+             " \"devices\": [\n"
+             "  {\"type\": \"gpio\", \"chip\": \"gpiochip7\", \"retry_min_ms\": 20,\n"
+             "   \"encoders\": [{\"name\": \"knob1\", \"line_a\": \"17\", \"line_b\": \"27\"}]},\n"
+             "  {\"type\": \"hid\", \"name\": \"powermate\", \"vid\": \"077d\", \"pid\": \"0410\",\n"
+             "   \"retry_min_ms\": 20},\n"
+             "  {\"type\": \"usb\", \"retry_min_ms\": 20, \"rescan_ms\": 20,\n"
+             "   \"watch\": [{\"name\": \"shuttle\", \"vid\": \"0b33\", \"pid\": \"0020\"}]},\n"
+             "  {\"type\": \"sim\", \"text\": \"0.1 dimmer absolute 1\\n0.3 dimmer absolute 0.25\\n\"}],\n"
+             " \"controls\": [{\"control\": \"dimmer\", \"param\": \"light.intensity\",\n"
+             "   \"range\": [0, 0.01]},\n"
+             "  {\"control\": \"gpio/knob1\", \"param\": \"render.exposure\", \"range\": [1e5, 1e7]}],\n"
+             " \"output\": {\"width\": 16, \"height\": 16, \"renderer\": \"preview\"}}\n",
+             LR_SOURCE_CONFIGS);
+    char *cfg = lr_test_write(dir, "rig.json", text, (size_t)-1);
+    lr_test_log log = {0};
+    lr_rig_opts o = {.config = cfg, .duration_s = 1.0, .no_signals = true,
+                     .log = {lr_test_log_fn, &log}};
+    lr_rig *r;
+    lr_err e = {0};
+    if (lr_rig_create(&o, &r, &e))
+        fail_msg("%s", e.msg);
+    assert_int_equal(lr_rig_run(r, &e), LR_OK);
+    assert_near(scene_num(r, "light.intensity"), 0.0025, 1e-12);
+    lr_rig_info info;
+    lr_rig_get_info(r, &info);
+    assert_int_equal(info.events, 2);
+    lr_rig_destroy(r);
+    /* One line each, although each was retried many times in that second. */
+    assert_int_equal(lr_test_log_count(&log, "gpiochip7"), 1);
+    assert_int_equal(lr_test_log_count(&log, "powermate"), 1);
+    assert_true(lr_test_log_count(&log, "shuttle") <= 1);
+    free(cfg);
+    lr_test_rmtree(dir);
+}
+
 /* ---- child processes ---- */
 
 static pid_t spawn(char *const argv[], const char *err_path)
@@ -361,6 +405,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sim_in_process),
+        cmocka_unit_test(test_missing_devices_keep_running),
         cmocka_unit_test(test_shipped_sim_demo),
         cmocka_unit_test(test_sigterm_clean_exit),
         cmocka_unit_test(test_sighup_reload),

@@ -64,14 +64,15 @@ struct lr_rig {
     uint64_t frames, events, reloads, reload_failures;
     unsigned frame_errors;
     bool fading; /* a fade was running at the last apply: apply once more after it ends */
+    lr_frame_stats flip_stats; /* KMS: the frame on its way to the screen */
+    bool flip_stats_pending;
+    bool used_hid; /* hidapi's process-wide state is released once, at the very end */
 };
 
 static void set_free(rigset *s)
 {
     for (int i = 0; i < s->n_devs; i++)
         lr_dev_destroy(s->devs[i]);
-    if (s->has_hid)
-        lr_hid_library_exit();
     lr_control_map_destroy(s->map);
     lr_scene_destroy(s->scene);
     lr_rig_config_destroy(s->cfg);
@@ -211,8 +212,10 @@ static int set_build(lr_rig *r, rigset *s, lr_err *e)
         rc = lr_control_map_create(s->cfg, s->scene, true, lr_now_ns(), &s->map, e);
     for (int i = 0; !rc && i < s->cfg->n_devices; i++)
         rc = create_device(r, s, &s->cfg->devices[i], e);
-    if (rc)
+    if (rc) {
+        r->used_hid |= s->has_hid;
         set_free(s);
+    }
     return rc;
 }
 
@@ -345,7 +348,15 @@ static void frame(lr_rig *r, int64_t now)
     }
     r->frame_errors = 0;
     r->frames++;
-    lr_rig_stats_frame(r->stats, &st, lr_now_ns());
+    if (r->kms && lr_gl_flip_pending(r->gl)) {
+        /* On the projector a frame shows at its page flip: the latency ends there. */
+        if (r->flip_stats_pending)
+            lr_rig_stats_frame(r->stats, &r->flip_stats, lr_now_ns());
+        r->flip_stats = st;
+        r->flip_stats_pending = true;
+    } else {
+        lr_rig_stats_frame(r->stats, &st, lr_now_ns());
+    }
     r->next_frame_ns = now + r->frame_interval_ns;
 }
 
@@ -483,8 +494,10 @@ int lr_rig_reload(lr_rig *r, lr_err *e)
         r->set = s;
         rc = view_build(r, s.scene, &view, e);
         r->set = old;
-        if (rc)
+        if (rc) {
+            r->used_hid |= s.has_hid;
             set_free(&s);
+        }
     }
     if (rc) {
         r->reload_failures++;
@@ -496,6 +509,7 @@ int lr_rig_reload(lr_rig *r, lr_err *e)
     while (lr_event_ring_pop(r->ring, &ev))
         ;
     lr_rig_view_destroy(r->view);
+    r->used_hid |= r->set.has_hid;
     set_free(&r->set);
     r->set = s;
     r->view = view;
@@ -598,6 +612,10 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
                 lr_err ge = {0};
                 if (lr_gl_dispatch(r->gl, &ge))
                     lr_log_write(&r->log, LR_LOG_ERROR, "output: %s", ge.msg);
+                if (r->flip_stats_pending && !lr_gl_flip_pending(r->gl)) {
+                    lr_rig_stats_frame(r->stats, &r->flip_stats, now);
+                    r->flip_stats_pending = false;
+                }
             }
         }
         /* Every device is dispatched on every wake: dispatch reads only what is ready and runs
@@ -650,7 +668,10 @@ void lr_rig_destroy(lr_rig *r)
     lr_rig_view_destroy(r->view);
     if (r->gl)
         lr_gl_destroy(r->gl);
+    r->used_hid |= r->set.has_hid;
     set_free(&r->set);
+    if (r->used_hid)
+        lr_hid_library_exit();
     free(r->rgba);
     lr_rig_stats_destroy(r->stats);
     lr_event_ring_destroy(r->ring);
