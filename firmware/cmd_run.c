@@ -2,6 +2,7 @@
 #include "firmware/cmd_run.h"
 
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -78,6 +79,8 @@ int lr_cmd_run(int argc, char **argv)
         if (!(o.duration_s > 0) || o.duration_s > 1e7)
             return usage_error("--duration: must be > 0 seconds");
     }
+    /* A peer that closes its socket must be an error return, never a fatal signal. */
+    signal(SIGPIPE, SIG_IGN);
     lr_rig *r;
     if (lr_rig_create(&o, &r, &e)) {
         fprintf(stderr, "lamprig run: %s\n", e.msg);
