@@ -171,6 +171,40 @@ static void test_light_outside(void **state)
     lr_scene_destroy(s);
 }
 
+/* A directional light (orthographic G-buffer, unit radiance) and a spot light (perspective
+ * G-buffer along its axis, angular profile) on a marble ball over a table: finite,
+ * non-negative, and the ball and the table are lit. */
+static void test_directional_and_spot(void **state)
+{
+    static const char *const lights[] = {
+        "{\"type\": \"directional\", \"direction\": [0.3, 0.2, -1], \"radiance\": 1e-3}",
+        "{\"type\": \"spot\", \"position\": [0, -60, 120], \"direction\": [0, 0.4, -1],"
+        " \"inner_deg\": 15, \"outer_deg\": 25, \"intensity\": 1}"};
+    for (int i = 0; i < 2; i++) {
+        char text[2048];
+        snprintf(text, sizeof text,
+                 "{\"name\": \"ball\", \"objects\": [{\"name\": \"ball\", \"material\": \"marble\","
+                 " \"mesh\": {\"type\": \"sphere\", \"radius\": 40}}], \"lights\": [%s],"
+                 " \"camera\": {\"position\": [0, -300, 120], \"target\": [0, 0, 0]},"
+                 " \"receivers\": [{\"name\": \"table\", \"type\": \"plane\", \"center\": [0, 0, -40],"
+                 " \"normal\": [0, 0, 1], \"size\": [600, 600], \"albedo\": [0.8, 0.8, 0.8]}]}",
+                 lights[i]);
+        lr_scene *s = lr_test_scene_text(text, lr_test_small_settings);
+        double f[3];
+        render_and_scan(s, f);
+        lr_renderer *r = lr_test_renderer(gl, s, W, H, false, 1);
+        lr_test_converge(r, 8);
+        float *hdr = lr_test_hdr(r);
+        /* The centre pixel is on the ball, the bottom-centre one on the table in front. */
+        size_t ball = 3 * ((size_t)(H / 2) * W + W / 2), table = 3 * ((size_t)2 * W + W / 2);
+        printf("%s: ball %g, table %g\n", i ? "spot" : "directional", hdr[ball], hdr[table]);
+        assert_true(hdr[ball] > 0.0f && hdr[table] > 0.0f);
+        free(hdr);
+        lr_renderer_destroy(r);
+        lr_scene_destroy(s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -179,6 +213,7 @@ int main(void)
         cmocka_unit_test(test_zero_thickness_shade),
         cmocka_unit_test(test_albedo_one),
         cmocka_unit_test(test_light_outside),
+        cmocka_unit_test(test_directional_and_spot),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
