@@ -79,7 +79,7 @@ static void test_render_writes_images_and_stats(void **state)
     free(out);
     char *js = slurp("s.json");
     assert_non_null(strstr(js, "\"scene\":\"candle\""));
-    assert_non_null(strstr(js, "\"width\":32,\"height\":24"));
+    assert_non_null(strstr(js, "\"width\":32,\"height\":24,\"uncovered_pixels\":"));
     assert_non_null(strstr(js, "{\"index\":0,\"passes\":[\"gbuffer\",\"radiosity\",\"vpl\",\"compose\"]"));
     assert_non_null(strstr(js, "{\"index\":1,\"passes\":[\"radiosity\",\"vpl\",\"compose\"]"));
     /* The event before frame 2: composition alone. Frame 3: nothing left to do. */
