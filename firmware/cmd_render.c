@@ -15,6 +15,7 @@
 #include "render/gl/gl.h"
 #include "render/image/image.h"
 #include "render/renderer.h"
+#include "render/renderer_debug.h"
 #include "render/scene/scene.h"
 
 const char lr_render_summary[] = "render a scene headless: PNG, linear PFM, per-pass statistics";
@@ -32,7 +33,8 @@ const char lr_render_usage[] =
     "  --width, --height output size (default 640 x 480)\n"
     "  --out F.png       tone-mapped 8-bit sRGB image (exposure render.exposure)\n"
     "  --hdr F.pfm       linear RGB radiance, W/(mm^2 sr), PFM\n"
-    "  --stats F.json    {\"scene\",\"width\",\"height\",\"renderer\",\"frames\":[{\"index\",\n"
+    "  --stats F.json    {\"scene\",\"width\",\"height\",\"uncovered_pixels\",\"renderer\",\n"
+    "                    \"settings\",\"frames\":[{\"index\",\n"
     "                    \"passes\":[...],\"ms\":{pass:ms},\"total_ms\",\"samples\"},...]}\n"
     "  --no-vpl          no emergent light on the receivers (direct light only)\n"
     "  --set key=value   change a scene parameter before rendering (repeatable), names as\n"
@@ -123,9 +125,13 @@ static void json_string(FILE *f, const char *s)
     fputc('"', f);
 }
 
-static int write_stats(const char *path, const lr_scene *scene, const lr_renderer *r,
+static int write_stats(const char *path, const lr_scene *scene, lr_renderer *r,
                        const stats_log *log, lr_err *e)
 {
+    /* Object pixels of the final image that no radiosity map sees (PIPELINE.md, pass 3). */
+    int uncovered = -1;
+    if (log->n)
+        lr_renderer_debug_uncovered(r, &uncovered, NULL);
     lr_atomic_file *af;
     int rc = lr_atomic_file_open(path, &af, e);
     if (rc)
@@ -136,7 +142,8 @@ static int write_stats(const char *path, const lr_scene *scene, const lr_rendere
     const lr_render_settings *rs = lr_scene_render(scene);
     fputs("{\"scene\":", f);
     json_string(f, lr_scene_name(scene));
-    fprintf(f, ",\"width\":%d,\"height\":%d,\"renderer\":", w, h);
+    fprintf(f, ",\"width\":%d,\"height\":%d,\"uncovered_pixels\":%d,\"renderer\":", w, h,
+            uncovered);
     json_string(f, lr_renderer_info(r));
     fprintf(f, ",\"settings\":{\"K\":%d,\"N\":%d,\"N_vpl\":%d,\"map_size\":%d,\"gbuffer_size\":%d,"
                "\"vpl_map_size\":%d,\"frames\":%d},\n\"frames\":[",

@@ -245,6 +245,8 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
 
 int lr_renderer_read_hdr(lr_renderer *r, float *rgb, lr_err *e)
 {
+    if (!r->fb_hdr)
+        return lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
     size_t n = (size_t)r->width * (size_t)r->height;
     float *rgba = malloc(n * 4 * sizeof *rgba);
     if (!rgba)
@@ -259,6 +261,8 @@ int lr_renderer_read_hdr(lr_renderer *r, float *rgb, lr_err *e)
 
 int lr_renderer_read_rgba8(lr_renderer *r, unsigned char *out, lr_err *e)
 {
+    if (!r->fb_ldr)
+        return lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
     size_t n = (size_t)r->width * (size_t)r->height;
     float *rgba = malloc(n * 4 * sizeof *rgba);
     if (!rgba)
@@ -280,6 +284,8 @@ int lr_renderer_read_rgba8(lr_renderer *r, unsigned char *out, lr_err *e)
 int lr_renderer_present(lr_renderer *r, lr_err *e)
 {
     int w, h;
+    if (!r->ldr)
+        return lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
     lr_gl_size(r->gl, &w, &h);
     if (w > 0 && h > 0) {
         lr_gl_bind_default(r->gl);

@@ -45,7 +45,9 @@ static void set_intensity(const lr_renderer *r, const lr_program *p)
 
 int lr_pass_compose(lr_renderer *r, lr_err *e)
 {
-    static const float zero[4] = {0, 0, 0, 0};
+    /* Alpha 1 everywhere but on object fragments no map sees (compose_object.frag writes 0
+     * there): lr_renderer_debug_uncovered counts them. */
+    static const float zero[4] = {0, 0, 0, 1};
     const lr_camera *cam = lr_scene_camera(r->scene);
     double view[16], proj[16], vp[16];
     lr_camera_view(cam, view);
