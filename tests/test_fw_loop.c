@@ -128,6 +128,48 @@ static void test_sim_in_process(void **state)
     lr_test_rmtree(dir);
 }
 
+/* A scene switch (button2) loads the next scene file and writes every control's value into
+ * it again: the dimmer's intensity, the material picked by button1 and the translucency
+ * scale survive the switch (the votive's file says 0.004 W/sr and scale 1.5). */
+static void test_scene_switch_keeps_controls(void **state)
+{
+    (void)state;
+    char *dir = lr_test_tmpdir();
+    char text[2048];
+    snprintf(text, sizeof text,
+             "{\"scene\": \"%s/scenes/candle.json\",\n"
+             " \"devices\": [{\"type\": \"sim\", \"text\": \"0.05 dimmer absolute 0.3\\n"
+             "0.10 button1 press\\n0.15 knob2 absolute 1\\n0.25 button2 press\\n\"}],\n"
+             " \"controls\": [\n"
+             "  {\"control\": \"dimmer\", \"param\": \"light.intensity\", \"range\": [0, 0.01]},\n"
+             "  {\"control\": \"button1\", \"param\": \"objects[0].material\",\n"
+             "   \"values\": [\"candle_wax\", \"marble\"]},\n"
+             "  {\"control\": \"knob2\", \"param\": \"objects[0].material.scale\", \"range\": [0.5, 3]},\n"
+             "  {\"control\": \"button2\", \"param\": \"scene\",\n"
+             "   \"values\": [\"%s/scenes/candle.json\", \"%s/scenes/votive.json\"]}],\n"
+             " \"output\": {\"width\": 16, \"height\": 16, \"renderer\": \"preview\"}}\n",
+             LR_SOURCE_CONFIGS, LR_SOURCE_CONFIGS, LR_SOURCE_CONFIGS);
+    char *cfg = lr_test_write(dir, "rig.json", text, (size_t)-1);
+    lr_test_log log = {0};
+    lr_rig_opts o = {.config = cfg, .duration_s = 0.6, .no_signals = true,
+                     .log = {lr_test_log_fn, &log}};
+    lr_rig *r;
+    lr_err e = {0};
+    if (lr_rig_create(&o, &r, &e))
+        fail_msg("%s", e.msg);
+    assert_int_equal(lr_rig_run(r, &e), LR_OK);
+    assert_string_equal(lr_scene_name(lr_rig_scene(r)), "votive");
+    assert_near(scene_num(r, "light.intensity"), 0.003, 1e-12);
+    assert_near(scene_num(r, "objects[0].material.scale"), 3.0, 1e-9);
+    char buf[64];
+    lr_scene_get(lr_rig_scene(r), "objects[0].material.base", buf, sizeof buf, NULL);
+    assert_string_equal(buf, "marble");
+    assert_int_equal(lr_test_log_count(&log, "scene: "), 1);
+    lr_rig_destroy(r);
+    free(cfg);
+    lr_test_rmtree(dir);
+}
+
 /* Devices missing at start (no GPIO chip, no HID knob, no USB device here): each is logged
  * once (not once per retry) and retried, and the rig runs on the sim script meanwhile. */
 static void test_missing_devices_keep_running(void **state)
@@ -309,7 +351,12 @@ static void test_sigterm_clean_exit(void **state)
         usleep(10000);
     }
     assert_true(seen);
-    usleep(300000);
+    /* The periodic stats write (stats.period_s 0.2) happens while running. */
+    for (int i = 0; i < 500 && access(stats, F_OK) != 0; i++)
+        usleep(10000);
+    assert_int_equal(access(stats, F_OK), 0);
+    assert_int_equal(waitpid(pid, NULL, WNOHANG), 0);
+    usleep(300000); /* a few more scripted dimmer moves */
     assert_int_equal(kill(pid, SIGTERM), 0);
     int st = reap(pid);
     assert_true(WIFEXITED(st));
@@ -405,6 +452,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sim_in_process),
+        cmocka_unit_test(test_scene_switch_keeps_controls),
         cmocka_unit_test(test_missing_devices_keep_running),
         cmocka_unit_test(test_shipped_sim_demo),
         cmocka_unit_test(test_sigterm_clean_exit),

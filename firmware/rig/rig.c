@@ -492,7 +492,15 @@ int lr_rig_reload(lr_rig *r, lr_err *e)
         /* The view belongs to the scene: build it against the new one, then swap. */
         rigset old = r->set;
         r->set = s;
-        rc = view_build(r, s.scene, &view, e);
+        /* A new renderer may need GL where the old one did not (the output mode itself is
+         * kept until restart). */
+        if (!r->gl && lr_rig_view_needs_gl(s.cfg->output.renderer)) {
+            lr_gl_desc gd = {.backend = LR_GL_SURFACELESS};
+            if ((rc = lr_gl_create(&gd, &r->gl, e)))
+                lr_err_prefix(e, "output: headless GL");
+        }
+        if (!rc)
+            rc = view_build(r, s.scene, &view, e);
         r->set = old;
         if (rc) {
             r->used_hid |= s.has_hid;
