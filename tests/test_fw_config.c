@@ -144,6 +144,38 @@ static void test_bad_fields_named(void **state)
     lr_test_rmtree(dir);
 }
 
+/* A control map in its own file (configs/controls/NAME.json): its errors name that file and
+ * its lines, and the scene-side checks (parameters) too. */
+static void test_control_map_file_errors(void **state)
+{
+    (void)state;
+    char *dir = lr_test_tmpdir();
+    free(lr_test_write(dir, "controls/a.json",
+                       "{\"controls\": [\n {\"control\": \"dimmer\",\n  \"param\": "
+                       "\"light.nope\"}]}\n", (size_t)-1));
+    free(lr_test_write(dir, "controls/b.json",
+                       "{\"controls\": [\n {\"control\": \"dimmer\", \"param\": "
+                       "\"light.intensity\",\n  \"step\": 0}]}\n", (size_t)-1));
+    free(lr_test_write(dir, "controls/c.json", "{\"bindings\": []}\n", (size_t)-1));
+    char text[600], msg[LR_ERR_MSG_MAX], want[1200];
+    const struct { const char *file, *msg; } cases[] = {
+        {"a.json", "controls/a.json:3: field 'controls[0].param': light.nope: a point light has "
+                   "no parameter 'nope' (known: intensity, color, position, flicker.{amplitude, "
+                   "frequency_hz, jitter_mm, seed})"},
+        {"b.json", "controls/b.json:3: field 'controls[0].step': must be in 1e-06..1, got 0"},
+        {"c.json", "controls/c.json:1: field 'bindings': unknown field"},
+    };
+    for (int i = 0; i < 3; i++) {
+        snprintf(text, sizeof text,
+                 "{\"scene\": \"%s/scenes/candle.json\",\n \"controls\": \"controls/%s\"}\n",
+                 LR_SOURCE_CONFIGS, cases[i].file);
+        load_msg(dir, text, msg, sizeof msg);
+        snprintf(want, sizeof want, "%s/%s", dir, cases[i].msg);
+        assert_string_equal(msg, want);
+    }
+    lr_test_rmtree(dir);
+}
+
 /* Truncated and garbage files: an error naming the file, never a crash. */
 static void test_truncated_and_garbage(void **state)
 {
@@ -227,8 +259,11 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bad_fields_named),
+        cmocka_unit_test(test_control_map_file_errors),
         cmocka_unit_test(test_truncated_and_garbage),
         cmocka_unit_test(test_shipped_rigs),
     };
+    if (getenv("LR_TEST_FILTER")) /* e.g. LR_TEST_FILTER='test_soak*' to run one test */
+        cmocka_set_test_filter(getenv("LR_TEST_FILTER"));
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

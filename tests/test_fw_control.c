@@ -328,5 +328,7 @@ int main(void)
         cmocka_unit_test(test_garbage_ignored),
         cmocka_unit_test(test_scene_request),
     };
+    if (getenv("LR_TEST_FILTER")) /* e.g. LR_TEST_FILTER='test_soak*' to run one test */
+        cmocka_set_test_filter(getenv("LR_TEST_FILTER"));
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -25,6 +25,7 @@
 #include "render/base/json.h"
 #include "render/scene/scene.h"
 #include "tests/support/fs.h"
+#include "tests/support/gl.h"
 #include "tests/support/hal_test.h"
 #include "tests/support/modbus_server.h"
 #include "tests/support/near.h"
@@ -211,6 +212,38 @@ static void test_missing_devices_keep_running(void **state)
     assert_int_equal(lr_test_log_count(&log, "powermate"), 1);
     assert_true(lr_test_log_count(&log, "shuttle") <= 1);
     free(cfg);
+    lr_test_rmtree(dir);
+}
+
+/* The shipped sim demo in-process with the real renderer, under ASan/UBSan: no error, no leak
+ * (LSan at exit), frames and latencies recorded. LAMPRIG_SOAK_S sets the length (default 4 s;
+ * the issue's soak is LAMPRIG_SOAK_S=120). */
+static void test_soak_shipped_sim(void **state)
+{
+    (void)state;
+    lr_gl *gl;
+    assert_int_equal(lr_test_gl_create(&gl), LR_OK); /* pins the driver for LSan */
+    lr_gl_destroy(gl);
+    const char *env = getenv("LAMPRIG_SOAK_S");
+    double secs = env ? atof(env) : 4.0;
+    if (!(secs > 0))
+        secs = 4.0;
+    char *dir = lr_test_tmpdir();
+    char *stats = lr_test_path(dir, "stats.json");
+    lr_rig_opts o = {.config = LR_SOURCE_CONFIGS "/rig/sim.json", .stats_path = stats,
+                     .duration_s = secs, .no_signals = true, .log = {lr_log_silent, NULL}};
+    lr_rig *r;
+    lr_err e = {0};
+    if (lr_rig_create(&o, &r, &e))
+        fail_msg("%s", e.msg);
+    assert_int_equal(lr_rig_run(r, &e), LR_OK);
+    lr_rig_info info;
+    lr_rig_get_info(r, &info);
+    assert_string_equal(info.view, "passes");
+    assert_true(info.frames >= 2);
+    lr_rig_destroy(r);
+    check_stats(stats, 2, 1);
+    free(stats);
     lr_test_rmtree(dir);
 }
 
@@ -454,10 +487,13 @@ int main(void)
         cmocka_unit_test(test_sim_in_process),
         cmocka_unit_test(test_scene_switch_keeps_controls),
         cmocka_unit_test(test_missing_devices_keep_running),
+        cmocka_unit_test(test_soak_shipped_sim),
         cmocka_unit_test(test_shipped_sim_demo),
         cmocka_unit_test(test_sigterm_clean_exit),
         cmocka_unit_test(test_sighup_reload),
         cmocka_unit_test(test_cli_errors),
     };
+    if (getenv("LR_TEST_FILTER")) /* e.g. LR_TEST_FILTER='test_soak*' to run one test */
+        cmocka_set_test_filter(getenv("LR_TEST_FILTER"));
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

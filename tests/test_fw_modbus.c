@@ -315,5 +315,7 @@ int main(void)
         cmocka_unit_test(test_shipped_modbus_demo),
         cmocka_unit_test(test_missing_at_start),
     };
+    if (getenv("LR_TEST_FILTER")) /* e.g. LR_TEST_FILTER='test_soak*' to run one test */
+        cmocka_set_test_filter(getenv("LR_TEST_FILTER"));
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

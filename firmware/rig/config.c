@@ -527,6 +527,7 @@ static int binding(ctx *x, lr_jnode o, const char *where, lr_rig_binding *b)
     int rc = keys(x, o, where, b_keys);
     if (rc)
         return rc;
+    snprintf(b->file, sizeof b->file, "%s", lr_json_name(x->j));
     b->line = b->line_param = b->line_range = lr_json_line(x->j, o);
     if (lr_json_get(x->j, o, "param") != LR_JNONE)
         b->line_param = lr_json_line(x->j, lr_json_get(x->j, o, "param"));
@@ -927,7 +928,7 @@ static int parse_root(ctx *x)
             char f[64];
             snprintf(f, sizeof f, "controls[%d].control", i);
             return lr_err_set(x->e, LR_EPARSE, "%s:%d: field '%s': no device named '%s'",
-                              lr_json_name(j), b->line, f, b->source);
+                              b->file, b->line, f, b->source);
         }
     }
     return LR_OK;

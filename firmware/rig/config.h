@@ -149,6 +149,7 @@ typedef struct lr_rig_binding {
     char source[LR_RIG_NAME_MAX];  /* "" = any */
     char control[LR_RIG_NAME_MAX];
     char param[128];
+    char file[LR_RIG_PATH_MAX]; /* the file it is in (the rig config or a control-map file) */
     int line;        /* of the binding; of its "param", "range"/"colors", each value: */
     int line_param, line_range, line_values[LR_RIG_MAX_VALUES];
     lr_binding_kind kind;

@@ -62,8 +62,8 @@ static void value_of(const lr_rig_binding *b, double y, double out[3])
 static int param_fail(const lr_rig_config *cfg, int i, int line, const char *field, lr_err *e,
                       const char *msg)
 {
-    return lr_err_set(e, LR_EPARSE, "%s:%d: field 'controls[%d].%s': %s", cfg->path, line, i,
-                      field, msg);
+    return lr_err_set(e, LR_EPARSE, "%s:%d: field 'controls[%d].%s': %s",
+                      cfg->bindings[i].file, line, i, field, msg);
 }
 
 static void format_value(double v[3], bool vector, char *buf, size_t cap)
