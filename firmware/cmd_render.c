@@ -23,7 +23,7 @@ const char lr_render_summary[] = "render a scene headless: PNG, linear PFM, per-
 const char lr_render_usage[] =
     "usage: lamprig render --scene FILE [--frames N] [--width W --height H] [--out F.png]\n"
     "                      [--hdr F.pfm] [--stats F.json] [--no-vpl] [--set key=value ...]\n"
-    "                      [--events FILE]\n"
+    "                      [--events FILE] [--vpl-visibility]\n"
     "\n"
     "Renders FILE (configs/scenes/*.json) with seed 003's passes (light G-buffer, scattered-\n"
     "radiosity maps, virtual point lights, composition) on a headless EGL context.\n"
@@ -37,6 +37,7 @@ const char lr_render_usage[] =
     "                    \"settings\",\"frames\":[{\"index\",\n"
     "                    \"passes\":[...],\"ms\":{pass:ms},\"total_ms\",\"samples\"},...]}\n"
     "  --no-vpl          no emergent light on the receivers (direct light only)\n"
+    "  --vpl-visibility  shadow the VPLs' light by the objects (beyond seed 003; slower)\n"
     "  --set key=value   change a scene parameter before rendering (repeatable), names as\n"
     "                    in the scene file: light.intensity=0.01, render.K=8, camera.position=0,-400,200\n"
     "  --events FILE     one change per line, FRAME PARAMETER VALUE (e.g. '4 light.intensity\n"
@@ -228,7 +229,8 @@ int lr_cmd_render(int argc, char **argv)
     }
     static const lr_argspec specs[] = {
         {"--scene", 1}, {"--frames", 1}, {"--width", 1}, {"--height", 1}, {"--out", 1},
-        {"--hdr", 1},   {"--stats", 1},  {"--no-vpl", 0}, {"--events", 1}, {NULL, 0}};
+        {"--hdr", 1},   {"--stats", 1},  {"--no-vpl", 0}, {"--events", 1},
+        {"--vpl-visibility", 0}, {NULL, 0}};
     lr_args a;
     lr_err e = {0};
     if (lr_args_parse(nrest, rest, specs, 0, &a, &e)) {
@@ -249,6 +251,7 @@ int lr_cmd_render(int argc, char **argv)
     const char *out = lr_args_get(&a, "--out"), *hdr = lr_args_get(&a, "--hdr");
     const char *stats_path = lr_args_get(&a, "--stats"), *events_path = lr_args_get(&a, "--events");
     bool no_vpl = lr_args_has(&a, "--no-vpl");
+    bool vpl_vis = lr_args_has(&a, "--vpl-visibility");
     free(rest);
     if (status)
         return status;
@@ -278,7 +281,8 @@ int lr_cmd_render(int argc, char **argv)
     }
     if (lr_gl_create(NULL, &gl, &e) ||
         lr_renderer_create(&(lr_renderer_desc){.gl = gl, .scene = scene, .width = width,
-                                               .height = height, .no_vpl = no_vpl},
+                                               .height = height, .no_vpl = no_vpl,
+                                               .vpl_visibility = vpl_vis},
                            &r, &e)) {
         status = fail(&e);
         goto done;
@@ -308,6 +312,9 @@ int lr_cmd_render(int argc, char **argv)
             goto done;
         }
     }
+    for (; next_ev < ev.count; next_ev++)
+        fprintf(stderr, "lamprig render: %s:%d: event for frame %d not applied (--frames %d)\n",
+                ev.path, ev.ev[next_ev].line, ev.ev[next_ev].frame, frames);
     if (out || hdr) {
         if (read_image(r, &img, &e)) {
             status = fail(&e);

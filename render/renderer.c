@@ -103,6 +103,7 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
     r->width = w;
     r->height = h;
     r->no_vpl = desc->no_vpl;
+    r->vpl_visibility = desc->vpl_visibility;
     r->seed = desc->seed ? desc->seed : 1;
     r->caps = caps;
     const char *maps = "RGBA32F maps";
