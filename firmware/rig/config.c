@@ -1,0 +1,1010 @@
+/* lamprig firmware — rig config parsing and validation (schema in config.h). */
+#include "firmware/rig/config.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "firmware/control/curve.h"
+#include "hal/gpio.h"
+#include "hal/hid_report.h"
+#include "hal/modbus.h"
+#include "render/base/json.h"
+#include "render/scene/scene.h"
+
+typedef struct ctx {
+    const lr_json *j;
+    lr_rig_config *c;
+    char dir[LR_RIG_PATH_MAX]; /* directory of the config file, "" for the cwd */
+    lr_err *e;
+} ctx;
+
+/* ---- field helpers: messages name the full field path ---- */
+
+static void field_name(char *buf, size_t cap, const char *prefix, const char *key)
+{
+    if (prefix && *prefix)
+        snprintf(buf, cap, "%s.%s", prefix, key);
+    else
+        snprintf(buf, cap, "%s", key);
+}
+
+static int missing(ctx *x, lr_jnode obj, const char *prefix, const char *key)
+{
+    char f[192];
+    field_name(f, sizeof f, prefix, key);
+    return lr_json_fail(x->j, obj, f, x->e, LR_EPARSE, "required field is missing");
+}
+
+static int get_num(ctx *x, lr_jnode obj, const char *prefix, const char *key, bool required,
+                   double *out)
+{
+    lr_jnode v = lr_json_get(x->j, obj, key);
+    if (v == LR_JNONE)
+        return required ? missing(x, obj, prefix, key) : LR_OK;
+    char f[192];
+    field_name(f, sizeof f, prefix, key);
+    return lr_json_number(x->j, v, f, out, x->e);
+}
+
+static int get_num_in(ctx *x, lr_jnode obj, const char *prefix, const char *key, bool required,
+                      double lo, double hi, double *out)
+{
+    double v = *out;
+    int rc = get_num(x, obj, prefix, key, required, &v);
+    if (rc)
+        return rc;
+    if (v < lo || v > hi) {
+        char f[192];
+        field_name(f, sizeof f, prefix, key);
+        return lr_json_fail(x->j, lr_json_get(x->j, obj, key), f, x->e, LR_EPARSE,
+                            "must be in %g..%g, got %g", lo, hi, v);
+    }
+    *out = v;
+    return LR_OK;
+}
+
+static int get_int_in(ctx *x, lr_jnode obj, const char *prefix, const char *key, bool required,
+                      long lo, long hi, int *out)
+{
+    lr_jnode v = lr_json_get(x->j, obj, key);
+    if (v == LR_JNONE)
+        return required ? missing(x, obj, prefix, key) : LR_OK;
+    char f[192];
+    field_name(f, sizeof f, prefix, key);
+    long n;
+    int rc = lr_json_int(x->j, v, f, &n, x->e);
+    if (rc)
+        return rc;
+    if (n < lo || n > hi)
+        return lr_json_fail(x->j, v, f, x->e, LR_EPARSE, "must be in %ld..%ld, got %ld", lo, hi,
+                            n);
+    *out = (int)n;
+    return LR_OK;
+}
+
+static int get_bool(ctx *x, lr_jnode obj, const char *prefix, const char *key, bool *out)
+{
+    lr_jnode v = lr_json_get(x->j, obj, key);
+    if (v == LR_JNONE)
+        return LR_OK;
+    char f[192];
+    field_name(f, sizeof f, prefix, key);
+    return lr_json_bool(x->j, v, f, out, x->e);
+}
+
+static int get_str(ctx *x, lr_jnode obj, const char *prefix, const char *key, bool required,
+                   char *buf, size_t cap)
+{
+    lr_jnode v = lr_json_get(x->j, obj, key);
+    if (v == LR_JNONE)
+        return required ? missing(x, obj, prefix, key) : LR_OK;
+    char f[192];
+    field_name(f, sizeof f, prefix, key);
+    int rc = lr_json_string(x->j, v, f, buf, cap, x->e);
+    if (rc)
+        return rc;
+    if (!*buf)
+        return lr_json_fail(x->j, v, f, x->e, LR_EPARSE, "must not be empty");
+    return LR_OK;
+}
+
+/* Checks keys, naming unknown ones with the object's path. */
+static int keys(ctx *x, lr_jnode obj, const char *where, const char *const *allowed)
+{
+    if (lr_json_type(x->j, obj) != LR_JSON_OBJECT)
+        return lr_json_fail(x->j, obj, where, x->e, LR_EPARSE, "expected an object, got %s",
+                            lr_json_type_name(lr_json_type(x->j, obj)));
+    int n = lr_json_count(x->j, obj);
+    for (int m = 0; m < n; m++) {
+        lr_jnode k = lr_json_key_at(x->j, obj, m);
+        bool ok = false;
+        for (const char *const *a = allowed; *a && !ok; a++)
+            ok = lr_json_str_eq(x->j, k, *a);
+        if (!ok) {
+            char key[96] = "?";
+            lr_json_string(x->j, k, "key", key, sizeof key, NULL);
+            char f[192];
+            field_name(f, sizeof f, where, key);
+            return lr_json_fail(x->j, k, f, x->e, LR_EPARSE, "unknown field");
+        }
+    }
+    return lr_json_check_keys(x->j, obj, where, allowed, x->e);
+}
+
+/* A control or device name: 1..31 characters of [A-Za-z0-9_.-] (what events carry). */
+static int check_name(ctx *x, lr_jnode n, const char *field, const char *s)
+{
+    size_t len = strlen(s);
+    bool ok = len > 0 && len < LR_RIG_NAME_MAX;
+    for (size_t i = 0; ok && i < len; i++) {
+        char ch = s[i];
+        ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
+             ch == '_' || ch == '.' || ch == '-';
+    }
+    if (!ok)
+        return lr_json_fail(x->j, n, field, x->e, LR_EPARSE,
+                            "'%s' is not a name (1..31 of A-Z a-z 0-9 _ . -)", s);
+    return LR_OK;
+}
+
+/* Resolves a path against the config's directory and checks that the file exists. */
+static int resolve(ctx *x, lr_jnode n, const char *field, const char *rel, char *out, size_t cap)
+{
+    int w;
+    if (rel[0] == '/' || !x->dir[0])
+        w = snprintf(out, cap, "%s", rel);
+    else
+        w = snprintf(out, cap, "%s/%s", x->dir, rel);
+    if (w < 0 || (size_t)w >= cap)
+        return lr_json_fail(x->j, n, field, x->e, LR_EPARSE, "path too long");
+    struct stat st;
+    if (stat(out, &st) != 0)
+        return lr_json_fail(x->j, n, field, x->e, LR_EPARSE, "'%s': %s", out, strerror(errno));
+    if (!S_ISREG(st.st_mode))
+        return lr_json_fail(x->j, n, field, x->e, LR_EPARSE, "'%s' is not a file", out);
+    return LR_OK;
+}
+
+static int get_hex16(ctx *x, lr_jnode obj, const char *prefix, const char *key, uint16_t *out)
+{
+    char s[16] = "";
+    int rc = get_str(x, obj, prefix, key, true, s, sizeof s);
+    if (rc)
+        return rc;
+    char *end;
+    errno = 0;
+    unsigned long v = strtoul(s, &end, 16);
+    if (errno || *end || v > 0xffff || s[0] == '-' || s[0] == '+') {
+        char f[192];
+        field_name(f, sizeof f, prefix, key);
+        return lr_json_fail(x->j, lr_json_get(x->j, obj, key), f, x->e, LR_EPARSE,
+                            "'%s' is not a 16-bit hex id like \"077d\"", s);
+    }
+    *out = (uint16_t)v;
+    return LR_OK;
+}
+
+static int get_proto(ctx *x, lr_jnode obj, const char *prefix, int *out)
+{
+    static const char *const names[] = {"auto", "powermate", "shuttlexpress", "shuttlepro",
+                                        "consumer"};
+    char s[32] = "auto";
+    int rc = get_str(x, obj, prefix, "proto", false, s, sizeof s);
+    if (rc)
+        return rc;
+    for (int i = 0; i < 5; i++)
+        if (strcmp(s, names[i]) == 0) {
+            *out = i; /* the lr_hid_proto order */
+            return LR_OK;
+        }
+    char f[192];
+    field_name(f, sizeof f, prefix, "proto");
+    return lr_json_fail(x->j, lr_json_get(x->j, obj, "proto"), f, x->e, LR_EPARSE,
+                        "unknown protocol '%s' (auto, powermate, shuttlexpress, shuttlepro, "
+                        "consumer)", s);
+}
+
+/* ---- devices ---- */
+
+static int modbus_reg(ctx *x, lr_jnode o, const char *where, bool lamp, lr_rig_modbus_reg *r)
+{
+    static const char *const in_keys[] = {"control", "unit", "reg", "base", "type", "raw_min",
+                                          "raw_max", NULL};
+    static const char *const out_keys[] = {"unit", "reg", "base", "raw_min", "raw_max",
+                                           "multiple", NULL};
+    int rc = keys(x, o, where, lamp ? out_keys : in_keys);
+    if (rc)
+        return rc;
+    snprintf(r->control, sizeof r->control, "dimmer");
+    r->unit = lamp ? 2 : 1;
+    r->raw_min = 0;
+    r->raw_max = lamp ? 255 : 1000;
+    if (!lamp) {
+        if ((rc = get_str(x, o, where, "control", false, r->control, sizeof r->control)))
+            return rc;
+        char f[192];
+        field_name(f, sizeof f, where, "control");
+        if ((rc = check_name(x, o, f, r->control)))
+            return rc;
+        char type[16] = "holding";
+        if ((rc = get_str(x, o, where, "type", false, type, sizeof type)))
+            return rc;
+        if (strcmp(type, "holding") && strcmp(type, "input")) {
+            field_name(f, sizeof f, where, "type");
+            return lr_json_fail(x->j, lr_json_get(x->j, o, "type"), f, x->e, LR_EPARSE,
+                                "'%s' is not holding or input", type);
+        }
+        r->input_regs = strcmp(type, "input") == 0;
+    } else if ((rc = get_bool(x, o, where, "multiple", &r->multiple))) {
+        return rc;
+    }
+    if ((rc = get_int_in(x, o, where, "unit", false, 1, 255, &r->unit)) ||
+        (rc = get_int_in(x, o, where, "base", false, 0, 1, &r->base)) ||
+        (rc = get_int_in(x, o, where, "reg", true, r->base, 65535 + r->base, &r->reg)) ||
+        (rc = get_int_in(x, o, where, "raw_min", false, 0, 65535, &r->raw_min)) ||
+        (rc = get_int_in(x, o, where, "raw_max", false, 0, 65535, &r->raw_max)))
+        return rc;
+    if (r->raw_max <= r->raw_min) {
+        char f[192];
+        field_name(f, sizeof f, where, "raw_max");
+        return lr_json_fail(x->j, o, f, x->e, LR_EPARSE, "must be greater than raw_min (%d), got %d",
+                            r->raw_min, r->raw_max);
+    }
+    return LR_OK;
+}
+
+static int device(ctx *x, lr_jnode o, int index, lr_rig_device *d)
+{
+    char where[64];
+    snprintf(where, sizeof where, "devices[%d]", index);
+    d->line = lr_json_line(x->j, o);
+    if (lr_json_type(x->j, o) != LR_JSON_OBJECT)
+        return lr_json_fail(x->j, o, where, x->e, LR_EPARSE, "expected an object");
+    char type[16];
+    int rc = get_str(x, o, where, "type", true, type, sizeof type);
+    if (rc)
+        return rc;
+    static const char *const types[] = {"sim", "modbus", "gpio", "hid", "usb"};
+    int t = -1;
+    for (int i = 0; i < 5; i++)
+        if (strcmp(type, types[i]) == 0)
+            t = i;
+    char f[192];
+    field_name(f, sizeof f, where, "type");
+    if (t < 0)
+        return lr_json_fail(x->j, lr_json_get(x->j, o, "type"), f, x->e, LR_EPARSE,
+                            "unknown device type '%s' (sim, modbus, gpio, hid, usb)", type);
+    d->type = (lr_rig_dev_type)t;
+#define COMMON "type", "name", "required", "retry_min_ms", "retry_max_ms"
+    static const char *const sim_keys[] = {COMMON, "script", "text", "loop", NULL};
+    static const char *const modbus_keys[] = {COMMON, "url", "poll_ms", "timeout_ms",
+                                              "byte_timeout_ms", "max_timeouts", "inputs",
+                                              "lamp", NULL};
+    static const char *const gpio_keys[] = {COMMON, "chip", "bias", "encoders", "buttons", NULL};
+    static const char *const hid_keys[] = {COMMON, "vid", "pid", "serial", "poll_ms", "proto",
+                                           "report_id", NULL};
+    static const char *const usb_keys[] = {COMMON, "watch", "rescan_ms", "no_hotplug", NULL};
+#undef COMMON
+    static const char *const *const all_keys[] = {sim_keys, modbus_keys, gpio_keys, hid_keys,
+                                                  usb_keys};
+    if ((rc = keys(x, o, where, all_keys[t])))
+        return rc;
+    snprintf(d->name, sizeof d->name, "%s", type);
+    if ((rc = get_str(x, o, where, "name", false, d->name, sizeof d->name)))
+        return rc;
+    field_name(f, sizeof f, where, "name");
+    if ((rc = check_name(x, o, f, d->name)))
+        return rc;
+    d->retry_min_ms = 250;
+    d->retry_max_ms = 10000;
+    if ((rc = get_bool(x, o, where, "required", &d->required)) ||
+        (rc = get_int_in(x, o, where, "retry_min_ms", false, 1, 3600000, &d->retry_min_ms)) ||
+        (rc = get_int_in(x, o, where, "retry_max_ms", false, 1, 3600000, &d->retry_max_ms)))
+        return rc;
+    switch (d->type) {
+    case LR_RIG_DEV_SIM: {
+        lr_jnode s = lr_json_get(x->j, o, "script"), tx = lr_json_get(x->j, o, "text");
+        if ((s == LR_JNONE) == (tx == LR_JNONE))
+            return lr_json_fail(x->j, o, where, x->e, LR_EPARSE,
+                                "give exactly one of 'script' (a file) or 'text'");
+        if (s != LR_JNONE) {
+            char rel[LR_RIG_PATH_MAX];
+            if ((rc = get_str(x, o, where, "script", true, rel, sizeof rel)))
+                return rc;
+            field_name(f, sizeof f, where, "script");
+            if ((rc = resolve(x, s, f, rel, d->script, sizeof d->script)))
+                return rc;
+        } else {
+            enum { TEXT_MAX = 1 << 16 };
+            field_name(f, sizeof f, where, "text");
+            d->text = malloc(TEXT_MAX);
+            if (!d->text)
+                return lr_err_set(x->e, LR_ENOMEM, "out of memory");
+            if ((rc = lr_json_string(x->j, tx, f, d->text, TEXT_MAX, x->e)))
+                return rc;
+        }
+        return get_bool(x, o, where, "loop", &d->loop);
+    }
+    case LR_RIG_DEV_MODBUS: {
+        d->poll_ms = 50;
+        d->timeout_ms = 100;
+        d->byte_timeout_ms = 50;
+        d->max_timeouts = 3;
+        if ((rc = get_str(x, o, where, "url", true, d->url, sizeof d->url)) ||
+            (rc = get_int_in(x, o, where, "poll_ms", false, 1, 600000, &d->poll_ms)) ||
+            (rc = get_int_in(x, o, where, "timeout_ms", false, 1, 60000, &d->timeout_ms)) ||
+            (rc = get_int_in(x, o, where, "byte_timeout_ms", false, 1, 60000,
+                             &d->byte_timeout_ms)) ||
+            (rc = get_int_in(x, o, where, "max_timeouts", false, 1, 1000, &d->max_timeouts)))
+            return rc;
+        lr_modbus_url u;
+        lr_err ue = {0};
+        if (lr_modbus_url_parse(d->url, &u, &ue)) {
+            field_name(f, sizeof f, where, "url");
+            return lr_json_fail(x->j, lr_json_get(x->j, o, "url"), f, x->e, LR_EPARSE, "%s",
+                                ue.msg);
+        }
+        lr_jnode in = lr_json_get(x->j, o, "inputs");
+        if (in != LR_JNONE) {
+            field_name(f, sizeof f, where, "inputs");
+            if (lr_json_type(x->j, in) != LR_JSON_ARRAY)
+                return lr_json_fail(x->j, in, f, x->e, LR_EPARSE, "expected an array");
+            if (lr_json_count(x->j, in) > LR_RIG_MAX_ITEMS)
+                return lr_json_fail(x->j, in, f, x->e, LR_EPARSE, "at most %d inputs",
+                                    LR_RIG_MAX_ITEMS);
+            for (int i = 0; i < lr_json_count(x->j, in); i++) {
+                char w[96];
+                snprintf(w, sizeof w, "%s.inputs[%d]", where, i);
+                if ((rc = modbus_reg(x, lr_json_at(x->j, in, i), w, false, &d->inputs[i])))
+                    return rc;
+                for (int k = 0; k < i; k++)
+                    if (strcmp(d->inputs[k].control, d->inputs[i].control) == 0)
+                        return lr_json_fail(x->j, lr_json_at(x->j, in, i), w, x->e, LR_EPARSE,
+                                            "control '%s' appears twice", d->inputs[i].control);
+                d->n_inputs = i + 1;
+            }
+        }
+        lr_jnode lamp = lr_json_get(x->j, o, "lamp");
+        if (lamp != LR_JNONE) {
+            char w[96];
+            snprintf(w, sizeof w, "%s.lamp", where);
+            if ((rc = modbus_reg(x, lamp, w, true, &d->lamp)))
+                return rc;
+            d->has_lamp = true;
+        }
+        if (!d->n_inputs && !d->has_lamp)
+            return lr_json_fail(x->j, o, where, x->e, LR_EPARSE,
+                                "a modbus device needs 'inputs', 'lamp' or both");
+        return LR_OK;
+    }
+    case LR_RIG_DEV_GPIO: {
+        snprintf(d->chip, sizeof d->chip, "gpiochip0");
+        if ((rc = get_str(x, o, where, "chip", false, d->chip, sizeof d->chip)))
+            return rc;
+        char bias[16] = "pull-up";
+        if ((rc = get_str(x, o, where, "bias", false, bias, sizeof bias)))
+            return rc;
+        static const char *const biases[] = {"pull-up", "as-is", "disable", "pull-down"};
+        d->bias = -1;
+        for (int i = 0; i < 4; i++)
+            if (strcmp(bias, biases[i]) == 0)
+                d->bias = i; /* the lr_gpio_bias order */
+        if (d->bias < 0) {
+            field_name(f, sizeof f, where, "bias");
+            return lr_json_fail(x->j, lr_json_get(x->j, o, "bias"), f, x->e, LR_EPARSE,
+                                "'%s' is not pull-up, as-is, disable or pull-down", bias);
+        }
+        for (int pass = 0; pass < 2; pass++) {
+            const char *key = pass ? "buttons" : "encoders";
+            lr_jnode arr = lr_json_get(x->j, o, key);
+            if (arr == LR_JNONE)
+                continue;
+            field_name(f, sizeof f, where, key);
+            if (lr_json_type(x->j, arr) != LR_JSON_ARRAY)
+                return lr_json_fail(x->j, arr, f, x->e, LR_EPARSE, "expected an array");
+            if (lr_json_count(x->j, arr) > LR_RIG_MAX_ITEMS)
+                return lr_json_fail(x->j, arr, f, x->e, LR_EPARSE, "at most %d entries",
+                                    LR_RIG_MAX_ITEMS);
+            for (int i = 0; i < lr_json_count(x->j, arr); i++) {
+                lr_jnode it = lr_json_at(x->j, arr, i);
+                char w[96], wf[128];
+                snprintf(w, sizeof w, "%s.%s[%d]", where, key, i);
+                static const char *const enc_keys[] = {"name", "line_a", "line_b",
+                                                       "steps_per_detent", "reverse", NULL};
+                static const char *const btn_keys[] = {"name", "line", "active_high",
+                                                       "debounce_ms", NULL};
+                if ((rc = keys(x, it, w, pass ? btn_keys : enc_keys)))
+                    return rc;
+                lr_rig_gpio_line *l = pass ? &d->buttons[i] : &d->encoders[i];
+                l->steps_per_detent = 4;
+                l->debounce_ms = 5;
+                if ((rc = get_str(x, it, w, "name", true, l->name, sizeof l->name)))
+                    return rc;
+                field_name(wf, sizeof wf, w, "name");
+                if ((rc = check_name(x, it, wf, l->name)))
+                    return rc;
+                if (pass) {
+                    if ((rc = get_str(x, it, w, "line", true, l->line_a, sizeof l->line_a)) ||
+                        (rc = get_bool(x, it, w, "active_high", &l->active_high)) ||
+                        (rc = get_int_in(x, it, w, "debounce_ms", false, 0, 1000,
+                                         &l->debounce_ms)))
+                        return rc;
+                    d->n_buttons = i + 1;
+                } else {
+                    if ((rc = get_str(x, it, w, "line_a", true, l->line_a, sizeof l->line_a)) ||
+                        (rc = get_str(x, it, w, "line_b", true, l->line_b, sizeof l->line_b)) ||
+                        (rc = get_bool(x, it, w, "reverse", &l->reverse)) ||
+                        (rc = get_int_in(x, it, w, "steps_per_detent", false, 1, 4,
+                                         &l->steps_per_detent)))
+                        return rc;
+                    if (l->steps_per_detent == 3) {
+                        field_name(wf, sizeof wf, w, "steps_per_detent");
+                        return lr_json_fail(x->j, it, wf, x->e, LR_EPARSE,
+                                            "must be 1, 2 or 4, got 3");
+                    }
+                    d->n_encoders = i + 1;
+                }
+            }
+        }
+        if (!d->n_encoders && !d->n_buttons)
+            return lr_json_fail(x->j, o, where, x->e, LR_EPARSE,
+                                "a gpio device needs 'encoders', 'buttons' or both");
+        return LR_OK;
+    }
+    case LR_RIG_DEV_HID: {
+        d->poll_ms = 8;
+        if ((rc = get_hex16(x, o, where, "vid", &d->vid)) ||
+            (rc = get_hex16(x, o, where, "pid", &d->pid)) ||
+            (rc = get_int_in(x, o, where, "poll_ms", false, 1, 10000, &d->poll_ms)) ||
+            (rc = get_int_in(x, o, where, "report_id", false, 0, 255, &d->report_id)) ||
+            (rc = get_proto(x, o, where, &d->proto)))
+            return rc;
+        return get_str(x, o, where, "serial", false, d->serial, sizeof d->serial);
+    }
+    case LR_RIG_DEV_USB: {
+        d->rescan_ms = 1000;
+        if ((rc = get_int_in(x, o, where, "rescan_ms", false, 10, 600000, &d->rescan_ms)) ||
+            (rc = get_bool(x, o, where, "no_hotplug", &d->no_hotplug)))
+            return rc;
+        lr_jnode arr = lr_json_get(x->j, o, "watch");
+        field_name(f, sizeof f, where, "watch");
+        if (arr == LR_JNONE)
+            return missing(x, o, where, "watch");
+        if (lr_json_type(x->j, arr) != LR_JSON_ARRAY || lr_json_count(x->j, arr) < 1 ||
+            lr_json_count(x->j, arr) > LR_RIG_MAX_ITEMS)
+            return lr_json_fail(x->j, arr, f, x->e, LR_EPARSE, "expected an array of 1..%d",
+                                LR_RIG_MAX_ITEMS);
+        for (int i = 0; i < lr_json_count(x->j, arr); i++) {
+            lr_jnode it = lr_json_at(x->j, arr, i);
+            char w[96], wf[128];
+            snprintf(w, sizeof w, "%s.watch[%d]", where, i);
+            static const char *const w_keys[] = {"name", "vid", "pid", "read_reports",
+                                                 "interface", "proto", NULL};
+            lr_rig_usb_watch *u = &d->watch[i];
+            if ((rc = keys(x, it, w, w_keys)) ||
+                (rc = get_str(x, it, w, "name", true, u->name, sizeof u->name)))
+                return rc;
+            field_name(wf, sizeof wf, w, "name");
+            if ((rc = check_name(x, it, wf, u->name)) ||
+                (rc = get_hex16(x, it, w, "vid", &u->vid)) ||
+                (rc = get_hex16(x, it, w, "pid", &u->pid)) ||
+                (rc = get_bool(x, it, w, "read_reports", &u->read_reports)) ||
+                (rc = get_int_in(x, it, w, "interface", false, 0, 255, &u->interface)) ||
+                (rc = get_proto(x, it, w, &u->proto)))
+                return rc;
+            d->n_watch = i + 1;
+        }
+        return LR_OK;
+    }
+    }
+    return LR_OK;
+}
+
+/* ---- bindings ---- */
+
+static int color3(ctx *x, lr_jnode n, const char *field, double out[3])
+{
+    int rc = lr_json_numbers(x->j, n, field, out, 3, x->e);
+    if (rc)
+        return rc;
+    for (int k = 0; k < 3; k++)
+        if (out[k] < 0)
+            return lr_json_fail(x->j, n, field, x->e, LR_EPARSE,
+                                "colour components must be >= 0, got %g", out[k]);
+    return LR_OK;
+}
+
+static int binding(ctx *x, lr_jnode o, const char *where, lr_rig_binding *b)
+{
+    static const char *const b_keys[] = {"name", "control", "param", "range", "colors", "curve",
+                                         "step", "accel", "fade_s", "initial", "lamp", "values",
+                                         "wrap", NULL};
+    int rc = keys(x, o, where, b_keys);
+    if (rc)
+        return rc;
+    snprintf(b->file, sizeof b->file, "%s", lr_json_name(x->j));
+    b->line = b->line_param = b->line_range = lr_json_line(x->j, o);
+    if (lr_json_get(x->j, o, "param") != LR_JNONE)
+        b->line_param = lr_json_line(x->j, lr_json_get(x->j, o, "param"));
+    char f[192];
+    char control[2 * LR_RIG_NAME_MAX + 2];
+    if ((rc = get_str(x, o, where, "control", true, control, sizeof control)) ||
+        (rc = get_str(x, o, where, "param", true, b->param, sizeof b->param)))
+        return rc;
+    field_name(f, sizeof f, where, "control");
+    lr_jnode cn = lr_json_get(x->j, o, "control");
+    char *slash = strchr(control, '/');
+    if (slash) {
+        *slash = '\0';
+        if ((rc = check_name(x, cn, f, control)))
+            return rc;
+        snprintf(b->source, sizeof b->source, "%.31s", control);
+        if ((rc = check_name(x, cn, f, slash + 1)))
+            return rc;
+        snprintf(b->control, sizeof b->control, "%.31s", slash + 1);
+    } else {
+        if ((rc = check_name(x, cn, f, control)))
+            return rc;
+        snprintf(b->control, sizeof b->control, "%.31s", control);
+    }
+    snprintf(b->name, sizeof b->name, "%s", b->control);
+    if ((rc = get_str(x, o, where, "name", false, b->name, sizeof b->name)))
+        return rc;
+
+    lr_jnode values = lr_json_get(x->j, o, "values");
+    lr_jnode colors = lr_json_get(x->j, o, "colors");
+    lr_jnode range = lr_json_get(x->j, o, "range");
+    bool scene = strcmp(b->param, "scene") == 0;
+    b->wrap = true;
+    if (values != LR_JNONE) {
+        b->kind = LR_BIND_CYCLE;
+        static const char *const level_only[] = {"range", "colors", "curve", "step", "accel",
+                                                 "fade_s", "lamp", NULL};
+        for (const char *const *k = level_only; *k; k++)
+            if (lr_json_get(x->j, o, *k) != LR_JNONE) {
+                field_name(f, sizeof f, where, *k);
+                return lr_json_fail(x->j, lr_json_get(x->j, o, *k), f, x->e, LR_EPARSE,
+                                    "not allowed with 'values' (a cycle binding)");
+            }
+        field_name(f, sizeof f, where, "values");
+        int n = lr_json_count(x->j, values);
+        if (lr_json_type(x->j, values) != LR_JSON_ARRAY || n < 1 || n > LR_RIG_MAX_VALUES)
+            return lr_json_fail(x->j, values, f, x->e, LR_EPARSE,
+                                "expected an array of 1..%d values", LR_RIG_MAX_VALUES);
+        for (int i = 0; i < n; i++) {
+            lr_jnode v = lr_json_at(x->j, values, i);
+            b->line_values[i] = lr_json_line(x->j, v);
+            char vf[224];
+            snprintf(vf, sizeof vf, "%s[%d]", f, i);
+            if (lr_json_type(x->j, v) == LR_JSON_ARRAY && !scene) {
+                double c[3];
+                if ((rc = color3(x, v, vf, c)))
+                    return rc;
+                snprintf(b->values[i], sizeof b->values[i], "%.17g,%.17g,%.17g", c[0], c[1],
+                         c[2]);
+            } else {
+                char s[LR_RIG_PATH_MAX];
+                if ((rc = lr_json_string(x->j, v, vf, s, sizeof s, x->e)))
+                    return rc;
+                if (!*s)
+                    return lr_json_fail(x->j, v, vf, x->e, LR_EPARSE, "must not be empty");
+                if (scene) {
+                    if ((rc = resolve(x, v, vf, s, b->values[i], sizeof b->values[i])))
+                        return rc;
+                } else {
+                    snprintf(b->values[i], sizeof b->values[i], "%s", s);
+                }
+            }
+        }
+        b->n_values = n;
+        if ((rc = get_bool(x, o, where, "wrap", &b->wrap)))
+            return rc;
+        lr_jnode in = lr_json_get(x->j, o, "initial");
+        if (in != LR_JNONE) {
+            int idx = 0;
+            if ((rc = get_int_in(x, o, where, "initial", false, 0, n - 1, &idx)))
+                return rc;
+            b->has_initial = true;
+            b->initial = idx;
+        }
+        return LR_OK;
+    }
+    b->kind = LR_BIND_LEVEL;
+    if (scene)
+        return lr_json_fail(x->j, o, where, x->e, LR_EPARSE,
+                            "param 'scene' needs 'values' (a list of scene files)");
+    if (lr_json_get(x->j, o, "wrap") != LR_JNONE) {
+        field_name(f, sizeof f, where, "wrap");
+        return lr_json_fail(x->j, lr_json_get(x->j, o, "wrap"), f, x->e, LR_EPARSE,
+                            "only for cycle bindings (with 'values')");
+    }
+    b->range[0] = 0;
+    b->range[1] = 1;
+    if (colors != LR_JNONE && range != LR_JNONE) {
+        field_name(f, sizeof f, where, "colors");
+        return lr_json_fail(x->j, colors, f, x->e, LR_EPARSE, "give 'range' or 'colors', not both");
+    }
+    if (range != LR_JNONE || colors != LR_JNONE)
+        b->line_range = lr_json_line(x->j, range != LR_JNONE ? range : colors);
+    if (range != LR_JNONE) {
+        field_name(f, sizeof f, where, "range");
+        if ((rc = lr_json_numbers(x->j, range, f, b->range, 2, x->e)))
+            return rc;
+        if (!(b->range[0] != b->range[1]))
+            return lr_json_fail(x->j, range, f, x->e, LR_EPARSE, "range is empty: [%g, %g]",
+                                b->range[0], b->range[1]);
+    }
+    if (colors != LR_JNONE) {
+        field_name(f, sizeof f, where, "colors");
+        if (lr_json_type(x->j, colors) != LR_JSON_ARRAY || lr_json_count(x->j, colors) != 2)
+            return lr_json_fail(x->j, colors, f, x->e, LR_EPARSE,
+                                "expected two colours [[r,g,b], [r,g,b]]");
+        for (int i = 0; i < 2; i++) {
+            char vf[224];
+            snprintf(vf, sizeof vf, "%s[%d]", f, i);
+            if ((rc = color3(x, lr_json_at(x->j, colors, i), vf, b->colors[i])))
+                return rc;
+        }
+        b->is_color = true;
+    }
+    char curve[16] = "linear";
+    if ((rc = get_str(x, o, where, "curve", false, curve, sizeof curve)))
+        return rc;
+    enum lr_curve cv;
+    if (lr_curve_parse(curve, &cv) != 0) {
+        field_name(f, sizeof f, where, "curve");
+        return lr_json_fail(x->j, lr_json_get(x->j, o, "curve"), f, x->e, LR_EPARSE,
+                            "unknown curve '%s' (linear, square, s-curve, log)", curve);
+    }
+    b->curve = (int)cv;
+    b->step = 0.02;
+    b->accel_rate0 = 5;
+    b->accel_max = 10;
+    if ((rc = get_num_in(x, o, where, "step", false, 1e-6, 1, &b->step)) ||
+        (rc = get_num_in(x, o, where, "fade_s", false, 0, 3600, &b->fade_s)) ||
+        (rc = get_bool(x, o, where, "lamp", &b->lamp)))
+        return rc;
+    if (lr_json_get(x->j, o, "initial") != LR_JNONE) {
+        if ((rc = get_num_in(x, o, where, "initial", false, 0, 1, &b->initial)))
+            return rc;
+        b->has_initial = true;
+    }
+    lr_jnode acc = lr_json_get(x->j, o, "accel");
+    if (acc != LR_JNONE) {
+        char w[96];
+        snprintf(w, sizeof w, "%s.accel", where);
+        static const char *const a_keys[] = {"gain", "rate0", "max", NULL};
+        if ((rc = keys(x, acc, w, a_keys)) ||
+            (rc = get_num_in(x, acc, w, "gain", false, 0, 100, &b->accel_gain)) ||
+            (rc = get_num_in(x, acc, w, "rate0", false, 0.1, 1000, &b->accel_rate0)) ||
+            (rc = get_num_in(x, acc, w, "max", false, 1, 1000, &b->accel_max)))
+            return rc;
+    }
+    if (b->lamp && b->is_color) {
+        field_name(f, sizeof f, where, "lamp");
+        return lr_json_fail(x->j, lr_json_get(x->j, o, "lamp"), f, x->e, LR_EPARSE,
+                            "a colour binding cannot drive the lamp driver");
+    }
+    return LR_OK;
+}
+
+static int bindings(ctx *x, lr_jnode arr, const lr_json *owner)
+{
+    (void)owner;
+    if (lr_json_type(x->j, arr) != LR_JSON_ARRAY)
+        return lr_json_fail(x->j, arr, "controls", x->e, LR_EPARSE, "expected an array");
+    int n = lr_json_count(x->j, arr);
+    if (n > LR_RIG_MAX_BINDINGS)
+        return lr_json_fail(x->j, arr, "controls", x->e, LR_EPARSE, "at most %d bindings",
+                            LR_RIG_MAX_BINDINGS);
+    int lamps = 0;
+    for (int i = 0; i < n; i++) {
+        char where[64];
+        snprintf(where, sizeof where, "controls[%d]", i);
+        lr_rig_binding *b = &x->c->bindings[i];
+        lr_jnode o = lr_json_at(x->j, arr, i);
+        int rc = binding(x, o, where, b);
+        if (rc)
+            return rc;
+        x->c->n_bindings = i + 1;
+        if (b->lamp && ++lamps > 1)
+            return lr_json_fail(x->j, o, where, x->e, LR_EPARSE,
+                                "only one binding may drive the lamp driver ('lamp': true)");
+        for (int k = 0; k < i; k++) {
+            const lr_rig_binding *p = &x->c->bindings[k];
+            bool string_param = b->kind == LR_BIND_CYCLE || p->kind == LR_BIND_CYCLE;
+            if (string_param && strcmp(p->param, b->param) == 0)
+                return lr_json_fail(x->j, o, where, x->e, LR_EPARSE,
+                                    "param '%s' is already driven by controls[%d]; a cycle "
+                                    "binding must be the only one on its parameter",
+                                    b->param, k);
+        }
+    }
+    return LR_OK;
+}
+
+/* ---- top level ---- */
+
+static int parse_root(ctx *x)
+{
+    const lr_json *j = x->j;
+    lr_jnode root = lr_json_root(j);
+    lr_rig_config *c = x->c;
+    static const char *const top[] = {"scene", "scene_set", "devices", "controls", "output",
+                                      "safe_level", "stats", NULL};
+    int rc = keys(x, root, "", top);
+    if (rc)
+        return rc;
+    char rel[LR_RIG_PATH_MAX];
+    if ((rc = get_str(x, root, "", "scene", true, rel, sizeof rel)) ||
+        (rc = resolve(x, lr_json_get(j, root, "scene"), "scene", rel, c->scene, sizeof c->scene)))
+        return rc;
+
+    lr_jnode sets = lr_json_get(j, root, "scene_set");
+    if (sets != LR_JNONE) {
+        if (lr_json_type(j, sets) != LR_JSON_OBJECT)
+            return lr_json_fail(j, sets, "scene_set", x->e, LR_EPARSE, "expected an object");
+        if (lr_json_count(j, sets) > LR_RIG_MAX_SETS)
+            return lr_json_fail(j, sets, "scene_set", x->e, LR_EPARSE, "at most %d parameters",
+                                LR_RIG_MAX_SETS);
+        for (int i = 0; i < lr_json_count(j, sets); i++) {
+            lr_jnode k = lr_json_key_at(j, sets, i), v = lr_json_at(j, sets, i);
+            char *key = c->sets[i].key, *val = c->sets[i].value;
+            if ((rc = lr_json_string(j, k, "scene_set", key, sizeof c->sets[i].key, x->e)))
+                return rc;
+            char f[160];
+            snprintf(f, sizeof f, "scene_set.%s", key);
+            c->sets[i].line = lr_json_line(j, v);
+            enum lr_json_type t = lr_json_type(j, v);
+            if (t == LR_JSON_NUMBER) {
+                double d;
+                if ((rc = lr_json_number(j, v, f, &d, x->e)))
+                    return rc;
+                snprintf(val, sizeof c->sets[i].value, "%.17g", d);
+            } else if (t == LR_JSON_STRING) {
+                if ((rc = lr_json_string(j, v, f, val, sizeof c->sets[i].value, x->e)))
+                    return rc;
+            } else if (t == LR_JSON_BOOL) {
+                bool b;
+                lr_json_bool(j, v, f, &b, NULL);
+                snprintf(val, sizeof c->sets[i].value, "%s", b ? "true" : "false");
+            } else if (t == LR_JSON_ARRAY && lr_json_count(j, v) == 3) {
+                double d[3];
+                if ((rc = lr_json_numbers(j, v, f, d, 3, x->e)))
+                    return rc;
+                snprintf(val, sizeof c->sets[i].value, "%.17g,%.17g,%.17g", d[0], d[1], d[2]);
+            } else {
+                return lr_json_fail(j, v, f, x->e, LR_EPARSE,
+                                    "expected a number, a string, a boolean or [x, y, z]");
+            }
+            c->n_sets = i + 1;
+        }
+    }
+
+    lr_jnode devs = lr_json_get(j, root, "devices");
+    if (devs != LR_JNONE) {
+        if (lr_json_type(j, devs) != LR_JSON_ARRAY)
+            return lr_json_fail(j, devs, "devices", x->e, LR_EPARSE, "expected an array");
+        if (lr_json_count(j, devs) > LR_RIG_MAX_DEVICES)
+            return lr_json_fail(j, devs, "devices", x->e, LR_EPARSE, "at most %d devices",
+                                LR_RIG_MAX_DEVICES);
+        for (int i = 0; i < lr_json_count(j, devs); i++) {
+            lr_jnode o = lr_json_at(j, devs, i);
+            if ((rc = device(x, o, i, &c->devices[i])))
+                return rc;
+            c->n_devices = i + 1;
+            for (int k = 0; k < i; k++)
+                if (strcmp(c->devices[k].name, c->devices[i].name) == 0) {
+                    char f[64];
+                    snprintf(f, sizeof f, "devices[%d].name", i);
+                    return lr_json_fail(j, o, f, x->e, LR_EPARSE,
+                                        "device name '%s' is already used by devices[%d]",
+                                        c->devices[i].name, k);
+                }
+        }
+    }
+
+    lr_jnode ctl = lr_json_get(j, root, "controls");
+    if (ctl != LR_JNONE && lr_json_type(j, ctl) == LR_JSON_STRING) {
+        char rel2[LR_RIG_PATH_MAX], path[LR_RIG_PATH_MAX];
+        if ((rc = get_str(x, root, "", "controls", true, rel2, sizeof rel2)) ||
+            (rc = resolve(x, ctl, "controls", rel2, path, sizeof path)))
+            return rc;
+        lr_json *cj;
+        if ((rc = lr_json_load(path, &cj, x->e)))
+            return rc;
+        ctx y = *x;
+        y.j = cj;
+        /* Paths inside a control-map file resolve against that file. */
+        char *sl = strrchr(path, '/');
+        if (sl) {
+            *sl = '\0';
+            snprintf(y.dir, sizeof y.dir, "%s", path);
+        } else {
+            y.dir[0] = '\0';
+        }
+        static const char *const ck[] = {"controls", NULL};
+        lr_jnode croot = lr_json_root(cj);
+        rc = keys(&y, croot, "", ck);
+        if (!rc) {
+            lr_jnode arr = lr_json_get(cj, croot, "controls");
+            rc = arr == LR_JNONE ? missing(&y, croot, "", "controls") : bindings(&y, arr, cj);
+        }
+        lr_json_destroy(cj);
+        if (rc)
+            return rc;
+    } else if (ctl != LR_JNONE) {
+        if ((rc = bindings(x, ctl, j)))
+            return rc;
+    }
+
+    c->output.width = 640;
+    c->output.height = 480;
+    c->output.fps = 30;
+    lr_jnode out = lr_json_get(j, root, "output");
+    if (out != LR_JNONE) {
+        static const char *const ok[] = {"mode", "connector", "drm_device", "mode_size",
+                                         "refresh_hz", "width", "height", "fps", "renderer",
+                                         NULL};
+        /* "mode" is headless|kms; the display mode size is "mode_size": [W, H]. */
+        if ((rc = keys(x, out, "output", ok)))
+            return rc;
+        char mode[16] = "headless";
+        if ((rc = get_str(x, out, "output", "mode", false, mode, sizeof mode)))
+            return rc;
+        if (strcmp(mode, "headless") == 0)
+            c->output.mode = LR_RIG_HEADLESS;
+        else if (strcmp(mode, "kms") == 0)
+            c->output.mode = LR_RIG_KMS;
+        else
+            return lr_json_fail(j, lr_json_get(j, out, "mode"), "output.mode", x->e, LR_EPARSE,
+                                "'%s' is not headless or kms", mode);
+        lr_jnode ms = lr_json_get(j, out, "mode_size");
+        if (ms != LR_JNONE) {
+            double wh[2];
+            if ((rc = lr_json_numbers(j, ms, "output.mode_size", wh, 2, x->e)))
+                return rc;
+            if (wh[0] < 1 || wh[1] < 1 || wh[0] > 16384 || wh[1] > 16384 ||
+                wh[0] != floor(wh[0]) || wh[1] != floor(wh[1]))
+                return lr_json_fail(j, ms, "output.mode_size", x->e, LR_EPARSE,
+                                    "expected [W, H] in pixels (1..16384)");
+            c->output.mode_w = (int)wh[0];
+            c->output.mode_h = (int)wh[1];
+        }
+        if ((rc = get_str(x, out, "output", "connector", false, c->output.connector,
+                          sizeof c->output.connector)) ||
+            (rc = get_str(x, out, "output", "drm_device", false, c->output.drm_device,
+                          sizeof c->output.drm_device)) ||
+            (rc = get_int_in(x, out, "output", "refresh_hz", false, 0, 1000,
+                             &c->output.refresh_hz)) ||
+            (rc = get_int_in(x, out, "output", "width", false, 16, 8192, &c->output.width)) ||
+            (rc = get_int_in(x, out, "output", "height", false, 16, 8192, &c->output.height)) ||
+            (rc = get_num_in(x, out, "output", "fps", false, 0.1, 1000, &c->output.fps)) ||
+            (rc = get_str(x, out, "output", "renderer", false, c->output.renderer,
+                          sizeof c->output.renderer)))
+            return rc;
+    }
+    if ((rc = get_num_in(x, root, "", "safe_level", false, 0, 1, &c->safe_level)))
+        return rc;
+    c->stats_period_s = 10;
+    lr_jnode st = lr_json_get(j, root, "stats");
+    if (st != LR_JNONE) {
+        static const char *const ok[] = {"path", "period_s", NULL};
+        if ((rc = keys(x, st, "stats", ok)) ||
+            (rc = get_num_in(x, st, "stats", "period_s", false, 0, 86400, &c->stats_period_s)))
+            return rc;
+        char p[LR_RIG_PATH_MAX] = "";
+        if ((rc = get_str(x, st, "stats", "path", false, p, sizeof p)))
+            return rc;
+        if (*p) {
+            if (p[0] == '/' || !x->dir[0])
+                snprintf(c->stats_path, sizeof c->stats_path, "%s", p);
+            else if (snprintf(c->stats_path, sizeof c->stats_path, "%s/%s", x->dir, p) >=
+                     (int)sizeof c->stats_path)
+                return lr_json_fail(j, st, "stats.path", x->e, LR_EPARSE, "path too long");
+        }
+    }
+    /* Bindings name devices by source: a source that no device has (and no sim script could
+     * speak for, i.e. there is no sim device) is a typo. */
+    bool have_sim = false;
+    for (int i = 0; i < c->n_devices; i++)
+        have_sim |= c->devices[i].type == LR_RIG_DEV_SIM;
+    for (int i = 0; i < c->n_bindings && !have_sim; i++) {
+        const lr_rig_binding *b = &c->bindings[i];
+        if (!b->source[0])
+            continue;
+        bool found = false;
+        for (int k = 0; k < c->n_devices && !found; k++) {
+            found = strcmp(c->devices[k].name, b->source) == 0;
+            for (int w = 0; w < c->devices[k].n_watch && !found; w++)
+                found = strcmp(c->devices[k].watch[w].name, b->source) == 0;
+        }
+        if (!found) {
+            char f[64];
+            snprintf(f, sizeof f, "controls[%d].control", i);
+            return lr_err_set(x->e, LR_EPARSE, "%s:%d: field '%s': no device named '%s'",
+                              b->file, b->line, f, b->source);
+        }
+    }
+    return LR_OK;
+}
+
+static int parse_json(lr_json *j, const char *name, lr_rig_config **out, lr_err *e)
+{
+    lr_rig_config *c = calloc(1, sizeof *c);
+    if (!c)
+        return lr_err_set(e, LR_ENOMEM, "out of memory");
+    ctx x = {.j = j, .c = c, .e = e};
+    snprintf(c->path, sizeof c->path, "%s", name);
+    const char *sl = strrchr(name, '/');
+    if (sl)
+        snprintf(x.dir, sizeof x.dir, "%.*s", (int)(sl - name), name);
+    int rc = parse_root(&x);
+    if (rc) {
+        lr_rig_config_destroy(c);
+        return rc;
+    }
+    *out = c;
+    return LR_OK;
+}
+
+int lr_rig_config_load(const char *path, lr_rig_config **out, lr_err *e)
+{
+    lr_json *j;
+    int rc = lr_json_load(path, &j, e);
+    if (rc)
+        return rc;
+    rc = parse_json(j, path, out, e);
+    lr_json_destroy(j);
+    return rc;
+}
+
+int lr_rig_config_parse(const char *text, const char *name, lr_rig_config **out, lr_err *e)
+{
+    lr_json *j;
+    int rc = lr_json_parse(text, strlen(text), name, &j, e);
+    if (rc)
+        return rc;
+    rc = parse_json(j, name, out, e);
+    lr_json_destroy(j);
+    return rc;
+}
+
+void lr_rig_config_destroy(lr_rig_config *c)
+{
+    if (!c)
+        return;
+    for (int i = 0; i < LR_RIG_MAX_DEVICES; i++)
+        free(c->devices[i].text);
+    free(c);
+}
+
+int lr_rig_config_apply_sets(const lr_rig_config *c, lr_scene *scene, lr_err *e)
+{
+    for (int i = 0; i < c->n_sets; i++) {
+        lr_err le = {0};
+        if (lr_scene_set(scene, c->sets[i].key, c->sets[i].value, NULL, &le))
+            return lr_err_set(e, LR_EPARSE, "%s:%d: field 'scene_set.%s': %s", c->path,
+                              c->sets[i].line, c->sets[i].key, le.msg);
+    }
+    return LR_OK;
+}
+
+int lr_rig_config_lamp_device(const lr_rig_config *c)
+{
+    for (int i = 0; i < c->n_devices; i++)
+        if (c->devices[i].type == LR_RIG_DEV_MODBUS && c->devices[i].has_lamp)
+            return i;
+    return -1;
+}
+
+const char *lr_rig_dev_type_name(lr_rig_dev_type t)
+{
+    static const char *const names[] = {"sim", "modbus", "gpio", "hid", "usb"};
+    return (unsigned)t < 5 ? names[t] : "?";
+}

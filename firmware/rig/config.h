@@ -1,0 +1,222 @@
+/* lamprig firmware — the rig config: devices, control map, output, scene, safe lamp level,
+ * stats. One JSON file (configs/rig/NAME.json), validated completely before anything is
+ * opened; every error reads "FILE:LINE: field 'F': what" (render/base/json.h).
+ *
+ * {
+ *   "scene":    "PATH"                 scene file; relative paths resolve against this file
+ *   "scene_set": {"render.K": 4, "light.color": [1, 0.6, 0.3], ...}   scene parameters set
+ *                                      after every load of the scene (the rig's render budget:
+ *                                      a small GPU needs smaller maps than the scene file's)
+ *   "devices":  [ DEVICE, ... ]        zero or more (names unique)
+ *   "controls": [ BINDING, ... ] | "PATH"   the control map, inline or a file holding
+ *                                      {"controls": [ ... ]} (configs/controls/NAME.json)
+ *   "output":   {"mode": "headless" | "kms" (default headless),
+ *                "connector": "HDMI-A-1" (kms; default the first connected),
+ *                "drm_device": "/dev/dri/card1" (kms; default: probe),
+ *                "mode_size": [W, H] (kms; default the preferred mode), "refresh_hz": 0,
+ *                "width": 640, "height": 480 (headless image size),
+ *                "fps": 30 (headless frame rate cap; kms follows vsync),
+ *                "renderer": "passes" | "preview" (default: the first one built in)}
+ *   "safe_level": 0                    lamp-driver level (0..1, as written to the driver,
+ *                                      after any curve) set at shutdown
+ *   "stats":    {"path": "PATH" (default none), "period_s": 10 (0: only at exit)}
+ * }
+ *
+ * DEVICE (every kind): "type", "name" (default the type), "required": false,
+ * "retry_min_ms": 250, "retry_max_ms": 10000, and
+ *   sim:    "script": "PATH" | "text": "...", "loop": false
+ *   modbus: "url": "tcp://HOST:PORT" | "rtu:DEV?baud=...", "poll_ms": 50, "timeout_ms": 100,
+ *           "byte_timeout_ms": 50, "max_timeouts": 3,
+ *           "inputs": [{"control": "dimmer", "unit": 1, "reg": 0, "base": 0,
+ *                       "type": "holding" | "input", "raw_min": 0, "raw_max": 1000}],
+ *           "lamp": {"unit": 2, "reg": 0, "base": 0, "raw_min": 0, "raw_max": 255,
+ *                    "multiple": false}                (optional: the lamp driver)
+ *   gpio:   "chip": "gpiochip0", "bias": "pull-up" | "as-is" | "disable" | "pull-down",
+ *           "encoders": [{"name", "line_a", "line_b", "steps_per_detent": 4, "reverse"}],
+ *           "buttons": [{"name", "line", "active_high": false, "debounce_ms": 5}]
+ *   hid:    "vid": "077d", "pid": "0410" (hex strings), "serial", "poll_ms": 8,
+ *           "proto": "auto" | "powermate" | "shuttlexpress" | "shuttlepro" | "consumer",
+ *           "report_id": 0
+ *   usb:    "watch": [{"name", "vid", "pid", "read_reports": false, "interface": 0,
+ *                      "proto": "auto"}], "rescan_ms": 1000, "no_hotplug": false
+ *
+ * BINDING (one control → one scene parameter; firmware/rig/control_map.h):
+ *   "control": "SOURCE/CONTROL" | "CONTROL" (any source)      required
+ *   "param":   scene parameter name (lr_scene_set) or "scene"  required
+ *   "name":    for logs and stats (default: the control)
+ *   level bindings (a number or a colour following a position 0..1):
+ *     "range": [MIN, MAX] (default [0, 1]) | "colors": [[r,g,b], [r,g,b]] (interpolated),
+ *     "curve": "linear" | "square" | "s-curve" | "log" (default linear),
+ *     "step": 0.02 (position per encoder detent), "accel": {"gain": 0, "rate0": 5, "max": 10},
+ *     "fade_s": 0 (seconds a change takes), "initial": position 0..1 (default: from the
+ *     scene's value), "lamp": false (this binding's curved level also drives the lamp driver)
+ *   cycle bindings (a button or encoder steps through a list):
+ *     "values": ["marble", "candle_wax", ...] (names, or scene files for "scene") or
+ *               [[r,g,b], ...] (colours), "initial": index (default: not applied), "wrap": true
+ */
+#ifndef LR_RIG_CONFIG_H
+#define LR_RIG_CONFIG_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "render/base/err.h"
+
+#define LR_RIG_NAME_MAX 32
+#define LR_RIG_PATH_MAX 512
+#define LR_RIG_MAX_DEVICES 16
+#define LR_RIG_MAX_BINDINGS 32
+#define LR_RIG_MAX_VALUES 32
+#define LR_RIG_MAX_ITEMS 16 /* inputs, encoders, buttons, watches per device */
+#define LR_RIG_MAX_SETS 32
+
+typedef enum lr_rig_dev_type {
+    LR_RIG_DEV_SIM = 0,
+    LR_RIG_DEV_MODBUS,
+    LR_RIG_DEV_GPIO,
+    LR_RIG_DEV_HID,
+    LR_RIG_DEV_USB,
+} lr_rig_dev_type;
+
+typedef struct lr_rig_modbus_reg {
+    char control[LR_RIG_NAME_MAX];
+    int unit, reg, base;
+    bool input_regs; /* "type": "input" */
+    int raw_min, raw_max;
+    bool multiple;   /* lamp only */
+} lr_rig_modbus_reg;
+
+typedef struct lr_rig_gpio_line {
+    char name[LR_RIG_NAME_MAX];
+    char line_a[LR_RIG_NAME_MAX], line_b[LR_RIG_NAME_MAX]; /* buttons: line_a */
+    int steps_per_detent;
+    bool reverse;
+    bool active_high;
+    int debounce_ms;
+} lr_rig_gpio_line;
+
+typedef struct lr_rig_usb_watch {
+    char name[LR_RIG_NAME_MAX];
+    uint16_t vid, pid;
+    bool read_reports;
+    int interface;
+    int proto; /* lr_hid_proto */
+} lr_rig_usb_watch;
+
+typedef struct lr_rig_device {
+    lr_rig_dev_type type;
+    char name[LR_RIG_NAME_MAX];
+    int line; /* in the config file, for messages */
+    bool required;
+    int retry_min_ms, retry_max_ms;
+    /* sim */
+    char script[LR_RIG_PATH_MAX]; /* resolved path, or "" with text */
+    char *text;                   /* owned; inline script */
+    bool loop;
+    /* modbus */
+    char url[LR_RIG_PATH_MAX];
+    int poll_ms, timeout_ms, byte_timeout_ms, max_timeouts;
+    lr_rig_modbus_reg inputs[LR_RIG_MAX_ITEMS];
+    int n_inputs;
+    bool has_lamp;
+    lr_rig_modbus_reg lamp;
+    /* gpio */
+    char chip[LR_RIG_NAME_MAX];
+    int bias; /* lr_gpio_bias */
+    lr_rig_gpio_line encoders[LR_RIG_MAX_ITEMS];
+    int n_encoders;
+    lr_rig_gpio_line buttons[LR_RIG_MAX_ITEMS];
+    int n_buttons;
+    /* hid */
+    uint16_t vid, pid;
+    char serial[64];
+    int proto; /* lr_hid_proto */
+    int report_id;
+    /* usb */
+    lr_rig_usb_watch watch[LR_RIG_MAX_ITEMS];
+    int n_watch;
+    int rescan_ms;
+    bool no_hotplug;
+} lr_rig_device;
+
+typedef enum lr_binding_kind {
+    LR_BIND_LEVEL = 0, /* a position 0..1 → curve → range (number) or colors (RGB) */
+    LR_BIND_CYCLE,     /* steps through `values` */
+} lr_binding_kind;
+
+typedef struct lr_rig_binding {
+    char name[LR_RIG_NAME_MAX];
+    char source[LR_RIG_NAME_MAX];  /* "" = any */
+    char control[LR_RIG_NAME_MAX];
+    char param[128];
+    char file[LR_RIG_PATH_MAX]; /* the file it is in (the rig config or a control-map file) */
+    int line;        /* of the binding; of its "param", "range"/"colors", each value: */
+    int line_param, line_range, line_values[LR_RIG_MAX_VALUES];
+    lr_binding_kind kind;
+    /* level */
+    bool is_color;
+    double range[2];
+    double colors[2][3];
+    int curve; /* enum lr_curve */
+    double step;
+    double accel_gain, accel_rate0, accel_max;
+    double fade_s;
+    bool has_initial;
+    double initial; /* level: position; cycle: index */
+    bool lamp;
+    /* cycle */
+    int n_values;
+    char values[LR_RIG_MAX_VALUES][LR_RIG_PATH_MAX]; /* names, resolved scene paths, "r,g,b" */
+    bool wrap;
+} lr_rig_binding;
+
+typedef enum lr_rig_output_mode {
+    LR_RIG_HEADLESS = 0,
+    LR_RIG_KMS,
+} lr_rig_output_mode;
+
+typedef struct lr_rig_config {
+    char path[LR_RIG_PATH_MAX];  /* the file it came from */
+    char scene[LR_RIG_PATH_MAX]; /* resolved */
+    struct {
+        char key[128], value[256];
+        int line;
+    } sets[LR_RIG_MAX_SETS];
+    int n_sets;
+    lr_rig_device devices[LR_RIG_MAX_DEVICES];
+    int n_devices;
+    lr_rig_binding bindings[LR_RIG_MAX_BINDINGS];
+    int n_bindings;
+    struct {
+        lr_rig_output_mode mode;
+        char connector[LR_RIG_NAME_MAX];
+        char drm_device[LR_RIG_PATH_MAX];
+        int mode_w, mode_h, refresh_hz;
+        int width, height;
+        double fps;
+        char renderer[LR_RIG_NAME_MAX]; /* "" = default */
+    } output;
+    double safe_level;
+    char stats_path[LR_RIG_PATH_MAX];
+    double stats_period_s;
+} lr_rig_config;
+
+/* Loads and validates path completely (every device, binding and the output; file paths are
+ * resolved and checked to exist; scene parameters are checked against the scene by the
+ * control map, see lr_control_map_create). LR_EIO / LR_EPARSE naming file, line and field. */
+int lr_rig_config_load(const char *path, lr_rig_config **out, lr_err *e);
+/* The same from text; name is used in messages and as the base of relative paths. */
+int lr_rig_config_parse(const char *text, const char *name, lr_rig_config **out, lr_err *e);
+void lr_rig_config_destroy(lr_rig_config *c);
+
+/* Applies "scene_set" to a freshly loaded scene; errors name the config file, line and field. */
+struct lr_scene;
+int lr_rig_config_apply_sets(const lr_rig_config *c, struct lr_scene *scene, lr_err *e);
+
+/* The modbus device the lamp driver is on, -1 when none. */
+int lr_rig_config_lamp_device(const lr_rig_config *c);
+
+/* "sim", "modbus", "gpio", "hid", "usb". */
+const char *lr_rig_dev_type_name(lr_rig_dev_type t);
+
+#endif

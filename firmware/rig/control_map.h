@@ -1,0 +1,72 @@
+/* lamprig firmware — the control map: hal events in, scene parameters (and the lamp-driver
+ * level) out. The bindings come from the rig config (firmware/rig/config.h).
+ *
+ * A level binding keeps a control *position* x in [0, 1]: an absolute event (dimmer, fader)
+ * sets it, a delta event (encoder detent) moves it by value * step * acceleration
+ * (firmware/control/accel.h). The curve (firmware/control/curve.h) turns x into a *level*
+ * y = curve(x) in [0, 1]; this is the one place a curve is applied. y fades (fade.h) over
+ * fade_s to its new target, and the faded level is what both the scene and the lamp driver get:
+ * the parameter becomes min + (max - min) * y (or the colour c0 + (c1 - c0) * y) and, for the
+ * binding marked "lamp", y itself goes to lr_modbus_write_level.
+ * Several level bindings on one parameter multiply (a translucency-scale knob and a shade
+ * colour both on objects[0].material.scale give scale * colour).
+ *
+ * A cycle binding steps through its values: a press moves one on, a delta moves by its sign
+ * and size, an absolute position picks value floor(x * n). Param "scene" switches the scene
+ * file (the rig loads it, see lr_control_map_scene_request).
+ *
+ * Events with non-finite values, or kinds a binding does not take (releases), are ignored.
+ */
+#ifndef LR_RIG_CONTROL_MAP_H
+#define LR_RIG_CONTROL_MAP_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "firmware/rig/config.h"
+#include "hal/event.h"
+#include "render/base/err.h"
+#include "render/scene/scene.h"
+
+typedef struct lr_control_map lr_control_map;
+
+/* Builds the map over cfg's bindings (cfg must outlive the map) for `scene`: checks every
+ * parameter exists in the scene and that the range ends and every cycle value are accepted
+ * (on a scratch copy of the scene file when check_values; errors name the config file, line
+ * and field), takes the starting positions (`initial`, else inverted from the scene's current
+ * value), and leaves nothing applied yet: call lr_control_map_update. */
+int lr_control_map_create(const lr_rig_config *cfg, lr_scene *scene, bool check_values,
+                          int64_t now_ns, lr_control_map **out, lr_err *e);
+void lr_control_map_destroy(lr_control_map *m);
+
+/* Feeds one event at now_ns. Returns the index of the binding it moved, or -1 when no binding
+ * took it (no match, a release, a non-finite value, a position that did not change). */
+int lr_control_map_event(lr_control_map *m, const lr_event *ev, int64_t now_ns);
+
+/* Writes every parameter whose value at now_ns differs from what was last written into the
+ * scene (fades in progress move), ORing the LR_DIRTY_* flags into *dirty. A value the scene
+ * rejects is reported in e (the other parameters are still written). */
+int lr_control_map_update(lr_control_map *m, lr_scene *scene, int64_t now_ns, unsigned *dirty,
+                          lr_err *e);
+/* The scene was replaced (scene switch or reload): the next update rewrites everything. */
+void lr_control_map_scene_replaced(lr_control_map *m);
+
+/* True while a fade runs at now_ns (the loop keeps updating and rendering frames). */
+bool lr_control_map_fading(const lr_control_map *m, int64_t now_ns);
+
+/* The lamp binding's faded level at now_ns (the same y its parameter is computed from);
+ * false when no binding drives the lamp. */
+bool lr_control_map_lamp_level(const lr_control_map *m, int64_t now_ns, double *level);
+
+/* A scene switch waiting to be loaded (a path from the binding's values), or NULL. Clears it. */
+const char *lr_control_map_scene_request(lr_control_map *m);
+
+/* For tests and logs. */
+int lr_control_map_count(const lr_control_map *m);
+double lr_control_map_position(const lr_control_map *m, int binding);   /* level: x */
+double lr_control_map_level(const lr_control_map *m, int binding, int64_t now_ns); /* y faded */
+int lr_control_map_index(const lr_control_map *m, int binding);         /* cycle: index */
+/* Events ignored for garbage (non-finite values). */
+unsigned lr_control_map_garbage(const lr_control_map *m);
+
+#endif

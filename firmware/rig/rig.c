@@ -1,0 +1,705 @@
+/* lamprig firmware — the rig and its poll loop (see rig.h). */
+#include "firmware/rig/rig.h"
+
+#include <errno.h>
+#include <math.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/signalfd.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "firmware/rig/config.h"
+#include "firmware/rig/control_map.h"
+#include "firmware/rig/stats.h"
+#include "firmware/rig/view.h"
+#include "hal/dev.h"
+#include "hal/event.h"
+#include "hal/gpio.h"
+#include "hal/hid.h"
+#include "hal/modbus.h"
+#include "hal/sim.h"
+#include "hal/usb.h"
+#include "render/gl/gl.h"
+#include "render/image/image.h"
+#include "render/scene/scene.h"
+
+#define MAX_POLL 128
+#define FLUSH_MS 1000
+
+/* What a config builds; swapped whole on reload. */
+typedef struct rigset {
+    lr_rig_config *cfg;
+    lr_scene *scene;
+    lr_control_map *map;
+    lr_dev *devs[LR_RIG_MAX_DEVICES];
+    lr_modbus *lamp[LR_RIG_MAX_DEVICES]; /* modbus devices with a lamp driver */
+    int n_devs, n_lamps;
+    bool has_hid;
+} rigset;
+
+struct lr_rig {
+    lr_rig_opts opts;
+    char config_path[LR_RIG_PATH_MAX];
+    char out_dir[LR_RIG_PATH_MAX];
+    char stats_path[LR_RIG_PATH_MAX];
+    char modbus_url[LR_RIG_PATH_MAX];
+    lr_log log;
+    rigset set;
+    lr_event_ring *ring;
+    lr_gl *gl;
+    bool kms;
+    lr_rig_view *view;
+    unsigned char *rgba;
+    lr_rig_stats *stats;
+    int sigfd;
+    sigset_t old_mask;
+    bool masked;
+    bool stop;
+    int64_t start_ns, end_ns, next_frame_ns, frame_interval_ns, next_stats_ns;
+    double lamp_written; /* -1: nothing written */
+    uint64_t frames, events, reloads, reload_failures;
+    unsigned frame_errors;
+    bool fading; /* a fade was running at the last apply: apply once more after it ends */
+    lr_frame_stats flip_stats; /* KMS: the frame on its way to the screen */
+    bool flip_stats_pending;
+    bool used_hid; /* hidapi's process-wide state is released once, at the very end */
+};
+
+static void set_free(rigset *s)
+{
+    for (int i = 0; i < s->n_devs; i++)
+        lr_dev_destroy(s->devs[i]);
+    lr_control_map_destroy(s->map);
+    lr_scene_destroy(s->scene);
+    lr_rig_config_destroy(s->cfg);
+    memset(s, 0, sizeof *s);
+}
+
+static void scene_warn(void *user, const char *msg)
+{
+    lr_rig *r = user;
+    lr_log_write(&r->log, LR_LOG_WARN, "scene: %s", msg);
+}
+
+static int create_device(lr_rig *r, rigset *s, const lr_rig_device *d, lr_err *e)
+{
+    lr_dev_desc dev = {
+        .name = d->name,
+        .sink = lr_event_ring_sink(r->ring),
+        .log = r->log,
+        .retry_min_ms = d->retry_min_ms,
+        .retry_max_ms = d->retry_max_ms,
+        .required = d->required,
+    };
+    int rc = LR_OK;
+    lr_dev *out = NULL;
+    switch (d->type) {
+    case LR_RIG_DEV_SIM: {
+        lr_sim_desc sd = {.dev = dev, .path = d->script[0] ? d->script : NULL, .text = d->text,
+                          .loop = d->loop};
+        lr_sim *sim;
+        if (!(rc = lr_sim_create(&sd, &sim, e)))
+            out = lr_sim_dev(sim);
+        break;
+    }
+    case LR_RIG_DEV_MODBUS: {
+        lr_modbus_input in[LR_RIG_MAX_ITEMS];
+        for (int i = 0; i < d->n_inputs; i++) {
+            const lr_rig_modbus_reg *g = &d->inputs[i];
+            in[i] = (lr_modbus_input){.control = g->control, .unit = g->unit, .reg = g->reg,
+                                      .base = g->base,
+                                      .type = g->input_regs ? LR_MODBUS_INPUT : LR_MODBUS_HOLDING,
+                                      .raw_min = g->raw_min, .raw_max = g->raw_max};
+        }
+        lr_modbus_desc md = {
+            .dev = dev,
+            .url = r->modbus_url[0] ? r->modbus_url : d->url,
+            .inputs = in,
+            .n_inputs = d->n_inputs,
+            .poll_ms = d->poll_ms,
+            .timeout_ms = d->timeout_ms,
+            .byte_timeout_ms = d->byte_timeout_ms,
+            .max_timeouts = d->max_timeouts,
+        };
+        if (d->has_lamp)
+            md.output = (lr_modbus_output){.enabled = true, .unit = d->lamp.unit,
+                                           .reg = d->lamp.reg, .base = d->lamp.base,
+                                           .raw_min = d->lamp.raw_min,
+                                           .raw_max = d->lamp.raw_max,
+                                           .multiple = d->lamp.multiple};
+        lr_modbus *m;
+        if (!(rc = lr_modbus_create(&md, &m, e))) {
+            out = lr_modbus_dev(m);
+            if (d->has_lamp)
+                s->lamp[s->n_lamps++] = m;
+        }
+        break;
+    }
+    case LR_RIG_DEV_GPIO: {
+        lr_gpio_encoder enc[LR_RIG_MAX_ITEMS];
+        lr_gpio_button btn[LR_RIG_MAX_ITEMS];
+        for (int i = 0; i < d->n_encoders; i++)
+            enc[i] = (lr_gpio_encoder){d->encoders[i].name, d->encoders[i].line_a,
+                                       d->encoders[i].line_b, d->encoders[i].steps_per_detent,
+                                       d->encoders[i].reverse};
+        for (int i = 0; i < d->n_buttons; i++)
+            btn[i] = (lr_gpio_button){d->buttons[i].name, d->buttons[i].line_a,
+                                      d->buttons[i].active_high, d->buttons[i].debounce_ms};
+        lr_gpio_desc gd = {.dev = dev, .chip = d->chip, .bias = (lr_gpio_bias)d->bias,
+                           .encoders = enc, .n_encoders = d->n_encoders,
+                           .buttons = btn, .n_buttons = d->n_buttons};
+        lr_gpio *g;
+        if (!(rc = lr_gpio_create(&gd, &g, e)))
+            out = lr_gpio_dev(g);
+        break;
+    }
+    case LR_RIG_DEV_HID: {
+        lr_hid_desc hd = {.dev = dev, .vid = d->vid, .pid = d->pid,
+                          .serial = d->serial[0] ? d->serial : NULL, .poll_ms = d->poll_ms};
+        hd.parser.proto = (lr_hid_proto)d->proto;
+        hd.parser.report_id = (uint8_t)d->report_id;
+        lr_hid *h;
+        s->has_hid = true;
+        if (!(rc = lr_hid_create(&hd, &h, e)))
+            out = lr_hid_dev(h);
+        break;
+    }
+    case LR_RIG_DEV_USB: {
+        lr_usb_watch w[LR_RIG_MAX_ITEMS];
+        for (int i = 0; i < d->n_watch; i++) {
+            w[i] = (lr_usb_watch){.name = d->watch[i].name, .vid = d->watch[i].vid,
+                                  .pid = d->watch[i].pid, .read_reports = d->watch[i].read_reports,
+                                  .interface = d->watch[i].interface};
+            w[i].parser.proto = (lr_hid_proto)d->watch[i].proto;
+        }
+        lr_usb_desc ud = {.dev = dev, .watch = w, .n_watch = d->n_watch,
+                          .rescan_ms = d->rescan_ms, .no_hotplug = d->no_hotplug};
+        lr_usb *u;
+        if (!(rc = lr_usb_create(&ud, &u, e)))
+            out = lr_usb_dev(u);
+        break;
+    }
+    }
+    if (rc)
+        return lr_err_prefix(e, "%s:%d: device '%s'", r->config_path, d->line, d->name);
+    s->devs[s->n_devs++] = out;
+    return LR_OK;
+}
+
+/* Config, scene, control map, devices: all or nothing. */
+static int set_build(lr_rig *r, rigset *s, lr_err *e)
+{
+    memset(s, 0, sizeof *s);
+    int rc = lr_rig_config_load(r->config_path, &s->cfg, e);
+    if (!rc && r->modbus_url[0]) {
+        bool any = false;
+        for (int i = 0; i < s->cfg->n_devices; i++)
+            any |= s->cfg->devices[i].type == LR_RIG_DEV_MODBUS;
+        if (!any)
+            lr_log_write(&r->log, LR_LOG_WARN,
+                         "--modbus %s: the config has no modbus device; ignored", r->modbus_url);
+    }
+    lr_warn_sink warn = {scene_warn, r};
+    if (!rc)
+        rc = lr_scene_load(s->cfg->scene, &warn, &s->scene, e);
+    if (!rc)
+        rc = lr_rig_config_apply_sets(s->cfg, s->scene, e);
+    if (!rc)
+        rc = lr_control_map_create(s->cfg, s->scene, true, lr_now_ns(), &s->map, e);
+    for (int i = 0; !rc && i < s->cfg->n_devices; i++)
+        rc = create_device(r, s, &s->cfg->devices[i], e);
+    if (rc) {
+        r->used_hid |= s->has_hid;
+        set_free(s);
+    }
+    return rc;
+}
+
+static int view_build(lr_rig *r, lr_scene *scene, lr_rig_view **out, lr_err *e)
+{
+    const lr_rig_config *c = r->set.cfg;
+    lr_rig_view_desc vd = {.name = c->output.renderer, .gl = r->gl, .scene = scene,
+                           .width = c->output.width, .height = c->output.height};
+    if (r->kms)
+        lr_gl_size(r->gl, &vd.width, &vd.height);
+    return lr_rig_view_create(&vd, out, e);
+}
+
+static int ensure_rgba(lr_rig *r)
+{
+    int w, h;
+    lr_rig_view_size(r->view, &w, &h);
+    free(r->rgba);
+    r->rgba = malloc((size_t)w * (size_t)h * 4);
+    return r->rgba ? LR_OK : LR_ENOMEM;
+}
+
+/* ---- applying control changes ---- */
+
+static void write_lamp(lr_rig *r, double level)
+{
+    if (!r->set.n_lamps || level == r->lamp_written)
+        return;
+    for (int i = 0; i < r->set.n_lamps; i++)
+        lr_modbus_write_level(r->set.lamp[i], level);
+    r->lamp_written = level;
+}
+
+static void apply(lr_rig *r, int64_t now)
+{
+    unsigned dirty = 0;
+    lr_err e = {0};
+    if (lr_control_map_update(r->set.map, r->set.scene, now, &dirty, &e))
+        lr_log_write(&r->log, LR_LOG_WARN, "control map: %s", e.msg);
+    if (dirty)
+        lr_rig_view_invalidate(r->view, dirty);
+    double level;
+    if (lr_control_map_lamp_level(r->set.map, now, &level))
+        write_lamp(r, level);
+    r->fading = lr_control_map_fading(r->set.map, now);
+}
+
+static void switch_scene(lr_rig *r, const char *path)
+{
+    lr_scene *scene = NULL;
+    lr_err e = {0};
+    lr_warn_sink warn = {scene_warn, r};
+    if (lr_scene_load(path, &warn, &scene, &e) ||
+        lr_rig_config_apply_sets(r->set.cfg, scene, &e)) {
+        lr_log_write(&r->log, LR_LOG_ERROR, "scene switch: %s; keeping %s", e.msg,
+                     lr_scene_path(r->set.scene));
+        lr_scene_destroy(scene);
+        return;
+    }
+    lr_rig_view *view;
+    if (view_build(r, scene, &view, &e)) {
+        lr_log_write(&r->log, LR_LOG_ERROR, "scene switch: %s", e.msg);
+        lr_scene_destroy(scene);
+        return;
+    }
+    lr_rig_view_destroy(r->view);
+    lr_scene_destroy(r->set.scene);
+    r->view = view;
+    r->set.scene = scene;
+    lr_control_map_scene_replaced(r->set.map);
+    lr_log_write(&r->log, LR_LOG_INFO, "scene: %s", path);
+}
+
+static void handle_event(lr_rig *r, const lr_event *ev, int64_t now)
+{
+    /* A knob's USB arrival: reopen the hid device of that name now, not at its next backoff. */
+    if (strcmp(ev->control, "present") == 0 && ev->value == 1)
+        for (int i = 0; i < r->set.n_devs; i++)
+            if (strcmp(lr_dev_kind(r->set.devs[i]), "hid") == 0 &&
+                strcmp(lr_dev_name(r->set.devs[i]), ev->source) == 0)
+                lr_dev_retry_now(r->set.devs[i], now);
+    int b = lr_control_map_event(r->set.map, ev, now);
+    if (b < 0) {
+        if (isfinite(ev->value))
+            lr_rig_stats_unmatched(r->stats);
+        return;
+    }
+    r->events++;
+    lr_rig_stats_event(r->stats, ev);
+}
+
+/* ---- frames ---- */
+
+static void write_png(lr_rig *r, int index)
+{
+    int w, h;
+    lr_rig_view_size(r->view, &w, &h);
+    lr_image img = {0};
+    lr_err e = {0};
+    if (lr_image_alloc(&img, w, h, &e) == LR_OK) {
+        for (size_t i = 0; i < (size_t)w * (size_t)h; i++)
+            for (int k = 0; k < 3; k++)
+                img.rgb[3 * i + k] = lr_srgb_decode(r->rgba[4 * i + k] / 255.0f);
+        char path[LR_RIG_PATH_MAX + 32];
+        snprintf(path, sizeof path, "%s/frame_%06d.png", r->out_dir, index);
+        if (lr_image_write_png(path, &img, NULL, &e) && r->frame_errors++ == 0)
+            lr_log_write(&r->log, LR_LOG_ERROR, "frames: %s", e.msg);
+    }
+    lr_image_free(&img);
+}
+
+static void frame(lr_rig *r, int64_t now)
+{
+    lr_frame_stats st;
+    lr_err e = {0};
+    int rc = lr_rig_view_frame(r->view, &st, &e);
+    if (!rc && r->kms)
+        rc = lr_rig_view_present(r->view, &e);
+    if (!rc && r->out_dir[0]) {
+        rc = lr_rig_view_read_rgba8(r->view, r->rgba, &e);
+        if (!rc)
+            write_png(r, st.index);
+    }
+    if (rc) {
+        /* Logged once per run of failures; the loop keeps going on the controls. */
+        if (r->frame_errors++ == 0)
+            lr_log_write(&r->log, LR_LOG_ERROR, "frame: %s", e.msg);
+        r->next_frame_ns = now + 1000000000LL;
+        return;
+    }
+    r->frame_errors = 0;
+    r->frames++;
+    if (r->kms && lr_gl_flip_pending(r->gl)) {
+        /* On the projector a frame shows at its page flip: the latency ends there. */
+        if (r->flip_stats_pending)
+            lr_rig_stats_frame(r->stats, &r->flip_stats, lr_now_ns());
+        r->flip_stats = st;
+        r->flip_stats_pending = true;
+    } else {
+        lr_rig_stats_frame(r->stats, &st, lr_now_ns());
+    }
+    r->next_frame_ns = now + r->frame_interval_ns;
+}
+
+static bool frame_wanted(lr_rig *r, int64_t now)
+{
+    (void)now;
+    return lr_rig_view_needs_frame(r->view) || r->fading;
+}
+
+static void write_stats(lr_rig *r, int64_t now)
+{
+    if (!r->stats_path[0])
+        return;
+    lr_err e = {0};
+    if (lr_rig_stats_write(r->stats, r->stats_path, r->config_path, now,
+                           lr_control_map_garbage(r->set.map), &e))
+        lr_log_write(&r->log, LR_LOG_ERROR, "stats: %s", e.msg);
+}
+
+/* ---- create / reload / destroy ---- */
+
+static int open_output(lr_rig *r, lr_err *e)
+{
+    const lr_rig_config *c = r->set.cfg;
+    if (c->output.mode == LR_RIG_KMS && !r->opts.headless) {
+        lr_gl_desc gd = {.backend = LR_GL_KMS,
+                         .drm_device = c->output.drm_device[0] ? c->output.drm_device : NULL,
+                         .connector = c->output.connector[0] ? c->output.connector : NULL,
+                         .width = c->output.mode_w, .height = c->output.mode_h,
+                         .refresh_hz = c->output.refresh_hz};
+        lr_err ge = {0};
+        if (lr_gl_create(&gd, &r->gl, &ge) == LR_OK) {
+            r->kms = true;
+            int w, h;
+            lr_gl_size(r->gl, &w, &h);
+            lr_log_write(&r->log, LR_LOG_INFO, "output: kms %dx%d", w, h);
+        } else {
+            lr_log_write(&r->log, LR_LOG_WARN, "output: kms: %s; running headless", ge.msg);
+        }
+    }
+    if (!r->gl && lr_rig_view_needs_gl(c->output.renderer)) {
+        lr_gl_desc gd = {.backend = LR_GL_SURFACELESS};
+        int rc = lr_gl_create(&gd, &r->gl, e);
+        if (rc)
+            return lr_err_prefix(e, "output: headless GL");
+    }
+    if (!r->kms)
+        lr_log_write(&r->log, LR_LOG_INFO, "output: headless%s%s",
+                     r->out_dir[0] ? ", frames to " : "", r->out_dir);
+    return LR_OK;
+}
+
+int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
+{
+    if (!opts || !opts->config)
+        return lr_err_set(e, LR_EINVAL, "no config file given");
+    lr_rig *r = calloc(1, sizeof *r);
+    if (!r)
+        return lr_err_set(e, LR_ENOMEM, "out of memory");
+    r->opts = *opts;
+    r->log = opts->log;
+    r->sigfd = -1;
+    r->lamp_written = -1;
+    snprintf(r->config_path, sizeof r->config_path, "%s", opts->config);
+    if (opts->out_dir)
+        snprintf(r->out_dir, sizeof r->out_dir, "%s", opts->out_dir);
+    if (opts->modbus_url)
+        snprintf(r->modbus_url, sizeof r->modbus_url, "%s", opts->modbus_url);
+    int rc = LR_OK;
+    if (r->modbus_url[0]) {
+        lr_modbus_url u;
+        rc = lr_modbus_url_parse(r->modbus_url, &u, e);
+        if (rc)
+            lr_err_prefix(e, "--modbus");
+    }
+    r->start_ns = lr_now_ns();
+    if (!rc)
+        rc = lr_event_ring_create(1024, &r->ring, e);
+    if (!rc)
+        rc = lr_rig_stats_create(r->start_ns, &r->stats, e);
+    if (!rc && !opts->no_signals) {
+        sigset_t m;
+        sigemptyset(&m);
+        sigaddset(&m, SIGINT);
+        sigaddset(&m, SIGTERM);
+        sigaddset(&m, SIGHUP);
+        if (sigprocmask(SIG_BLOCK, &m, &r->old_mask) == 0) {
+            r->masked = true;
+            r->sigfd = signalfd(-1, &m, SFD_NONBLOCK | SFD_CLOEXEC);
+        }
+        if (r->sigfd < 0)
+            rc = lr_err_set(e, LR_EIO, "signalfd: %s", strerror(errno));
+    }
+    if (!rc && r->out_dir[0] && mkdir(r->out_dir, 0777) != 0 && errno != EEXIST)
+        rc = lr_err_set(e, LR_EIO, "--out-dir %s: %s", r->out_dir, strerror(errno));
+    if (!rc)
+        rc = set_build(r, &r->set, e);
+    if (!rc) {
+        if (opts->stats_path)
+            snprintf(r->stats_path, sizeof r->stats_path, "%s", opts->stats_path);
+        else
+            snprintf(r->stats_path, sizeof r->stats_path, "%s", r->set.cfg->stats_path);
+        rc = open_output(r, e);
+    }
+    if (!rc)
+        rc = view_build(r, r->set.scene, &r->view, e);
+    if (!rc && ensure_rgba(r))
+        rc = lr_err_set(e, LR_ENOMEM, "out of memory");
+    if (rc) {
+        lr_rig_destroy(r);
+        return rc;
+    }
+    const lr_rig_config *c = r->set.cfg;
+    r->frame_interval_ns = r->kms ? 0 : (int64_t)(1e9 / c->output.fps);
+    r->end_ns = opts->duration_s > 0 ? r->start_ns + (int64_t)(opts->duration_s * 1e9)
+                                     : INT64_MAX;
+    r->next_stats_ns = c->stats_period_s > 0 ? r->start_ns + (int64_t)(c->stats_period_s * 1e9)
+                                             : INT64_MAX;
+    lr_log_write(&r->log, LR_LOG_INFO, "config %s: scene %s, %d devices, %d controls, view %s",
+                 r->config_path, c->scene, c->n_devices, c->n_bindings,
+                 lr_rig_view_name(r->view));
+    apply(r, r->start_ns);
+    *out = r;
+    return LR_OK;
+}
+
+int lr_rig_reload(lr_rig *r, lr_err *e)
+{
+    rigset s;
+    int rc = set_build(r, &s, e);
+    lr_rig_view *view = NULL;
+    if (!rc) {
+        /* The view belongs to the scene: build it against the new one, then swap. */
+        rigset old = r->set;
+        r->set = s;
+        /* A new renderer may need GL where the old one did not (the output mode itself is
+         * kept until restart). */
+        if (!r->gl && lr_rig_view_needs_gl(s.cfg->output.renderer)) {
+            lr_gl_desc gd = {.backend = LR_GL_SURFACELESS};
+            if ((rc = lr_gl_create(&gd, &r->gl, e)))
+                lr_err_prefix(e, "output: headless GL");
+        }
+        if (!rc)
+            rc = view_build(r, s.scene, &view, e);
+        r->set = old;
+        if (rc) {
+            r->used_hid |= s.has_hid;
+            set_free(&s);
+        }
+    }
+    if (rc) {
+        r->reload_failures++;
+        lr_log_write(&r->log, LR_LOG_ERROR, "reload: %s; keeping the running config", e->msg);
+        return rc;
+    }
+    /* Events already queued by the old devices still apply to the old map: drop them. */
+    lr_event ev;
+    while (lr_event_ring_pop(r->ring, &ev))
+        ;
+    lr_rig_view_destroy(r->view);
+    r->used_hid |= r->set.has_hid;
+    set_free(&r->set);
+    r->set = s;
+    r->view = view;
+    ensure_rgba(r);
+    r->lamp_written = -1;
+    r->reloads++;
+    const lr_rig_config *c = r->set.cfg;
+    if (!r->opts.stats_path)
+        snprintf(r->stats_path, sizeof r->stats_path, "%s", c->stats_path);
+    if (!r->kms)
+        r->frame_interval_ns = (int64_t)(1e9 / c->output.fps);
+    lr_log_write(&r->log, LR_LOG_INFO, "reloaded %s: scene %s, %d devices, %d controls",
+                 r->config_path, c->scene, c->n_devices, c->n_bindings);
+    apply(r, lr_now_ns());
+    return LR_OK;
+}
+
+void lr_rig_stop(lr_rig *r) { r->stop = true; }
+
+static void read_signals(lr_rig *r)
+{
+    struct signalfd_siginfo si;
+    while (read(r->sigfd, &si, sizeof si) == (ssize_t)sizeof si) {
+        if (si.ssi_signo == SIGHUP) {
+            lr_log_write(&r->log, LR_LOG_INFO, "SIGHUP: reloading %s", r->config_path);
+            lr_err e = {0};
+            lr_rig_reload(r, &e);
+        } else {
+            lr_log_write(&r->log, LR_LOG_INFO, "%s: shutting down",
+                         si.ssi_signo == SIGINT ? "SIGINT" : "SIGTERM");
+            r->stop = true;
+        }
+    }
+}
+
+int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
+{
+    (void)e;
+    while (!r->stop) {
+        int64_t now = lr_now_ns();
+        if (now >= r->end_ns) {
+            lr_log_write(&r->log, LR_LOG_INFO, "duration reached: shutting down");
+            r->stop = true;
+            break;
+        }
+        if (now >= until_ns)
+            break;
+        /* The poll set and the earliest deadline. */
+        struct pollfd fds[MAX_POLL];
+        int owner[MAX_POLL]; /* -1 signalfd, -2 gl, else device index */
+        int nf = 0;
+        int64_t t = r->end_ns < until_ns ? r->end_ns : until_ns;
+        if (r->sigfd >= 0) {
+            fds[nf] = (struct pollfd){r->sigfd, POLLIN, 0};
+            owner[nf++] = -1;
+        }
+        if (r->kms && lr_gl_flip_pending(r->gl) && lr_gl_event_fd(r->gl) >= 0) {
+            fds[nf] = (struct pollfd){lr_gl_event_fd(r->gl), POLLIN, 0};
+            owner[nf++] = -2;
+        }
+        for (int i = 0; i < r->set.n_devs; i++) {
+            int k = lr_dev_pollfds(r->set.devs[i], fds + nf, MAX_POLL - nf);
+            if (k > MAX_POLL - nf)
+                k = MAX_POLL - nf;
+            for (int j = 0; j < k; j++)
+                owner[nf + j] = i;
+            nf += k;
+            int64_t d = lr_dev_next_deadline(r->set.devs[i]);
+            if (d < t)
+                t = d;
+        }
+        bool want = frame_wanted(r, now);
+        if (want && !(r->kms && lr_gl_flip_pending(r->gl)) && r->next_frame_ns < t)
+            t = r->next_frame_ns;
+        if (r->stats_path[0] && r->next_stats_ns < t)
+            t = r->next_stats_ns;
+        int timeout;
+        if (t == INT64_MAX)
+            timeout = -1;
+        else if (t <= now)
+            timeout = 0;
+        else {
+            int64_t ms = (t - now + 999999) / 1000000;
+            timeout = ms > 1000000 ? 1000000 : (int)ms;
+        }
+        int n = poll(fds, (nfds_t)nf, timeout);
+        if (n < 0 && errno != EINTR) {
+            lr_log_write(&r->log, LR_LOG_ERROR, "poll: %s", strerror(errno));
+            return lr_err_set(e, LR_EIO, "poll: %s", strerror(errno));
+        }
+        now = lr_now_ns();
+        for (int i = 0; i < nf && n > 0; i++) {
+            if (!fds[i].revents)
+                continue;
+            if (owner[i] == -1) {
+                read_signals(r);
+                if (r->stop)
+                    return LR_OK;
+            } else if (owner[i] == -2) {
+                lr_err ge = {0};
+                if (lr_gl_dispatch(r->gl, &ge))
+                    lr_log_write(&r->log, LR_LOG_ERROR, "output: %s", ge.msg);
+                if (r->flip_stats_pending && !lr_gl_flip_pending(r->gl)) {
+                    lr_rig_stats_frame(r->stats, &r->flip_stats, now);
+                    r->flip_stats_pending = false;
+                }
+            }
+        }
+        /* Every device is dispatched on every wake: dispatch reads only what is ready and runs
+         * only due timers, so this costs nothing when idle, and it stays right when a reload
+         * above replaced the devices (owner[] then refers to the old set). */
+        for (int i = 0; i < r->set.n_devs; i++)
+            lr_dev_dispatch(r->set.devs[i], now);
+        lr_event ev;
+        bool any = false;
+        while (lr_event_ring_pop(r->ring, &ev)) {
+            handle_event(r, &ev, now);
+            any = true;
+        }
+        const char *sw = lr_control_map_scene_request(r->set.map);
+        if (sw)
+            switch_scene(r, sw);
+        if (any || sw || r->fading)
+            apply(r, now);
+        if (frame_wanted(r, now) && now >= r->next_frame_ns &&
+            !(r->kms && lr_gl_flip_pending(r->gl)))
+            frame(r, now);
+        if (r->stats_path[0] && now >= r->next_stats_ns) {
+            write_stats(r, now);
+            r->next_stats_ns = now + (int64_t)(r->set.cfg->stats_period_s * 1e9);
+        }
+    }
+    return LR_OK;
+}
+
+int lr_rig_run(lr_rig *r, lr_err *e) { return lr_rig_run_until(r, INT64_MAX, e); }
+
+void lr_rig_destroy(lr_rig *r)
+{
+    if (!r)
+        return;
+    /* The lamp driver goes to its safe level first, and we wait for the acknowledgement. */
+    if (r->set.cfg) {
+        for (int i = 0; i < r->set.n_lamps; i++) {
+            lr_modbus_write_level(r->set.lamp[i], r->set.cfg->safe_level);
+            lr_err e = {0};
+            if (lr_modbus_flush(r->set.lamp[i], FLUSH_MS, &e))
+                lr_log_write(&r->log, LR_LOG_ERROR, "shutdown: lamp driver: %s", e.msg);
+            else
+                lr_log_write(&r->log, LR_LOG_INFO, "shutdown: lamp driver at safe level %g (raw %d)",
+                             r->set.cfg->safe_level, lr_modbus_output_raw(r->set.lamp[i]));
+        }
+    }
+    if (r->stats && r->set.cfg)
+        write_stats(r, lr_now_ns());
+    lr_rig_view_destroy(r->view);
+    if (r->gl)
+        lr_gl_destroy(r->gl);
+    r->used_hid |= r->set.has_hid;
+    set_free(&r->set);
+    if (r->used_hid)
+        lr_hid_library_exit();
+    free(r->rgba);
+    lr_rig_stats_destroy(r->stats);
+    lr_event_ring_destroy(r->ring);
+    if (r->sigfd >= 0)
+        close(r->sigfd);
+    if (r->masked)
+        sigprocmask(SIG_SETMASK, &r->old_mask, NULL);
+    free(r);
+}
+
+void lr_rig_get_info(const lr_rig *r, lr_rig_info *out)
+{
+    out->frames = r->frames;
+    out->events = r->events;
+    out->reloads = r->reloads;
+    out->reload_failures = r->reload_failures;
+    out->lamp_level = r->lamp_written;
+    out->output = r->kms ? "kms" : "headless";
+    out->view = r->view ? lr_rig_view_name(r->view) : "";
+    out->idle = r->view && !frame_wanted((lr_rig *)r, lr_now_ns());
+}
+
+struct lr_scene *lr_rig_scene(lr_rig *r) { return r->set.scene; }

@@ -1,0 +1,70 @@
+/* lamprig firmware — the rig: config → devices → control map → scene → view → output, driven
+ * by one poll loop (`lamprig run`).
+ *
+ * The loop waits in poll(2) on: a signalfd (SIGINT, SIGTERM, SIGHUP), every device's
+ * descriptors (hal/dev.h), the DRM page-flip fd while a flip is pending (KMS), with a timeout
+ * that is the earliest of: a device deadline (retry, debounce, Modbus poll, sim script), the
+ * next frame when one is due (the view needs a frame, or a fade is running; headless frames
+ * are spaced by 1/fps, KMS frames by the flip), the next periodic stats write, the end of
+ * --duration. Nothing to do means an infinite timeout: no busy waiting.
+ *
+ * Every wake: dispatch devices, feed their events to the control map, write the changed scene
+ * parameters (their dirty flags go to the view) and the lamp-driver level (the control map's
+ * curved level, written as is), then render when a frame is due and needed; headless frames go
+ * to out_dir/frame_NNNNNN.png when given. Stats record each event's latency to the first
+ * frame after it.
+ *
+ * SIGINT/SIGTERM end the loop (lr_rig_run returns LR_OK); lr_rig_destroy then writes the safe
+ * level to the lamp driver and flushes it, closes every device, writes the stats. SIGHUP
+ * reloads the config file: the new config, scene, control map and devices are built first
+ * and swapped in only when all succeed; otherwise the error (file, line, field) is logged and
+ * the old rig runs on. The output (KMS or headless) is kept across reloads.
+ */
+#ifndef LR_RIG_H
+#define LR_RIG_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "hal/log.h"
+#include "render/base/err.h"
+
+typedef struct lr_rig lr_rig;
+
+typedef struct lr_rig_opts {
+    const char *config;     /* required: the rig config file */
+    bool headless;          /* force headless whatever output.mode says */
+    const char *out_dir;    /* headless: write every frame as a PNG here (created) */
+    double duration_s;      /* > 0: clean exit after this long */
+    const char *stats_path; /* overrides the config's stats.path */
+    const char *modbus_url; /* overrides every modbus device's url */
+    lr_log log;             /* default: stderr */
+    bool no_signals;        /* do not block signals or open the signalfd (in-process tests) */
+} lr_rig_opts;
+
+typedef struct lr_rig_info {
+    uint64_t frames;
+    uint64_t events;          /* events that changed something */
+    uint64_t reloads, reload_failures;
+    double lamp_level;        /* last level written to the lamp driver, -1 none */
+    const char *output;       /* "headless" or "kms" */
+    const char *view;         /* "passes" or "preview" */
+    bool idle;                /* no frame wanted: converged, no fade running */
+} lr_rig_info;
+
+int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e);
+/* Runs the loop until a stop signal, lr_rig_stop or the duration. */
+int lr_rig_run(lr_rig *r, lr_err *e);
+/* Runs the loop until now >= until_ns (or a stop); for tests that drive it in steps. */
+int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e);
+/* What SIGTERM / SIGHUP do, for in-process callers. */
+void lr_rig_stop(lr_rig *r);
+int lr_rig_reload(lr_rig *r, lr_err *e);
+/* Safe level, device close, stats: the clean shutdown. NULL is a no-op. */
+void lr_rig_destroy(lr_rig *r);
+
+void lr_rig_get_info(const lr_rig *r, lr_rig_info *out);
+/* The current scene (for tests: lr_scene_get on it). */
+struct lr_scene *lr_rig_scene(lr_rig *r);
+
+#endif

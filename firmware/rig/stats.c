@@ -1,0 +1,248 @@
+/* lamprig firmware — run statistics (see stats.h). */
+#include "firmware/rig/stats.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render/base/atomic_file.h"
+
+#define LOG_MAX 4096
+
+/* The pass names of render/renderer.h's lr_pass_name, kept here so that the stats do not
+ * depend on which renderer is linked. */
+static const char *const pass_names[LR_PASS_COUNT] = {"gbuffer", "radiosity", "vpl", "compose"};
+#define PENDING_MAX 1024
+
+typedef struct ev_rec {
+    lr_event ev;
+    uint64_t frame;
+    double latency_ms;
+} ev_rec;
+
+typedef struct fr_rec {
+    lr_frame_stats f;
+    int64_t t_ns;
+} fr_rec;
+
+struct lr_rig_stats {
+    int64_t start_ns;
+    lr_event pending[PENDING_MAX];
+    int n_pending;
+    uint64_t dropped_pending;
+    ev_rec *events; /* ring of LOG_MAX */
+    uint64_t n_events;
+    fr_rec *frames; /* ring of LOG_MAX */
+    uint64_t n_frames;
+    uint64_t unmatched;
+    double *lat;    /* every latency (grown), for quantiles */
+    size_t n_lat, cap_lat;
+};
+
+int lr_rig_stats_create(int64_t start_ns, lr_rig_stats **out, lr_err *e)
+{
+    lr_rig_stats *s = calloc(1, sizeof *s);
+    if (s) {
+        s->events = calloc(LOG_MAX, sizeof *s->events);
+        s->frames = calloc(LOG_MAX, sizeof *s->frames);
+    }
+    if (!s || !s->events || !s->frames) {
+        lr_rig_stats_destroy(s);
+        return lr_err_set(e, LR_ENOMEM, "out of memory");
+    }
+    s->start_ns = start_ns;
+    *out = s;
+    return LR_OK;
+}
+
+void lr_rig_stats_destroy(lr_rig_stats *s)
+{
+    if (!s)
+        return;
+    free(s->events);
+    free(s->frames);
+    free(s->lat);
+    free(s);
+}
+
+void lr_rig_stats_event(lr_rig_stats *s, const lr_event *ev)
+{
+    if (s->n_pending == PENDING_MAX) {
+        /* A frame that never comes (renderer failing): keep the newest. */
+        memmove(s->pending, s->pending + 1, (PENDING_MAX - 1) * sizeof s->pending[0]);
+        s->n_pending--;
+        s->dropped_pending++;
+    }
+    s->pending[s->n_pending++] = *ev;
+}
+
+void lr_rig_stats_unmatched(lr_rig_stats *s) { s->unmatched++; }
+
+void lr_rig_stats_frame(lr_rig_stats *s, const lr_frame_stats *f, int64_t done_ns)
+{
+    fr_rec *r = &s->frames[s->n_frames % LOG_MAX];
+    r->f = *f;
+    r->t_ns = done_ns;
+    s->n_frames++;
+    for (int i = 0; i < s->n_pending; i++) {
+        ev_rec *er = &s->events[s->n_events % LOG_MAX];
+        er->ev = s->pending[i];
+        er->frame = (uint64_t)f->index;
+        double ms = (double)(done_ns - s->pending[i].t_ns) * 1e-6;
+        /* A device clock ahead of ours (never with CLOCK_MONOTONIC stamps) reads as 0. */
+        er->latency_ms = ms > 0 ? ms : 0;
+        s->n_events++;
+        if (s->n_lat == s->cap_lat) {
+            size_t cap = s->cap_lat ? 2 * s->cap_lat : 1024;
+            double *p = realloc(s->lat, cap * sizeof *p);
+            if (!p)
+                continue;
+            s->lat = p;
+            s->cap_lat = cap;
+        }
+        s->lat[s->n_lat++] = er->latency_ms;
+    }
+    s->n_pending = 0;
+}
+
+int lr_rig_stats_pending(const lr_rig_stats *s) { return s->n_pending; }
+uint64_t lr_rig_stats_frames(const lr_rig_stats *s) { return s->n_frames; }
+uint64_t lr_rig_stats_events(const lr_rig_stats *s) { return s->n_events; }
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double quantile(double *sorted, size_t n, double q)
+{
+    if (!n)
+        return NAN;
+    double pos = q * (double)(n - 1);
+    size_t i = (size_t)floor(pos);
+    if (i + 1 >= n)
+        return sorted[n - 1];
+    double f = pos - (double)i;
+    return sorted[i] * (1 - f) + sorted[i + 1] * f;
+}
+
+double lr_rig_stats_latency_ms(const lr_rig_stats *s, double q)
+{
+    if (!s->n_lat)
+        return NAN;
+    double *tmp = malloc(s->n_lat * sizeof *tmp);
+    if (!tmp)
+        return NAN;
+    memcpy(tmp, s->lat, s->n_lat * sizeof *tmp);
+    qsort(tmp, s->n_lat, sizeof *tmp, cmp_double);
+    double v = quantile(tmp, s->n_lat, q);
+    free(tmp);
+    return v;
+}
+
+static void json_str(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            fprintf(f, "\\%c", c);
+        else if (c < 0x20)
+            fprintf(f, "\\u%04x", c);
+        else
+            fputc(c, f);
+    }
+    fputc('"', f);
+}
+
+static void json_num(FILE *f, double v)
+{
+    if (isfinite(v))
+        fprintf(f, "%.6g", v);
+    else
+        fputs("null", f);
+}
+
+int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *config,
+                       int64_t now_ns, unsigned garbage, lr_err *e)
+{
+    lr_atomic_file *af;
+    int rc = lr_atomic_file_open(path, &af, e);
+    if (rc)
+        return rc;
+    FILE *f = lr_atomic_file_stream(af);
+    fputs("{\n  \"config\": ", f);
+    if (config)
+        json_str(f, config);
+    else
+        fputs("null", f);
+    fprintf(f, ",\n  \"duration_s\": %.6f,\n", (double)(now_ns - s->start_ns) * 1e-9);
+    fprintf(f, "  \"frames\": %llu,\n  \"events\": %llu,\n  \"events_pending\": %d,\n",
+            (unsigned long long)s->n_frames, (unsigned long long)s->n_events, s->n_pending);
+    fprintf(f, "  \"events_unmatched\": %llu,\n  \"garbage\": %u,\n",
+            (unsigned long long)s->unmatched, garbage);
+    double *tmp = s->n_lat ? malloc(s->n_lat * sizeof *tmp) : NULL;
+    double mean = NAN;
+    if (tmp) {
+        memcpy(tmp, s->lat, s->n_lat * sizeof *tmp);
+        qsort(tmp, s->n_lat, sizeof *tmp, cmp_double);
+        mean = 0;
+        for (size_t i = 0; i < s->n_lat; i++)
+            mean += tmp[i];
+        mean /= (double)s->n_lat;
+    }
+    size_t n = tmp ? s->n_lat : 0;
+    fprintf(f, "  \"latency_ms\": {\"n\": %zu, \"min\": ", n);
+    json_num(f, n ? tmp[0] : NAN);
+    fputs(", \"median\": ", f);
+    json_num(f, tmp ? quantile(tmp, n, 0.5) : NAN);
+    fputs(", \"p99\": ", f);
+    json_num(f, tmp ? quantile(tmp, n, 0.99) : NAN);
+    fputs(", \"max\": ", f);
+    json_num(f, n ? tmp[n - 1] : NAN);
+    fputs(", \"mean\": ", f);
+    json_num(f, mean);
+    fputs("},\n  \"event_log\": [", f);
+    free(tmp);
+    uint64_t first = s->n_events > LOG_MAX ? s->n_events - LOG_MAX : 0;
+    for (uint64_t i = first; i < s->n_events; i++) {
+        const ev_rec *r = &s->events[i % LOG_MAX];
+        fputs(i > first ? ",\n    {" : "\n    {", f);
+        fputs("\"source\": ", f);
+        json_str(f, r->ev.source);
+        fputs(", \"control\": ", f);
+        json_str(f, r->ev.control);
+        fprintf(f, ", \"kind\": \"%s\", \"value\": ", lr_event_kind_name(r->ev.kind));
+        json_num(f, r->ev.value);
+        fprintf(f, ", \"t_s\": %.6f, \"frame\": %llu, \"latency_ms\": %.6f}",
+                (double)(r->ev.t_ns - s->start_ns) * 1e-9, (unsigned long long)r->frame,
+                r->latency_ms);
+    }
+    fputs("\n  ],\n  \"frame_log\": [", f);
+    first = s->n_frames > LOG_MAX ? s->n_frames - LOG_MAX : 0;
+    for (uint64_t i = first; i < s->n_frames; i++) {
+        const fr_rec *r = &s->frames[i % LOG_MAX];
+        fprintf(f, "%s{\"index\": %d, \"t_s\": %.6f, \"passes\": [", i > first ? ",\n    " : "\n    ",
+                r->f.index, (double)(r->t_ns - s->start_ns) * 1e-9);
+        bool any = false;
+        for (int p = 0; p < LR_PASS_COUNT; p++)
+            if (r->f.passes & (1u << p)) {
+                fprintf(f, "%s\"%s\"", any ? ", " : "", pass_names[p]);
+                any = true;
+            }
+        fputs("], \"ms\": [", f);
+        for (int p = 0; p < LR_PASS_COUNT; p++) {
+            if (p)
+                fputs(", ", f);
+            json_num(f, r->f.ms[p]);
+        }
+        fputs("], \"total_ms\": ", f);
+        json_num(f, r->f.total_ms);
+        fprintf(f, ", \"samples\": %d, \"converged\": %s}", r->f.samples,
+                r->f.converged ? "true" : "false");
+    }
+    fputs("\n  ]\n}\n", f);
+    return lr_atomic_file_commit(af, e);
+}

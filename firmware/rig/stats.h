@@ -1,0 +1,48 @@
+/* lamprig firmware — run statistics: per control event, the time from the event's timestamp
+ * to the end of the frame that first shows it; per frame, the passes that ran and their
+ * times. Written as JSON, atomically (render/base/atomic_file.h), periodically and at exit.
+ *
+ * {
+ *   "config": "configs/rig/sim.json", "duration_s": 12.5,
+ *   "frames": 321, "events": 40, "events_unmatched": 3, "garbage": 0,
+ *   "latency_ms": {"n": 40, "min": 0.8, "median": 2.1, "p99": 7.9, "max": 8.3, "mean": 2.4},
+ *   "event_log": [{"source": "sim", "control": "dimmer", "kind": "absolute", "value": 0.5,
+ *                  "t_s": 1.25, "frame": 38, "latency_ms": 2.1}, ...],     (last 4096)
+ *   "frame_log": [{"index": 38, "t_s": 1.252, "passes": ["compose"], "ms": [0,0,0,0.4],
+ *                  "total_ms": 0.4, "samples": 64, "converged": true}, ...]  (last 4096)
+ * }
+ * t_s are seconds since the stats were created (CLOCK_MONOTONIC).
+ */
+#ifndef LR_RIG_STATS_H
+#define LR_RIG_STATS_H
+
+#include <stdint.h>
+
+#include "hal/event.h"
+#include "render/base/err.h"
+#include "render/renderer.h"
+
+typedef struct lr_rig_stats lr_rig_stats;
+
+int lr_rig_stats_create(int64_t start_ns, lr_rig_stats **out, lr_err *e);
+void lr_rig_stats_destroy(lr_rig_stats *s);
+
+/* A control event that changed something: pending until the next frame. */
+void lr_rig_stats_event(lr_rig_stats *s, const lr_event *ev);
+/* An event no binding took. */
+void lr_rig_stats_unmatched(lr_rig_stats *s);
+/* A frame finished (presented or written) at done_ns: every pending event gets its latency. */
+void lr_rig_stats_frame(lr_rig_stats *s, const lr_frame_stats *f, int64_t done_ns);
+
+int lr_rig_stats_pending(const lr_rig_stats *s);
+uint64_t lr_rig_stats_frames(const lr_rig_stats *s);
+uint64_t lr_rig_stats_events(const lr_rig_stats *s); /* with a latency */
+/* Latency quantile q in [0, 1] over every event so far, ms; NaN when none. */
+double lr_rig_stats_latency_ms(const lr_rig_stats *s, double q);
+
+/* Writes the JSON above to path atomically. config may be NULL; garbage counts events with
+ * non-finite values. */
+int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *config,
+                       int64_t now_ns, unsigned garbage, lr_err *e);
+
+#endif
