@@ -108,10 +108,14 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
     r->caps = caps;
     const char *maps = "RGBA32F maps";
     r->map_format = LR_TEX_RGBA32F;
-    if (!caps->float_blend) {
+    if (desc->half_maps) {
+        r->map_format = LR_TEX_RGBA16F;
+        maps = "RGBA16F maps (asked for; accumulation capped at " STR(LR_HALF_MAX_FRAMES) " frames)";
+    } else if (!caps->float_blend) {
         /* Accumulation blends into the maps: without EXT_float_blend, half floats. */
         r->map_format = LR_TEX_RGBA16F;
-        maps = "RGBA16F maps (EXT_float_blend missing)";
+        maps = "RGBA16F maps (EXT_float_blend missing; accumulation capped at " STR(
+            LR_HALF_MAX_FRAMES) " frames)";
     }
     find_shaders(r);
     if ((rc = lr_timer_create(r->gl, NULL, &r->timer, e)))
@@ -165,9 +169,16 @@ void lr_renderer_invalidate(lr_renderer *r, unsigned dirty)
     r->dirty |= dirty;
 }
 
+/* Frames to accumulate: render.frames, capped for half-float maps (LR_HALF_MAX_FRAMES). */
+static int frames_target(const lr_renderer *r)
+{
+    int f = lr_scene_render(r->scene)->frames;
+    return r->map_format == LR_TEX_RGBA16F && f > LR_HALF_MAX_FRAMES ? LR_HALF_MAX_FRAMES : f;
+}
+
 bool lr_renderer_needs_frame(const lr_renderer *r)
 {
-    return r->dirty != 0 || r->rad.F < lr_scene_render(r->scene)->frames;
+    return r->dirty != 0 || r->rad.F < frames_target(r);
 }
 
 static bool resources_stale(const lr_renderer *r)
@@ -196,7 +207,7 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
         }
     }
     r->rs.exposure = lr_scene_render(r->scene)->exposure;
-    r->rs.frames = lr_scene_render(r->scene)->frames;
+    r->rs.frames = frames_target(r);
     r->rs.N = lr_scene_render(r->scene)->N;
     if (dirty & (LR_DIRTY_GEOMETRY | LR_DIRTY_SETTINGS | LR_DIRTY_RECEIVERS | LR_DIRTY_MATERIAL))
         if ((rc = lr_passes_upload_meshes(r, e)))

@@ -34,6 +34,8 @@ typedef struct lr_renderer_desc {
     bool vpl_visibility;   /* shadow the VPLs by the objects (beyond seed 003; costs
                             * N_vpl x 8 cube-map lookups per receiver pixel) */
     unsigned seed;         /* base of the per-texel/map/frame sample seeds; 0 = 1 */
+    bool half_maps;        /* RGBA16F radiosity maps even where RGBA32F blending exists (the
+                            * fallback for drivers without EXT_float_blend; for its tests) */
 } lr_renderer_desc;
 
 enum { LR_PASS_COUNT = 4 }; /* gbuffer, radiosity, vpl, compose (render/scene/dirty.h) */

@@ -68,6 +68,9 @@ int lr_renderer_debug_read_map(lr_renderer *r, int k, float *B, float *pos, floa
         return e ? e->code : LR_EIO;
     }
     copy3(B, b, cnt);
+    if (B)
+        for (size_t i = 0; i < 3 * cnt; i++)
+            B[i] /= r->rad.scale;
     copy3(pos, p, cnt);
     copy3(nrm, q, cnt);
     if (object)

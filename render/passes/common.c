@@ -200,6 +200,7 @@ void lr_passes_bind_gather(lr_renderer *r, const lr_program *p)
     lr_passes_uniform_i(p, "u_K", r->rad.K);
     lr_passes_uniform_f(p, "u_eps_bias", r->rad.eps_bias);
     lr_passes_uniform_f(p, "u_eps_comb", r->rad.eps_comb);
+    lr_passes_uniform_f(p, "u_map_scale", r->rad.scale);
 }
 
 void lr_passes_cube_face_vp(lr_vec3 at, int f, double znear, double zfar, double out[16])

@@ -23,6 +23,11 @@
 #define LR_MAX_K 32
 #define LR_MAX_RECEIVERS 16
 #define LR_MAX_VPL 4096
+/* Frames accumulated at most in RGBA16F maps. Drivers may round the blended result toward
+ * zero when storing half floats (llvmpipe does): the running mean then loses ~2^-13 of
+ * itself per frame, 1.1% after 64 frames, 16% after 1024 (measured, tests/test_render_hard.c).
+ * 32 frames keep that below 0.6%. */
+#define LR_HALF_MAX_FRAMES 32
 
 /* Tone curve of the output (lr_tonemap_op, render/image/image.h): the GPU pass and the PNG
  * writer of `lamprig render` use the same. */
@@ -89,6 +94,7 @@ struct lr_renderer {
         float eps_bias, eps_comb; /* depth units, mm */
         lr_tex *B, *pos, *nrm, *depth;
         lr_fb *fb[LR_MAX_K];
+        float scale; /* the maps store B * scale (see radiosity.c place_maps) */
         int F; /* frames accumulated */
     } rad;
 

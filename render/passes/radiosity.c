@@ -82,9 +82,29 @@ static void place_maps(lr_renderer *r)
         r->rad.df[3 * k + 1] = (float)d.y;
         r->rad.df[3 * k + 2] = (float)d.z;
     }
+    /* Maps hold B for a unit light: ~1/d^2 W/mm^2 for a point light at d mm, 1e-4..1e-6 in
+     * the shipped scenes, below half floats' normal range (6e-5) and flushed to zero by some
+     * drivers. They store B R^2 instead (O(1) at the bounding radius); directional lights
+     * (unit radiance, B ~ 1) store B. */
+    r->rad.scale = r->gb.type == 2 ? 1.0f : (float)(R * R);
     double texel = 2.0 * R / r->rad.size;
     r->rad.eps_comb = (float)texel;
     r->rad.eps_bias = (float)(2.0 * texel / (2.0 * R)); /* two texels, in depth units */
+}
+
+/* The running mean's weight for frame F: 1/F. For RGBA16F maps the GPU may evaluate the blend
+ * factors in half precision, where 1 - 1/F is not representable (fp16 has 11 bits below 1):
+ * rounded the same way every frame, it would scale the mean by up to (1 +- 2^-12) per frame,
+ * a drift of tens of percent over a thousand frames. There the weight is rounded to a
+ * multiple of 2^-11, so that both it and 1 - it are exact; the estimate stays a weighted mean
+ * whose weights sum to 1 (unbiased), and from F = 2048 on it is an exponential average over
+ * ~2048 frames. */
+static float blend_weight(lr_tex_format format, int F)
+{
+    if (format != LR_TEX_RGBA16F)
+        return (float)(1.0 / F);
+    double k = floor(2048.0 / F + 0.5);
+    return (float)((k < 1.0 ? 1.0 : k) / 2048.0);
 }
 
 int lr_pass_radiosity(lr_renderer *r, bool restart, lr_err *e)
@@ -122,7 +142,7 @@ int lr_pass_radiosity(lr_renderer *r, bool restart, lr_err *e)
             glDrawBuffers(3, first);
             glEnable(GL_BLEND);
             glBlendEquation(GL_FUNC_ADD);
-            glBlendColor(0.0f, 0.0f, 0.0f, (float)(1.0 / F));
+            glBlendColor(0.0f, 0.0f, 0.0f, blend_weight(r->map_format, F));
             glBlendFunc(GL_CONSTANT_ALPHA, GL_ONE_MINUS_CONSTANT_ALPHA);
         }
         glDepthMask(GL_FALSE);
@@ -135,6 +155,9 @@ int lr_pass_radiosity(lr_renderer *r, bool restart, lr_err *e)
         lr_passes_uniform_i(p, "u_N", r->rs.N);
         lr_passes_uniform_f(p, "u_r_max", (float)r->rad.r_max);
         lr_passes_uniform_i(p, "u_map_size", r->rad.size);
+        lr_passes_uniform_f(p, "u_map_scale", r->rad.scale);
+        /* Half floats: stay below 65504 (a light on the surface has B -> Inf at x_o -> x_l). */
+        lr_passes_uniform_f(p, "u_map_max", r->map_format == LR_TEX_RGBA16F ? 6.0e4f : 3.0e38f);
         glUniform1ui(lr_program_uniform(p, "u_seed"), r->seed);
         glUniform1ui(lr_program_uniform(p, "u_map"), (GLuint)k);
         glUniform1ui(lr_program_uniform(p, "u_frame"), (GLuint)F);

@@ -18,6 +18,8 @@ uniform uint u_seed;
 uniform uint u_map;
 uniform uint u_frame;
 uniform int u_map_size;
+uniform float u_map_scale; // stored value = B * scale (render/passes/radiosity.c)
+uniform float u_map_max;   // largest stored value (half-float maps: below the fp16 maximum)
 layout(location = 0) out vec4 o_B;
 layout(location = 1) out vec4 o_pos;
 layout(location = 2) out vec4 o_nrm;
@@ -114,7 +116,7 @@ void main()
         }
         B[c] = LR_PI * sum / float(u_N);
     }
-    o_B = vec4(B, 1.0);
+    o_B = vec4(min(B * u_map_scale, vec3(u_map_max)), 1.0);
     o_pos = vec4(xo, 1.0);
     o_nrm = vec4(no, float(u_object));
 }

@@ -20,6 +20,7 @@ uniform vec3 u_map_d[LR_MAX_K];
 uniform int u_K;
 uniform float u_eps_bias; // in map depth units
 uniform float u_eps_comb; // mm
+uniform float u_map_scale; // the maps store B * scale
 
 // Returns B; *n receives the summed visibility weight (0: no map sees x_o, in which case the
 // map with the largest n_o . d_k is used without visibility).
@@ -62,10 +63,10 @@ vec3 lr_gather(vec3 xo, vec3 no, out float n)
         }
     }
     if (n > 1e-6)
-        return color / n;
+        return color / (n * u_map_scale);
     // No map sees x_o: the one that faces it most, nearest texel, no visibility test.
     vec3 t = (u_map_P[best] * vec4(xo, 1.0)).xyz;
     ivec2 ti = clamp(ivec2(t.xy * vec2(sz)), ivec2(0), sz - 1);
     n = 0.0;
-    return texelFetch(u_map_B, ivec3(ti, best), 0).rgb;
+    return texelFetch(u_map_B, ivec3(ti, best), 0).rgb / u_map_scale;
 }
