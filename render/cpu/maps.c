@@ -216,7 +216,13 @@ void lr_cpu_maps_compose(const lr_cpu_maps *m, lr_vec3 xo, lr_vec3 no, double B[
             best_cos = cs;
             best = k;
         }
-        cs = cs < 0.0 ? 0.0 : cs > 1.0 ? 1.0 : cs;
+        /* Beyond Algorithm 1: a map can only see surfaces that face it. Without this test a
+         * thin shell (thickness < eps_bias) passes the depth test of maps that see its other
+         * side, and the inner and outer radiosity mix (measured: the lamp shade's image 2x
+         * too bright). */
+        if (!(cs > 0.0))
+            continue;
+        cs = cs > 1.0 ? 1.0 : cs;
         /* seed 003 Algorithm 1: x_o - eps_comb (n_o - cos(theta) d_k). */
         lr_vec3 xb = lr_v3_sub(xo, lr_v3_scale(lr_v3_sub(no, lr_v3_scale(m->dir[k], cs)),
                                               m->eps_comb));

@@ -62,7 +62,8 @@ const lr_cpu_texel *lr_cpu_maps_texel(const lr_cpu_maps *m, int k, int i, int j)
 
 /* Seed 003 Algorithm 1 at (xo, no): B = sum v_k B_k / sum v_k over the maps that see x_o
  * (x_o moved by eps_comb along -(n_o - cos d_k); 2x2 bilinear taps, each visible when the
- * moved point is no deeper than the texel's depth + eps_bias). When no map sees it, the map
+ * moved point is no deeper than the texel's depth + eps_bias). Beyond the paper, maps with
+ * n_o . d_k <= 0 are skipped (they cannot see x_o; needed for shells thinner than eps_bias). When no map sees it, the map
  * with the largest n_o . d_k gives its valid taps without the depth test, and *fallback (may
  * be NULL) is set. B = 0 when not even that has a valid tap. var_mean (may be NULL): variance
  * of B from the taps' variances of the mean (taps treated as independent). */
