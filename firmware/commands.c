@@ -4,8 +4,10 @@
 #include <stddef.h>
 
 #include "firmware/cmd_optics.h"
+#include "firmware/cmd_render.h"
 
 const lr_command lr_commands[] = {
     {"optics", lr_optics_summary, lr_optics_usage, lr_cmd_optics},
+    {"render", lr_render_summary, lr_render_usage, lr_cmd_render},
     {NULL, NULL, NULL, NULL},
 };

@@ -20,6 +20,7 @@
 
 #include "render/base/err.h"
 #include "render/gl/gl.h"
+#include "render/image/image.h"
 #include "render/scene/dirty.h"
 #include "render/scene/scene.h"
 
@@ -60,6 +61,15 @@ int lr_renderer_read_hdr(lr_renderer *r, float *rgb, lr_err *e);
 int lr_renderer_read_rgba8(lr_renderer *r, unsigned char *rgba, lr_err *e);
 /* Draws the last frame to the context's default framebuffer (projector) and presents it. */
 int lr_renderer_present(lr_renderer *r, lr_err *e);
+
+/* One line naming the GL renderer, the map format (RGBA32F, or RGBA16F and why) and the
+ * timer kind, for stats and logs. */
+const char *lr_renderer_info(const lr_renderer *r);
+/* Output size. */
+void lr_renderer_size(const lr_renderer *r, int *width, int *height);
+/* The tone mapping the output uses (exposure from render.exposure), so that a PNG written
+ * from lr_renderer_read_hdr matches lr_renderer_read_rgba8. */
+void lr_renderer_tonemap(const lr_renderer *r, lr_tonemap *tm);
 
 /* "gbuffer", "radiosity", "vpl", "compose" for bit index 0..3. */
 const char *lr_pass_name(int index);

@@ -1,0 +1,345 @@
+/* lamprig render — renders a scene headless (EGL surfaceless) through the renderer of
+ * render/renderer.h, writes the image, the linear HDR image and per-frame statistics. */
+#include "firmware/cmd_render.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "firmware/args.h"
+#include "firmware/cli.h"
+#include "firmware/render_events.h"
+#include "render/base/atomic_file.h"
+#include "render/gl/gl.h"
+#include "render/image/image.h"
+#include "render/renderer.h"
+#include "render/scene/scene.h"
+
+const char lr_render_summary[] = "render a scene headless: PNG, linear PFM, per-pass statistics";
+
+const char lr_render_usage[] =
+    "usage: lamprig render --scene FILE [--frames N] [--width W --height H] [--out F.png]\n"
+    "                      [--hdr F.pfm] [--stats F.json] [--no-vpl] [--set key=value ...]\n"
+    "                      [--events FILE]\n"
+    "\n"
+    "Renders FILE (configs/scenes/*.json) with seed 003's passes (light G-buffer, scattered-\n"
+    "radiosity maps, virtual point lights, composition) on a headless EGL context.\n"
+    "\n"
+    "  --frames N        frames to render (default: until the maps have accumulated\n"
+    "                    render.frames frames and every event has been applied)\n"
+    "  --width, --height output size (default 640 x 480)\n"
+    "  --out F.png       tone-mapped 8-bit sRGB image (exposure render.exposure)\n"
+    "  --hdr F.pfm       linear RGB radiance, W/(mm^2 sr), PFM\n"
+    "  --stats F.json    {\"scene\",\"width\",\"height\",\"renderer\",\"frames\":[{\"index\",\n"
+    "                    \"passes\":[...],\"ms\":{pass:ms},\"total_ms\",\"samples\"},...]}\n"
+    "  --no-vpl          no emergent light on the receivers (direct light only)\n"
+    "  --set key=value   change a scene parameter before rendering (repeatable), names as\n"
+    "                    in the scene file: light.intensity=0.01, render.K=8, camera.position=0,-400,200\n"
+    "  --events FILE     one change per line, FRAME PARAMETER VALUE (e.g. '4 light.intensity\n"
+    "                    0.5'), applied before that frame; '#' starts a comment line\n"
+    "\n"
+    "Files are written atomically. Exit status: 0 done; 1 rendering or I/O failed; 2 bad\n"
+    "arguments (one line on stderr).\n"
+    "\n"
+    "Example:\n"
+    "  lamprig render --scene configs/scenes/candle.json --out candle.png --stats s.json";
+
+#define MAX_SETS 64
+
+static int usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static int usage_error(const char *fmt, ...)
+{
+    char msg[LR_ERR_MSG_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    for (char *c = msg; *c; c++)
+        if ((unsigned char)*c < 0x20 || *c == 0x7f)
+            *c = '?';
+    fprintf(stderr, "lamprig render: %s (see `lamprig help render`)\n", msg);
+    return LR_EXIT_USAGE;
+}
+
+static int fail(const lr_err *e)
+{
+    fprintf(stderr, "lamprig render: %s\n", e->msg);
+    return LR_EXIT_FAIL;
+}
+
+static int positive_int(const char *flag, const char *text, int max, int *out)
+{
+    lr_err e = {0};
+    double v;
+    if (lr_args_number(flag, text, &v, &e))
+        return usage_error("%s", e.msg);
+    if (v != floor(v) || v < 1 || v > max)
+        return usage_error("%s %s: must be a whole number in 1..%d", flag, text, max);
+    *out = (int)v;
+    return LR_EXIT_OK;
+}
+
+static void json_ms(FILE *f, double v)
+{
+    if (isfinite(v))
+        fprintf(f, "%.4f", v);
+    else
+        fputs("null", f);
+}
+
+typedef struct stats_log {
+    lr_frame_stats *v;
+    int n, cap;
+} stats_log;
+
+static int log_push(stats_log *l, const lr_frame_stats *s)
+{
+    if (l->n == l->cap) {
+        int cap = l->cap ? 2 * l->cap : 64;
+        lr_frame_stats *n = realloc(l->v, (size_t)cap * sizeof *n);
+        if (!n)
+            return -1;
+        l->v = n;
+        l->cap = cap;
+    }
+    l->v[l->n++] = *s;
+    return 0;
+}
+
+static void json_string(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            fprintf(f, "\\%c", c);
+        else if (c < 0x20)
+            fprintf(f, "\\u%04x", c);
+        else
+            fputc(c, f);
+    }
+    fputc('"', f);
+}
+
+static int write_stats(const char *path, const lr_scene *scene, const lr_renderer *r,
+                       const stats_log *log, lr_err *e)
+{
+    lr_atomic_file *af;
+    int rc = lr_atomic_file_open(path, &af, e);
+    if (rc)
+        return rc;
+    FILE *f = lr_atomic_file_stream(af);
+    int w, h;
+    lr_renderer_size(r, &w, &h);
+    const lr_render_settings *rs = lr_scene_render(scene);
+    fputs("{\"scene\":", f);
+    json_string(f, lr_scene_name(scene));
+    fprintf(f, ",\"width\":%d,\"height\":%d,\"renderer\":", w, h);
+    json_string(f, lr_renderer_info(r));
+    fprintf(f, ",\"settings\":{\"K\":%d,\"N\":%d,\"N_vpl\":%d,\"map_size\":%d,\"gbuffer_size\":%d,"
+               "\"vpl_map_size\":%d,\"frames\":%d},\n\"frames\":[",
+            rs->K, rs->N, rs->N_vpl, rs->map_size, rs->gbuffer_size, rs->vpl_map_size, rs->frames);
+    for (int i = 0; i < log->n; i++) {
+        const lr_frame_stats *s = &log->v[i];
+        fprintf(f, "%s\n{\"index\":%d,\"passes\":[", i ? "," : "", s->index);
+        int first = 1;
+        for (int p = 0; p < LR_PASS_COUNT; p++)
+            if (s->passes & (1u << p)) {
+                fprintf(f, "%s\"%s\"", first ? "" : ",", lr_pass_name(p));
+                first = 0;
+            }
+        fputs("],\"ms\":{", f);
+        first = 1;
+        for (int p = 0; p < LR_PASS_COUNT; p++)
+            if (s->passes & (1u << p)) {
+                fprintf(f, "%s\"%s\":", first ? "" : ",", lr_pass_name(p));
+                json_ms(f, s->ms[p]);
+                first = 0;
+            }
+        fputs("},\"total_ms\":", f);
+        json_ms(f, s->total_ms);
+        fprintf(f, ",\"samples\":%d,\"converged\":%s}", s->samples, s->converged ? "true" : "false");
+    }
+    fputs("\n]}\n", f);
+    return lr_atomic_file_commit(af, e);
+}
+
+/* Builds an lr_image (rows top to bottom) from the renderer's HDR readback (bottom up). */
+static int read_image(lr_renderer *r, lr_image *img, lr_err *e)
+{
+    int w, h;
+    lr_renderer_size(r, &w, &h);
+    int rc = lr_image_alloc(img, w, h, e);
+    if (rc)
+        return rc;
+    float *rgb = malloc((size_t)w * h * 3 * sizeof *rgb);
+    if (!rgb) {
+        lr_image_free(img);
+        return lr_err_set(e, LR_ENOMEM, "out of memory");
+    }
+    if ((rc = lr_renderer_read_hdr(r, rgb, e))) {
+        free(rgb);
+        lr_image_free(img);
+        return rc;
+    }
+    for (int y = 0; y < h; y++)
+        memcpy(img->rgb + (size_t)y * w * 3, rgb + (size_t)(h - 1 - y) * w * 3, (size_t)w * 3 * sizeof *rgb);
+    free(rgb);
+    return LR_OK;
+}
+
+int lr_cmd_render(int argc, char **argv)
+{
+    /* --set may repeat: take those out before the table parser, which rejects repeats. */
+    const char *sets[MAX_SETS];
+    int nsets = 0;
+    char **rest = calloc((size_t)argc + 1, sizeof *rest);
+    if (!rest)
+        return LR_EXIT_FAIL;
+    int nrest = 0;
+    for (int i = 1; i < argc; i++) {
+        const char *v = NULL;
+        if (!strcmp(argv[i], "--set")) {
+            if (i + 1 >= argc) {
+                free(rest);
+                return usage_error("--set: missing key=value");
+            }
+            v = argv[++i];
+        } else if (!strncmp(argv[i], "--set=", 6)) {
+            v = argv[i] + 6;
+        } else {
+            rest[nrest++] = argv[i];
+            continue;
+        }
+        if (nsets == MAX_SETS) {
+            free(rest);
+            return usage_error("--set: at most %d", MAX_SETS);
+        }
+        sets[nsets++] = v;
+    }
+    static const lr_argspec specs[] = {
+        {"--scene", 1}, {"--frames", 1}, {"--width", 1}, {"--height", 1}, {"--out", 1},
+        {"--hdr", 1},   {"--stats", 1},  {"--no-vpl", 0}, {"--events", 1}, {NULL, 0}};
+    lr_args a;
+    lr_err e = {0};
+    if (lr_args_parse(nrest, rest, specs, 0, &a, &e)) {
+        free(rest);
+        return usage_error("%s", e.msg);
+    }
+    int status = LR_EXIT_OK;
+    int frames = 0, width = 640, height = 480;
+    const char *scene_path = lr_args_get(&a, "--scene");
+    if (!scene_path)
+        status = usage_error("--scene FILE is required");
+    if (!status && lr_args_has(&a, "--frames"))
+        status = positive_int("--frames", lr_args_get(&a, "--frames"), 1000000, &frames);
+    if (!status && lr_args_has(&a, "--width"))
+        status = positive_int("--width", lr_args_get(&a, "--width"), 16384, &width);
+    if (!status && lr_args_has(&a, "--height"))
+        status = positive_int("--height", lr_args_get(&a, "--height"), 16384, &height);
+    const char *out = lr_args_get(&a, "--out"), *hdr = lr_args_get(&a, "--hdr");
+    const char *stats_path = lr_args_get(&a, "--stats"), *events_path = lr_args_get(&a, "--events");
+    bool no_vpl = lr_args_has(&a, "--no-vpl");
+    free(rest);
+    if (status)
+        return status;
+    for (int i = 0; i < nsets; i++)
+        if (!strchr(sets[i], '='))
+            return usage_error("--set %s: expected key=value", sets[i]);
+
+    lr_scene *scene = NULL;
+    lr_gl *gl = NULL;
+    lr_renderer *r = NULL;
+    lr_render_events ev = {0};
+    stats_log log = {0};
+    lr_image img = {0};
+    if (lr_scene_load(scene_path, NULL, &scene, &e)) {
+        /* A scene that cannot be read or is invalid is bad input. */
+        status = e.code == LR_EIO ? fail(&e) : usage_error("%s", e.msg);
+        goto done;
+    }
+    for (int i = 0; i < nsets; i++)
+        if (lr_scene_set_assignment(scene, sets[i], NULL, &e)) {
+            status = usage_error("--set %s: %s", sets[i], e.msg);
+            goto done;
+        }
+    if (events_path && lr_render_events_load(events_path, &ev, &e)) {
+        status = e.code == LR_EIO ? fail(&e) : usage_error("%s", e.msg);
+        goto done;
+    }
+    if (lr_gl_create(NULL, &gl, &e) ||
+        lr_renderer_create(&(lr_renderer_desc){.gl = gl, .scene = scene, .width = width,
+                                               .height = height, .no_vpl = no_vpl},
+                           &r, &e)) {
+        status = fail(&e);
+        goto done;
+    }
+    int next_ev = 0;
+    for (int i = 0;; i++) {
+        if (frames ? i >= frames : (!lr_renderer_needs_frame(r) && next_ev >= ev.count))
+            break;
+        if (!frames && i >= 1000000)
+            break;
+        while (next_ev < ev.count && ev.ev[next_ev].frame <= i) {
+            const lr_render_event *x = &ev.ev[next_ev++];
+            unsigned dirty = 0;
+            if (lr_scene_set(scene, x->key, x->value, &dirty, &e)) {
+                status = usage_error("%s:%d: %s", ev.path, x->line, e.msg);
+                goto done;
+            }
+            lr_renderer_invalidate(r, dirty);
+        }
+        lr_frame_stats st;
+        if (lr_renderer_frame(r, &st, &e)) {
+            status = fail(&e);
+            goto done;
+        }
+        if (log_push(&log, &st)) {
+            status = LR_EXIT_FAIL;
+            goto done;
+        }
+    }
+    if (out || hdr) {
+        if (read_image(r, &img, &e)) {
+            status = fail(&e);
+            goto done;
+        }
+        lr_tonemap tm;
+        lr_renderer_tonemap(r, &tm);
+        if (out && lr_image_write_png(out, &img, &tm, &e)) {
+            status = fail(&e);
+            goto done;
+        }
+        if (hdr && lr_image_write_pfm(hdr, &img, &e)) {
+            status = fail(&e);
+            goto done;
+        }
+    }
+    if (stats_path && write_stats(stats_path, scene, r, &log, &e)) {
+        status = fail(&e);
+        goto done;
+    }
+    {
+        double total = 0.0;
+        for (int i = 0; i < log.n; i++)
+            total += isfinite(log.v[i].total_ms) ? log.v[i].total_ms : 0.0;
+        printf("lamprig render: %s, %d x %d, %d frames (%d samples), %.0f ms\n", lr_scene_name(scene),
+               width, height, log.n, log.n ? log.v[log.n - 1].samples : 0, total);
+        if (out)
+            printf("wrote %s\n", out);
+        if (hdr)
+            printf("wrote %s\n", hdr);
+        if (stats_path)
+            printf("wrote %s\n", stats_path);
+    }
+done:
+    lr_image_free(&img);
+    free(log.v);
+    lr_render_events_free(&ev);
+    lr_renderer_destroy(r);
+    lr_gl_destroy(gl);
+    lr_scene_destroy(scene);
+    return status;
+}

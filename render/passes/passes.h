@@ -1,0 +1,153 @@
+/* lamprig — the renderer's private state, shared by its passes (one file per pass:
+ * gbuffer.c, radiosity.c, vpl.c, compose.c; common.c holds meshes and shared uniforms).
+ * Nothing outside render/renderer.c, render/renderer_debug.c and render/passes/ includes
+ * this. The estimators are those of render/passes/PIPELINE.md. */
+#ifndef LR_PASSES_H
+#define LR_PASSES_H
+
+#include <GLES3/gl31.h>
+#include <stdbool.h>
+
+#include "render/base/err.h"
+#include "render/base/vec3.h"
+#include "render/gl/gl.h"
+#include "render/gl/shader.h"
+#include "render/gl/tex.h"
+#include "render/gl/timer.h"
+#include "render/image/image.h"
+#include "render/renderer.h"
+#include "render/scene/scene.h"
+
+/* Limits of the shaders' uniform arrays (render/shaders/lib/material.glsl, gather.glsl). */
+#define LR_MAX_OBJECTS 8
+#define LR_MAX_K 32
+#define LR_MAX_RECEIVERS 16
+#define LR_MAX_VPL 4096
+
+/* Tone curve of the output (lr_tonemap_op, render/image/image.h): the GPU pass and the PNG
+ * writer of `lamprig render` use the same. */
+#define LR_RENDER_TONEMAP LR_TONEMAP_ACES
+
+/* Light G-buffer layouts (render/shaders/lib/gbuffer.glsl u_gb_mode). */
+enum { LR_GB_CUBE = 0, LR_GB_PERSPECTIVE = 1, LR_GB_ORTHO = 2 };
+
+typedef struct lr_gpu_mesh {
+    GLuint vao, vbo[2], ebo;
+    GLsizei count;
+} lr_gpu_mesh;
+
+struct lr_renderer {
+    lr_gl *gl;
+    lr_scene *scene;
+    int width, height;
+    bool no_vpl;
+    unsigned seed;
+    const lr_gl_caps *caps;
+    lr_tex_format map_format; /* RGBA32F, or RGBA16F when float targets/blending are missing */
+    char info[256];           /* renderer string for the stats */
+    char shader_dir[512];
+    lr_timer *timer;
+
+    lr_program *p_surface, *p_depth, *p_radiosity, *p_vpl, *p_obj, *p_recv, *p_tonemap, *p_blit;
+
+    /* Settings the resources were made for. */
+    lr_render_settings rs;
+    bool allocated;
+
+    /* Meshes (re-uploaded when geometry, receivers or settings change). */
+    int n_objects, n_receivers;
+    lr_gpu_mesh obj[LR_MAX_OBJECTS];
+    lr_gpu_mesh recv[LR_MAX_RECEIVERS];
+    bool two_sided[LR_MAX_OBJECTS];
+    float coef[5 * 4 * LR_MAX_OBJECTS];
+
+    /* The light of the transport (lights[0]) as seen by the last gbuffer pass. */
+    struct {
+        int type;  /* 0 point, 1 spot, 2 directional */
+        lr_vec3 pos, dir;
+        float spot_cos[2]; /* cos(outer), cos(inner) */
+        int mode;  /* LR_GB_* */
+        int size;
+        lr_tex *pos_cube, *nrm_cube, *pos_2d, *nrm_2d;
+        lr_fb *fb[6], *fb_2d;
+        float vp[16]; /* 2D map: world -> clip */
+        double vp_d[16];
+        double face_vp[6][16];
+    } gb;
+
+    /* Scattered-radiosity maps. */
+    struct {
+        int K, size;
+        lr_vec3 center;
+        double radius, r_max;
+        lr_vec3 d[LR_MAX_K];
+        double vp[LR_MAX_K][16];  /* world -> clip */
+        double P[LR_MAX_K][16];   /* world -> texture (Algorithm 1's P_k) */
+        float Pf[LR_MAX_K * 16];
+        float df[LR_MAX_K * 3];
+        float eps_bias, eps_comb; /* depth units, mm */
+        lr_tex *B, *pos, *nrm, *depth;
+        lr_fb *fb[LR_MAX_K];
+        int F; /* frames accumulated */
+    } rad;
+
+    /* VPLs. */
+    struct {
+        int n, size;
+        lr_vec3 center;
+        lr_tex *outer_pos, *outer_nrm, *dirs;
+        lr_fb *outer_fb[6];
+        lr_tex *pos, *nrm, *B;
+        lr_fb *fb;
+        bool outer_valid;
+    } vpl;
+
+    /* Output. */
+    lr_tex *hdr, *ldr;
+    lr_fb *fb_hdr, *fb_ldr;
+    int uncovered; /* not reported yet */
+
+    unsigned dirty;
+    int frame_index;
+};
+
+/* common.c */
+int lr_passes_upload_meshes(lr_renderer *r, lr_err *e);
+void lr_passes_free_meshes(lr_renderer *r);
+void lr_passes_draw(const lr_gpu_mesh *m);
+/* One object's block of render/shaders/lib/material.glsl's u_coef (20 floats). */
+void lr_passes_pack_coeffs(const lr_coeffs *c, float out[20]);
+/* Coefficient block of every object (render/shaders/lib/material.glsl). */
+void lr_passes_update_coeffs(lr_renderer *r);
+void lr_passes_set_coeffs(lr_renderer *r, const lr_program *p);
+/* Light G-buffer samplers and uniforms on units 0..3. */
+void lr_passes_bind_gbuffer(lr_renderer *r, const lr_program *p);
+/* Algorithm 1 uniforms and samplers (units 4..6). */
+void lr_passes_bind_gather(lr_renderer *r, const lr_program *p);
+void lr_passes_uniform_mat4(const lr_program *p, const char *name, const double m[16]);
+void lr_passes_uniform_v3(const lr_program *p, const char *name, lr_vec3 v);
+void lr_passes_uniform_i(const lr_program *p, const char *name, int v);
+void lr_passes_uniform_f(const lr_program *p, const char *name, float v);
+void lr_passes_bind_tex(const lr_program *p, const char *name, int unit, const lr_tex *t);
+/* View-projection of cube face f (0..5 = +X..-Z) around `at`. */
+void lr_passes_cube_face_vp(lr_vec3 at, int f, double znear, double zfar, double out[16]);
+/* The light of the transport (lights[0]) and its per-band intensity I (unit-scaled). */
+const lr_light *lr_passes_light(const lr_renderer *r);
+
+/* The passes. */
+int lr_pass_gbuffer(lr_renderer *r, lr_err *e);
+int lr_pass_radiosity(lr_renderer *r, bool restart, lr_err *e);
+int lr_pass_vpl(lr_renderer *r, bool geometry_changed, lr_err *e);
+int lr_pass_compose(lr_renderer *r, lr_err *e);
+
+/* Resources of each pass (allocated for r->rs). */
+int lr_gbuffer_alloc(lr_renderer *r, lr_err *e);
+void lr_gbuffer_free(lr_renderer *r);
+int lr_radiosity_alloc(lr_renderer *r, lr_err *e);
+void lr_radiosity_free(lr_renderer *r);
+int lr_vpl_alloc(lr_renderer *r, lr_err *e);
+void lr_vpl_free(lr_renderer *r);
+int lr_compose_alloc(lr_renderer *r, lr_err *e);
+void lr_compose_free(lr_renderer *r);
+
+#endif

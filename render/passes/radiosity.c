@@ -1,0 +1,152 @@
+/* Pass 2 — scattered-radiosity maps (render/passes/PIPELINE.md): K orthographic views along
+ * d_k = lr_halton_sphere(k + 1) of the objects' bounding sphere. Each frame adds one N-sample
+ * estimate per texel and colour band; the maps keep the running mean through the constant
+ * blend colour 1/F (GL_CONSTANT_ALPHA), so values stay O(B) over any number of frames.
+ * A depth-only prepass at restart fixes each texel's visible surface (seed 003 Sec. 3.2);
+ * the depth stays for composition's visibility test. */
+#include <math.h>
+
+#include "render/base/mat4.h"
+#include "render/optics/optics.h"
+#include "render/passes/passes.h"
+
+int lr_radiosity_alloc(lr_renderer *r, lr_err *e)
+{
+    int K = r->rs.K, n = r->rs.map_size, rc;
+    if (K > LR_MAX_K)
+        return lr_err_set(e, LR_EUNSUPPORTED, "render.K = %d: at most %d maps", K, LR_MAX_K);
+    r->rad.K = K;
+    r->rad.size = n;
+    lr_tex_desc d = {.type = LR_TEX_2D_ARRAY, .format = r->map_format, .width = n, .height = n,
+                     .layers = K, .label = "radiosity maps"};
+    if ((rc = lr_tex_create(r->gl, &d, &r->rad.B, e)))
+        return rc;
+    d.format = LR_TEX_RGBA32F;
+    d.label = "radiosity map positions";
+    if ((rc = lr_tex_create(r->gl, &d, &r->rad.pos, e)))
+        return rc;
+    d.label = "radiosity map normals";
+    if ((rc = lr_tex_create(r->gl, &d, &r->rad.nrm, e)))
+        return rc;
+    d.format = LR_TEX_DEPTH32F;
+    d.label = "radiosity map depth";
+    if ((rc = lr_tex_create(r->gl, &d, &r->rad.depth, e)))
+        return rc;
+    for (int k = 0; k < K; k++) {
+        lr_fb_desc fd = {.color = {{r->rad.B, k}, {r->rad.pos, k}, {r->rad.nrm, k}},
+                         .depth = {r->rad.depth, k}, .label = "radiosity map"};
+        if ((rc = lr_fb_create(r->gl, &fd, &r->rad.fb[k], e)))
+            return rc;
+    }
+    r->rad.F = 0;
+    return LR_OK;
+}
+
+void lr_radiosity_free(lr_renderer *r)
+{
+    for (int k = 0; k < LR_MAX_K; k++) {
+        lr_fb_destroy(r->rad.fb[k]);
+        r->rad.fb[k] = NULL;
+    }
+    lr_tex_destroy(r->rad.B);
+    lr_tex_destroy(r->rad.pos);
+    lr_tex_destroy(r->rad.nrm);
+    lr_tex_destroy(r->rad.depth);
+    r->rad.B = r->rad.pos = r->rad.nrm = r->rad.depth = NULL;
+    r->rad.F = 0;
+}
+
+/* Map cameras from the current geometry: orthographic, looking at the bounding sphere's
+ * centre from d_k, frustum around the sphere (depth range [R, 3R] from an eye at 2R). */
+static void place_maps(lr_renderer *r)
+{
+    lr_vec3 c;
+    double R;
+    lr_scene_bounds(r->scene, &c, &R);
+    R = fmax(R, 1e-3);
+    r->rad.center = c;
+    r->rad.radius = R;
+    r->rad.r_max = 20.0 * R;
+    double S[16] = {0.5, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, 0.5, 0, 0.5, 0.5, 0.5, 1};
+    for (int k = 0; k < r->rad.K; k++) {
+        lr_vec3 d = lr_halton_sphere((unsigned)k + 1);
+        r->rad.d[k] = d;
+        double view[16], proj[16];
+        lr_vec3 up = fabs(d.z) > 0.99 ? lr_v3(0.0, 1.0, 0.0) : lr_v3(0.0, 0.0, 1.0);
+        lr_mat4_look_at(lr_v3_add(c, lr_v3_scale(d, 2.0 * R)), c, up, view);
+        lr_mat4_ortho(-R, R, -R, R, R, 3.0 * R, proj);
+        lr_mat4_mul(proj, view, r->rad.vp[k]);
+        lr_mat4_mul(S, r->rad.vp[k], r->rad.P[k]);
+        lr_mat4_to_float(r->rad.P[k], r->rad.Pf + 16 * k);
+        r->rad.df[3 * k] = (float)d.x;
+        r->rad.df[3 * k + 1] = (float)d.y;
+        r->rad.df[3 * k + 2] = (float)d.z;
+    }
+    double texel = 2.0 * R / r->rad.size;
+    r->rad.eps_comb = (float)texel;
+    r->rad.eps_bias = (float)(2.0 * texel / (2.0 * R)); /* two texels, in depth units */
+}
+
+int lr_pass_radiosity(lr_renderer *r, bool restart, lr_err *e)
+{
+    static const GLenum all[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+    static const GLenum first[3] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE};
+    static const float zero[4] = {0, 0, 0, 0};
+    if (restart || r->rad.F == 0) {
+        place_maps(r);
+        r->rad.F = 0;
+    }
+    int F = r->rad.F + 1;
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_DEPTH_TEST);
+    for (int k = 0; k < r->rad.K; k++) {
+        lr_fb_bind(r->rad.fb[k]);
+        if (F == 1) {
+            glDrawBuffers(3, all);
+            glClearBufferfv(GL_COLOR, 0, zero);
+            glClearBufferfv(GL_COLOR, 1, zero);
+            glClearBufferfv(GL_COLOR, 2, zero);
+            glDepthMask(GL_TRUE);
+            glClearDepthf(1.0f);
+            glClear(GL_DEPTH_BUFFER_BIT);
+            /* Depth-only prepass. */
+            glUseProgram(lr_program_id(r->p_depth));
+            glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+            glDepthFunc(GL_LESS);
+            lr_passes_uniform_mat4(r->p_depth, "u_vp", r->rad.vp[k]);
+            for (int i = 0; i < r->n_objects; i++)
+                lr_passes_draw(&r->obj[i]);
+            glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+            glDisable(GL_BLEND);
+        } else {
+            glDrawBuffers(3, first);
+            glEnable(GL_BLEND);
+            glBlendEquation(GL_FUNC_ADD);
+            glBlendColor(0.0f, 0.0f, 0.0f, (float)(1.0 / F));
+            glBlendFunc(GL_CONSTANT_ALPHA, GL_ONE_MINUS_CONSTANT_ALPHA);
+        }
+        glDepthMask(GL_FALSE);
+        glDepthFunc(GL_LEQUAL);
+        const lr_program *p = r->p_radiosity;
+        glUseProgram(lr_program_id(p));
+        lr_passes_set_coeffs(r, p);
+        lr_passes_bind_gbuffer(r, p);
+        lr_passes_uniform_mat4(p, "u_vp", r->rad.vp[k]);
+        lr_passes_uniform_i(p, "u_N", r->rs.N);
+        lr_passes_uniform_f(p, "u_r_max", (float)r->rad.r_max);
+        lr_passes_uniform_i(p, "u_map_size", r->rad.size);
+        glUniform1ui(lr_program_uniform(p, "u_seed"), r->seed);
+        glUniform1ui(lr_program_uniform(p, "u_map"), (GLuint)k);
+        glUniform1ui(lr_program_uniform(p, "u_frame"), (GLuint)F);
+        for (int i = 0; i < r->n_objects; i++) {
+            lr_passes_uniform_i(p, "u_object", i);
+            lr_passes_uniform_i(p, "u_two_sided", r->two_sided[i]);
+            lr_passes_draw(&r->obj[i]);
+        }
+    }
+    glDisable(GL_BLEND);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    r->rad.F = F;
+    return lr_gl_check("radiosity pass", e);
+}

@@ -1,0 +1,161 @@
+/* Readback of the passes' intermediate results (render/renderer_debug.h). */
+#include "render/renderer_debug.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "render/optics/optics.h"
+#include "render/passes/passes.h"
+
+void lr_renderer_debug_map_info(const lr_renderer *r, lr_debug_map_info *out)
+{
+    memset(out, 0, sizeof *out);
+    out->K = r->rad.K;
+    out->size = r->rad.size;
+    out->frames = r->rad.F;
+    out->N = r->rs.N;
+    out->center = r->rad.center;
+    out->radius = r->rad.radius;
+    out->r_max = r->rad.r_max;
+    out->seed = r->seed;
+}
+
+lr_vec3 lr_renderer_debug_map_dir(const lr_renderer *r, int k)
+{
+    return k >= 0 && k < r->rad.K ? r->rad.d[k] : lr_v3(0, 0, 0);
+}
+
+void lr_renderer_debug_map_matrix(const lr_renderer *r, int k, double out[16])
+{
+    memcpy(out, r->rad.P[k >= 0 && k < r->rad.K ? k : 0], 16 * sizeof *out);
+}
+
+/* Reads colour attachment `att` of framebuffer fb into 4-float texels. */
+static float *read_fb(lr_fb *fb, int att, int w, int h, lr_err *e)
+{
+    float *buf = malloc((size_t)w * h * 4 * sizeof *buf);
+    if (!buf) {
+        lr_err_set(e, LR_ENOMEM, "debug readback: out of memory");
+        return NULL;
+    }
+    if (lr_fb_read(fb, att, 0, 0, w, h, buf, e)) {
+        free(buf);
+        return NULL;
+    }
+    return buf;
+}
+
+static void copy3(float *dst, const float *src, size_t n)
+{
+    if (dst)
+        for (size_t i = 0; i < n; i++)
+            memcpy(dst + 3 * i, src + 4 * i, 3 * sizeof *dst);
+}
+
+int lr_renderer_debug_read_map(lr_renderer *r, int k, float *B, float *pos, float *nrm, int *object,
+                               lr_err *e)
+{
+    if (k < 0 || k >= r->rad.K)
+        return lr_err_set(e, LR_EINVAL, "debug: map %d of %d", k, r->rad.K);
+    int n = r->rad.size;
+    size_t cnt = (size_t)n * n;
+    float *b = read_fb(r->rad.fb[k], 0, n, n, e);
+    float *p = b ? read_fb(r->rad.fb[k], 1, n, n, e) : NULL;
+    float *q = p ? read_fb(r->rad.fb[k], 2, n, n, e) : NULL;
+    if (!q) {
+        free(b);
+        free(p);
+        return e ? e->code : LR_EIO;
+    }
+    copy3(B, b, cnt);
+    copy3(pos, p, cnt);
+    copy3(nrm, q, cnt);
+    if (object)
+        for (size_t i = 0; i < cnt; i++)
+            object[i] = p[4 * i + 3] > 0.5f ? (int)(q[4 * i + 3] + 0.5f) : -1;
+    free(b);
+    free(p);
+    free(q);
+    return LR_OK;
+}
+
+int lr_renderer_debug_vpl_count(const lr_renderer *r)
+{
+    return r->vpl.fb ? r->vpl.n : 0;
+}
+
+lr_vec3 lr_renderer_debug_vpl_center(const lr_renderer *r)
+{
+    return r->vpl.center;
+}
+
+int lr_renderer_debug_read_vpls(lr_renderer *r, lr_debug_vpl *out, lr_err *e)
+{
+    int n = lr_renderer_debug_vpl_count(r);
+    if (!n)
+        return LR_OK;
+    float *p = read_fb(r->vpl.fb, 0, n, 1, e);
+    float *q = p ? read_fb(r->vpl.fb, 1, n, 1, e) : NULL;
+    float *b = q ? read_fb(r->vpl.fb, 2, n, 1, e) : NULL;
+    if (!b) {
+        free(p);
+        free(q);
+        return e ? e->code : LR_EIO;
+    }
+    for (int v = 0; v < n; v++) {
+        lr_debug_vpl *o = &out[v];
+        memset(o, 0, sizeof *o);
+        o->u = lr_halton_sphere((unsigned)v + 1);
+        o->valid = p[4 * v + 3] > 0.0f;
+        o->pos = lr_v3(p[4 * v], p[4 * v + 1], p[4 * v + 2]);
+        o->area = p[4 * v + 3];
+        o->nrm = lr_v3(q[4 * v], q[4 * v + 1], q[4 * v + 2]);
+        o->object = o->valid ? (int)(q[4 * v + 3] + 0.5f) : -1;
+        for (int c = 0; c < 3; c++)
+            o->B[c] = b[4 * v + c];
+        o->weight = b[4 * v + 3];
+    }
+    free(p);
+    free(q);
+    free(b);
+    return LR_OK;
+}
+
+void lr_renderer_debug_gbuffer_info(const lr_renderer *r, lr_debug_gbuffer_info *out)
+{
+    memset(out, 0, sizeof *out);
+    out->cube = r->gb.mode == LR_GB_CUBE;
+    out->orthographic = r->gb.mode == LR_GB_ORTHO;
+    out->size = r->gb.size;
+    if (out->cube)
+        memcpy(out->vp, r->gb.face_vp, sizeof out->vp);
+    else
+        memcpy(out->vp[0], r->gb.vp_d, sizeof out->vp[0]);
+    out->light_pos = r->gb.pos;
+    out->light_dir = r->gb.dir;
+}
+
+int lr_renderer_debug_read_gbuffer(lr_renderer *r, int face, float *pos, float *nrm, int *object,
+                                   lr_err *e)
+{
+    bool cube = r->gb.mode == LR_GB_CUBE;
+    if (face < 0 || face >= (cube ? 6 : 1))
+        return lr_err_set(e, LR_EINVAL, "debug: G-buffer face %d", face);
+    lr_fb *fb = cube ? r->gb.fb[face] : r->gb.fb_2d;
+    int n = r->gb.size;
+    size_t cnt = (size_t)n * n;
+    float *p = read_fb(fb, 0, n, n, e);
+    float *q = p ? read_fb(fb, 1, n, n, e) : NULL;
+    if (!q) {
+        free(p);
+        return e ? e->code : LR_EIO;
+    }
+    copy3(pos, p, cnt);
+    copy3(nrm, q, cnt);
+    if (object)
+        for (size_t i = 0; i < cnt; i++)
+            object[i] = p[4 * i + 3] > 0.5f ? (int)(p[4 * i + 3] + 0.5f) - 1 : -1;
+    free(p);
+    free(q);
+    return LR_OK;
+}

@@ -1,0 +1,78 @@
+/* lamprig — inspection of the renderer's intermediate results, for the GPU/CPU parity tests
+ * (render/cpu/), the bench and debugging. Reads back from the GPU (slow; not for the frame
+ * loop). All calls need the renderer's GL context current and a frame rendered since the
+ * last change (lr_renderer_frame). Arrays are in GL order: row 0 is the bottom of the map. */
+#ifndef LR_RENDERER_DEBUG_H
+#define LR_RENDERER_DEBUG_H
+
+#include <stdbool.h>
+
+#include "render/base/err.h"
+#include "render/base/vec3.h"
+#include "render/renderer.h"
+
+/* ---- scattered-radiosity maps (pass 2) ---------------------------------------------------- */
+
+typedef struct lr_debug_map_info {
+    int K;           /* maps */
+    int size;        /* side, texels */
+    int frames;      /* frames accumulated (F) */
+    int N;           /* samples per texel, band and frame */
+    lr_vec3 center;  /* bounding sphere the map cameras look at */
+    double radius;
+    double r_max;    /* radius truncation of the exponential sampling (20 radii) */
+    unsigned seed;
+} lr_debug_map_info;
+
+void lr_renderer_debug_map_info(const lr_renderer *r, lr_debug_map_info *out);
+
+/* Direction d_k = lr_halton_sphere(k + 1) of map k (the camera sits at centre + 2 R d_k). */
+lr_vec3 lr_renderer_debug_map_dir(const lr_renderer *r, int k);
+/* World -> texture matrix P_k of map k (column-major, render/base/mat4.h): x, y in [0, 1]
+ * across the map, z its depth in [0, 1] (depth range [R, 3R] from the camera). Texel (i, j)
+ * covers [i, i+1] / size x [j, j+1] / size. */
+void lr_renderer_debug_map_matrix(const lr_renderer *r, int k, double out[16]);
+
+/* Map k, size*size texels. Any output may be NULL. B: 3 floats per texel, scattered radiosity
+ * for a unit light intensity (W/mm^2 per W/sr), the running mean over `frames` frames;
+ * pos / nrm: 3 floats per texel, x_o and n_o (the normal the estimator used); object: the
+ * object index, -1 where the map sees no surface (covered == false). */
+int lr_renderer_debug_read_map(lr_renderer *r, int k, float *B, float *pos, float *nrm, int *object,
+                               lr_err *e);
+
+/* ---- virtual point lights (pass 4) -------------------------------------------------------- */
+
+typedef struct lr_debug_vpl {
+    bool valid;      /* a surface exists along u */
+    lr_vec3 u;       /* fixed direction from the bounding-box centre, lr_halton_sphere(v + 1) */
+    lr_vec3 pos, nrm;
+    double area;     /* A_v, mm^2 */
+    double B[3];     /* B(x_v) from Algorithm 1, unit intensity */
+    double weight;   /* Algorithm 1's visibility weight n (0: fallback map) */
+    int object;
+} lr_debug_vpl;
+
+/* Number of VPLs (render.N_vpl; 0 with no_vpl). */
+int lr_renderer_debug_vpl_count(const lr_renderer *r);
+/* The VPL centre c (bounding-box centre of the objects). */
+lr_vec3 lr_renderer_debug_vpl_center(const lr_renderer *r);
+/* Fills out[0 .. count). */
+int lr_renderer_debug_read_vpls(lr_renderer *r, lr_debug_vpl *out, lr_err *e);
+
+/* ---- light G-buffer (pass 1) -------------------------------------------------------------- */
+
+typedef struct lr_debug_gbuffer_info {
+    bool cube;          /* cube map (6 faces) or one 2D map */
+    bool orthographic;  /* 2D map of a directional light */
+    int size;           /* side (each face) */
+    double vp[6][16];   /* world -> clip of each face (cube) or of the map ([0]) */
+    lr_vec3 light_pos, light_dir;
+} lr_debug_gbuffer_info;
+
+void lr_renderer_debug_gbuffer_info(const lr_renderer *r, lr_debug_gbuffer_info *out);
+/* Face `face` (0..5 = +X..-Z; 0 for a 2D map): pos and nrm 3 floats per texel, object the
+ * object index or -1 for an empty texel. Any output may be NULL. */
+int lr_renderer_debug_read_gbuffer(lr_renderer *r, int face, float *pos, float *nrm, int *object,
+                                   lr_err *e);
+
+#endif

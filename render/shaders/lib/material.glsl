@@ -1,0 +1,28 @@
+// Material coefficients of every translucent object, indexed by object id (the G-buffer's
+// material id minus one). Five vec4 per object, filled by render/passes/common.c:
+//   [0] sigma_tr.rgb, eta   [1] D.rgb, C_phi_norm   [2] de.rgb (< 0: infinite), C_phi
+//   [3] sigma_t.rgb, C_E    [4] mfp.rgb, A_dir
+#include "optics.glsl"
+
+#ifndef LR_MAX_OBJECTS
+#define LR_MAX_OBJECTS 8
+#endif
+
+uniform vec4 u_coef[5 * LR_MAX_OBJECTS];
+
+lr_coeffs_gl lr_material(int id)
+{
+    int b = 5 * clamp(id, 0, LR_MAX_OBJECTS - 1);
+    lr_coeffs_gl c;
+    c.sigma_tr = u_coef[b].xyz;
+    c.eta = u_coef[b].w;
+    c.D = u_coef[b + 1].xyz;
+    c.C_phi_norm = u_coef[b + 1].w;
+    c.de = u_coef[b + 2].xyz;
+    c.C_phi = u_coef[b + 2].w;
+    c.sigma_t = u_coef[b + 3].xyz;
+    c.C_E = u_coef[b + 3].w;
+    c.mfp = u_coef[b + 4].xyz;
+    c.A_dir = u_coef[b + 4].w;
+    return c;
+}

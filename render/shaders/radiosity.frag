@@ -1,0 +1,110 @@
+// Pass 2: one frame's estimate of scattered radiosity B(x_o) per colour band for a light of
+// unit intensity (render/passes/PIPELINE.md, seed 003 Eq. 4/9 with the exact Jacobian),
+// written to attachment 0 and blended into the running mean by the caller (constant blend
+// colour 1/F). Attachments 1 and 2 keep x_o (coverage in .w) and n_o (object id in .w).
+#include "lib/material.glsl"
+#include "lib/random.glsl"
+#include "lib/gbuffer.glsl"
+
+in vec3 v_pos;
+in vec3 v_nrm;
+uniform int u_object;
+uniform bool u_two_sided;
+uniform int u_light_type;   // 0 point, 1 spot, 2 directional
+uniform vec2 u_spot_cos;    // cos(outer), cos(inner)
+uniform int u_N;
+uniform float u_r_max;
+uniform uint u_seed;
+uniform uint u_map;
+uniform uint u_frame;
+uniform int u_map_size;
+layout(location = 0) out vec4 o_B;
+layout(location = 1) out vec4 o_pos;
+layout(location = 2) out vec4 o_nrm;
+
+float spot_shape(vec3 dir)
+{
+    if (u_light_type != 1)
+        return 1.0;
+    float c = dot(normalize(dir), u_light_dir);
+    return smoothstep(u_spot_cos.x, u_spot_cos.y, c);
+}
+
+void main()
+{
+    vec3 xo = v_pos;
+    vec3 no = normalize(v_nrm);
+    if (u_two_sided && !gl_FrontFacing)
+        no = -no;
+    lr_coeffs_gl mat = lr_material(u_object);
+    ivec2 tx = ivec2(gl_FragCoord.xy);
+    uint state = lr_seed(uint(tx.y * u_map_size + tx.x), u_map, u_frame, u_seed);
+
+    // Tangent frame at x_o (point lights), or the light's view plane (directional).
+    vec3 axis = u_light_type == 2 ? u_light_dir : no;
+    vec3 a = abs(axis.z) < 0.9 ? vec3(0.0, 0.0, 1.0) : vec3(1.0, 0.0, 0.0);
+    vec3 t1 = normalize(cross(a, axis));
+    vec3 t2 = cross(axis, t1);
+
+    vec3 h = u_light_pos - xo;
+    float d = length(h);
+    vec3 A = u_light_pos + h; // antipode of x_o on the sphere of radius d around the light
+
+    vec3 B = vec3(0.0);
+    for (int c = 0; c < 3; c++) {
+        float sigma_tr = mat.sigma_tr[c];
+        float sum = 0.0;
+        for (int j = 0; j < u_N; j++) {
+            float xi1 = lr_rand(state);
+            float xi2 = lr_rand(state);
+            float r = lr_exp_radius_sample(sigma_tr, u_r_max, xi1);
+            float alpha = 2.0 * LR_PI * xi2;
+            // 1 / p_A = 2 pi r / p(r) (density per unit area of the sampling plane).
+            float pr = lr_exp_radius_pdf(sigma_tr, u_r_max, r);
+            if (!(pr > 0.0) || !(r > 0.0))
+                continue;
+            float inv_pA = 2.0 * LR_PI * r / pr;
+            vec3 xj = xo + r * (cos(alpha) * t1 + sin(alpha) * t2);
+            vec3 xi, ni;
+            int id;
+            vec3 wi;
+            float J;
+            float shape = 1.0;
+            if (u_light_type == 2) {
+                if (!lr_gbuffer_fetch(xj, xi, ni, id))
+                    continue;
+                wi = -u_light_dir;
+                J = 1.0; // cos theta_i dA_i = dA_plane
+            } else {
+                if (!(d > 1e-6))
+                    continue;
+                // Seed 003 Eq. 13-14 (stereographic lookup), Jacobian of PIPELINE.md.
+                vec3 q = xj - A;
+                float q2 = dot(q, q);
+                if (!(q2 > 0.0))
+                    continue;
+                vec3 l = q * inversesqrt(q2);
+                float hl = dot(h, l);
+                vec3 v = h - 2.0 * hl * l;
+                float t = abs(2.0 * hl);
+                J = 2.0 * t * abs(dot(l, no)) / (d * q2);
+                if (!lr_gbuffer_fetch(v, xi, ni, id))
+                    continue;
+                wi = normalize(u_light_pos - xi);
+                shape = spot_shape(v);
+            }
+            if (id != u_object)
+                continue; // light does not scatter from one object into another
+            float cos_i = dot(ni, wi);
+            if (!(cos_i > 0.0))
+                continue;
+            float Ft = lr_fresnel_transmittance(cos_i, mat.eta);
+            float sd = lr_dirpole_sd_band(mat, c, xi, ni, wi, xo, no);
+            sum += sd * Ft * J * inv_pA * shape;
+        }
+        B[c] = LR_PI * sum / float(u_N);
+    }
+    o_B = vec4(B, 1.0);
+    o_pos = vec4(xo, 1.0);
+    o_nrm = vec4(no, float(u_object));
+}

@@ -1,0 +1,213 @@
+/* The GLSL optics (render/shaders/lib/optics.glsl) against the C reference (render/optics/),
+ * evaluated by a fragment shader on a grid of inputs: directional dipole S_d with and without
+ * Fresnel transmission, Fresnel reflectance, exponential radius sampling and its density.
+ *
+ * Tolerance. The shader computes in IEEE float (highp: 24-bit significand, unit roundoff
+ * u = 6e-8); the C reference in double. GLSL ES 3.10 (section "Range and Precision") bounds
+ * exp/exp2 by (3 + 2|x|) ULP and log, sqrt, inversesqrt, division by 3 ULP or less; S_d takes
+ * exp(-s) with s = sigma_tr d <= 87 (beyond it both sides give 0), i.e. at most ~180 ULP =
+ * 1.1e-5 relative, plus ~60 roundings in the geometry (<= 4e-6). The clamped difference
+ * real - virtual source amplifies relative error by real / (real - virt), which on this grid
+ * (x_o at >= 0.05 mfp from x_i) stays below ~20: 20 * 1.5e-5 = 3e-4. We assert 1e-3 relative
+ * plus an absolute floor of 1e-5 times the case's largest band (a band that cancels to nearly
+ * 0 while the others do not). Fresnel: a handful of operations, 1e-5 absolute. Sampling:
+ * the float log1p/expm1 forms of the shader keep 1e-5 relative. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <GLES3/gl31.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render/gl/gl.h"
+#include "render/gl/shader.h"
+#include "render/gl/tex.h"
+#include "render/material/material.h"
+#include "render/optics/optics.h"
+#include "render/passes/passes.h"
+#include "tests/support/gl.h"
+#include "tests/support/near.h"
+
+#define NMAT 5
+
+typedef struct tcase {
+    lr_vec3 xi, ni, wi, xo, no;
+    int mat;
+    double cos_i, eta, xi_s, r_max;
+} tcase;
+
+static lr_gl *gl;
+
+static int setup(void **state)
+{
+    return lr_test_gl_create(&gl) ? -1 : 0;
+}
+
+static int teardown(void **state)
+{
+    lr_gl_destroy(gl);
+    return 0;
+}
+
+static lr_vec3 unit(double x, double y, double z)
+{
+    return lr_v3_normalize(lr_v3(x, y, z));
+}
+
+/* The shader sees float inputs: the reference gets the same rounded values. */
+static lr_vec3 f3(lr_vec3 v)
+{
+    return lr_v3((float)v.x, (float)v.y, (float)v.z);
+}
+
+static void load_coeffs(lr_coeffs c[NMAT])
+{
+    static const char *const names[] = {"marble", "candle_wax", "spectralon", "ketchup"};
+    lr_err e = {0};
+    for (int i = 0; i < 4; i++) {
+        lr_material m;
+        if (lr_material_find(names[i], &m, &e) || lr_coeffs_derive(&m.medium, &c[i], &e))
+            fail_msg("%s: %s", names[i], e.msg);
+    }
+    /* eta < 1 (a medium optically thinner than outside): total internal reflection on entry. */
+    lr_medium thin = {{0.01, 0.02, 0.05}, {1.0, 1.5, 2.0}, 0.8, 0.0};
+    if (lr_coeffs_derive(&thin, &c[4], &e))
+        fail_msg("%s", e.msg);
+}
+
+static void test_optics_glsl_matches_c(void **state)
+{
+    lr_coeffs co[NMAT];
+    load_coeffs(co);
+    /* The grid. */
+    static const double radii_mfp[] = {0.05, 0.3, 1.0, 3.0, 10.0, 30.0};
+    static const double wi_deg[] = {0.0, 30.0, 60.0, 85.0};
+    static const double no_tilt[] = {0.0, 40.0, 120.0};
+    int n = NMAT * 6 * 4 * 3;
+    tcase *cs = calloc((size_t)n, sizeof *cs);
+    int k = 0;
+    for (int m = 0; m < NMAT; m++)
+        for (int a = 0; a < 6; a++)
+            for (int b = 0; b < 4; b++)
+                for (int t = 0; t < 3; t++, k++) {
+                    tcase *c = &cs[k];
+                    double r = radii_mfp[a] * co[m].mfp[1];
+                    c->mat = m;
+                    c->xi = lr_v3(1.0, -2.0, 0.5);
+                    c->ni = unit(0.0, 0.2, 1.0);
+                    double w = wi_deg[b] * M_PI / 180.0;
+                    c->wi = unit(sin(w), 0.1, cos(w));
+                    double phi = 0.7 * a + 0.3 * b;
+                    c->xo = lr_v3_add(c->xi, lr_v3(r * cos(phi), r * sin(phi), 0.1 * r));
+                    double tt = no_tilt[t] * M_PI / 180.0;
+                    c->no = unit(sin(tt), 0.0, cos(tt));
+                    c->cos_i = (k % 17) / 16.0;
+                    c->eta = m == 4 ? 0.8 : co[m].eta;
+                    c->xi_s = (k % 13) / 13.0;
+                    c->r_max = m == 2 ? 500.0 : 50.0;
+                }
+    /* Inputs: 6 texels per case. */
+    float *in = calloc((size_t)n * 6 * 4, sizeof *in);
+    for (int i = 0; i < n; i++) {
+        const tcase *c = &cs[i];
+        lr_vec3 v[5] = {c->xi, c->ni, c->wi, c->xo, c->no};
+        for (int j = 0; j < 5; j++) {
+            in[(i * 6 + j) * 4 + 0] = (float)v[j].x;
+            in[(i * 6 + j) * 4 + 1] = (float)v[j].y;
+            in[(i * 6 + j) * 4 + 2] = (float)v[j].z;
+        }
+        in[(i * 6) * 4 + 3] = (float)c->mat;
+        float *s = in + (i * 6 + 5) * 4;
+        s[0] = (float)c->cos_i;
+        s[1] = (float)c->eta;
+        s[2] = (float)c->xi_s;
+        s[3] = (float)c->r_max;
+    }
+    lr_err e = {0};
+    lr_tex *tin = NULL, *tout = NULL;
+    lr_fb *fb = NULL;
+    lr_program *p = NULL;
+    if (lr_tex_create(gl, &(lr_tex_desc){.width = 6, .height = n}, &tin, &e) ||
+        lr_tex_upload(tin, 0, in, &e) ||
+        lr_tex_create(gl, &(lr_tex_desc){.width = 3, .height = n}, &tout, &e) ||
+        lr_fb_create(gl, &(lr_fb_desc){.color = {{tout, 0}}}, &fb, &e) ||
+        lr_program_create(&(lr_program_desc){.vertex = "render/shaders/fullscreen.vert",
+                                             .fragment = "tests/shaders/optics_eval.frag"},
+                          &p, &e))
+        fail_msg("%s", e.msg);
+    float coef[5 * 4 * LR_MAX_OBJECTS] = {0};
+    for (int m = 0; m < NMAT; m++)
+        lr_passes_pack_coeffs(&co[m], coef + 20 * m);
+    lr_fb_bind(fb);
+    glUseProgram(lr_program_id(p));
+    glUniform4fv(lr_program_uniform(p, "u_coef"), 5 * LR_MAX_OBJECTS, coef);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, lr_tex_id(tin));
+    glUniform1i(lr_program_uniform(p, "u_cases"), 0);
+    lr_gl_draw_fullscreen(gl);
+    float *out = calloc((size_t)n * 3 * 4, sizeof *out);
+    if (lr_fb_read(fb, 0, 0, 0, 3, n, out, &e))
+        fail_msg("%s", e.msg);
+
+    double worst_sd = 0.0;
+    int nonzero = 0;
+    for (int i = 0; i < n; i++) {
+        tcase cr = cs[i];
+        const tcase *c = &cr;
+        cr.xi = f3(cr.xi);
+        cr.ni = f3(cr.ni);
+        cr.wi = f3(cr.wi);
+        cr.xo = f3(cr.xo);
+        cr.no = f3(cr.no);
+        cr.cos_i = (float)cr.cos_i;
+        cr.eta = (float)cr.eta;
+        const lr_coeffs *cf = &co[c->mat];
+        double sd[3], sdf[3];
+        lr_dirpole_sd(cf, c->xi, c->ni, c->wi, c->xo, c->no, sd);
+        lr_dirpole_sd_fresnel(cf, c->xi, c->ni, c->wi, c->xo, c->no, sdf);
+        const float *g = out + (size_t)i * 3 * 4;
+        double mx = fmax(sd[0], fmax(sd[1], sd[2]));
+        for (int j = 0; j < 3; j++) {
+            double tol = 1e-3 * fabs(sd[j]) + 1e-5 * mx;
+            if (getenv("LR_TEST_VERBOSE") && !(fabs(g[j] - sd[j]) <= tol))
+                printf("case %d (material %d) band %d: GLSL S_d %.9g, C %.9g\n", i, c->mat, j,
+                       g[j], sd[j]);
+            else if (!(fabs(g[j] - sd[j]) <= tol))
+                fail_msg("case %d (material %d) band %d: GLSL S_d %.9g, C %.9g", i, c->mat, j,
+                         g[j], sd[j]);
+            if (sd[j] > 0.0) {
+                nonzero++;
+                worst_sd = fmax(worst_sd, fabs(g[j] - sd[j]) / sd[j]);
+            }
+            double mf = fmax(sdf[0], fmax(sdf[1], sdf[2]));
+            assert_near(g[4 + j], sdf[j], 1e-3 * fabs(sdf[j]) + 1e-5 * mf);
+        }
+        assert_near(g[8], lr_fresnel_reflectance(c->cos_i, c->eta), 1e-5);
+        double rs = lr_exp_radius_sample(cf->sigma_tr[0], c->r_max, (float)c->xi_s);
+        assert_near(g[9], rs, 1e-5 * rs + 1e-6);
+        assert_near_rel(g[10], lr_exp_radius_pdf(cf->sigma_tr[0], c->r_max, rs), 1e-4);
+    }
+    /* The grid must exercise the model, not compare zeros. */
+    assert_true(nonzero > n);
+    printf("GLSL vs C optics: %d cases, worst relative S_d difference %.3g\n", n, worst_sd);
+    lr_program_destroy(p);
+    lr_fb_destroy(fb);
+    lr_tex_destroy(tin);
+    lr_tex_destroy(tout);
+    free(out);
+    free(in);
+    free(cs);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_optics_glsl_matches_c),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
