@@ -461,9 +461,11 @@ static void test_albedo_one_sphere(void **state)
     lrt_object_free(&o);
 }
 
-/* A zero-thickness shade (one outward surface) around a bulb: the light meets the back of the
- * surface everywhere (n_i . w_i < 0), so under PIPELINE.md's rule B = 0 exactly at every point
- * (finite, not NaN); the same shade lit from outside glows (B > 0) where it faces the light. */
+/* A zero-thickness shade (one surface, open, so two-sided as in the GLSL passes: the light
+ * G-buffer turns n_i toward the light) around a bulb: the bulb lights the inside of the
+ * surface; at a point of it seen from outside (n_o outward) x_i = x_o is reached with n_i = -n_o
+ * and S_d at r -> 0 stays finite (the dipole's distance floors). Finite, > 0, pass agrees with
+ * the reference within 4 sigma; the side facing the bulb (n_o inward) is brighter. */
 static void test_zero_thickness_shade(void **state)
 {
     (void)state;
@@ -475,20 +477,18 @@ static void test_zero_thickness_shade(void **state)
         fail_msg("%s", e.msg);
     lrt_object o;
     lrt_object_make(mesh, &m, &o);
+    assert_false(o.obj.closed);
     lr_light inside = lrt_point_light(lr_v3(0, 0, 75));
     lr_vec3 xo, no;
     assert_true(lr_cpu_first_surface(&o.obj, lr_v3(300, 0, 75), lr_v3(-1, 0, 0), 0, &xo, &no));
-    lr_cpu_radiosity_desc d = {.N = 2000};
-    lr_cpu_estimate est;
-    lr_cpu_radiosity(&o.obj, &inside, xo, no, &d, lr_cpu_key(41, 0, 0, 0), &est);
+    assert_true(no.x > 0.5); /* the outward side */
+    double out[3], in[3];
+    check_pass_vs_ref(&o, &inside, xo, no, 6000, out);
+    check_pass_vs_ref(&o, &inside, xo, lr_v3_scale(no, -1.0), 6000, in);
     for (int c = 0; c < 3; c++) {
-        assert_true(est.mean[c] == 0.0);
-        assert_true(est.var[c] == 0.0);
+        print_message("zero-thickness shade band %d: B outside %.4g, inside %.4g\n", c, out[c], in[c]);
+        assert_true(out[c] > 0.0 && in[c] > out[c]);
     }
-    lr_light outside = lrt_point_light(lr_v3(200, 0, 75));
-    check_pass_vs_ref(&o, &outside, xo, no, 6000, est.mean);
-    for (int c = 0; c < 3; c++)
-        assert_true(est.mean[c] > 0.0);
     lrt_object_free(&o);
 }
 

@@ -34,6 +34,7 @@ typedef struct rctx {
     int W, H, nobj, nlight, nvpl, samples;
     double inv_vp[16];
     lr_cpu_maps **maps;  /* [obj * nlight + light] (PASS) */
+    const lr_scene_object **objs; /* every object: occluders of each other's light lookups */
     lr_cpu_vpl *vpl;     /* [obj * nvpl + v]; B per band already summed over lights with I */
     double (*I)[3];      /* per light: intensity * color */
     lr_image *rgb, *var;
@@ -47,7 +48,8 @@ static void radiosity_at(const rctx *r, int o, int l, lr_vec3 x, lr_vec3 n, uint
                          double B[3], double var[3], bool *fallback)
 {
     if (r->d->mode == LR_CPU_REFERENCE) {
-        lr_cpu_radiosity_desc rd = {.N = r->samples, .sampler = LR_CPU_REFERENCE};
+        lr_cpu_radiosity_desc rd = {.N = r->samples, .sampler = LR_CPU_REFERENCE,
+                                    .others = r->objs, .n_others = r->nobj};
         lr_cpu_estimate est;
         lr_cpu_radiosity(lr_scene_object_at(r->s, o), lr_scene_light_at(r->s, l), x, n, &rd, key,
                          &est);
@@ -129,6 +131,8 @@ static void pixel_item(void *p, long item)
     if (kind == 0) {
         r->object_px[item] = 1;
         const lr_scene_object *o = lr_scene_object_at(r->s, idx);
+        if (!o->closed && lr_v3_dot(n, dir) > 0.0)
+            n = lr_v3_scale(n, -1.0); /* two-sided open surface: the side the camera sees */
         double cos_o = -lr_v3_dot(n, dir);
         double ft = lr_fresnel_transmittance(cos_o > 0.0 ? cos_o : 0.0, o->coeffs.eta);
         for (int l = 0; l < r->nlight; l++) {
@@ -205,12 +209,15 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
     r.vpl = calloc((size_t)r.nobj * (r.nvpl ? r.nvpl : 1), sizeof *r.vpl);
     r.object_px = calloc((size_t)r.W * r.H, sizeof *r.object_px);
     r.fallback_px = calloc((size_t)r.W * r.H, sizeof *r.fallback_px);
-    if (!r.I || !r.maps || !r.vpl || !r.object_px || !r.fallback_px) {
+    r.objs = calloc((size_t)r.nobj, sizeof *r.objs);
+    if (!r.I || !r.objs || !r.maps || !r.vpl || !r.object_px || !r.fallback_px) {
         rc = lr_err_set(e, LR_ENOMEM, "cpu render: out of memory");
         goto fail;
     }
     for (int l = 0; l < r.nlight; l++)
         lr_light_rgb(lr_scene_light_at(s, l), r.I[l]);
+    for (int o = 0; o < r.nobj; o++)
+        r.objs[o] = lr_scene_object_at(s, o);
     double samples = 0.0;
     if (!ref) {
         for (int o = 0; o < r.nobj; o++)
@@ -222,7 +229,9 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
                                        .N = d->N ? d->N : rs->N,
                                        .seed = (unsigned)lr_cpu_key(seed_of(&r), (uint64_t)o,
                                                                     (uint64_t)l, 2),
-                                       .threads = d->threads};
+                                       .threads = d->threads,
+                                       .others = r.objs,
+                                       .n_others = r.nobj};
                 lr_cpu_maps **m = &r.maps[o * r.nlight + l];
                 if ((rc = lr_cpu_maps_create(&md, m, e)))
                     goto fail;
@@ -271,6 +280,7 @@ fail:
     free(r.I);
     free(r.object_px);
     free(r.fallback_px);
+    free(r.objs);
     if (rc) {
         lr_image_free(rgb);
         if (var)

@@ -13,6 +13,8 @@ struct lr_cpu_maps {
     lr_light light;
     int K, S, N, frames, threads;
     double r_max, eps_bias, eps_comb, texel;
+    const lr_scene_object *const *others;
+    int n_others;
     enum lr_cpu_sampler sampler;
     unsigned seed;
     lr_vec3 *dir, *eye, *right, *up;
@@ -29,7 +31,7 @@ static void place_views(lr_cpu_maps *m)
     const lr_scene_object *o = m->obj;
     for (int k = 0; k < m->K; k++) {
         lr_vec3 d = lr_halton_sphere((unsigned)k + 1);
-        lr_vec3 up0 = fabs(d.z) > 0.99 ? lr_v3(1, 0, 0) : lr_v3(0, 0, 1);
+        lr_vec3 up0 = fabs(d.z) > 0.99 ? lr_v3(0, 1, 0) : lr_v3(0, 0, 1);
         lr_vec3 right = lr_v3_normalize(lr_v3_cross(up0, d));
         m->dir[k] = d;
         m->right[k] = right;
@@ -55,6 +57,8 @@ static void raster_item(void *p, long item)
     lr_vec3 x, n;
     lr_vec3 back = lr_v3_scale(m->dir[k], -1.0);
     if (lr_cpu_first_surface(m->obj, org, back, 0.0, &x, &n)) {
+        if (!m->obj->closed && lr_v3_dot(n, m->dir[k]) < 0.0)
+            n = lr_v3_scale(n, -1.0); /* two-sided open surface: the side the map sees */
         t->valid = true;
         t->x = x;
         t->n = n;
@@ -79,12 +83,14 @@ int lr_cpu_maps_create(const lr_cpu_maps_desc *d, lr_cpu_maps **out, lr_err *e)
     m->S = d->map_size ? d->map_size : 256;
     m->N = d->N ? d->N : 16;
     m->r_max = d->r_max;
+    m->others = d->others;
+    m->n_others = d->n_others;
     m->sampler = d->sampler;
     m->seed = d->seed ? d->seed : 1;
     m->threads = d->threads;
     m->texel = 2.0 * m->obj->radius / m->S;
     m->eps_bias = d->eps_bias > 0.0 ? d->eps_bias : 2.0 * m->texel;
-    m->eps_comb = d->eps_comb > 0.0 ? d->eps_comb : 0.5 * m->texel;
+    m->eps_comb = d->eps_comb > 0.0 ? d->eps_comb : m->texel;
     m->dir = calloc((size_t)m->K, sizeof *m->dir);
     m->eye = calloc((size_t)m->K, sizeof *m->eye);
     m->right = calloc((size_t)m->K, sizeof *m->right);
@@ -129,7 +135,8 @@ static void acc_item(void *p, long item)
     lr_cpu_texel *t = m->tex + item;
     if (!t->valid)
         return;
-    lr_cpu_radiosity_desc d = {.N = m->N, .sampler = m->sampler, .r_max = m->r_max};
+    lr_cpu_radiosity_desc d = {.N = m->N, .sampler = m->sampler, .r_max = m->r_max,
+                               .others = m->others, .n_others = m->n_others};
     lr_cpu_estimate est;
     lr_cpu_radiosity(m->obj, &m->light, t->x, t->n, &d,
                      lr_cpu_key(m->seed, (uint64_t)k, (uint64_t)texel, (uint64_t)a->frame), &est);
@@ -174,9 +181,9 @@ const lr_cpu_texel *lr_cpu_maps_texel(const lr_cpu_maps *m, int k, int i, int j)
     return texel_at(m, k, i, j);
 }
 
-/* Bilinear 2x2 taps of map k around point p; with depth_test, a tap counts only when p is no
- * deeper than its depth + eps_bias. Adds w*B, w^2*var/n and w into the sums. */
-static void taps(const lr_cpu_maps *m, int k, lr_vec3 p, bool depth_test, double sum[3],
+/* Bilinear 2x2 taps of map k around point p: a tap counts when p is no deeper than its depth +
+ * eps_bias and its normal faces the same side as no. Adds w*B, w^2*var/n and w into the sums. */
+static void taps(const lr_cpu_maps *m, int k, lr_vec3 p, lr_vec3 no, double sum[3],
                  double var[3], double *wsum)
 {
     double R = m->obj->radius;
@@ -193,7 +200,11 @@ static void taps(const lr_cpu_maps *m, int k, lr_vec3 p, bool depth_test, double
             const lr_cpu_texel *t = lr_cpu_maps_texel(m, k, i0 + di, j0 + dj);
             if (!t || !t->valid || t->samples == 0)
                 continue;
-            if (depth_test && !(depth <= t->depth + m->eps_bias))
+            if (!(depth <= t->depth + m->eps_bias))
+                continue;
+            /* Beyond Algorithm 1 (as the GLSL pass): the texel's surface must face the same
+             * side as x_o, or a shell thinner than eps_bias mixes its two sides' radiosity. */
+            if (!(lr_v3_dot(t->n, no) > 0.0))
                 continue;
             double w = (di ? fu : 1.0 - fu) * (dj ? fv : 1.0 - fv);
             for (int c = 0; c < 3; c++) {
@@ -216,22 +227,28 @@ void lr_cpu_maps_compose(const lr_cpu_maps *m, lr_vec3 xo, lr_vec3 no, double B[
             best_cos = cs;
             best = k;
         }
-        /* Beyond Algorithm 1: a map can only see surfaces that face it. Without this test a
-         * thin shell (thickness < eps_bias) passes the depth test of maps that see its other
-         * side, and the inner and outer radiosity mix (measured: the lamp shade's image 2x
-         * too bright). */
-        if (!(cs > 0.0))
-            continue;
-        cs = cs > 1.0 ? 1.0 : cs;
+        cs = cs < 0.0 ? 0.0 : cs > 1.0 ? 1.0 : cs;
         /* seed 003 Algorithm 1: x_o - eps_comb (n_o - cos(theta) d_k). */
         lr_vec3 xb = lr_v3_sub(xo, lr_v3_scale(lr_v3_sub(no, lr_v3_scale(m->dir[k], cs)),
                                               m->eps_comb));
-        taps(m, k, xb, true, sum, var, &wsum);
+        taps(m, k, xb, no, sum, var, &wsum);
     }
     bool fb = false;
-    if (!(wsum > 0.0)) {
+    if (!(wsum > 1e-6)) {
+        /* No map sees x_o: the map facing it most, nearest texel, no visibility test. */
         fb = true;
-        taps(m, best, xo, false, sum, var, &wsum);
+        double R = m->obj->radius;
+        lr_vec3 rel = lr_v3_sub(xo, m->eye[best]);
+        int i = (int)floor((lr_v3_dot(rel, m->right[best]) + R) / m->texel);
+        int j = (int)floor((lr_v3_dot(rel, m->up[best]) + R) / m->texel);
+        i = i < 0 ? 0 : i >= m->S ? m->S - 1 : i;
+        j = j < 0 ? 0 : j >= m->S ? m->S - 1 : j;
+        const lr_cpu_texel *t = texel_at(m, best, i, j);
+        for (int c = 0; c < 3; c++) {
+            sum[c] = t->valid ? t->mean[c] : 0.0;
+            var[c] = t->valid && t->samples ? t->var[c] / t->samples : 0.0;
+        }
+        wsum = 1.0;
     }
     for (int c = 0; c < 3; c++) {
         B[c] = wsum > 0.0 ? sum[c] / wsum : 0.0;

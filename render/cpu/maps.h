@@ -5,7 +5,7 @@
  * an orthographic view of [-R, R]^2 around the centre c, map_size^2 texels, texel (i, j) with
  * i along `right`, j along `up` (j = 0 at the bottom, GL order), centre at
  * c + 2R d_k + ((i + 0.5) h - R) right + ((j + 0.5) h - R) up, h = 2R / map_size. The view
- * basis: up0 = +z (or +x when |d_k.z| > 0.99), right = normalize(up0 x d_k), up = d_k x right
+ * basis: up0 = +z (or +y when |d_k.z| > 0.99), right = normalize(up0 x d_k), up = d_k x right
  * -- the same as lr_mat4_look_at(c + 2R d_k, c, up0). Each texel holds the first surface
  * along -d_k (x_o, interpolated n_o, depth = distance from the eye plane) and the running mean
  * of B over the frames accumulated so far with its pooled sample variance.
@@ -28,10 +28,12 @@ typedef struct lr_cpu_maps_desc {
     int map_size;                  /* texels per side; 0: 256 */
     int N;                         /* samples per texel, band and frame; 0: 16 */
     double r_max;                  /* 0: LR_CPU_RMAX_RADII radii (PIPELINE.md) */
+    const lr_scene_object *const *others; /* see lr_cpu_radiosity_desc; may be NULL */
+    int n_others;
     enum lr_cpu_sampler sampler;   /* LR_CPU_PASS (the twin) or LR_CPU_REFERENCE */
     unsigned seed;                 /* 0: 1 */
     int threads;                   /* 0: all CPUs */
-    /* Algorithm 1's biases in mm; 0: eps_bias = 2 texels, eps_comb = 0.5 texel. */
+    /* Algorithm 1's biases in mm; 0: eps_bias = 2 texels, eps_comb = 1 texel (as the GPU). */
     double eps_bias, eps_comb;
 } lr_cpu_maps_desc;
 
@@ -62,11 +64,11 @@ const lr_cpu_texel *lr_cpu_maps_texel(const lr_cpu_maps *m, int k, int i, int j)
 
 /* Seed 003 Algorithm 1 at (xo, no): B = sum v_k B_k / sum v_k over the maps that see x_o
  * (x_o moved by eps_comb along -(n_o - cos d_k); 2x2 bilinear taps, each visible when the
- * moved point is no deeper than the texel's depth + eps_bias). Beyond the paper, maps with
- * n_o . d_k <= 0 are skipped (they cannot see x_o; needed for shells thinner than eps_bias). When no map sees it, the map
- * with the largest n_o . d_k gives its valid taps without the depth test, and *fallback (may
- * be NULL) is set. B = 0 when not even that has a valid tap. var_mean (may be NULL): variance
- * of B from the taps' variances of the mean (taps treated as independent). */
+ * moved point is no deeper than the texel's depth + eps_bias and, beyond the paper, the
+ * texel's normal faces the same side as n_o: shells thinner than eps_bias). When no map sees
+ * it (weight <= 1e-6), the nearest texel of the map with the largest n_o . d_k, without
+ * visibility (B = 0 if that texel is empty), and *fallback (may be NULL) is set. var_mean
+ * (may be NULL): variance of B from the taps' variances of the mean (taps independent). */
 void lr_cpu_maps_compose(const lr_cpu_maps *m, lr_vec3 xo, lr_vec3 no, double B[3],
                          double var_mean[3], bool *fallback);
 

@@ -81,14 +81,32 @@ typedef struct ctx {
     lr_vec3 wl;   /* directional: travel direction */
     lr_vec3 cp;   /* directional reference: object centre projected into x_o's light plane */
     double tmin;
+    const lr_scene_object *const *others;
+    int n_others;
 } ctx;
+
+/* The light G-buffer's view of the lit point: two-sided open surfaces face the light, and
+ * another object nearer to the light along the ray takes the texel. */
+static bool gbuffer_texel(const ctx *k, lr_vec3 org, lr_vec3 dir, double tmin, lr_vec3 *xi,
+                          lr_vec3 *ni)
+{
+    if (!lr_cpu_first_surface(k->obj, org, dir, tmin, xi, ni))
+        return false;
+    if (!k->obj->closed && lr_v3_dot(*ni, dir) > 0.0)
+        *ni = lr_v3_scale(*ni, -1.0);
+    double t = lr_v3_len(lr_v3_sub(*xi, org));
+    for (int i = 0; i < k->n_others; i++)
+        if (k->others[i] != k->obj && lr_bvh_occluded(k->others[i]->bvh, org, dir, tmin, t))
+            return false;
+    return true;
+}
 
 /* pi S_d F_t for the surface seen from the light along unit vh (point/spot), band c;
  * 0 when the ray misses or the light cannot enter there. */
 static double lit_point(const ctx *k, lr_vec3 vh, int c)
 {
     lr_vec3 xi, ni;
-    if (!lr_cpu_first_surface(k->obj, k->xl, vh, k->tmin, &xi, &ni))
+    if (!gbuffer_texel(k, k->xl, vh, k->tmin, &xi, &ni))
         return 0.0;
     double shape = lr_light_shape(k->light, vh);
     if (!(shape > 0.0))
@@ -106,7 +124,7 @@ static double lit_plane(const ctx *k, lr_vec3 xj, int c)
     double back = lr_v3_dot(lr_v3_sub(xj, o->center), k->wl) + 1.01 * o->radius + 1.0;
     lr_vec3 org = lr_v3_sub(xj, lr_v3_scale(k->wl, back));
     lr_vec3 xi, ni;
-    if (!lr_cpu_first_surface(o, org, k->wl, 0.0, &xi, &ni))
+    if (!gbuffer_texel(k, org, k->wl, 0.0, &xi, &ni))
         return 0.0;
     double sd[3];
     lr_dirpole_sd_fresnel(&o->coeffs, xi, ni, lr_v3_scale(k->wl, -1.0), k->xo, k->no, sd);
@@ -267,7 +285,8 @@ void lr_cpu_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3
     enum lr_cpu_sampler mode = d ? d->sampler : LR_CPU_PASS;
     double rmax = d && d->r_max > 0.0 ? d->r_max : LR_CPU_RMAX_RADII * obj->radius;
 
-    ctx k = {.obj = obj, .light = light, .xo = xo, .no = no, .tmin = LR_CPU_TMIN * obj->radius};
+    ctx k = {.obj = obj, .light = light, .xo = xo, .no = no, .tmin = LR_CPU_TMIN * obj->radius,
+             .others = d ? d->others : NULL, .n_others = d ? d->n_others : 0};
     if (light->type == LR_LIGHT_DIRECTIONAL) {
         k.wl = light->direction;
         lr_cpu_tangents(k.wl, &k.t1, &k.t2);

@@ -5,7 +5,9 @@
  * intensity (point/spot: 1 W/sr, directional: unit radiance); callers multiply by
  * intensity * color[c]. The light G-buffer is replaced by ray casts from the light against the
  * object's BVH: x_i, n_i are the first surface along the lookup direction, n_i the interpolated
- * vertex normal (what the rasteriser would store).
+ * vertex normal (what the rasteriser would store); an open object (closed == false, e.g. a
+ * zero-thickness shade) is two-sided: n_i is turned toward the light, as the GLSL G-buffer
+ * does.
  *
  * Two samplers of the same integral B = pi * int S_d F_t(w_i) d(omega) (point/spot) or
  * pi * int S_d F_t dA_plane (directional):
@@ -38,6 +40,11 @@ typedef struct lr_cpu_radiosity_desc {
     int N;                       /* samples per band; 0: 16 */
     enum lr_cpu_sampler sampler; /* default LR_CPU_PASS */
     double r_max;                /* LR_CPU_PASS: 0 = LR_CPU_RMAX_RADII * object radius */
+    /* Other translucent objects of the scene: the light G-buffer holds the first surface of
+     * any of them, and a lookup that meets another object first brings no light (as the GLSL
+     * pass). NULL / 0: the object alone. */
+    const lr_scene_object *const *others;
+    int n_others;
 } lr_cpu_radiosity_desc;
 
 typedef struct lr_cpu_estimate {
