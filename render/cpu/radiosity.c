@@ -83,6 +83,8 @@ typedef struct ctx {
     double tmin;
     const lr_scene_object *const *others;
     int n_others;
+    lr_vec3 (*snap)(void *, lr_vec3);
+    void *snap_ctx;
 } ctx;
 
 /* The light G-buffer's view of the lit point: two-sided open surfaces face the light, and
@@ -106,14 +108,15 @@ static bool gbuffer_texel(const ctx *k, lr_vec3 org, lr_vec3 dir, double tmin, l
 static double lit_point(const ctx *k, lr_vec3 vh, int c)
 {
     lr_vec3 xi, ni;
-    if (!gbuffer_texel(k, k->xl, vh, k->tmin, &xi, &ni))
+    lr_vec3 look = k->snap ? lr_v3_normalize(k->snap(k->snap_ctx, vh)) : vh;
+    if (!gbuffer_texel(k, k->xl, look, k->tmin, &xi, &ni))
         return 0.0;
     double shape = lr_light_shape(k->light, vh);
     if (!(shape > 0.0))
         return 0.0;
     double sd[3];
-    /* w_i = -vh points from x_i to the light; n_i . w_i <= 0 contributes 0 (PIPELINE.md). */
-    lr_dirpole_sd_fresnel(&k->obj->coeffs, xi, ni, lr_v3_scale(vh, -1.0), k->xo, k->no, sd);
+    /* w_i = -look points from x_i to the light; n_i . w_i <= 0 contributes 0 (PIPELINE.md). */
+    lr_dirpole_sd_fresnel(&k->obj->coeffs, xi, ni, lr_v3_scale(look, -1.0), k->xo, k->no, sd);
     return M_PI * sd[c] * shape;
 }
 
@@ -121,6 +124,8 @@ static double lit_point(const ctx *k, lr_vec3 vh, int c)
 static double lit_plane(const ctx *k, lr_vec3 xj, int c)
 {
     const lr_scene_object *o = k->obj;
+    if (k->snap)
+        xj = k->snap(k->snap_ctx, xj);
     double back = lr_v3_dot(lr_v3_sub(xj, o->center), k->wl) + 1.01 * o->radius + 1.0;
     lr_vec3 org = lr_v3_sub(xj, lr_v3_scale(k->wl, back));
     lr_vec3 xi, ni;
@@ -286,7 +291,8 @@ void lr_cpu_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3
     double rmax = d && d->r_max > 0.0 ? d->r_max : LR_CPU_RMAX_RADII * obj->radius;
 
     ctx k = {.obj = obj, .light = light, .xo = xo, .no = no, .tmin = LR_CPU_TMIN * obj->radius,
-             .others = d ? d->others : NULL, .n_others = d ? d->n_others : 0};
+             .others = d ? d->others : NULL, .n_others = d ? d->n_others : 0,
+             .snap = d ? d->snap : NULL, .snap_ctx = d ? d->snap_ctx : NULL};
     if (light->type == LR_LIGHT_DIRECTIONAL) {
         k.wl = light->direction;
         lr_cpu_tangents(k.wl, &k.t1, &k.t2);

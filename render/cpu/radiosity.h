@@ -45,6 +45,11 @@ typedef struct lr_cpu_radiosity_desc {
      * pass). NULL / 0: the object alone. */
     const lr_scene_object *const *others;
     int n_others;
+    /* Optional emulation of the light G-buffer's resolution (for GPU parity): maps the lookup
+     * direction v (point/spot) or plane point x_j (directional) to the one whose first
+     * surface the G-buffer texel holds (its texel centre). NULL: exact ray casts. */
+    lr_vec3 (*snap)(void *snap_ctx, lr_vec3 v);
+    void *snap_ctx;
 } lr_cpu_radiosity_desc;
 
 typedef struct lr_cpu_estimate {
