@@ -525,6 +525,47 @@ static void test_tiny_object(void **state)
     lrt_object_free(&o);
 }
 
+/* Every shipped material preset (albedo 0 to 1, ketchup to spectralon), point light outside a
+ * sphere and enclosed in a shell, directional light on the slab: pass and reference finite,
+ * >= 0, variance finite; the reference > 0 where the light reaches x_o's neighbourhood. */
+static void test_all_presets_finite(void **state)
+{
+    (void)state;
+    char **names;
+    int count;
+    lr_err e = {0};
+    if (lr_material_names(&names, &count, &e))
+        fail_msg("%s", e.msg);
+    assert_true(count >= 10);
+    for (int i = 0; i < count; i++) {
+        lr_medium m = preset(names[i]);
+        lrt_object o[2];
+        lrt_object_make(lrt_shell_mesh(40, 0, 3), &m, &o[0]);
+        lrt_object_make(lrt_shell_mesh(40, 37, 3), &m, &o[1]);
+        lr_light lights[2] = {lrt_point_light(lr_v3(0, 0, 70)), lrt_point_light(lr_v3(0, 0, 0))};
+        for (int j = 0; j < 2; j++) {
+            lr_vec3 xo, no;
+            assert_true(lr_cpu_first_surface(&o[j].obj, lr_v3(0, 0, 100), lr_v3(0, 0, -1), 0, &xo, &no));
+            for (int mode = 0; mode < 2; mode++) {
+                lr_cpu_radiosity_desc d = {.N = 64, .sampler = mode ? LR_CPU_REFERENCE : LR_CPU_PASS};
+                lr_cpu_estimate est;
+                lr_cpu_radiosity(&o[j].obj, &lights[j], xo, no, &d, lr_cpu_key(61, (uint64_t)i, 0, 0), &est);
+                for (int c = 0; c < 3; c++) {
+                    if (!(isfinite(est.mean[c]) && est.mean[c] >= 0.0 && isfinite(est.var[c])))
+                        fail_msg("%s, %s, %s band %d: B = %g, var %g", names[i],
+                                 j ? "enclosed" : "outside", mode ? "reference" : "pass", c,
+                                 est.mean[c], est.var[c]);
+                    if (mode)
+                        assert_true(est.mean[c] > 0.0);
+                }
+            }
+        }
+        lrt_object_free(&o[0]);
+        lrt_object_free(&o[1]);
+    }
+    lr_material_names_free(names, count);
+}
+
 /* Same key, same numbers; a different key, different numbers. */
 static void test_deterministic(void **state)
 {
@@ -562,6 +603,7 @@ int main(void)
         cmocka_unit_test(test_albedo_one_sphere),
         cmocka_unit_test(test_zero_thickness_shade),
         cmocka_unit_test(test_tiny_object),
+        cmocka_unit_test(test_all_presets_finite),
         cmocka_unit_test(test_deterministic),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
