@@ -114,9 +114,12 @@ build/test/test_%: build/obj/asan/tests/test_%.o $(SUPPORT:%.c=build/obj/asan/%.
 test: $(TESTS:%=build/test/%) build/bin/lamprig $(TOOLS:%=build/bin/lamprig-%)
 	@sh tests/run.sh $(TESTS:%=build/test/%)
 
+# 8 progressive frames (the scene converges at 64): about a minute on llvmpipe; leave out
+# --frames to render until render.frames are accumulated.
 run: build/bin/lamprig
-	./build/bin/lamprig render --scene configs/scenes/candle.json --out build/out/candle.png \
-	    --stats build/out/candle-stats.json
+	@mkdir -p build/out
+	./build/bin/lamprig render --scene configs/scenes/candle.json --frames 8 --out build/out/candle.png \
+	    --hdr build/out/candle.pfm --stats build/out/candle-stats.json
 
 bench: build/bin/lamprig $(TOOLS:%=build/bin/lamprig-%)
 	./build/bin/lamprig-bench

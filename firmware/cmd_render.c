@@ -15,6 +15,7 @@
 #include "render/gl/gl.h"
 #include "render/image/image.h"
 #include "render/renderer.h"
+#include "render/renderer_debug.h"
 #include "render/scene/scene.h"
 
 const char lr_render_summary[] = "render a scene headless: PNG, linear PFM, per-pass statistics";
@@ -22,7 +23,7 @@ const char lr_render_summary[] = "render a scene headless: PNG, linear PFM, per-
 const char lr_render_usage[] =
     "usage: lamprig render --scene FILE [--frames N] [--width W --height H] [--out F.png]\n"
     "                      [--hdr F.pfm] [--stats F.json] [--no-vpl] [--set key=value ...]\n"
-    "                      [--events FILE]\n"
+    "                      [--events FILE] [--vpl-visibility]\n"
     "\n"
     "Renders FILE (configs/scenes/*.json) with seed 003's passes (light G-buffer, scattered-\n"
     "radiosity maps, virtual point lights, composition) on a headless EGL context.\n"
@@ -32,9 +33,11 @@ const char lr_render_usage[] =
     "  --width, --height output size (default 640 x 480)\n"
     "  --out F.png       tone-mapped 8-bit sRGB image (exposure render.exposure)\n"
     "  --hdr F.pfm       linear RGB radiance, W/(mm^2 sr), PFM\n"
-    "  --stats F.json    {\"scene\",\"width\",\"height\",\"renderer\",\"frames\":[{\"index\",\n"
+    "  --stats F.json    {\"scene\",\"width\",\"height\",\"uncovered_pixels\",\"renderer\",\n"
+    "                    \"settings\",\"frames\":[{\"index\",\n"
     "                    \"passes\":[...],\"ms\":{pass:ms},\"total_ms\",\"samples\"},...]}\n"
     "  --no-vpl          no emergent light on the receivers (direct light only)\n"
+    "  --vpl-visibility  shadow the VPLs' light by the objects (beyond seed 003; slower)\n"
     "  --set key=value   change a scene parameter before rendering (repeatable), names as\n"
     "                    in the scene file: light.intensity=0.01, render.K=8, camera.position=0,-400,200\n"
     "  --events FILE     one change per line, FRAME PARAMETER VALUE (e.g. '4 light.intensity\n"
@@ -123,9 +126,13 @@ static void json_string(FILE *f, const char *s)
     fputc('"', f);
 }
 
-static int write_stats(const char *path, const lr_scene *scene, const lr_renderer *r,
+static int write_stats(const char *path, const lr_scene *scene, lr_renderer *r,
                        const stats_log *log, lr_err *e)
 {
+    /* Object pixels of the final image that no radiosity map sees (PIPELINE.md, pass 3). */
+    int uncovered = -1;
+    if (log->n)
+        lr_renderer_debug_uncovered(r, &uncovered, NULL);
     lr_atomic_file *af;
     int rc = lr_atomic_file_open(path, &af, e);
     if (rc)
@@ -136,7 +143,8 @@ static int write_stats(const char *path, const lr_scene *scene, const lr_rendere
     const lr_render_settings *rs = lr_scene_render(scene);
     fputs("{\"scene\":", f);
     json_string(f, lr_scene_name(scene));
-    fprintf(f, ",\"width\":%d,\"height\":%d,\"renderer\":", w, h);
+    fprintf(f, ",\"width\":%d,\"height\":%d,\"uncovered_pixels\":%d,\"renderer\":", w, h,
+            uncovered);
     json_string(f, lr_renderer_info(r));
     fprintf(f, ",\"settings\":{\"K\":%d,\"N\":%d,\"N_vpl\":%d,\"map_size\":%d,\"gbuffer_size\":%d,"
                "\"vpl_map_size\":%d,\"frames\":%d},\n\"frames\":[",
@@ -221,7 +229,8 @@ int lr_cmd_render(int argc, char **argv)
     }
     static const lr_argspec specs[] = {
         {"--scene", 1}, {"--frames", 1}, {"--width", 1}, {"--height", 1}, {"--out", 1},
-        {"--hdr", 1},   {"--stats", 1},  {"--no-vpl", 0}, {"--events", 1}, {NULL, 0}};
+        {"--hdr", 1},   {"--stats", 1},  {"--no-vpl", 0}, {"--events", 1},
+        {"--vpl-visibility", 0}, {NULL, 0}};
     lr_args a;
     lr_err e = {0};
     if (lr_args_parse(nrest, rest, specs, 0, &a, &e)) {
@@ -242,6 +251,7 @@ int lr_cmd_render(int argc, char **argv)
     const char *out = lr_args_get(&a, "--out"), *hdr = lr_args_get(&a, "--hdr");
     const char *stats_path = lr_args_get(&a, "--stats"), *events_path = lr_args_get(&a, "--events");
     bool no_vpl = lr_args_has(&a, "--no-vpl");
+    bool vpl_vis = lr_args_has(&a, "--vpl-visibility");
     free(rest);
     if (status)
         return status;
@@ -271,7 +281,8 @@ int lr_cmd_render(int argc, char **argv)
     }
     if (lr_gl_create(NULL, &gl, &e) ||
         lr_renderer_create(&(lr_renderer_desc){.gl = gl, .scene = scene, .width = width,
-                                               .height = height, .no_vpl = no_vpl},
+                                               .height = height, .no_vpl = no_vpl,
+                                               .vpl_visibility = vpl_vis},
                            &r, &e)) {
         status = fail(&e);
         goto done;
@@ -301,6 +312,9 @@ int lr_cmd_render(int argc, char **argv)
             goto done;
         }
     }
+    for (; next_ev < ev.count; next_ev++)
+        fprintf(stderr, "lamprig render: %s:%d: event for frame %d not applied (--frames %d)\n",
+                ev.path, ev.ev[next_ev].line, ev.ev[next_ev].frame, frames);
     if (out || hdr) {
         if (read_image(r, &img, &e)) {
             status = fail(&e);

@@ -103,6 +103,7 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
     r->width = w;
     r->height = h;
     r->no_vpl = desc->no_vpl;
+    r->vpl_visibility = desc->vpl_visibility;
     r->seed = desc->seed ? desc->seed : 1;
     r->caps = caps;
     const char *maps = "RGBA32F maps";
@@ -245,6 +246,8 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
 
 int lr_renderer_read_hdr(lr_renderer *r, float *rgb, lr_err *e)
 {
+    if (!r->fb_hdr)
+        return lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
     size_t n = (size_t)r->width * (size_t)r->height;
     float *rgba = malloc(n * 4 * sizeof *rgba);
     if (!rgba)
@@ -259,6 +262,8 @@ int lr_renderer_read_hdr(lr_renderer *r, float *rgb, lr_err *e)
 
 int lr_renderer_read_rgba8(lr_renderer *r, unsigned char *out, lr_err *e)
 {
+    if (!r->fb_ldr)
+        return lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
     size_t n = (size_t)r->width * (size_t)r->height;
     float *rgba = malloc(n * 4 * sizeof *rgba);
     if (!rgba)
@@ -280,6 +285,8 @@ int lr_renderer_read_rgba8(lr_renderer *r, unsigned char *out, lr_err *e)
 int lr_renderer_present(lr_renderer *r, lr_err *e)
 {
     int w, h;
+    if (!r->ldr)
+        return lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
     lr_gl_size(r->gl, &w, &h);
     if (w > 0 && h > 0) {
         lr_gl_bind_default(r->gl);

@@ -31,6 +31,8 @@ typedef struct lr_renderer_desc {
     lr_scene *scene;       /* read at every frame; owned by the caller */
     int width, height;     /* output image; 0 = 640 x 480 */
     bool no_vpl;           /* skip emergent light (pass 4) */
+    bool vpl_visibility;   /* shadow the VPLs by the objects (beyond seed 003; costs
+                            * N_vpl x 8 cube-map lookups per receiver pixel) */
     unsigned seed;         /* base of the per-texel/map/frame sample seeds; 0 = 1 */
 } lr_renderer_desc;
 

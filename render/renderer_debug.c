@@ -159,3 +159,16 @@ int lr_renderer_debug_read_gbuffer(lr_renderer *r, int face, float *pos, float *
     free(q);
     return LR_OK;
 }
+
+int lr_renderer_debug_uncovered(lr_renderer *r, int *count, lr_err *e)
+{
+    float *p = read_fb(r->fb_hdr, 0, r->width, r->height, e);
+    if (!p)
+        return e ? e->code : LR_EIO;
+    int n = 0;
+    for (size_t i = 0; i < (size_t)r->width * r->height; i++)
+        n += p[4 * i + 3] < 0.5f;
+    free(p);
+    *count = n;
+    return LR_OK;
+}

@@ -75,4 +75,10 @@ void lr_renderer_debug_gbuffer_info(const lr_renderer *r, lr_debug_gbuffer_info 
 int lr_renderer_debug_read_gbuffer(lr_renderer *r, int face, float *pos, float *nrm, int *object,
                                    lr_err *e);
 
+/* ---- composition (pass 3) ------------------------------------------------------------------ */
+
+/* Object pixels of the last composed image that no radiosity map sees (Algorithm 1's n = 0:
+ * they took the map facing them most, without visibility; PIPELINE.md pass 3). */
+int lr_renderer_debug_uncovered(lr_renderer *r, int *count, lr_err *e);
+
 #endif

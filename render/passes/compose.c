@@ -45,7 +45,9 @@ static void set_intensity(const lr_renderer *r, const lr_program *p)
 
 int lr_pass_compose(lr_renderer *r, lr_err *e)
 {
-    static const float zero[4] = {0, 0, 0, 0};
+    /* Alpha 1 everywhere but on object fragments no map sees (compose_object.frag writes 0
+     * there): lr_renderer_debug_uncovered counts them. */
+    static const float zero[4] = {0, 0, 0, 1};
     const lr_camera *cam = lr_scene_camera(r->scene);
     double view[16], proj[16], vp[16];
     lr_camera_view(cam, view);
@@ -90,6 +92,10 @@ int lr_pass_compose(lr_renderer *r, lr_err *e)
     lr_passes_bind_tex(p, "u_vpl_pos", 7, use_vpl ? r->vpl.pos : NULL);
     lr_passes_bind_tex(p, "u_vpl_nrm", 8, use_vpl ? r->vpl.nrm : NULL);
     lr_passes_bind_tex(p, "u_vpl_B", 9, use_vpl ? r->vpl.B : NULL);
+    lr_passes_uniform_i(p, "u_vpl_vis", use_vpl && r->vpl_visibility);
+    lr_passes_bind_tex(p, "u_outer_pos", 10, use_vpl ? r->vpl.outer_pos : NULL);
+    lr_passes_uniform_v3(p, "u_center", r->vpl.center);
+    lr_passes_uniform_f(p, "u_vis_eps", (float)(2.0 * r->rad.radius / (r->vpl.size > 0 ? r->vpl.size : 1)));
     for (int i = 0; i < r->n_receivers; i++) {
         const lr_receiver *rc = lr_scene_receiver_at(r->scene, i);
         GLint loc = lr_program_uniform(p, "u_albedo");

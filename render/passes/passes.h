@@ -41,6 +41,7 @@ struct lr_renderer {
     lr_scene *scene;
     int width, height;
     bool no_vpl;
+    bool vpl_visibility;
     unsigned seed;
     const lr_gl_caps *caps;
     lr_tex_format map_format; /* RGBA32F, or RGBA16F when float targets/blending are missing */
@@ -105,7 +106,6 @@ struct lr_renderer {
     /* Output. */
     lr_tex *hdr, *ldr;
     lr_fb *fb_hdr, *fb_ldr;
-    int uncovered; /* not reported yet */
 
     unsigned dirty;
     int frame_index;

@@ -16,7 +16,32 @@ uniform highp sampler2D u_vpl_pos; // x_v, A_v
 uniform highp sampler2D u_vpl_nrm; // n_v, object id
 uniform highp sampler2D u_vpl_B;   // B_v
 uniform int u_n_vpl;
+// VPL visibility (beyond seed 003, whose VPLs have none): the segment from the VPL to x is
+// blocked where it passes inside the objects' outer envelope, i.e. nearer to the VPL centre c
+// than the outermost surface in that direction (the VPL pass's cube map; exact for objects
+// star-shaped around c, and a hollow shade counts as solid, which is right for light leaving
+// its outer surface: it would have to cross the wall again).
+uniform bool u_vpl_vis;
+uniform highp samplerCube u_outer_pos;
+uniform vec3 u_center;
+uniform float u_vis_eps; // mm: the start is moved this far off the surface along n_v
 layout(location = 0) out vec4 o_color;
+
+#define LR_VIS_STEPS 8
+
+bool vpl_visible(vec3 xv, vec3 nv, vec3 x)
+{
+    vec3 a = xv + u_vis_eps * nv;
+    for (int s = 1; s <= LR_VIS_STEPS; s++) {
+        vec3 p = mix(a, x, float(s) / float(LR_VIS_STEPS + 1));
+        vec3 d = p - u_center;
+        vec4 o = texture(u_outer_pos, d);
+        vec3 od = o.xyz - u_center;
+        if (o.w > 0.5 && dot(d, d) < dot(od, od))
+            return false;
+    }
+    return true;
+}
 
 void main()
 {
@@ -51,6 +76,8 @@ void main()
             float cv = dot(nv.xyz, w);
             float cx = -dot(nx, w);
             if (!(cv > 0.0 && cx > 0.0))
+                continue;
+            if (u_vpl_vis && !vpl_visible(p.xyz, nv.xyz, x))
                 continue;
             float eta = lr_material(int(nv.w + 0.5)).eta;
             vec3 B = texelFetch(u_vpl_B, ivec2(v, 0), 0).rgb;

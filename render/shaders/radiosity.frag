@@ -53,14 +53,24 @@ void main()
     vec3 B = vec3(0.0);
     for (int c = 0; c < 3; c++) {
         float sigma_tr = mat.sigma_tr[c];
+        // lr_exp_radius_sample / _pdf with the per-band constant hoisted: for the inverted
+        // CDF, e^{-sigma_tr r} = 1 - xi mass, so p(r) = sigma_tr (1 - xi mass) / mass.
+        bool flat_r = sigma_tr * u_r_max < 1e-30;
+        float mass = flat_r ? 1.0 : -lr_expm1(-sigma_tr * u_r_max);
         float sum = 0.0;
         for (int j = 0; j < u_N; j++) {
             float xi1 = lr_rand(state);
             float xi2 = lr_rand(state);
-            float r = lr_exp_radius_sample(sigma_tr, u_r_max, xi1);
+            float r, pr;
+            if (flat_r) {
+                r = xi1 * u_r_max;
+                pr = 1.0 / u_r_max;
+            } else {
+                r = min(-lr_log1p(-xi1 * mass) / sigma_tr, u_r_max);
+                pr = sigma_tr * (1.0 - xi1 * mass) / mass;
+            }
             float alpha = 2.0 * LR_PI * xi2;
             // 1 / p_A = 2 pi r / p(r) (density per unit area of the sampling plane).
-            float pr = lr_exp_radius_pdf(sigma_tr, u_r_max, r);
             if (!(pr > 0.0) || !(r > 0.0))
                 continue;
             float inv_pA = 2.0 * LR_PI * r / pr;

@@ -58,6 +58,15 @@ lr_renderer *lr_test_renderer(lr_gl *gl, lr_scene *s, int w, int h, bool no_vpl,
     return r;
 }
 
+lr_renderer *lr_test_renderer_desc(const lr_renderer_desc *d)
+{
+    lr_renderer *r = NULL;
+    lr_err e = {0};
+    if (lr_renderer_create(d, &r, &e))
+        fail_msg("lr_renderer_create: %s", e.msg);
+    return r;
+}
+
 lr_frame_stats lr_test_frame(lr_renderer *r)
 {
     lr_frame_stats st;

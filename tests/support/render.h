@@ -20,6 +20,8 @@ lr_scene *lr_test_scene(const char *name, const char *const *sets1, const char *
 /* Parses scene text. */
 lr_scene *lr_test_scene_text(const char *text, const char *const *sets);
 lr_renderer *lr_test_renderer(lr_gl *gl, lr_scene *s, int w, int h, bool no_vpl, unsigned seed);
+/* The same from a full descriptor (gl and scene filled in by the caller). */
+lr_renderer *lr_test_renderer_desc(const lr_renderer_desc *d);
 /* Renders frames until lr_renderer_needs_frame is false (at most max); returns the count. */
 int lr_test_converge(lr_renderer *r, int max);
 /* One frame; returns its stats. */
