@@ -1,0 +1,290 @@
+/* Whole CPU images, twin and reference; see frame.h. */
+#include "render/cpu/frame.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "render/base/mat4.h"
+#include "render/cpu/maps.h"
+#include "render/cpu/parallel.h"
+#include "render/cpu/rng.h"
+#include "render/cpu/vpl.h"
+
+void lr_cpu_camera_ray(const lr_scene *s, int width, int height, int px, int py, lr_vec3 *org,
+                       lr_vec3 *dir)
+{
+    const lr_camera *cam = lr_scene_camera(s);
+    double view[16], proj[16], vp[16], inv[16];
+    lr_camera_view(cam, view);
+    lr_camera_projection(cam, (double)width / height, proj);
+    lr_mat4_mul(proj, view, vp);
+    lr_mat4_inverse(vp, inv);
+    double nx = (px + 0.5) / width * 2.0 - 1.0, ny = 1.0 - (py + 0.5) / height * 2.0;
+    lr_vec3 a = lr_mat4_project(inv, lr_v3(nx, ny, -1.0));
+    lr_vec3 b = lr_mat4_project(inv, lr_v3(nx, ny, 1.0));
+    *org = a;
+    *dir = lr_v3_normalize(lr_v3_sub(b, a));
+}
+
+typedef struct rctx {
+    const lr_cpu_render_desc *d;
+    const lr_scene *s;
+    int W, H, nobj, nlight, nvpl, samples;
+    double inv_vp[16];
+    lr_cpu_maps **maps;  /* [obj * nlight + light] (PASS) */
+    const lr_scene_object **objs; /* every object: occluders of each other's light lookups */
+    lr_cpu_vpl *vpl;     /* [obj * nvpl + v]; B per band already summed over lights with I */
+    double (*I)[3];      /* per light: intensity * color */
+    lr_image *rgb, *var;
+    long *object_px, *fallback_px; /* per pixel flags, summed at the end */
+} rctx;
+
+static uint64_t seed_of(const rctx *r) { return r->d->seed ? r->d->seed : 1; }
+
+/* B at (x, n) of object o for light l, per unit intensity, with the variance of the mean. */
+static void radiosity_at(const rctx *r, int o, int l, lr_vec3 x, lr_vec3 n, uint64_t key,
+                         double B[3], double var[3], bool *fallback)
+{
+    if (r->d->mode == LR_CPU_REFERENCE) {
+        lr_cpu_radiosity_desc rd = {.N = r->samples, .sampler = LR_CPU_REFERENCE,
+                                    .others = r->objs, .n_others = r->nobj};
+        lr_cpu_estimate est;
+        lr_cpu_radiosity(lr_scene_object_at(r->s, o), lr_scene_light_at(r->s, l), x, n, &rd, key,
+                         &est);
+        for (int c = 0; c < 3; c++) {
+            B[c] = est.mean[c];
+            var[c] = est.var[c] / est.n;
+        }
+        if (fallback)
+            *fallback = false;
+        return;
+    }
+    lr_cpu_maps_compose(r->maps[o * r->nlight + l], x, n, B, var, fallback);
+}
+
+static void vpl_item(void *p, long item)
+{
+    rctx *r = p;
+    int o = (int)(item / r->nvpl);
+    lr_cpu_vpl *v = &r->vpl[item];
+    if (!v->valid)
+        return;
+    for (int l = 0; l < r->nlight; l++) {
+        double B[3], var[3];
+        radiosity_at(r, o, l, v->x, v->n,
+                     lr_cpu_key(seed_of(r) ^ 0x7B1u, (uint64_t)item, (uint64_t)l, 0), B, var, NULL);
+        for (int c = 0; c < 3; c++) {
+            v->B[c] += r->I[l][c] * B[c];
+            v->var[c] += r->I[l][c] * r->I[l][c] * var[c];
+        }
+    }
+}
+
+/* Nearest hit of the camera ray among objects (kind 0) and receivers (kind 1). */
+static bool trace(const lr_scene *s, lr_vec3 org, lr_vec3 dir, int *kind, int *index, lr_vec3 *x,
+                  lr_vec3 *n)
+{
+    double best = INFINITY;
+    lr_hit h;
+    bool any = false;
+    for (int i = 0; i < lr_scene_object_count(s); i++)
+        if (lr_bvh_intersect(lr_scene_object_at(s, i)->bvh, org, dir, 0.0, best, &h) && h.t < best) {
+            best = h.t;
+            *kind = 0;
+            *index = i;
+            any = true;
+        }
+    for (int i = 0; i < lr_scene_receiver_count(s); i++)
+        if (lr_bvh_intersect(lr_scene_receiver_at(s, i)->bvh, org, dir, 0.0, best, &h) &&
+            h.t < best) {
+            best = h.t;
+            *kind = 1;
+            *index = i;
+            any = true;
+            *n = lr_mesh_triangle_normal(lr_scene_receiver_at(s, i)->mesh, h.triangle);
+        }
+    if (!any)
+        return false;
+    if (*kind == 0) {
+        /* Same hit again, now with the interpolated normal. */
+        lr_cpu_first_surface(lr_scene_object_at(s, *index), org, dir, 0.0, x, n);
+    } else {
+        *x = lr_v3_add(org, lr_v3_scale(dir, best));
+    }
+    return true;
+}
+
+static void pixel_item(void *p, long item)
+{
+    rctx *r = p;
+    int px = (int)(item % r->W), py = (int)(item / r->W);
+    float *out = r->rgb->rgb + 3 * item;
+    float *vout = r->var ? r->var->rgb + 3 * item : NULL;
+    lr_vec3 org, dir, x, n;
+    lr_cpu_camera_ray(r->s, r->W, r->H, px, py, &org, &dir);
+    int kind = -1, idx = -1;
+    if (!trace(r->s, org, dir, &kind, &idx, &x, &n))
+        return;
+    double L[3] = {0}, V[3] = {0};
+    if (kind == 0) {
+        r->object_px[item] = 1;
+        const lr_scene_object *o = lr_scene_object_at(r->s, idx);
+        if (!o->closed && lr_v3_dot(n, dir) > 0.0)
+            n = lr_v3_scale(n, -1.0); /* two-sided open surface: the side the camera sees */
+        double cos_o = -lr_v3_dot(n, dir);
+        double ft = lr_fresnel_transmittance(cos_o > 0.0 ? cos_o : 0.0, o->coeffs.eta);
+        for (int l = 0; l < r->nlight; l++) {
+            double B[3], var[3];
+            bool fb = false;
+            radiosity_at(r, idx, l, x, n, lr_cpu_key(seed_of(r), (uint64_t)item, (uint64_t)l, 1),
+                         B, var, &fb);
+            if (fb)
+                r->fallback_px[item] = 1;
+            for (int c = 0; c < 3; c++) {
+                double k = r->I[l][c] * ft / M_PI; /* seed 003 Eq. 5 */
+                L[c] += k * B[c];
+                V[c] += k * k * var[c];
+            }
+        }
+    } else {
+        const lr_receiver *rc = lr_scene_receiver_at(r->s, idx);
+        double E[3] = {0}, EV[3] = {0};
+        for (int l = 0; l < r->nlight; l++) {
+            double ed = lr_cpu_direct_irradiance(r->s, lr_scene_light_at(r->s, l), x, n);
+            for (int c = 0; c < 3; c++)
+                E[c] += r->I[l][c] * ed;
+        }
+        if (!r->d->no_vpl)
+            for (int o = 0; o < r->nobj; o++)
+                lr_cpu_vpl_irradiance(r->vpl + (size_t)o * r->nvpl, r->nvpl,
+                                      lr_scene_object_at(r->s, o)->coeffs.eta, x, n, E, EV);
+        for (int c = 0; c < 3; c++) {
+            L[c] = rc->albedo[c] / M_PI * E[c];
+            V[c] = rc->albedo[c] * rc->albedo[c] / (M_PI * M_PI) * EV[c];
+        }
+    }
+    for (int c = 0; c < 3; c++) {
+        out[c] = (float)L[c];
+        if (vout)
+            vout[c] = (float)V[c];
+    }
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
+                  lr_cpu_render_stats *stats, lr_err *e)
+{
+    if (!d || !d->scene || !rgb)
+        return lr_err_set(e, LR_EINVAL, "cpu render: NULL %s", !d ? "descriptor" : !d->scene ? "scene" : "image");
+    double t0 = now_s();
+    const lr_scene *s = d->scene;
+    const lr_render_settings *rs = lr_scene_render(s);
+    rctx r = {.d = d, .s = s};
+    r.W = d->width ? d->width : 160;
+    r.H = d->height ? d->height : 120;
+    r.nobj = lr_scene_object_count(s);
+    r.nlight = lr_scene_light_count(s);
+    bool ref = d->mode == LR_CPU_REFERENCE;
+    r.nvpl = d->no_vpl ? 0 : d->vpl_count ? d->vpl_count : ref ? 1024 : rs->N_vpl;
+    r.samples = d->samples ? d->samples : 1024;
+    int frames = d->frames ? d->frames : rs->frames;
+    int rc = LR_OK;
+    memset(rgb, 0, sizeof *rgb);
+    if (var)
+        memset(var, 0, sizeof *var);
+    if ((rc = lr_image_alloc(rgb, r.W, r.H, e)) || (var && (rc = lr_image_alloc(var, r.W, r.H, e))))
+        goto fail;
+    r.rgb = rgb;
+    r.var = var;
+    r.I = calloc((size_t)r.nlight, sizeof *r.I);
+    r.maps = calloc((size_t)r.nobj * r.nlight, sizeof *r.maps);
+    r.vpl = calloc((size_t)r.nobj * (r.nvpl ? r.nvpl : 1), sizeof *r.vpl);
+    r.object_px = calloc((size_t)r.W * r.H, sizeof *r.object_px);
+    r.fallback_px = calloc((size_t)r.W * r.H, sizeof *r.fallback_px);
+    r.objs = calloc((size_t)r.nobj, sizeof *r.objs);
+    if (!r.I || !r.objs || !r.maps || !r.vpl || !r.object_px || !r.fallback_px) {
+        rc = lr_err_set(e, LR_ENOMEM, "cpu render: out of memory");
+        goto fail;
+    }
+    for (int l = 0; l < r.nlight; l++)
+        lr_light_rgb(lr_scene_light_at(s, l), r.I[l]);
+    for (int o = 0; o < r.nobj; o++)
+        r.objs[o] = lr_scene_object_at(s, o);
+    double samples = 0.0;
+    if (!ref) {
+        for (int o = 0; o < r.nobj; o++)
+            for (int l = 0; l < r.nlight; l++) {
+                lr_cpu_maps_desc md = {.object = lr_scene_object_at(s, o),
+                                       .light = lr_scene_light_at(s, l),
+                                       .K = d->K ? d->K : rs->K,
+                                       .map_size = d->map_size ? d->map_size : rs->map_size,
+                                       .N = d->N ? d->N : rs->N,
+                                       .seed = (unsigned)lr_cpu_key(seed_of(&r), (uint64_t)o,
+                                                                    (uint64_t)l, 2),
+                                       .threads = d->threads,
+                                       .others = r.objs,
+                                       .n_others = r.nobj};
+                lr_cpu_maps **m = &r.maps[o * r.nlight + l];
+                if ((rc = lr_cpu_maps_create(&md, m, e)))
+                    goto fail;
+                lr_cpu_maps_accumulate(*m, frames);
+                int K = lr_cpu_maps_count(*m), S = lr_cpu_maps_size(*m);
+                for (int k = 0; k < K; k++)
+                    for (int j = 0; j < S; j++)
+                        for (int i = 0; i < S; i++)
+                            if (lr_cpu_maps_texel(*m, k, i, j)->valid)
+                                samples += 3.0 * md.N * frames;
+            }
+    }
+    int nv = 0;
+    if (r.nvpl > 0) {
+        for (int o = 0; o < r.nobj; o++)
+            lr_cpu_vpl_place(lr_scene_object_at(s, o), r.nvpl, r.vpl + (size_t)o * r.nvpl);
+        lr_cpu_parallel_for((long)r.nobj * r.nvpl, d->threads, vpl_item, &r);
+        for (long v = 0; v < (long)r.nobj * r.nvpl; v++)
+            nv += r.vpl[v].valid;
+        if (ref)
+            samples += 3.0 * r.samples * nv * r.nlight;
+    }
+    lr_cpu_parallel_for((long)r.W * r.H, d->threads, pixel_item, &r);
+    long objpx = 0, fbpx = 0;
+    for (long i = 0; i < (long)r.W * r.H; i++) {
+        objpx += r.object_px[i];
+        fbpx += r.fallback_px[i];
+    }
+    if (ref)
+        samples += 3.0 * r.samples * objpx * r.nlight;
+    if (stats) {
+        memset(stats, 0, sizeof *stats);
+        stats->seconds = now_s() - t0;
+        stats->samples = samples;
+        stats->samples_per_s = stats->seconds > 0 ? samples / stats->seconds : 0;
+        stats->object_pixels = objpx;
+        stats->fallback_pixels = fbpx;
+        stats->vpls = nv;
+    }
+fail:
+    if (r.maps)
+        for (int i = 0; i < r.nobj * r.nlight; i++)
+            lr_cpu_maps_destroy(r.maps[i]);
+    free(r.maps);
+    free(r.vpl);
+    free(r.I);
+    free(r.object_px);
+    free(r.fallback_px);
+    free(r.objs);
+    if (rc) {
+        lr_image_free(rgb);
+        if (var)
+            lr_image_free(var);
+    }
+    return rc;
+}

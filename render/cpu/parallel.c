@@ -1,0 +1,57 @@
+#include "render/cpu/parallel.h"
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <unistd.h>
+
+#define LR_CPU_MAX_THREADS 64
+#define LR_CPU_CHUNK 16
+
+typedef struct job {
+    atomic_long next;
+    long count;
+    lr_cpu_item_fn fn;
+    void *ctx;
+} job;
+
+int lr_cpu_threads_default(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    if (n < 1)
+        n = 1;
+    return n > LR_CPU_MAX_THREADS ? LR_CPU_MAX_THREADS : (int)n;
+}
+
+static void *worker(void *p)
+{
+    job *j = p;
+    for (;;) {
+        long start = atomic_fetch_add(&j->next, LR_CPU_CHUNK);
+        if (start >= j->count)
+            break;
+        long end = start + LR_CPU_CHUNK < j->count ? start + LR_CPU_CHUNK : j->count;
+        for (long i = start; i < end; i++)
+            j->fn(j->ctx, i);
+    }
+    return NULL;
+}
+
+void lr_cpu_parallel_for(long count, int threads, lr_cpu_item_fn fn, void *ctx)
+{
+    if (threads <= 0)
+        threads = lr_cpu_threads_default();
+    if (threads > LR_CPU_MAX_THREADS)
+        threads = LR_CPU_MAX_THREADS;
+    job j = {.count = count, .fn = fn, .ctx = ctx};
+    atomic_init(&j.next, 0);
+    pthread_t tid[LR_CPU_MAX_THREADS];
+    int started = 0;
+    for (int t = 1; t < threads && t < count; t++) {
+        if (pthread_create(&tid[started], NULL, worker, &j) != 0)
+            break;
+        started++;
+    }
+    worker(&j); /* the calling thread works too */
+    for (int t = 0; t < started; t++)
+        pthread_join(tid[t], NULL);
+}

@@ -1,0 +1,17 @@
+/* lamprig — CPU twin: a parallel loop over independent items on worker threads (pthreads).
+ * Each item writes only its own outputs and draws its random numbers from its own key, so
+ * results do not depend on the number of threads or on scheduling. */
+#ifndef LR_CPU_PARALLEL_H
+#define LR_CPU_PARALLEL_H
+
+typedef void (*lr_cpu_item_fn)(void *ctx, long item);
+
+/* Number of online CPUs (at least 1). */
+int lr_cpu_threads_default(void);
+
+/* Runs fn(ctx, i) for i in [0, count) on `threads` threads (0: lr_cpu_threads_default()),
+ * items handed out in chunks by an atomic counter; the calling thread works too. A thread that
+ * cannot start only makes the loop slower: every item is run either way. */
+void lr_cpu_parallel_for(long count, int threads, lr_cpu_item_fn fn, void *ctx);
+
+#endif

@@ -1,0 +1,81 @@
+/* lamprig — CPU twin of pass 2 (render/passes/PIPELINE.md): the scattered-radiosity estimator
+ * at one surface point, and the converged (untruncated) reference of the same quantity.
+ *
+ * B_c(x_o, n_o) is the scattered radiosity (seed 003 Eq. 4) at x_o for a light of UNIT
+ * intensity (point/spot: 1 W/sr, directional: unit radiance); callers multiply by
+ * intensity * color[c]. The light G-buffer is replaced by ray casts from the light against the
+ * object's BVH: x_i, n_i are the first surface along the lookup direction, n_i the interpolated
+ * vertex normal (what the rasteriser would store); an open object (closed == false, e.g. a
+ * zero-thickness shade) is two-sided: n_i is turned toward the light, as the GLSL G-buffer
+ * does.
+ *
+ * Two samplers of the same integral B = pi * int S_d F_t(w_i) d(omega) (point/spot) or
+ * pi * int S_d F_t dA_plane (directional):
+ *   LR_CPU_PASS       exactly the GPU pass: per band N samples of r ~ exp(sigma_tr) truncated
+ *                     at r_max, alpha uniform (seed 003 Eq. 11-12); point/spot through the
+ *                     stereographic lookup (Eq. 13-14) with the exact Jacobian J; directional
+ *                     through the light's view plane (J = 1). Biased only by the truncation.
+ *   LR_CPU_REFERENCE  no truncation: a one-sample mixture (balance heuristic) of the pass's
+ *                     plane sampling with r_max = Inf and uniform directions over the sphere
+ *                     (directional: uniform over the object's projected disk). The mixture
+ *                     keeps the weight f/p bounded where the plane's far end maps to the
+ *                     antipodal cap, so the variance is finite for every material, albedo 1
+ *                     (sigma_tr = 0, plane sampled at rate 1/radius) included.
+ */
+#ifndef LR_CPU_RADIOSITY_H
+#define LR_CPU_RADIOSITY_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "render/base/vec3.h"
+#include "render/scene/scene.h"
+
+/* PIPELINE.md: r_max = 20 bounding radii. */
+#define LR_CPU_RMAX_RADII 20.0
+
+enum lr_cpu_sampler { LR_CPU_PASS = 0, LR_CPU_REFERENCE = 1 };
+
+typedef struct lr_cpu_radiosity_desc {
+    int N;                       /* samples per band; 0: 16 */
+    enum lr_cpu_sampler sampler; /* default LR_CPU_PASS */
+    double r_max;                /* LR_CPU_PASS: 0 = LR_CPU_RMAX_RADII * object radius */
+    /* Other translucent objects of the scene: the light G-buffer holds the first surface of
+     * any of them, and a lookup that meets another object first brings no light (as the GLSL
+     * pass). NULL / 0: the object alone. */
+    const lr_scene_object *const *others;
+    int n_others;
+    /* Optional emulation of the light G-buffer's resolution (for GPU parity): maps the lookup
+     * direction v (point/spot) or plane point x_j (directional) to the one whose first
+     * surface the G-buffer texel holds (its texel centre). NULL: exact ray casts. */
+    lr_vec3 (*snap)(void *snap_ctx, lr_vec3 v);
+    void *snap_ctx;
+} lr_cpu_radiosity_desc;
+
+typedef struct lr_cpu_estimate {
+    double mean[3]; /* B_c per unit light intensity, W/mm^2 per W/sr */
+    double var[3];  /* sample variance of ONE sample (unbiased, n - 1); of the mean: var / n */
+    int n;          /* samples per band */
+} lr_cpu_estimate;
+
+/* Estimates B at (xo, no) (no unit, pointing out of the medium) for object `obj` lit by
+ * `light`; `stream` keys the random numbers (lr_cpu_key of seed, map, texel, frame): the same
+ * key gives the same result on any thread. Finite and >= 0 for every finite input. */
+void lr_cpu_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3 xo, lr_vec3 no,
+                      const lr_cpu_radiosity_desc *d, uint64_t stream, lr_cpu_estimate *out);
+
+/* Stereographic lookup of seed 003 Eq. 13-14 for a light at xl and a plane sample xj in the
+ * tangent plane (xo, no): writes the (unnormalised) lookup direction v = h - 2 (h.l) l and
+ * returns the Jacobian d(omega)/dA_j = 2 t |l.no| / (d |xj - A|^2), t = |2 h.l|, of the map
+ * from the plane to directions around the light (PIPELINE.md). 0 where undefined (xj == A). */
+double lr_cpu_stereo_lookup(lr_vec3 xl, lr_vec3 xo, lr_vec3 no, lr_vec3 xj, lr_vec3 *v);
+
+/* The light G-buffer's texel along unit direction dir from origin o: first surface of the
+ * object with t > tmin; x_i and its interpolated unit normal. False when the ray misses. */
+bool lr_cpu_first_surface(const lr_scene_object *obj, lr_vec3 o, lr_vec3 dir, double tmin,
+                          lr_vec3 *xi, lr_vec3 *ni);
+
+/* Orthonormal tangents t1, t2 of unit n (t1 x t2 = n). */
+void lr_cpu_tangents(lr_vec3 n, lr_vec3 *t1, lr_vec3 *t2);
+
+#endif

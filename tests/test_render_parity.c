@@ -1,0 +1,397 @@
+/* GPU/CPU parity (issue 3, item 4): the GLSL passes (render/passes, read back through
+ * render/renderer_debug.h) against their CPU twin (render/cpu) on the same inputs.
+ *
+ *  - Radiosity maps: at every covered texel of the GPU's maps, the CPU estimator is evaluated
+ *    at the GPU's own x_o, n_o (as floats) with n_cpu samples per band. Both estimate the same
+ *    quantity with the same sampling scheme, so the one-sample variance s^2 the CPU measures
+ *    at that texel is the GPU's too, and z = (B_gpu - B_cpu) / sqrt(s^2 / n_gpu + s^2 / n_cpu),
+ *    n_gpu = N * frames, is ~ N(0, 1) where the estimator is well behaved. Checked: the
+ *    aggregate (sum over texels) within 4 aggregate sigma + the G-buffer's discretisation
+ *    allowance (below), and the fraction of texel-bands with |z| > 3 and > 4.
+ *  - VPLs: positions, normals and areas of the GPU's cube-map placement against the CPU's
+ *    exact ray casts along the same directions.
+ *  - A small final image: the CPU twin (its own maps, same settings) against the GPU image.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render/base/mat4.h"
+#include "render/cpu/frame.h"
+#include "render/cpu/radiosity.h"
+#include "render/cpu/rng.h"
+#include "render/cpu/vpl.h"
+#include "render/renderer.h"
+#include "render/renderer_debug.h"
+#include "tests/support/gl.h"
+#include "tests/support/near.h"
+#include "tests/support/render.h"
+
+static lr_gl *gl;
+
+static int setup(void **state)
+{
+    (void)state;
+    return lr_test_gl_create(&gl) ? -1 : 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    lr_gl_destroy(gl);
+    return 0;
+}
+
+/* The light G-buffer's texel for a lookup (render/shaders/lib/gbuffer.glsl): cube face by the
+ * major axis (GL's selection), or the 2D map; the texel floor((ndc * 0.5 + 0.5) * size) its
+ * rasterisation put there; returned: the direction (point for a directional light) through
+ * that texel's centre, whose first surface the texel holds. */
+typedef struct snap_ctx {
+    lr_debug_gbuffer_info info;
+    double inv[6][16];
+} snap_ctx;
+
+static lr_vec3 snap(void *p, lr_vec3 v)
+{
+    snap_ctx *g = p;
+    int face = 0;
+    if (g->info.cube) {
+        double ax = fabs(v.x), ay = fabs(v.y), az = fabs(v.z);
+        if (ax >= ay && ax >= az)
+            face = v.x > 0 ? 0 : 1;
+        else if (ay >= az)
+            face = v.y > 0 ? 2 : 3;
+        else
+            face = v.z > 0 ? 4 : 5;
+    }
+    lr_vec3 world = g->info.orthographic ? v : lr_v3_add(g->info.light_pos, v);
+    const double *m = g->info.vp[face];
+    double cx = m[0] * world.x + m[4] * world.y + m[8] * world.z + m[12];
+    double cy = m[1] * world.x + m[5] * world.y + m[9] * world.z + m[13];
+    double cz = m[2] * world.x + m[6] * world.y + m[10] * world.z + m[14];
+    double cw = m[3] * world.x + m[7] * world.y + m[11] * world.z + m[15];
+    if (!(cw > 0.0))
+        return v;
+    double nx = cx / cw, ny = cy / cw, nz = cz / cw;
+    if (fabs(nx) > 1.0 || fabs(ny) > 1.0)
+        return v;
+    int S = g->info.size;
+    int tx = (int)floor((nx * 0.5 + 0.5) * S), ty = (int)floor((ny * 0.5 + 0.5) * S);
+    tx = tx < 0 ? 0 : tx >= S ? S - 1 : tx;
+    ty = ty < 0 ? 0 : ty >= S ? S - 1 : ty;
+    lr_vec3 c = lr_mat4_project(g->inv[face], lr_v3((tx + 0.5) / S * 2.0 - 1.0,
+                                                    (ty + 0.5) / S * 2.0 - 1.0, nz));
+    return g->info.orthographic ? c : lr_v3_sub(c, g->info.light_pos);
+}
+
+static void snap_init(lr_renderer *r, snap_ctx *g)
+{
+    lr_renderer_debug_gbuffer_info(r, &g->info);
+    for (int f = 0; f < (g->info.cube ? 6 : 1); f++)
+        assert_int_equal(lr_mat4_inverse(g->info.vp[f], g->inv[f]), 0);
+}
+
+typedef struct parity {
+    long n;          /* texel-bands compared */
+    long over3, over4;
+    double sum_gpu, sum_cpu, var_sum; /* aggregate and its variance */
+    /* the same z statistics restricted to texels facing the light (n_o . h^ > 0.2) */
+    long nf, over3f, over4f;
+} parity;
+
+static void compare_maps(lr_renderer *r, lr_scene *s, int n_cpu, bool emulate, parity *out)
+{
+    snap_ctx g;
+    snap_init(r, &g);
+    lr_debug_map_info info;
+    lr_renderer_debug_map_info(r, &info);
+    size_t S = (size_t)info.size;
+    float *B = calloc(S * S * 3, sizeof *B), *pos = calloc(S * S * 3, sizeof *pos),
+          *nrm = calloc(S * S * 3, sizeof *nrm);
+    int *obj = calloc(S * S, sizeof *obj);
+    assert_non_null(B);
+    const lr_scene_object *objs[8];
+    int nobj = lr_scene_object_count(s);
+    for (int i = 0; i < nobj && i < 8; i++)
+        objs[i] = lr_scene_object_at(s, i);
+    memset(out, 0, sizeof *out);
+    double n_gpu = (double)info.N * info.frames;
+    for (int k = 0; k < info.K; k++) {
+        lr_err e = {0};
+        if (lr_renderer_debug_read_map(r, k, B, pos, nrm, obj, &e))
+            fail_msg("%s", e.msg);
+        for (size_t t = 0; t < S * S; t++) {
+            if (obj[t] < 0)
+                continue;
+            lr_vec3 xo = lr_v3(pos[3 * t], pos[3 * t + 1], pos[3 * t + 2]);
+            lr_vec3 no = lr_v3_normalize(lr_v3(nrm[3 * t], nrm[3 * t + 1], nrm[3 * t + 2]));
+            lr_cpu_radiosity_desc d = {.N = n_cpu, .r_max = info.r_max, .others = objs,
+                                       .n_others = nobj, .snap = emulate ? snap : NULL,
+                                       .snap_ctx = &g};
+            lr_cpu_estimate est;
+            lr_cpu_radiosity(objs[obj[t]], lr_scene_light_at(s, 0), xo, no, &d,
+                             lr_cpu_key(4242, (uint64_t)k, t, 0), &est);
+            for (int c = 0; c < 3; c++) {
+                double gv = B[3 * t + c], v = est.var[c] / n_gpu + est.var[c] / n_cpu;
+                assert_true(isfinite(gv) && gv >= 0.0);
+                out->n++;
+                out->sum_gpu += gv;
+                out->sum_cpu += est.mean[c];
+                out->var_sum += v;
+                double dz = fabs(gv - est.mean[c]);
+                if (getenv("LR_PARITY_DEBUG") && dz > 3.0 * sqrt(v) && out->over3 < 40)
+                    print_message("k %d t %zu c %d: gpu %.4g cpu %.4g sd %.3g (cpu sd1 %.3g) n.h %.3f\n", k, t, c, gv, est.mean[c], sqrt(v), sqrt(est.var[c]),
+                        lr_v3_dot(no, lr_v3_normalize(lr_v3_sub(lr_scene_light_at(s, 0)->position, xo))));
+                bool o3, o4;
+                if (v > 0.0) {
+                    o3 = dz > 3.0 * sqrt(v);
+                    o4 = dz > 4.0 * sqrt(v);
+                } else {
+                    o3 = o4 = dz > 1e-6 * (gv + est.mean[c]);
+                }
+                out->over3 += o3;
+                out->over4 += o4;
+                lr_vec3 hl = lr_v3_normalize(lr_v3_sub(lr_scene_light_at(s, 0)->position, xo));
+                if (lr_v3_dot(no, hl) > 0.2) {
+                    out->nf++;
+                    out->over3f += o3;
+                    out->over4f += o4;
+                }
+            }
+        }
+    }
+    free(B);
+    free(pos);
+    free(nrm);
+    free(obj);
+}
+
+static void report(const char *what, const parity *p)
+{
+    print_message("%s: %ld texel-bands; sum GPU %.5g, CPU %.5g (%+.2f %%, aggregate sigma "
+                  "%.2f %%); |z| > 3: %.2f %%, |z| > 4: %.2f %%; facing the light (%ld): "
+                  "|z| > 3: %.2f %%, |z| > 4: %.2f %%\n", what, p->n, p->sum_gpu,
+                  p->sum_cpu, 100 * (p->sum_gpu / p->sum_cpu - 1),
+                  100 * sqrt(p->var_sum) / p->sum_cpu, 100.0 * p->over3 / p->n,
+                  100.0 * p->over4 / p->n, p->nf, 100.0 * p->over3f / p->nf,
+                  100.0 * p->over4f / p->nf);
+}
+
+/* The asserted part (with the G-buffer emulated): the aggregate within 4 aggregate sigma, and
+ * over texels facing the light |z| > 3 in at most 2 % and |z| > 4 in at most 0.5 % of the
+ * texel-bands (Gaussian: 0.27 % and 0.006 %; the allowance covers s^2 estimated from 256
+ * samples, float positions and the texels at the terminator where the weights start to be
+ * heavy-tailed). Measured: lampshade 0.70 % / 0.00 %, sphere 1.26 % / 0.23 %. Texels facing
+ * away from the light are reported, not asserted: there the pass's weights are heavy-tailed
+ * (test_cpu_radiosity's blind spot) and a sample variance does not bound the error (measured
+ * |z| > 4: 0.4 % lampshade, 4.7 % sphere over all texels). Without the G-buffer emulation (the
+ * CPU's exact rays, i.e. the model itself) 75 % of the lampshade's lit texel-bands are beyond
+ * 4 sigma: the 256^2 G-buffer's quantisation of x_i is a real per-texel error of the GPU at
+ * porcelain's scale (seed 003 Sec. 5's 'pearling'), though it averages out (+0.3 %). */
+static void check_parity(const parity *p)
+{
+    assert_true(p->nf > 100);
+    assert_near(p->sum_gpu, p->sum_cpu, 4.0 * sqrt(p->var_sum));
+    assert_true(p->over3f <= 0.02 * p->nf);
+    assert_true(p->over4f <= 0.005 * p->nf);
+}
+
+static const char *const parity_settings[] = {
+    "render.K=3", "render.N=16", "render.map_size=24", "render.gbuffer_size=256",
+    "render.vpl_map_size=32", "render.N_vpl=48", "render.frames=8", NULL};
+
+static void test_maps_lampshade(void **state)
+{
+    (void)state;
+    lr_scene *s = lr_test_scene("lampshade", parity_settings, NULL);
+    lr_renderer *r = lr_test_renderer(gl, s, 16, 12, true, 3);
+    lr_test_converge(r, 20);
+    parity p;
+    compare_maps(r, s, 256, true, &p);
+    report("lampshade maps (G-buffer emulated)", &p);
+    check_parity(&p);
+    compare_maps(r, s, 256, false, &p);
+    report("lampshade maps (exact rays)", &p);
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+}
+
+static void test_maps_sphere_outside_light(void **state)
+{
+    (void)state;
+    static const char *const ball[] = {"objects[ball].material=marble", "light.position=0,0,120",
+                                       NULL};
+    lr_scene *s = lr_test_scene("sphere", parity_settings, ball);
+    lr_renderer *r = lr_test_renderer(gl, s, 16, 12, true, 3);
+    lr_test_converge(r, 20);
+    parity p;
+    compare_maps(r, s, 256, true, &p);
+    report("sphere maps (light outside, G-buffer emulated)", &p);
+    check_parity(&p);
+    compare_maps(r, s, 256, false, &p);
+    report("sphere maps (light outside, exact rays)", &p);
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+}
+
+/* VPLs: the GPU places them from a cube map of the outer surface (vpl_map_size^2 faces), the
+ * CPU by exact rays along the same directions u_v = lr_halton_sphere(v + 1) from the same
+ * centre. Same validity; positions within 1.5 cube texels (|x_v - c| * 2 / size * 1.5 /
+ * max(|n.u|, 0.3): a texel's footprint on a tilted surface); normals within 0.05 where the
+ * positions agree to a texel; areas within 10 % (the area uses n_v . u_v, interpolated at a
+ * texel centre on the GPU). Measured: 0.58 texels, 9.3 %, 0.040. Also reported (not
+ * asserted): sum A_v B_v of the GPU against the reference estimator at the GPU's own VPL
+ * positions -- with K = 3 maps it is +26 %, dominated by one VPL near the flame that no map
+ * sees (Algorithm 1's fallback). */
+static void test_vpls(void **state)
+{
+    (void)state;
+    lr_scene *s = lr_test_scene("candle", parity_settings, NULL);
+    lr_renderer *r = lr_test_renderer(gl, s, 16, 12, false, 3);
+    lr_test_converge(r, 20);
+    int n = lr_renderer_debug_vpl_count(r);
+    assert_int_equal(n, 48);
+    lr_debug_vpl g[48];
+    lr_err e = {0};
+    if (lr_renderer_debug_read_vpls(r, g, &e))
+        fail_msg("%s", e.msg);
+    const lr_scene_object *o = lr_scene_object_at(s, 0);
+    lr_vec3 gc = lr_renderer_debug_vpl_center(r);
+    assert_near(lr_v3_len(lr_v3_sub(gc, o->center)), 0.0, 1e-3);
+    lr_cpu_vpl c[48];
+    lr_cpu_vpl_place(o, 48, c);
+    double worst_pos = 0, worst_area = 0, worst_n = 0;
+    for (int v = 0; v < n; v++) {
+        assert_int_equal(g[v].valid, c[v].valid);
+        if (!c[v].valid)
+            continue;
+        assert_near(lr_v3_len(lr_v3_sub(g[v].u, c[v].u)), 0.0, 1e-6);
+        double dist = lr_v3_len(lr_v3_sub(c[v].x, o->center));
+        double cosv = fmax(fabs(lr_v3_dot(c[v].n, c[v].u)), 0.3);
+        double texel = dist * 2.0 / 32 / cosv;
+        double dp = lr_v3_len(lr_v3_sub(g[v].pos, c[v].x)) / texel;
+        double da = fabs(g[v].area / c[v].area - 1);
+        double dn = lr_v3_len(lr_v3_sub(g[v].nrm, c[v].n));
+        worst_pos = fmax(worst_pos, dp);
+        worst_area = fmax(worst_area, da);
+        if (dp < 1.0)
+            worst_n = fmax(worst_n, dn);
+    }
+    /* B at the VPLs: the GPU's (Algorithm 1 over its maps) against the reference estimator at
+     * the GPU's own positions, weighted by area (what the receivers see). */
+    double sg = 0, sr = 0, sv = 0, sa_g = 0, sa_c = 0;
+    for (int v = 0; v < n; v++) {
+        if (!g[v].valid)
+            continue;
+        lr_cpu_radiosity_desc rd = {.N = 1000, .sampler = LR_CPU_REFERENCE};
+        lr_cpu_estimate est;
+        lr_cpu_radiosity(o, lr_scene_light_at(s, 0), g[v].pos, lr_v3_normalize(g[v].nrm), &rd,
+                         lr_cpu_key(77, (uint64_t)v, 0, 0), &est);
+        sg += g[v].area * g[v].B[1];
+        sr += g[v].area * est.mean[1];
+        sv += g[v].area * g[v].area * est.var[1] / est.n;
+        sa_g += g[v].area;
+        sa_c += c[v].area;
+        if (getenv("LR_PARITY_DEBUG"))
+            print_message("vpl %d: B gpu %.4g ref %.4g +- %.2g weight %.2f area %.4g/%.4g\n", v,
+                          g[v].B[1], est.mean[1], sqrt(est.var[1] / est.n), g[v].weight,
+                          g[v].area, c[v].area);
+    }
+    print_message("VPLs: sum A B: GPU %.5g, reference at the GPU's positions %.5g +- %.2g "
+                  "(%+.1f %%); sum A: GPU %.5g, CPU %.5g\n", sg, sr, sqrt(sv),
+                  100 * (sg / sr - 1), sa_g, sa_c);
+    print_message("VPLs: worst position error %.2f texels, area %.1f %%, normal %.3f\n", worst_pos,
+                  100 * worst_area, worst_n);
+    assert_true(worst_pos < 1.5);
+    assert_true(worst_area < 0.10);
+    assert_true(worst_n < 0.05);
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+}
+
+/* A small final image of the candle (32 x 24, K = 8): the GPU renderer against the CPU twin
+ * with the same settings (its own maps and seeds). Compared per region, since per pixel both
+ * carry map noise and the GPU's G-buffer and VPL cube-map quantisation. Every GPU pixel is
+ * finite and >= 0. Object pixels (summed): within 4 sigma (twin's variance image, taken for
+ * both) + 5 %; measured +3.1 % (sigma 3.0 %). Receivers without VPLs (direct light and the
+ * candle's shadow): the same to 1e-3 (measured 0.00 %). Receivers with VPLs: within 20 %;
+ * measured +4.4 % (K = 8; +13 % in the VPL part alone): the VPLs' B comes from Algorithm 1
+ * over few maps at positions that differ by up to 0.6 cube texels, several VPLs fall back to
+ * the nearest texel of one map, and most sit on the candle's side, facing away from the flame,
+ * where the texels are heavy-tailed -- so the twin's variance image understates it. */
+static void final_image(bool no_vpl)
+{
+    const int W = 32, H = 24;
+    static const char *const more_maps[] = {"render.K=8", NULL};
+    lr_scene *s = lr_test_scene("candle", parity_settings, more_maps);
+    lr_renderer *r = lr_test_renderer(gl, s, W, H, no_vpl, 3);
+    lr_test_converge(r, 20);
+    float *hdr = lr_test_hdr(r); /* rows bottom up */
+    lr_cpu_render_desc d = {.scene = s, .width = W, .height = H, .mode = LR_CPU_PASS,
+                            .no_vpl = no_vpl};
+    lr_image twin, var;
+    lr_cpu_render_stats st;
+    lr_err e = {0};
+    if (lr_cpu_render(&d, &twin, &var, &st, &e))
+        fail_msg("%s", e.msg);
+    double sum_g[2] = {0}, sum_c[2] = {0}, v[2] = {0};
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            lr_vec3 org, dir;
+            lr_cpu_camera_ray(s, W, H, x, y, &org, &dir);
+            lr_hit h;
+            int region = lr_bvh_intersect(lr_scene_object_at(s, 0)->bvh, org, dir, 0, INFINITY, &h) ? 0 : 1;
+            const float *gp = hdr + 3 * ((size_t)(H - 1 - y) * W + x);
+            const float *cp = twin.rgb + 3 * ((size_t)y * W + x);
+            const float *vp = var.rgb + 3 * ((size_t)y * W + x);
+            for (int c = 0; c < 3; c++) {
+                assert_true(isfinite(gp[c]) && gp[c] >= 0.0f);
+                sum_g[region] += gp[c];
+                sum_c[region] += cp[c];
+                v[region] += 2.0 * vp[c];
+            }
+        }
+    const char *names[2] = {"object", "receivers"};
+    for (int i = 0; i < 2; i++) {
+        print_message("final image%s, %s pixels: GPU %.5g, CPU twin %.5g (%+.2f %%, sigma %.2f %%)\n",
+                      no_vpl ? " (no VPL)" : "", names[i], sum_g[i], sum_c[i],
+                      100 * (sum_g[i] / sum_c[i] - 1),
+                      100 * sqrt(v[i]) / sum_c[i]);
+        if (i == 0)
+            assert_near(sum_g[i], sum_c[i], 4.0 * sqrt(v[i]) + 0.05 * sum_c[i]);
+        else
+            assert_near_rel(sum_g[i], sum_c[i], no_vpl ? 1e-3 : 0.20);
+    }
+    free(hdr);
+    lr_image_free(&twin);
+    lr_image_free(&var);
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+}
+
+static void test_final_image(void **state)
+{
+    (void)state;
+    final_image(true);
+    final_image(false);
+}
+
+int main(void)
+{
+    if (getenv("LR_TEST_FILTER"))
+        cmocka_set_test_filter(getenv("LR_TEST_FILTER"));
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_maps_lampshade),
+        cmocka_unit_test(test_maps_sphere_outside_light),
+        cmocka_unit_test(test_vpls),
+        cmocka_unit_test(test_final_image),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
