@@ -199,6 +199,22 @@ static double untonemap(float v)
     return 0.5 * (lo + hi);
 }
 
+/* Ratio of the scene-linear radiance of frame b to frame a (b the brighter), over the pixels off
+ * the tone curve's shoulder in b and above 8-bit quantization in a. */
+static double radiance_ratio(const lr_image *a, const lr_image *b)
+{
+    double sa = 0, sb = 0;
+    int used = 0;
+    for (size_t i = 0; i < (size_t)a->width * (size_t)a->height * 3; i++)
+        if (b->rgb[i] < 0.8f && a->rgb[i] > 0.02f) {
+            sa += untonemap(a->rgb[i]);
+            sb += untonemap(b->rgb[i]);
+            used++;
+        }
+    assert_true(used > 100);
+    return sb / sa;
+}
+
 static bool settled(lr_rig *r, lr_test_mb_server *s, int want)
 {
     lr_rig_info info;
@@ -246,16 +262,7 @@ static void test_shipped_modbus_demo(void **state)
     assert_true(run_until(r, s, settled, 51));
     assert_near(intensity(r), 0.002, 1e-12);
     lr_image b = newest_frame(dir);
-    double sa = 0, sb = 0;
-    int used = 0;
-    for (size_t i = 0; i < (size_t)a.width * (size_t)a.height * 3; i++)
-        if (b.rgb[i] < 0.8f && a.rgb[i] > 0.02f) { /* off the shoulder, above quantization */
-            sa += untonemap(a.rgb[i]);
-            sb += untonemap(b.rgb[i]);
-            used++;
-        }
-    assert_true(used > 100);
-    assert_near(sb / sa, 2.0, 0.01);
+    assert_near(radiance_ratio(&a, &b), 2.0, 0.01);
     lr_image_free(&a);
     lr_image_free(&b);
 
@@ -266,6 +273,80 @@ static void test_shipped_modbus_demo(void **state)
     lr_rig_destroy(r);
     assert_int_equal(lr_test_mb_server_reg(s, 2, 0), 0); /* safe_level 0 */
     lr_test_mb_server_free(s);
+    lr_test_rmtree(dir);
+}
+
+/* The same over RTU on a pseudo-terminal pair: the shipped modbus-demo rig with
+ * --modbus rtu:LINK?baud=19200&parity=E, LINK a symlink to the pty's slave end (as udev's
+ * /dev/serial/by-id links are), the real renderer at the demo's budget. A panel change reaches
+ * the driver register and the frame's radiance; the bus goes away (the pty is closed, the
+ * device node disappears) and comes back as a new pty behind the same link: the rig logs the
+ * loss, reconnects, reads the moved panel and resends the level to a driver that restarted
+ * at 0. The safe level reaches the driver at shutdown. */
+static void test_rtu_over_pty(void **state)
+{
+    (void)state;
+    lr_gl *gl;
+    assert_int_equal(lr_test_gl_create(&gl), LR_OK); /* pins the driver for LSan */
+    lr_gl_destroy(gl);
+    char *dir = lr_test_tmpdir();
+    char *link = lr_test_path(dir, "ttyPANEL");
+    char *frames = lr_test_path(dir, "frames");
+    lr_test_mb_server *s = lr_test_mb_server_start_rtu(link);
+    char url[700];
+    snprintf(url, sizeof url, "rtu:%s?baud=19200&parity=E&data=8&stop=1", link);
+    lr_test_mb_server_set_reg(s, 1, 0, 100);
+    lr_test_log log = {0};
+    lr_rig_opts o = {.config = LR_SOURCE_CONFIGS "/rig/modbus-demo.json", .modbus_url = url,
+                     .headless = true, .out_dir = frames, .no_signals = true,
+                     .log = {lr_test_log_fn, &log}};
+    lr_rig *r;
+    lr_err e = {0};
+    if (lr_rig_create(&o, &r, &e))
+        fail_msg("%s", e.msg);
+    lr_rig_info info;
+    lr_rig_get_info(r, &info);
+    assert_string_equal(info.view, "passes");
+
+    /* 100 → 0.1 → round(25.5) = 26 on the driver, 0.001 W/sr in the scene; converged. */
+    assert_true(run_until(r, s, settled, 26));
+    assert_near(intensity(r), 0.001, 1e-12);
+    lr_rig_get_info(r, &info);
+    assert_near(info.lamp_level, 0.1, 1e-12);
+    lr_image a = newest_frame(frames);
+    /* 200 → 51; the converged frame's radiance doubles. */
+    lr_test_mb_server_set_reg(s, 1, 0, 200);
+    assert_true(run_until(r, s, settled, 51));
+    assert_near(intensity(r), 0.002, 1e-12);
+    lr_image b = newest_frame(frames);
+    assert_near(radiance_ratio(&a, &b), 2.0, 0.01);
+    lr_image_free(&b);
+    assert_int_equal(lr_test_log_count(&log, "retrying with backoff"), 0);
+
+    /* The bus goes away for 0.8 s: the rig keeps running and logs the loss. */
+    lr_test_mb_server_stop(s);
+    int64_t until = lr_now_ns() + 800 * MS;
+    while (lr_now_ns() < until)
+        assert_int_equal(lr_rig_run_until(r, until, &e), LR_OK);
+    assert_true(lr_test_log_count(&log, "retrying with backoff") >= 1);
+    /* Back as a new pty behind the same link, the panel moved to 300 and the driver at 0:
+     * 0.3 → round(76.5) = 77, resent; the frame follows (3× the first one). */
+    lr_test_mb_server_set_reg(s, 1, 0, 300);
+    lr_test_mb_server_set_reg(s, 2, 0, 0);
+    lr_test_mb_server_restart(s);
+    assert_true(run_until(r, s, settled, 77));
+    assert_near(intensity(r), 0.003, 1e-12);
+    assert_true(lr_test_log_count(&log, "open (after") >= 1);
+    lr_image c = newest_frame(frames);
+    assert_near(radiance_ratio(&a, &c), 3.0, 0.015);
+    lr_image_free(&a);
+    lr_image_free(&c);
+
+    lr_rig_destroy(r);
+    assert_int_equal(lr_test_mb_server_reg(s, 2, 0), 0); /* safe_level 0, acknowledged */
+    lr_test_mb_server_free(s);
+    free(link);
+    free(frames);
     lr_test_rmtree(dir);
 }
 
@@ -314,6 +395,7 @@ int main(void)
         cmocka_unit_test(test_panel_to_driver_and_frame),
         cmocka_unit_test(test_shipped_modbus_demo),
         cmocka_unit_test(test_missing_at_start),
+        cmocka_unit_test(test_rtu_over_pty),
     };
     if (getenv("LR_TEST_FILTER")) /* e.g. LR_TEST_FILTER='test_soak*' to run one test */
         cmocka_set_test_filter(getenv("LR_TEST_FILTER"));

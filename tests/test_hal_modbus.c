@@ -3,14 +3,11 @@
  * server is the dimmer panel (unit 1) and the lamp driver (unit 2) of configs/rig/modbus-demo.
  * Also the endpoint URL parser. No timed assertions: the loop runs until a condition holds,
  * with generous guards against hangs. */
-#include <arpa/inet.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
 #include <modbus.h>
-#include <netinet/in.h>
 #include <poll.h>
-#include <pthread.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -18,13 +15,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <cmocka.h>
 
 #include "hal/modbus.h"
 #include "tests/support/hal_test.h"
+#include "tests/support/modbus_server.h"
 
 /* ---- URL parsing ---- */
 
@@ -107,247 +104,14 @@ static void url_bad(void **state)
     }
 }
 
-/* ---- the server: panel = unit 1, lamp driver = unit 2, 10 holding registers each ---- */
-
-typedef struct server {
-    bool rtu;
-    int port;
-    int listen_fd;
-    int pty_master, pty_keep; /* rtu: the bus end, and a slave fd that keeps it from hanging up */
-    char pty_path[64];
-    int stop[2];
-    pthread_t th;
-    bool running;
-    pthread_mutex_t mu;
-    modbus_mapping_t *panel, *driver;
-    int silent;       /* answer nothing */
-    int corrupt;      /* rtu: damage the CRC of this many replies */
-    int answered;
-} server;
-
-static int reg(server *s, modbus_mapping_t *map, int i)
-{
-    pthread_mutex_lock(&s->mu);
-    int v = map->tab_registers[i];
-    pthread_mutex_unlock(&s->mu);
-    return v;
-}
-
-static void set_reg(server *s, modbus_mapping_t *map, int i, int v)
-{
-    pthread_mutex_lock(&s->mu);
-    map->tab_registers[i] = (uint16_t)v;
-    pthread_mutex_unlock(&s->mu);
-}
-
-static void set_flag(server *s, int *flag, int v)
-{
-    pthread_mutex_lock(&s->mu);
-    *flag = v;
-    pthread_mutex_unlock(&s->mu);
-}
-
-/* Answers one request with libmodbus's own server logic (modbus_reply). For RTU the reply goes
- * through a pipe first so that the test can damage its CRC. */
-static void serve(server *s, modbus_t *ctx, const uint8_t *q, int len, int capture[2])
-{
-    int unit = q[modbus_get_header_length(ctx) - 1];
-    pthread_mutex_lock(&s->mu);
-    modbus_mapping_t *map = unit == 1 ? s->panel : unit == 2 ? s->driver : NULL;
-    if (map && !s->silent) {
-        if (!s->rtu) {
-            modbus_reply(ctx, q, len, map);
-        } else {
-            modbus_set_socket(ctx, capture[1]);
-            int n = modbus_reply(ctx, q, len, map);
-            uint8_t rsp[MODBUS_RTU_MAX_ADU_LENGTH];
-            if (n > 0 && read(capture[0], rsp, (size_t)n) == n) {
-                if (s->corrupt > 0) {
-                    rsp[n - 1] ^= 0x5a;
-                    s->corrupt--;
-                }
-                if (write(s->pty_master, rsp, (size_t)n) != n)
-                    n = -1;
-            }
-        }
-        s->answered++;
-    }
-    pthread_mutex_unlock(&s->mu);
-}
-
-static void *tcp_thread(void *arg)
-{
-    server *s = arg;
-    modbus_t *ctx = modbus_new_tcp("127.0.0.1", s->port);
-    int clients[8], nc = 0;
-    for (;;) {
-        struct pollfd p[10] = {{s->stop[0], POLLIN, 0}, {s->listen_fd, POLLIN, 0}};
-        for (int i = 0; i < nc; i++)
-            p[2 + i] = (struct pollfd){clients[i], POLLIN, 0};
-        if (poll(p, (nfds_t)(2 + nc), -1) < 0)
-            continue;
-        if (p[0].revents)
-            break;
-        if (p[1].revents & POLLIN) {
-            int c = accept(s->listen_fd, NULL, NULL);
-            if (c >= 0 && nc < 8)
-                clients[nc++] = c;
-            else if (c >= 0)
-                close(c);
-        }
-        for (int i = 0; i < nc; i++) {
-            if (!p[2 + i].revents)
-                continue;
-            uint8_t q[MODBUS_TCP_MAX_ADU_LENGTH];
-            modbus_set_socket(ctx, clients[i]);
-            int rc = modbus_receive(ctx, q);
-            if (rc > 0) {
-                serve(s, ctx, q, rc, NULL);
-            } else if (rc < 0) {
-                close(clients[i]);
-                clients[i] = clients[--nc];
-                break; /* p[] no longer matches clients[]: poll again */
-            }
-        }
-    }
-    for (int i = 0; i < nc; i++)
-        close(clients[i]);
-    modbus_set_socket(ctx, -1);
-    modbus_free(ctx);
-    return NULL;
-}
-
-/* Bytes of an RTU request by function code (with CRC); 0 = need more; -1 = unknown. */
-static int rtu_frame_len(const uint8_t *b, int n)
-{
-    if (n < 2)
-        return 0;
-    switch (b[1]) {
-    case MODBUS_FC_READ_HOLDING_REGISTERS:
-    case MODBUS_FC_READ_INPUT_REGISTERS:
-    case MODBUS_FC_WRITE_SINGLE_REGISTER: return 8;
-    case MODBUS_FC_WRITE_MULTIPLE_REGISTERS: return n < 7 ? 0 : 9 + b[6];
-    }
-    return -1;
-}
-
-static void *rtu_thread(void *arg)
-{
-    server *s = arg;
-    modbus_t *ctx = modbus_new_rtu(s->pty_path, 19200, 'E', 8, 1);
-    int capture[2];
-    if (pipe(capture) != 0)
-        return NULL;
-    uint8_t buf[512];
-    int len = 0;
-    for (;;) {
-        struct pollfd p[2] = {{s->stop[0], POLLIN, 0}, {s->pty_master, POLLIN, 0}};
-        if (poll(p, 2, -1) < 0)
-            continue;
-        if (p[0].revents)
-            break;
-        if (!(p[1].revents & POLLIN))
-            continue;
-        ssize_t n = read(s->pty_master, buf + len, sizeof buf - (size_t)len);
-        if (n <= 0)
-            continue;
-        len += (int)n;
-        /* Framing by length is enough for a test bus with one master. */
-        for (;;) {
-            int fl = rtu_frame_len(buf, len);
-            if (fl < 0) {
-                len = 0;
-                break;
-            }
-            if (fl == 0 || len < fl)
-                break;
-            serve(s, ctx, buf, fl, capture);
-            memmove(buf, buf + fl, (size_t)(len - fl));
-            len -= fl;
-        }
-    }
-    close(capture[0]);
-    close(capture[1]);
-    modbus_set_socket(ctx, -1);
-    modbus_free(ctx);
-    return NULL;
-}
-
-static void server_init(server *s, bool rtu)
-{
-    memset(s, 0, sizeof *s);
-    s->rtu = rtu;
-    s->listen_fd = s->pty_master = s->pty_keep = -1;
-    pthread_mutex_init(&s->mu, NULL);
-    s->panel = modbus_mapping_new(0, 0, 10, 0);
-    s->driver = modbus_mapping_new(0, 0, 10, 0);
-    assert_non_null(s->panel);
-    assert_non_null(s->driver);
-    if (rtu) {
-        s->pty_master = posix_openpt(O_RDWR | O_NOCTTY);
-        assert_true(s->pty_master >= 0);
-        assert_int_equal(grantpt(s->pty_master), 0);
-        assert_int_equal(unlockpt(s->pty_master), 0);
-        assert_int_equal(ptsname_r(s->pty_master, s->pty_path, sizeof s->pty_path), 0);
-        s->pty_keep = open(s->pty_path, O_RDWR | O_NOCTTY);
-        assert_true(s->pty_keep >= 0);
-    }
-}
-
-/* Starts (or restarts, on the same port) the server thread. */
-static void server_start(server *s)
-{
-    assert_int_equal(pipe(s->stop), 0);
-    if (!s->rtu) {
-        s->listen_fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-        assert_true(s->listen_fd >= 0);
-        int one = 1;
-        setsockopt(s->listen_fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
-        struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)s->port)};
-        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-        assert_int_equal(bind(s->listen_fd, (struct sockaddr *)&a, sizeof a), 0);
-        socklen_t al = sizeof a;
-        assert_int_equal(getsockname(s->listen_fd, (struct sockaddr *)&a, &al), 0);
-        s->port = ntohs(a.sin_port); /* 0 at first start: the kernel picked a free port */
-        assert_int_equal(listen(s->listen_fd, 8), 0);
-    }
-    assert_int_equal(pthread_create(&s->th, NULL, s->rtu ? rtu_thread : tcp_thread, s), 0);
-    s->running = true;
-}
-
-/* Kills the server: its thread closes every connection and the listening socket. */
-static void server_stop(server *s)
-{
-    if (!s->running)
-        return;
-    assert_int_equal(write(s->stop[1], "x", 1), 1);
-    pthread_join(s->th, NULL);
-    close(s->stop[0]);
-    close(s->stop[1]);
-    if (s->listen_fd >= 0)
-        close(s->listen_fd);
-    s->listen_fd = -1;
-    s->running = false;
-}
-
-static void server_free(server *s)
-{
-    server_stop(s);
-    if (s->pty_keep >= 0)
-        close(s->pty_keep);
-    if (s->pty_master >= 0)
-        close(s->pty_master);
-    modbus_mapping_free(s->panel);
-    modbus_mapping_free(s->driver);
-    pthread_mutex_destroy(&s->mu);
-}
+/* The server (panel = unit 1, lamp driver = unit 2) is tests/support/modbus_server.c. */
 
 /* ---- loop conditions ---- */
 
 typedef struct cond {
     lr_modbus *m;
     lr_event_ring *ring;
-    server *s;
+    lr_test_mb_server *s;
     int n;        /* ring events wanted, or a counter threshold */
     int want;     /* driver register value */
 } cond;
@@ -361,7 +125,7 @@ static bool has_events(void *u)
 static bool driver_has(void *u)
 {
     cond *c = u;
-    return lr_modbus_output_synced(c->m) && reg(c->s, c->s->driver, 0) == c->want;
+    return lr_modbus_output_synced(c->m) && lr_test_mb_server_reg(c->s, 2, 0) == c->want;
 }
 
 static bool link_down(void *u)
@@ -422,16 +186,14 @@ static const lr_modbus_input PANEL = {.control = "dimmer", .unit = 1, .reg = 0, 
 static void tcp_panel_driver_and_reconnect(void **state)
 {
     (void)state;
-    server s;
-    server_init(&s, false);
-    set_reg(&s, s.panel, 0, 500);
-    server_start(&s);
+    lr_test_mb_server *s = lr_test_mb_server_start();
+    lr_test_mb_server_set_reg(s, 1, 0, 500);
 
     lr_event_ring *ring;
     assert_int_equal(lr_event_ring_create(0, &ring, NULL), LR_OK);
     lr_test_log log = {0};
     char url[64];
-    snprintf(url, sizeof url, "tcp://127.0.0.1:%d", s.port);
+    snprintf(url, sizeof url, "tcp://127.0.0.1:%d", lr_test_mb_server_port(s));
     lr_modbus_desc desc = {
         .dev = {.sink = lr_event_ring_sink(ring), .log = {lr_test_log_fn, &log},
                 .retry_min_ms = 20, .retry_max_ms = 200},
@@ -449,7 +211,7 @@ static void tcp_panel_driver_and_reconnect(void **state)
     assert_int_equal(lr_dev_pollfds(d, &pfd, 1), 1);
 
     /* The panel's position is reported once after connecting: 500 of 0..1000. */
-    cond c = {.m = m, .ring = ring, .s = &s, .n = 1};
+    cond c = {.m = m, .ring = ring, .s = s, .n = 1};
     assert_true(run(m, has_events, &c));
     lr_event ev = pop(ring);
     assert_string_equal(ev.source, "modbus");
@@ -458,7 +220,7 @@ static void tcp_panel_driver_and_reconnect(void **state)
     assert_float_equal(ev.value, 0.5, 1e-12);
 
     /* A change on the panel becomes exactly one event with the new value. */
-    set_reg(&s, s.panel, 0, 250);
+    lr_test_mb_server_set_reg(s, 1, 0, 250);
     assert_true(run(m, has_events, &c));
     ev = pop(ring);
     assert_float_equal(ev.value, 0.25, 1e-12);
@@ -475,8 +237,8 @@ static void tcp_panel_driver_and_reconnect(void **state)
     assert_int_equal(lr_modbus_write_level(m, NAN), LR_EINVAL);
     assert_int_equal(lr_modbus_write_level(m, 0.2), LR_OK);
     assert_int_equal(lr_modbus_flush(m, 10000, &e), LR_OK); /* the shutdown path */
-    assert_int_equal(reg(&s, s.driver, 0), 51);
-    assert_int_equal(reg(&s, s.panel, 0), 250); /* the panel was not written */
+    assert_int_equal(lr_test_mb_server_reg(s, 2, 0), 51);
+    assert_int_equal(lr_test_mb_server_reg(s, 1, 0), 250); /* the panel was not written */
 
     lr_modbus_counters k;
     lr_modbus_get_counters(m, &k);
@@ -485,7 +247,7 @@ static void tcp_panel_driver_and_reconnect(void **state)
     assert_int_equal(k.exceptions + k.timeouts + k.crc_errors + k.bad_responses + k.io_errors, 0);
 
     /* The server dies: the link drops, one line is logged, reconnects back off silently. */
-    server_stop(&s);
+    lr_test_mb_server_stop(s);
     assert_true(run(m, link_down, &c));
     int lines_after_loss = lr_test_log_count(&log, "retrying with backoff");
     c.n = 4;
@@ -500,9 +262,9 @@ static void tcp_panel_driver_and_reconnect(void **state)
 
     /* It comes back (same port) with a moved dimmer and a driver that restarted at 0: the
      * master reconnects, reports the new position and resends the level. */
-    set_reg(&s, s.panel, 0, 900);
-    set_reg(&s, s.driver, 0, 0);
-    server_start(&s);
+    lr_test_mb_server_set_reg(s, 1, 0, 900);
+    lr_test_mb_server_set_reg(s, 2, 0, 0);
+    lr_test_mb_server_restart(s);
     c.n = 1;
     lr_event_ring_pop(ring, &ev);
     assert_true(run(m, has_events, &c));
@@ -515,22 +277,20 @@ static void tcp_panel_driver_and_reconnect(void **state)
     assert_int_equal(lr_test_log_count(&log, ": open (after 4 failed attempts)"), 1);
 
     lr_modbus_destroy(m);
-    server_free(&s);
+    lr_test_mb_server_free(s);
     lr_event_ring_destroy(ring);
 }
 
 static void tcp_exceptions_are_counted_not_fatal(void **state)
 {
     (void)state;
-    server s;
-    server_init(&s, false);
-    set_reg(&s, s.panel, 0, 1000);
-    server_start(&s);
+    lr_test_mb_server *s = lr_test_mb_server_start();
+    lr_test_mb_server_set_reg(s, 1, 0, 1000);
     lr_event_ring *ring;
     assert_int_equal(lr_event_ring_create(0, &ring, NULL), LR_OK);
     lr_test_log log = {0};
     char url[64];
-    snprintf(url, sizeof url, "tcp://127.0.0.1:%d", s.port);
+    snprintf(url, sizeof url, "tcp://127.0.0.1:%d", lr_test_mb_server_port(s));
     /* Register 50 does not exist on the panel (10 registers): illegal data address. */
     lr_modbus_input in[2] = {PANEL, {.control = "fader", .unit = 1, .reg = 50}};
     lr_modbus_desc desc = {
@@ -543,7 +303,7 @@ static void tcp_exceptions_are_counted_not_fatal(void **state)
     lr_err e = {0};
     assert_int_equal(lr_modbus_create(&desc, &m, &e), LR_OK);
     assert_int_equal(lr_modbus_write_level(m, 1.0), LR_OK);
-    cond c = {.m = m, .ring = ring, .s = &s, .n = 5};
+    cond c = {.m = m, .ring = ring, .s = s, .n = 5};
     assert_true(run(m, exceptions_reached, &c));
     lr_event ev = last(ring);
     assert_string_equal(ev.source, "panel");
@@ -567,23 +327,21 @@ static void tcp_exceptions_are_counted_not_fatal(void **state)
     assert_int_equal(lr_modbus_flush(m, 1000, &e), LR_EPROTO);
     assert_non_null(strstr(e.msg, "rejected the level (raw 255)"));
     lr_modbus_destroy(m);
-    server_free(&s);
+    lr_test_mb_server_free(s);
     lr_event_ring_destroy(ring);
 }
 
 static void tcp_timeouts_drop_and_restore_the_link(void **state)
 {
     (void)state;
-    server s;
-    server_init(&s, false);
-    set_reg(&s, s.panel, 0, 100);
-    s.silent = 1;
-    server_start(&s);
+    lr_test_mb_server *s = lr_test_mb_server_start();
+    lr_test_mb_server_set_reg(s, 1, 0, 100);
+    lr_test_mb_server_set_silent(s, true);
     lr_event_ring *ring;
     assert_int_equal(lr_event_ring_create(0, &ring, NULL), LR_OK);
     lr_test_log log = {0};
     char url[64];
-    snprintf(url, sizeof url, "tcp://127.0.0.1:%d", s.port);
+    snprintf(url, sizeof url, "tcp://127.0.0.1:%d", lr_test_mb_server_port(s));
     lr_modbus_desc desc = {
         .dev = {.sink = lr_event_ring_sink(ring), .log = {lr_test_log_fn, &log},
                 .retry_min_ms = 10, .retry_max_ms = 50},
@@ -592,7 +350,7 @@ static void tcp_timeouts_drop_and_restore_the_link(void **state)
     };
     lr_modbus *m = NULL;
     assert_int_equal(lr_modbus_create(&desc, &m, NULL), LR_OK);
-    cond c = {.m = m, .ring = ring, .s = &s, .n = 1};
+    cond c = {.m = m, .ring = ring, .s = s, .n = 1};
     /* The server accepts the connection but never answers. */
     assert_true(run(m, link_down, &c));
     lr_dev *d = lr_modbus_dev(m);
@@ -604,13 +362,13 @@ static void tcp_timeouts_drop_and_restore_the_link(void **state)
     assert_int_equal(lr_test_log_count(&log, "no answer within 30 ms"), 1);
     assert_int_equal(lr_event_ring_count(ring), 0);
     /* It answers again: reconnected, and the value arrives. */
-    set_flag(&s, &s.silent, 0);
+    lr_test_mb_server_set_silent(s, false);
     assert_true(run(m, has_events, &c));
     assert_float_equal(pop(ring).value, 0.1, 1e-12);
     lr_modbus_get_counters(m, &k);
     assert_true(k.connects >= 2);
     lr_modbus_destroy(m);
-    server_free(&s);
+    lr_test_mb_server_free(s);
     lr_event_ring_destroy(ring);
 }
 
@@ -659,15 +417,14 @@ static void config_errors(void **state)
 static void rtu_over_pty(void **state)
 {
     (void)state;
-    server s;
-    server_init(&s, true);
-    set_reg(&s, s.panel, 0, 300);
-    server_start(&s);
+    lr_test_mb_server *s = lr_test_mb_server_start_rtu(NULL);
+    lr_test_mb_server_set_reg(s, 1, 0, 300);
     lr_event_ring *ring;
     assert_int_equal(lr_event_ring_create(0, &ring, NULL), LR_OK);
     lr_test_log log = {0};
     char url[128];
-    snprintf(url, sizeof url, "rtu:%s?baud=19200&parity=E&data=8&stop=1", s.pty_path);
+    snprintf(url, sizeof url, "rtu:%s?baud=19200&parity=E&data=8&stop=1",
+             lr_test_mb_server_device(s));
     /* Panel registers numbered from 1 in its manual: register 1 is address 0. */
     lr_modbus_input in[2] = {{.control = "dimmer", .unit = 1, .reg = 1, .base = 1},
                              {.control = "fader", .unit = 1, .reg = 51, .base = 1}};
@@ -681,7 +438,7 @@ static void rtu_over_pty(void **state)
     lr_err e = {0};
     assert_int_equal(lr_modbus_create(&desc, &m, &e), LR_OK);
     assert_int_equal(lr_dev_get_state(lr_modbus_dev(m)), LR_DEV_OPEN);
-    cond c = {.m = m, .ring = ring, .s = &s, .n = 1};
+    cond c = {.m = m, .ring = ring, .s = s, .n = 1};
     assert_true(run(m, has_events, &c));
     lr_event ev = pop(ring);
     assert_string_equal(ev.control, "dimmer");
@@ -693,10 +450,10 @@ static void rtu_over_pty(void **state)
     assert_true(run(m, driver_has, &c));
 
     /* Damaged CRCs are counted and the link carries on. */
-    set_flag(&s, &s.corrupt, 2);
+    lr_test_mb_server_corrupt(s, 2);
     c.n = 2;
     assert_true(run(m, crc_errors_reached, &c));
-    set_reg(&s, s.panel, 0, 700);
+    lr_test_mb_server_set_reg(s, 1, 0, 700);
     c.n = 1;
     assert_true(run(m, has_events, &c));
     assert_float_equal(last(ring).value, 0.7, 1e-12);
@@ -711,7 +468,7 @@ static void rtu_over_pty(void **state)
     lr_modbus_destroy(m);
 
     /* RS-485 mode needs the TIOCSRS485 ioctl, which a pty refuses: a clear error. */
-    snprintf(url, sizeof url, "rtu:%s?rs485=1", s.pty_path);
+    snprintf(url, sizeof url, "rtu:%s?rs485=1", lr_test_mb_server_device(s));
     desc.dev.required = true;
     assert_int_equal(lr_modbus_create(&desc, &m, &e), LR_EUNSUPPORTED);
     assert_non_null(strstr(e.msg, "rs485=1 but the port refuses RS-485 mode (TIOCSRS485)"));
@@ -721,7 +478,7 @@ static void rtu_over_pty(void **state)
     assert_int_equal(lr_modbus_create(&desc, &m, &e), LR_ENODEV);
     assert_non_null(strstr(e.msg, "modbus: rtu:/dev/ttyLAMPRIG-none?baud=19200&parity=E&data=8&"
                                   "stop=1: cannot connect: No such file or directory"));
-    server_free(&s);
+    lr_test_mb_server_free(s);
     lr_event_ring_destroy(ring);
 }
 
