@@ -20,6 +20,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "firmware/cli.h"
 #include "firmware/rig/rig.h"
 #include "hal/dev.h"
 #include "render/base/json.h"
@@ -215,38 +216,6 @@ static void test_missing_devices_keep_running(void **state)
     lr_test_rmtree(dir);
 }
 
-/* The shipped sim demo in-process with the real renderer, under ASan/UBSan: no error, no leak
- * (LSan at exit), frames and latencies recorded. LAMPRIG_SOAK_S sets the length (default 4 s;
- * the issue's soak is LAMPRIG_SOAK_S=120). */
-static void test_soak_shipped_sim(void **state)
-{
-    (void)state;
-    lr_gl *gl;
-    assert_int_equal(lr_test_gl_create(&gl), LR_OK); /* pins the driver for LSan */
-    lr_gl_destroy(gl);
-    const char *env = getenv("LAMPRIG_SOAK_S");
-    double secs = env ? atof(env) : 4.0;
-    if (!(secs > 0))
-        secs = 4.0;
-    char *dir = lr_test_tmpdir();
-    char *stats = lr_test_path(dir, "stats.json");
-    lr_rig_opts o = {.config = LR_SOURCE_CONFIGS "/rig/sim.json", .stats_path = stats,
-                     .duration_s = secs, .no_signals = true, .log = {lr_log_silent, NULL}};
-    lr_rig *r;
-    lr_err e = {0};
-    if (lr_rig_create(&o, &r, &e))
-        fail_msg("%s", e.msg);
-    assert_int_equal(lr_rig_run(r, &e), LR_OK);
-    lr_rig_info info;
-    lr_rig_get_info(r, &info);
-    assert_string_equal(info.view, "passes");
-    assert_true(info.frames >= 2);
-    lr_rig_destroy(r);
-    check_stats(stats, 2, 1);
-    free(stats);
-    lr_test_rmtree(dir);
-}
-
 /* ---- child processes ---- */
 
 static pid_t spawn(char *const argv[], const char *err_path)
@@ -302,6 +271,158 @@ static bool wait_file_has(const char *path, const char *needle, int guard_ms)
         usleep(10000);
     }
     return false;
+}
+
+/* ---- the soak: `lamprig run` in a re-executed copy of this ASan/UBSan test binary ---- */
+
+#define CHILD_FLAG "--as-lamprig"      /* argv[1] of the child: the rest goes to lr_cli_main */
+#define LEAK_FLAG "--as-leaker"        /* argv[1] of the control child that leaks on purpose */
+#define LEAK_EXIT 86                   /* exitcode given to LSan/ASan in the child */
+
+/* The child's sanitizer settings: a leak or an ASan error makes the exit status LEAK_EXIT,
+ * a UBSan error aborts; the driver's own leaks are suppressed as in tests/run.sh. */
+static void child_env(void)
+{
+    setenv("ASAN_OPTIONS", "detect_leaks=1:abort_on_error=0:exitcode=86", 1);
+    setenv("LSAN_OPTIONS", "suppressions=" LR_SOURCE_CONFIGS "/../tests/lsan.supp:"
+                           "print_suppressions=0:exitcode=86", 1);
+    setenv("UBSAN_OPTIONS", "print_stacktrace=1:halt_on_error=1", 1);
+}
+
+/* fork + exec of /proc/self/exe (a fresh process: no threads or GL state inherited from the
+ * tests that ran before), output to out_path. */
+static pid_t spawn_self(char *const args[], const char *out_path)
+{
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        int fd = open(out_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (fd >= 0) {
+            dup2(fd, 2);
+            dup2(fd, 1);
+        }
+        child_env();
+        execv("/proc/self/exe", args);
+        _exit(127);
+    }
+    return pid;
+}
+
+/* What the child runs instead of the tests; its return from main() is where LSan checks. */
+static int child_main(int argc, char **argv)
+{
+    if (strcmp(argv[1], LEAK_FLAG) == 0) {
+        void *volatile lost = malloc(4096); /* never freed: LSan must fail the exit */
+        memset(lost, 1, 4096);
+        lost = NULL;
+        return 0;
+    }
+    /* Pin the GL driver (its own leaks are suppressed by library name), then run as
+     * build/bin/lamprig would: argv[1] stands in for argv[0]. */
+    lr_gl *gl;
+    if (lr_test_gl_create(&gl) != LR_OK)
+        return 1;
+    lr_gl_destroy(gl);
+    return lr_cli_main(argc - 1, argv + 1);
+}
+
+static int count_in_file(const char *path, const char *needle)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return 0;
+    char line[4096];
+    int n = 0;
+    while (fgets(line, sizeof line, f))
+        n += strstr(line, needle) != NULL;
+    fclose(f);
+    return n;
+}
+
+static void print_file(const char *path)
+{
+    size_t len = 0;
+    unsigned char *text = lr_test_read(path, &len);
+    if (text)
+        fprintf(stderr, "---- %s ----\n%.*s\n----\n", path, (int)(len > 20000 ? 20000 : len),
+                (const char *)text);
+    free(text);
+}
+
+/* Sanitizers are live in the child: a deliberate leak gives LEAK_EXIT and a LeakSanitizer
+ * report, so a clean exit status from the soak does mean "no leak". */
+static void test_child_leak_is_caught(void **state)
+{
+    (void)state;
+    char *dir = lr_test_tmpdir();
+    char *out = lr_test_path(dir, "out.txt");
+    char *args[] = {"lamprig-test", LEAK_FLAG, NULL};
+    int st = reap(spawn_self(args, out));
+    assert_true(WIFEXITED(st));
+    assert_int_equal(WEXITSTATUS(st), LEAK_EXIT);
+    assert_true(count_in_file(out, "ERROR: LeakSanitizer") == 1);
+    free(out);
+    lr_test_rmtree(dir);
+}
+
+/* The issue's soak: the shipped sim demo (configs/rig/sim.json, its script looping, the real
+ * `passes` renderer at the rig's budget, 320x240) run as `lamprig run --headless --stats F`
+ * in an ASan/UBSan/LSan child for LAMPRIG_SOAK_S seconds (default 120), then SIGTERM. Exit
+ * status 0 (LSan at exit would make it LEAK_EXIT), no sanitizer report, the stats file valid:
+ * frames plausible for the time (at least 1 per second of the 30 fps cap, at most the cap),
+ * events with per-event latencies (the 10 s script has 24 events that change something). */
+static void test_soak_shipped_sim(void **state)
+{
+    (void)state;
+    const char *env = getenv("LAMPRIG_SOAK_S");
+    double secs = env ? atof(env) : 120.0;
+    if (!(secs > 0))
+        secs = 120.0;
+    char *dir = lr_test_tmpdir();
+    char *stats = lr_test_path(dir, "stats.json");
+    char *out = lr_test_path(dir, "out.txt");
+    char *args[] = {"lamprig-test", CHILD_FLAG, "run", "--config",
+                    LR_SOURCE_CONFIGS "/rig/sim.json", "--headless", "--stats", stats, NULL};
+    int64_t t0 = lr_now_ns();
+    pid_t pid = spawn_self(args, out);
+    int64_t end = t0 + (int64_t)(secs * 1e9);
+    while (lr_now_ns() < end) {
+        if (waitpid(pid, NULL, WNOHANG) != 0) {
+            print_file(out);
+            fail_msg("lamprig exited before SIGTERM");
+        }
+        usleep(100000);
+    }
+    assert_int_equal(kill(pid, SIGTERM), 0);
+    int st = reap(pid);
+    double ran = (double)(lr_now_ns() - t0) * 1e-9;
+    bool clean = WIFEXITED(st) && WEXITSTATUS(st) == 0;
+    if (!clean || count_in_file(out, "Sanitizer") || count_in_file(out, "runtime error"))
+        print_file(out);
+    assert_true(WIFEXITED(st));
+    assert_int_equal(WEXITSTATUS(st), 0);
+    assert_int_equal(count_in_file(out, "Sanitizer"), 0);
+    assert_int_equal(count_in_file(out, "runtime error"), 0);
+    assert_int_equal(count_in_file(out, "SIGTERM: shutting down"), 1);
+
+    int events = check_stats(stats, 1, (int)(secs / 10 * 24 * 0.5));
+    lr_json *j;
+    lr_err e = {0};
+    assert_int_equal(lr_json_load(stats, &j, &e), LR_OK);
+    lr_jnode root = lr_json_root(j);
+    long frames = 0;
+    double dur = 0;
+    assert_int_equal(lr_json_get_int(j, root, "frames", true, &frames, &e), LR_OK);
+    assert_int_equal(lr_json_get_number(j, root, "duration_s", true, &dur, &e), LR_OK);
+    lr_json_destroy(j);
+    /* The rig's clock starts after process and GL start-up (about 2 s under ASan). */
+    assert_true(dur >= 0.75 * secs && dur <= ran);
+    assert_true(frames >= (long)dur && frames <= (long)(30 * dur) + 2);
+    print_message("soak: %.1f s in the rig, %ld frames, %d events with latencies\n", dur, frames,
+                  events);
+    free(stats);
+    free(out);
+    lr_test_rmtree(dir);
 }
 
 /* The shipped sim demo, headless, frames and stats, --duration: exit 0. */
@@ -481,17 +602,20 @@ static void test_cli_errors(void **state)
     lr_test_rmtree(dir);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+    if (argc >= 2 && (!strcmp(argv[1], CHILD_FLAG) || !strcmp(argv[1], LEAK_FLAG)))
+        return child_main(argc, argv);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sim_in_process),
         cmocka_unit_test(test_scene_switch_keeps_controls),
         cmocka_unit_test(test_missing_devices_keep_running),
-        cmocka_unit_test(test_soak_shipped_sim),
         cmocka_unit_test(test_shipped_sim_demo),
         cmocka_unit_test(test_sigterm_clean_exit),
         cmocka_unit_test(test_sighup_reload),
         cmocka_unit_test(test_cli_errors),
+        cmocka_unit_test(test_child_leak_is_caught),
+        cmocka_unit_test(test_soak_shipped_sim),
     };
     if (getenv("LR_TEST_FILTER")) /* e.g. LR_TEST_FILTER='test_soak*' to run one test */
         cmocka_set_test_filter(getenv("LR_TEST_FILTER"));

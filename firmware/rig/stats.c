@@ -85,6 +85,10 @@ void lr_rig_stats_frame(lr_rig_stats *s, const lr_frame_stats *f, int64_t done_n
     r->f = *f;
     r->t_ns = done_ns;
     s->n_frames++;
+    /* A frame that ran no pass re-presents the previous image: it shows no event yet (the
+     * first frame of a fade, still at the old level, is one). */
+    if (!f->passes)
+        return;
     for (int i = 0; i < s->n_pending; i++) {
         ev_rec *er = &s->events[s->n_events % LOG_MAX];
         er->ev = s->pending[i];

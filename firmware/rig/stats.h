@@ -31,7 +31,8 @@ void lr_rig_stats_destroy(lr_rig_stats *s);
 void lr_rig_stats_event(lr_rig_stats *s, const lr_event *ev);
 /* An event no binding took. */
 void lr_rig_stats_unmatched(lr_rig_stats *s);
-/* A frame finished (presented or written) at done_ns: every pending event gets its latency. */
+/* A frame finished (presented or written) at done_ns: if it ran at least one pass, every
+ * pending event gets its latency; a frame with no pass (the previous image again) shows none. */
 void lr_rig_stats_frame(lr_rig_stats *s, const lr_frame_stats *f, int64_t done_ns);
 
 int lr_rig_stats_pending(const lr_rig_stats *s);

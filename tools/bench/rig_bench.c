@@ -1,0 +1,339 @@
+/* Section "rig": the firmware, `lamprig run`, measured from outside as a child process (the
+ * release build/bin/lamprig next to this binary).
+ * (1) Control-to-frame latency of a dimmer turn, headless: the shipped sim rig's render budget
+ *     and control map (configs/rig/sim.json: K = 4, N = 4, 64² maps, 8 frames, 320×240, 30 fps
+ *     cap, the candle's dimmer with its square curve and 0.25 s fade), driven by a sim script of
+ *     60 dimmer turns over 30 s; median and p99 of the per-event latencies in its --stats file.
+ * (2) Idle CPU when nothing changes: utime + stime from /proc/PID/stat over 10 s, once the
+ *     scene has converged (one scripted dimmer move, then no events); also the Modbus demo rig
+ *     against lamprig-modbus-sim, whose panel is polled every 50 ms. */
+#include "tools/bench/bench.h"
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "render/base/json.h"
+#include "render/base/paths.h"
+
+#define TURNS 60
+#define TURN_SPACING_S 0.5
+#define IDLE_WINDOW_S 10.0
+
+static char bindir[PATH_MAX];
+static char configs[PATH_MAX]; /* absolute: the rig configs are written to a scratch dir */
+
+static void sleep_s(double s)
+{
+    struct timespec ts = {(time_t)s, (long)((s - (double)(time_t)s) * 1e9)};
+    while (nanosleep(&ts, &ts) != 0)
+        ;
+}
+
+static void print_log(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return;
+    char line[1024];
+    while (fgets(line, sizeof line, f))
+        fprintf(stderr, "  | %s", line);
+    fclose(f);
+}
+
+static pid_t spawn(char *const argv[], const char *log_path)
+{
+    pid_t pid = fork();
+    if (pid == 0) {
+        int fd = open(log_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (fd >= 0) {
+            dup2(fd, 1);
+            dup2(fd, 2);
+        }
+        execv(argv[0], argv);
+        _exit(127);
+    }
+    return pid;
+}
+
+/* utime + stime of pid in clock ticks, or -1. */
+static long cpu_ticks(pid_t pid)
+{
+    char path[64], buf[1024];
+    snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return -1;
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = '\0';
+    char *p = strrchr(buf, ')'); /* the command name may contain spaces */
+    if (!p)
+        return -1;
+    unsigned long ut = 0, st = 0;
+    /* after ')': state(3) ... utime is field 14, stime 15 */
+    if (sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %lu %lu", &ut, &st) != 2)
+        return -1;
+    return (long)(ut + st);
+}
+
+static int write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return -1;
+    fputs(text, f);
+    return fclose(f);
+}
+
+/* A rig config with the shipped sim rig's budget, output and control map, driven by script. */
+static int write_rig(const char *path, const char *script)
+{
+    char text[4096];
+    snprintf(text, sizeof text,
+             "{\"scene\": \"%s/scenes/candle.json\",\n"
+             " \"scene_set\": {\"render.K\": 4, \"render.N\": 4, \"render.map_size\": 64,\n"
+             "   \"render.gbuffer_size\": 64, \"render.vpl_map_size\": 32, \"render.N_vpl\": 16,\n"
+             "   \"render.frames\": 8},\n"
+             " \"devices\": [{\"type\": \"sim\", \"name\": \"sim\", \"script\": \"%s\"}],\n"
+             " \"controls\": \"%s/controls/candle.json\",\n"
+             " \"output\": {\"mode\": \"headless\", \"width\": 320, \"height\": 240, \"fps\": 30},\n"
+             " \"safe_level\": 0, \"stats\": {\"period_s\": 60}}\n",
+             configs, script, configs);
+    return write_file(path, text);
+}
+
+static int reap(pid_t pid, double guard_s)
+{
+    int st = 0;
+    for (int i = 0; i < (int)(guard_s * 20); i++) {
+        if (waitpid(pid, &st, WNOHANG) == pid)
+            return st;
+        sleep_s(0.05);
+    }
+    kill(pid, SIGKILL);
+    waitpid(pid, &st, 0);
+    return -1;
+}
+
+typedef struct latency {
+    long n, pending, frames;
+    double median, p99, max, duration;
+} latency;
+
+static int read_stats(const char *path, latency *l)
+{
+    lr_json *j;
+    lr_err e = {0};
+    if (lr_json_load(path, &j, &e)) {
+        fprintf(stderr, "bench rig: %s\n", e.msg);
+        return 1;
+    }
+    lr_jnode root = lr_json_root(j), lat = lr_json_get(j, root, "latency_ms");
+    int rc = lr_json_get_int(j, root, "frames", true, &l->frames, &e) ||
+             lr_json_get_int(j, root, "events_pending", true, &l->pending, &e) ||
+             lr_json_get_number(j, root, "duration_s", true, &l->duration, &e) ||
+             lr_json_get_int(j, lat, "n", true, &l->n, &e) ||
+             lr_json_get_number(j, lat, "median", true, &l->median, &e) ||
+             lr_json_get_number(j, lat, "p99", true, &l->p99, &e) ||
+             lr_json_get_number(j, lat, "max", true, &l->max, &e);
+    if (rc)
+        fprintf(stderr, "bench rig: %s\n", e.msg);
+    lr_json_destroy(j);
+    return rc;
+}
+
+static int dimmer_latency(const char *dir, latency *l)
+{
+    char script[PATH_MAX], cfg[PATH_MAX], stats[PATH_MAX], log[PATH_MAX];
+    snprintf(script, sizeof script, "%s/turns.sim", dir);
+    snprintf(cfg, sizeof cfg, "%s/turns.json", dir);
+    snprintf(stats, sizeof stats, "%s/turns-stats.json", dir);
+    snprintf(log, sizeof log, "%s/turns.log", dir);
+    /* Turns every 0.5 s, starting after 1 s (the first full frame is done), between 20 % and
+     * 100 %, each to a new position. */
+    char text[8192];
+    size_t len = 0;
+    for (int i = 0; i < TURNS; i++)
+        len += (size_t)snprintf(text + len, sizeof text - len, "%.2f dimmer absolute %.3f\n",
+                                1.0 + TURN_SPACING_S * i, 0.2 + 0.8 * ((i * 5) % 9) / 8.0);
+    snprintf(text + len, sizeof text - len, "%.2f end\n", 1.0 + TURN_SPACING_S * TURNS);
+    if (write_file(script, text) || write_rig(cfg, script))
+        return 1;
+    char duration[32];
+    snprintf(duration, sizeof duration, "%.1f", 1.0 + TURN_SPACING_S * TURNS + 1.0);
+    char lamprig[PATH_MAX + 16];
+    snprintf(lamprig, sizeof lamprig, "%s/lamprig", bindir);
+    char *argv[] = {lamprig, "run", "--config", cfg, "--headless", "--duration", duration,
+                    "--stats", stats, NULL};
+    int st = reap(spawn(argv, log), 120);
+    if (st < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+        fprintf(stderr, "bench rig: lamprig run failed (status %#x):\n", st);
+        print_log(log);
+        return 1;
+    }
+    return read_stats(stats, l);
+}
+
+/* Starts argv, waits until its CPU use stays at most 1 tick a second (the scene converged,
+ * the fades done), then returns the CPU % over IDLE_WINDOW_S; -1 on failure. */
+static double idle_cpu(char *const argv[], const char *log)
+{
+    pid_t pid = spawn(argv, log);
+    if (pid < 0)
+        return -1;
+    long prev = -1;
+    double quiet_at = -1;
+    for (int i = 0; i < 60; i++) { /* 30 s at most */
+        sleep_s(0.5);
+        long t = cpu_ticks(pid);
+        if (t < 0)
+            break;
+        if (prev >= 0 && t - prev == 0 && i >= 6) {
+            quiet_at = lrb_now();
+            break;
+        }
+        prev = t;
+    }
+    double pct = -1;
+    if (quiet_at > 0) {
+        long t0 = cpu_ticks(pid);
+        double w0 = lrb_now();
+        sleep_s(IDLE_WINDOW_S);
+        long t1 = cpu_ticks(pid);
+        double w1 = lrb_now();
+        if (t0 >= 0 && t1 >= t0)
+            pct = 100.0 * (double)(t1 - t0) / (double)sysconf(_SC_CLK_TCK) / (w1 - w0);
+    }
+    kill(pid, SIGTERM);
+    int st = reap(pid, 10);
+    if (st < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+        fprintf(stderr, "bench rig: lamprig run did not exit cleanly on SIGTERM (status %#x):\n",
+                st);
+        print_log(log);
+        return -1;
+    }
+    return pct;
+}
+
+static int free_port(void)
+{
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in a = {.sin_family = AF_INET};
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t al = sizeof a;
+    int port = -1;
+    if (fd >= 0 && bind(fd, (struct sockaddr *)&a, sizeof a) == 0 &&
+        getsockname(fd, (struct sockaddr *)&a, &al) == 0)
+        port = ntohs(a.sin_port);
+    if (fd >= 0)
+        close(fd);
+    return port;
+}
+
+static int run(FILE *out)
+{
+    ssize_t n = readlink("/proc/self/exe", bindir, sizeof bindir - 1);
+    if (n <= 0)
+        return 1;
+    bindir[n] = '\0';
+    char *sl = strrchr(bindir, '/');
+    if (sl)
+        *sl = '\0';
+    if (!realpath(lr_configs_dir(), configs)) {
+        fprintf(stderr, "bench rig: no configs directory '%s'\n", lr_configs_dir());
+        return 1;
+    }
+    char dir[] = "/tmp/lamprig-bench-rig-XXXXXX";
+    if (!mkdtemp(dir))
+        return 1;
+    fprintf(out, "## Rig firmware: `lamprig run`, headless\n\n");
+    fflush(out);
+    latency l = {0};
+    int rc = dimmer_latency(dir, &l);
+
+    char lamprig[PATH_MAX + 16], cfg[PATH_MAX], script[PATH_MAX], log[PATH_MAX];
+    snprintf(lamprig, sizeof lamprig, "%s/lamprig", bindir);
+    snprintf(script, sizeof script, "%s/once.sim", dir);
+    snprintf(cfg, sizeof cfg, "%s/once.json", dir);
+    snprintf(log, sizeof log, "%s/idle.log", dir);
+    double idle_sim = -1, idle_mb = -1;
+    if (!write_file(script, "0.0 dimmer absolute 0.6\n0.1 end\n") && !write_rig(cfg, script)) {
+        char *argv[] = {lamprig, "run", "--config", cfg, "--headless", NULL};
+        idle_sim = idle_cpu(argv, log);
+    }
+    /* The Modbus demo rig against the simulator: a converged scene, the panel still polled. */
+    int port = free_port();
+    char sim_bin[PATH_MAX + 32], port_s[16], url[64], mb_cfg[PATH_MAX], sim_log[PATH_MAX];
+    snprintf(sim_bin, sizeof sim_bin, "%s/lamprig-modbus-sim", bindir);
+    snprintf(port_s, sizeof port_s, "%d", port);
+    snprintf(url, sizeof url, "tcp://127.0.0.1:%d", port);
+    snprintf(mb_cfg, sizeof mb_cfg, "%s/rig/modbus-demo.json", configs);
+    snprintf(sim_log, sizeof sim_log, "%s/modbus-sim.log", dir);
+    if (port > 0 && access(sim_bin, X_OK) == 0) {
+        char *sargv[] = {sim_bin, "--port", port_s, "--panel", "600", NULL};
+        pid_t sim = spawn(sargv, sim_log);
+        sleep_s(0.5);
+        char *argv[] = {lamprig, "run", "--config", mb_cfg, "--modbus", url, "--headless", NULL};
+        idle_mb = idle_cpu(argv, log);
+        kill(sim, SIGTERM);
+        reap(sim, 5);
+    }
+
+    if (rc == 0) {
+        fprintf(out, "Control-to-frame latency of a dimmer turn: %d absolute dimmer moves, one "
+                     "every %.1f s, through the candle's control map (square curve, 0.25 s fade) "
+                     "with the shipped sim rig's render budget (K = 4, N = 4, 64² maps, "
+                     "8 frames, 320×240, 30 fps cap); per-event latency from the stats "
+                     "(event timestamp to the end of the first frame after it).\n\n",
+                TURNS, TURN_SPACING_S);
+        fprintf(out, "| events | median | p99 | max | frames in %.0f s | pending at exit |\n"
+                     "|---|---|---|---|---|---|\n",
+                l.duration);
+        fprintf(out, "| %ld | %.1f ms | %.1f ms | %.1f ms | %ld | %ld |\n\n", l.n, l.median,
+                l.p99, l.max, l.frames, l.pending);
+    } else {
+        fprintf(out, "Dimmer latency: the run failed.\n\n");
+    }
+    fprintf(out, "Idle CPU of `lamprig run` once converged, with nothing changing "
+                 "(utime + stime from /proc/PID/stat over %.0f s):\n\n"
+                 "| rig | idle CPU |\n|---|---|\n",
+            IDLE_WINDOW_S);
+    if (idle_sim >= 0)
+        fprintf(out, "| sim rig (script ended) | %.2f %% of one core |\n", idle_sim);
+    else
+        fprintf(out, "| sim rig (script ended) | failed |\n");
+    if (idle_mb >= 0)
+        fprintf(out, "| modbus-demo against lamprig-modbus-sim (panel polled every 50 ms) | "
+                     "%.2f %% of one core |\n", idle_mb);
+    else
+        fprintf(out, "| modbus-demo against lamprig-modbus-sim | not measured |\n");
+    char cpu[256];
+    lrb_cpu_name(cpu, sizeof cpu);
+    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    double load[3] = {0};
+    if (getloadavg(load, 3) < 1)
+        load[0] = -1;
+    fprintf(out, "\nHost: %s, %ld CPUs, load average %.2f at the end; GL: whatever EGL gives "
+                 "headless (Mesa llvmpipe without a GPU).\n\n",
+            cpu, ncpu, load[0]);
+    char cmd[PATH_MAX + 16];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    if (system(cmd) != 0)
+        fprintf(stderr, "bench rig: could not remove %s\n", dir);
+    return rc || idle_sim < 0;
+}
+
+const lrb_section lrb_rig_section = {
+    .name = "rig",
+    .summary = "lamprig run: dimmer control-to-frame latency (median, p99) and idle CPU",
+    .run = run,
+};
