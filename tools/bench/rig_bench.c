@@ -293,7 +293,9 @@ static int run(FILE *out)
                      "every %.1f s, through the candle's control map (square curve, 0.25 s fade) "
                      "with the shipped sim rig's render budget (K = 4, N = 4, 64² maps, "
                      "8 frames, 320×240, 30 fps cap); per-event latency from the stats "
-                     "(event timestamp to the end of the first frame after it).\n\n",
+                     "(event timestamp to the end of the first frame after it that runs a "
+                     "pass: the fade's first frame, still at the old level, does not "
+                     "count).\n\n",
                 TURNS, TURN_SPACING_S);
         fprintf(out, "| events | median | p99 | max | frames in %.0f s | pending at exit |\n"
                      "|---|---|---|---|---|---|\n",
