@@ -2,7 +2,8 @@
  * build/bin/lamprig with --duration); SIGTERM mid-run → exit 0, the lamp driver at its safe
  * level (a libmodbus server on loopback), stats flushed; SIGHUP with a broken config keeps the
  * old one and names file/line/field, with a good one applies it. Latency stats: one entry per
- * event that changed something, each non-negative. */
+ * event that changed something, each non-negative. The soak: two minutes of the shipped sim
+ * demo as `lamprig run` in a sanitized child, ended by SIGTERM (LAMPRIG_SOAK_S shortens it). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
