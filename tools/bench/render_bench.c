@@ -12,11 +12,16 @@
  *     sqrt(sum (g - r)^2 / sum r^2) over the bands of the masked pixels, in linear light,
  *     against (a) the converged CPU reference of the model (lr_cpu_render, LR_CPU_REFERENCE,
  *     the scene's N_vpl VPLs so that the VPL discretisation is the GPU's) and (b) the
- *     renderer's own SELF_FRAMES-frame image (pure sampling noise of the progressive maps).
+ *     renderer's own SELF_FRAMES-frame image (pure sampling noise of the progressive maps;
+ *     scaled by 1/sqrt(1 - F/SELF_FRAMES), since that image contains the first F frames).
+ *     The CPU reference's own relative standard error (from its variance image) is printed
+ *     against the GPU's 64-frame noise.
  *     Masks: object pixels are those whose camera ray hits an object's BVH; receiver pixels
  *     the rest where the CPU reference is non-zero (the background is 0).
  *
- * Files: build/bench/render.csv and build/bench/render-error.csv (atomic writes). */
+ * Files: build/bench/render.csv and build/bench/render-error.csv (atomic writes; a file is
+ * only replaced when its part ran). LRB_RENDER_PARTS=timing or =error runs one part. About
+ * 6 minutes on 2 shared cores with llvmpipe (timing 3.3, error 2.5). */
 #include "tools/bench/bench.h"
 
 #include <errno.h>
