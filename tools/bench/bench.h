@@ -16,6 +16,7 @@ typedef struct lrb_section {
 /* Sections (one file each). */
 extern const lrb_section lrb_optics_section;
 extern const lrb_section lrb_cpu_section;
+extern const lrb_section lrb_render_section;
 extern const lrb_section lrb_rig_section;
 
 /* Shared timing helpers (timing.c). */

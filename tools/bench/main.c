@@ -7,6 +7,7 @@
 static const lrb_section *const sections[] = {
     &lrb_optics_section,
     &lrb_cpu_section,
+    &lrb_render_section,
     &lrb_rig_section,
 };
 #define NSECTIONS (sizeof sections / sizeof sections[0])

@@ -97,7 +97,7 @@ static int write_file(const char *path, const char *text)
 /* A rig config with the shipped sim rig's budget, output and control map, driven by script. */
 static int write_rig(const char *path, const char *script)
 {
-    char text[4096];
+    char text[2 * PATH_MAX + 1024];
     snprintf(text, sizeof text,
              "{\"scene\": \"%s/scenes/candle.json\",\n"
              " \"scene_set\": {\"render.K\": 4, \"render.N\": 4, \"render.map_size\": 64,\n"
@@ -272,7 +272,7 @@ static int run(FILE *out)
     }
     /* The Modbus demo rig against the simulator: a converged scene, the panel still polled. */
     int port = free_port();
-    char sim_bin[PATH_MAX + 32], port_s[16], url[64], mb_cfg[PATH_MAX], sim_log[PATH_MAX];
+    char sim_bin[PATH_MAX + 32], port_s[16], url[64], mb_cfg[PATH_MAX + 32], sim_log[PATH_MAX + 32];
     snprintf(sim_bin, sizeof sim_bin, "%s/lamprig-modbus-sim", bindir);
     snprintf(port_s, sizeof port_s, "%d", port);
     snprintf(url, sizeof url, "tcp://127.0.0.1:%d", port);
