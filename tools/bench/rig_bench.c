@@ -97,7 +97,7 @@ static int write_file(const char *path, const char *text)
 /* A rig config with the shipped sim rig's budget, output and control map, driven by script. */
 static int write_rig(const char *path, const char *script)
 {
-    char text[2 * PATH_MAX + 1024];
+    char text[3 * PATH_MAX + 1024];
     snprintf(text, sizeof text,
              "{\"scene\": \"%s/scenes/candle.json\",\n"
              " \"scene_set\": {\"render.K\": 4, \"render.N\": 4, \"render.map_size\": 64,\n"
