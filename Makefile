@@ -98,7 +98,8 @@ build/bin/lamprig: build/obj/rel/firmware/main.o build/lib/liblamprig.a
 	$(Q)$(CXX) -o $@ $^ $(LDLIBS)
 
 .SECONDEXPANSION:
-build/bin/lamprig-%: $$(patsubst %.c,build/obj/rel/%.o,$$(wildcard tools/$$*/*.c)) build/lib/liblamprig.a
+# No '%' inside the prerequisite functions: make would substitute the stem into them.
+build/bin/lamprig-%: $$(addprefix build/obj/rel/,$$(addsuffix .o,$$(basename $$(wildcard tools/$$*/*.c)))) build/lib/liblamprig.a
 	@mkdir -p $(@D)
 	@echo "  LD      $@"
 	$(Q)$(CXX) -o $@ $^ $(LDLIBS)

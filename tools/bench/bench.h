@@ -1,0 +1,44 @@
+/* lamprig-bench — speed (and, as sections are added, error against a reference) of each part of
+ * the renderer, one section per module. Each section prints a markdown block that can be pasted
+ * into the README as it is. */
+#ifndef LRB_BENCH_H
+#define LRB_BENCH_H
+
+#include <stdio.h>
+
+typedef struct lrb_section {
+    const char *name;    /* selects the section on the command line */
+    const char *summary; /* one line for --list */
+    /* Prints the section's markdown to out; returns 0 or a nonzero exit status. */
+    int (*run)(FILE *out);
+} lrb_section;
+
+/* Sections (one file each). */
+extern const lrb_section lrb_optics_section;
+
+/* Shared timing helpers (timing.c). */
+
+/* Monotonic wall clock in seconds. */
+double lrb_now(void);
+/* CPU time of the calling thread in seconds: what the rates are measured in, so that time the
+ * scheduler gives to other processes on a shared machine does not count (on an idle core it
+ * equals wall time). */
+double lrb_thread_cpu_now(void);
+/* Pins the calling thread to the CPU it is running on, so that "one core" means one core and
+ * the scheduler does not migrate it mid-run. Returns the CPU number, or -1 if pinning failed
+ * (the figures are then still single-threaded, only noisier). */
+int lrb_pin_to_current_cpu(void);
+/* One line naming the host CPU (from /proc/cpuinfo), for the record under each table. */
+void lrb_cpu_name(char *buf, size_t len);
+
+/* Rate measurement: calls body(ctx, n) (which must perform n evaluations and return a value
+ * depending on all of them), choosing n so that one run lasts about min_run_s of thread CPU
+ * time, then times `runs` runs after one warm-up. Fills evaluations/s of each run into
+ * rates[] (runs <= 32) and returns the median. */
+typedef double (*lrb_body)(void *ctx, long n);
+double lrb_measure_rate(lrb_body body, void *ctx, double min_run_s, int runs, double *rates);
+
+/* Result sink: the bodies' return values go here so the compiler cannot drop the work. */
+extern volatile double lrb_sink;
+
+#endif
