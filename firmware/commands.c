@@ -3,6 +3,9 @@
 
 #include <stddef.h>
 
+#include "firmware/cmd_optics.h"
+
 const lr_command lr_commands[] = {
+    {"optics", lr_optics_summary, lr_optics_usage, lr_cmd_optics},
     {NULL, NULL, NULL, NULL},
 };

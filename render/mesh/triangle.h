@@ -1,0 +1,23 @@
+/* lamprig — single-triangle geometry in double precision for the CPU reference code. */
+#ifndef LR_TRIANGLE_H
+#define LR_TRIANGLE_H
+
+#include <stdbool.h>
+
+#include "render/base/vec3.h"
+
+/* Ray o + t d against triangle (a, b, c), Moller & Trumbore 1997, both sides. True when it
+ * hits with tmin <= t <= tmax; then *t and the barycentrics (u, v) of the hit point
+ * a + u (b - a) + v (c - a) are set. d need not be unit length (t is in its units). */
+bool lr_ray_triangle(lr_vec3 o, lr_vec3 d, lr_vec3 a, lr_vec3 b, lr_vec3 c, double tmin,
+                     double tmax, double *t, double *u, double *v);
+
+/* Closest point to p on triangle (a, b, c) (Ericson, Real-Time Collision Detection 5.1.5),
+ * with its barycentric weights w (w[0] a + w[1] b + w[2] c; a weight is exactly 0 when the
+ * point lies on the opposite edge or beyond). Degenerate triangles are handled. */
+lr_vec3 lr_closest_on_triangle(lr_vec3 p, lr_vec3 a, lr_vec3 b, lr_vec3 c, double w[3]);
+
+/* Closest point to p on segment [a, b], with weights w (w[0] a + w[1] b). */
+lr_vec3 lr_closest_on_segment(lr_vec3 p, lr_vec3 a, lr_vec3 b, double w[2]);
+
+#endif
