@@ -56,7 +56,7 @@ void lr_ref_chain_topology(const lr_ref_scene *s, lr_vec3 p, int mp, lr_vec3 x, 
     lr_vec3 o = p;
     int m = mp;
     double remaining = len;
-    lr_vec3 last_p = p, last_n = u;
+    lr_vec3 first_p = p, first_n = u, last_p = p, last_n = u;
     out->k = 0;
     for (int b = 0; b < 3; b++)
         out->tau[b] = 0.0;
@@ -90,6 +90,10 @@ void lr_ref_chain_topology(const lr_ref_scene *s, lr_vec3 p, int mp, lr_vec3 x, 
                 out->k = -1;
                 return;
             }
+            if (out->k == 1) {
+                first_p = h.p;
+                first_n = h.n;
+            }
             last_p = h.p;
             last_n = h.n;
         }
@@ -98,9 +102,11 @@ void lr_ref_chain_topology(const lr_ref_scene *s, lr_vec3 p, int mp, lr_vec3 x, 
         out->k = -1;
         return;
     }
-    double depth = out->k ? fabs(lr_v3_dot(lr_v3_sub(x, last_p), last_n)) : 0.0;
+    double dx = out->k ? fabs(lr_v3_dot(lr_v3_sub(x, last_p), last_n)) : 0.0;
+    double dp = out->k ? fabs(lr_v3_dot(lr_v3_sub(p, first_p), first_n)) : 0.0;
     for (int b = 0; b < 3; b++)
-        out->tau_last[b] = out->k ? s->media[mx].sigma_t[b] * depth : out->tau[b];
+        out->tau_bound[b] = out->k ? s->media[mx].sigma_t[b] * dx + s->media[mp].sigma_t[b] * dp
+                                   : out->tau[b];
 }
 
 /* The chain of exactly k refractions from p (medium mp) along w. */
@@ -223,9 +229,8 @@ bool lr_ref_connect(const lr_ref_scene *s, const lr_ref_emitter *em, lr_vec3 x, 
         E[b] = 0.0;
     if (st)
         st->nee++;
-    const lr_ref_light *l = em->light;
     lr_ref_topology topo;
-    lr_ref_chain_topology(s, em->p, l->medium, x, mx, &topo);
+    lr_ref_chain_topology(s, em->p, em->medium, x, mx, &topo);
     if (topo.k < 0)
         return false;
     lr_vec3 w;        /* emission direction */
@@ -247,7 +252,7 @@ bool lr_ref_connect(const lr_ref_scene *s, const lr_ref_emitter *em, lr_vec3 x, 
             double bound = 0.0;
             for (int b = 0; b < 3; b++)
                 if (mask & (1 << b))
-                    bound = fmax(bound, exp(-topo.tau_last[b]));
+                    bound = fmax(bound, exp(-topo.tau_bound[b]));
             if (bound < LR_REF_NEE_RR) {
                 double q = bound / LR_REF_NEE_RR;
                 if (!(lr_ref_rng_uniform(rr) < q))
@@ -257,7 +262,7 @@ bool lr_ref_connect(const lr_ref_scene *s, const lr_ref_emitter *em, lr_vec3 x, 
         }
         chain c;
         double det;
-        if (!solve_chain(s, em->p, l->medium, x, topo.k, &c, &w, &det)) {
+        if (!solve_chain(s, em->p, em->medium, x, topo.k, &c, &w, &det)) {
             if (st)
                 st->nee_unsolved++;
             return false;

@@ -16,6 +16,11 @@ static double spot_profile(const lr_ref_light *l, double c)
 double lr_ref_emitter_intensity(const lr_ref_emitter *em, lr_vec3 w, int b)
 {
     const lr_ref_light *l = em->light;
+    if (!l) {
+        if (em->lambert)
+            return em->power[b] * fmax(0.0, lr_v3_dot(em->n, w)) / LR_REF_PI;
+        return em->power[b] * lr_ref_hg_eval(em->g, lr_v3_dot(em->d_in, w));
+    }
     switch (l->d.kind) {
     case LR_REF_LIGHT_POINT:
         return l->d.emission[b];
@@ -51,8 +56,7 @@ void lr_ref_light_sample(const lr_ref_scene *s, lr_ref_rng *rng, lr_ref_emitter 
     }
     const lr_ref_light *l = &s->lights[i];
     *pick = s->light_pick[i];
-    em->light = l;
-    em->area_weight = 1.0;
+    *em = (lr_ref_emitter){.light = l, .medium = l->medium, .area_weight = 1.0};
     em->p = l->d.position;
     if (l->object >= 0) {
         double a = lr_ref_rng_uniform(rng), b = lr_ref_rng_uniform(rng);
@@ -66,37 +70,46 @@ double lr_ref_light_power(const lr_ref_scene *s, int light, int band)
     return s->lights[light].power[band];
 }
 
-int lr_ref_light_emit(const lr_ref_scene *s, int light, int band, lr_ref_rng *rng,
-                      lr_vec3 *origin, lr_vec3 *dir, double *power)
+void lr_ref_light_emit_all(const lr_ref_light *l, lr_ref_rng *rng, lr_vec3 *origin,
+                           lr_vec3 *dir, double power[3])
 {
-    const lr_ref_light *l = &s->lights[light];
     double u1 = lr_ref_rng_uniform(rng), u2 = lr_ref_rng_uniform(rng);
     double phi = 2.0 * LR_REF_PI * u2;
     lr_vec3 axis = lr_v3(0.0, 0.0, 1.0);
-    double c;
+    double c, k; /* power[b] = k * emission[b] */
     *origin = l->d.position;
     switch (l->d.kind) {
     case LR_REF_LIGHT_POINT: /* uniform on the sphere: power 4 pi I per photon */
         c = 1.0 - 2.0 * u1;
-        *power = l->power[band];
+        k = 4.0 * LR_REF_PI;
         break;
     case LR_REF_LIGHT_SPOT: /* uniform in the outer cone, weighted by the profile */
         axis = l->normal;
         c = 1.0 - u1 * (1.0 - l->cos_outer);
-        *power = l->d.emission[band] * spot_profile(l, c) * 2.0 * LR_REF_PI * (1.0 - l->cos_outer);
+        k = spot_profile(l, c) * 2.0 * LR_REF_PI * (1.0 - l->cos_outer);
         break;
     default: /* uniform point, cosine-weighted direction: each photon carries pi L_e A */
         axis = l->normal;
         *origin = area_point(l, lr_ref_rng_uniform(rng), lr_ref_rng_uniform(rng));
         c = sqrt(u1);
-        *power = l->power[band];
+        k = LR_REF_PI * l->area;
         break;
     }
+    for (int b = 0; b < 3; b++)
+        power[b] = k * l->d.emission[b];
     lr_vec3 t1, t2;
     lr_ref_frame(axis, &t1, &t2);
     double sn = sqrt(fmax(0.0, 1.0 - c * c));
     *dir = lr_v3_normalize(lr_v3_add(lr_v3_scale(axis, c),
                                      lr_v3_add(lr_v3_scale(t1, sn * cos(phi)),
                                                lr_v3_scale(t2, sn * sin(phi)))));
-    return l->medium;
+}
+
+int lr_ref_light_emit(const lr_ref_scene *s, int light, int band, lr_ref_rng *rng,
+                      lr_vec3 *origin, lr_vec3 *dir, double *power)
+{
+    double p[3];
+    lr_ref_light_emit_all(&s->lights[light], rng, origin, dir, p);
+    *power = p[band];
+    return s->lights[light].medium;
 }

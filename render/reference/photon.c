@@ -1,59 +1,95 @@
 /* Photons: the same transport steps run forward from a source, carrying flux. */
 #include "render/reference/ref_priv.h"
 
-void lr_ref_photon_trace(const lr_ref_scene *s, lr_vec3 origin, lr_vec3 dir, int medium,
-                         int band, lr_ref_rng *rng, lr_ref_stats *stats,
-                         lr_ref_photon_exit *out)
+static double max3(const double v[3])
 {
-    lr_ref_stats local = {0};
-    lr_ref_stats *st = stats ? stats : &local;
-    *out = (lr_ref_photon_exit){.position = origin, .direction = dir, .weight = 1.0};
-    lr_ref_walker w = {.x = origin, .d = dir, .medium = medium, .on_surface = true};
-    st->paths++;
+    return fmax(v[0], fmax(v[1], v[2]));
+}
+
+void lr_ref_photon_walk(const lr_ref_scene *s, lr_ref_walker w, int mask, int hero,
+                        lr_ref_rng *rng, lr_ref_stats *st, lr_ref_photon_visit visit,
+                        void *user, lr_ref_photon_exit *out, double beta[3])
+{
+    lr_ref_photon_exit local;
+    if (!out)
+        out = &local;
+    *out = (lr_ref_photon_exit){.position = w.x, .direction = w.d};
+    lr_ref_photon_vertex v = {.beta = beta};
     for (int ev = 0;; ev++) {
         if (ev == LR_REF_MAX_EVENTS) {
             st->truncated++;
-            out->weight = 0.0;
-            return;
+            break;
         }
         lr_ref_surf h;
-        enum lr_ref_event e = lr_ref_flight(s, &w, band, rng, &h);
+        enum lr_ref_event e = lr_ref_flight(s, &w, hero, rng, &h, NULL);
         if (e == LR_REF_EV_ESCAPE) {
             out->escaped = true;
             out->direction = w.d;
             return;
         }
         st->events++;
+        const double *albedo;
         if (e == LR_REF_EV_SURFACE) {
             const lr_ref_object *ob = &s->objects[h.object];
             out->position = h.p;
-            if (ob->kind == LR_REF_SURF_LIGHT) { /* lights absorb */
-                out->weight = 0.0;
-                return;
-            }
+            if (ob->kind == LR_REF_SURF_LIGHT) /* lights absorb */
+                break;
             if (ob->kind == LR_REF_SURF_BOUNDARY) {
                 double n2; /* flux crosses unscaled */
-                lr_ref_cross(s, &w, &h, rng, &n2, st);
+                enum lr_ref_crossing c = lr_ref_cross(s, &w, &h, rng, &n2, st);
+                if (v.index == 0) {
+                    v.reflected = v.reflected || c == LR_REF_REFLECT;
+                    v.refractions += c == LR_REF_REFRACT;
+                }
                 continue;
             }
-            lr_vec3 nf = lr_v3_dot(w.d, h.n) < 0.0 ? h.n : lr_v3_scale(h.n, -1.0);
-            out->weight *= ob->albedo[band];
-            out->receiver_hits++;
-            w.d = lr_ref_cosine_sample(nf, lr_ref_rng_uniform(rng), lr_ref_rng_uniform(rng));
+            v.receiver = ob;
+            v.n = lr_v3_dot(w.d, h.n) < 0.0 ? h.n : lr_v3_scale(h.n, -1.0);
+            albedo = ob->albedo;
         } else {
-            const lr_ref_medium *m = &s->media[w.medium];
-            out->weight *= m->albedo[band];
-            out->scatterings++;
-            w.d = lr_ref_hg_sample(m->g, w.d, lr_ref_rng_uniform(rng), lr_ref_rng_uniform(rng));
+            v.receiver = NULL;
+            albedo = s->media[w.medium].albedo;
         }
-        /* Russian roulette (unbiased): below the threshold survive with probability w / t at
-         * weight t (MCML's scheme, Wang, Jacques, Zheng 1995, Sec. 3.8). */
-        if (out->weight < LR_REF_RR_THRESHOLD) {
-            if (!(lr_ref_rng_uniform(rng) * LR_REF_RR_THRESHOLD < out->weight)) {
-                out->weight = 0.0;
-                return;
-            }
-            out->weight = LR_REF_RR_THRESHOLD;
+        v.x = w.x;
+        v.medium = w.medium;
+        v.d_in = w.d;
+        if (visit && !visit(user, &v))
+            return;
+        v.index++;
+        for (int b = 0; b < 3; b++)
+            beta[b] *= albedo[b];
+        if (v.receiver) {
+            out->receiver_hits++;
+            w.d = lr_ref_cosine_sample(v.n, lr_ref_rng_uniform(rng), lr_ref_rng_uniform(rng));
+        } else {
+            out->scatterings++;
+            w.d = lr_ref_hg_sample(s->media[w.medium].g, w.d, lr_ref_rng_uniform(rng),
+                                   lr_ref_rng_uniform(rng));
+        }
+        /* Russian roulette (unbiased): below the threshold survive with probability m / t at
+         * throughput scaled by t / m (MCML's scheme, Wang, Jacques, Zheng 1995, Sec. 3.8). */
+        double m = max3(beta);
+        if (m < LR_REF_RR_THRESHOLD) {
+            if (!(lr_ref_rng_uniform(rng) * LR_REF_RR_THRESHOLD < m))
+                break;
+            for (int b = 0; b < 3; b++)
+                beta[b] *= LR_REF_RR_THRESHOLD / m;
         }
     }
+    for (int b = 0; b < 3; b++)
+        beta[b] = 0.0; /* absorbed, roulette or capped: nothing leaves */
+}
+
+void lr_ref_photon_trace(const lr_ref_scene *s, lr_vec3 origin, lr_vec3 dir, int medium,
+                         int band, lr_ref_rng *rng, lr_ref_stats *stats,
+                         lr_ref_photon_exit *out)
+{
+    lr_ref_stats local = {0};
+    double beta[3] = {0.0, 0.0, 0.0};
+    beta[band] = 1.0;
+    lr_ref_walker w = {.x = origin, .d = dir, .medium = medium, .on_surface = true};
+    lr_ref_stats *st = stats ? stats : &local;
+    st->paths++;
+    lr_ref_photon_walk(s, w, 1 << band, band, rng, st, NULL, NULL, out, beta);
+    out->weight = beta[band];
 }

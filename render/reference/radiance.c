@@ -15,7 +15,15 @@
  * single-scattering albedo at each collision (the walk is analogue in the hero band; the
  * other bands of its group have the same coefficients). At a boundary it chooses reflection
  * with the Fresnel probability and multiplies by (n_from / n_to)^2 on refraction (radiance,
- * not flux). */
+ * not flux).
+ *
+ * A point or spot light inside a scattering medium (a light embedded in the material): NEE
+ * from free-flight collisions alone has infinite variance there (the 1/d^2 of the connection
+ * is not square-integrable over the volume around the light). Each flight segment in such a
+ * medium therefore also takes one equiangular sample toward the light (Kulla & Fajardo 2012,
+ * "Importance sampling techniques for path tracing in participating media", Sec. 4), and the
+ * two distance strategies are combined with the balance heuristic (Veach & Guibas 1995), so
+ * both stay unbiased and the singularity is cancelled by the equiangular density. */
 #include "render/reference/ref_priv.h"
 
 /* State of the last non-specular vertex, for deciding (b). */
@@ -31,11 +39,60 @@ static double max3(const double v[3])
     return fmax(v[0], fmax(v[1], v[2]));
 }
 
+/* A free-flight segment in a medium: where the walk left from, and how far the next surface
+ * is. */
+typedef struct segment {
+    lr_vec3 x0, d;
+    double len;
+    int medium;
+    double sigma_t; /* hero band */
+} segment;
+
+/* Whether the equiangular strategy applies to light l on this segment. */
+static bool eq_applies(const lr_ref_scene *s, const segment *sg, const lr_ref_light *l, int hero)
+{
+    return (l->d.kind == LR_REF_LIGHT_POINT || l->d.kind == LR_REF_LIGHT_SPOT) &&
+           l->medium == sg->medium && s->media[sg->medium].sigma_s[hero] > 0.0 &&
+           isfinite(sg->len);
+}
+
+/* Equiangular sampling of t in [0, len] for a point p: with delta the ray parameter closest to
+ * p and D the distance there, t = delta + D tan(theta), theta uniform in [ta, tb], has density
+ * D / ((tb - ta) (D^2 + (t - delta)^2)) (Kulla & Fajardo 2012, Eq. 6-7). */
+typedef struct equiangular {
+    double delta, D, ta, tb;
+} equiangular;
+
+static bool eq_setup(const segment *sg, lr_vec3 p, equiangular *q)
+{
+    lr_vec3 v = lr_v3_sub(p, sg->x0);
+    q->delta = lr_v3_dot(v, sg->d);
+    q->D = lr_v3_len(lr_v3_sub(v, lr_v3_scale(sg->d, q->delta)));
+    if (!(q->D > 1e-12 * (1.0 + lr_v3_len(v))))
+        return false; /* the ray runs through the light: a set of measure zero */
+    q->ta = atan2(-q->delta, q->D);
+    q->tb = atan2(sg->len - q->delta, q->D);
+    return q->tb > q->ta;
+}
+
+static double eq_pdf(const equiangular *q, double t)
+{
+    double y = t - q->delta;
+    return q->D / ((q->tb - q->ta) * (q->D * q->D + y * y));
+}
+
+/* Density of a free-flight collision at t (hero band). */
+static double ff_pdf(const segment *sg, double t)
+{
+    return sg->sigma_t * exp(-sg->sigma_t * t);
+}
+
 /* Next-event estimation at x; f converts the arriving flux density into outgoing radiance
- * (phase function value, or albedo / pi times the cosine). */
-static void nee(const lr_ref_scene *s, lr_vec3 x, int medium, int mask, const double beta[3],
-                lr_vec3 d, const lr_vec3 *receiver_n, const double *albedo, lr_ref_rng *rng,
-                lr_ref_stats *st, double L[3])
+ * (phase function value, or albedo / pi times the cosine). sg: the segment whose free-flight
+ * collision x is (medium vertices), for the MIS weight against equiangular sampling. */
+static void nee(const lr_ref_scene *s, lr_vec3 x, int medium, int mask, int hero,
+                const double beta[3], lr_vec3 d, const lr_vec3 *receiver_n, const double *albedo,
+                const segment *sg, lr_ref_rng *rng, lr_ref_stats *st, double L[3])
 {
     if (s->n_lights == 0)
         return;
@@ -58,9 +115,52 @@ static void nee(const lr_ref_scene *s, lr_vec3 x, int medium, int mask, const do
         /* Light travels along -w_in and leaves toward the camera along -d. */
         f = lr_ref_hg_eval(s->media[medium].g, lr_v3_dot(w_in, d));
     }
+    equiangular q;
+    if (sg && eq_applies(s, sg, em.light, hero) && eq_setup(sg, em.p, &q)) {
+        double t = lr_v3_dot(lr_v3_sub(x, sg->x0), sg->d), pf = ff_pdf(sg, t);
+        f *= pf / (pf + eq_pdf(&q, t)); /* balance heuristic */
+    }
     for (int b = 0; b < 3; b++)
         if (mask & (1 << b))
             L[b] += beta[b] * f * (albedo ? albedo[b] : 1.0) * E[b] / pick;
+}
+
+/* The equiangular half of the MIS pair: one distance on the segment sampled toward a light
+ * embedded in its medium. beta is the throughput at the segment's start. */
+static void nee_equiangular(const lr_ref_scene *s, const segment *sg, int mask, int hero,
+                            const double beta[3], lr_ref_rng *rng, lr_ref_stats *st,
+                            double L[3])
+{
+    lr_ref_emitter em;
+    double pick;
+    lr_ref_light_sample(s, rng, &em, &pick);
+    double u = lr_ref_rng_uniform(rng);
+    equiangular q;
+    if (!(pick > 0.0) || !eq_applies(s, sg, em.light, hero) || !eq_setup(sg, em.p, &q))
+        return;
+    double t = q.delta + q.D * tan(q.ta + u * (q.tb - q.ta));
+    if (!(t > 0.0 && t < sg->len))
+        return;
+    lr_vec3 x = lr_v3_add(sg->x0, lr_v3_scale(sg->d, t));
+    double E[3];
+    lr_vec3 w_in;
+    if (!lr_ref_connect(s, &em, x, sg->medium, mask, NULL, st, E, &w_in))
+        return;
+    const lr_ref_medium *m = &s->media[sg->medium];
+    double f = lr_ref_hg_eval(m->g, lr_v3_dot(w_in, sg->d)) / (pick * (eq_pdf(&q, t) + ff_pdf(sg, t)));
+    for (int b = 0; b < 3; b++)
+        if (mask & (1 << b))
+            L[b] += beta[b] * exp(-m->sigma_t[b] * t) * m->sigma_s[b] * f * E[b];
+}
+
+/* Whether some point or spot light sits in medium m (which then needs equiangular samples). */
+static bool has_embedded_light(const lr_ref_scene *s, int m)
+{
+    for (int i = 0; i < s->n_lights; i++)
+        if (s->lights[i].medium == m && (s->lights[i].d.kind == LR_REF_LIGHT_POINT ||
+                                         s->lights[i].d.kind == LR_REF_LIGHT_SPOT))
+            return true;
+    return false;
 }
 
 /* True when NEE from v could have produced the path that just hit area-light point p. */
@@ -103,7 +203,12 @@ static void trace_group(const lr_ref_scene *s, lr_vec3 origin, lr_vec3 dir, int 
             return;
         }
         lr_ref_surf h;
-        enum lr_ref_event e = lr_ref_flight(s, &w, hero, rng, &h);
+        segment sg = {.x0 = w.x, .d = w.d, .medium = w.medium,
+                      .sigma_t = s->media[w.medium].sigma_t[hero]};
+        bool eq = s->media[w.medium].sigma_s[hero] > 0.0 && has_embedded_light(s, w.medium);
+        enum lr_ref_event e = lr_ref_flight(s, &w, hero, rng, &h, eq ? &sg.len : NULL);
+        if (eq)
+            nee_equiangular(s, &sg, mask, hero, beta, rng, st, L);
         if (e == LR_REF_EV_ESCAPE)
             return;
         st->events++;
@@ -111,7 +216,7 @@ static void trace_group(const lr_ref_scene *s, lr_vec3 origin, lr_vec3 dir, int 
             const lr_ref_medium *m = &s->media[w.medium];
             for (int b = 0; b < 3; b++)
                 beta[b] *= m->albedo[b];
-            nee(s, w.x, w.medium, mask, beta, w.d, NULL, NULL, rng, st, L);
+            nee(s, w.x, w.medium, mask, hero, beta, w.d, NULL, NULL, eq ? &sg : NULL, rng, st, L);
             w.d = lr_ref_hg_sample(m->g, w.d, lr_ref_rng_uniform(rng), lr_ref_rng_uniform(rng));
             v = (last_vertex){.valid = true, .x = w.x, .medium = w.medium, .chain = 0};
             if (!roulette(beta, rng))
@@ -128,7 +233,7 @@ static void trace_group(const lr_ref_scene *s, lr_vec3 origin, lr_vec3 dir, int 
         }
         if (ob->kind == LR_REF_SURF_RECEIVER) {
             lr_vec3 nf = lr_v3_dot(w.d, h.n) < 0.0 ? h.n : lr_v3_scale(h.n, -1.0);
-            nee(s, w.x, w.medium, mask, beta, w.d, &nf, ob->albedo, rng, st, L);
+            nee(s, w.x, w.medium, mask, hero, beta, w.d, &nf, ob->albedo, NULL, rng, st, L);
             for (int b = 0; b < 3; b++)
                 beta[b] *= ob->albedo[b];
             w.d = lr_ref_cosine_sample(nf, lr_ref_rng_uniform(rng), lr_ref_rng_uniform(rng));

@@ -57,6 +57,7 @@ struct lr_ref_scene {
     lr_ref_light *lights;
     int n_lights, cap_lights;
     double *light_pick; /* selection probability of each light for NEE (by total power) */
+    double *delta_pick; /* ... for light tracing: point and spot lights only (0 for others) */
     /* Colour bands whose coefficients agree in every medium share one path: n_groups groups,
      * each a bit mask of bands and the band whose coefficients drive distance sampling. */
     int n_groups;
@@ -102,9 +103,10 @@ enum lr_ref_event { LR_REF_EV_ESCAPE, LR_REF_EV_SCATTER, LR_REF_EV_SURFACE };
 
 /* Samples the distance to the next collision in the walker's medium with the coefficients of
  * band `hero` (exponential free path) and moves the walker to whichever comes first: the
- * collision, or the next surface (filled into *hit). ESCAPE when neither exists. */
+ * collision, or the next surface (filled into *hit). ESCAPE when neither exists. segment
+ * (may be NULL) receives the distance to the next surface along the ray (INFINITY if none). */
 enum lr_ref_event lr_ref_flight(const lr_ref_scene *s, lr_ref_walker *w, int hero,
-                                lr_ref_rng *rng, lr_ref_surf *hit);
+                                lr_ref_rng *rng, lr_ref_surf *hit, double *segment);
 
 enum lr_ref_crossing { LR_REF_PASS, LR_REF_REFLECT, LR_REF_REFRACT };
 
@@ -115,6 +117,29 @@ enum lr_ref_crossing { LR_REF_PASS, LR_REF_REFLECT, LR_REF_REFRACT };
 enum lr_ref_crossing lr_ref_cross(const lr_ref_scene *s, lr_ref_walker *w,
                                   const lr_ref_surf *hit, lr_ref_rng *rng, double *n_ratio2,
                                   lr_ref_stats *st);
+
+/* A non-specular event of a forward (photon) walk: a medium collision or a receiver bounce. */
+typedef struct lr_ref_photon_vertex {
+    lr_vec3 x;
+    int medium;
+    lr_vec3 d_in;                  /* direction of travel arriving at x */
+    const double *beta;            /* throughput per band before this event's albedo */
+    const lr_ref_object *receiver; /* NULL for a medium collision */
+    lr_vec3 n;                     /* receiver: its normal on the arriving side */
+    int index;                     /* 0 for the first non-specular event of the walk */
+    bool reflected;                /* a Fresnel reflection came before the first event */
+    int refractions;               /* refractions before the first event */
+} lr_ref_photon_vertex;
+
+/* Called at each non-specular event before it is applied; returning false ends the walk. */
+typedef bool (*lr_ref_photon_visit)(void *user, const lr_ref_photon_vertex *v);
+
+/* The forward walk behind lr_ref_photon_trace and light tracing: from w, carrying throughput
+ * beta (bands in mask; distances sampled with band hero), until it escapes, is absorbed
+ * (roulette), is capped or visit stops it. out may be NULL; beta holds the final throughput. */
+void lr_ref_photon_walk(const lr_ref_scene *s, lr_ref_walker w, int mask, int hero,
+                        lr_ref_rng *rng, lr_ref_stats *st, lr_ref_photon_visit visit,
+                        void *user, lr_ref_photon_exit *out, double beta[3]);
 
 /* Henyey-Greenstein (phase.c). */
 double lr_ref_hg_eval(double g, double cos_theta);
@@ -136,24 +161,37 @@ bool lr_ref_refract(lr_vec3 d, lr_vec3 n, double eta_rel, lr_vec3 *out);
 
 /* ---- lights (light.c) ------------------------------------------------------------------- */
 
-/* A point that emits: a point or spot light, or one sampled point of an area light. */
+/* A point that emits: a point or spot light, one sampled point of an area light, or (light
+ * tracing) a photon's scattering vertex re-emitting its flux toward the camera. */
 typedef struct lr_ref_emitter {
-    const lr_ref_light *light;
+    const lr_ref_light *light; /* NULL: a photon vertex */
     lr_vec3 p;
-    double area_weight; /* area lights: 1 / pdf of the sampled point (the area); else 1 */
+    int medium;                /* the medium p emits into */
+    double area_weight;        /* area lights: 1 / pdf of the sampled point (the area); else 1 */
+    /* photon vertex: flux leaving it per band (after albedo), and its angular distribution,
+     * HG about d_in for a medium collision or Lambertian about n for a receiver */
+    double power[3];
+    lr_vec3 d_in, n;
+    double g;
+    bool lambert;
 } lr_ref_emitter;
 
 /* Radiant intensity (W/sr) the emitter sends along unit w, in band b: point I; spot I times
- * the cone profile; area point L_e * cos * area_weight on the front side, 0 behind. */
+ * the cone profile; area point L_e * cos * area_weight on the front side, 0 behind; photon
+ * vertex power * HG(d_in . w), or power * max(0, n . w) / pi. */
 double lr_ref_emitter_intensity(const lr_ref_emitter *em, lr_vec3 w, int b);
 /* Picks a light by power (pick probability in *pick) and a point on it. */
 void lr_ref_light_sample(const lr_ref_scene *s, lr_ref_rng *rng, lr_ref_emitter *em,
                          double *pick);
 
+/* Samples an emitted photon: origin, direction and the power it carries per band. */
+void lr_ref_light_emit_all(const lr_ref_light *l, lr_ref_rng *rng, lr_vec3 *origin,
+                           lr_vec3 *dir, double power[3]);
+
 /* ---- next-event connections (connect.c) ------------------------------------------------- */
 
 /* Flux density E (W/mm^2 per band, measured across the beam) arriving at x in medium mx from
- * the emitter, along unit *w_in (pointing from x back toward where the light comes from).
+ * the emitter (in em->medium), along unit *w_in (pointing from x back toward where the light comes from).
  * The connection passes straight through index-matched boundaries and is solved through up
  * to LR_REF_MAX_CHAIN refractive ones (Newton on the emission direction; see connect.c).
  * Returns false when there is no connection (blocked, too many interfaces, not solved): E is
@@ -167,15 +205,57 @@ typedef struct lr_ref_topology {
     int k;             /* refractive interfaces crossed; -1: blocked by an opaque surface,
                         * inconsistent media, or more than LR_REF_MAX_CHAIN */
     double tau[3];     /* optical depth along the straight segment, per band */
-    /* Optical depth of x below the tangent plane of the last refractive interface (per band,
-     * with x's medium): no refracted path through a plane can be shorter, so exp(-tau_last)
-     * bounds its transmittance. Equal to tau when k == 0. */
-    double tau_last[3];
+    /* Optical depth of x below the tangent plane of the last refractive interface, plus that
+     * of p below the plane of the first (per band, with the media of x and p): no refracted
+     * path through planes can be shorter, so exp(-tau_bound) bounds its transmittance. Equal
+     * to tau when k == 0. */
+    double tau_bound[3];
 } lr_ref_topology;
 
 /* The straight-segment analysis lr_ref_connect starts from; also used to tell path hits on
  * area lights apart from what next-event estimation covers. */
 void lr_ref_chain_topology(const lr_ref_scene *s, lr_vec3 p, int mp, lr_vec3 x, int mx,
                            lr_ref_topology *out);
+
+/* The pinhole camera of a render, as light tracing needs it: position, unit frame, image
+ * plane half-extents at distance 1, size and the medium the camera sits in. */
+typedef struct lr_ref_pinhole {
+    lr_vec3 c, f, r, u;
+    double tx, ty;
+    int width, height, medium;
+} lr_ref_pinhole;
+
+void lr_ref_pinhole_init(lr_ref_pinhole *p, const lr_ref_camera *cam, int width, int height,
+                         int medium);
+/* Pixel (row-major, rows top to bottom) that sees direction w (unit, from the camera toward
+ * what it sees), or -1 outside the image; *cos3 receives cos^3 of its angle to the axis. */
+long lr_ref_pinhole_pixel(const lr_ref_pinhole *p, lr_vec3 w, double *cos3);
+
+/* ---- light tracing (lighttrace.c) ------------------------------------------------------- */
+
+/* Whether camera-path NEE covers a light path whose light end is: the light at p (medium mp),
+ * then the specular events recorded in v, then v's vertex. It does when there was no
+ * reflection and the refractions are those of the straight segment (at most
+ * LR_REF_MAX_CHAIN): the connection lr_ref_connect solves. Light tracing takes the rest. */
+bool lr_ref_nee_covers_light_end(const lr_ref_scene *s, lr_vec3 p, int mp,
+                                 const lr_ref_photon_vertex *v);
+
+typedef struct lr_ref_splat {
+    long pixel;
+    double rgb[3];
+} lr_ref_splat;
+
+typedef struct lr_ref_splats {
+    lr_ref_splat *v;
+    size_t n, cap;
+    bool oom;
+} lr_ref_splats;
+
+/* Traces photons [first, first + count) of sample index j from the point and spot lights and
+ * appends their contributions to the pinhole's pixels (radiance, to be divided by the number
+ * of photons of the sample index). Only paths camera-path NEE cannot produce contribute. */
+void lr_ref_light_trace(const lr_ref_scene *s, const lr_ref_pinhole *cam, uint64_t seed,
+                        uint64_t j, uint64_t first, uint64_t count, lr_ref_splats *out,
+                        lr_ref_stats *st);
 
 #endif

@@ -189,7 +189,8 @@ int lr_ref_scene_medium_at(const lr_ref_scene *s, lr_vec3 p);
 
 /* Per-run counters; the failure counts say how far a result may be from exact. */
 typedef struct lr_ref_stats {
-    uint64_t paths;          /* camera paths or photons started */
+    uint64_t paths;          /* camera paths or validation photons started */
+    uint64_t photons;        /* light-tracing photons started (renders) */
     uint64_t events;         /* scattering, reflection, refraction and receiver events */
     uint64_t nee;            /* next-event connections attempted */
     uint64_t nee_refracted;  /* ... of which through at least one refractive interface */
@@ -269,18 +270,29 @@ typedef struct lr_ref_slab_result {
 int lr_ref_slab_rt(const lr_ref_slab_problem *p, lr_ref_slab_result *out, lr_err *e);
 
 /* A sphere of the given medium (radius in mm, vacuum outside) around an isotropic point light
- * at `offset` from its centre: the fraction of the light's power that escapes. */
+ * at `offset` from its centre: the fraction of the light's power that escapes. With cavity > 0
+ * the sphere is a shell around a concentric vacuum cavity of that radius (a bulb in a
+ * shade), and the light must sit in the cavity. */
 typedef struct lr_ref_sphere_problem {
     lr_ref_medium_desc medium;
     double radius;
+    double cavity;
     lr_vec3 offset;
     uint64_t photons;
     uint64_t seed;
     int threads;
 } lr_ref_sphere_problem;
 
-int lr_ref_sphere_escape(const lr_ref_sphere_problem *p, lr_ref_estimate *escaped,
-                         lr_ref_stats *stats, lr_err *e);
+typedef struct lr_ref_sphere_result {
+    lr_ref_estimate escaped;           /* fraction of the light's power leaving the sphere */
+    lr_ref_estimate escaped_scattered; /* ... of which scattered at least once */
+    /* ... of which reached the first scattering along a path camera-path NEE does not solve
+     * (a Fresnel reflection came first): the part renders get from light tracing */
+    lr_ref_estimate escaped_light_traced;
+    lr_ref_stats stats;
+} lr_ref_sphere_result;
+
+int lr_ref_sphere_escape(const lr_ref_sphere_problem *p, lr_ref_sphere_result *out, lr_err *e);
 
 /* ---- parallel batches ------------------------------------------------------------------- */
 

@@ -1,28 +1,41 @@
-/* The progressive renderer: camera rays through pixels, accumulated pass by pass.
+/* The progressive renderer: camera rays through pixels plus light tracing (lighttrace.c),
+ * accumulated pass by pass.
  *
- * Each pixel keeps the sum and the sum of squares of its per-sample radiance, so the mean and
- * the variance of the mean are available after any pass. Sample j of pixel i draws from the
- * random stream (seed, i << 32 | j): the image depends on the seed and the sample count only,
- * not on the thread count, tile order or pass size. */
+ * Camera paths: each pixel keeps the sum and the sum of squares of its per-sample radiance, so
+ * the mean and the variance of the mean are available after any pass. Sample j of pixel i
+ * draws from the random stream (seed, i << 32 | j).
+ * Light tracing: sample index j also traces as many photons as there are pixels (streams
+ * (seed', j << 32 | photon)); their splats, divided by that count, are one estimate of the
+ * light-traced image per sample index, and the variance of its mean comes from the spread of
+ * those estimates. Splats are collected per fixed batch and applied in batch order.
+ * So the image depends on the seed and the sample count only, not on the thread count, tile
+ * order or pass size. The mean is the sum of the two images; the variance the sum of their
+ * variances (independent streams). */
 #include "render/reference/ref_priv.h"
 
 #include <stdlib.h>
 #include <string.h>
 
 #define TILE 16
+#define LT_BATCH 4096 /* photons per light-tracing batch */
 
 struct lr_ref_render {
     const lr_ref_scene *s;
-    lr_ref_camera cam;
     lr_ref_render_desc d;
-    lr_vec3 fwd, right, up; /* camera frame, right and up scaled to the image plane at 1 */
-    int cam_medium;
     double *sum, *sum2; /* width * height * 3 */
     int spp_done;
     int pass_n; /* samples added by the pass in progress */
     int tiles_x, tiles_y;
     lr_ref_stats *tile_stats;
     lr_ref_stats stats;
+    /* light tracing */
+    lr_ref_pinhole pin;
+    bool trace_lights;   /* the scene has point or spot lights */
+    double *lt_sum, *lt_sum2, *lt_cur; /* per pixel and band */
+    int lt_batches;
+    lr_ref_splats *lt_splats;          /* per batch */
+    lr_ref_stats *lt_stats;            /* per batch */
+    uint64_t lt_j;                     /* sample index being light-traced */
 };
 
 lr_ref_render_desc lr_ref_render_desc_resolve(const lr_ref_render_desc *in)
@@ -69,27 +82,35 @@ int lr_ref_render_create(const lr_ref_scene *s, const lr_ref_camera *cam,
         return lr_err_set(e, LR_EINVAL, "reference: camera needs distinct position and "
                           "look_at, an up vector not along the view, and 0 < fov_y_deg < 180");
     lr_ref_render *r = calloc(1, sizeof *r);
-    size_t n = (size_t)d.width * (size_t)d.height * 3;
+    size_t npix = (size_t)d.width * (size_t)d.height, n = npix * 3;
+    bool lt = false;
+    for (int i = 0; i < s->n_lights; i++)
+        lt = lt || s->delta_pick[i] > 0.0;
     if (r) {
         r->sum = calloc(n, sizeof *r->sum);
         r->sum2 = calloc(n, sizeof *r->sum2);
         r->tiles_x = (d.width + TILE - 1) / TILE;
         r->tiles_y = (d.height + TILE - 1) / TILE;
         r->tile_stats = calloc((size_t)r->tiles_x * (size_t)r->tiles_y, sizeof *r->tile_stats);
+        r->trace_lights = lt;
+        r->lt_batches = (int)((npix + LT_BATCH - 1) / LT_BATCH);
+        if (lt) {
+            r->lt_sum = calloc(n, sizeof *r->lt_sum);
+            r->lt_sum2 = calloc(n, sizeof *r->lt_sum2);
+            r->lt_cur = calloc(n, sizeof *r->lt_cur);
+            r->lt_splats = calloc((size_t)r->lt_batches, sizeof *r->lt_splats);
+            r->lt_stats = calloc((size_t)r->lt_batches, sizeof *r->lt_stats);
+        }
     }
-    if (!r || !r->sum || !r->sum2 || !r->tile_stats) {
+    if (!r || !r->sum || !r->sum2 || !r->tile_stats ||
+        (lt && (!r->lt_sum || !r->lt_sum2 || !r->lt_cur || !r->lt_splats || !r->lt_stats))) {
         lr_ref_render_destroy(r);
         return lr_err_set(e, LR_ENOMEM, "reference: out of memory for a %dx%d render", d.width,
                           d.height);
     }
     r->s = s;
-    r->cam = c;
     r->d = d;
-    double th = tan(0.5 * c.fov_y_deg * LR_REF_PI / 180.0);
-    r->fwd = lr_v3_normalize(fwd);
-    r->right = lr_v3_scale(lr_v3_normalize(right), th * (double)d.width / (double)d.height);
-    r->up = lr_v3_scale(lr_v3_normalize(lr_v3_cross(r->right, r->fwd)), th);
-    r->cam_medium = lr_ref_scene_medium_at(s, c.position);
+    lr_ref_pinhole_init(&r->pin, &c, d.width, d.height, lr_ref_scene_medium_at(s, c.position));
     *out = r;
     return LR_OK;
 }
@@ -101,6 +122,14 @@ void lr_ref_render_destroy(lr_ref_render *r)
     free(r->sum);
     free(r->sum2);
     free(r->tile_stats);
+    free(r->lt_sum);
+    free(r->lt_sum2);
+    free(r->lt_cur);
+    if (r->lt_splats)
+        for (int b = 0; b < r->lt_batches; b++)
+            free(r->lt_splats[b].v);
+    free(r->lt_splats);
+    free(r->lt_stats);
     free(r);
 }
 
@@ -119,10 +148,11 @@ static void render_tile(int tile, void *user)
                 /* Box filter: a uniform point in the pixel; rows top to bottom. */
                 double sx = 2.0 * ((double)x + lr_ref_rng_uniform(&rng)) / W - 1.0;
                 double sy = 1.0 - 2.0 * ((double)y + lr_ref_rng_uniform(&rng)) / H;
+                const lr_ref_pinhole *p = &r->pin;
                 lr_vec3 dir = lr_v3_normalize(lr_v3_add(
-                    r->fwd, lr_v3_add(lr_v3_scale(r->right, sx), lr_v3_scale(r->up, sy))));
+                    p->f, lr_v3_add(lr_v3_scale(p->r, sx * p->tx), lr_v3_scale(p->u, sy * p->ty))));
                 double L[3] = {0.0, 0.0, 0.0};
-                lr_ref_radiance(r->s, r->cam.position, dir, r->cam_medium, &rng, st, L);
+                lr_ref_radiance(r->s, p->c, dir, p->medium, &rng, st, L);
                 if (!(isfinite(L[0]) && isfinite(L[1]) && isfinite(L[2]))) {
                     st->nonfinite++;
                     continue; /* counted; the sample adds zero */
@@ -136,6 +166,47 @@ static void render_tile(int tile, void *user)
     }
 }
 
+static void trace_batch(int batch, void *user)
+{
+    lr_ref_render *r = user;
+    uint64_t npix = (uint64_t)r->d.width * (uint64_t)r->d.height;
+    uint64_t first = (uint64_t)batch * LT_BATCH;
+    uint64_t count = first + LT_BATCH <= npix ? LT_BATCH : npix - first;
+    r->lt_splats[batch].n = 0;
+    lr_ref_light_trace(r->s, &r->pin, r->d.seed, r->lt_j, first, count, &r->lt_splats[batch],
+                       &r->lt_stats[batch]);
+}
+
+/* Light tracing of sample index j: one more estimate of the light-traced image. */
+static int light_trace_sample(lr_ref_render *r, uint64_t j, lr_err *e)
+{
+    size_t n = (size_t)r->d.width * (size_t)r->d.height * 3;
+    double inv = 1.0 / ((double)r->d.width * (double)r->d.height); /* photons per sample */
+    r->lt_j = j;
+    int rc = lr_ref_parallel(r->lt_batches, r->d.threads, trace_batch, r, e);
+    if (rc)
+        return rc;
+    memset(r->lt_cur, 0, n * sizeof *r->lt_cur);
+    for (int b = 0; b < r->lt_batches; b++) {
+        const lr_ref_splats *sp = &r->lt_splats[b];
+        if (sp->oom)
+            return lr_err_set(e, LR_ENOMEM, "reference: out of memory for light-tracing splats");
+        for (size_t k = 0; k < sp->n; k++)
+            for (int c = 0; c < 3; c++)
+                r->lt_cur[3 * (size_t)sp->v[k].pixel + (size_t)c] += sp->v[k].rgb[c] * inv;
+    }
+    for (size_t i = 0; i < n; i++) {
+        double x = r->lt_cur[i];
+        if (!isfinite(x)) {
+            r->lt_stats[0].nonfinite++;
+            continue;
+        }
+        r->lt_sum[i] += x;
+        r->lt_sum2[i] += x * x;
+    }
+    return LR_OK;
+}
+
 int lr_ref_render_pass(lr_ref_render *r, lr_err *e)
 {
     int left = r->d.spp - r->spp_done;
@@ -143,12 +214,16 @@ int lr_ref_render_pass(lr_ref_render *r, lr_err *e)
         return LR_OK;
     r->pass_n = left < r->d.spp_per_pass ? left : r->d.spp_per_pass;
     int rc = lr_ref_parallel(r->tiles_x * r->tiles_y, r->d.threads, render_tile, r, e);
+    for (int j = r->spp_done; !rc && r->trace_lights && j < r->spp_done + r->pass_n; j++)
+        rc = light_trace_sample(r, (uint64_t)j, e);
     if (rc)
         return rc;
     r->spp_done += r->pass_n;
     r->stats = (lr_ref_stats){0};
     for (int t = 0; t < r->tiles_x * r->tiles_y; t++)
         lr_ref_stats_add(&r->stats, &r->tile_stats[t]);
+    for (int b = 0; r->trace_lights && b < r->lt_batches; b++)
+        lr_ref_stats_add(&r->stats, &r->lt_stats[b]);
     return LR_OK;
 }
 
@@ -198,7 +273,7 @@ int lr_ref_render_mean(const lr_ref_render *r, lr_ref_image *out, lr_err *e)
     size_t n = (size_t)out->width * (size_t)out->height * 3;
     double k = r->spp_done > 0 ? 1.0 / r->spp_done : 0.0;
     for (size_t i = 0; i < n; i++)
-        out->rgb[i] = (float)(r->sum[i] * k);
+        out->rgb[i] = (float)((r->sum[i] + (r->trace_lights ? r->lt_sum[i] : 0.0)) * k);
     return LR_OK;
 }
 
@@ -211,11 +286,16 @@ int lr_ref_render_variance(const lr_ref_render *r, lr_ref_image *out, lr_err *e)
     double N = r->spp_done;
     for (size_t i = 0; i < n; i++) {
         /* Unbiased sample variance of the per-sample values, divided by N: the variance of
-         * the pixel's mean. Undefined (reported as 0) below two samples. */
+         * the pixel's mean; the same for the per-sample light-traced estimates, and the two
+         * add (independent). Undefined (reported as 0) below two samples. */
         double v = 0.0;
         if (N > 1.0) {
             double mean = r->sum[i] / N;
             v = fmax(0.0, (r->sum2[i] - N * mean * mean) / (N - 1.0)) / N;
+            if (r->trace_lights) {
+                mean = r->lt_sum[i] / N;
+                v += fmax(0.0, (r->lt_sum2[i] - N * mean * mean) / (N - 1.0)) / N;
+            }
         }
         out->rgb[i] = (float)v;
     }

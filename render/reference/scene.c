@@ -60,6 +60,7 @@ void lr_ref_scene_destroy(lr_ref_scene *s)
     free(s->media);
     free(s->lights);
     free(s->light_pick);
+    free(s->delta_pick);
     free(s);
 }
 
@@ -296,7 +297,7 @@ int lr_ref_scene_finish(lr_ref_scene *s, lr_err *e)
         if (s->media[0].sigma_t[b] != 0.0)
             return lr_err_set(e, LR_EINVAL, "reference: the ambient medium must not scatter "
                               "or absorb");
-    double total = 0.0;
+    double total = 0.0, delta = 0.0;
     for (int i = 0; i < s->n_lights; i++) {
         lr_ref_light *l = &s->lights[i];
         lr_vec3 p = l->d.position;
@@ -305,14 +306,21 @@ int lr_ref_scene_finish(lr_ref_scene *s, lr_err *e)
         if (l->object >= 0) /* area light: the medium it emits into, just in front */
             p = lr_v3_add(p, lr_v3_scale(l->normal, 1e3 * lr_ref_eps(p)));
         l->medium = lr_ref_scene_medium_at(s, p);
-        total += l->power[0] + l->power[1] + l->power[2];
+        double pw = l->power[0] + l->power[1] + l->power[2];
+        total += pw;
+        if (l->object < 0)
+            delta += pw;
     }
-    s->light_pick = calloc((size_t)(s->n_lights ? s->n_lights : 1), sizeof *s->light_pick);
-    if (!s->light_pick)
+    size_t n = (size_t)(s->n_lights ? s->n_lights : 1);
+    s->light_pick = calloc(n, sizeof *s->light_pick);
+    s->delta_pick = calloc(n, sizeof *s->delta_pick);
+    if (!s->light_pick || !s->delta_pick)
         return lr_err_set(e, LR_ENOMEM, "reference: out of memory");
     for (int i = 0; i < s->n_lights; i++) {
         const double *pw = s->lights[i].power;
-        s->light_pick[i] = total > 0.0 ? (pw[0] + pw[1] + pw[2]) / total : 0.0;
+        double p = pw[0] + pw[1] + pw[2];
+        s->light_pick[i] = total > 0.0 ? p / total : 0.0;
+        s->delta_pick[i] = delta > 0.0 && s->lights[i].object < 0 ? p / delta : 0.0;
     }
     s->finished = true;
     return LR_OK;
@@ -366,6 +374,7 @@ int lr_ref_scene_medium_at(const lr_ref_scene *s, lr_vec3 p)
 void lr_ref_stats_add(lr_ref_stats *into, const lr_ref_stats *from)
 {
     into->paths += from->paths;
+    into->photons += from->photons;
     into->events += from->events;
     into->nee += from->nee;
     into->nee_refracted += from->nee_refracted;

@@ -8,7 +8,7 @@
  * has its own random stream, and batch sums are combined in order. */
 #define BATCHES 64
 
-enum { T_RTOT, T_RSPEC, T_RDIFF, T_TTOT, T_TUNS, T_ABS, N_TALLY };
+enum { T_RTOT, T_RSPEC, T_RDIFF, T_TTOT, T_TUNS, T_ABS, T_SCAT, T_LT, N_TALLY };
 
 typedef struct tally {
     double sum[N_TALLY], sum2[N_TALLY];
@@ -29,6 +29,23 @@ static void add(tally *t, int i, double x)
     t->sum2[i] += x * x;
 }
 
+/* Light end of a photon from the light: whether camera-path NEE covers it. */
+typedef struct first_vertex {
+    const lr_ref_scene *s;
+    bool seen, covered;
+} first_vertex;
+
+static bool classify(void *user, const lr_ref_photon_vertex *v)
+{
+    first_vertex *f = user;
+    if (v->index == 0) {
+        f->seen = true;
+        f->covered = lr_ref_nee_covers_light_end(f->s, f->s->lights[0].d.position,
+                                                 f->s->lights[0].medium, v);
+    }
+    return true;
+}
+
 static void run_batch(int batch, void *user)
 {
     const job *j = user;
@@ -45,8 +62,13 @@ static void run_batch(int batch, void *user)
             power /= lr_ref_light_power(j->scene, 0, 0); /* fraction of the light's power */
         }
         lr_ref_photon_exit x;
-        lr_ref_photon_trace(j->scene, o, d, medium, 0, &rng, &t->stats, &x);
-        double w = x.escaped ? x.weight * power : 0.0;
+        double beta[3] = {1.0, 0.0, 0.0};
+        first_vertex fv = {.s = j->scene};
+        lr_ref_walker wk = {.x = o, .d = d, .medium = medium, .on_surface = true};
+        t->stats.paths++;
+        lr_ref_photon_walk(j->scene, wk, 1, 0, &rng, &t->stats, j->from_light ? classify : NULL,
+                           &fv, &x, beta);
+        double w = x.escaped ? beta[0] * power : 0.0;
         bool up = x.direction.z > 0.0;
         add(t, T_RTOT, up ? w : 0.0);
         add(t, T_RSPEC, up && x.scatterings == 0 ? w : 0.0);
@@ -54,6 +76,8 @@ static void run_batch(int batch, void *user)
         add(t, T_TTOT, up ? 0.0 : w);
         add(t, T_TUNS, !up && x.scatterings == 0 ? w : 0.0);
         add(t, T_ABS, power - w);
+        add(t, T_SCAT, x.scatterings > 0 ? w : 0.0);
+        add(t, T_LT, fv.seen && !fv.covered ? w : 0.0);
     }
 }
 
@@ -127,13 +151,15 @@ int lr_ref_slab_rt(const lr_ref_slab_problem *p, lr_ref_slab_result *out, lr_err
     return rc;
 }
 
-int lr_ref_sphere_escape(const lr_ref_sphere_problem *p, lr_ref_estimate *escaped,
-                         lr_ref_stats *stats, lr_err *e)
+int lr_ref_sphere_escape(const lr_ref_sphere_problem *p, lr_ref_sphere_result *out, lr_err *e)
 {
-    *escaped = (lr_ref_estimate){0};
-    if (!(p->radius > 0.0) || !(lr_v3_len(p->offset) < p->radius) || p->photons < 2)
-        return lr_err_set(e, LR_EINVAL, "reference: sphere problem: need radius > 0, the light "
-                          "inside and at least 2 photons");
+    *out = (lr_ref_sphere_result){0};
+    double rl = lr_v3_len(p->offset);
+    if (!(p->radius > 0.0) || !(rl < p->radius) || !(p->cavity >= 0.0 && p->cavity < p->radius) ||
+        (p->cavity > 0.0 && !(rl < p->cavity)) || p->photons < 2)
+        return lr_err_set(e, LR_EINVAL, "reference: sphere problem: need radius > 0, 0 <= "
+                          "cavity < radius, the light inside (the cavity) and at least 2 "
+                          "photons");
     lr_ref_scene *s;
     int rc = lr_ref_scene_create(NULL, &s, e);
     if (rc)
@@ -146,6 +172,12 @@ int lr_ref_sphere_escape(const lr_ref_sphere_problem *p, lr_ref_estimate *escape
                                  .name = "sphere"};
         rc = lr_ref_scene_add_object(s, &od, e);
     }
+    if (!rc && p->cavity > 0.0 &&
+        !(rc = lr_ref_sphere_create(lr_v3(0.0, 0.0, 0.0), p->cavity, &shape, e))) {
+        lr_ref_object_desc od = {.kind = LR_REF_BOUNDARY, .shape = shape, .inside = 0,
+                                 .outside = id, .name = "cavity"};
+        rc = lr_ref_scene_add_object(s, &od, e);
+    }
     lr_ref_light_desc ld = {.kind = LR_REF_LIGHT_POINT, .position = p->offset,
                             .emission = {1.0, 1.0, 1.0}};
     if (!rc)
@@ -154,15 +186,16 @@ int lr_ref_sphere_escape(const lr_ref_sphere_problem *p, lr_ref_estimate *escape
         rc = lr_ref_scene_finish(s, e);
     job j = {.scene = s, .photons = p->photons, .seed = p->seed, .from_light = true};
     if (!rc)
-        rc = run(&j, p->threads, stats, e);
+        rc = run(&j, p->threads, &out->stats, e);
     if (!rc) {
-        /* Everything escaping counts, whichever way it leaves. */
-        lr_ref_estimate up = estimate(j.t, T_RTOT, p->photons);
-        lr_ref_estimate down = estimate(j.t, T_TTOT, p->photons);
+        /* Everything escaping counts, whichever way it leaves: escaped = 1 - absorbed per
+         * photon, so the absorbed tally's error is the escape's; likewise the scattered part
+         * is everything but the photons that left without scattering. */
         lr_ref_estimate absorbed = estimate(j.t, T_ABS, p->photons);
-        escaped->value = up.value + down.value;
-        /* escaped = 1 - absorbed per photon: the absorbed tally's error is the escape's. */
-        escaped->se = absorbed.se;
+        lr_ref_estimate scat = estimate(j.t, T_SCAT, p->photons);
+        out->escaped = (lr_ref_estimate){1.0 - absorbed.value, absorbed.se};
+        out->escaped_scattered = scat;
+        out->escaped_light_traced = estimate(j.t, T_LT, p->photons);
     }
     free(j.t);
     lr_ref_scene_destroy(s);

@@ -5,14 +5,19 @@
 #include "render/optics/optics.h"
 
 enum lr_ref_event lr_ref_flight(const lr_ref_scene *s, lr_ref_walker *w, int hero,
-                                lr_ref_rng *rng, lr_ref_surf *hit)
+                                lr_ref_rng *rng, lr_ref_surf *hit, double *segment)
 {
     double st = s->media[w->medium].sigma_t[hero];
     /* Free path with density st exp(-st t) (inversion; 1 - u lies in (0, 1], so the log is
      * finite). A transparent medium never collides. */
     double tc = st > 0.0 ? -log(1.0 - lr_ref_rng_uniform(rng)) / st : INFINITY;
     double tmin = w->on_surface ? lr_ref_eps(w->x) : 0.0;
-    if (lr_ref_scene_intersect(s, w->x, w->d, tmin, tc, hit)) {
+    /* The whole segment to the next surface when the caller wants its length (equiangular
+     * sampling needs it), else only as far as the collision. */
+    bool found = lr_ref_scene_intersect(s, w->x, w->d, tmin, segment ? INFINITY : tc, hit);
+    if (segment)
+        *segment = found ? hit->t : INFINITY;
+    if (found && hit->t < tc) {
         w->x = hit->p;
         w->on_surface = true;
         return LR_REF_EV_SURFACE;

@@ -219,9 +219,9 @@ static int cmd_validate(int argc, char **argv)
     lr_ref_sphere_problem sp = {.medium = {.sigma_s = {1, 1, 1}, .eta = 1.5}, .radius = 1.0,
                                 .photons = (uint64_t)photons, .seed = (uint64_t)seed + 2,
                                 .threads = (int)threads};
-    lr_ref_estimate esc;
+    lr_ref_sphere_result esc;
     if (lr_ref_slab_rt(&gio, &rg, &e) || lr_ref_slab_rt(&vdh, &rv, &e) ||
-        lr_ref_sphere_escape(&sp, &esc, NULL, &e)) {
+        lr_ref_sphere_escape(&sp, &esc, &e)) {
         fprintf(stderr, "lamprig-reference: %s\n", e.msg);
         return 1;
     }
@@ -234,7 +234,8 @@ static int cmd_validate(int argc, char **argv)
         0.09739);
     row("slab tau = 2, a = 0.9, g = 0.75, n = 1: total transmittance (van de Hulst 1980)",
         rv.t_total, 0.66096);
-    row("sphere, sigma_a = 0, n = 1.5, point light inside: escaping power / 4 pi I", esc, 1.0);
+    row("sphere, sigma_a = 0, n = 1.5, point light inside: escaping power / 4 pi I", esc.escaped,
+        1.0);
     printf("\n%ld photons per problem, %.1f s on %d threads (%.3g photons/s); specular part "
            "of the first: %.5f (Fresnel at normal incidence 0.04); unscattered part of the "
            "transmittance: %.5f (exp(-2) = 0.13534)\n",
