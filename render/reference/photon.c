@@ -31,10 +31,14 @@ void lr_ref_photon_walk(const lr_ref_scene *s, lr_ref_walker w, int mask, int he
         const double *albedo;
         if (e == LR_REF_EV_SURFACE) {
             const lr_ref_object *ob = &s->objects[h.object];
-            out->position = h.p;
-            if (ob->kind == LR_REF_SURF_LIGHT) /* lights absorb */
-                break;
+            if (ob->kind == LR_REF_SURF_LIGHT) { /* lights absorb */
+                out->hit_light = true;
+                out->direction = w.d;
+                return;
+            }
             if (ob->kind == LR_REF_SURF_BOUNDARY) {
+                out->position = h.p;
+                out->boundaries++;
                 double n2; /* flux crosses unscaled */
                 enum lr_ref_crossing c = lr_ref_cross(s, &w, &h, rng, &n2, st);
                 if (v.index == 0) {

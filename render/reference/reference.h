@@ -214,7 +214,10 @@ void lr_ref_radiance(const lr_ref_scene *s, lr_vec3 origin, lr_vec3 dir, int med
 
 typedef struct lr_ref_photon_exit {
     bool escaped;       /* left the scene; otherwise absorbed, killed by roulette or capped */
-    lr_vec3 position;   /* last surface the photon crossed (where it left an object) */
+    bool hit_light;     /* absorbed by an area light's surface (weight: what arrived there) */
+    lr_vec3 position;   /* last medium boundary it met (where it left an object); the
+                         * origin when boundaries == 0 */
+    int boundaries;     /* reflections and refractions at medium boundaries */
     lr_vec3 direction;  /* direction it escaped in */
     double weight;      /* carried flux fraction, 1 at launch */
     int scatterings;    /* medium scattering events (0: reflected or transmitted specularly) */
