@@ -10,7 +10,8 @@
  * light:
  *
  *   F(w) = where the ray leaving the light along w, refracted at each of the k interfaces the
- *          straight segment p -> x crosses, passes the plane through x perpendicular to it;
+ *          straight segment p -> x crosses, passes the plane through x perpendicular to it
+ *          (or the same from x toward the light when x is the end in the thinner medium);
  *
  * Newton's method drives F(w) - x to zero from the straight-line guess. At the solution the
  * same 2x2 Jacobian J = dF/dw (mm per radian, in the plane perpendicular to the arriving ray)
@@ -34,9 +35,11 @@
 
 #include "render/optics/optics.h"
 
-/* Russian roulette below this transmittance bound: a connection from deep inside a dense
- * medium is attempted with probability bound / LR_REF_NEE_RR and weighted by the inverse, so
- * no weight exceeds 1 / LR_REF_NEE_RR times the bound (unbiased; bounded variance). */
+/* Russian roulette below this transmittance estimate (exp(-tau_bound), see
+ * lr_ref_chain_topology): a connection from deep inside a dense medium, or through a thick
+ * one, is attempted with probability estimate / LR_REF_NEE_RR and weighted by the inverse
+ * (unbiased). With k = 1 the estimate bounds the transmittance, so no weight exceeds
+ * 1 / LR_REF_NEE_RR times it; through middle segments it is an estimate only. */
 #define LR_REF_NEE_RR 1e-3
 /* Newton: forward-difference step in the emission direction (radians) and iteration cap. */
 #define NEWTON_H 1e-6
@@ -57,6 +60,8 @@ void lr_ref_chain_topology(const lr_ref_scene *s, lr_vec3 p, int mp, lr_vec3 x, 
     int m = mp;
     double remaining = len;
     lr_vec3 first_p = p, first_n = u, last_p = p, last_n = u;
+    double tau_last_cross[3] = {0, 0, 0}; /* tau up to the last refractive crossing so far */
+    double tau_first_cross[3] = {0, 0, 0};
     out->k = 0;
     for (int b = 0; b < 3; b++)
         out->tau[b] = 0.0;
@@ -93,19 +98,29 @@ void lr_ref_chain_topology(const lr_ref_scene *s, lr_vec3 p, int mp, lr_vec3 x, 
             if (out->k == 1) {
                 first_p = h.p;
                 first_n = h.n;
+                for (int b = 0; b < 3; b++)
+                    tau_first_cross[b] = out->tau[b];
             }
             last_p = h.p;
             last_n = h.n;
+            for (int b = 0; b < 3; b++)
+                tau_last_cross[b] = out->tau[b];
         }
     }
     if (m != mx) {
         out->k = -1;
         return;
     }
+    /* End segments: the depth of each end below the plane of its nearest crossing (a lower
+     * bound on any refracted path's length there). Middle segments, between the first and
+     * the last crossing: their straight-line optical depth, which the refracted path
+     * approximates (not a bound; it only sets a roulette probability, see LR_REF_NEE_RR). */
     double dx = out->k ? fabs(lr_v3_dot(lr_v3_sub(x, last_p), last_n)) : 0.0;
     double dp = out->k ? fabs(lr_v3_dot(lr_v3_sub(p, first_p), first_n)) : 0.0;
     for (int b = 0; b < 3; b++)
-        out->tau_bound[b] = out->k ? s->media[mx].sigma_t[b] * dx + s->media[mp].sigma_t[b] * dp
+        out->tau_bound[b] = out->k ? s->media[mx].sigma_t[b] * dx +
+                                         s->media[mp].sigma_t[b] * dp +
+                                         (tau_last_cross[b] - tau_first_cross[b])
                                    : out->tau[b];
 }
 
@@ -260,21 +275,35 @@ bool lr_ref_connect(const lr_ref_scene *s, const lr_ref_emitter *em, lr_vec3 x, 
                 T /= q;
             }
         }
+        /* Newton runs from the end in the optically thinner medium: rays leaving it refract
+         * into the denser side under any angle, while rays leaving the dense side meet total
+         * internal reflection beyond the critical angle, which would make the straight-line
+         * start fail (a vertex inside wax connecting to the camera, say). Solved backwards,
+         * the ray tube's Jacobian converts by etendue conservation (n^2 dA dw along a
+         * pencil): det J_{p->x} = (n_p / n_x)^2 det J_{x->p}. */
+        double np = s->media[em->medium].eta, nx = s->media[mx].eta;
+        bool back = nx < np;
         chain c;
         double det;
-        if (!solve_chain(s, em->p, em->medium, x, topo.k, &c, &w, &det)) {
+        lr_vec3 w0;
+        if (back ? !solve_chain(s, x, mx, em->p, topo.k, &c, &w0, &det)
+                 : !solve_chain(s, em->p, em->medium, x, topo.k, &c, &w0, &det)) {
             if (st)
                 st->nee_unsolved++;
             return false;
         }
-        /* The final segment, from the last refraction to x: clear of anything but
-         * index-matched boundaries, and ending in x's medium. */
+        /* The final segment, from the last refraction to the far end: clear of anything but
+         * index-matched boundaries, and ending in that end's medium. */
         lr_ref_topology fin;
-        lr_ref_chain_topology(s, c.o, c.m, x, mx, &fin);
+        if (back)
+            lr_ref_chain_topology(s, c.o, c.m, em->p, em->medium, &fin);
+        else
+            lr_ref_chain_topology(s, c.o, c.m, x, mx, &fin);
         if (fin.k != 0)
             return false;
-        *w_in = lr_v3_scale(c.d, -1.0);
-        geom = 1.0 / det;
+        w = back ? lr_v3_scale(c.d, -1.0) : w0;
+        *w_in = back ? w0 : lr_v3_scale(c.d, -1.0);
+        geom = back ? (nx / np) * (nx / np) / det : 1.0 / det;
         T *= c.T;
         for (int b = 0; b < 3; b++)
             tau[b] = c.tau[b] + fin.tau[b];

@@ -195,8 +195,9 @@ void lr_ref_light_emit_all(const lr_ref_light *l, lr_ref_rng *rng, lr_vec3 *orig
  * The connection passes straight through index-matched boundaries and is solved through up
  * to LR_REF_MAX_CHAIN refractive ones (Newton on the emission direction; see connect.c).
  * Returns false when there is no connection (blocked, too many interfaces, not solved): E is
- * then zero. rr (may be NULL) allows Russian roulette on connections whose straight-line
- * transmittance is negligible. Bands outside mask are left zero. */
+ * then zero. rr (may be NULL) allows Russian roulette on refracted connections whose
+ * transmittance estimate (lr_ref_topology.tau_bound) is below 1e-3. Bands outside mask are
+ * left zero. */
 bool lr_ref_connect(const lr_ref_scene *s, const lr_ref_emitter *em, lr_vec3 x, int mx,
                     int mask, lr_ref_rng *rr, lr_ref_stats *st, double E[3], lr_vec3 *w_in);
 
@@ -206,9 +207,10 @@ typedef struct lr_ref_topology {
                         * inconsistent media, or more than LR_REF_MAX_CHAIN */
     double tau[3];     /* optical depth along the straight segment, per band */
     /* Optical depth of x below the tangent plane of the last refractive interface, plus that
-     * of p below the plane of the first (per band, with the media of x and p): no refracted
-     * path through planes can be shorter, so exp(-tau_bound) bounds its transmittance. Equal
-     * to tau when k == 0. */
+     * of p below the plane of the first (no refracted path through planes can be shorter),
+     * plus the straight optical depth between the first and last interface (an estimate):
+     * exp(-tau_bound) estimates, and for k = 1 bounds, a refracted connection's
+     * transmittance. Equal to tau when k == 0. */
     double tau_bound[3];
 } lr_ref_topology;
 

@@ -118,6 +118,12 @@ int lr_ref_quad_create(lr_vec3 corner, lr_vec3 edge1, lr_vec3 edge2, lr_ref_shap
 int lr_ref_disk_create(lr_vec3 center, lr_vec3 normal, double radius, lr_ref_shape **out,
                        lr_err *e);
 
+/* A triangle mesh of render/mesh (ray casts through its BVH, flat triangle normals: the
+ * faceted surface itself). It may bound a medium when it is watertight and consistently
+ * oriented (lr_mesh_analyze). take: the shape owns and frees m; otherwise m must outlive it. */
+typedef struct lr_mesh lr_mesh;
+int lr_ref_mesh_create(lr_mesh *m, bool take, lr_ref_shape **out, lr_err *e);
+
 /* ---- scene ------------------------------------------------------------------------------ */
 
 /* A homogeneous medium. Zero-initialised: a vacuum of index 1. */
@@ -128,6 +134,12 @@ typedef struct lr_ref_medium_desc {
     double eta;        /* absolute refractive index; 0 means 1 */
     const char *name;  /* for messages; may be NULL */
 } lr_ref_medium_desc;
+
+/* From the render model's medium (render/optics: reduced scattering sigma_s' and eta relative
+ * to the outside): sigma_s = sigma_s' / (1 - g), and eta taken as absolute, i.e. for a medium
+ * whose outside is air (index 1). */
+typedef struct lr_medium lr_medium;
+void lr_ref_medium_from_optics(const lr_medium *m, lr_ref_medium_desc *out);
 
 typedef enum lr_ref_object_kind {
     LR_REF_BOUNDARY = 0, /* closed shape separating `inside` from `outside` medium */

@@ -4,7 +4,7 @@
  * Camera paths: each pixel keeps the sum and the sum of squares of its per-sample radiance, so
  * the mean and the variance of the mean are available after any pass. Sample j of pixel i
  * draws from the random stream (seed, i << 32 | j).
- * Light tracing: sample index j also traces as many photons as there are pixels (streams
+ * Light tracing: sample index j also traces LT_PER_PIXEL photons per pixel (streams
  * (seed', j << 32 | photon)); their splats, divided by that count, are one estimate of the
  * light-traced image per sample index, and the variance of its mean comes from the spread of
  * those estimates. Splats are collected per fixed batch and applied in batch order.
@@ -18,6 +18,10 @@
 
 #define TILE 16
 #define LT_BATCH 4096 /* photons per light-tracing batch */
+/* Light-tracing photons per pixel and sample. Photons whose light end camera paths cover stop
+ * at their first vertex (a few ray casts), so several per camera path cost little and keep
+ * the sparse splats of reflected light from dominating a pixel's noise. */
+#define LT_PER_PIXEL 4
 
 struct lr_ref_render {
     const lr_ref_scene *s;
@@ -93,7 +97,7 @@ int lr_ref_render_create(const lr_ref_scene *s, const lr_ref_camera *cam,
         r->tiles_y = (d.height + TILE - 1) / TILE;
         r->tile_stats = calloc((size_t)r->tiles_x * (size_t)r->tiles_y, sizeof *r->tile_stats);
         r->trace_lights = lt;
-        r->lt_batches = (int)((npix + LT_BATCH - 1) / LT_BATCH);
+        r->lt_batches = (int)((LT_PER_PIXEL * npix + LT_BATCH - 1) / LT_BATCH);
         if (lt) {
             r->lt_sum = calloc(n, sizeof *r->lt_sum);
             r->lt_sum2 = calloc(n, sizeof *r->lt_sum2);
@@ -169,9 +173,9 @@ static void render_tile(int tile, void *user)
 static void trace_batch(int batch, void *user)
 {
     lr_ref_render *r = user;
-    uint64_t npix = (uint64_t)r->d.width * (uint64_t)r->d.height;
+    uint64_t n = LT_PER_PIXEL * (uint64_t)r->d.width * (uint64_t)r->d.height;
     uint64_t first = (uint64_t)batch * LT_BATCH;
-    uint64_t count = first + LT_BATCH <= npix ? LT_BATCH : npix - first;
+    uint64_t count = first + LT_BATCH <= n ? LT_BATCH : n - first;
     r->lt_splats[batch].n = 0;
     lr_ref_light_trace(r->s, &r->pin, r->d.seed, r->lt_j, first, count, &r->lt_splats[batch],
                        &r->lt_stats[batch]);
@@ -181,7 +185,7 @@ static void trace_batch(int batch, void *user)
 static int light_trace_sample(lr_ref_render *r, uint64_t j, lr_err *e)
 {
     size_t n = (size_t)r->d.width * (size_t)r->d.height * 3;
-    double inv = 1.0 / ((double)r->d.width * (double)r->d.height); /* photons per sample */
+    double inv = 1.0 / (LT_PER_PIXEL * (double)r->d.width * (double)r->d.height); /* 1/photons */
     r->lt_j = j;
     int rc = lr_ref_parallel(r->lt_batches, r->d.threads, trace_batch, r, e);
     if (rc)

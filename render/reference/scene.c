@@ -1,6 +1,8 @@
 /* Reference scene: media, objects (medium boundaries, receivers, area-light surfaces), lights. */
 #include "render/reference/ref_priv.h"
 
+#include "render/optics/optics.h"
+
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -69,6 +71,16 @@ static int not_finished(const lr_ref_scene *s, const char *what, lr_err *e)
     if (s->finished)
         return lr_err_set(e, LR_EINVAL, "reference: %s after lr_ref_scene_finish", what);
     return LR_OK;
+}
+
+void lr_ref_medium_from_optics(const lr_medium *m, lr_ref_medium_desc *out)
+{
+    *out = (lr_ref_medium_desc){.g = m->g, .eta = m->eta};
+    for (int b = 0; b < 3; b++) {
+        out->sigma_a[b] = m->sigma_a[b];
+        /* Similarity relation sigma_s' = sigma_s (1 - g) (render/optics/optics.h). */
+        out->sigma_s[b] = m->sigma_s_prime[b] / (1.0 - m->g);
+    }
 }
 
 int lr_ref_scene_add_medium(lr_ref_scene *s, const lr_ref_medium_desc *m, int *id, lr_err *e)

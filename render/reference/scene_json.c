@@ -7,6 +7,10 @@
 #include <string.h>
 
 #include "render/base/json.h"
+#include "render/base/mat4.h"
+#include "render/material/material.h"
+#include "render/mesh/mesh_io.h"
+#include "render/mesh/shapes.h"
 
 #define MAX_MEDIA 64
 
@@ -29,8 +33,8 @@ static int vec(const lr_json *j, lr_jnode o, const char *key, bool req, lr_vec3 
 
 static int load_media(loader *L, lr_jnode arr, lr_err *e)
 {
-    static const char *const keys[] = {"name", "sigma_a", "sigma_s", "sigma_s_prime", "g",
-                                       "eta", NULL};
+    static const char *const keys[] = {"name", "material", "sigma_a", "sigma_s",
+                                       "sigma_s_prime", "g", "eta", NULL};
     const lr_json *j = L->j;
     if (lr_json_type(j, arr) != LR_JSON_ARRAY)
         return lr_json_fail(j, arr, "media", e, LR_EPARSE, "expected an array");
@@ -49,23 +53,38 @@ static int load_media(loader *L, lr_jnode arr, lr_err *e)
         for (int k = 0; k < L->n && !rc; k++)
             if (!strcmp(L->names[k], name))
                 rc = lr_json_fail(j, o, "name", e, LR_EPARSE, "medium '%s' defined twice", name);
-        if (!rc)
-            rc = lr_json_get_numbers(j, o, "sigma_a", true, md.sigma_a, 3, e);
-        if (!rc)
-            rc = lr_json_get_number(j, o, "g", false, &md.g, e);
-        if (!rc)
-            rc = lr_json_get_number(j, o, "eta", false, &md.eta, e);
-        lr_jnode ss = lr_json_get(j, o, "sigma_s"), sp = lr_json_get(j, o, "sigma_s_prime");
-        if (!rc && (ss == LR_JNONE) == (sp == LR_JNONE))
-            rc = lr_json_fail(j, o, where, e, LR_EPARSE,
-                              "give exactly one of sigma_s and sigma_s_prime");
-        if (!rc && ss != LR_JNONE)
-            rc = lr_json_numbers(j, ss, "sigma_s", md.sigma_s, 3, e);
-        if (!rc && sp != LR_JNONE) {
-            rc = lr_json_numbers(j, sp, "sigma_s_prime", md.sigma_s, 3, e);
-            /* sigma_s' = sigma_s (1 - g) (similarity relation; render/optics convention) */
-            for (int b = 0; b < 3 && !rc; b++)
-                md.sigma_s[b] /= 1.0 - md.g;
+        lr_jnode mat = lr_json_get(j, o, "material");
+        if (!rc && mat != LR_JNONE) {
+            /* A preset of configs/materials (render/material), or coefficients below. */
+            char preset[LR_MATERIAL_NAME_MAX];
+            lr_material m;
+            if (!(rc = lr_json_string(j, mat, "material", preset, sizeof preset, e)) &&
+                !(rc = lr_material_find(preset, &m, e)))
+                lr_ref_medium_from_optics(&m.medium, &md);
+            if (!rc && (lr_json_get(j, o, "sigma_a") != LR_JNONE ||
+                        lr_json_get(j, o, "sigma_s") != LR_JNONE ||
+                        lr_json_get(j, o, "sigma_s_prime") != LR_JNONE))
+                rc = lr_json_fail(j, o, where, e, LR_EPARSE,
+                                  "give either 'material' or the coefficients");
+        } else {
+            if (!rc)
+                rc = lr_json_get_numbers(j, o, "sigma_a", true, md.sigma_a, 3, e);
+            if (!rc)
+                rc = lr_json_get_number(j, o, "g", false, &md.g, e);
+            if (!rc)
+                rc = lr_json_get_number(j, o, "eta", false, &md.eta, e);
+            lr_jnode ss = lr_json_get(j, o, "sigma_s"), sp = lr_json_get(j, o, "sigma_s_prime");
+            if (!rc && (ss == LR_JNONE) == (sp == LR_JNONE))
+                rc = lr_json_fail(j, o, where, e, LR_EPARSE,
+                                  "give exactly one of sigma_s and sigma_s_prime");
+            if (!rc && ss != LR_JNONE)
+                rc = lr_json_numbers(j, ss, "sigma_s", md.sigma_s, 3, e);
+            if (!rc && sp != LR_JNONE) {
+                rc = lr_json_numbers(j, sp, "sigma_s_prime", md.sigma_s, 3, e);
+                /* sigma_s' = sigma_s (1 - g) (similarity relation; render/optics convention) */
+                for (int b = 0; b < 3 && !rc; b++)
+                    md.sigma_s[b] /= 1.0 - md.g;
+            }
         }
         md.name = name;
         if (!rc && (rc = lr_ref_scene_add_medium(L->s, &md, &L->ids[L->n], e)))
@@ -92,6 +111,58 @@ static int medium_id(const loader *L, lr_jnode o, const char *key, int *id, lr_e
                         "no medium named '%s'", name);
 }
 
+/* Meshes: a file (relative to the scene file) or the procedural candle and shade of
+ * render/mesh, moved by an optional "offset". */
+static int load_mesh(const lr_json *j, lr_jnode o, const char *kind, lr_ref_shape **shape,
+                     lr_err *e)
+{
+    lr_mesh *m = NULL;
+    int rc;
+    if (!strcmp(kind, "mesh")) {
+        char file[1024], path[2048];
+        if ((rc = lr_json_get_string(j, o, "file", true, file, sizeof file, e)))
+            return rc;
+        const char *scene = lr_json_name(j), *slash = strrchr(scene, '/');
+        if (file[0] == '/' || !slash)
+            snprintf(path, sizeof path, "%s", file);
+        else
+            snprintf(path, sizeof path, "%.*s/%s", (int)(slash - scene), scene, file);
+        rc = lr_mesh_load(path, NULL, &m, e);
+    } else if (!strcmp(kind, "candle")) {
+        lr_candle_desc d = {0};
+        if (!(rc = lr_json_get_number(j, o, "radius", false, &d.radius, e)) &&
+            !(rc = lr_json_get_number(j, o, "height", false, &d.height, e)) &&
+            !(rc = lr_json_get_number(j, o, "pool_depth", false, &d.pool_depth, e)) &&
+            !(rc = lr_json_get_number(j, o, "pool_radius", false, &d.pool_radius, e)) &&
+            !(rc = lr_json_get_bool(j, o, "flat_top", false, &d.flat_top, e)))
+            rc = lr_mesh_candle(&d, &m, e);
+    } else {
+        lr_shade_desc d = {0};
+        if (!(rc = lr_json_get_number(j, o, "radius_bottom", false, &d.radius_bottom, e)) &&
+            !(rc = lr_json_get_number(j, o, "radius_top", false, &d.radius_top, e)) &&
+            !(rc = lr_json_get_number(j, o, "height", false, &d.height, e)) &&
+            !(rc = lr_json_get_number(j, o, "thickness", false, &d.thickness, e)))
+            rc = lr_mesh_shade(&d, &m, e);
+    }
+    lr_vec3 off = {0, 0, 0};
+    if (!rc)
+        rc = vec(j, o, "offset", false, &off, e);
+    if (!rc && lr_v3_len(off) > 0.0) {
+        double t[16];
+        lr_mesh *moved;
+        lr_mat4_translate(off, t);
+        if (!(rc = lr_mesh_transform(m, t, &moved, e))) {
+            lr_mesh_destroy(m);
+            m = moved;
+        }
+    }
+    if (rc) {
+        lr_mesh_destroy(m);
+        return rc;
+    }
+    return lr_ref_mesh_create(m, true, shape, e);
+}
+
 /* The shape of an object or an area light; *shape NULL when kind names no geometry. */
 static int load_shape(const lr_json *j, lr_jnode o, const char *kind, lr_ref_shape **shape,
                       lr_err *e)
@@ -100,7 +171,9 @@ static int load_shape(const lr_json *j, lr_jnode o, const char *kind, lr_ref_sha
     lr_vec3 a = {0}, b = {0}, c = {0};
     double r = 0.0, top = 0.0, th = INFINITY;
     int rc;
-    if (!strcmp(kind, "sphere")) {
+    if (!strcmp(kind, "mesh") || !strcmp(kind, "candle") || !strcmp(kind, "shade")) {
+        rc = load_mesh(j, o, kind, shape, e);
+    } else if (!strcmp(kind, "sphere")) {
         if (!(rc = vec(j, o, "center", true, &a, e)) &&
             !(rc = lr_json_get_number(j, o, "radius", true, &r, e)))
             rc = lr_ref_sphere_create(a, r, shape, e);
@@ -128,7 +201,9 @@ static int load_objects(loader *L, lr_jnode arr, lr_err *e)
 {
     static const char *const keys[] = {"name", "shape", "center", "radius", "top", "thickness",
                                        "corner", "edge1", "edge2", "normal", "inside",
-                                       "outside", "albedo", NULL};
+                                       "outside", "albedo", "file", "offset", "height",
+                                       "pool_depth", "pool_radius", "flat_top",
+                                       "radius_bottom", "radius_top", NULL};
     const lr_json *j = L->j;
     if (lr_json_type(j, arr) != LR_JSON_ARRAY)
         return lr_json_fail(j, arr, "objects", e, LR_EPARSE, "expected an array");
@@ -144,7 +219,8 @@ static int load_objects(loader *L, lr_jnode arr, lr_err *e)
         lr_ref_object_desc od = {.name = name};
         if (!rc && !(rc = load_shape(j, o, kind, &od.shape, e)) && !od.shape)
             rc = lr_json_fail(j, lr_json_get(j, o, "shape"), "shape", e, LR_EPARSE,
-                              "'%s': expected sphere, slab, quad or disk", kind);
+                              "'%s': expected sphere, slab, quad, disk, mesh, candle or shade",
+                              kind);
         if (!rc) {
             bool boundary = lr_json_get(j, o, "inside") != LR_JNONE;
             bool receiver = lr_json_get(j, o, "albedo") != LR_JNONE;
