@@ -303,6 +303,22 @@ static void test_refracted_connection_closed_form(void **state)
     assert_true(lr_v3_len(lr_v3_sub(w_in, back)) < 1e-7);
     assert_int_equal(st.nee_refracted, 1);
     assert_int_equal(st.nee_unsolved, 0);
+
+    /* Backwards: an emitter inside the medium (at the former receiving point) lighting the
+     * former light position outside. The connection is then solved from the outside end and
+     * converted by etendue conservation, det J_{p->x} = (n_p / n_x)^2 det J_{x->p}: the same
+     * pencil of rays, so E_back = E_forward (n_out / n_in)^2 (the Fresnel factor is the same
+     * both ways). */
+    lr_ref_emitter in = {.light = NULL, .p = lr_v3(D, 0, -z), .medium = m, .area_weight = 1.0,
+                         .power = {1, 1, 1}, .g = 0.0};
+    double Eb[3];
+    lr_vec3 wb;
+    assert_true(lr_ref_connect(s, &in, ld.position, 0, 7, NULL, &st, Eb, &wb));
+    /* The vertex emitter is an isotropic HG (g = 0) of power 1: intensity 1 / (4 pi). */
+    double expect_back = expect / (n * n) / (4.0 * LR_REF_PI);
+    printf("  backwards %.12g, expected %.12g\n", Eb[0], expect_back);
+    assert_true(fabs(Eb[0] / expect_back - 1.0) < 1e-6);
+    assert_true(lr_v3_len(lr_v3_sub(wb, lr_v3_normalize(lr_v3(u, 0, -H)))) < 1e-7);
     lr_ref_scene_destroy(s);
 }
 
