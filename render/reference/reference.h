@@ -16,15 +16,18 @@
  *              lights;
  *   camera     pinhole, box-filtered pixels.
  *
- * Estimators (see README "Physical reference" for the derivations):
+ * Estimators (README "Physical reference"; each light path is counted by exactly one):
  *   - camera paths (lr_ref_radiance, lr_ref_render): unidirectional random walk from the
  *     camera with next-event estimation (NEE) at every non-specular vertex: diffuse receivers
  *     and scattering events inside media. NEE toward a light behind smooth refractive
  *     boundaries (a flame enclosed by wax, a bulb inside a shade) solves for the refracted
- *     connection path by Newton's method on the light's emission direction and weights it
+ *     connection path (planar steps, then Newton on the emission direction) and weights it
  *     with the exact ray-tube (generalised geometry) Jacobian: a point light enclosed by a
  *     dielectric is otherwise unreachable by any unidirectional estimator. Hits on area
- *     lights count only for paths NEE cannot produce, so no path is counted twice.
+ *     lights count only for paths NEE cannot produce. A point light inside a scattering
+ *     medium adds equiangular distance samples (MIS with free flights).
+ *   - light tracing (renders): photons from point and spot lights whose first specular event
+ *     is a Fresnel reflection, connected to the pinhole at each non-specular vertex.
  *   - photons (lr_ref_photon_trace): the same transport functions run forward from a source;
  *     "photon in, count what comes out" estimators validate them against published slab
  *     solutions and closed-form sphere results (lr_ref_slab_rt, lr_ref_sphere_escape).
