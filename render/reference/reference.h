@@ -301,16 +301,21 @@ typedef struct lr_ref_sphere_problem {
     int threads;
 } lr_ref_sphere_problem;
 
-typedef struct lr_ref_sphere_result {
-    lr_ref_estimate escaped;           /* fraction of the light's power leaving the sphere */
+/* What leaves a scene to infinity, as fractions of a light's power (band 0). */
+typedef struct lr_ref_escape_result {
+    lr_ref_estimate escaped;           /* fraction of the light's power leaving the scene */
     lr_ref_estimate escaped_scattered; /* ... of which scattered at least once */
     /* ... of which reached the first scattering along a path camera-path NEE does not solve
      * (a Fresnel reflection came first): the part renders get from light tracing */
     lr_ref_estimate escaped_light_traced;
     lr_ref_stats stats;
-} lr_ref_sphere_result;
+} lr_ref_escape_result;
 
-int lr_ref_sphere_escape(const lr_ref_sphere_problem *p, lr_ref_sphere_result *out, lr_err *e);
+int lr_ref_sphere_escape(const lr_ref_sphere_problem *p, lr_ref_escape_result *out, lr_err *e);
+
+/* The same count on any finished scene: photons from light `light`, in fixed batches. */
+int lr_ref_escape(const lr_ref_scene *s, int light, uint64_t photons, uint64_t seed, int threads,
+                  lr_ref_escape_result *out, lr_err *e);
 
 /* ---- parallel batches ------------------------------------------------------------------- */
 

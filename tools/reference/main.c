@@ -219,7 +219,7 @@ static int cmd_validate(int argc, char **argv)
     lr_ref_sphere_problem sp = {.medium = {.sigma_s = {1, 1, 1}, .eta = 1.5}, .radius = 1.0,
                                 .photons = (uint64_t)photons, .seed = (uint64_t)seed + 2,
                                 .threads = (int)threads};
-    lr_ref_sphere_result esc;
+    lr_ref_escape_result esc;
     if (lr_ref_slab_rt(&gio, &rg, &e) || lr_ref_slab_rt(&vdh, &rv, &e) ||
         lr_ref_sphere_escape(&sp, &esc, &e)) {
         fprintf(stderr, "lamprig-reference: %s\n", e.msg);
