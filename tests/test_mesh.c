@@ -876,6 +876,9 @@ static void test_obj_errors(void **state)
     write_text(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n");
     assert_int_equal(lr_mesh_load(path, NULL, &m, &e), LR_EPARSE);
     expect_msg(&e, "bad.obj:4: face with 2 corners");
+    write_text(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//0\n");
+    assert_int_equal(lr_mesh_load(path, NULL, &m, &e), LR_EPARSE);
+    expect_msg(&e, "bad.obj:5: malformed face corner '3//0'");
     write_text(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/ 2 3\n");
     assert_int_equal(lr_mesh_load(path, NULL, &m, &e), LR_EPARSE);
     expect_msg(&e, "bad.obj:4: malformed face corner '1/'");

@@ -91,10 +91,9 @@ static size_t reorient(const float *pos, uint32_t *idx, size_t nt, const lr_mesh
     uint8_t *same = malloc(ne ? ne : 1);
     uint8_t *open = calloc(nt ? nt : 1, 1); /* touches a boundary or non-manifold edge */
     int8_t *flip = malloc(nt ? nt : 1);
-    uint32_t *queue = malloc((nt ? nt : 1) * sizeof *queue);
-    uint32_t *comp = malloc((nt ? nt : 1) * sizeof *comp);
+    uint32_t *queue = malloc((nt ? nt : 1) * sizeof *queue); /* also: the piece's faces */
     size_t flipped = (size_t)-1;
-    if (!start || !nb || !same || !open || !flip || !queue || !comp)
+    if (!start || !nb || !same || !open || !flip || !queue)
         goto done;
     for (size_t i = 0; i < ne;) {
         size_t j = i + 1;
@@ -142,7 +141,6 @@ static size_t reorient(const float *pos, uint32_t *idx, size_t nt, const lr_mesh
         queue[tail++] = (uint32_t)seed;
         while (head < tail) {
             uint32_t t = queue[head++];
-            comp[head - 1] = t;
             if (open[t])
                 closed = false;
             for (size_t k = start[t]; k < start[t + 1]; k++) {
@@ -160,16 +158,16 @@ static size_t reorient(const float *pos, uint32_t *idx, size_t nt, const lr_mesh
             /* Volume of the piece as it will be: turn it inside out when negative. */
             double vol = 0.0;
             for (size_t i = 0; i < n; i++) {
-                uint32_t *tri = &idx[3 * comp[i]];
+                uint32_t *tri = &idx[3 * queue[i]];
                 lr_vec3 a = fpos(pos, tri[0]), b = fpos(pos, tri[1]), c = fpos(pos, tri[2]);
                 double v = lr_v3_dot(a, lr_v3_cross(b, c));
-                vol += (flip[comp[i]] ^ invert) ? -v : v;
+                vol += (flip[queue[i]] ^ invert) ? -v : v;
             }
             if (vol < 0.0)
                 invert = !invert;
         }
         for (size_t i = 0; i < n; i++) {
-            uint32_t t = comp[i];
+            uint32_t t = queue[i];
             if (flip[t] ^ invert) {
                 uint32_t tmp = idx[3 * t + 1];
                 idx[3 * t + 1] = idx[3 * t + 2];
@@ -185,7 +183,6 @@ done:
     free(open);
     free(flip);
     free(queue);
-    free(comp);
     return flipped;
 }
 

@@ -116,7 +116,8 @@ static bool parse_ref(const char *s, long long *vi, long long *ni)
     if (*s == '\0')
         return true; /* "i/j/" is tolerated as "i/j" */
     *ni = strtoll(s, &end, 10);
-    return end != s && *end == '\0' && !errno;
+    /* 0 is no index in OBJ (they start at 1); absent is written as nothing, not 0. */
+    return end != s && *end == '\0' && !errno && *ni != 0;
 }
 
 int lr_mesh_load_obj(const char *path, const lr_mesh_checks *checks, lr_mesh **out, lr_err *e)

@@ -1,0 +1,60 @@
+/* Light shape and flicker: the parts of a light that are not its intensity. */
+#include <math.h>
+
+#include "render/scene/scene.h"
+
+void lr_light_rgb(const lr_light *l, double out[3])
+{
+    for (int b = 0; b < 3; b++)
+        out[b] = l->intensity * l->color[b];
+}
+
+double lr_light_shape(const lr_light *l, lr_vec3 dir)
+{
+    if (l->type != LR_LIGHT_SPOT)
+        return 1.0;
+    double c = lr_v3_dot(dir, l->direction);
+    double ci = cos(l->inner_deg * (M_PI / 180.0)), co = cos(l->outer_deg * (M_PI / 180.0));
+    if (c >= ci)
+        return 1.0;
+    if (c <= co)
+        return 0.0;
+    double t = (c - co) / (ci - co);
+    return t * t * (3.0 - 2.0 * t);
+}
+
+/* A phase in [0, 2 pi) from the seed and a channel number (splitmix64 finaliser). */
+static double phase(unsigned seed, unsigned k)
+{
+    unsigned long long z = (unsigned long long)seed * 0x9E3779B97F4A7C15ull + k * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    return (double)(z >> 11) * (2.0 * M_PI / 9007199254740992.0);
+}
+
+/* Sum of three sines at f, 1.618 f, 2.718 f (never in step), normalised to [-1, 1]. */
+static double wobble(const lr_flicker *f, double t, unsigned channel)
+{
+    static const double mult[3] = {1.0, 1.6180339887, 2.7182818285};
+    static const double weight[3] = {0.5, 0.3, 0.2};
+    double s = 0.0;
+    for (unsigned i = 0; i < 3; i++)
+        s += weight[i] * sin(2.0 * M_PI * f->frequency_hz * mult[i] * t +
+                             phase(f->seed, 3 * channel + i));
+    return s;
+}
+
+void lr_light_flicker_at(const lr_light *l, double t, double *scale, lr_vec3 *offset)
+{
+    const lr_flicker *f = &l->flicker;
+    if (scale) {
+        double s = 1.0 + f->amplitude * wobble(f, t, 0);
+        *scale = s > 0.0 ? s : 0.0;
+    }
+    if (offset) {
+        /* A flame sways sideways more than it bobs: the vertical channel at a third. */
+        *offset = lr_v3(f->jitter_mm * wobble(f, t, 1), f->jitter_mm * wobble(f, t, 2),
+                        f->jitter_mm * wobble(f, t, 3) / 3.0);
+    }
+}

@@ -1,0 +1,256 @@
+/* lamprig — scenes: translucent objects, the lights inside or around them, the diffuse
+ * receivers they light (table, wall), the camera, and the render settings; loaded from JSON,
+ * changed at run time by name (`--set key=value`, event scripts, the control map).
+ *
+ * Units: millimetres, degrees where a name says _deg, radiometry linear. z is up.
+ *
+ * ---- Scene file (configs/scenes/NAME.json) -------------------------------------------------
+ * Every object below rejects unknown and duplicate fields; absent optional fields (and, for
+ * counts and sizes, 0) take the default shown. Errors read "FILE:LINE: field 'F': what".
+ *
+ * {
+ *   "name":      string (default: the file name)
+ *   "objects": [                                   one or more translucent objects
+ *     { "name":      string, unique (default "objects[i]")
+ *       "material":  "PRESET"  (configs/materials/PRESET.json)
+ *                  | { material object, render/material/material.h: name, source,
+ *                      sigma_a, sigma_s_prime, eta, g | base, scale (number or RGB) }
+ *       "mesh": one of
+ *         {"type": "candle", "radius": 35, "height": 120, "pool_depth": 8 (0: flat top),
+ *          "pool_radius": radius - 3, "segments": 64, "pool_rings": 12, "side_rings": auto}
+ *         {"type": "shade", "radius_bottom": 100, "radius_top": 60, "height": 150,
+ *          "thickness": 1.5 (0: a single surface), "rims": true, "segments": 96,
+ *          "rings": auto}
+ *         {"type": "sphere", "radius": 50, "subdivisions": 4}
+ *         {"type": "box", "size": [100, 100, 100]}
+ *         {"type": "file", "path": "x.ply" | "x.obj" (relative to the scene file's
+ *          directory), "scale": 1 (e.g. 1000 for a file in metres)}
+ *       "transform": {"translate": [0,0,0], "rotate_deg": [0,0,0] (about x, then y, then z),
+ *                     "scale": 1 | [sx, sy, sz] (> 0)}                      (optional)
+ *     } ]
+ *   "lights": [                                    one or more
+ *     {"type": "point", "name": string, "position": [x,y,z], "intensity": W/sr (>= 0),
+ *      "color": [1,1,1] (relative, per band: I_band = intensity * color[band]),
+ *      "flicker": {"amplitude": 0..1 (relative intensity), "frequency_hz": 8,
+ *                  "jitter_mm": 0 (position sway), "seed": 1}             (optional)}
+ *     {"type": "spot", "name", "position", "direction", "inner_deg": 20, "outer_deg": 30
+ *      (half-angles, 0 < inner <= outer < 90), "intensity": on-axis W/sr, "color"}
+ *     {"type": "directional", "name", "direction" (the way the light travels),
+ *      "radiance": L of seed 003 Eq. 6 = irradiance on a surface facing it, W/mm^2,
+ *      "color"} ]
+ *   "camera":  {"type": "perspective" | "orthographic", "position", "target",
+ *               "up": [0,0,1], "fov_deg": 40 (vertical, perspective),
+ *               "height_mm": 300 (view height, orthographic), "near": 10, "far": 10000}
+ *   "receivers": [                                 diffuse surfaces (optional)
+ *     {"name", "type": "plane", "center", "normal", "size": [w, h],
+ *      "u_dir": direction of w (default x, or y for a normal along x),
+ *      "albedo": [r,g,b] in [0, 1], "subdivisions": 1}
+ *     {"name", "type": "box", "center", "size": [x,y,z], "albedo"} ]
+ *   "render":  {"K": 16 maps, "N": 16 samples per texel, band and frame, "N_vpl": 64,
+ *               "map_size": 256, "gbuffer_size": 256 (cube face or 2D map),
+ *               "vpl_map_size": 64 (cube map of the outer surface for stable VPLs),
+ *               "frames": 64 (progressive accumulation), "exposure": 1 (multiplies
+ *               radiance in W/(mm^2 sr) before tone mapping)}            (optional)
+ *   "quality": {"max_error": 0 (relative RMS against the converged reference; 0: no
+ *               budget), "frame_ms": 0 (0: no budget)}                    (optional)
+ * }
+ *
+ * ---- Parameters -----------------------------------------------------------------------------
+ * lr_scene_set() takes the same names: "lights[1].intensity", "light.intensity" (= lights[0]),
+ * "objects[0].material", "objects[pillar].material.scale" (an element by index or by name),
+ * "camera.position", "render.K", "objects[0].mesh.thickness", "receivers[wall].albedo".
+ * Values: numbers as in JSON; vectors "x,y,z" (or "[x,y,z]"); names bare; booleans
+ * true/false. Each change is validated like the file and either applies completely or
+ * leaves the scene untouched.
+ */
+#ifndef LR_SCENE_H
+#define LR_SCENE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "render/base/err.h"
+#include "render/base/vec3.h"
+#include "render/base/warn.h"
+#include "render/material/material.h"
+#include "render/mesh/bvh.h"
+#include "render/mesh/mesh.h"
+#include "render/optics/optics.h"
+#include "render/scene/dirty.h"
+
+typedef struct lr_scene lr_scene;
+
+#define LR_SCENE_NAME_MAX 64
+
+/* ---- Objects ------------------------------------------------------------------------------ */
+
+enum lr_mesh_kind { LR_MESH_CANDLE, LR_MESH_SHADE, LR_MESH_SPHERE, LR_MESH_BOX, LR_MESH_FILE };
+
+typedef struct lr_scene_object {
+    char name[LR_SCENE_NAME_MAX];
+    enum lr_mesh_kind kind;
+    lr_material material; /* effective (base and scale applied) */
+    lr_coeffs coeffs;     /* lr_coeffs_derive(&material.medium) */
+    const lr_mesh *mesh;  /* world space */
+    const lr_bvh *bvh;    /* over mesh */
+    double model[16];     /* object to world (column-major) */
+    lr_vec3 center;       /* world bounding sphere (lr_mesh_bounding_sphere): the K map */
+    double radius;        /*   cameras sit on it */
+    double area;          /* world surface area, mm^2 */
+    bool closed;          /* watertight (a shade with rims is; one without is not) */
+} lr_scene_object;
+
+/* ---- Lights ------------------------------------------------------------------------------- */
+
+enum lr_light_type { LR_LIGHT_POINT, LR_LIGHT_SPOT, LR_LIGHT_DIRECTIONAL };
+
+typedef struct lr_flicker {
+    double amplitude;    /* relative intensity swing, 0..1; 0: steady */
+    double frequency_hz; /* dominant frequency */
+    double jitter_mm;    /* position sway amplitude; 0: the flame stays put */
+    unsigned seed;       /* phases */
+} lr_flicker;
+
+typedef struct lr_light {
+    char name[LR_SCENE_NAME_MAX];
+    enum lr_light_type type;
+    lr_vec3 position;  /* point, spot; mm */
+    lr_vec3 direction; /* spot, directional: unit, the way the light travels */
+    double inner_deg, outer_deg; /* spot: half-angles of full and zero intensity */
+    /* The scale the dimmer turns, kept apart from the light's shape (position, direction,
+     * cone, flicker) so that a renderer can rescale its result linearly. Point and spot:
+     * radiant intensity in W/sr (on axis for a spot); directional: the file's `radiance`,
+     * W/mm^2 on a surface facing the light. */
+    double intensity;
+    double color[3]; /* relative per band (not normalised): band b gets intensity * color[b] */
+    lr_flicker flicker;
+} lr_light;
+
+/* intensity * color. */
+void lr_light_rgb(const lr_light *l, double out[3]);
+/* The light's angular shape in travel direction dir (unit): 1 for a point light; for a spot
+ * 1 inside inner_deg, 0 outside outer_deg, smoothstep in the cosine between; for a
+ * directional light 1. */
+double lr_light_shape(const lr_light *l, lr_vec3 dir);
+/* Flicker at time t seconds: the factor on intensity (>= 0, mean 1) and the position offset
+ * (mm). Deterministic in (seed, t): a sum of three sines at incommensurate multiples of
+ * frequency_hz with seed-derived phases, so that replays and tests see the same flame. */
+void lr_light_flicker_at(const lr_light *l, double t, double *scale, lr_vec3 *offset);
+
+/* Whether a light is surrounded by an object: then the light G-buffer is a cube map and the
+ * radiosity sampling uses the stereographic correction (seed 003 Sec. 3.3).
+ *   SOLID: the light is inside the object's material (winding number >= 1/2: an LED cast in
+ *          wax);
+ *   HULL:  inside the object's convex hull but not its material: a flame in the melt pool
+ *          below the candle's rim, a bulb inside an open shade.
+ * Directional lights are never enclosed. */
+enum lr_enclosure { LR_ENCLOSURE_NONE, LR_ENCLOSURE_HULL, LR_ENCLOSURE_SOLID };
+
+/* ---- Camera ------------------------------------------------------------------------------- */
+
+typedef struct lr_camera {
+    bool orthographic;
+    lr_vec3 position, target, up;
+    double fov_deg;   /* perspective: vertical field of view */
+    double height_mm; /* orthographic: height of the view */
+    double near_mm, far_mm;
+} lr_camera;
+
+/* World to view (OpenGL conventions, render/base/mat4.h). A scene's camera always has one:
+ * position != target and up not along the view, checked on load and on every change. */
+void lr_camera_view(const lr_camera *c, double out[16]);
+/* View to clip for a viewport of the given aspect (width / height). */
+void lr_camera_projection(const lr_camera *c, double aspect, double out[16]);
+/* The same as float for glUniformMatrix4fv. */
+void lr_camera_view_f(const lr_camera *c, float out[16]);
+void lr_camera_projection_f(const lr_camera *c, double aspect, float out[16]);
+
+/* ---- Receivers ---------------------------------------------------------------------------- */
+
+enum lr_receiver_type { LR_RECEIVER_PLANE, LR_RECEIVER_BOX };
+
+typedef struct lr_receiver {
+    char name[LR_SCENE_NAME_MAX];
+    enum lr_receiver_type type;
+    double albedo[3];    /* diffuse reflectance per band, [0, 1] */
+    lr_vec3 center;      /* mm */
+    lr_vec3 normal;      /* plane: unit front normal */
+    lr_vec3 u_dir;       /* plane: unit direction of size[0] */
+    double size[3];      /* plane: w, h (size[2] = 0); box: x, y, z */
+    int subdivisions;    /* plane */
+    const lr_mesh *mesh; /* world space, front faces toward the scene */
+    const lr_bvh *bvh;
+} lr_receiver;
+
+/* ---- Settings ------------------------------------------------------------------------------ */
+
+typedef struct lr_render_settings {
+    int K;            /* scattered-radiosity maps */
+    int N;            /* samples per texel, band and frame */
+    int N_vpl;        /* virtual point lights */
+    int map_size;     /* radiosity map side, texels */
+    int gbuffer_size; /* light G-buffer side (each cube face when enclosed) */
+    int vpl_map_size; /* cube map of the outer surface that places the VPLs */
+    int frames;       /* progressive frames until converged */
+    double exposure;  /* multiplies radiance before tone mapping */
+} lr_render_settings;
+
+typedef struct lr_quality {
+    double max_error; /* relative RMS error budget; 0: none */
+    double frame_ms;  /* time budget per frame; 0: none */
+} lr_quality;
+
+/* ---- Loading ------------------------------------------------------------------------------- */
+
+/* Loads and validates a scene file, builds every mesh (world space) and BVH and resolves
+ * every material. Warnings (mesh repairs) go to warn, which may be NULL; the sink is kept for
+ * later changes and must stay valid for the scene's life. */
+int lr_scene_load(const char *path, const lr_warn_sink *warn, lr_scene **out, lr_err *e);
+/* The same from text; `name` is used in messages and relative mesh paths resolve against
+ * its directory. */
+int lr_scene_parse(const char *text, size_t len, const char *name, const lr_warn_sink *warn,
+                   lr_scene **out, lr_err *e);
+void lr_scene_destroy(lr_scene *s);
+
+const char *lr_scene_name(const lr_scene *s);
+const char *lr_scene_path(const lr_scene *s);
+
+/* Pointers into the scene stay valid until the next lr_scene_set() or destroy. */
+int lr_scene_object_count(const lr_scene *s);
+const lr_scene_object *lr_scene_object_at(const lr_scene *s, int i);
+int lr_scene_light_count(const lr_scene *s);
+const lr_light *lr_scene_light_at(const lr_scene *s, int i);
+int lr_scene_receiver_count(const lr_scene *s);
+const lr_receiver *lr_scene_receiver_at(const lr_scene *s, int i);
+const lr_camera *lr_scene_camera(const lr_scene *s);
+const lr_render_settings *lr_scene_render(const lr_scene *s);
+const lr_quality *lr_scene_quality(const lr_scene *s);
+/* Index of the object, light or receiver with that name; -1 when none. */
+int lr_scene_find_object(const lr_scene *s, const char *name);
+int lr_scene_find_light(const lr_scene *s, const char *name);
+int lr_scene_find_receiver(const lr_scene *s, const char *name);
+
+/* A sphere around every object (not the receivers). */
+void lr_scene_bounds(const lr_scene *s, lr_vec3 *center, double *radius);
+
+/* Whether light `light` is surrounded by an object (see lr_enclosure); *object receives the
+ * index of the (first) enclosing object, or -1. */
+enum lr_enclosure lr_scene_light_enclosure(const lr_scene *s, int light, int *object);
+
+/* ---- Changes ------------------------------------------------------------------------------- */
+
+/* Sets one parameter by its scene-file name (see the top of this file) from its text value,
+ * validated as the file would be; ORs the lr_dirty flags it implies into *dirty (which may be
+ * NULL). On error nothing changes and the message names the key. Setting a value equal to the
+ * current one still reports its flags (callers may want to re-render). A new material preset
+ * ("objects[0].material") replaces the whole material, scale included. */
+int lr_scene_set(lr_scene *s, const char *key, const char *value, unsigned *dirty, lr_err *e);
+
+/* "key=value" (a --set argument): split at the first '=' and lr_scene_set. */
+int lr_scene_set_assignment(lr_scene *s, const char *assignment, unsigned *dirty, lr_err *e);
+
+/* The current value of a parameter as lr_scene_set accepts it (for `lamprig scene get`, logs
+ * and event-script round trips). */
+int lr_scene_get(const lr_scene *s, const char *key, char *buf, size_t cap, lr_err *e);
+
+#endif

@@ -1,0 +1,111 @@
+/* lamprig — scene internals shared by the files of render/scene/ (not a public header). */
+#ifndef LR_SCENE_INTERNAL_H
+#define LR_SCENE_INTERNAL_H
+
+#include <limits.h>
+
+#include "render/mesh/shapes.h"
+#include "render/scene/scene.h"
+
+#define LR_SCENE_PATH_MAX 1024
+
+/* An object's material as the scene file (or the latest change) wrote it, so that a change of
+ * one field can be re-resolved through lr_material_from_json with the file's semantics. */
+typedef struct mat_spec {
+    bool is_preset; /* "material": "NAME" */
+    char preset[LR_MATERIAL_NAME_MAX];
+    /* Inline object fields (has_*: present). */
+    char name[LR_MATERIAL_NAME_MAX];
+    char source[LR_MATERIAL_SOURCE_MAX];
+    bool has_base, has_scale, has_sigma_a, has_sigma_s_prime, has_eta, has_g;
+    char base[LR_MATERIAL_NAME_MAX];
+    double scale[3];
+    double sigma_a[3], sigma_s_prime[3], eta, g;
+} mat_spec;
+
+/* An object's mesh as written: generator descriptors hold 0 for "default" so that defaults
+ * derived from other fields (pool_radius from radius) follow changes of those fields. */
+typedef struct mesh_spec {
+    enum lr_mesh_kind kind;
+    lr_candle_desc candle;
+    lr_shade_desc shade;
+    lr_sphere_desc sphere;
+    lr_box_desc box;
+    char path[LR_SCENE_PATH_MAX]; /* file: as written */
+    double file_scale;            /* file: default 1 */
+} mesh_spec;
+
+typedef struct xform_spec {
+    lr_vec3 translate, rotate_deg, scale;
+} xform_spec;
+
+typedef struct obj_rec {
+    lr_scene_object pub;
+    mat_spec mat;
+    mesh_spec mesh;
+    xform_spec xf;
+    lr_mesh *world;
+    lr_bvh *bvh;
+} obj_rec;
+
+typedef struct recv_rec {
+    lr_receiver pub;
+    lr_mesh *mesh;
+    lr_bvh *bvh;
+} recv_rec;
+
+struct lr_scene {
+    char name[LR_SCENE_NAME_MAX];
+    char path[LR_SCENE_PATH_MAX];
+    char dir[LR_SCENE_PATH_MAX]; /* where relative mesh paths start */
+    lr_warn_sink warn;
+    obj_rec *obj;
+    int nobj;
+    lr_light *light;
+    int nlight;
+    recv_rec *recv;
+    int nrecv;
+    lr_camera camera;
+    lr_render_settings render;
+    lr_quality quality;
+};
+
+/* ---- checks shared by the file and lr_scene_set (check.c) ---------------------------------
+ * Each returns LR_OK, or LR_EINVAL with a message (no location) and *field set to the name of
+ * the offending field inside the record ("intensity", "flicker.amplitude"). They may
+ * normalise (directions to unit length). */
+int lr_scene_check_light(lr_light *l, const char **field, lr_err *e);
+int lr_scene_check_camera(lr_camera *c, const char **field, lr_err *e);
+int lr_scene_check_receiver(lr_receiver *r, const char **field, lr_err *e);
+int lr_scene_check_render(lr_render_settings *r, const char **field, lr_err *e);
+int lr_scene_check_quality(const lr_quality *q, const char **field, lr_err *e);
+int lr_scene_check_transform(const xform_spec *x, const char **field, lr_err *e);
+/* Generator parameters (through the shapes' own checks) and the file mesh's scale. */
+int lr_scene_check_mesh(const mesh_spec *m, const char **field, lr_err *e);
+
+/* Defaults for a zero-initialised record (lights of the given type, camera, settings). */
+void lr_scene_light_defaults(lr_light *l, enum lr_light_type type);
+void lr_scene_camera_defaults(lr_camera *c);
+void lr_scene_render_defaults(lr_render_settings *r);
+
+/* ---- building (build.c) --------------------------------------------------------------------- */
+
+/* Builds the world mesh and BVH of an object from its mesh and transform specs (replacing
+ * nothing: the caller swaps them in on success). `where` names the object in messages. */
+int lr_scene_build_object(const lr_scene *s, const char *where, const mesh_spec *ms,
+                          const xform_spec *xf, lr_mesh **world, lr_bvh **bvh, double model[16],
+                          lr_err *e);
+int lr_scene_build_receiver(const lr_scene *s, lr_receiver *r, lr_mesh **mesh, lr_bvh **bvh,
+                            lr_err *e);
+/* Fills pub's mesh-derived fields (mesh, bvh, bounds, area, closed) from world and bvh. */
+void lr_scene_object_attach(lr_scene_object *pub, const lr_mesh *world, const lr_bvh *bvh);
+
+/* Resolves a material spec by writing it as JSON and reading it back through
+ * lr_material_from_json (the file's semantics, base and scale included); `where` names it. */
+int lr_scene_resolve_material(const mat_spec *ms, const char *where, lr_material *out,
+                              lr_err *e);
+
+/* Resolves a path relative to the scene's directory (absolute paths pass through). */
+int lr_scene_resolve_path(const lr_scene *s, const char *rel, char *out, size_t cap);
+
+#endif

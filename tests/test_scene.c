@@ -1,0 +1,662 @@
+/* Scenes: the shipped scene files, whether lights are surrounded, camera matrices, errors
+ * naming file, line and field, and run-time parameters with their dirty flags. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "render/base/mat4.h"
+#include "render/mesh/shapes.h"
+#include "render/scene/scene.h"
+
+typedef struct warnings {
+    int n;
+    char msg[8][LR_ERR_MSG_MAX];
+} warnings;
+
+static void collect(void *user, const char *msg)
+{
+    warnings *w = user;
+    if (w->n < 8)
+        snprintf(w->msg[w->n], sizeof w->msg[0], "%s", msg);
+    w->n++;
+}
+
+static void expect_msg(const lr_err *e, const char *needle)
+{
+    if (!strstr(e->msg, needle))
+        fail_msg("message '%s' lacks '%s'", e->msg, needle);
+}
+
+static lr_scene *load(const char *path)
+{
+    lr_scene *s = NULL;
+    lr_err e = {0};
+    warnings w = {0};
+    lr_warn_sink sink = {collect, &w};
+    if (lr_scene_load(path, &sink, &s, &e))
+        fail_msg("%s", e.msg);
+    /* The shipped scenes build without a single repair. */
+    if (w.n)
+        fail_msg("%s: unexpected warning: %s", path, w.msg[0]);
+    /* The sink must outlive the scene: later changes may warn. A changed mesh of the shipped
+     * scenes does not, so a dangling pointer would only matter then; keep none. */
+    lr_scene_destroy(s);
+    assert_int_equal(lr_scene_load(path, NULL, &s, &e), LR_OK);
+    return s;
+}
+
+static char tmpdir[64];
+
+static int setup(void **state)
+{
+    (void)state;
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/lr_scene_XXXXXX");
+    return mkdtemp(tmpdir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+/* Parses a scene text named tmpdir/t.json (relative mesh paths resolve in tmpdir). */
+static int parse(const char *text, lr_scene **s, lr_err *e)
+{
+    char name[128];
+    snprintf(name, sizeof name, "%s/t.json", tmpdir);
+    return lr_scene_parse(text, strlen(text), name, NULL, s, e);
+}
+
+static void get(const lr_scene *s, const char *key, const char *want)
+{
+    char buf[256];
+    lr_err e = {0};
+    if (lr_scene_get(s, key, buf, sizeof buf, &e))
+        fail_msg("get %s: %s", key, e.msg);
+    if (strcmp(buf, want) != 0)
+        fail_msg("get %s = '%s', expected '%s'", key, buf, want);
+}
+
+/* Sets key and asserts exactly the dirty flags `want` come back. */
+static void set_ok(lr_scene *s, const char *key, const char *value, unsigned want)
+{
+    unsigned d = 0;
+    lr_err e = {0};
+    if (lr_scene_set(s, key, value, &d, &e))
+        fail_msg("set %s=%s: %s", key, value, e.msg);
+    if (d != want)
+        fail_msg("set %s: dirty %#x, expected %#x", key, d, want);
+}
+
+/* Asserts a refused change: the message starts with the key and contains needle, the dirty
+ * mask is untouched and the value reads back as before. */
+static void set_bad(lr_scene *s, const char *key, const char *value, const char *needle)
+{
+    char before[256] = "", after[256] = "";
+    lr_err ge = {0};
+    bool readable = lr_scene_get(s, key, before, sizeof before, &ge) == LR_OK;
+    unsigned d = 0x100;
+    lr_err e = {0};
+    int rc = lr_scene_set(s, key, value, &d, &e);
+    if (rc == LR_OK)
+        fail_msg("set %s=%s accepted", key, value);
+    assert_int_equal(d, 0x100);
+    if (strncmp(e.msg, key, strlen(key)) != 0)
+        fail_msg("message '%s' does not start with the key '%s'", e.msg, key);
+    expect_msg(&e, needle);
+    if (readable) {
+        assert_int_equal(lr_scene_get(s, key, after, sizeof after, &ge), LR_OK);
+        assert_string_equal(before, after);
+    }
+}
+
+/* ---- shipped scenes ----------------------------------------------------------------------- */
+
+static void test_candle_scene(void **state)
+{
+    (void)state;
+    lr_scene *s = load("configs/scenes/candle.json");
+    assert_string_equal(lr_scene_name(s), "candle");
+    assert_int_equal(lr_scene_object_count(s), 1);
+    const lr_scene_object *o = lr_scene_object_at(s, 0);
+    assert_string_equal(o->name, "pillar");
+    assert_int_equal(o->kind, LR_MESH_CANDLE);
+    assert_true(o->closed);
+    /* A wax preset, scaled from a measured one (candle_wax = marble at half density). */
+    lr_material wax, marble;
+    lr_err e = {0};
+    assert_int_equal(lr_material_find("candle_wax", &wax, &e), LR_OK);
+    assert_int_equal(lr_material_find("marble", &marble, &e), LR_OK);
+    assert_string_equal(o->material.name, "candle_wax");
+    for (int b = 0; b < 3; b++) {
+        assert_true(o->material.medium.sigma_a[b] == wax.medium.sigma_a[b]);
+        assert_true(o->material.medium.sigma_s_prime[b] == 0.5 * marble.medium.sigma_s_prime[b]);
+        assert_true(o->coeffs.sigma_tr[b] > 0 && isfinite(o->coeffs.sigma_tr[b]));
+    }
+    /* A 70 mm pillar, 120 mm tall, standing on the table. */
+    lr_vec3 lo, hi;
+    lr_mesh_bounds(o->mesh, &lo, &hi);
+    assert_true(fabs(hi.x - lo.x - 70) < 1e-4 && fabs(hi.z - 120) < 1e-4 && fabs(lo.z) < 1e-9);
+    /* The flame: a point light in the melt pool, below the rim, above the pool's surface. */
+    assert_int_equal(lr_scene_light_count(s), 1);
+    const lr_light *l = lr_scene_light_at(s, 0);
+    assert_int_equal(l->type, LR_LIGHT_POINT);
+    assert_true(l->position.z < 120 && l->position.z > 112);
+    assert_true(l->flicker.amplitude > 0);
+    int obj = -2;
+    assert_int_equal(lr_scene_light_enclosure(s, 0, &obj), LR_ENCLOSURE_HULL);
+    assert_int_equal(obj, 0);
+    /* Wax surrounds it: every horizontal ray from the flame hits the wax, as does the ray
+     * down; only upward rays escape through the pool's opening. */
+    for (int k = 0; k < 16; k++) {
+        double a = 2 * M_PI * k / 16;
+        assert_true(lr_bvh_occluded(o->bvh, l->position, lr_v3(cos(a), sin(a), 0), 0, 1e4));
+    }
+    assert_true(lr_bvh_occluded(o->bvh, l->position, lr_v3(0, 0, -1), 0, 1e4));
+    assert_false(lr_bvh_occluded(o->bvh, l->position, lr_v3(0, 0, 1), 0, 1e4));
+    /* Table and wall. */
+    assert_int_equal(lr_scene_receiver_count(s), 2);
+    int t = lr_scene_find_receiver(s, "table"), w = lr_scene_find_receiver(s, "wall");
+    assert_true(t >= 0 && w >= 0);
+    const lr_receiver *table = lr_scene_receiver_at(s, t), *wall = lr_scene_receiver_at(s, w);
+    assert_true(table->normal.z == 1.0 && wall->normal.y == -1.0);
+    assert_true(table->albedo[0] > 0 && table->albedo[0] <= 1);
+    assert_true(fabs(lr_mesh_area(wall->mesh) - 1200.0 * 800.0) < 1e-6);
+    /* The wall stands behind the candle as the camera sees it. */
+    assert_true(wall->center.y > hi.y && lr_scene_camera(s)->position.y < lo.y);
+    const lr_render_settings *r = lr_scene_render(s);
+    assert_true(r->K == 16 && r->N == 16 && r->N_vpl == 64 && r->frames == 64);
+    assert_true(lr_scene_quality(s)->max_error == 0.05);
+    lr_scene_destroy(s);
+}
+
+static void test_lampshade_scene(void **state)
+{
+    (void)state;
+    lr_scene *s = load("configs/scenes/lampshade.json");
+    const lr_scene_object *o = lr_scene_object_at(s, 0);
+    assert_int_equal(o->kind, LR_MESH_SHADE);
+    assert_string_equal(o->material.name, "porcelain");
+    /* Shade ~150-250 mm across, open top and bottom: a ray up the axis leaves untouched. */
+    lr_vec3 lo, hi;
+    lr_mesh_bounds(o->mesh, &lo, &hi);
+    assert_true(hi.x - lo.x > 150 && hi.x - lo.x < 250);
+    const lr_light *bulb = lr_scene_light_at(s, 0);
+    assert_false(lr_bvh_occluded(o->bvh, bulb->position, lr_v3(0, 0, 1), 0, 1e4));
+    assert_false(lr_bvh_occluded(o->bvh, bulb->position, lr_v3(0, 0, -1), 0, 1e4));
+    /* Sideways through the middle of a facet (half a segment round, 3 mm off a ring): the
+     * inner and outer facets are the vertex radii's offset delta apart radially, which is
+     * delta cos(pi/96) at the facet's middle; 1e-4 mm covers float positions ~200 mm. */
+    lr_hit h1, h2;
+    double a = M_PI / 96;
+    lr_vec3 from = lr_v3_add(bulb->position, lr_v3(0, 0, 3)), dir = lr_v3(cos(a), sin(a), 0);
+    assert_true(lr_bvh_intersect(o->bvh, from, dir, 0, 1e4, &h1));
+    assert_true(lr_bvh_intersect(o->bvh, from, dir, h1.t + 1e-6, 1e4, &h2));
+    lr_shade_desc sd = {.radius_bottom = 110, .radius_top = 70, .height = 170, .thickness = 1.5,
+                        .segments = 96};
+    assert_true(fabs((h2.t - h1.t) - lr_shade_radial_offset(&sd) * cos(a)) < 1e-4);
+    /* The bulb is inside the shade's bounding volume (its convex hull), not in the porcelain. */
+    int obj;
+    assert_int_equal(lr_scene_light_enclosure(s, 0, &obj), LR_ENCLOSURE_HULL);
+    assert_int_equal(obj, 0);
+    assert_true(lr_scene_find_receiver(s, "table") >= 0 && lr_scene_find_receiver(s, "wall") >= 0);
+    lr_scene_destroy(s);
+}
+
+static void test_sphere_and_votive_scenes(void **state)
+{
+    (void)state;
+    lr_scene *s = load("configs/scenes/sphere.json");
+    const lr_scene_object *o = lr_scene_object_at(s, 0);
+    /* Non-absorbing: sigma_a = 0, so sigma_tr = 0 (albedo 1). */
+    for (int b = 0; b < 3; b++)
+        assert_true(o->material.medium.sigma_a[b] == 0.0 && o->coeffs.sigma_tr[b] == 0.0);
+    assert_int_equal(lr_scene_light_enclosure(s, 0, NULL), LR_ENCLOSURE_SOLID);
+    /* Defaults where the file is silent. */
+    const lr_render_settings *r = lr_scene_render(s);
+    assert_true(r->K == 16 && r->N == 16 && r->N_vpl == 64 && r->map_size == 256 &&
+                r->gbuffer_size == 256 && r->vpl_map_size == 64 && r->frames == 64);
+    assert_true(r->exposure == 1e3);
+    assert_int_equal(lr_scene_receiver_count(s), 0);
+    lr_scene_destroy(s);
+
+    /* A designer's mesh file, path relative to the scene; a scaled preset inline. */
+    s = load("configs/scenes/votive.json");
+    o = lr_scene_object_at(s, 0);
+    assert_int_equal(o->kind, LR_MESH_FILE);
+    assert_true(o->closed);
+    lr_material wax;
+    lr_err e = {0};
+    assert_int_equal(lr_material_find("candle_wax", &wax, &e), LR_OK);
+    for (int b = 0; b < 3; b++)
+        assert_true(fabs(o->material.medium.sigma_s_prime[b] - 1.5 * wax.medium.sigma_s_prime[b]) <
+                    1e-15);
+    assert_int_equal(lr_scene_light_enclosure(s, 0, NULL), LR_ENCLOSURE_HULL);
+    get(s, "objects[votive].material.scale", "1.5");
+    get(s, "objects[votive].mesh.path", "../meshes/votive.obj");
+    lr_scene_destroy(s);
+}
+
+static void test_camera_matrices(void **state)
+{
+    (void)state;
+    lr_scene *s = load("configs/scenes/candle.json");
+    const lr_camera *c = lr_scene_camera(s);
+    double v[16], p[16], vp[16];
+    lr_camera_view(c, v);
+    lr_camera_projection(c, 4.0 / 3.0, p);
+    /* The target lies on the view axis at its distance: exact up to rounding (1e-9 mm). */
+    lr_vec3 t = lr_mat4_point(v, c->target);
+    double dist = lr_v3_len(lr_v3_sub(c->target, c->position));
+    assert_true(fabs(t.x) < 1e-9 && fabs(t.y) < 1e-9 && fabs(t.z + dist) < 1e-9);
+    /* Up stays up: a point above the target projects above the centre. */
+    lr_mat4_mul(p, v, vp);
+    lr_vec3 ndc = lr_mat4_project(vp, c->target);
+    assert_true(fabs(ndc.x) < 1e-12 && fabs(ndc.y) < 1e-12 && ndc.z > -1 && ndc.z < 1);
+    assert_true(lr_mat4_project(vp, lr_v3_add(c->target, lr_v3(0, 0, 10))).y > 0);
+    /* The vertical field of view: a point at the top edge of the frustum maps to y = 1. */
+    double half = c->fov_deg / 2 * M_PI / 180;
+    lr_vec3 view_top = lr_v3(0, dist * tan(half), -dist);
+    double inv[16];
+    assert_int_equal(lr_mat4_inverse(v, inv), 0);
+    assert_true(fabs(lr_mat4_project(vp, lr_mat4_point(inv, view_top)).y - 1) < 1e-9);
+    /* The float versions are the double ones rounded. */
+    float vf[16], pf[16];
+    lr_camera_view_f(c, vf);
+    lr_camera_projection_f(c, 4.0 / 3.0, pf);
+    for (int i = 0; i < 16; i++)
+        assert_true(vf[i] == (float)v[i] && pf[i] == (float)p[i]);
+    /* Orthographic: the view height maps to [-1, 1]. */
+    unsigned d = 0;
+    lr_err e = {0};
+    assert_int_equal(lr_scene_set(s, "camera.type", "orthographic", &d, &e), LR_OK);
+    assert_int_equal(lr_scene_set(s, "camera.height_mm", "400", &d, &e), LR_OK);
+    lr_camera_projection(lr_scene_camera(s), 1.0, p);
+    lr_mat4_mul(p, v, vp);
+    lr_vec3 top = lr_mat4_point(inv, lr_v3(0, 200, -dist));
+    assert_true(fabs(lr_mat4_project(vp, top).y - 1) < 1e-9);
+    lr_scene_destroy(s);
+}
+
+static void test_light_shape_and_flicker(void **state)
+{
+    (void)state;
+    lr_light spot = {.type = LR_LIGHT_SPOT, .direction = lr_v3(0, 0, -1), .inner_deg = 20,
+                     .outer_deg = 30, .intensity = 2, .color = {1, 0.5, 0.25}};
+    double rgb[3];
+    lr_light_rgb(&spot, rgb);
+    assert_true(rgb[0] == 2 && rgb[1] == 1 && rgb[2] == 0.5);
+    assert_true(lr_light_shape(&spot, lr_v3(0, 0, -1)) == 1.0);
+    double a = 25 * M_PI / 180; /* halfway in angle: strictly between */
+    double mid = lr_light_shape(&spot, lr_v3(sin(a), 0, -cos(a)));
+    assert_true(mid > 0.0 && mid < 1.0);
+    a = 31 * M_PI / 180;
+    assert_true(lr_light_shape(&spot, lr_v3(sin(a), 0, -cos(a))) == 0.0);
+
+    lr_scene *s = load("configs/scenes/candle.json");
+    const lr_light *l = lr_scene_light_at(s, 0);
+    double s1, s2;
+    lr_vec3 o1, o2;
+    lr_light_flicker_at(l, 1.234, &s1, &o1);
+    lr_light_flicker_at(l, 1.234, &s2, &o2);
+    assert_true(s1 == s2 && o1.x == o2.x && o1.y == o2.y && o1.z == o2.z); /* deterministic */
+    /* Mean 1: the average of each sine over T = 100 s at >= 7 Hz is at most 1/(pi f T) <
+     * 5e-4 of its weight, sampling at 100 Hz aliases none of 7, 11.3, 19 Hz onto 0 Hz. So
+     * |mean - 1| < amplitude * 1e-3; the swing stays within the amplitude and the sway within
+     * jitter_mm. */
+    double sum = 0, lo = INFINITY, hi = -INFINITY, sway = 0;
+    for (int i = 0; i < 10000; i++) {
+        double f;
+        lr_vec3 off;
+        lr_light_flicker_at(l, i * 0.01, &f, &off);
+        sum += f;
+        lo = fmin(lo, f);
+        hi = fmax(hi, f);
+        sway = fmax(sway, lr_v3_len(off));
+    }
+    assert_true(fabs(sum / 10000 - 1) < l->flicker.amplitude * 1e-3);
+    assert_true(lo >= 1 - l->flicker.amplitude && hi <= 1 + l->flicker.amplitude);
+    assert_true(hi - lo > l->flicker.amplitude); /* it does flicker */
+    assert_true(sway > 0 && sway <= sqrt(2.0 + 1.0 / 9.0) * l->flicker.jitter_mm);
+    lr_scene_destroy(s);
+}
+
+/* ---- errors in files ---------------------------------------------------------------------- */
+
+/* A valid scene with a placeholder for one line of the object and one of the light. */
+static void scene_text(char *buf, size_t cap, const char *object_extra, const char *light_extra,
+                       const char *mesh)
+{
+    snprintf(buf, cap,
+             "{\n"                                                       /* 1 */
+             "  \"objects\": [\n"                                        /* 2 */
+             "    {\"name\": \"c\",\n"                                   /* 3 */
+             "     \"material\": \"candle_wax\",\n"                      /* 4 */
+             "     \"mesh\": %s%s\n"                                     /* 5 */
+             "    }\n"                                                   /* 6 */
+             "  ],\n"                                                    /* 7 */
+             "  \"lights\": [\n"                                         /* 8 */
+             "    {\"type\": \"point\", \"position\": [0, 0, 115],\n"    /* 9 */
+             "     \"intensity\": 0.01%s}\n"                             /* 10 */
+             "  ],\n"                                                    /* 11 */
+             "  \"camera\": {\"position\": [0, -400, 200],\n"            /* 12 */
+             "             \"target\": [0, 0, 60]}\n"                    /* 13 */
+             "}\n",
+             mesh ? mesh : "{\"type\": \"candle\"}", object_extra, light_extra);
+}
+
+static void expect_scene_error(const char *text, int code, const char *needle)
+{
+    lr_scene *s = NULL;
+    lr_err e = {0};
+    int rc = parse(text, &s, &e);
+    if (rc == LR_OK)
+        fail_msg("accepted:\n%s", text);
+    assert_null(s);
+    assert_int_equal(rc, code);
+    expect_msg(&e, needle);
+}
+
+static void test_file_errors_name_file_line_field(void **state)
+{
+    (void)state;
+    char t[2048];
+    lr_scene *s;
+    lr_err e = {0};
+    scene_text(t, sizeof t, "", "", NULL);
+    assert_int_equal(parse(t, &s, &e), LR_OK);
+    lr_scene_destroy(s);
+
+    /* Unknown field (a typo), on its line. */
+    scene_text(t, sizeof t, ",\n     \"colour\": [1, 1, 1]", "", NULL);
+    expect_scene_error(t, LR_EPARSE, "t.json:6: field 'colour': unknown field in objects[0]");
+    /* Wrong type. */
+    scene_text(t, sizeof t, "", ", \"color\": \"warm\"", NULL);
+    expect_scene_error(t, LR_EPARSE, "t.json:10: field 'lights[0].color': expected an array, "
+                                     "got a string");
+    /* A duplicate field (the second would silently win in a lax reader). */
+    scene_text(t, sizeof t, "", ",\n     \"intensity\": -1", NULL);
+    expect_scene_error(t, LR_EPARSE, "t.json:11: field 'intensity': duplicate field in lights[0]");
+    /* A value out of range, at its own line. */
+    snprintf(t, sizeof t, "{\"objects\": [{\"material\": \"candle_wax\", \"mesh\": {\"type\": "
+             "\"sphere\"}}],\n \"lights\": [{\"type\": \"point\", \"position\": [0,0,0],\n"
+             " \"intensity\": -1}],\n \"camera\": {\"position\": [0,-1,0], \"target\": [0,0,0]}}");
+    expect_scene_error(t, LR_EINVAL, "t.json:3: field 'lights[0].intensity': must be >= 0 "
+                                     "(W/sr), got -1");
+    /* Missing material; unknown preset; an inline material's own error. */
+    snprintf(t, sizeof t, "{\"objects\": [\n {\"mesh\": {\"type\": \"sphere\"}}],\n"
+             " \"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"intensity\": 1}],\n"
+             " \"camera\": {\"position\": [0,-1,0], \"target\": [0,0,0]}}");
+    expect_scene_error(t, LR_EPARSE, "t.json:2: field 'objects[0].material': missing (required");
+    scene_text(t, sizeof t, "", "", NULL);
+    char *m = strstr(t, "candle_wax");
+    memcpy(m, "candlewax_", 10);
+    expect_scene_error(t, LR_EIO, "t.json:4: field 'objects[0].material': no usable preset "
+                                  "'candlewax_'");
+    /* Mesh parameters: the generator's check, at the parameter's line. */
+    scene_text(t, sizeof t, "", "",
+               "{\"type\": \"candle\",\n       \"height\": 100, \"pool_depth\": 120}");
+    expect_scene_error(t, LR_EINVAL, "t.json:6: field 'objects[0].mesh.pool_depth': must be > 0 "
+                                     "and < height (100 mm), got 120");
+    scene_text(t, sizeof t, "", "", "{\"type\": \"cylinder\"}");
+    expect_scene_error(t, LR_EINVAL, "t.json:5: field 'objects[0].mesh.type': unknown type "
+                                     "'cylinder' (one of: candle, shade, sphere, box, file)");
+    /* A mesh file that is not there: the path in the scene, then the reason. */
+    scene_text(t, sizeof t, "", "", "{\"type\": \"file\",\n  \"path\": \"nope.ply\"}");
+    expect_scene_error(t, LR_EIO, "t.json:6: field 'objects[0].mesh.path': ");
+    expect_scene_error(t, LR_EIO, "nope.ply: cannot open");
+    /* A broken mesh file: its own file and line come through. */
+    char mp[128];
+    snprintf(mp, sizeof mp, "%s/bad.obj", tmpdir);
+    FILE *f = fopen(mp, "w");
+    fputs("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", f);
+    fclose(f);
+    scene_text(t, sizeof t, "", "", "{\"type\": \"file\", \"path\": \"bad.obj\"}");
+    expect_scene_error(t, LR_EINVAL, "bad.obj:4: vertex index 4 out of range (3 vertices)");
+    /* Cross-field checks: a spot's inner cone wider than its outer one. */
+    snprintf(t, sizeof t, "{\"objects\": [{\"material\": \"candle_wax\", \"mesh\": {\"type\": "
+             "\"sphere\"}}],\n \"lights\": [{\"type\": \"spot\", \"position\": [0,0,200], "
+             "\"direction\": [0,0,-1],\n \"inner_deg\": 40, \"outer_deg\": 30, \"intensity\": 1}],\n"
+             " \"camera\": {\"position\": [0,-1,0], \"target\": [0,0,0]}}");
+    expect_scene_error(t, LR_EINVAL, "t.json:3: field 'lights[0].inner_deg': must be in (0, "
+                                     "outer_deg = 30] degrees, got 40");
+    /* A camera looking nowhere; an albedo above 1; duplicate names; nothing lit. */
+    snprintf(t, sizeof t, "{\"objects\": [{\"material\": \"candle_wax\", \"mesh\": {\"type\": "
+             "\"sphere\"}}],\n \"lights\": [{\"type\": \"point\", \"position\": [0,0,0], "
+             "\"intensity\": 1}],\n \"camera\": {\"position\": [0,0,9],\n \"target\": [0,0,9]}}");
+    expect_scene_error(t, LR_EINVAL, "t.json:4: field 'camera.target': must differ from position");
+    snprintf(t, sizeof t, "{\"objects\": [{\"material\": \"candle_wax\", \"mesh\": {\"type\": "
+             "\"sphere\"}}],\n \"lights\": [{\"type\": \"point\", \"position\": [0,0,0], "
+             "\"intensity\": 1}],\n \"camera\": {\"position\": [0,-1,0], \"target\": [0,0,0]},\n"
+             " \"receivers\": [{\"type\": \"plane\", \"center\": [0,0,0], \"normal\": [0,0,1], "
+             "\"size\": [1, 1],\n \"albedo\": [1.2, 0.5, 0.5]}]}");
+    expect_scene_error(t, LR_EINVAL, "t.json:5: field 'receivers[0].albedo': each band must be "
+                                     "in [0, 1]");
+    snprintf(t, sizeof t, "{\"objects\": [{\"name\": \"a\", \"material\": \"marble\", \"mesh\": "
+             "{\"type\": \"sphere\"}},\n {\"name\": \"a\", \"material\": \"marble\", \"mesh\": "
+             "{\"type\": \"box\"}}],\n \"lights\": [{\"type\": \"point\", \"position\": [0,0,0], "
+             "\"intensity\": 1}],\n \"camera\": {\"position\": [0,-1,0], \"target\": [0,0,0]}}");
+    expect_scene_error(t, LR_EINVAL, "t.json:2: field 'objects[1].name': 'a' is already the name "
+                                     "of objects[0]");
+    snprintf(t, sizeof t, "{\"objects\": [{\"material\": \"marble\", \"mesh\": {\"type\": "
+             "\"sphere\"}}],\n \"lights\": [],\n \"camera\": {\"position\": [0,-1,0], "
+             "\"target\": [0,0,0]}}");
+    expect_scene_error(t, LR_EPARSE, "t.json:2: field 'lights': must not be empty");
+    /* Not JSON at all. */
+    expect_scene_error("{\"objects\": [", LR_EPARSE, "t.json:1: unexpected end of file");
+    /* A file that is not there. */
+    assert_int_equal(lr_scene_load("configs/scenes/no_such.json", NULL, &s, &e), LR_EIO);
+    expect_msg(&e, "configs/scenes/no_such.json: cannot open");
+}
+
+/* ---- parameters -------------------------------------------------------------------------------- */
+
+static void test_set_dirty_flags(void **state)
+{
+    (void)state;
+    lr_scene *s = load("configs/scenes/candle.json");
+    const lr_scene_object *o = lr_scene_object_at(s, 0);
+    const lr_light *l = lr_scene_light_at(s, 0);
+
+    /* Dimmer: composition only, and the value is what was set. */
+    set_ok(s, "light.intensity", "0.0025", LR_DIRTY_INTENSITY);
+    assert_true(l->intensity == 0.0025);
+    get(s, "lights[0].intensity", "0.0025");
+    assert_int_equal(lr_dirty_passes(LR_DIRTY_INTENSITY), LR_PASS_COMPOSE);
+    set_ok(s, "lights[flame].color", "1,0.5,0.25", LR_DIRTY_INTENSITY);
+    assert_true(l->color[1] == 0.5);
+    set_ok(s, "lights[0].flicker.amplitude", "0.2", LR_DIRTY_INTENSITY);
+
+    /* The flame moves: everything; flicker that sways is light geometry too. */
+    set_ok(s, "lights[0].position", "[0, 0, 116]", LR_DIRTY_LIGHT_GEOMETRY);
+    assert_true(l->position.z == 116);
+    set_ok(s, "lights[0].flicker.jitter_mm", "0.5", LR_DIRTY_LIGHT_GEOMETRY);
+    set_ok(s, "lights[0].flicker.frequency_hz", "9", LR_DIRTY_INTENSITY | LR_DIRTY_LIGHT_GEOMETRY);
+    assert_int_equal(lr_dirty_passes(LR_DIRTY_LIGHT_GEOMETRY),
+                     LR_PASS_GBUFFER | LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_COMPOSE);
+
+    /* Materials: maps, VPLs and composition, not the light's G-buffer. */
+    lr_material marble;
+    lr_err e = {0};
+    assert_int_equal(lr_material_find("marble", &marble, &e), LR_OK);
+    set_ok(s, "objects[0].material", "marble", LR_DIRTY_MATERIAL);
+    assert_string_equal(o->material.name, "marble");
+    set_ok(s, "objects[pillar].material.scale", "2", LR_DIRTY_MATERIAL);
+    for (int b = 0; b < 3; b++) /* x2 is exact in binary */
+        assert_true(o->material.medium.sigma_s_prime[b] == 2 * marble.medium.sigma_s_prime[b]);
+    get(s, "objects[0].material.scale", "2");
+    get(s, "objects[0].material", "marble");
+    set_ok(s, "objects[0].material.scale", "0.5,1,2", LR_DIRTY_MATERIAL);
+    assert_true(o->material.medium.sigma_a[0] == 0.5 * marble.medium.sigma_a[0] &&
+                o->material.medium.sigma_a[2] == 2 * marble.medium.sigma_a[2]);
+    set_ok(s, "objects[0].material.eta", "1.3", LR_DIRTY_MATERIAL);
+    assert_true(o->material.medium.eta == 1.3 && o->coeffs.eta == 1.3);
+    set_ok(s, "objects[0].material.sigma_a", "0.01,0.02,0.03", LR_DIRTY_MATERIAL);
+    assert_true(o->material.medium.sigma_a[1] == 0.02); /* an override is not scaled */
+    get(s, "objects[0].material.sigma_a", "0.01,0.02,0.03");
+    /* A new preset replaces the whole material, scale included. */
+    set_ok(s, "objects[0].material", "candle_wax", LR_DIRTY_MATERIAL);
+    get(s, "objects[0].material.scale", "1");
+    assert_int_equal(lr_dirty_passes(LR_DIRTY_MATERIAL),
+                     LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_COMPOSE);
+
+    /* View and receivers: composition only. */
+    set_ok(s, "camera.position", "0,-500,250", LR_DIRTY_CAMERA);
+    set_ok(s, "camera.fov_deg", "30", LR_DIRTY_CAMERA);
+    assert_int_equal(lr_dirty_passes(LR_DIRTY_CAMERA), LR_PASS_COMPOSE);
+    set_ok(s, "receivers[wall].albedo", "0.5,0.5,0.5", LR_DIRTY_RECEIVERS);
+    set_ok(s, "receivers[table].center", "0,-75,-1", LR_DIRTY_RECEIVERS);
+    assert_true(lr_mesh_vertex(lr_scene_receiver_at(s, 0)->mesh, 0).z == -1.0);
+    assert_int_equal(lr_dirty_passes(LR_DIRTY_RECEIVERS), LR_PASS_COMPOSE);
+    set_ok(s, "render.exposure", "1e6", LR_DIRTY_DISPLAY);
+    assert_int_equal(lr_dirty_passes(LR_DIRTY_DISPLAY), LR_PASS_COMPOSE);
+    set_ok(s, "render.K", "32", LR_DIRTY_SETTINGS);
+    assert_int_equal(lr_scene_render(s)->K, 32);
+    set_ok(s, "render.K", "0", LR_DIRTY_SETTINGS); /* 0: the default, as in the file */
+    assert_int_equal(lr_scene_render(s)->K, 16);
+    set_ok(s, "quality.max_error", "0.02", LR_DIRTY_SETTINGS);
+
+    /* Geometry: everything, and the mesh and its BVH are rebuilt. Deeper pool: a ray down the
+     * axis meets the wax at 120 - 12 (float positions: 1e-5 mm). */
+    set_ok(s, "objects[0].mesh.pool_depth", "12", LR_DIRTY_GEOMETRY);
+    lr_hit h;
+    assert_true(lr_bvh_intersect(o->bvh, lr_v3(0, 0, 200), lr_v3(0, 0, -1), 0, 1e4, &h));
+    assert_true(fabs(200 - h.t - 108) < 1e-5);
+    get(s, "objects[0].mesh.pool_depth", "12");
+    set_ok(s, "objects[0].transform.translate", "100,0,0", LR_DIRTY_GEOMETRY);
+    assert_true(fabs(o->center.x - 100) < 1e-4);
+    assert_int_equal(lr_dirty_passes(LR_DIRTY_GEOMETRY),
+                     LR_PASS_GBUFFER | LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_COMPOSE);
+    /* The flame stayed at the origin: now outside the moved candle's hull. */
+    assert_int_equal(lr_scene_light_enclosure(s, 0, NULL), LR_ENCLOSURE_NONE);
+    set_ok(s, "light.position", "100,0,60", LR_DIRTY_LIGHT_GEOMETRY); /* in the wax */
+    assert_int_equal(lr_scene_light_enclosure(s, 0, NULL), LR_ENCLOSURE_SOLID);
+    set_ok(s, "objects[0].mesh.pool_depth", "0", LR_DIRTY_GEOMETRY); /* flat top */
+    get(s, "objects[0].mesh.pool_depth", "0");
+
+    /* Flags accumulate in the caller's mask; an empty mask needs no pass. */
+    unsigned d = 0;
+    assert_int_equal(lr_scene_set(s, "light.intensity", "0.005", &d, &e), LR_OK);
+    assert_int_equal(lr_scene_set(s, "camera.far", "5000", &d, &e), LR_OK);
+    assert_int_equal(d, LR_DIRTY_INTENSITY | LR_DIRTY_CAMERA);
+    assert_int_equal(lr_dirty_passes(d), LR_PASS_COMPOSE);
+    assert_int_equal(lr_dirty_passes(0), 0);
+    assert_string_equal(lr_dirty_name(LR_DIRTY_MATERIAL), "material");
+    /* --set KEY=VALUE: split at the first '='. */
+    d = 0;
+    assert_int_equal(lr_scene_set_assignment(s, "render.exposure=2e6", &d, &e), LR_OK);
+    assert_true(lr_scene_render(s)->exposure == 2e6 && d == LR_DIRTY_DISPLAY);
+    assert_int_equal(lr_scene_set_assignment(s, "render.exposure", &d, &e), LR_EINVAL);
+    expect_msg(&e, "'render.exposure': expected KEY=VALUE");
+    lr_scene_destroy(s);
+}
+
+static void test_set_rejects_bad_values(void **state)
+{
+    (void)state;
+    lr_scene *s = load("configs/scenes/candle.json");
+    set_bad(s, "light.intensity", "-1", "must be >= 0 (W/sr), got -1");
+    set_bad(s, "light.intensity", "abc", "expected a number, got 'abc'");
+    set_bad(s, "light.intensity", "nan", "expected a number");
+    set_bad(s, "light.intensity", "0x10", "expected a number");
+    set_bad(s, "light.intensity", "1 2", "expected a number");
+    set_bad(s, "lights[0].position", "1,2", "expected x,y,z (three numbers), got '1,2'");
+    set_bad(s, "lights[0].position", "1,2,1e999", "expected x,y,z");
+    set_bad(s, "lights[0].radiance", "1", "a point light's strength is its 'intensity'");
+    set_bad(s, "lights[0].outer_deg", "10", "a point light has no parameter 'outer_deg'");
+    set_bad(s, "lights[3].intensity", "1", "index 3 out of range (the scene has 1 lights)");
+    set_bad(s, "lights[candle].intensity", "1", "no lights named 'candle'");
+    set_bad(s, "lights[0].flicker.amplitude", "1.5", "must be in [0, 1], got 1.5");
+    set_bad(s, "objects[0].material", "no_such", "objects[0].material: no usable preset 'no_such'");
+    set_bad(s, "objects[0].material", "../configs/x", "is not a name");
+    set_bad(s, "objects[0].material.scale", "0", "must be > 0, got 0");
+    set_bad(s, "objects[0].material.scale", "1,2", "expected a number or x,y,z");
+    set_bad(s, "objects[0].material.eta", "9", "eta");
+    set_bad(s, "objects[0].material.g", "1", "g");
+    set_bad(s, "objects[0].material.colour", "1", "a material has no parameter 'colour'");
+    set_bad(s, "objects[0].mesh.pool_depth", "130",
+            "objects[0].mesh.pool_depth: must be > 0 and < height (120 mm), got 130");
+    /* The scene file set pool_radius to 31: a 20 mm radius would leave it outside. */
+    set_bad(s, "objects[0].mesh.radius", "20",
+            "then pool_radius must be > 0 and <= radius (20 mm), got 31");
+    set_bad(s, "objects[0].mesh.type", "sphere", "cannot change");
+    set_bad(s, "objects[0].mesh.thickness", "2", "a candle mesh has no parameter 'thickness'");
+    set_bad(s, "objects[0].transform.scale", "0", "must be > 0 (no mirroring)");
+    set_bad(s, "camera.target", "0,-450,230", "must differ from position");
+    set_bad(s, "camera.up", "0,0,0", "must be a non-zero vector");
+    set_bad(s, "camera.fov_deg", "180", "must be in (0, 180) degrees");
+    set_bad(s, "render.K", "1000", "must be between 1 and 256, got 1000");
+    set_bad(s, "render.K", "2.5", "expected an integer");
+    set_bad(s, "render.exposure", "-1", "must be > 0");
+    set_bad(s, "receivers[wall].albedo", "1.2,0.5,0.5", "each band must be in [0, 1]");
+    set_bad(s, "receivers[wall].size", "0,100", "must be > 0 mm");
+    set_bad(s, "nonsense.x", "1", "unknown parameter");
+    set_bad(s, "objects.material", "marble", "expected objects[INDEX or NAME].PARAMETER");
+    set_bad(s, "camera[0].fov_deg", "30", "'camera' takes no index");
+    /* After all that, the scene is as loaded. */
+    get(s, "light.intensity", "0.005");
+    get(s, "objects[0].mesh.pool_depth", "8");
+    get(s, "objects[0].material", "candle_wax");
+    lr_scene_destroy(s);
+}
+
+static void test_set_shade_and_file_mesh(void **state)
+{
+    (void)state;
+    lr_scene *s = load("configs/scenes/lampshade.json");
+    const lr_scene_object *o = lr_scene_object_at(s, 0);
+    assert_true(o->closed);
+    /* A thicker wall: the shell's volume grows in proportion (Pappus, see test_mesh). */
+    double v1 = lr_mesh_volume(o->mesh);
+    set_ok(s, "objects[shade].mesh.thickness", "2", LR_DIRTY_GEOMETRY);
+    double ratio = lr_mesh_volume(o->mesh) / v1;
+    assert_true(ratio > 1.3 && ratio < 1.34); /* 2/1.5 less the thinner inner radius */
+    /* Without rims it is open; zero thickness is a single surface. The bulb stays inside the
+     * bounding volume either way. */
+    set_ok(s, "objects[shade].mesh.rims", "false", LR_DIRTY_GEOMETRY);
+    assert_false(o->closed);
+    get(s, "objects[shade].mesh.rims", "false");
+    set_ok(s, "objects[shade].mesh.thickness", "0", LR_DIRTY_GEOMETRY);
+    lr_mesh_report rep;
+    lr_mesh_analyze(o->mesh, &rep);
+    assert_int_equal(rep.boundary_loops, 2);
+    assert_int_equal(lr_scene_light_enclosure(s, 0, NULL), LR_ENCLOSURE_HULL);
+    get(s, "objects[0].mesh.thickness", "0");
+    get(s, "objects[0].mesh.radius_top", "70");
+    lr_scene_destroy(s);
+
+    s = load("configs/scenes/votive.json");
+    set_bad(s, "objects[0].mesh.path", "missing.obj", "missing.obj: cannot open");
+    set_ok(s, "objects[0].mesh.scale", "1.5", LR_DIRTY_GEOMETRY);
+    lr_vec3 lo, hi;
+    lr_mesh_bounds(lr_scene_object_at(s, 0)->mesh, &lo, &hi);
+    assert_true(fabs(hi.z - 1.5 * 65) < 1e-4);
+    lr_scene_destroy(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_candle_scene),
+        cmocka_unit_test(test_lampshade_scene),
+        cmocka_unit_test(test_sphere_and_votive_scenes),
+        cmocka_unit_test(test_camera_matrices),
+        cmocka_unit_test(test_light_shape_and_flicker),
+        cmocka_unit_test(test_file_errors_name_file_line_field),
+        cmocka_unit_test(test_set_dirty_flags),
+        cmocka_unit_test(test_set_rejects_bad_values),
+        cmocka_unit_test(test_set_shade_and_file_mesh),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
