@@ -400,4 +400,16 @@ int lr_ref_render_cached(const lr_ref_scene *s, const lr_ref_camera *cam,
 int lr_ref_scene_load(const char *path, lr_ref_scene **out, lr_ref_camera *cam,
                       lr_ref_render_desc *d, lr_err *e);
 
+/* The reference scene of a project scene (render/scene: configs/scenes/NAME.json) and its
+ * camera: each object's world mesh bounds its material (outside: air), each receiver's mesh
+ * is a receiver (planes moved 1 um away from the scene so that a candle standing on the
+ * table does not share its plane), point and spot lights at their steady intensity times
+ * colour (flicker is a display effect). The object meshes are borrowed: sc must outlive the
+ * returned scene and not change meanwhile. Directional lights and orthographic cameras have
+ * no counterpart here (LR_EUNSUPPORTED); an object that is not watertight cannot bound its
+ * material (LR_EINVAL). */
+typedef struct lr_scene lr_scene;
+int lr_ref_scene_from_scene(const lr_scene *sc, lr_ref_scene **out, lr_ref_camera *cam,
+                            lr_err *e);
+
 #endif
