@@ -53,7 +53,7 @@
 /* Version of the transport code; part of every cache key. Bump it whenever a change alters
  * what a given scene renders to (a bug fix, a new estimator), so stale references are not
  * reused. */
-#define LR_REF_VERSION "lamprig-reference 1"
+#define LR_REF_VERSION "lamprig-reference 2"
 
 /* Most refractive interfaces a next-event connection may pass through (e.g. 2 for the outer
  * and inner surface of a lamp shade between a receiver and the bulb). Longer chains are left
