@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "render/reference/ref_priv.h"
+#include "render/scene/scene.h"
 
 /* A small lamp-like scene: a scattering sphere (n = 1.4) with an air cavity around a point
  * light, on a floor, with a wall, and a disk light; chromatic media so that colour groups are
@@ -382,6 +383,61 @@ static void test_scene_validation(void **state)
     lr_ref_scene_destroy(s);
 }
 
+/* Project scenes (configs/scenes) become reference scenes: the shipped candle keeps its
+ * object (a wax boundary), its two receivers and its flame (in the air of the melt pool, at
+ * intensity times colour), and renders finite, non-negative radiance with light on it; what
+ * the reference cannot represent is refused by name. */
+static void test_from_project_scene(void **state)
+{
+    (void)state;
+    lr_scene *sc;
+    lr_err e = {0};
+    assert_int_equal(lr_scene_load(LR_SOURCE_CONFIGS "/scenes/candle.json", NULL, &sc, &e),
+                     LR_OK);
+    lr_ref_scene *s;
+    lr_ref_camera cam;
+    assert_int_equal(lr_ref_scene_from_scene(sc, &s, &cam, &e), LR_OK);
+    assert_int_equal(s->n_objects, 3);
+    assert_int_equal(s->objects[0].kind, LR_REF_SURF_BOUNDARY);
+    assert_int_equal(s->objects[1].kind, LR_REF_SURF_RECEIVER);
+    assert_int_equal(s->n_lights, 1);
+    assert_int_equal(s->lights[0].medium, 0); /* the flame burns in air */
+    double rgb[3];
+    lr_light_rgb(lr_scene_light_at(sc, 0), rgb);
+    assert_true(s->lights[0].d.emission[0] == rgb[0] && s->lights[0].d.emission[2] == rgb[2]);
+    assert_true(s->media[1].eta > 1.4 && s->media[1].sigma_s[0] > 0.0);
+    assert_true(cam.fov_y_deg == lr_scene_camera(sc)->fov_deg);
+    lr_ref_render_desc d = {.width = 16, .height = 12, .spp = 2, .seed = 1};
+    lr_ref_render *r;
+    assert_int_equal(lr_ref_render_create(s, &cam, &d, &r, NULL), LR_OK);
+    assert_int_equal(lr_ref_render_run(r, NULL, NULL, NULL), LR_OK);
+    lr_ref_image m;
+    assert_int_equal(lr_ref_render_mean(r, &m, NULL), LR_OK);
+    int lit = 0;
+    for (size_t i = 0; i < npix3(&m); i++) {
+        assert_true(isfinite(m.rgb[i]) && m.rgb[i] >= 0.0f);
+        lit += m.rgb[i] > 0.0f;
+    }
+    assert_true(lit > 16);
+    assert_int_equal(lr_ref_render_stats(r)->medium_mismatch, 0);
+    lr_ref_image_free(&m);
+    lr_ref_render_destroy(r);
+    lr_ref_scene_destroy(s);
+    lr_scene_destroy(sc);
+
+    static const char directional[] =
+        "{\"objects\": [{\"material\": \"marble\", \"mesh\": {\"type\": \"sphere\"}}],\n"
+        " \"lights\": [{\"type\": \"directional\", \"name\": \"sun\",\n"
+        "   \"direction\": [0, 0, -1], \"radiance\": 1}],\n"
+        " \"camera\": {\"position\": [0, -300, 0], \"target\": [0, 0, 0]}}\n";
+    assert_int_equal(lr_scene_parse(directional, sizeof directional - 1, "sun.json", NULL, &sc,
+                                    &e), LR_OK);
+    assert_int_equal(lr_ref_scene_from_scene(sc, &s, &cam, &e), LR_EUNSUPPORTED);
+    assert_null(s);
+    assert_non_null(strstr(e.msg, "sun"));
+    lr_scene_destroy(sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -392,6 +448,7 @@ int main(void)
         cmocka_unit_test(test_cache_reuse),
         cmocka_unit_test(test_scene_file),
         cmocka_unit_test(test_scene_validation),
+        cmocka_unit_test(test_from_project_scene),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,11 +1,6 @@
 /* Photons: the same transport steps run forward from a source, carrying flux. */
 #include "render/reference/ref_priv.h"
 
-static double max3(const double v[3])
-{
-    return fmax(v[0], fmax(v[1], v[2]));
-}
-
 void lr_ref_photon_walk(const lr_ref_scene *s, lr_ref_walker w, int mask, int hero,
                         lr_ref_rng *rng, lr_ref_stats *st, lr_ref_photon_visit visit,
                         void *user, lr_ref_photon_exit *out, double beta[3])
@@ -72,7 +67,7 @@ void lr_ref_photon_walk(const lr_ref_scene *s, lr_ref_walker w, int mask, int he
         }
         /* Russian roulette (unbiased): below the threshold survive with probability m / t at
          * throughput scaled by t / m (MCML's scheme, Wang, Jacques, Zheng 1995, Sec. 3.8). */
-        double m = max3(beta);
+        double m = lr_ref_max3(beta);
         if (m < LR_REF_RR_THRESHOLD) {
             if (!(lr_ref_rng_uniform(rng) * LR_REF_RR_THRESHOLD < m))
                 break;

@@ -8,8 +8,10 @@
  *   (b) the walk hitting an area light, for paths (a) cannot produce: no non-specular vertex
  *       yet (camera -> [specular chain] -> light), a Fresnel reflection since the last one, a
  *       longer chain, or a chain whose interface sequence differs from the straight
- *       segment's (lr_ref_chain_topology).
- * Point and spot lights are reached by (a) only, since no walk can hit them.
+ *       segment's (lr_ref_chain_topology);
+ *   (c) in renders, light tracing (lighttrace.c) for point and spot lights whose light meets
+ *       a Fresnel reflection before its first non-specular vertex, which (a) cannot connect
+ *       and no walk can hit.
  *
  * Inside media the walk samples free paths with the hero band's sigma_t and weights by the
  * single-scattering albedo at each collision (the walk is analogue in the hero band; the
@@ -33,11 +35,6 @@ typedef struct last_vertex {
     int medium;
     int chain;    /* refractive interfaces since */
 } last_vertex;
-
-static double max3(const double v[3])
-{
-    return fmax(v[0], fmax(v[1], v[2]));
-}
 
 /* A free-flight segment in a medium: where the walk left from, and how far the next surface
  * is. */
@@ -177,7 +174,7 @@ static bool nee_covers(const lr_ref_scene *s, const last_vertex *v, const lr_ref
 /* Russian roulette on the path throughput; false when the path ends. */
 static bool roulette(double beta[3], lr_ref_rng *rng)
 {
-    double m = max3(beta);
+    double m = lr_ref_max3(beta);
     if (m >= LR_REF_RR_THRESHOLD)
         return true;
     double q = m / LR_REF_RR_THRESHOLD;

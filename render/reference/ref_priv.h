@@ -78,6 +78,11 @@ typedef struct lr_ref_surf {
     int object;
 } lr_ref_surf;
 
+static inline double lr_ref_max3(const double v[3])
+{
+    return fmax(v[0], fmax(v[1], v[2]));
+}
+
 /* Self-intersection guard for rays leaving a surface: relative to the coordinates' magnitude
  * so it stays far above double rounding (1e-16 relative) and far below any mean free path of
  * interest (scenes are metres at most: 1e-9 * 1e3 mm = 1 nm). */

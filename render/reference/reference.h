@@ -16,15 +16,18 @@
  *              lights;
  *   camera     pinhole, box-filtered pixels.
  *
- * Estimators (see README "Physical reference" for the derivations):
+ * Estimators (README "Physical reference"; each light path is counted by exactly one):
  *   - camera paths (lr_ref_radiance, lr_ref_render): unidirectional random walk from the
  *     camera with next-event estimation (NEE) at every non-specular vertex: diffuse receivers
  *     and scattering events inside media. NEE toward a light behind smooth refractive
  *     boundaries (a flame enclosed by wax, a bulb inside a shade) solves for the refracted
- *     connection path by Newton's method on the light's emission direction and weights it
+ *     connection path (planar steps, then Newton on the emission direction) and weights it
  *     with the exact ray-tube (generalised geometry) Jacobian: a point light enclosed by a
  *     dielectric is otherwise unreachable by any unidirectional estimator. Hits on area
- *     lights count only for paths NEE cannot produce, so no path is counted twice.
+ *     lights count only for paths NEE cannot produce. A point light inside a scattering
+ *     medium adds equiangular distance samples (MIS with free flights).
+ *   - light tracing (renders): photons from point and spot lights whose first specular event
+ *     is a Fresnel reflection, connected to the pinhole at each non-specular vertex.
  *   - photons (lr_ref_photon_trace): the same transport functions run forward from a source;
  *     "photon in, count what comes out" estimators validate them against published slab
  *     solutions and closed-form sphere results (lr_ref_slab_rt, lr_ref_sphere_escape).
@@ -50,7 +53,7 @@
 /* Version of the transport code; part of every cache key. Bump it whenever a change alters
  * what a given scene renders to (a bug fix, a new estimator), so stale references are not
  * reused. */
-#define LR_REF_VERSION "lamprig-reference 1"
+#define LR_REF_VERSION "lamprig-reference 2"
 
 /* Most refractive interfaces a next-event connection may pass through (e.g. 2 for the outer
  * and inner surface of a lamp shade between a receiver and the bulb). Longer chains are left
@@ -298,16 +301,21 @@ typedef struct lr_ref_sphere_problem {
     int threads;
 } lr_ref_sphere_problem;
 
-typedef struct lr_ref_sphere_result {
-    lr_ref_estimate escaped;           /* fraction of the light's power leaving the sphere */
+/* What leaves a scene to infinity, as fractions of a light's power (band 0). */
+typedef struct lr_ref_escape_result {
+    lr_ref_estimate escaped;           /* fraction of the light's power leaving the scene */
     lr_ref_estimate escaped_scattered; /* ... of which scattered at least once */
     /* ... of which reached the first scattering along a path camera-path NEE does not solve
      * (a Fresnel reflection came first): the part renders get from light tracing */
     lr_ref_estimate escaped_light_traced;
     lr_ref_stats stats;
-} lr_ref_sphere_result;
+} lr_ref_escape_result;
 
-int lr_ref_sphere_escape(const lr_ref_sphere_problem *p, lr_ref_sphere_result *out, lr_err *e);
+int lr_ref_sphere_escape(const lr_ref_sphere_problem *p, lr_ref_escape_result *out, lr_err *e);
+
+/* The same count on any finished scene: photons from light `light`, in fixed batches. */
+int lr_ref_escape(const lr_ref_scene *s, int light, uint64_t photons, uint64_t seed, int threads,
+                  lr_ref_escape_result *out, lr_err *e);
 
 /* ---- parallel batches ------------------------------------------------------------------- */
 
@@ -391,5 +399,17 @@ int lr_ref_render_cached(const lr_ref_scene *s, const lr_ref_camera *cam,
  * *d had on entry). */
 int lr_ref_scene_load(const char *path, lr_ref_scene **out, lr_ref_camera *cam,
                       lr_ref_render_desc *d, lr_err *e);
+
+/* The reference scene of a project scene (render/scene: configs/scenes/NAME.json) and its
+ * camera: each object's world mesh bounds its material (outside: air), each receiver's mesh
+ * is a receiver (planes moved 1 um away from the scene so that a candle standing on the
+ * table does not share its plane), point and spot lights at their steady intensity times
+ * colour (flicker is a display effect). The object meshes are borrowed: sc must outlive the
+ * returned scene and not change meanwhile. Directional lights and orthographic cameras have
+ * no counterpart here (LR_EUNSUPPORTED); an object that is not watertight cannot bound its
+ * material (LR_EINVAL). */
+typedef struct lr_scene lr_scene;
+int lr_ref_scene_from_scene(const lr_scene *sc, lr_ref_scene **out, lr_ref_camera *cam,
+                            lr_err *e);
 
 #endif

@@ -18,9 +18,9 @@ typedef struct tally {
 typedef struct job {
     const lr_ref_scene *scene;
     uint64_t photons, seed;
-    lr_vec3 origin, dir; /* slab: the pencil beam; sphere: unused (the light emits) */
-    bool from_light;
-    tally *t; /* BATCHES */
+    lr_vec3 origin, dir; /* slab: the pencil beam; else unused (the light emits) */
+    int light;           /* the light that emits, or -1 for the pencil beam */
+    tally *t;            /* BATCHES */
 } job;
 
 static void add(tally *t, int i, double x)
@@ -32,6 +32,7 @@ static void add(tally *t, int i, double x)
 /* Light end of a photon from the light: whether camera-path NEE covers it. */
 typedef struct first_vertex {
     const lr_ref_scene *s;
+    const lr_ref_light *l;
     bool seen, covered;
 } first_vertex;
 
@@ -40,8 +41,7 @@ static bool classify(void *user, const lr_ref_photon_vertex *v)
     first_vertex *f = user;
     if (v->index == 0) {
         f->seen = true;
-        f->covered = lr_ref_nee_covers_light_end(f->s, f->s->lights[0].d.position,
-                                                 f->s->lights[0].medium, v);
+        f->covered = lr_ref_nee_covers_light_end(f->s, f->l->d.position, f->l->medium, v);
     }
     return true;
 }
@@ -57,16 +57,18 @@ static void run_batch(int batch, void *user)
         lr_vec3 o = j->origin, d = j->dir;
         int medium = 0;
         double power = 1.0;
-        if (j->from_light) {
-            medium = lr_ref_light_emit(j->scene, 0, 0, &rng, &o, &d, &power);
-            power /= lr_ref_light_power(j->scene, 0, 0); /* fraction of the light's power */
+        if (j->light >= 0) {
+            medium = lr_ref_light_emit(j->scene, j->light, 0, &rng, &o, &d, &power);
+            power /= lr_ref_light_power(j->scene, j->light, 0); /* fraction of its power */
         }
         lr_ref_photon_exit x;
         double beta[3] = {1.0, 0.0, 0.0};
         first_vertex fv = {.s = j->scene};
+        if (j->light >= 0)
+            fv.l = &j->scene->lights[j->light];
         lr_ref_walker wk = {.x = o, .d = d, .medium = medium, .on_surface = true};
         t->stats.paths++;
-        lr_ref_photon_walk(j->scene, wk, 1, 0, &rng, &t->stats, j->from_light ? classify : NULL,
+        lr_ref_photon_walk(j->scene, wk, 1, 0, &rng, &t->stats, j->light >= 0 ? classify : NULL,
                            &fv, &x, beta);
         double w = x.escaped ? beta[0] * power : 0.0;
         bool up = x.direction.z > 0.0;
@@ -135,7 +137,7 @@ int lr_ref_slab_rt(const lr_ref_slab_problem *p, lr_ref_slab_result *out, lr_err
     if (!rc)
         rc = lr_ref_scene_finish(s, e);
     job j = {.scene = s, .photons = p->photons, .seed = p->seed,
-             .origin = lr_v3(0.0, 0.0, 1.0), .dir = lr_v3(0.0, 0.0, -1.0)};
+             .origin = lr_v3(0.0, 0.0, 1.0), .dir = lr_v3(0.0, 0.0, -1.0), .light = -1};
     if (!rc)
         rc = run(&j, p->threads, &out->stats, e);
     if (!rc) {
@@ -151,9 +153,31 @@ int lr_ref_slab_rt(const lr_ref_slab_problem *p, lr_ref_slab_result *out, lr_err
     return rc;
 }
 
-int lr_ref_sphere_escape(const lr_ref_sphere_problem *p, lr_ref_sphere_result *out, lr_err *e)
+int lr_ref_escape(const lr_ref_scene *s, int light, uint64_t photons, uint64_t seed, int threads,
+                  lr_ref_escape_result *out, lr_err *e)
 {
-    *out = (lr_ref_sphere_result){0};
+    *out = (lr_ref_escape_result){0};
+    if (!s->finished || light < 0 || light >= s->n_lights || photons < 2 ||
+        !(lr_ref_light_power(s, light, 0) > 0.0))
+        return lr_err_set(e, LR_EINVAL, "reference: escape count needs a finished scene, a "
+                          "light with power in band 0 and at least 2 photons");
+    job j = {.scene = s, .photons = photons, .seed = seed, .light = light};
+    int rc = run(&j, threads, &out->stats, e);
+    if (!rc) {
+        /* Everything escaping counts, whichever way it leaves: escaped = 1 - absorbed per
+         * photon, so the absorbed tally's error is the escape's. */
+        lr_ref_estimate absorbed = estimate(j.t, T_ABS, photons);
+        out->escaped = (lr_ref_estimate){1.0 - absorbed.value, absorbed.se};
+        out->escaped_scattered = estimate(j.t, T_SCAT, photons);
+        out->escaped_light_traced = estimate(j.t, T_LT, photons);
+    }
+    free(j.t);
+    return rc;
+}
+
+int lr_ref_sphere_escape(const lr_ref_sphere_problem *p, lr_ref_escape_result *out, lr_err *e)
+{
+    *out = (lr_ref_escape_result){0};
     double rl = lr_v3_len(p->offset);
     if (!(p->radius > 0.0) || !(rl < p->radius) || !(p->cavity >= 0.0 && p->cavity < p->radius) ||
         (p->cavity > 0.0 && !(rl < p->cavity)) || p->photons < 2)
@@ -184,20 +208,8 @@ int lr_ref_sphere_escape(const lr_ref_sphere_problem *p, lr_ref_sphere_result *o
         rc = lr_ref_scene_add_light(s, &ld, e);
     if (!rc)
         rc = lr_ref_scene_finish(s, e);
-    job j = {.scene = s, .photons = p->photons, .seed = p->seed, .from_light = true};
     if (!rc)
-        rc = run(&j, p->threads, &out->stats, e);
-    if (!rc) {
-        /* Everything escaping counts, whichever way it leaves: escaped = 1 - absorbed per
-         * photon, so the absorbed tally's error is the escape's; likewise the scattered part
-         * is everything but the photons that left without scattering. */
-        lr_ref_estimate absorbed = estimate(j.t, T_ABS, p->photons);
-        lr_ref_estimate scat = estimate(j.t, T_SCAT, p->photons);
-        out->escaped = (lr_ref_estimate){1.0 - absorbed.value, absorbed.se};
-        out->escaped_scattered = scat;
-        out->escaped_light_traced = estimate(j.t, T_LT, p->photons);
-    }
-    free(j.t);
+        rc = lr_ref_escape(s, 0, p->photons, p->seed, p->threads, out, e);
     lr_ref_scene_destroy(s);
     return rc;
 }

@@ -14,7 +14,9 @@
 #include <unistd.h>
 
 #include "firmware/args.h"
+#include "render/base/json.h"
 #include "render/reference/reference.h"
+#include "render/scene/scene.h"
 
 static const char usage[] =
     "usage: lamprig-reference render --scene FILE [options]\n"
@@ -22,7 +24,8 @@ static const char usage[] =
     "\n"
     "render: a volumetric Monte Carlo reference image of a scene file (README, \"Physical\n"
     "reference\"): linear radiance as PFM, and the variance of each pixel's mean.\n"
-    "  --scene FILE       reference scene (JSON)\n"
+    "  --scene FILE       reference scene (configs/reference/) or project scene\n"
+    "                     (configs/scenes/: objects with meshes, receivers)\n"
     "  --out FILE         mean image, PFM (default build/reference.pfm)\n"
     "  --variance FILE    per-pixel variance of the mean, PFM (default: OUT with .var.pfm)\n"
     "  --cache            reuse or fill build/reference-cache/<key>.pfm (+ .var.pfm, .json)\n"
@@ -82,6 +85,21 @@ static void show_progress(const lr_ref_render *r, void *user)
     fflush(stderr);
 }
 
+/* A project scene (render/scene) has receivers or objects with a "mesh"; a reference scene
+ * file (render/reference) has neither. */
+static bool is_project_scene(const char *path)
+{
+    lr_json *j;
+    if (lr_json_load(path, &j, NULL))
+        return false; /* the reference loader will report it */
+    lr_jnode root = lr_json_root(j), objs = lr_json_get(j, root, "objects");
+    bool project = lr_json_get(j, root, "receivers") != LR_JNONE ||
+                   (lr_json_count(j, objs) > 0 &&
+                    lr_json_get(j, lr_json_at(j, objs, 0), "mesh") != LR_JNONE);
+    lr_json_destroy(j);
+    return project;
+}
+
 static int cmd_render(int argc, char **argv)
 {
     static const lr_argspec specs[] = {
@@ -109,9 +127,13 @@ static int cmd_render(int argc, char **argv)
         return 2;
     lr_ref_camera cam = {0};
     lr_ref_render_desc d = {0};
-    lr_ref_scene *s;
-    if (lr_ref_scene_load(scene, &s, &cam, &d, &e)) {
+    lr_ref_scene *s = NULL;
+    lr_scene *project = NULL;
+    if (is_project_scene(scene) ? lr_scene_load(scene, NULL, &project, &e) ||
+                                      lr_ref_scene_from_scene(project, &s, &cam, &e)
+                                : lr_ref_scene_load(scene, &s, &cam, &d, &e)) {
         fprintf(stderr, "lamprig-reference: %s\n", e.msg);
+        lr_scene_destroy(project);
         return 1;
     }
     if (w > 0)
@@ -181,6 +203,7 @@ static int cmd_render(int argc, char **argv)
     lr_ref_image_free(&mean);
     lr_ref_image_free(&vimg);
     lr_ref_scene_destroy(s);
+    lr_scene_destroy(project); /* after s: s borrows its meshes */
     return status;
 }
 
@@ -219,7 +242,7 @@ static int cmd_validate(int argc, char **argv)
     lr_ref_sphere_problem sp = {.medium = {.sigma_s = {1, 1, 1}, .eta = 1.5}, .radius = 1.0,
                                 .photons = (uint64_t)photons, .seed = (uint64_t)seed + 2,
                                 .threads = (int)threads};
-    lr_ref_sphere_result esc;
+    lr_ref_escape_result esc;
     if (lr_ref_slab_rt(&gio, &rg, &e) || lr_ref_slab_rt(&vdh, &rv, &e) ||
         lr_ref_sphere_escape(&sp, &esc, &e)) {
         fprintf(stderr, "lamprig-reference: %s\n", e.msg);
