@@ -183,7 +183,7 @@ static int write_stats(const char *path, const lr_scene *scene, lr_renderer *r,
 
 /* The planner (firmware/plan_scene.h) for a scene with a quality budget: applies its settings
  * and prints its lines. A missing or unusable table is not fatal: the scene's own settings
- * render, and stderr says why. */
+ * render, and a "plan: skipped: WHY" line says so. */
 static int plan(lr_scene *scene, const char *table, bool *no_vpl, bool *planned)
 {
     lr_plan_scene_result *res = calloc(1, sizeof *res);
@@ -191,7 +191,8 @@ static int plan(lr_scene *scene, const char *table, bool *no_vpl, bool *planned)
         return LR_EXIT_FAIL;
     lr_err e = {0};
     if (lr_plan_scene(scene, table, res, &e)) {
-        fprintf(stderr, "lamprig render: plan: %s; rendering with the scene's settings\n", e.msg);
+        /* Informational like the plan itself (stdout): the render goes on. */
+        printf("plan: skipped: %s; rendering with the scene's settings\n", e.msg);
     } else if (res->planned) {
         char *text = lr_plan_scene_text(res);
         if (text)
@@ -303,20 +304,27 @@ int lr_cmd_render(int argc, char **argv)
         status = e.code == LR_EIO ? fail(&e) : usage_error("%s", e.msg);
         goto done;
     }
-    bool planned = false;
-    if (!no_plan && (status = plan(scene, table, &no_vpl, &planned)))
-        goto done;
-    for (int i = 0; i < nsets; i++) {
+    /* --set is checked before the plan (a bad one is a one-line usage error) and applied again
+     * after it, so that an explicit render.* setting wins over the plan. */
+    for (int i = 0; i < nsets; i++)
         if (lr_scene_set_assignment(scene, sets[i], NULL, &e)) {
             status = usage_error("--set %s: %s", sets[i], e.msg);
             goto done;
         }
-        if (planned && !strncmp(sets[i], "render.", 7))
-            printf("plan: --set %s overrides the plan\n", sets[i]);
-    }
     if (events_path && lr_render_events_load(events_path, &ev, &e)) {
         status = e.code == LR_EIO ? fail(&e) : usage_error("%s", e.msg);
         goto done;
+    }
+    bool planned = false;
+    if (!no_plan && (status = plan(scene, table, &no_vpl, &planned)))
+        goto done;
+    for (int i = 0; planned && i < nsets; i++) {
+        if (lr_scene_set_assignment(scene, sets[i], NULL, &e)) {
+            status = usage_error("--set %s: %s", sets[i], e.msg);
+            goto done;
+        }
+        if (!strncmp(sets[i], "render.", 7))
+            printf("plan: --set %s overrides the plan\n", sets[i]);
     }
     if (lr_gl_create(NULL, &gl, &e) ||
         lr_renderer_create(&(lr_renderer_desc){.gl = gl, .scene = scene, .width = width,

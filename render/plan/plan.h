@@ -60,10 +60,11 @@ const char *lr_plan_table_name(const lr_plan_table *t);
 /* Whether any row measures `scene`. */
 bool lr_plan_table_has_scene(const lr_plan_table *t, const char *scene);
 
-/* The default table: <root>/build/bench/results.csv when it exists and is at least as new as
- * <root>/configs/bench/front.csv (or that one is missing), else configs/bench/front.csv, where
- * root is the parent of lr_configs_dir(). Writes the path to buf and a short reason ("newest
- * bench run" | "committed front") to *why. LR_EIO when neither exists. */
+/* The default table: ROOT/build/bench/results.csv when it exists and is at least as new as
+ * CONFIGS/bench/front.csv (or that one is missing), else CONFIGS/bench/front.csv, where
+ * CONFIGS is lr_configs_dir() and ROOT its parent (the source tree). Writes the path to buf
+ * and a short reason ("newest bench run" | "committed front") to *why. LR_EIO when neither
+ * exists. */
 int lr_plan_default_table(char *buf, size_t cap, const char **why, lr_err *e);
 
 /* ---- Scene analysis ------------------------------------------------------------------- */

@@ -305,10 +305,18 @@ bool lr_plan_table_has_scene(const lr_plan_table *t, const char *scene)
 
 int lr_plan_default_table(char *buf, size_t cap, const char **why, lr_err *e)
 {
+    /* The committed front sits in the configs directory; a bench run's results in the build
+     * directory beside it (the source tree's layout). */
+    const char *configs = lr_configs_dir();
     char root[1024], results[1200], front[1200];
-    snprintf(root, sizeof root, "%s/..", lr_configs_dir());
+    snprintf(root, sizeof root, "%s", configs);
+    char *slash = strrchr(root, '/');
+    if (slash && slash != root)
+        *slash = '\0';
+    else
+        snprintf(root, sizeof root, "%s", slash ? "/" : ".");
     if (lr_path_join(results, sizeof results, root, "build/bench", "results.csv") ||
-        lr_path_join(front, sizeof front, root, "configs/bench", "front.csv"))
+        lr_path_join(front, sizeof front, configs, "bench", "front.csv"))
         return lr_err_set(e, LR_EINVAL, "configs path too long");
     struct stat sr, sf;
     bool have_r = stat(results, &sr) == 0, have_f = stat(front, &sf) == 0;
