@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include "render/base/file.h"
 #include "render/base/json.h"
@@ -165,22 +166,28 @@ static void test_table_errors(void **state)
 /* What the planner must pick for a max_error budget, worked out independently of it: among
  * the scene's directional-dipole rows with at least K_cover maps and error <= budget, the
  * soonest converged (ms_gbuffer + frames x frame_ms). */
-static const lr_plan_row *brute_force(const char *scene, int K_cover, double max_error)
+static const lr_plan_row *brute_force_in(const lr_plan_table *t, const char *scene, int K_cover,
+                                         double max_error)
 {
     const lr_plan_row *best = NULL;
     double best_t = INFINITY;
-    for (int i = 0; i < lr_plan_table_count(table); i++) {
-        const lr_plan_row *r = lr_plan_table_row(table, i);
+    for (int i = 0; i < lr_plan_table_count(t); i++) {
+        const lr_plan_row *r = lr_plan_table_row(t, i);
         if (strcmp(r->scene, scene) || strcmp(r->model, "directional_dipole") || r->K < K_cover ||
             r->rel_rmse > max_error)
             continue;
-        double t = r->ms_gbuffer + r->frames * r->frame_ms;
-        if (t < best_t) {
-            best_t = t;
+        double ms = (isnan(r->ms_gbuffer) ? 0.0 : r->ms_gbuffer) + r->frames * r->frame_ms;
+        if (ms < best_t) {
+            best_t = ms;
             best = r;
         }
     }
     return best;
+}
+
+static const lr_plan_row *brute_force(const char *scene, int K_cover, double max_error)
+{
+    return brute_force_in(table, scene, K_cover, max_error);
 }
 
 static void test_max_error_both_scenes(void **state)
@@ -220,6 +227,45 @@ static void test_max_error_both_scenes(void **state)
     assert_near(p->objects[0].predicted_converge_ms, 4830.0, 1e-9);
     assert_true(p->objects[0].vpl);
     free(p);
+}
+
+
+static void test_committed_front_both_scenes(void **state)
+{
+    /* The same on the bench's committed table, when this tree has one (the bench writes it;
+     * skipped before it exists): every measured error of each scene, used as the budget, is
+     * met, by the soonest-converging row that meets it. */
+    lr_plan_table *t;
+    lr_err e = {0};
+    if (lr_plan_table_load("configs/bench/front.csv", &t, &e)) {
+        if (e.code == LR_EIO)
+            skip();
+        fail_msg("%s", e.msg);
+    }
+    const lr_scene *scenes[2] = {candle, shade};
+    const char *names[2] = {"candle", "lampshade"};
+    for (int s = 0; s < 2; s++) {
+        assert_true(lr_plan_table_has_scene(t, names[s]));
+        lr_plan_analysis a;
+        assert_int_equal(lr_plan_analyze(scenes[s], 0, &a, &e), LR_OK);
+        for (int i = 0; i < lr_plan_table_count(t); i++) {
+            const lr_plan_row *r = lr_plan_table_row(t, i);
+            if (strcmp(r->scene, names[s]) || strcmp(r->model, "directional_dipole") ||
+                r->K < a.K_cover)
+                continue;
+            lr_plan p;
+            assert_int_equal(lr_plan_create(scenes[s], t, &(lr_plan_budget){r->rel_rmse, 0}, NULL,
+                                            &p, &e),
+                             LR_OK);
+            assert_true(p.feasible);
+            assert_true(p.objects[0].predicted_error <= r->rel_rmse);
+            const lr_plan_row *want = brute_force_in(t, names[s], a.K_cover, r->rel_rmse);
+            double want_ms = (isnan(want->ms_gbuffer) ? 0.0 : want->ms_gbuffer) +
+                             want->frames * want->frame_ms;
+            assert_near(p.objects[0].predicted_converge_ms, want_ms, 1e-9 * want_ms);
+        }
+    }
+    lr_plan_table_destroy(t);
 }
 
 static void test_frame_ms_budget(void **state)
@@ -566,6 +612,35 @@ static void test_cli_render_applies_plan(void **state)
     expect_in("s.json", "\"N_vpl\":64"); /* the scene file's */
 }
 
+
+static void test_cli_run_applies_plan(void **state)
+{
+    /* A rig config whose scene_set gives the budget (quality.*) and one render setting: the
+     * log has the plan, and the explicit render.K wins over it. The preview view keeps this
+     * free of GL work. */
+    char cwd[1024], cfg[2048];
+    assert_non_null(getcwd(cwd, sizeof cwd));
+    snprintf(cfg, sizeof cfg,
+             "{\"scene\": \"%s/configs/scenes/lampshade.json\",\n"
+             " \"scene_set\": {\"render.K\": 4, \"quality.max_error\": 0.1, \"quality.frame_ms\": 0},\n"
+             " \"controls\": [],\n"
+             " \"output\": {\"mode\": \"headless\", \"renderer\": \"preview\", \"width\": 16,"
+             " \"height\": 16}}\n",
+             cwd);
+    char *path = lr_test_write(dir, "rig.json", cfg, (size_t)-1);
+    assert_int_equal(run("./build/bin/lamprig run --config %s --headless --duration 0.3 --table "
+                         FIXTURE, path), 0);
+    expect_in("err", "plan: shade: directional_dipole K=16 N=8");
+    expect_in("err", "plan: lampshade: budget error <= 0.1 met");
+    expect_in("err", "plan: the config's scene_set overrides it: render K=4 N=8");
+    assert_int_equal(run("./build/bin/lamprig run --config %s --headless --duration 0.3 --no-plan "
+                         "--table " FIXTURE, path), 0);
+    char *t = slurp("err");
+    assert_null(strstr(t, "plan:"));
+    free(t);
+    free(path);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -573,6 +648,7 @@ int main(void)
         cmocka_unit_test(test_table_header_driven),
         cmocka_unit_test(test_table_errors),
         cmocka_unit_test(test_max_error_both_scenes),
+        cmocka_unit_test(test_committed_front_both_scenes),
         cmocka_unit_test(test_frame_ms_budget),
         cmocka_unit_test(test_both_budgets_and_infeasible),
         cmocka_unit_test(test_models_and_coverage_filter),
@@ -582,6 +658,7 @@ int main(void)
         cmocka_unit_test(test_no_pass_after_convergence),
         cmocka_unit_test(test_cli_plan),
         cmocka_unit_test(test_cli_render_applies_plan),
+        cmocka_unit_test(test_cli_run_applies_plan),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
