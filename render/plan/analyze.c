@@ -212,6 +212,9 @@ int lr_plan_analyze(const lr_scene *s, int index, lr_plan_analysis *out, lr_err 
     memset(out, 0, sizeof *out);
     if (index < 0 || index >= lr_scene_object_count(s))
         return lr_err_set(e, LR_EINVAL, "planner: no object %d", index);
+    int nr = lr_scene_receiver_count(s);
+    if (nr > 32) /* one bit each in receivers_seeing; scenes hold at most 16 */
+        return lr_err_set(e, LR_EINVAL, "planner: %d receivers, at most 32", nr);
     const lr_scene_object *o = lr_scene_object_at(s, index);
     features(s, index, &out->features, &out->convex_violation_mm);
     sampler so;
@@ -219,7 +222,6 @@ int lr_plan_analyze(const lr_scene *s, int index, lr_plan_analysis *out, lr_err 
     if (rc)
         return rc;
     coverage(o, &so, out);
-    int nr = lr_scene_receiver_count(s);
     out->receivers_checked = nr;
     for (int i = 0; i < nr && !rc; i++) {
         bool sees;
