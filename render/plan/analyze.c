@@ -178,7 +178,7 @@ static void coverage(const lr_scene_object *o, const sampler *so, lr_plan_analys
     }
     a->K_cover = LR_PLAN_KMAX;
     for (int k = 0; k < LR_PLAN_KMAX; k++)
-        if (a->coverage[k] >= a->coverage[LR_PLAN_KMAX - 1] - 0.005) {
+        if (a->coverage[k] >= a->coverage[LR_PLAN_KMAX - 1] - 0.002) {
             a->K_cover = k + 1;
             break;
         }

@@ -89,7 +89,8 @@ typedef struct lr_plan_analysis {
      * coverage[k-1]. A point is seen by map k when its normal faces d_k (n.d_k > 0.1) and the
      * ray toward d_k leaves the object without a hit (the map's depth test). */
     double coverage[LR_PLAN_KMAX];
-    /* The fewest maps whose coverage is within 0.5 % of what all LR_PLAN_KMAX maps see. */
+    /* The fewest maps whose coverage is within 0.2 % (2 of the 1024 samples:
+     * sampling noise, not a hole) of what all LR_PLAN_KMAX maps see. */
     int K_cover;
     double convex_violation_mm; /* largest distance of a vertex outside a face plane */
 } lr_plan_analysis;
