@@ -610,6 +610,26 @@ static void test_cli_render_applies_plan(void **state)
     assert_null(strstr(t, "plan:"));
     free(t);
     expect_in("s.json", "\"N_vpl\":64"); /* the scene file's */
+
+    /* A ball whose only receiver faces away: the plan cuts the VPL pass, and the renderer
+     * runs without it (the frame's passes in the stats). */
+    const char *scene =
+        "{\"objects\": [{\"name\": \"ball\", \"material\": \"marble\","
+        "  \"mesh\": {\"type\": \"sphere\", \"radius\": 30, \"subdivisions\": 2}}],"
+        " \"lights\": [{\"type\": \"point\", \"position\": [0, 0, 60], \"intensity\": 1}],"
+        " \"camera\": {\"position\": [0, -400, 100], \"target\": [0, 0, 0]},"
+        " \"receivers\": [{\"name\": \"back\", \"type\": \"plane\", \"center\": [0, 200, 0],"
+        "  \"normal\": [0, 1, 0], \"size\": [200, 200], \"albedo\": [0.5, 0.5, 0.5]}],"
+        " \"quality\": {\"max_error\": 0.2}}";
+    char *sp = lr_test_write(dir, "ball.json", scene, (size_t)-1);
+    assert_int_equal(run("./build/bin/lamprig render --scene %s --table " FIXTURE " --frames 1 "
+                         "--width 16 --height 12 --set render.map_size=16 "
+                         "--set render.gbuffer_size=16 --set render.vpl_map_size=8 --stats %s",
+                         sp, stats), 0);
+    expect_in("out", "no receiver sees ball: VPL pass off");
+    expect_in("out", "nearest measured scene 'candle'");
+    expect_in("s.json", "\"passes\":[\"gbuffer\",\"radiosity\",\"compose\"]");
+    free(sp);
 }
 
 
