@@ -122,7 +122,8 @@ typedef struct lr_plan_choice {
     bool vpl;                           /* VPL pass for this object */
     double predicted_error;             /* rel_rmse of the row */
     double predicted_frame_ms;          /* the row's frame_ms (less ms_vpl when VPLs are cut) */
-    double predicted_converge_ms;       /* ms_gbuffer + frames x frame_ms */
+    double predicted_converge_ms;       /* ms_gbuffer (0 when not measured) + frames x
+                                         * predicted_frame_ms */
     bool feasible;                      /* meets every budget given */
     lr_plan_analysis analysis;
     int nreasons;
@@ -179,8 +180,10 @@ bool lr_plan_budget_from_scene(const lr_scene *s, lr_plan_budget *out);
 int lr_plan_apply(const lr_plan *p, lr_scene *s, unsigned *dirty, lr_err *e);
 
 /* One line per object, "plan: OBJECT: MODEL K=.. N=.. N_vpl=.. map=.. gbuffer=.. frames=..
- * vpl=on|off, error 0.031 (budget 0.05), 95 ms/frame, converged in 6.1 s[; reasons]", then
- * the scene line; written to buf (truncated to cap). Returns the length it needed. */
+ * vpl=on|off, error 0.05, 150 ms/frame, converged in 4.8 s[ [INFEASIBLE]] (reason; ...)",
+ * then the scene line (budget met or NOT MET, the settings applied, and that no pass runs
+ * after the planned frames until something changes); written to buf (truncated to cap,
+ * which may be 0). Returns the length it needed, without the NUL. */
 size_t lr_plan_format(const lr_plan *p, char *buf, size_t cap);
 /* The same as one JSON object. */
 size_t lr_plan_format_json(const lr_plan *p, char *buf, size_t cap);
