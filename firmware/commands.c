@@ -5,6 +5,7 @@
 
 #include "firmware/cmd_calib.h"
 #include "firmware/cmd_optics.h"
+#include "firmware/cmd_plan.h"
 #include "firmware/cmd_render.h"
 #include "firmware/cmd_run.h"
 
@@ -14,5 +15,6 @@ const lr_command lr_commands[] = {
      lr_cmd_calib_usage, lr_cmd_calib},
     {"render", lr_render_summary, lr_render_usage, lr_cmd_render},
     {"run", lr_run_summary, lr_run_usage, lr_cmd_run},
+    {"plan", lr_plan_summary, lr_plan_usage, lr_cmd_plan},
     {NULL, NULL, NULL, NULL},
 };

@@ -28,6 +28,7 @@ typedef struct lr_rig_view_desc {
     lr_gl *gl;        /* may be NULL for "preview" headless */
     lr_scene *scene;  /* read at every frame; owned by the caller */
     int width, height;
+    bool no_vpl;      /* "passes": skip the VPL pass (the planner found no receiver in sight) */
 } lr_rig_view_desc;
 
 /* Comma-separated names of the back ends built in, default first ("passes, preview"). */
