@@ -23,7 +23,8 @@ const char *lr_pass_name(int index)
 static int program(lr_renderer *r, const char *vert, const char *frag, lr_program **out, lr_err *e)
 {
     static const char *const defines[] = {"LR_MAX_OBJECTS " STR(LR_MAX_OBJECTS),
-                                          "LR_MAX_K " STR(LR_MAX_K), NULL};
+                                          "LR_MAX_K " STR(LR_MAX_K),
+                                          "LR_MAX_LIGHTS " STR(LR_MAX_LIGHTS), NULL};
     lr_program_desc d = {.vertex = vert, .fragment = frag, .dir = r->shader_dir, .defines = defines};
     return lr_program_create(&d, out, e);
 }
