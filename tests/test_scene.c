@@ -478,11 +478,13 @@ static void test_set_dirty_flags(void **state)
     assert_true(l->color[1] == 0.5);
     set_ok(s, "lights[0].flicker.amplitude", "0.2", LR_DIRTY_INTENSITY);
 
-    /* The flame moves: everything; flicker that sways is light geometry too. */
+    /* The flame moves: everything. Flicker, sway included, is applied at composition on the
+     * renderer's clock (the transport stays at the mean position): composition only. */
     set_ok(s, "lights[0].position", "[0, 0, 116]", LR_DIRTY_LIGHT_GEOMETRY);
     assert_true(l->position.z == 116);
-    set_ok(s, "lights[0].flicker.jitter_mm", "0.5", LR_DIRTY_LIGHT_GEOMETRY);
-    set_ok(s, "lights[0].flicker.frequency_hz", "9", LR_DIRTY_INTENSITY | LR_DIRTY_LIGHT_GEOMETRY);
+    set_ok(s, "lights[0].flicker.jitter_mm", "0.5", LR_DIRTY_INTENSITY);
+    set_ok(s, "lights[0].flicker.frequency_hz", "9", LR_DIRTY_INTENSITY);
+    set_ok(s, "lights[0].flicker.seed", "4", LR_DIRTY_INTENSITY);
     assert_int_equal(lr_dirty_passes(LR_DIRTY_LIGHT_GEOMETRY),
                      LR_PASS_GBUFFER | LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_COMPOSE);
 

@@ -360,10 +360,18 @@ static void frame(lr_rig *r, int64_t now)
     r->next_frame_ns = now + r->frame_interval_ns;
 }
 
+/* Whether something is due, without moving the clock. */
+static bool frame_due(const lr_rig *r)
+{
+    return lr_rig_view_needs_frame(r->view) || r->fading;
+}
+
 static bool frame_wanted(lr_rig *r, int64_t now)
 {
-    (void)now;
-    return lr_rig_view_needs_frame(r->view) || r->fading;
+    /* The renderer's clock is the rig's wall clock: a flickering flame wants a frame (a
+     * composition only) at every frame interval. */
+    lr_rig_view_set_time(r->view, (double)(now - r->start_ns) * 1e-9);
+    return frame_due(r);
 }
 
 static void write_stats(lr_rig *r, int64_t now)
@@ -699,7 +707,7 @@ void lr_rig_get_info(const lr_rig *r, lr_rig_info *out)
     out->lamp_level = r->lamp_written;
     out->output = r->kms ? "kms" : "headless";
     out->view = r->view ? lr_rig_view_name(r->view) : "";
-    out->idle = r->view && !frame_wanted((lr_rig *)r, lr_now_ns());
+    out->idle = r->view && !frame_due(r);
 }
 
 struct lr_scene *lr_rig_scene(lr_rig *r) { return r->set.scene; }

@@ -300,4 +300,7 @@ const lr_light *lr_passes_light(const lr_renderer *r, int l)
 void lr_passes_light_rgb(const lr_renderer *r, int l, double out[3])
 {
     lr_light_rgb(lr_passes_light(r, l), out);
+    double f = lr_renderer_flicker(r, l);
+    for (int c = 0; c < 3; c++)
+        out[c] *= f;
 }

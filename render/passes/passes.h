@@ -123,6 +123,10 @@ struct lr_renderer {
 
     unsigned dirty;
     int frame_index;
+
+    /* The clock of lr_renderer_set_time (flicker at composition). */
+    bool clock_set;
+    double time_s;
 };
 
 /* common.c */

@@ -244,22 +244,23 @@ static int light_field(op *o, lr_light *l, const char *f, unsigned *d)
     }
     if (!dir && strncmp(f, "flicker.", 8) == 0) {
         const char *g = f + 8;
-        /* The intensity wobble only rescales; a swaying flame moves the light. */
-        unsigned moves = l->flicker.jitter_mm > 0.0 ? LR_DIRTY_LIGHT_GEOMETRY : 0;
+        /* Flicker is applied by the renderer at composition on its clock (render/renderer.h
+         * lr_renderer_set_time), the sway included: the transport stays at the light's mean
+         * position (jitter << 1/sigma_tr), so every flicker field is composition-only. */
         if (strcmp(g, "amplitude") == 0) {
             *d = LR_DIRTY_INTENSITY;
             return num_field(o, &l->flicker.amplitude);
         }
         if (strcmp(g, "frequency_hz") == 0) {
-            *d = LR_DIRTY_INTENSITY | moves;
+            *d = LR_DIRTY_INTENSITY;
             return num_field(o, &l->flicker.frequency_hz);
         }
         if (strcmp(g, "jitter_mm") == 0) {
-            *d = LR_DIRTY_LIGHT_GEOMETRY;
+            *d = LR_DIRTY_INTENSITY;
             return num_field(o, &l->flicker.jitter_mm);
         }
         if (strcmp(g, "seed") == 0) {
-            *d = LR_DIRTY_INTENSITY | moves;
+            *d = LR_DIRTY_INTENSITY;
             int seed = (int)l->flicker.seed;
             int rc = int_field(o, &seed);
             if (!rc && seed < 0)
