@@ -24,7 +24,8 @@ const char lr_render_summary[] = "render a scene headless: PNG, linear PFM, per-
 const char lr_render_usage[] =
     "usage: lamprig render --scene FILE [--frames N] [--width W --height H] [--out F.png]\n"
     "                      [--hdr F.pfm] [--stats F.json] [--no-vpl] [--set key=value ...]\n"
-    "                      [--events FILE] [--vpl-visibility] [--no-plan] [--table CSV]\n"
+    "                      [--events FILE] [--vpl-visibility] [--fps F] [--no-plan]\n"
+    "                      [--table CSV]\n"
     "\n"
     "Renders FILE (configs/scenes/*.json) with seed 003's passes (light G-buffer, scattered-\n"
     "radiosity maps, virtual point lights, composition) on a headless EGL context.\n"
@@ -36,13 +37,17 @@ const char lr_render_usage[] =
     "  --hdr F.pfm       linear RGB radiance, W/(mm^2 sr), PFM\n"
     "  --stats F.json    {\"scene\",\"width\",\"height\",\"uncovered_pixels\",\"renderer\",\n"
     "                    \"settings\",\"frames\":[{\"index\",\n"
-    "                    \"passes\":[...],\"ms\":{pass:ms},\"total_ms\",\"samples\"},...]}\n"
+    "                    \"passes\":[...],\"ms\":{pass:ms},\"total_ms\",\"samples\",\n"
+    "                    \"converged\",\"time_s\"},...]}\n"
     "  --no-vpl          no emergent light on the receivers (direct light only)\n"
     "  --vpl-visibility  shadow the VPLs' light by the objects (beyond seed 003; slower)\n"
     "  --set key=value   change a scene parameter before rendering (repeatable), names as\n"
     "                    in the scene file: light.intensity=0.01, render.K=8, camera.position=0,-400,200\n"
     "  --events FILE     one change per line, FRAME PARAMETER VALUE (e.g. '4 light.intensity\n"
     "                    0.5'), applied before that frame; '#' starts a comment line\n"
+    "  --fps F           the renderer's clock: frame i is composed at i / F seconds, which\n"
+    "                    drives the lights' flicker (default 30; lights[0].flicker.amplitude=0\n"
+    "                    makes a light steady)\n"
     "  --no-plan         keep the scene's render settings even when it has a quality budget\n"
     "  --table CSV       the planner's measured table (default: see `lamprig help plan`)\n"
     "\n"
@@ -175,7 +180,8 @@ static int write_stats(const char *path, const lr_scene *scene, lr_renderer *r,
             }
         fputs("},\"total_ms\":", f);
         json_ms(f, s->total_ms);
-        fprintf(f, ",\"samples\":%d,\"converged\":%s}", s->samples, s->converged ? "true" : "false");
+        fprintf(f, ",\"samples\":%d,\"converged\":%s,\"time_s\":%.6g}", s->samples,
+                s->converged ? "true" : "false", s->time_s);
     }
     fputs("\n]}\n", f);
     return lr_atomic_file_commit(af, e);
@@ -262,7 +268,7 @@ int lr_cmd_render(int argc, char **argv)
     static const lr_argspec specs[] = {
         {"--scene", 1}, {"--frames", 1}, {"--width", 1}, {"--height", 1}, {"--out", 1},
         {"--hdr", 1},   {"--stats", 1},  {"--no-vpl", 0}, {"--events", 1},
-        {"--vpl-visibility", 0}, {"--no-plan", 0}, {"--table", 1}, {NULL, 0}};
+        {"--vpl-visibility", 0}, {"--fps", 1}, {"--no-plan", 0}, {"--table", 1}, {NULL, 0}};
     lr_args a;
     lr_err e = {0};
     if (lr_args_parse(nrest, rest, specs, 0, &a, &e)) {
@@ -280,6 +286,14 @@ int lr_cmd_render(int argc, char **argv)
         status = positive_int("--width", lr_args_get(&a, "--width"), 16384, &width);
     if (!status && lr_args_has(&a, "--height"))
         status = positive_int("--height", lr_args_get(&a, "--height"), 16384, &height);
+    double fps = 30.0;
+    if (!status && lr_args_has(&a, "--fps")) {
+        lr_err fe = {0};
+        if (lr_args_number("--fps", lr_args_get(&a, "--fps"), &fps, &fe))
+            status = usage_error("%s", fe.msg);
+        else if (!(fps > 0.0 && fps <= 1e6))
+            status = usage_error("--fps %s: must be > 0 and <= 1e6", lr_args_get(&a, "--fps"));
+    }
     const char *out = lr_args_get(&a, "--out"), *hdr = lr_args_get(&a, "--hdr");
     const char *stats_path = lr_args_get(&a, "--stats"), *events_path = lr_args_get(&a, "--events");
     bool no_vpl = lr_args_has(&a, "--no-vpl");
@@ -349,6 +363,9 @@ int lr_cmd_render(int argc, char **argv)
             }
             lr_renderer_invalidate(r, dirty);
         }
+        /* The clock after the stop test: flicker alone never keeps the loop going (without
+         * --frames it ends once the maps converged and the events are applied). */
+        lr_renderer_set_time(r, i / fps);
         lr_frame_stats st;
         if (lr_renderer_frame(r, &st, &e)) {
             status = fail(&e);

@@ -409,10 +409,22 @@ static void frame(lr_rig *r, int64_t now)
     r->next_frame_ns = now + r->frame_interval_ns;
 }
 
+/* Whether something is due, without moving the clock. */
+static bool frame_due(const lr_rig *r)
+{
+    return lr_rig_view_needs_frame(r->view) || r->fading;
+}
+
 /* A running fade does not by itself want a frame: its first step often leaves the level
  * where it was (nothing dirty), and rendering that would only push the frame that shows the
  * change one frame interval later. The loop wakes for the fade instead (fade_wake). */
-static bool frame_wanted(lr_rig *r) { return lr_rig_view_needs_frame(r->view); }
+static bool frame_wanted(lr_rig *r, int64_t now)
+{
+    /* The renderer's clock is the rig's wall clock: a flickering flame wants a frame (a
+     * composition only) at every frame interval. */
+    lr_rig_view_set_time(r->view, (double)(now - r->start_ns) * 1e-9);
+    return lr_rig_view_needs_frame(r->view);
+}
 
 /* When to apply a running fade again: at the next frame slot, but at least FADE_TICK_NS
  * from now so an unchanged level (a fade clamped at a limit) cannot spin the loop. */
@@ -646,7 +658,7 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             if (d < t)
                 t = d;
         }
-        bool want = frame_wanted(r);
+        bool want = frame_wanted(r, now);
         if (want && !(r->kms && lr_gl_flip_pending(r->gl)) && r->next_frame_ns < t)
             t = r->next_frame_ns;
         if (r->fading && fade_wake(r, now) < t)
@@ -701,7 +713,7 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             switch_scene(r, sw);
         if (any || sw || r->fading)
             apply(r, now);
-        if (frame_wanted(r) && now >= r->next_frame_ns &&
+        if (frame_wanted(r, now) && now >= r->next_frame_ns &&
             !(r->kms && lr_gl_flip_pending(r->gl)))
             frame(r, now);
         if (r->stats_path[0] && now >= r->next_stats_ns) {
@@ -758,7 +770,7 @@ void lr_rig_get_info(const lr_rig *r, lr_rig_info *out)
     out->lamp_level = r->lamp_written;
     out->output = r->kms ? "kms" : "headless";
     out->view = r->view ? lr_rig_view_name(r->view) : "";
-    out->idle = r->view && !frame_wanted((lr_rig *)r) && !r->fading;
+    out->idle = r->view && !frame_due(r);
 }
 
 struct lr_scene *lr_rig_scene(lr_rig *r) { return r->set.scene; }

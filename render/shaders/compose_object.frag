@@ -1,5 +1,6 @@
-// Pass 3 for the translucent objects: B from the K maps (Algorithm 1), then
-// L_o = I F_t(w_o) B / pi (seed 003 Eq. 5); I = intensity * colour of the light.
+// Pass 3 for the translucent objects: I B = sum_l I_l B_l from every light's K maps (Algorithm
+// 1, the gather weighted by the intensities I_l = intensity * colour), then
+// L_o = F_t(w_o) I B / pi (seed 003 Eq. 5).
 #include "lib/material.glsl"
 #include "lib/gather.glsl"
 
@@ -10,7 +11,6 @@ uniform bool u_two_sided;
 uniform vec3 u_eye;          // camera position (perspective)
 uniform vec3 u_view_dir;     // camera forward (orthographic)
 uniform bool u_ortho;
-uniform vec3 u_intensity;    // I per band
 layout(location = 0) out vec4 o_color;
 
 void main()
@@ -23,5 +23,5 @@ void main()
     vec3 B = lr_gather(v_pos, no, n);
     float eta = lr_material(u_object).eta;
     float Ft = lr_fresnel_transmittance(abs(dot(no, wo)), eta);
-    o_color = vec4(u_intensity * Ft * B / LR_PI, n > 0.0 ? 1.0 : 0.0);
+    o_color = vec4(Ft * B / LR_PI, n > 0.0 ? 1.0 : 0.0);
 }
