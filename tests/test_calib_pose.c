@@ -13,10 +13,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
+#include "calib/camcal.h"
 #include "calib/camview.h"
 #include "calib/pose.h"
 #include "calib/rig.h"
+#include "firmware/cmd_calib.h"
 #include "render/base/atomic_file.h"
 #include "tests/support/calib_sim.h"
 #include "tests/support/near.h"
@@ -273,6 +276,57 @@ static void test_projector_pose_and_file(void **state)
     free(dir);
 }
 
+/* `lamprig calib pose` on a simulated photo: writes pose.json that the rig loader reads,
+ * with the same pose as the library call; a photo without the board fails (exit 1) and
+ * leaves no file. */
+static void test_pose_cli(void **state)
+{
+    (void)state;
+    double C[3] = {-40, -420, 380}, tgt[3] = {10, 0, 0};
+    lr_pose truth = look_at(C, tgt);
+    lr_img photo = board_photo(&truth, 1.0);
+    char *dir = sim_tempdir("posecli");
+    char img[600], blank[600], camf[600], out[600];
+    snprintf(img, sizeof img, "%s/board.png", dir);
+    snprintf(blank, sizeof blank, "%s/blank.png", dir);
+    snprintf(camf, sizeof camf, "%s/camera.json", dir);
+    snprintf(out, sizeof out, "%s/pose.json", dir);
+    lr_err e = {0};
+    assert_int_equal(lr_img_write(img, &photo, &e), LR_OK);
+    memset(photo.px, 128, (size_t)photo.w * photo.h);
+    assert_int_equal(lr_img_write(blank, &photo, &e), LR_OK);
+    lr_camcal cc;
+    memset(&cc, 0, sizeof cc);
+    cc.k = cam;
+    cc.rms = 0.1;
+    cc.board = (lr_board){BC, BR, SQ, LR_BOARD_CHESSBOARD};
+    cc.subpix_window = 11;
+    assert_int_equal(lr_camcal_save(camf, &cc, &e), LR_OK);
+    char origin[64];
+    snprintf(origin, sizeof origin, "%g,%g,%g", ORIGIN[0], ORIGIN[1], ORIGIN[2]);
+    char *argv[] = {"calib", "pose", "--image", img, "--board", "9x6", "--square", "25",
+                    "--origin", origin, "--x-axis", "1,0,0", "--y-axis", "0,-1,0",
+                    "--camera", camf, "--out", out};
+    assert_int_equal(lr_cmd_calib(18, argv), 0);
+    lr_rig_calib *rig = calloc(1, sizeof *rig);
+    assert_int_equal(lr_rig_calib_load(dir, rig, &e), LR_OK);
+    assert_true(rig->has_pose && rig->has_camera);
+    assert_true(angle_between(rig->pose.camera.R, truth.R) < 0.1);
+    lr_vec3 c = lr_pose_center(&rig->pose.camera);
+    assert_near(c.x, C[0], 1.0);
+    assert_near(c.y, C[1], 1.0);
+    assert_near(c.z, C[2], 1.0);
+    lr_rig_calib_free(rig);
+    free(rig);
+    assert_int_equal(unlink(out), 0);
+    argv[3] = blank;
+    assert_int_equal(lr_cmd_calib(18, argv), 1);
+    assert_int_equal(access(out, F_OK), -1);
+    lr_img_free(&photo);
+    sim_rmdir(dir);
+    free(dir);
+}
+
 static void test_bad_placement(void **state)
 {
     (void)state;
@@ -290,6 +344,7 @@ int main(void)
         cmocka_unit_test(test_camview_remap_is_lens_model),
         cmocka_unit_test(test_pose_from_board),
         cmocka_unit_test(test_projector_pose_and_file),
+        cmocka_unit_test(test_pose_cli),
         cmocka_unit_test(test_bad_placement),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
