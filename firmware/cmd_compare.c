@@ -10,7 +10,7 @@
 #include <time.h>
 
 #include "calib/compare.h"
-#include "calib/json_out.h"
+#include "calib/calfile.h" /* the JSON writer (lr_jw), wherever it lives */
 #include "calib/rig.h"
 #include "calib/view_render.h"
 #include "firmware/cli.h"
