@@ -325,13 +325,9 @@ int lr_compare_capture_mask(const lr_img *images, int n, double sat, double dark
         bool all_sat = true, all_dark = true;
         for (int k = 0; k < n; k++) {
             int x = (int)(i % images[k].w), y = (int)(i / images[k].w);
-            double hi = 0, lo = 1;
-            for (int c = 0; c < 3; c++) {
-                double v = lr_img_get(&images[k], x, y, c);
-                hi = fmax(hi, v);
-                lo = fmin(lo, v);
-            }
-            (void)lo;
+            double hi = 0;
+            for (int c = 0; c < 3; c++)
+                hi = fmax(hi, lr_img_get(&images[k], x, y, c));
             all_sat = all_sat && hi >= sat;
             all_dark = all_dark && hi <= dark;
         }
