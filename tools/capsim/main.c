@@ -11,7 +11,9 @@
  *
  * --gain defaults to the scene's render.exposure (the capture is then about as bright as
  * the renderer's own PNG at --exposure 1); --noise defaults to 10000 e- full well and 4 e-
- * read noise. Exit status 0, 1 (failure, message on stderr), 2 (bad arguments). */
+ * read noise. --seed drives the sensor noise only; the render uses the renderers' default
+ * sample seed, as `lamprig compare` does. Exit status 0, 1 (failure, message on stderr),
+ * 2 (bad arguments). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -165,8 +167,10 @@ int main(int argc, char **argv)
         lr_camview_create(&rig->camera.k, &rig->pose.camera, 0, &view, &e))
         goto fail;
     double secs = 0;
-    lr_view_render_desc vd = {.scene = scene, .view = view, .cpu = cpu, .frames = (int)frames,
-                              .seed = (unsigned)s.seed + 1};
+    /* The renderers' default sample seed, as `lamprig compare` uses: a capture and a
+     * comparison at the same --frames see the same Monte Carlo samples, so what differs is
+     * the sensor alone (--seed drives its noise). */
+    lr_view_render_desc vd = {.scene = scene, .view = view, .cpu = cpu, .frames = (int)frames};
     if (lr_view_render(&vd, &rad, &secs, &e) || (hdr && lr_image_write_pfm(hdr, &rad, &e)) ||
         lr_sensor_capture(&s, &rad, &cap, &e) || lr_img_write(out, &cap, &e))
         goto fail;
