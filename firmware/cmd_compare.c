@@ -99,7 +99,7 @@ typedef struct report {
     const char *scene, *calib;
     const char *const *captures;
     const double *times;
-    int ncaptures, width, height;
+    int ncaptures, width, height, render_w, render_h;
     bool cpu;
     double render_s, total_s;
     const lr_compare_result *res;
@@ -131,6 +131,8 @@ static int write_report(const char *path, const report *r, lr_err *e)
     lr_jw_array_end(w);
     lr_jw_string(w, "renderer", r->cpu ? "cpu" : "gpu");
     lr_jw_numbers(w, "image_size", (const double[]){r->width, r->height}, 2);
+    /* The undistorted pinhole render behind the camera's view (calib/camview.h). */
+    lr_jw_numbers(w, "render_size", (const double[]){r->render_w, r->render_h}, 2);
     lr_jw_number(w, "render_s", r->render_s);
     lr_jw_number(w, "total_s", r->total_s);
     lr_jw_number(w, "scale", r->res->scale);
@@ -300,8 +302,10 @@ int lr_cmd_compare(int argc, char **argv)
     lr_compare_desc cd = {.render = &ren, .capture = &cap, .labels = labels, .exclude = exclude};
     if (lr_compare_run(&cd, &res, demap, &e))
         goto fail;
-    report r = {scene_path, calib, captures, times, ncap, k->width, k->height, cpu, render_s,
-                now_s() - t0, &res};
+    int rw, rh;
+    lr_camview_render_size(view, &rw, &rh);
+    report r = {scene_path, calib, captures, times, ncap, k->width, k->height, rw, rh, cpu,
+                render_s, now_s() - t0, &res};
     if ((render_out && lr_image_write_pfm(render_out, &ren, &e)) ||
         (heatmap && lr_heatmap_png(heatmap, demap, k->width, k->height, hmax,
                                    "CIEDE2000, render vs capture (grey: not compared)", &e)) ||
@@ -316,8 +320,8 @@ int lr_cmd_compare(int argc, char **argv)
                    lr_compare_region_name(g), s->pixels, s->rel_rmse, s->ssim, s->delta_e,
                    s->delta_e_p95);
     }
-    printf("render %.2f s (%s), total %.2f s -> %s\n", render_s, cpu ? "CPU twin" : "GPU",
-           r.total_s, report_path);
+    printf("render %.2f s (%s, %dx%d undistorted), total %.2f s -> %s\n", render_s,
+           cpu ? "CPU twin" : "GPU", rw, rh, r.total_s, report_path);
     status = LR_EXIT_OK;
     goto done;
 fail:
