@@ -484,7 +484,17 @@ static void test_cli(void **state)
     assert_non_null(strstr(text, "\"rel_rmse\""));
     assert_non_null(strstr(text, "\"render_s\""));
     free(text);
-    assert_int_equal(access(heat, F_OK), 0);
+    /* The heatmap: the image plus a 90 px colour bar and a 28 px title strip; the image's
+     * border pixels are never compared (1 px boundary rule), so they are grey (0.5 -> 128). */
+    lr_img hm;
+    assert_int_equal(lr_img_read(heat, LR_IMG_RGB8, &hm, &e), LR_OK);
+    assert_int_equal(hm.w, CW + 90);
+    assert_int_equal(hm.h, CH + 28);
+    const uint8_t *corner = (const uint8_t *)hm.px + 3 * (28 * hm.w + 0);
+    assert_int_equal(corner[0], 128);
+    assert_int_equal(corner[1], 128);
+    assert_int_equal(corner[2], 128);
+    lr_img_free(&hm);
 
     /* A capture of the wrong size: exit 1, message naming both sizes. */
     const char *bad_size[] = {"--scene", LR_SOURCE_CONFIGS "/scenes/candle.json", "--calib",
