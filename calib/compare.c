@@ -265,9 +265,10 @@ int lr_compare_run(const lr_compare_desc *d, lr_compare_result *out, float *dema
     for (int g = 0; g < LR_REGION_COUNT; g++) {
         lr_compare_stats *st = &out->region[g];
         if (st->pixels == 0) {
-            st->rel_rmse = st->ssim = st->delta_e = st->delta_e_p95 = NAN;
+            st->rmse = st->rel_rmse = st->ssim = st->delta_e = st->delta_e_p95 = NAN;
             continue;
         }
+        st->rmse = sqrt(num[g] / (3.0 * st->pixels));
         st->rel_rmse = den[g] > 0 ? sqrt(num[g] / den[g]) : (num[g] > 0 ? INFINITY : 0);
         st->ssim = ssim[g] / st->pixels;
         st->delta_e = desum[g] / st->pixels;

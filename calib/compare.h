@@ -14,6 +14,7 @@
  *   - it is not excluded (saturated or in shadow in the capture: lr_compare_capture_mask).
  *
  * Metrics per region:
+ *   rmse      RMSE in linear light, in the render's units (W/(mm^2 sr));
  *   rel_rmse  relative RMSE in linear light: sqrt(sum_px,c (C - R)^2 / sum_px,c R^2);
  *   ssim      Wang, Bovik, Sheikh, Simoncelli 2004 (IEEE TIP 13(4), Eq. 13) on luminance
  *             Y = 0.2126 R + 0.7152 G + 0.0722 B, 11 x 11 Gaussian window sigma 1.5
@@ -40,6 +41,7 @@ enum lr_compare_region { LR_REGION_OBJECT = 0, LR_REGION_RECEIVERS, LR_REGION_AL
 
 typedef struct lr_compare_stats {
     long pixels;        /* compared */
+    double rmse;        /* linear RMSE, render units: sqrt(sum (C - R)^2 / (3 pixels)) */
     double rel_rmse;
     double ssim;
     double delta_e;     /* mean */

@@ -144,6 +144,7 @@ static int write_report(const char *path, const report *r, lr_err *e)
         lr_jw_object(w, lr_compare_region_name(g));
         lr_jw_int(w, "pixels", s->pixels);
         if (s->pixels > 0) { /* no metric for an empty region (JSON has no NaN) */
+            lr_jw_number(w, "rmse", s->rmse);
             lr_jw_number(w, "rel_rmse", s->rel_rmse);
             lr_jw_number(w, "ssim", s->ssim);
             lr_jw_number(w, "delta_e", s->delta_e);

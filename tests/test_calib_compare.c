@@ -11,6 +11,7 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -112,6 +113,7 @@ static void test_identical_images(void **state)
     for (int g = 0; g < LR_REGION_COUNT; g++) {
         assert_true(r.region[g].pixels > 0);
         assert_near(r.region[g].rel_rmse, 0, 0);
+        assert_near(r.region[g].rmse, 0, 0);
         assert_near(r.region[g].ssim, 1, 1e-6); /* float accumulation of the local moments */
         assert_near(r.region[g].delta_e, 0, 1e-9);
     }
@@ -129,6 +131,25 @@ static void test_identical_images(void **state)
         b.rgb[i] = a.rgb[i] * 1.1f;
     assert_int_equal(lr_compare_run(&d, &r, NULL, &e), LR_OK);
     assert_near(r.region[LR_REGION_ALL].rel_rmse, 0.1, 1e-6);
+    /* rmse = 0.1 x the RMS of the render's values over the compared pixels. */
+    {
+        double ss = 0;
+        long m = 0;
+        for (int y = 1; y < H - 1; y++)
+            for (int x = 1; x < W - 1; x++) {
+                bool in = true;
+                for (int dy = -1; dy <= 1; dy++)
+                    for (int dx = -1; dx <= 1; dx++)
+                        in = in && labels[(y + dy) * W + x + dx] == labels[y * W + x];
+                if (!in || labels[y * W + x] == LR_LABEL_BACKGROUND)
+                    continue;
+                for (int c = 0; c < 3; c++)
+                    ss += (double)a.rgb[3 * (y * W + x) + c] * a.rgb[3 * (y * W + x) + c];
+                m++;
+            }
+        assert_int_equal(m, r.region[LR_REGION_ALL].pixels);
+        assert_near_rel(r.region[LR_REGION_ALL].rmse, 0.1 * sqrt(ss / (3.0 * m)), 1e-5);
+    }
     assert_true(r.region[LR_REGION_ALL].delta_e > 0.5);
     assert_true(r.region[LR_REGION_ALL].ssim < 1.0);
 
