@@ -9,6 +9,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "calib/capture_sim.h"
 #include "calib/compare.h"
 #include "calib/calfile.h" /* the JSON writer (lr_jw), wherever it lives */
 #include "calib/rig.h"
@@ -25,7 +26,7 @@ const char lr_compare_usage[] =
     "usage: lamprig compare --scene FILE --calib DIR --capture IMG [IMG...] --report OUT.json\n"
     "                       [--heatmap OUT.png] [--times T1,T2,...] [--gain G] [--gamma G]\n"
     "                       [--cpu] [--frames N] [--heatmap-max DE] [--render-out R.pfm]\n"
-    "                       [--set key=value ...]\n"
+    "                       [--vignette none|cos4|poly:V1,V2,V3] [--set key=value ...]\n"
     "\n"
     "Renders the camera's view of the scene with the calibrated intrinsics and pose (DIR:\n"
     "camera.json and pose.json required; camera_response.json and color.json used when\n"
@@ -36,7 +37,9 @@ const char lr_compare_usage[] =
     "all; boundary, saturated and shadow pixels excluded): relative RMSE in linear light,\n"
     "SSIM on luminance, mean and 95th-percentile CIEDE2000, and the render time.\n"
     "--heatmap writes the per-pixel CIEDE2000 (scale 0..--heatmap-max, default 10).\n"
-    "--cpu renders with the CPU twin instead of the GPU renderer.\n"
+    "--cpu renders with the CPU twin instead of the GPU renderer. --vignette divides the\n"
+    "capture by a vignetting model (as lamprig-capsim applies it; cos4 uses the calibrated\n"
+    "focal length and principal point).\n"
     "\n"
     "Exit status: 0 success, 1 failure (nothing written), 2 bad arguments.";
 
@@ -165,7 +168,7 @@ static int write_report(const char *path, const report *r, lr_err *e)
 int lr_cmd_compare(int argc, char **argv)
 {
     const char *scene_path = NULL, *calib = NULL, *report_path = NULL, *heatmap = NULL;
-    const char *times_s = NULL, *render_out = NULL;
+    const char *times_s = NULL, *render_out = NULL, *vignette = NULL;
     const char *captures[MAX_CAPTURES], *sets[MAX_SETS];
     int ncap = 0, nsets = 0;
     double gain = 0, gamma = 0, frames = 0, hmax = 10;
@@ -201,6 +204,8 @@ int lr_cmd_compare(int argc, char **argv)
             times_s = v;
         else if (!strcmp(a, "--render-out"))
             render_out = v;
+        else if (!strcmp(a, "--vignette"))
+            vignette = v;
         else if (!strcmp(a, "--set")) {
             if (nsets >= MAX_SETS)
                 return usage_error("%s", "too many --set (at most 64)");
@@ -238,6 +243,13 @@ int lr_cmd_compare(int argc, char **argv)
         return usage_error("%s", "an exposure stack of several captures needs --times");
     } else {
         times[0] = 1.0;
+    }
+
+    lr_sensor vig = {0};
+    if (vignette) {
+        lr_err ve = {0};
+        if (lr_sensor_parse_vignette(vignette, &vig, &ve))
+            return usage_error("--vignette %s", ve.msg);
     }
 
     double t0 = now_s();
@@ -291,8 +303,24 @@ int lr_cmd_compare(int argc, char **argv)
         goto fail;
     }
     if (lr_compare_linearise(rig, imgs, times, ncap, gain, gamma, &cap, &e) ||
-        lr_compare_capture_mask(imgs, ncap, 0, 0, exclude, &e) ||
-        lr_camview_create(k, &rig->pose.camera, 0, &view, &e) ||
+        lr_compare_capture_mask(imgs, ncap, 0, 0, exclude, &e))
+        goto fail;
+    if (vig.vignette != LR_VIGNETTE_NONE) {
+        vig.focal_px = sqrt(k->fx * k->fy);
+        vig.cx = k->cx;
+        vig.cy = k->cy;
+        if (lr_sensor_check(&vig, &e))
+            goto fail;
+        for (int y = 0; y < k->height; y++)
+            for (int x = 0; x < k->width; x++) {
+                double V = lr_sensor_vignette(&vig, k->width, k->height, x, y);
+                for (int c = 0; c < 3; c++) { /* V = 0 (a polynomial's far corner): excluded */
+                    float *p = cap.rgb + 3 * ((size_t)y * k->width + x) + c;
+                    *p = V > 1e-6 ? (float)(*p / V) : NAN;
+                }
+            }
+    }
+    if (lr_camview_create(k, &rig->pose.camera, 0, &view, &e) ||
         lr_camview_labels(view, scene, labels, &e))
         goto fail;
     double render_s = 0;

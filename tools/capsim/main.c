@@ -111,16 +111,9 @@ int main(int argc, char **argv)
                 return usage("--noise '%s': expected FULL_WELL,READ (electrons) or none", v);
             }
         } else if (!strcmp(a, "--vignette")) {
-            int n = 0;
-            if (!strcmp(v, "none"))
-                s.vignette = LR_VIGNETTE_NONE;
-            else if (!strcmp(v, "cos4"))
-                s.vignette = LR_VIGNETTE_COS4;
-            else if (sscanf(v, "poly:%lf,%lf,%lf%n", &s.vignette_poly[0], &s.vignette_poly[1],
-                            &s.vignette_poly[2], &n) == 3 && !v[n])
-                s.vignette = LR_VIGNETTE_POLY;
-            else
-                return usage("--vignette '%s': expected none, cos4 or poly:V1,V2,V3", v);
+            lr_err ve = {0};
+            if (lr_sensor_parse_vignette(v, &s, &ve))
+                return usage("--vignette %s", ve.msg);
         } else {
             return usage("unknown option '%s'", a);
         }
