@@ -4,6 +4,7 @@
 #include <stddef.h>
 
 #include "firmware/cmd_calib.h"
+#include "firmware/cmd_fit.h"
 #include "firmware/cmd_optics.h"
 #include "firmware/cmd_render.h"
 #include "firmware/cmd_run.h"
@@ -12,6 +13,7 @@ const lr_command lr_commands[] = {
     {"optics", lr_optics_summary, lr_optics_usage, lr_cmd_optics},
     {"calib", "calibrate camera, projector and radiometry; check calibration files",
      lr_cmd_calib_usage, lr_cmd_calib},
+    {"fit", lr_fit_summary, lr_fit_usage, lr_cmd_fit},
     {"render", lr_render_summary, lr_render_usage, lr_cmd_render},
     {"run", lr_run_summary, lr_run_usage, lr_cmd_run},
     {NULL, NULL, NULL, NULL},
