@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "calib/albedo.h"
 #include "calib/camcal.h"
 #include "calib/camresp.h"
 #include "calib/capture.h"
@@ -18,6 +19,7 @@
 #include "calib/graycode.h"
 #include "calib/procam.h"
 #include "calib/projresp.h"
+#include "calib/rig.h"
 #include "firmware/cli.h"
 
 const char lr_cmd_calib_usage[] =
@@ -51,6 +53,11 @@ const char lr_cmd_calib_usage[] =
     "  color --pairs PAIRS.json --out FILE.json\n"
     "  color --checker PHOTO --out FILE.json [--camera-response FILE.json]\n"
     "      3x3 colour matrix, camera linear RGB -> linear sRGB\n"
+    "  albedo --captures DIR --out FILE.json [--calib DIR] [--proj WxH] [--contrast N]\n"
+    "         [--shadow N] [--fill N]\n"
+    "      the mockup's response to each projector pixel (white - black, linearised with the\n"
+    "      calibration folder's camera response) from a Gray-code capture of the white\n"
+    "      mockup, for spatial AR; writes FILE.json and FILE.pfm beside it\n"
     "  check FILE...\n"
     "      load and validate calibration files of any kind, print a summary\n"
     "\n"
@@ -719,6 +726,13 @@ static int check_one(const char *path)
         lr_colormatrix m;
         if (!(rc = lr_colormatrix_load(path, &m, &e)))
             printf("%s: colour matrix from %d patches, rms %.4f\n", path, m.patches, m.rms);
+    } else if (!strcmp(kind, LR_ALBEDO_KIND)) {
+        lr_albedo a;
+        if (!(rc = lr_albedo_load(path, &a, &e))) {
+            printf("%s: mockup response %dx%d, %ld pixels measured, %ld filled\n", path,
+                   a.response.width, a.response.height, a.measured_pixels, a.filled_pixels);
+            lr_albedo_free(&a);
+        }
     } else if (!strcmp(kind, LR_GC_SEQUENCE_KIND)) {
         char dir[4096];
         snprintf(dir, sizeof dir, "%s", path);
@@ -739,6 +753,95 @@ static int check_one(const char *path)
         return LR_EXIT_FAIL;
     }
     return LR_EXIT_OK;
+}
+
+/* Linear camera image of an 8-bit capture (the calibration's response and colour matrix). */
+static int read_linear(const char *path, const lr_rig_calib *cal, lr_image *out, lr_err *e)
+{
+    lr_img img;
+    int rc = lr_img_read(path, LR_IMG_RGB8, &img, e);
+    if (rc)
+        return rc;
+    if ((rc = lr_image_alloc(out, img.w, img.h, e))) {
+        lr_img_free(&img);
+        return rc;
+    }
+    const uint8_t *p = img.px;
+    for (size_t k = 0; k < (size_t)img.w * img.h; k++) {
+        double v[3];
+        lr_rig_camera_to_linear(cal, p + 3 * k, v);
+        for (int c = 0; c < 3; c++)
+            out->rgb[3 * k + c] = (float)v[c];
+    }
+    lr_img_free(&img);
+    return LR_OK;
+}
+
+static int cmd_albedo(int argc, char **argv)
+{
+    const char *dir = NULL, *out = NULL, *cdir = NULL, *proj = NULL, *contrast = NULL,
+               *shadow = NULL, *fill = NULL;
+    const char *cmd = "albedo";
+    const opt opts[] = {{"captures", &dir, NULL}, {"out", &out, NULL},
+                        {"calib", &cdir, NULL},   {"proj", &proj, NULL},
+                        {"contrast", &contrast, NULL}, {"shadow", &shadow, NULL},
+                        {"fill", &fill, NULL},    {NULL, NULL, NULL}};
+    int rc = parse(cmd, argc, argv, 2, opts, NULL, 0, NULL);
+    if (rc || (rc = need(cmd, dir, "captures")) || (rc = need(cmd, out, "out")))
+        return rc;
+    int pw = 0, ph = 0, passes = -1;
+    lr_gc_params params = {0};
+    if (proj && !parse_wxh(proj, &pw, &ph))
+        return usage_error(cmd, "--proj '%s': expected WIDTHxHEIGHT", proj);
+    if (contrast && !parse_int(contrast, 1, 255, &params.contrast))
+        return usage_error(cmd, "--contrast '%s': expected 1..255", contrast);
+    if (shadow && !parse_int(shadow, 1, 255, &params.shadow))
+        return usage_error(cmd, "--shadow '%s': expected 1..255", shadow);
+    if (fill && !parse_int(fill, 0, 64, &passes))
+        return usage_error(cmd, "--fill '%s': expected 0..64 passes", fill);
+    lr_err e = {0};
+    lr_rig_calib *cal = calloc(1, sizeof *cal);
+    if (!cal)
+        return LR_EXIT_FAIL;
+    if (cdir && lr_rig_calib_load(cdir, cal, &e)) {
+        free(cal);
+        return fail(cmd, &e);
+    }
+    progress_state ps = {{0}, -1};
+    lr_progress progress = {print_progress, &ps};
+    lr_gc_map *m = NULL;
+    lr_image white = {0}, black = {0};
+    lr_albedo a = {0};
+    char path[4096];
+    int status = LR_EXIT_OK;
+    if (lr_gc_decode_dir(dir, pw, ph, &params, &progress, &m, &e)) {
+        status = fail(cmd, &e);
+        goto done;
+    }
+    snprintf(path, sizeof path, "%s/white.png", dir);
+    if (read_linear(path, cal, &white, &e)) {
+        status = fail(cmd, &e);
+        goto done;
+    }
+    snprintf(path, sizeof path, "%s/black.png", dir);
+    if (read_linear(path, cal, &black, &e) ||
+        lr_albedo_measure(&white, &black, m, passes, &a, &e) || lr_albedo_save(out, &a, &e)) {
+        status = fail(cmd, &e);
+        goto done;
+    }
+    lr_gc_map_projector_size(m, &pw, &ph);
+    printf("%s: mockup response for a %dx%d projector: %ld pixels measured (%.1f %%), %ld "
+           "filled; scale %.4g (camera linear units of full white at M = 1)\n",
+           out, pw, ph, a.measured_pixels, 100.0 * a.measured_pixels / ((long)pw * ph),
+           a.filled_pixels, a.scale);
+done:
+    lr_albedo_free(&a);
+    lr_image_free(&white);
+    lr_image_free(&black);
+    lr_gc_map_destroy(m);
+    lr_rig_calib_free(cal);
+    free(cal);
+    return status;
 }
 
 static int cmd_check(int argc, char **argv)
@@ -765,6 +868,8 @@ int lr_cmd_calib(int argc, char **argv)
         return cmd_projector_response(argc, argv);
     if (!strcmp(sub, "color"))
         return cmd_color(argc, argv);
+    if (!strcmp(sub, "albedo"))
+        return cmd_albedo(argc, argv);
     if (!strcmp(sub, "check"))
         return cmd_check(argc, argv);
     fprintf(stderr, "%s\n", lr_cmd_calib_usage);

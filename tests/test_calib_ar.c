@@ -18,6 +18,8 @@
 #include "calib/albedo.h"
 #include "calib/graycode.h"
 #include "calib/spatial_ar.h"
+#include "firmware/cli.h"
+#include "firmware/cmd_calib.h"
 #include "render/base/mat4.h"
 #include "tests/support/calib_sim.h"
 #include "tests/support/near.h"
@@ -431,6 +433,40 @@ static void test_geometry_factor(void **state)
     lr_scene_destroy(sc);
 }
 
+/* `lamprig calib albedo` on a simulated capture folder writes a file `calib check` accepts,
+ * holding the same response as the library call; bad arguments exit 2, a folder without
+ * captures 1. */
+static void test_cli_albedo(void **state)
+{
+    (void)state;
+    sim_scene s;
+    build_rig(&s);
+    char *dir = sim_tempdir("ar_cli");
+    assert_int_equal(sim_write_graycode(&s, PW, PH, dir), 0);
+    char out[4096];
+    snprintf(out, sizeof out, "%s/albedo.json", dir);
+    char *argv[] = {"calib", "albedo", "--captures", dir, "--out", out, NULL};
+    assert_int_equal(lr_cmd_calib(6, argv), LR_EXIT_OK);
+    char *check[] = {"calib", "check", out, NULL};
+    assert_int_equal(lr_cmd_calib(3, check), LR_EXIT_OK);
+    lr_albedo a;
+    lr_err e = {0};
+    if (lr_albedo_load(out, &a, &e))
+        fail_msg("load: %s", e.msg);
+    assert_int_equal(a.measured_pixels, PW * PH);
+    /* the stripe, as in test_albedo_measured */
+    assert_near(a.response.rgb[3 * (10 * PW + 28)], STRIPE_ALBEDO / WHITE_ALBEDO, 0.03);
+    assert_near(a.response.rgb[3 * (10 * PW + 8)], 1, 0.03);
+    lr_albedo_free(&a);
+    char *bad[] = {"calib", "albedo", "--captures", dir, NULL};
+    assert_int_equal(lr_cmd_calib(4, bad), LR_EXIT_USAGE);
+    char *missing[] = {"calib", "albedo", "--captures", "/nonexistent", "--out", out, NULL};
+    assert_int_equal(lr_cmd_calib(6, missing), LR_EXIT_FAIL);
+    sim_rmdir(dir);
+    free(dir);
+    sim_scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -439,6 +475,7 @@ int main(void)
         cmocka_unit_test(test_compensation_clips),
         cmocka_unit_test(test_projector_view_warp),
         cmocka_unit_test(test_geometry_factor),
+        cmocka_unit_test(test_cli_albedo),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
