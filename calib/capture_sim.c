@@ -2,6 +2,7 @@
 
 #include <math.h>
 #include <stdbool.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -156,6 +157,25 @@ double lr_sensor_encode(const lr_sensor *s, int c, double X)
     }
     double span = cv[hi] - cv[lo];
     return lo + (span > 0 ? (X - cv[lo]) / span : 0.0);
+}
+
+int lr_sensor_parse_vignette(const char *text, lr_sensor *s, lr_err *e)
+{
+    int n = 0;
+    double v[3];
+    if (!strcmp(text, "none")) {
+        s->vignette = LR_VIGNETTE_NONE;
+    } else if (!strcmp(text, "cos4")) {
+        s->vignette = LR_VIGNETTE_COS4;
+    } else if (sscanf(text, "poly:%lf,%lf,%lf%n", &v[0], &v[1], &v[2], &n) == 3 && !text[n] &&
+               isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2])) {
+        s->vignette = LR_VIGNETTE_POLY;
+        memcpy(s->vignette_poly, v, sizeof v);
+    } else {
+        return lr_err_set(e, LR_EINVAL,
+                          "'%s': expected none, cos4 or poly:V1,V2,V3", text);
+    }
+    return LR_OK;
 }
 
 static double gauss(lr_cpu_rng *r)

@@ -78,6 +78,11 @@ int lr_sensor_exposure(const lr_sensor *s, const lr_image *radiance, double *out
  * channel c: the inverse response. */
 double lr_sensor_encode(const lr_sensor *s, int c, double X);
 
+/* Parses a vignetting model as the command lines give it: "none", "cos4" or
+ * "poly:V1,V2,V3" into s->vignette / s->vignette_poly (cos4 still needs focal_px, cx, cy).
+ * LR_EINVAL with a message quoting the text. */
+int lr_sensor_parse_vignette(const char *text, lr_sensor *s, lr_err *e);
+
 /* The whole chain: radiance (lr_image, rows top to bottom) -> an RGB image of 8 or 16 bits
  * (allocated into *out; free with lr_img_free). */
 int lr_sensor_capture(const lr_sensor *s, const lr_image *radiance, lr_img *out, lr_err *e);

@@ -4,6 +4,7 @@
 #include <stddef.h>
 
 #include "firmware/cmd_calib.h"
+#include "firmware/cmd_compare.h"
 #include "firmware/cmd_fit.h"
 #include "firmware/cmd_optics.h"
 #include "firmware/cmd_render.h"
@@ -13,6 +14,7 @@ const lr_command lr_commands[] = {
     {"optics", lr_optics_summary, lr_optics_usage, lr_cmd_optics},
     {"calib", "calibrate camera, projector and radiometry; check calibration files",
      lr_cmd_calib_usage, lr_cmd_calib},
+    {"compare", lr_compare_summary, lr_compare_usage, lr_cmd_compare},
     {"fit", lr_fit_summary, lr_fit_usage, lr_cmd_fit},
     {"render", lr_render_summary, lr_render_usage, lr_cmd_render},
     {"run", lr_run_summary, lr_run_usage, lr_cmd_run},
