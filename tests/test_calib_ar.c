@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "calib/albedo.h"
+#include "calib/ar_frame.h"
 #include "calib/graycode.h"
 #include "calib/spatial_ar.h"
 #include "firmware/cli.h"
@@ -433,6 +434,80 @@ static void test_geometry_factor(void **state)
     lr_scene_destroy(sc);
 }
 
+/* The whole frame from a calibration: the projector above a lit box, no mockup response
+ * file (an ideal white mockup: the response is the geometry factor g). Each level must be
+ * gain x target / g where unclipped (Eq. 1; float storage: 1e-5 relative), the scene's
+ * camera must come back unchanged, and without a projector pose the error says what is
+ * missing. */
+static void test_ar_frame(void **state)
+{
+    (void)state;
+    static const char scene_text[] =
+        "{\"objects\": [{\"material\": \"marble\", \"mesh\": {\"type\": \"box\", "
+        "\"size\": [300, 300, 100]}, \"transform\": {\"translate\": [0, 0, -50]}}],"
+        " \"lights\": [{\"type\": \"point\", \"position\": [20, 0, 30], \"intensity\": 1}],"
+        " \"camera\": {\"position\": [0, -300, 300], \"target\": [0, 0, 0]}}";
+    lr_scene *sc;
+    lr_err e = {0};
+    if (lr_scene_parse(scene_text, sizeof scene_text - 1, "box.json", NULL, &sc, &e))
+        fail_msg("scene: %s", e.msg);
+    lr_camera before = *lr_scene_camera(sc);
+    lr_rig_calib *cal = calloc(1, sizeof *cal);
+    cal->has_procam = true;
+    cal->procam.proj = (lr_intrinsics){.width = 32, .height = 24, .fx = 40, .fy = 40,
+                                       .cx = 17, .cy = 11};
+    lr_ar_frame_desc d = {.scene = sc, .calib = cal, .samples = 8, .no_vpl = true,
+                          .threads = 2};
+    lr_image levels, target;
+    lr_ar_stats st;
+    assert_int_equal(lr_ar_frame(&d, &levels, &target, &st, &e), LR_EINVAL);
+    assert_non_null(strstr(e.msg, "no projector pose"));
+    cal->has_pose = true;
+    cal->pose.has_projector = true;
+    /* 400 mm above, looking down, image +x along scene +x */
+    lr_pose p = {.R = {1, 0, 0, 0, -1, 0, 0, 0, -1}, .T = {0, 0, 400}};
+    cal->pose.projector = p;
+    if (lr_ar_frame(&d, &levels, &target, &st, &e))
+        fail_msg("frame: %s", e.msg);
+    lr_camera after = *lr_scene_camera(sc);
+    assert_near(after.position.y, before.position.y, 1e-9);
+    assert_near(after.fov_deg, before.fov_deg, 1e-9);
+    assert_near(after.target.z, before.target.z, 1e-9);
+    lr_image g;
+    long lit;
+    double gmax;
+    lr_ar_pose ap = {.R = {1, 0, 0, 0, -1, 0, 0, 0, -1}, .T = {0, 0, 400}};
+    assert_int_equal(lr_ar_geometry(sc, &cal->procam.proj, &ap, &g, &lit, &gmax, NULL), 0);
+    /* the outermost projector pixels miss the 300 mm box (+-0.4 x 400 mm = 160 mm) */
+    assert_int_equal(st.lit_pixels, lit);
+    assert_true(lit > 32 * 24 / 2 && lit < 32 * 24);
+    double tmax = 0;
+    for (int i = 0; i < 32 * 24 * 3; i++)
+        tmax = fmax(tmax, target.rgb[i]);
+    assert_true(tmax > 0);
+    assert_near_rel(st.gain, 1 / tmax, 1e-6);
+    long unclipped = 0;
+    for (int i = 0; i < 32 * 24 * 3; i++) {
+        if (g.rgb[i] == 0) { /* off the mockup: dark */
+            assert_true(levels.rgb[i] == 0);
+            continue;
+        }
+        double want = st.gain * target.rgb[i] / g.rgb[i];
+        if (want < 1) {
+            assert_near(levels.rgb[i], want, 1e-5 * fmax(1, want) + 1e-7);
+            unclipped++;
+        } else {
+            assert_near(levels.rgb[i], 1, 1e-6);
+        }
+    }
+    assert_true(unclipped > 32 * 24);
+    lr_image_free(&g);
+    lr_image_free(&levels);
+    lr_image_free(&target);
+    free(cal);
+    lr_scene_destroy(sc);
+}
+
 /* `lamprig calib albedo` on a simulated capture folder writes a file `calib check` accepts,
  * holding the same response as the library call; bad arguments exit 2, a folder without
  * captures 1. */
@@ -476,6 +551,7 @@ int main(void)
         cmocka_unit_test(test_projector_view_warp),
         cmocka_unit_test(test_geometry_factor),
         cmocka_unit_test(test_cli_albedo),
+        cmocka_unit_test(test_ar_frame),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
