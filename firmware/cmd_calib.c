@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "calib/albedo.h"
+#include "calib/ar_frame.h"
 #include "calib/camcal.h"
 #include "calib/camresp.h"
 #include "calib/capture.h"
@@ -68,6 +69,12 @@ const char lr_cmd_calib_usage[] =
     "      the mockup's response to each projector pixel (white - black, linearised with the\n"
     "      calibration folder's camera response) from a Gray-code capture of the white\n"
     "      mockup, for spatial AR; writes FILE.json and FILE.pfm beside it\n"
+    "  ar-frame --scene FILE --calib DIR --out LEVELS.png [--target OUT.pfm] [--gain G]\n"
+    "         [--samples N] [--render-width N] [--seed N]\n"
+    "      one spatial-AR projector frame: the scene rendered from the projector (pose.json's\n"
+    "      projector pose), divided by the mockup's response (DIR/albedo.json, else an ideal\n"
+    "      white mockup of the scene's geometry), clipped, through the inverse projector\n"
+    "      response; prints how much was clipped\n"
     "  check FILE...\n"
     "      load and validate calibration files of any kind, print a summary\n"
     "\n"
@@ -982,6 +989,89 @@ done:
     return status;
 }
 
+static int cmd_ar_frame(int argc, char **argv)
+{
+    const char *scene_path = NULL, *cdir = NULL, *out = NULL, *tpath = NULL, *gain = NULL,
+               *samples = NULL, *rwidth = NULL, *seed = NULL;
+    const char *cmd = "ar-frame";
+    const opt opts[] = {{"scene", &scene_path, NULL}, {"calib", &cdir, NULL},
+                        {"out", &out, NULL},          {"target", &tpath, NULL},
+                        {"gain", &gain, NULL},        {"samples", &samples, NULL},
+                        {"render-width", &rwidth, NULL}, {"seed", &seed, NULL},
+                        {NULL, NULL, NULL}};
+    int rc = parse(cmd, argc, argv, 2, opts, NULL, 0, NULL);
+    if (rc || (rc = need(cmd, scene_path, "scene")) || (rc = need(cmd, cdir, "calib")) ||
+        (rc = need(cmd, out, "out")))
+        return rc;
+    lr_ar_frame_desc d = {0};
+    int sd = 0;
+    if (gain && !parse_double(gain, 1e-30, 1e30, &d.gain))
+        return usage_error(cmd, "--gain '%s': expected a number > 0", gain);
+    if (samples && !parse_int(samples, 1, 1 << 20, &d.samples))
+        return usage_error(cmd, "--samples '%s': expected 1..1048576", samples);
+    if (rwidth && !parse_int(rwidth, 2, 16384, &d.render_width))
+        return usage_error(cmd, "--render-width '%s': expected 2..16384", rwidth);
+    if (seed && !parse_int(seed, 1, 1 << 30, &sd))
+        return usage_error(cmd, "--seed '%s': expected a whole number > 0", seed);
+    d.seed = (unsigned)sd;
+    lr_err e = {0};
+    lr_scene *scene = NULL;
+    lr_rig_calib *cal = calloc(1, sizeof *cal);
+    lr_albedo a = {0};
+    lr_image levels = {0}, target = {0};
+    lr_img png = {0};
+    int status = LR_EXIT_FAIL;
+    if (!cal)
+        return LR_EXIT_FAIL;
+    if (lr_scene_load(scene_path, NULL, &scene, &e) || lr_rig_calib_load(cdir, cal, &e)) {
+        fail(cmd, &e);
+        goto done;
+    }
+    char apath[4096];
+    snprintf(apath, sizeof apath, "%s/%s", cdir, LR_RIG_ALBEDO);
+    FILE *f = fopen(apath, "r");
+    if (f) {
+        fclose(f);
+        if (lr_albedo_load(apath, &a, &e)) {
+            fail(cmd, &e);
+            goto done;
+        }
+    }
+    d.scene = scene;
+    d.calib = cal;
+    d.response = f ? &a.response : NULL;
+    lr_ar_stats st;
+    if (lr_ar_frame(&d, &levels, &target, &st, &e) ||
+        (tpath && lr_image_write_pfm(tpath, &target, &e)) ||
+        lr_img_alloc(&png, levels.width, levels.height, 3, 1, &e)) {
+        fail(cmd, &e);
+        goto done;
+    }
+    uint8_t *px = png.px;
+    for (size_t k = 0; k < (size_t)levels.width * levels.height * 3; k++)
+        px[k] = (uint8_t)lrint(255 * fmin(1.0, fmax(0.0, levels.rgb[k])));
+    if (lr_img_write(out, &png, &e)) {
+        fail(cmd, &e);
+        goto done;
+    }
+    char msg[128];
+    lr_ar_stats_format(&st, msg, sizeof msg);
+    printf("%s: %dx%d projector frame, mockup response from %s; gain %.4g; %s (%ld of %ld lit "
+           "pixels)\n",
+           out, levels.width, levels.height, f ? apath : "the scene's geometry (ideal white)",
+           st.gain, msg, st.clipped_pixels, st.lit_pixels);
+    status = LR_EXIT_OK;
+done:
+    lr_img_free(&png);
+    lr_image_free(&levels);
+    lr_image_free(&target);
+    lr_albedo_free(&a);
+    lr_rig_calib_free(cal);
+    free(cal);
+    lr_scene_destroy(scene);
+    return status;
+}
+
 static int cmd_check(int argc, char **argv)
 {
     if (argc < 3)
@@ -1010,6 +1100,8 @@ int lr_cmd_calib(int argc, char **argv)
         return cmd_pose(argc, argv);
     if (!strcmp(sub, "albedo"))
         return cmd_albedo(argc, argv);
+    if (!strcmp(sub, "ar-frame"))
+        return cmd_ar_frame(argc, argv);
     if (!strcmp(sub, "check"))
         return cmd_check(argc, argv);
     fprintf(stderr, "%s\n", lr_cmd_calib_usage);

@@ -18,6 +18,8 @@
 #include "calib/albedo.h"
 #include "calib/ar_frame.h"
 #include "calib/graycode.h"
+#include "calib/pose.h"
+#include "calib/procam.h"
 #include "calib/spatial_ar.h"
 #include "firmware/cli.h"
 #include "firmware/cmd_calib.h"
@@ -542,6 +544,64 @@ static void test_cli_albedo(void **state)
     sim_scene_free(&s);
 }
 
+/* `lamprig calib ar-frame` on a calibration folder written by the calibration savers:
+ * without pose.json it names what is missing (exit 1); with it, a frame and the clip report. */
+static void test_cli_ar_frame(void **state)
+{
+    (void)state;
+    char *dir = sim_tempdir("ar_frame");
+    char path[4096], scene[4096], out[4096];
+    lr_err e = {0};
+    lr_procam pc;
+    memset(&pc, 0, sizeof pc);
+    pc.cam = (lr_intrinsics){.width = 64, .height = 48, .fx = 80, .fy = 80, .cx = 32, .cy = 24};
+    pc.proj = (lr_intrinsics){.width = 32, .height = 24, .fx = 40, .fy = 40, .cx = 17, .cy = 11};
+    double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    memcpy(pc.R, I, sizeof I);
+    pc.T[0] = 100;
+    pc.board = (lr_board){.cols = 9, .rows = 6, .square_mm = 25};
+    pc.decode = (lr_gc_params){.contrast = 5, .shadow = 40};
+    pc.local = (lr_gc_local_params){.half_window = 23, .min_points = 50};
+    pc.local.ransac_px = 2;
+    snprintf(path, sizeof path, "%s/projector.json", dir);
+    if (lr_procam_save(path, &pc, &e))
+        fail_msg("procam save: %s", e.msg);
+    snprintf(scene, sizeof scene, "%s/box.json", dir);
+    FILE *f = fopen(scene, "w");
+    fputs("{\"objects\": [{\"material\": \"marble\", \"mesh\": {\"type\": \"box\", "
+          "\"size\": [400, 400, 100]}, \"transform\": {\"translate\": [0, 0, -50]}}],"
+          " \"lights\": [{\"type\": \"point\", \"position\": [20, 0, 30], \"intensity\": 1}],"
+          " \"camera\": {\"position\": [0, -300, 300], \"target\": [0, 0, 0]}}",
+          f);
+    fclose(f);
+    snprintf(out, sizeof out, "%s/levels.png", dir);
+    char *argv[] = {"calib", "ar-frame", "--scene", scene, "--calib", dir, "--out", out,
+                    "--samples", "4", NULL};
+    assert_int_equal(lr_cmd_calib(10, argv), LR_EXIT_FAIL);
+    lr_rig_pose rp;
+    memset(&rp, 0, sizeof rp);
+    lr_pose down = {.R = {1, 0, 0, 0, -1, 0, 0, 0, -1}, .T = {0, 0, 400}};
+    rp.camera = down;
+    rp.camera.T[0] = -100;
+    rp.has_projector = true;
+    rp.projector = down;
+    rp.points = 6;
+    snprintf(rp.source, sizeof rp.source, "points");
+    snprintf(path, sizeof path, "%s/pose.json", dir);
+    if (lr_rig_pose_save(path, &rp, &e))
+        fail_msg("pose save: %s", e.msg);
+    assert_int_equal(lr_cmd_calib(10, argv), LR_EXIT_OK);
+    lr_img img;
+    assert_int_equal(lr_img_read(out, LR_IMG_RGB8, &img, NULL), 0);
+    assert_int_equal(img.w, 32);
+    assert_int_equal(img.h, 24);
+    lr_img_free(&img);
+    char *bad[] = {"calib", "ar-frame", "--scene", scene, "--out", out, NULL};
+    assert_int_equal(lr_cmd_calib(6, bad), LR_EXIT_USAGE);
+    sim_rmdir(dir);
+    free(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -552,6 +612,7 @@ int main(void)
         cmocka_unit_test(test_geometry_factor),
         cmocka_unit_test(test_cli_albedo),
         cmocka_unit_test(test_ar_frame),
+        cmocka_unit_test(test_cli_ar_frame),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
