@@ -138,8 +138,6 @@ void lr_nm_tell(lr_nm *nm, double f)
     case SHRINK:
         nm->f[nm->k++] = f;
         if (nm->k > n) {
-            if (nm->phase == INIT && !isfinite(nm->f_restart))
-                nm->f_restart = INFINITY;
             next_iteration(nm);
         } else if (nm->evals >= nm->max_evals) {
             nm->done = true;
