@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "calib/albedo.h"
 #include "calib/ar_frame.h"
@@ -23,7 +24,10 @@
 #include "calib/spatial_ar.h"
 #include "firmware/cli.h"
 #include "firmware/cmd_calib.h"
+#include "firmware/rig/rig.h"
 #include "render/base/mat4.h"
+#include "tests/support/fs.h"
+#include "tests/support/hal_test.h"
 #include "tests/support/calib_sim.h"
 #include "tests/support/near.h"
 
@@ -546,11 +550,12 @@ static void test_cli_albedo(void **state)
 
 /* `lamprig calib ar-frame` on a calibration folder written by the calibration savers:
  * without pose.json it names what is missing (exit 1); with it, a frame and the clip report. */
-static void test_cli_ar_frame(void **state)
+/* A calibration folder for a 32 x 24 projector 400 mm above a box (pose.json only when
+ * with_pose), and the box scene; returns the scene path (static buffer). */
+static const char *write_ar_calib(const char *dir, bool with_pose)
 {
-    (void)state;
-    char *dir = sim_tempdir("ar_frame");
-    char path[4096], scene[4096], out[4096];
+    static char scene[4096];
+    char path[4096];
     lr_err e = {0};
     lr_procam pc;
     memset(&pc, 0, sizeof pc);
@@ -561,8 +566,7 @@ static void test_cli_ar_frame(void **state)
     pc.T[0] = 100;
     pc.board = (lr_board){.cols = 9, .rows = 6, .square_mm = 25};
     pc.decode = (lr_gc_params){.contrast = 5, .shadow = 40};
-    pc.local = (lr_gc_local_params){.half_window = 23, .min_points = 50};
-    pc.local.ransac_px = 2;
+    pc.local = (lr_gc_local_params){.half_window = 23, .min_points = 50, .ransac_px = 2};
     snprintf(path, sizeof path, "%s/projector.json", dir);
     if (lr_procam_save(path, &pc, &e))
         fail_msg("procam save: %s", e.msg);
@@ -574,22 +578,34 @@ static void test_cli_ar_frame(void **state)
           " \"camera\": {\"position\": [0, -300, 300], \"target\": [0, 0, 0]}}",
           f);
     fclose(f);
+    if (with_pose) {
+        lr_rig_pose rp;
+        memset(&rp, 0, sizeof rp);
+        lr_pose down = {.R = {1, 0, 0, 0, -1, 0, 0, 0, -1}, .T = {0, 0, 400}};
+        rp.camera = down;
+        rp.camera.T[0] = -100;
+        rp.has_projector = true;
+        rp.projector = down;
+        rp.points = 6;
+        snprintf(rp.source, sizeof rp.source, "points");
+        snprintf(path, sizeof path, "%s/pose.json", dir);
+        if (lr_rig_pose_save(path, &rp, &e))
+            fail_msg("pose save: %s", e.msg);
+    }
+    return scene;
+}
+
+static void test_cli_ar_frame(void **state)
+{
+    (void)state;
+    char *dir = sim_tempdir("ar_frame");
+    char out[4096], scene[4096];
+    snprintf(scene, sizeof scene, "%s", write_ar_calib(dir, false));
     snprintf(out, sizeof out, "%s/levels.png", dir);
     char *argv[] = {"calib", "ar-frame", "--scene", scene, "--calib", dir, "--out", out,
                     "--samples", "4", NULL};
     assert_int_equal(lr_cmd_calib(10, argv), LR_EXIT_FAIL);
-    lr_rig_pose rp;
-    memset(&rp, 0, sizeof rp);
-    lr_pose down = {.R = {1, 0, 0, 0, -1, 0, 0, 0, -1}, .T = {0, 0, 400}};
-    rp.camera = down;
-    rp.camera.T[0] = -100;
-    rp.has_projector = true;
-    rp.projector = down;
-    rp.points = 6;
-    snprintf(rp.source, sizeof rp.source, "points");
-    snprintf(path, sizeof path, "%s/pose.json", dir);
-    if (lr_rig_pose_save(path, &rp, &e))
-        fail_msg("pose save: %s", e.msg);
+    write_ar_calib(dir, true);
     assert_int_equal(lr_cmd_calib(10, argv), LR_EXIT_OK);
     lr_img img;
     assert_int_equal(lr_img_read(out, LR_IMG_RGB8, &img, NULL), 0);
@@ -600,6 +616,64 @@ static void test_cli_ar_frame(void **state)
     assert_int_equal(lr_cmd_calib(6, bad), LR_EXIT_USAGE);
     sim_rmdir(dir);
     free(dir);
+}
+
+/* `lamprig run` with "calib": a compensated projector frame at start and after each change
+ * of the scene (a scripted dimmer), written to the out dir, reported in the log and in the
+ * stats; a folder without the projector's pose fails the config, naming the field. */
+static void test_rig_ar(void **state)
+{
+    (void)state;
+    char *dir = lr_test_tmpdir();
+    const char *scene = write_ar_calib(dir, true);
+    char text[2048];
+    snprintf(text, sizeof text,
+             "{\"scene\": \"%s\", \"calib\": \"%s\", \"ar_samples\": 4,\n"
+             " \"devices\": [{\"type\": \"sim\", \"text\": \"0.5 dimmer absolute 0.9\\n\"}],\n"
+             " \"controls\": [{\"control\": \"dimmer\", \"param\": \"light.intensity\", "
+             "\"range\": [0, 2]}],\n"
+             " \"output\": {\"width\": 32, \"height\": 24, \"fps\": 50, \"renderer\": "
+             "\"preview\"}}\n",
+             scene, dir);
+    char *cfg = lr_test_write(dir, "rig.json", text, (size_t)-1);
+    char *stats = lr_test_path(dir, "stats.json");
+    char *frames = lr_test_path(dir, "frames");
+    lr_test_log log = {0};
+    lr_rig_opts o = {.config = cfg, .stats_path = stats, .out_dir = frames, .headless = true,
+                     .duration_s = 1.2, .no_signals = true, .log = {lr_test_log_fn, &log}};
+    lr_rig *r;
+    lr_err e = {0};
+    if (lr_rig_create(&o, &r, &e))
+        fail_msg("%s", e.msg);
+    assert_int_equal(lr_rig_run(r, &e), LR_OK);
+    lr_rig_destroy(r);
+    /* the start (the first frame, well before the dimmer at 0.5 s) and the dimmer change:
+     * two frames, each logged with its clip report */
+    assert_int_equal(lr_test_log_count(&log, "spatial AR frame"), 2);
+    assert_int_equal(lr_test_log_count(&log, "% of the light"), 2);
+    char path[4096];
+    for (int i = 0; i < 2; i++) {
+        snprintf(path, sizeof path, "%s/ar_%06d.png", frames, i);
+        lr_img img;
+        assert_int_equal(lr_img_read(path, LR_IMG_RGB8, &img, NULL), 0);
+        assert_int_equal(img.w, 32);
+        lr_img_free(&img);
+    }
+    size_t len;
+    unsigned char *js = lr_test_read(stats, &len);
+    assert_non_null(js);
+    assert_non_null(strstr((char *)js, "\"ar\": {\"frames\": 2"));
+    free(js);
+    /* without pose.json */
+    snprintf(path, sizeof path, "%s/pose.json", dir);
+    assert_int_equal(unlink(path), 0);
+    assert_int_not_equal(lr_rig_create(&o, &r, &e), LR_OK);
+    assert_non_null(strstr(e.msg, "field 'calib'"));
+    assert_non_null(strstr(e.msg, "pose.json"));
+    free(cfg);
+    free(stats);
+    free(frames);
+    lr_test_rmtree(dir);
 }
 
 int main(void)
@@ -613,6 +687,7 @@ int main(void)
         cmocka_unit_test(test_cli_albedo),
         cmocka_unit_test(test_ar_frame),
         cmocka_unit_test(test_cli_ar_frame),
+        cmocka_unit_test(test_rig_ar),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

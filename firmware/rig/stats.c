@@ -36,6 +36,8 @@ struct lr_rig_stats {
     fr_rec *frames; /* ring of LOG_MAX */
     uint64_t n_frames;
     uint64_t unmatched;
+    uint64_t ar_frames;
+    double ar_last_px, ar_last_light, ar_max_px, ar_max_light;
     double *lat;    /* every latency (grown), for quantiles */
     size_t n_lat, cap_lat;
 };
@@ -78,6 +80,15 @@ void lr_rig_stats_event(lr_rig_stats *s, const lr_event *ev)
 }
 
 void lr_rig_stats_unmatched(lr_rig_stats *s) { s->unmatched++; }
+
+void lr_rig_stats_ar(lr_rig_stats *s, double clipped_pixels, double clipped_light)
+{
+    s->ar_frames++;
+    s->ar_last_px = clipped_pixels;
+    s->ar_last_light = clipped_light;
+    s->ar_max_px = fmax(s->ar_max_px, clipped_pixels);
+    s->ar_max_light = fmax(s->ar_max_light, clipped_light);
+}
 
 void lr_rig_stats_frame(lr_rig_stats *s, const lr_frame_stats *f, int64_t done_ns)
 {
@@ -187,6 +198,12 @@ int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *conf
             (unsigned long long)s->n_frames, (unsigned long long)s->n_events, s->n_pending);
     fprintf(f, "  \"events_unmatched\": %llu,\n  \"garbage\": %u,\n",
             (unsigned long long)s->unmatched, garbage);
+    if (s->ar_frames)
+        fprintf(f,
+                "  \"ar\": {\"frames\": %llu, \"clipped_pixels\": %.6f, \"clipped_light\": "
+                "%.6f, \"max_clipped_pixels\": %.6f, \"max_clipped_light\": %.6f},\n",
+                (unsigned long long)s->ar_frames, s->ar_last_px, s->ar_last_light,
+                s->ar_max_px, s->ar_max_light);
     double *tmp = s->n_lat ? malloc(s->n_lat * sizeof *tmp) : NULL;
     double mean = NAN;
     if (tmp) {
