@@ -13,9 +13,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "calib/capture_sim.h"
 #include "calib/fit.h"
+#include "calib/fit_captures.h"
 #include "calib/nelder_mead.h"
 #include "calib/rig.h"
 #include "render/cpu/frame.h"
@@ -225,12 +227,67 @@ static void test_fit_no_object(void **state)
     lr_scene_destroy(s);
 }
 
+/* Captures to the fit's target: an 8-bit photo of a ramp at twice the fit's size, through a
+ * gamma-2.2 camera response, box-filtered 2:1 and scaled; an exposure stack merged; bad
+ * inputs named. */
+static void test_fit_captures(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/lr_fitcap_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    lr_rig_calib *cal = calloc(1, sizeof *cal);
+    cal->has_camresp = true;
+    lr_camresp_gamma(&cal->camresp, 2.2);
+    lr_img img;
+    char p1[4096], p2[4096];
+    const double times[2] = {1, 0.25};
+    const char *paths[2] = {p1, p2};
+    for (int k = 0; k < 2; k++) {
+        assert_int_equal(lr_img_alloc(&img, 16, 8, 3, 1, NULL), 0);
+        uint8_t *px = img.px;
+        for (int y = 0; y < 8; y++)
+            for (int x = 0; x < 16; x++)
+                for (int c = 0; c < 3; c++)
+                    px[3 * (y * 16 + x) + c] = (uint8_t)(40 + 10 * x + (k ? 0 : 5 * c));
+        snprintf(k ? p2 : p1, 4096, "%s/shot%d.png", dir, k);
+        assert_int_equal(lr_img_write(k ? p2 : p1, &img, NULL), 0);
+        lr_img_free(&img);
+    }
+    lr_image t;
+    lr_err e = {0};
+    if (lr_fit_load_captures(paths, NULL, 1, cal, 8, 4, 2.0, &t, &e))
+        fail_msg("captures: %s", e.msg);
+    /* pixel (x, y) of the target averages source columns 2x and 2x+1 (rows alike):
+     * (curve(z0) + curve(z1)) / 2 / scale, exact up to float storage */
+    for (int x = 0; x < 8; x++)
+        for (int c = 0; c < 3; c++) {
+            double z0 = 40 + 20 * x + 5 * c, z1 = z0 + 10;
+            double want = 0.5 * (cal->camresp.curve[c][(int)z0] + cal->camresp.curve[c][(int)z1]) / 2.0;
+            assert_near_rel(t.rgb[3 * (2 * 8 + x) + c], want, 1e-5);
+        }
+    lr_image_free(&t);
+    /* a stack: merged (Debevec's weighted mean of curve(z) / t) before the filter */
+    if (lr_fit_load_captures(paths, times, 2, cal, 8, 4, 1.0, &t, &e))
+        fail_msg("stack: %s", e.msg);
+    assert_true(t.rgb[0] > 0 && isfinite(t.rgb[0]));
+    lr_image_free(&t);
+    assert_int_equal(lr_fit_load_captures(paths, NULL, 2, cal, 8, 4, 1.0, &t, &e), LR_EINVAL);
+    assert_non_null(strstr(e.msg, "exposure times"));
+    assert_int_equal(lr_fit_load_captures(paths, NULL, 1, cal, 8, 8, 1.0, &t, &e), LR_EINVAL);
+    assert_non_null(strstr(e.msg, "aspect"));
+    free(cal);
+    unlink(p1);
+    unlink(p2);
+    rmdir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_nelder_mead),
         cmocka_unit_test(test_fit_recovers_sigma),
         cmocka_unit_test(test_fit_no_object),
+        cmocka_unit_test(test_fit_captures),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
