@@ -10,6 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "calib/albedo.h"
+#include "calib/ar_frame.h"
 #include "calib/camcal.h"
 #include "calib/camresp.h"
 #include "calib/capture.h"
@@ -19,6 +21,7 @@
 #include "calib/pose.h"
 #include "calib/procam.h"
 #include "calib/projresp.h"
+#include "calib/rig.h"
 #include "firmware/cli.h"
 
 const char lr_cmd_calib_usage[] =
@@ -61,6 +64,17 @@ const char lr_cmd_calib_usage[] =
     "      along --x-axis / --y-axis), or from pixels of known scene points: POINTS.json is\n"
     "      {\"version\":1, \"kind\":\"pose_points\", \"points\":[{\"scene\":[x,y,z],\n"
     "      \"pixel\":[u,v]}, ...]}\n"
+    "  albedo --captures DIR --out FILE.json [--calib DIR] [--proj WxH] [--contrast N]\n"
+    "         [--shadow N] [--fill N]\n"
+    "      the mockup's response to each projector pixel (white - black, linearised with the\n"
+    "      calibration folder's camera response) from a Gray-code capture of the white\n"
+    "      mockup, for spatial AR; writes FILE.json and FILE.pfm beside it\n"
+    "  ar-frame --scene FILE --calib DIR --out LEVELS.png [--target OUT.pfm] [--gain G]\n"
+    "         [--samples N] [--render-width N] [--seed N]\n"
+    "      one spatial-AR projector frame: the scene rendered from the projector (pose.json's\n"
+    "      projector pose), divided by the mockup's response (DIR/albedo.json, else an ideal\n"
+    "      white mockup of the scene's geometry), clipped, through the inverse projector\n"
+    "      response; prints how much was clipped\n"
     "  check FILE...\n"
     "      load and validate calibration files of any kind, print a summary\n"
     "\n"
@@ -857,6 +871,13 @@ static int check_one(const char *path)
             printf("%s: pose from %s, camera at (%.2f, %.2f, %.2f) mm, rms %.4f px%s\n", path,
                    p.source, c.x, c.y, c.z, p.rms, p.has_projector ? ", with projector" : "");
         }
+    } else if (!strcmp(kind, LR_ALBEDO_KIND)) {
+        lr_albedo a;
+        if (!(rc = lr_albedo_load(path, &a, &e))) {
+            printf("%s: mockup response %dx%d, %ld pixels measured, %ld filled\n", path,
+                   a.response.width, a.response.height, a.measured_pixels, a.filled_pixels);
+            lr_albedo_free(&a);
+        }
     } else if (!strcmp(kind, LR_GC_SEQUENCE_KIND)) {
         char dir[4096];
         snprintf(dir, sizeof dir, "%s", path);
@@ -877,6 +898,178 @@ static int check_one(const char *path)
         return LR_EXIT_FAIL;
     }
     return LR_EXIT_OK;
+}
+
+/* Linear camera image of an 8-bit capture (the calibration's response and colour matrix). */
+static int read_linear(const char *path, const lr_rig_calib *cal, lr_image *out, lr_err *e)
+{
+    lr_img img;
+    int rc = lr_img_read(path, LR_IMG_RGB8, &img, e);
+    if (rc)
+        return rc;
+    if ((rc = lr_image_alloc(out, img.w, img.h, e))) {
+        lr_img_free(&img);
+        return rc;
+    }
+    const uint8_t *p = img.px;
+    for (size_t k = 0; k < (size_t)img.w * img.h; k++) {
+        double v[3];
+        lr_rig_camera_to_linear(cal, p + 3 * k, v);
+        for (int c = 0; c < 3; c++)
+            out->rgb[3 * k + c] = (float)v[c];
+    }
+    lr_img_free(&img);
+    return LR_OK;
+}
+
+static int cmd_albedo(int argc, char **argv)
+{
+    const char *dir = NULL, *out = NULL, *cdir = NULL, *proj = NULL, *contrast = NULL,
+               *shadow = NULL, *fill = NULL;
+    const char *cmd = "albedo";
+    const opt opts[] = {{"captures", &dir, NULL}, {"out", &out, NULL},
+                        {"calib", &cdir, NULL},   {"proj", &proj, NULL},
+                        {"contrast", &contrast, NULL}, {"shadow", &shadow, NULL},
+                        {"fill", &fill, NULL},    {NULL, NULL, NULL}};
+    int rc = parse(cmd, argc, argv, 2, opts, NULL, 0, NULL);
+    if (rc || (rc = need(cmd, dir, "captures")) || (rc = need(cmd, out, "out")))
+        return rc;
+    int pw = 0, ph = 0, passes = -1;
+    lr_gc_params params = {0};
+    if (proj && !parse_wxh(proj, &pw, &ph))
+        return usage_error(cmd, "--proj '%s': expected WIDTHxHEIGHT", proj);
+    if (contrast && !parse_int(contrast, 1, 255, &params.contrast))
+        return usage_error(cmd, "--contrast '%s': expected 1..255", contrast);
+    if (shadow && !parse_int(shadow, 1, 255, &params.shadow))
+        return usage_error(cmd, "--shadow '%s': expected 1..255", shadow);
+    if (fill && !parse_int(fill, 0, 64, &passes))
+        return usage_error(cmd, "--fill '%s': expected 0..64 passes", fill);
+    lr_err e = {0};
+    lr_rig_calib *cal = calloc(1, sizeof *cal);
+    if (!cal)
+        return LR_EXIT_FAIL;
+    if (cdir && lr_rig_calib_load(cdir, cal, &e)) {
+        free(cal);
+        return fail(cmd, &e);
+    }
+    progress_state ps = {{0}, -1};
+    lr_progress progress = {print_progress, &ps};
+    lr_gc_map *m = NULL;
+    lr_image white = {0}, black = {0};
+    lr_albedo a = {0};
+    char path[4096];
+    int status = LR_EXIT_OK;
+    if (lr_gc_decode_dir(dir, pw, ph, &params, &progress, &m, &e)) {
+        status = fail(cmd, &e);
+        goto done;
+    }
+    snprintf(path, sizeof path, "%s/white.png", dir);
+    if (read_linear(path, cal, &white, &e)) {
+        status = fail(cmd, &e);
+        goto done;
+    }
+    snprintf(path, sizeof path, "%s/black.png", dir);
+    if (read_linear(path, cal, &black, &e) ||
+        lr_albedo_measure(&white, &black, m, passes, &a, &e) || lr_albedo_save(out, &a, &e)) {
+        status = fail(cmd, &e);
+        goto done;
+    }
+    lr_gc_map_projector_size(m, &pw, &ph);
+    printf("%s: mockup response for a %dx%d projector: %ld pixels measured (%.1f %%), %ld "
+           "filled; scale %.4g (camera linear units of full white at M = 1)\n",
+           out, pw, ph, a.measured_pixels, 100.0 * a.measured_pixels / ((long)pw * ph),
+           a.filled_pixels, a.scale);
+done:
+    lr_albedo_free(&a);
+    lr_image_free(&white);
+    lr_image_free(&black);
+    lr_gc_map_destroy(m);
+    lr_rig_calib_free(cal);
+    free(cal);
+    return status;
+}
+
+static int cmd_ar_frame(int argc, char **argv)
+{
+    const char *scene_path = NULL, *cdir = NULL, *out = NULL, *tpath = NULL, *gain = NULL,
+               *samples = NULL, *rwidth = NULL, *seed = NULL;
+    const char *cmd = "ar-frame";
+    const opt opts[] = {{"scene", &scene_path, NULL}, {"calib", &cdir, NULL},
+                        {"out", &out, NULL},          {"target", &tpath, NULL},
+                        {"gain", &gain, NULL},        {"samples", &samples, NULL},
+                        {"render-width", &rwidth, NULL}, {"seed", &seed, NULL},
+                        {NULL, NULL, NULL}};
+    int rc = parse(cmd, argc, argv, 2, opts, NULL, 0, NULL);
+    if (rc || (rc = need(cmd, scene_path, "scene")) || (rc = need(cmd, cdir, "calib")) ||
+        (rc = need(cmd, out, "out")))
+        return rc;
+    lr_ar_frame_desc d = {0};
+    int sd = 0;
+    if (gain && !parse_double(gain, 1e-30, 1e30, &d.gain))
+        return usage_error(cmd, "--gain '%s': expected a number > 0", gain);
+    if (samples && !parse_int(samples, 1, 1 << 20, &d.samples))
+        return usage_error(cmd, "--samples '%s': expected 1..1048576", samples);
+    if (rwidth && !parse_int(rwidth, 2, 16384, &d.render_width))
+        return usage_error(cmd, "--render-width '%s': expected 2..16384", rwidth);
+    if (seed && !parse_int(seed, 1, 1 << 30, &sd))
+        return usage_error(cmd, "--seed '%s': expected a whole number > 0", seed);
+    d.seed = (unsigned)sd;
+    lr_err e = {0};
+    lr_scene *scene = NULL;
+    lr_rig_calib *cal = calloc(1, sizeof *cal);
+    lr_albedo a = {0};
+    lr_image levels = {0}, target = {0};
+    lr_img png = {0};
+    int status = LR_EXIT_FAIL;
+    if (!cal)
+        return LR_EXIT_FAIL;
+    if (lr_scene_load(scene_path, NULL, &scene, &e) || lr_rig_calib_load(cdir, cal, &e)) {
+        fail(cmd, &e);
+        goto done;
+    }
+    char apath[4096];
+    snprintf(apath, sizeof apath, "%s/%s", cdir, LR_RIG_ALBEDO);
+    FILE *f = fopen(apath, "r");
+    if (f) {
+        fclose(f);
+        if (lr_albedo_load(apath, &a, &e)) {
+            fail(cmd, &e);
+            goto done;
+        }
+    }
+    d.scene = scene;
+    d.calib = cal;
+    d.response = f ? &a.response : NULL;
+    lr_ar_stats st;
+    if (lr_ar_frame(&d, &levels, &target, &st, &e) ||
+        (tpath && lr_image_write_pfm(tpath, &target, &e)) ||
+        lr_img_alloc(&png, levels.width, levels.height, 3, 1, &e)) {
+        fail(cmd, &e);
+        goto done;
+    }
+    uint8_t *px = png.px;
+    for (size_t k = 0; k < (size_t)levels.width * levels.height * 3; k++)
+        px[k] = (uint8_t)lrint(255 * fmin(1.0, fmax(0.0, levels.rgb[k])));
+    if (lr_img_write(out, &png, &e)) {
+        fail(cmd, &e);
+        goto done;
+    }
+    char msg[128];
+    lr_ar_stats_format(&st, msg, sizeof msg);
+    printf("%s: %dx%d projector frame, mockup response from %s; gain %.4g; %s (%ld of %ld lit "
+           "pixels)\n",
+           out, levels.width, levels.height, f ? apath : "the scene's geometry (ideal white)",
+           st.gain, msg, st.clipped_pixels, st.lit_pixels);
+    status = LR_EXIT_OK;
+done:
+    lr_img_free(&png);
+    lr_image_free(&levels);
+    lr_image_free(&target);
+    lr_albedo_free(&a);
+    lr_rig_calib_free(cal);
+    free(cal);
+    lr_scene_destroy(scene);
+    return status;
 }
 
 static int cmd_check(int argc, char **argv)
@@ -905,6 +1098,10 @@ int lr_cmd_calib(int argc, char **argv)
         return cmd_color(argc, argv);
     if (!strcmp(sub, "pose"))
         return cmd_pose(argc, argv);
+    if (!strcmp(sub, "albedo"))
+        return cmd_albedo(argc, argv);
+    if (!strcmp(sub, "ar-frame"))
+        return cmd_ar_frame(argc, argv);
     if (!strcmp(sub, "check"))
         return cmd_check(argc, argv);
     fprintf(stderr, "%s\n", lr_cmd_calib_usage);

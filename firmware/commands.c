@@ -5,6 +5,7 @@
 
 #include "firmware/cmd_calib.h"
 #include "firmware/cmd_compare.h"
+#include "firmware/cmd_fit.h"
 #include "firmware/cmd_optics.h"
 #include "firmware/cmd_plan.h"
 #include "firmware/cmd_render.h"
@@ -15,6 +16,7 @@ const lr_command lr_commands[] = {
     {"calib", "calibrate camera, projector and radiometry; check calibration files",
      lr_cmd_calib_usage, lr_cmd_calib},
     {"compare", lr_compare_summary, lr_compare_usage, lr_cmd_compare},
+    {"fit", lr_fit_summary, lr_fit_usage, lr_cmd_fit},
     {"render", lr_render_summary, lr_render_usage, lr_cmd_render},
     {"run", lr_run_summary, lr_run_usage, lr_cmd_run},
     {"plan", lr_plan_summary, lr_plan_usage, lr_cmd_plan},

@@ -736,7 +736,7 @@ static int parse_root(ctx *x)
     lr_jnode root = lr_json_root(j);
     lr_rig_config *c = x->c;
     static const char *const top[] = {"scene", "scene_set", "devices", "controls", "output",
-                                      "safe_level", "stats", NULL};
+                                      "safe_level", "stats", "calib", "ar_samples", NULL};
     int rc = keys(x, root, "", top);
     if (rc)
         return rc;
@@ -890,6 +890,24 @@ static int parse_root(ctx *x)
             return rc;
     }
     if ((rc = get_num_in(x, root, "", "safe_level", false, 0, 1, &c->safe_level)))
+        return rc;
+    lr_jnode cal = lr_json_get(j, root, "calib");
+    if (cal != LR_JNONE) {
+        char p[LR_RIG_PATH_MAX] = "";
+        if ((rc = get_str(x, root, "", "calib", true, p, sizeof p)))
+            return rc;
+        int w = p[0] == '/' || !x->dir[0]
+                    ? snprintf(c->calib, sizeof c->calib, "%s", p)
+                    : snprintf(c->calib, sizeof c->calib, "%s/%s", x->dir, p);
+        if (w < 0 || (size_t)w >= sizeof c->calib)
+            return lr_json_fail(j, cal, "calib", x->e, LR_EPARSE, "path too long");
+        struct stat cst;
+        if (stat(c->calib, &cst) != 0 || !S_ISDIR(cst.st_mode))
+            return lr_json_fail(j, cal, "calib", x->e, LR_EPARSE,
+                                "'%s' is not a calibration folder", c->calib);
+    }
+    c->ar_samples = 16;
+    if ((rc = get_int_in(x, root, "", "ar_samples", false, 1, 1 << 20, &c->ar_samples)))
         return rc;
     c->stats_period_s = 10;
     lr_jnode st = lr_json_get(j, root, "stats");

@@ -20,6 +20,13 @@
  *   "safe_level": 0                    lamp-driver level (0..1, as written to the driver,
  *                                      after any curve) set at shutdown
  *   "stats":    {"path": "PATH" (default none), "period_s": 10 (0: only at exit)}
+ *   "calib":    "DIR"                  a calibration folder (calib/rig.h) with projector.json
+ *                                      and pose.json's projector pose (albedo.json optional):
+ *                                      spatial AR, headless only -- each change of the scene
+ *                                      also renders a compensated projector frame
+ *                                      (calib/ar_frame.h), written to out_dir/ar_NNNNNN.png,
+ *                                      its clipping logged and counted in the stats
+ *   "ar_samples": 16                   CPU reference samples per band and pixel for it
  * }
  *
  * DEVICE (every kind): "type", "name" (default the type), "required": false,
@@ -199,6 +206,8 @@ typedef struct lr_rig_config {
     double safe_level;
     char stats_path[LR_RIG_PATH_MAX];
     double stats_period_s;
+    char calib[LR_RIG_PATH_MAX]; /* resolved calibration folder; "" = no spatial AR */
+    int ar_samples;
 } lr_rig_config;
 
 /* Loads and validates path completely (every device, binding and the output; file paths are

@@ -12,6 +12,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "calib/albedo.h"
+#include "calib/ar_frame.h"
 #include "firmware/rig/config.h"
 #include "firmware/rig/control_map.h"
 #include "firmware/rig/stats.h"
@@ -41,6 +43,9 @@ typedef struct rigset {
     int n_devs, n_lamps;
     bool has_hid;
     bool no_vpl; /* the planner found no receiver that sees any object */
+    lr_rig_calib *calib;  /* spatial AR ("calib" in the config); NULL without */
+    lr_albedo albedo;     /* the mockup's response, when the folder has albedo.json */
+    bool has_albedo;
 } rigset;
 
 struct lr_rig {
@@ -69,6 +74,8 @@ struct lr_rig {
     lr_frame_stats flip_stats; /* KMS: the frame on its way to the screen */
     bool flip_stats_pending;
     bool used_hid; /* hidapi's process-wide state is released once, at the very end */
+    bool ar_dirty; /* spatial AR: the scene changed since the last projector frame */
+    uint64_t ar_frames;
 };
 
 static void set_free(rigset *s)
@@ -78,6 +85,9 @@ static void set_free(rigset *s)
     lr_control_map_destroy(s->map);
     lr_scene_destroy(s->scene);
     lr_rig_config_destroy(s->cfg);
+    lr_rig_calib_free(s->calib);
+    free(s->calib);
+    lr_albedo_free(&s->albedo);
     memset(s, 0, sizeof *s);
 }
 
@@ -234,6 +244,32 @@ static int plan_scene(lr_rig *r, const lr_rig_config *cfg, lr_scene *scene, bool
     return rc;
 }
 
+/* Spatial AR: the calibration folder must hold the projector and its scene pose; a broken
+ * or incomplete folder fails the whole config (file and field named by the loaders). */
+static int ar_load(rigset *s, lr_err *e)
+{
+    const char *dir = s->cfg->calib;
+    if (!(s->calib = calloc(1, sizeof *s->calib)))
+        return lr_err_set(e, LR_ENOMEM, "out of memory");
+    int rc = lr_rig_calib_load(dir, s->calib, e);
+    if (rc)
+        return lr_err_prefix(e, "%s: field 'calib'", s->cfg->path);
+    if (!s->calib->has_procam || !s->calib->has_pose || !s->calib->pose.has_projector)
+        return lr_err_set(e, LR_EINVAL,
+                          "%s: field 'calib': %s needs projector.json and a pose.json with the "
+                          "projector's pose for spatial AR",
+                          s->cfg->path, dir);
+    char path[LR_RIG_PATH_MAX + 32];
+    snprintf(path, sizeof path, "%s/%s", dir, LR_RIG_ALBEDO);
+    struct stat st;
+    if (stat(path, &st) == 0) {
+        if ((rc = lr_albedo_load(path, &s->albedo, e)))
+            return rc;
+        s->has_albedo = true;
+    }
+    return LR_OK;
+}
+
 /* Config, scene, control map, devices: all or nothing. */
 static int set_build(lr_rig *r, rigset *s, lr_err *e)
 {
@@ -256,6 +292,8 @@ static int set_build(lr_rig *r, rigset *s, lr_err *e)
         rc = plan_scene(r, s->cfg, s->scene, &s->no_vpl, e);
     if (!rc)
         rc = lr_control_map_create(s->cfg, s->scene, true, lr_now_ns(), &s->map, e);
+    if (!rc && s->cfg->calib[0])
+        rc = ar_load(s, e);
     for (int i = 0; !rc && i < s->cfg->n_devices; i++)
         rc = create_device(r, s, &s->cfg->devices[i], e);
     if (rc) {
@@ -302,8 +340,10 @@ static void apply(lr_rig *r, int64_t now)
     lr_err e = {0};
     if (lr_control_map_update(r->set.map, r->set.scene, now, &dirty, &e))
         lr_log_write(&r->log, LR_LOG_WARN, "control map: %s", e.msg);
-    if (dirty)
+    if (dirty) {
         lr_rig_view_invalidate(r->view, dirty);
+        r->ar_dirty = true;
+    }
     double level;
     if (lr_control_map_lamp_level(r->set.map, now, &level))
         write_lamp(r, level);
@@ -335,6 +375,7 @@ static void switch_scene(lr_rig *r, const char *path)
     r->view = view;
     r->set.scene = scene;
     lr_control_map_scene_replaced(r->set.map);
+    r->ar_dirty = true;
     lr_log_write(&r->log, LR_LOG_INFO, "scene: %s", path);
 }
 
@@ -376,6 +417,45 @@ static void write_png(lr_rig *r, int index)
     lr_image_free(&img);
 }
 
+/* Spatial AR: the compensated projector frame for the current scene (CPU reference from the
+ * projector's pose; calib/ar_frame.h), once per change of the scene. The frame the view
+ * rendered (the scene's camera) is kept as is for the stats and --out-dir. */
+static void ar_frame(lr_rig *r)
+{
+    lr_ar_frame_desc d = {.scene = r->set.scene, .calib = r->set.calib,
+                          .response = r->set.has_albedo ? &r->set.albedo.response : NULL,
+                          .samples = r->set.cfg->ar_samples};
+    lr_image levels = {0};
+    lr_ar_stats st;
+    lr_err e = {0};
+    r->ar_dirty = false;
+    if (lr_ar_frame(&d, &levels, NULL, &st, &e)) {
+        lr_log_write(&r->log, LR_LOG_ERROR, "spatial AR: %s", e.msg);
+        return;
+    }
+    char msg[128];
+    lr_ar_stats_format(&st, msg, sizeof msg);
+    lr_rig_stats_ar(r->stats, st.clipped_fraction, st.clipped_light_fraction);
+    if (r->out_dir[0]) {
+        lr_img png;
+        if (lr_img_alloc(&png, levels.width, levels.height, 3, 1, &e) == LR_OK) {
+            uint8_t *px = png.px;
+            for (size_t k = 0; k < (size_t)levels.width * levels.height * 3; k++)
+                px[k] = (uint8_t)lrint(255 * fmin(1.0, fmax(0.0, levels.rgb[k])));
+            char path[LR_RIG_PATH_MAX + 32];
+            snprintf(path, sizeof path, "%s/ar_%06llu.png", r->out_dir,
+                     (unsigned long long)r->ar_frames);
+            if (lr_img_write(path, &png, &e))
+                lr_log_write(&r->log, LR_LOG_ERROR, "spatial AR: %s", e.msg);
+            lr_img_free(&png);
+        }
+    }
+    lr_log_write(&r->log, LR_LOG_INFO, "spatial AR frame %llu: %dx%d, %s",
+                 (unsigned long long)r->ar_frames, levels.width, levels.height, msg);
+    r->ar_frames++;
+    lr_image_free(&levels);
+}
+
 static void frame(lr_rig *r, int64_t now)
 {
     lr_frame_stats st;
@@ -395,6 +475,8 @@ static void frame(lr_rig *r, int64_t now)
         r->next_frame_ns = now + 1000000000LL;
         return;
     }
+    if (r->set.calib && r->ar_dirty)
+        ar_frame(r);
     r->frame_errors = 0;
     r->frames++;
     if (r->kms && lr_gl_flip_pending(r->gl)) {
@@ -530,8 +612,14 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
             snprintf(r->stats_path, sizeof r->stats_path, "%s", r->set.cfg->stats_path);
         rc = open_output(r, e);
     }
+    if (!rc && r->kms && r->set.calib)
+        rc = lr_err_set(e, LR_EUNSUPPORTED,
+                        "%s: field 'calib': spatial AR frames are written headless only (KMS "
+                        "output of compensated frames is not built yet); run with --headless",
+                        r->set.cfg->path);
     if (!rc)
         rc = view_build(r, r->set.scene, r->set.no_vpl, &r->view, e);
+    r->ar_dirty = true;
     if (!rc && ensure_rgba(r))
         rc = lr_err_set(e, LR_ENOMEM, "out of memory");
     if (rc) {
@@ -557,6 +645,13 @@ int lr_rig_reload(lr_rig *r, lr_err *e)
     rigset s;
     int rc = set_build(r, &s, e);
     lr_rig_view *view = NULL;
+    if (!rc && r->kms && s.calib) {
+        rc = lr_err_set(e, LR_EUNSUPPORTED,
+                        "%s: field 'calib': spatial AR frames are written headless only",
+                        s.cfg->path);
+        r->used_hid |= s.has_hid;
+        set_free(&s);
+    }
     if (!rc) {
         /* The view belongs to the scene: build it against the new one, then swap. */
         rigset old = r->set;
@@ -591,6 +686,7 @@ int lr_rig_reload(lr_rig *r, lr_err *e)
     r->set = s;
     r->view = view;
     ensure_rgba(r);
+    r->ar_dirty = true;
     r->lamp_written = -1;
     r->reloads++;
     const lr_rig_config *c = r->set.cfg;

@@ -37,6 +37,8 @@ struct lr_rig_stats {
     fr_rec *frames; /* ring of LOG_MAX */
     uint64_t n_frames;
     uint64_t unmatched;
+    uint64_t ar_frames;
+    double ar_last_px, ar_last_light, ar_max_px, ar_max_light;
     double *lat;    /* every latency (grown), for quantiles */
     size_t n_lat, cap_lat;
 };
@@ -79,6 +81,15 @@ void lr_rig_stats_event(lr_rig_stats *s, const lr_event *ev)
 }
 
 void lr_rig_stats_unmatched(lr_rig_stats *s) { s->unmatched++; }
+
+void lr_rig_stats_ar(lr_rig_stats *s, double clipped_pixels, double clipped_light)
+{
+    s->ar_frames++;
+    s->ar_last_px = clipped_pixels;
+    s->ar_last_light = clipped_light;
+    s->ar_max_px = fmax(s->ar_max_px, clipped_pixels);
+    s->ar_max_light = fmax(s->ar_max_light, clipped_light);
+}
 
 void lr_rig_stats_frame(lr_rig_stats *s, const lr_frame_stats *f, int64_t done_ns)
 {
@@ -170,6 +181,15 @@ int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *conf
     lr_jw_int(w, "events_pending", s->n_pending);
     lr_jw_int(w, "events_unmatched", (long)s->unmatched);
     lr_jw_int(w, "garbage", (long)garbage);
+    if (s->ar_frames) {
+        lr_jw_object(w, "ar");
+        lr_jw_int(w, "frames", (long)s->ar_frames);
+        lr_jw_number_or_null(w, "clipped_pixels", s->ar_last_px);
+        lr_jw_number_or_null(w, "clipped_light", s->ar_last_light);
+        lr_jw_number_or_null(w, "max_clipped_pixels", s->ar_max_px);
+        lr_jw_number_or_null(w, "max_clipped_light", s->ar_max_light);
+        lr_jw_object_end(w);
+    }
     double *tmp = s->n_lat ? malloc(s->n_lat * sizeof *tmp) : NULL;
     double mean = NAN;
     if (tmp) {

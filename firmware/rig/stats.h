@@ -35,6 +35,10 @@ void lr_rig_stats_unmatched(lr_rig_stats *s);
  * pending event gets its latency; a frame with no pass (the previous image again) shows none. */
 void lr_rig_stats_frame(lr_rig_stats *s, const lr_frame_stats *f, int64_t done_ns);
 
+/* A spatial-AR projector frame (calib/ar_frame.h): its clipping, kept for the stats file
+ * ("ar": frames, last and worst clipped fraction of pixels and of the light). */
+void lr_rig_stats_ar(lr_rig_stats *s, double clipped_pixels, double clipped_light);
+
 int lr_rig_stats_pending(const lr_rig_stats *s);
 uint64_t lr_rig_stats_frames(const lr_rig_stats *s);
 uint64_t lr_rig_stats_events(const lr_rig_stats *s); /* with a latency */
