@@ -13,6 +13,7 @@
 #include "firmware/plan_scene.h"
 #include "firmware/render_events.h"
 #include "render/base/atomic_file.h"
+#include "render/base/json_write.h"
 #include "render/gl/gl.h"
 #include "render/image/image.h"
 #include "render/renderer.h"
@@ -96,14 +97,6 @@ static int positive_int(const char *flag, const char *text, int max, int *out)
     return LR_EXIT_OK;
 }
 
-static void json_ms(FILE *f, double v)
-{
-    if (isfinite(v))
-        fprintf(f, "%.4f", v);
-    else
-        fputs("null", f);
-}
-
 typedef struct stats_log {
     lr_frame_stats *v;
     int n, cap;
@@ -123,21 +116,6 @@ static int log_push(stats_log *l, const lr_frame_stats *s)
     return 0;
 }
 
-static void json_string(FILE *f, const char *s)
-{
-    fputc('"', f);
-    for (; *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\')
-            fprintf(f, "\\%c", c);
-        else if (c < 0x20)
-            fprintf(f, "\\u%04x", c);
-        else
-            fputc(c, f);
-    }
-    fputc('"', f);
-}
-
 static int write_stats(const char *path, const lr_scene *scene, lr_renderer *r,
                        const stats_log *log, lr_err *e)
 {
@@ -149,41 +127,56 @@ static int write_stats(const char *path, const lr_scene *scene, lr_renderer *r,
     int rc = lr_atomic_file_open(path, &af, e);
     if (rc)
         return rc;
-    FILE *f = lr_atomic_file_stream(af);
+    lr_jw *jw = lr_jw_create(lr_atomic_file_stream(af));
+    if (!jw) {
+        lr_atomic_file_abort(af);
+        return lr_err_set(e, LR_ENOMEM, "%s: out of memory", path);
+    }
     int w, h;
     lr_renderer_size(r, &w, &h);
     const lr_render_settings *rs = lr_scene_render(scene);
-    fputs("{\"scene\":", f);
-    json_string(f, lr_scene_name(scene));
-    fprintf(f, ",\"width\":%d,\"height\":%d,\"uncovered_pixels\":%d,\"renderer\":", w, h,
-            uncovered);
-    json_string(f, lr_renderer_info(r));
-    fprintf(f, ",\"settings\":{\"K\":%d,\"N\":%d,\"N_vpl\":%d,\"map_size\":%d,\"gbuffer_size\":%d,"
-               "\"vpl_map_size\":%d,\"frames\":%d},\n\"frames\":[",
-            rs->K, rs->N, rs->N_vpl, rs->map_size, rs->gbuffer_size, rs->vpl_map_size, rs->frames);
+    lr_jw_object(jw, NULL);
+    lr_jw_string(jw, "scene", lr_scene_name(scene));
+    lr_jw_int(jw, "width", w);
+    lr_jw_int(jw, "height", h);
+    lr_jw_int(jw, "uncovered_pixels", uncovered);
+    lr_jw_string(jw, "renderer", lr_renderer_info(r));
+    lr_jw_object(jw, "settings");
+    lr_jw_int(jw, "K", rs->K);
+    lr_jw_int(jw, "N", rs->N);
+    lr_jw_int(jw, "N_vpl", rs->N_vpl);
+    lr_jw_int(jw, "map_size", rs->map_size);
+    lr_jw_int(jw, "gbuffer_size", rs->gbuffer_size);
+    lr_jw_int(jw, "vpl_map_size", rs->vpl_map_size);
+    lr_jw_int(jw, "frames", rs->frames);
+    lr_jw_object_end(jw);
+    lr_jw_array(jw, "frames");
     for (int i = 0; i < log->n; i++) {
         const lr_frame_stats *s = &log->v[i];
-        fprintf(f, "%s\n{\"index\":%d,\"passes\":[", i ? "," : "", s->index);
-        int first = 1;
+        lr_jw_object(jw, NULL);
+        lr_jw_int(jw, "index", s->index);
+        lr_jw_array(jw, "passes");
         for (int p = 0; p < LR_PASS_COUNT; p++)
-            if (s->passes & (1u << p)) {
-                fprintf(f, "%s\"%s\"", first ? "" : ",", lr_pass_name(p));
-                first = 0;
-            }
-        fputs("],\"ms\":{", f);
-        first = 1;
+            if (s->passes & (1u << p))
+                lr_jw_string(jw, NULL, lr_pass_name(p));
+        lr_jw_array_end(jw);
+        lr_jw_object(jw, "ms");
         for (int p = 0; p < LR_PASS_COUNT; p++)
-            if (s->passes & (1u << p)) {
-                fprintf(f, "%s\"%s\":", first ? "" : ",", lr_pass_name(p));
-                json_ms(f, s->ms[p]);
-                first = 0;
-            }
-        fputs("},\"total_ms\":", f);
-        json_ms(f, s->total_ms);
-        fprintf(f, ",\"samples\":%d,\"converged\":%s,\"time_s\":%.6g}", s->samples,
-                s->converged ? "true" : "false", s->time_s);
+            if (s->passes & (1u << p))
+                lr_jw_number_or_null(jw, lr_pass_name(p), s->ms[p]);
+        lr_jw_object_end(jw);
+        lr_jw_number_or_null(jw, "total_ms", s->total_ms);
+        lr_jw_int(jw, "samples", s->samples);
+        lr_jw_bool(jw, "converged", s->converged);
+        lr_jw_number_or_null(jw, "time_s", s->time_s);
+        lr_jw_object_end(jw);
     }
-    fputs("\n]}\n", f);
+    lr_jw_array_end(jw);
+    lr_jw_object_end(jw);
+    if ((rc = lr_jw_finish(jw, e))) {
+        lr_atomic_file_abort(af);
+        return rc;
+    }
     return lr_atomic_file_commit(af, e);
 }
 
