@@ -25,6 +25,7 @@
 #include "firmware/cli.h"
 #include "firmware/cmd_calib.h"
 #include "firmware/rig/rig.h"
+#include "render/base/json.h"
 #include "render/base/mat4.h"
 #include "tests/support/fs.h"
 #include "tests/support/hal_test.h"
@@ -659,11 +660,15 @@ static void test_rig_ar(void **state)
         assert_int_equal(img.w, 32);
         lr_img_free(&img);
     }
-    size_t len;
-    unsigned char *js = lr_test_read(stats, &len);
-    assert_non_null(js);
-    assert_non_null(strstr((char *)js, "\"ar\": {\"frames\": 2"));
-    free(js);
+    lr_json *j = NULL;
+    if (lr_json_load(stats, &j, &e))
+        fail_msg("%s", e.msg);
+    lr_jnode ar = lr_json_get(j, lr_json_root(j), "ar");
+    assert_int_not_equal(ar, LR_JNONE);
+    long ar_frames = 0;
+    assert_int_equal(lr_json_get_int(j, ar, "frames", true, &ar_frames, &e), LR_OK);
+    assert_int_equal(ar_frames, 2);
+    lr_json_destroy(j);
     /* without pose.json */
     snprintf(path, sizeof path, "%s/pose.json", dir);
     assert_int_equal(unlink(path), 0);

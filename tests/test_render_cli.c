@@ -14,8 +14,10 @@
 #include <sys/wait.h>
 
 #include "render/base/file.h"
+#include "render/base/json.h"
 #include "render/image/image.h"
 #include "tests/support/fs.h"
+#include "tests/support/near.h"
 
 #define SMALL "--width 32 --height 24 --set render.K=4 --set render.N=2 --set render.map_size=32 " \
               "--set render.gbuffer_size=32 --set render.vpl_map_size=8 --set render.N_vpl=16 "  \
@@ -60,6 +62,54 @@ static char *slurp(const char *name)
     return t;
 }
 
+/* Frame i of a --stats file: its passes joined by ',' must be `passes`; samples, converged
+ * and time_s are checked when samples >= 0. */
+static void expect_frame(const lr_json *j, int i, const char *passes, int samples,
+                         bool converged, double time_s)
+{
+    lr_err e = {0};
+    lr_jnode frames = lr_json_get(j, lr_json_root(j), "frames");
+    assert_int_not_equal(frames, LR_JNONE);
+    lr_jnode f = lr_json_at(j, frames, i);
+    assert_int_not_equal(f, LR_JNONE);
+    long index = -1;
+    assert_int_equal(lr_json_get_int(j, f, "index", true, &index, &e), LR_OK);
+    assert_int_equal(index, i);
+    lr_jnode p = lr_json_get(j, f, "passes"), ms = lr_json_get(j, f, "ms");
+    char got[128] = "", name[32];
+    for (int k = 0; k < lr_json_count(j, p); k++) {
+        assert_int_equal(lr_json_string(j, lr_json_at(j, p, k), "passes", name, sizeof name, &e),
+                         LR_OK);
+        snprintf(got + strlen(got), sizeof got - strlen(got), "%s%s", k ? "," : "", name);
+        /* every pass that ran has its time, and only those */
+        assert_int_not_equal(lr_json_get(j, ms, name), LR_JNONE);
+    }
+    assert_int_equal(lr_json_count(j, ms), lr_json_count(j, p));
+    assert_string_equal(got, passes);
+    if (samples < 0)
+        return;
+    long n = -1;
+    bool conv = !converged;
+    double t = -1;
+    assert_int_equal(lr_json_get_int(j, f, "samples", true, &n, &e), LR_OK);
+    assert_int_equal(lr_json_get_bool(j, f, "converged", true, &conv, &e), LR_OK);
+    assert_int_equal(lr_json_get_number(j, f, "time_s", true, &t, &e), LR_OK);
+    assert_int_equal(n, samples);
+    assert_true(conv == converged);
+    assert_near(t, time_s, 1e-9);
+}
+
+static lr_json *load_stats(void)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/s.json", dir);
+    lr_json *j = NULL;
+    lr_err e = {0};
+    if (lr_json_load(path, &j, &e))
+        fail_msg("%s", e.msg);
+    return j;
+}
+
 static void test_render_writes_images_and_stats(void **state)
 {
     char ev[512];
@@ -77,30 +127,40 @@ static void test_render_writes_images_and_stats(void **state)
     char *out = slurp("out");
     assert_non_null(strstr(out, "/c.png"));
     free(out);
-    char *js = slurp("s.json");
-    assert_non_null(strstr(js, "\"scene\":\"candle\""));
-    assert_non_null(strstr(js, "\"width\":32,\"height\":24,\"uncovered_pixels\":"));
-    assert_non_null(strstr(js, "{\"index\":0,\"passes\":[\"gbuffer\",\"radiosity\",\"vpl\",\"compose\"]"));
-    assert_non_null(strstr(js, "{\"index\":1,\"passes\":[\"radiosity\",\"vpl\",\"compose\"]"));
+    lr_json *j = load_stats();
+    lr_err e = {0};
+    char name[64];
+    assert_int_equal(lr_json_get_string(j, lr_json_root(j), "scene", true, name, sizeof name, &e),
+                     LR_OK);
+    assert_string_equal(name, "candle");
+    long wh[2] = {0, 0};
+    assert_int_equal(lr_json_get_int(j, lr_json_root(j), "width", true, &wh[0], &e), LR_OK);
+    assert_int_equal(lr_json_get_int(j, lr_json_root(j), "height", true, &wh[1], &e), LR_OK);
+    assert_int_equal(wh[0], 32);
+    assert_int_equal(wh[1], 24);
+    assert_int_not_equal(lr_json_get(j, lr_json_root(j), "uncovered_pixels"), LR_JNONE);
+    expect_frame(j, 0, "gbuffer,radiosity,vpl,compose", -1, false, 0);
+    expect_frame(j, 1, "radiosity,vpl,compose", -1, false, 0);
     /* The event before frame 2: composition alone. Frame 3: converged, but the flame
      * flickers on the renderer's clock (frame i at i / 30 s): composition alone again. */
-    assert_non_null(strstr(js, "{\"index\":2,\"passes\":[\"compose\"],\"ms\":{\"compose\":"));
-    assert_non_null(strstr(js, "{\"index\":3,\"passes\":[\"compose\"],\"ms\":{\"compose\":"));
-    assert_non_null(strstr(js, "\"samples\":2,\"converged\":true,\"time_s\":0.1}"));
-    free(js);
+    expect_frame(j, 2, "compose", -1, false, 0);
+    expect_frame(j, 3, "compose", 2, true, 0.1);
+    lr_json_destroy(j);
     /* A steady flame (flicker.amplitude 0) at 10 fps: frame 3 has nothing left to do. */
     st = run("./build/bin/lamprig render --scene configs/scenes/candle.json " SMALL
              " --frames 4 --fps 10 --set lights[0].flicker.amplitude=0 --events %s --stats %s/s.json",
              ev, dir);
     if (st != 0)
         fail_msg("exit %d (steady flame)", st);
-    js = slurp("s.json");
-    assert_non_null(strstr(js, "{\"index\":3,\"passes\":[],\"ms\":{},\"total_ms\":0.0000,\"samples\":2"));
-    assert_non_null(strstr(js, "\"time_s\":0.3}"));
-    free(js);
+    j = load_stats();
+    expect_frame(j, 3, "", 2, true, 0.3);
+    lr_jnode f3 = lr_json_at(j, lr_json_get(j, lr_json_root(j), "frames"), 3);
+    double total = -1;
+    assert_int_equal(lr_json_get_number(j, f3, "total_ms", true, &total, &e), LR_OK);
+    assert_near(total, 0.0, 0.0);
+    lr_json_destroy(j);
     char path[512];
     lr_image img = {0};
-    lr_err e = {0};
     snprintf(path, sizeof path, "%s/c.pfm", dir);
     if (lr_image_read_pfm(path, &img, &e))
         fail_msg("%s", e.msg);
