@@ -322,7 +322,9 @@ void lr_cpu_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3
             mean += delta / (j + 1);
             m2 += delta * (f - mean);
         }
-        out->mean[c] = mean;
-        out->var[c] = N > 1 ? m2 / (N - 1) : 0.0;
+        /* PIPELINE.md "Energy": S_d times its per-band normalisation (1 for the raw model). */
+        double g = lr_scene_object_sd_norm(obj, c);
+        out->mean[c] = g * mean;
+        out->var[c] = N > 1 ? g * g * m2 / (N - 1) : 0.0;
     }
 }

@@ -107,6 +107,10 @@ void lr_passes_update_coeffs(lr_renderer *r)
     int no = lr_scene_object_count(r->scene);
     for (int i = 0; i < no && i < LR_MAX_OBJECTS; i++)
         lr_passes_pack_coeffs(&lr_scene_object_at(r->scene, i)->coeffs, r->coef + 20 * i);
+    for (int i = 0; i < LR_MAX_OBJECTS; i++)
+        for (int c = 0; c < 3; c++)
+            r->sd_norm[3 * i + c] =
+                i < no ? (float)lr_scene_object_sd_norm(lr_scene_object_at(r->scene, i), c) : 1.0f;
 }
 
 void lr_passes_set_coeffs(lr_renderer *r, const lr_program *p)
@@ -116,6 +120,11 @@ void lr_passes_set_coeffs(lr_renderer *r, const lr_program *p)
         loc = lr_program_uniform(p, "u_coef[0]");
     if (loc >= 0)
         glUniform4fv(loc, 5 * LR_MAX_OBJECTS, r->coef);
+    loc = lr_program_uniform(p, "u_sd_norm");
+    if (loc < 0)
+        loc = lr_program_uniform(p, "u_sd_norm[0]");
+    if (loc >= 0)
+        glUniform3fv(loc, LR_MAX_OBJECTS, r->sd_norm);
 }
 
 void lr_passes_uniform_mat4(const lr_program *p, const char *name, const double m[16])

@@ -66,6 +66,9 @@ struct lr_renderer {
     lr_gpu_mesh recv[LR_MAX_RECEIVERS];
     bool two_sided[LR_MAX_OBJECTS];
     float coef[5 * 4 * LR_MAX_OBJECTS];
+    /* Per object: the S_d energy normalisation (coeffs.sd_norm, or 1 for "normalize": false),
+     * radiosity.frag's u_sd_norm (PIPELINE.md "Energy"). */
+    float sd_norm[3 * LR_MAX_OBJECTS];
 
     /* The light of the transport (lights[0]) as seen by the last gbuffer pass. */
     struct {

@@ -98,7 +98,16 @@ typedef struct lr_scene_object {
     double radius;        /*   cameras sit on it */
     double area;          /* world surface area, mm^2 */
     bool closed;          /* watertight (a shade with rims is; one without is not) */
+    bool sd_raw;          /* scene "normalize": false: [14]'s S_d as published, without
+                           * coeffs.sd_norm (PIPELINE.md "Energy"); default: normalised */
 } lr_scene_object;
+
+/* The factor S_d is multiplied by for band c (0..2): coeffs.sd_norm[c], or 1 for the raw
+ * model (sd_raw). The GLSL pass and the CPU twin both use it. */
+static inline double lr_scene_object_sd_norm(const lr_scene_object *o, int c)
+{
+    return o->sd_raw ? 1.0 : o->coeffs.sd_norm[c];
+}
 
 /* ---- Lights ------------------------------------------------------------------------------- */
 

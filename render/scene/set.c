@@ -624,6 +624,14 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
         *d = LR_DIRTY_MATERIAL;
         return LR_OK;
     }
+    if (strcmp(f, "normalize") == 0) {
+        bool normalize = !rec->pub.sd_raw;
+        if ((rc = bool_field(o, &normalize)))
+            return rc;
+        rec->pub.sd_raw = !normalize;
+        *d = LR_DIRTY_MATERIAL; /* the radiosity maps restart */
+        return LR_OK;
+    }
     mesh_spec ms = rec->mesh;
     xform_spec xf = rec->xf;
     const char *bad = NULL;
@@ -638,7 +646,7 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
         if ((rc = lr_scene_check_transform(&xf, &bad, &inner)))
             return check_failed(o, f, bad, rc, &inner);
     } else {
-        return unknown(o, "an object", f, "material, material.*, mesh.*, transform.*");
+        return unknown(o, "an object", f, "material, material.*, mesh.*, transform.*, normalize");
     }
     lr_mesh *world;
     lr_bvh *bvh;
@@ -678,7 +686,11 @@ static int object_get(op *o, const lr_scene *s, int i, const char *f)
         return mesh_field(o, &rec.mesh, f + 5);
     if (strncmp(f, "transform.", 10) == 0)
         return transform_field(o, &rec.xf, f + 10);
-    return unknown(o, "an object", f, "material, material.*, mesh.*, transform.*");
+    if (strcmp(f, "normalize") == 0) {
+        bool normalize = !rec.pub.sd_raw;
+        return bool_field(o, &normalize);
+    }
+    return unknown(o, "an object", f, "material, material.*, mesh.*, transform.*, normalize");
 }
 
 /* ---- keys ------------------------------------------------------------------------------------- */

@@ -20,6 +20,8 @@ uniform uint u_frame;
 uniform int u_map_size;
 uniform float u_map_scale; // stored value = B * scale (render/passes/radiosity.c)
 uniform float u_map_max;   // largest stored value (half-float maps: below the fp16 maximum)
+// Per object: S_d's energy normalisation per band (PIPELINE.md "Energy"; 1: the raw model).
+uniform vec3 u_sd_norm[LR_MAX_OBJECTS];
 layout(location = 0) out vec4 o_B;
 layout(location = 1) out vec4 o_pos;
 layout(location = 2) out vec4 o_nrm;
@@ -114,7 +116,7 @@ void main()
             float sd = lr_dirpole_sd_band(mat, c, xi, ni, wi, xo, no);
             sum += sd * Ft * J * inv_pA * shape;
         }
-        B[c] = LR_PI * sum / float(u_N);
+        B[c] = LR_PI * sum / float(u_N) * u_sd_norm[clamp(u_object, 0, LR_MAX_OBJECTS - 1)][c];
     }
     o_B = vec4(min(B * u_map_scale, vec3(u_map_max)), 1.0);
     o_pos = vec4(xo, 1.0);
