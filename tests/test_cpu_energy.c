@@ -252,8 +252,8 @@ static void test_shell_energy_bookkeeping(void **state)
 /* Finding 4, issue 3's requirement: a closed hollow sphere (R 40) of non-absorbing material
  * around a point light at its centre, power out of the outer surface with the cavity gain =
  * 4 pi I within 5 %, for walls of 2 mm (a porcelain globe), 3 mm and 20 mm, eta 1.5 and 1.
- * The gain comes from lr_cpu_cavity_measure (its own 256 VPL points); the power is integrated
- * here over 32 other points (a fixed quadrature: the sphere's area per solid angle is
+ * The gain comes from lr_cpu_cavity_measure (its own 256 random points uniform by area); the
+ * power is integrated here over 32 Halton points (a fixed quadrature: the sphere's area per solid angle is
  * uniform), with the twin's pass sampler and with the untruncated reference sampler. The Monte
  * Carlo error (4 standard errors) is required to be below 2 % so that the test discriminates. */
 static void check_closed_shell(double ri, double eta)
@@ -268,6 +268,7 @@ static void check_closed_shell(double ri, double eta)
         fail_msg("%s", e.msg);
     assert_true(cav.applies);
     assert_near(cav.C, 1.0, 1e-12); /* every direction meets the closed shell */
+    assert_near(cav.F, 1.0, 1e-12); /* and everything it sends back meets it again */
     assert_near(cav.R1, lr_fresnel_reflectance(1.0, eta), 0.01); /* near-normal incidence */
     double Pm[2][3], Sm[2][3];
     for (int mode = 0; mode < 2; mode++) {
