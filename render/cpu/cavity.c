@@ -166,3 +166,24 @@ int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
     free(P);
     return LR_OK;
 }
+
+int lr_cpu_cavity_scene_gains(const lr_scene *s, int light, int threads, double (*gain)[3],
+                              int nobj, lr_err *e)
+{
+    for (int o = 0; o < nobj; o++)
+        gain[o][0] = gain[o][1] = gain[o][2] = 1.0;
+    const lr_light *l = lr_scene_light_at(s, light);
+    int k = -1;
+    enum lr_enclosure enc = l ? lr_scene_light_enclosure(s, light, &k) : LR_ENCLOSURE_NONE;
+    if (enc != LR_ENCLOSURE_HULL || k < 0 || k >= nobj)
+        return LR_OK;
+    lr_cpu_cavity_desc d = LR_CAVITY_SCENE_DESC;
+    d.threads = threads;
+    lr_cpu_cavity cav;
+    int rc = lr_cpu_cavity_measure(lr_scene_object_at(s, k), l, enc, &d, &cav, e);
+    if (rc)
+        return rc;
+    for (int c = 0; c < 3; c++)
+        gain[k][c] = cav.gain[c];
+    return LR_OK;
+}

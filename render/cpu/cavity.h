@@ -59,4 +59,12 @@ int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
                           enum lr_enclosure enclosure, const lr_cpu_cavity_desc *d,
                           lr_cpu_cavity *out, lr_err *e);
 
+/* The gains the renderer (GLSL composition) and lr_cpu_render apply, so that both get the same
+ * numbers: for light `light` of scene s, gain[o] for every object o < nobj, 1 except for the
+ * object that encloses the light (lr_scene_light_enclosure: LR_ENCLOSURE_HULL), measured with
+ * LR_CAVITY_SCENE_DESC (a few ms). */
+#define LR_CAVITY_SCENE_DESC {.directions = 2048, .points = 128, .N = 32, .seed = 1}
+int lr_cpu_cavity_scene_gains(const lr_scene *s, int light, int threads, double (*gain)[3],
+                              int nobj, lr_err *e);
+
 #endif

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "render/base/mat4.h"
+#include "render/cpu/cavity.h"
 #include "render/passes/passes.h"
 
 static int upload(lr_gpu_mesh *g, const lr_mesh *m, lr_err *e)
@@ -113,6 +114,19 @@ void lr_passes_update_coeffs(lr_renderer *r)
                 i < no ? (float)lr_scene_object_sd_norm(lr_scene_object_at(r->scene, i), c) : 1.0f;
 }
 
+int lr_passes_update_cavity(lr_renderer *r, lr_err *e)
+{
+    double g[LR_MAX_OBJECTS][3];
+    int no = lr_scene_object_count(r->scene);
+    if (no > LR_MAX_OBJECTS)
+        no = LR_MAX_OBJECTS;
+    int rc = lr_cpu_cavity_scene_gains(r->scene, 0, 0, g, no, e);
+    for (int i = 0; i < LR_MAX_OBJECTS; i++)
+        for (int c = 0; c < 3; c++)
+            r->cavity_gain[3 * i + c] = !rc && i < no ? (float)g[i][c] : 1.0f;
+    return rc;
+}
+
 void lr_passes_set_coeffs(lr_renderer *r, const lr_program *p)
 {
     GLint loc = lr_program_uniform(p, "u_coef");
@@ -125,6 +139,11 @@ void lr_passes_set_coeffs(lr_renderer *r, const lr_program *p)
         loc = lr_program_uniform(p, "u_sd_norm[0]");
     if (loc >= 0)
         glUniform3fv(loc, LR_MAX_OBJECTS, r->sd_norm);
+    loc = lr_program_uniform(p, "u_cavity_gain");
+    if (loc < 0)
+        loc = lr_program_uniform(p, "u_cavity_gain[0]");
+    if (loc >= 0)
+        glUniform3fv(loc, LR_MAX_OBJECTS, r->cavity_gain);
 }
 
 void lr_passes_uniform_mat4(const lr_program *p, const char *name, const double m[16])

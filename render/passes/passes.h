@@ -69,6 +69,9 @@ struct lr_renderer {
     /* Per object: the S_d energy normalisation (coeffs.sd_norm, or 1 for "normalize": false),
      * radiosity.frag's u_sd_norm (PIPELINE.md "Energy"). */
     float sd_norm[3 * LR_MAX_OBJECTS];
+    /* Per object: the cavity gain for lights[0] (render/cpu/cavity.h, measured on the CPU when
+     * the maps restart), compose's u_cavity_gain: multiplies the object's and its VPLs' B. */
+    float cavity_gain[3 * LR_MAX_OBJECTS];
 
     /* The light of the transport (lights[0]) as seen by the last gbuffer pass. */
     struct {
@@ -129,6 +132,8 @@ void lr_passes_pack_coeffs(const lr_coeffs *c, float out[20]);
 /* Coefficient block of every object (render/shaders/lib/material.glsl). */
 void lr_passes_update_coeffs(lr_renderer *r);
 void lr_passes_set_coeffs(lr_renderer *r, const lr_program *p);
+/* Measures r->cavity_gain for the current scene (PIPELINE.md "Energy"). */
+int lr_passes_update_cavity(lr_renderer *r, lr_err *e);
 /* Light G-buffer samplers and uniforms on units 0..3. */
 void lr_passes_bind_gbuffer(lr_renderer *r, const lr_program *p);
 /* Algorithm 1 uniforms and samplers (units 4..6). */

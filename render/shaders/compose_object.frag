@@ -11,6 +11,8 @@ uniform vec3 u_eye;          // camera position (perspective)
 uniform vec3 u_view_dir;     // camera forward (orthographic)
 uniform bool u_ortho;
 uniform vec3 u_intensity;    // I per band
+// Per object: light sent back into a cavity around the light (PIPELINE.md "Energy").
+uniform vec3 u_cavity_gain[LR_MAX_OBJECTS];
 layout(location = 0) out vec4 o_color;
 
 void main()
@@ -23,5 +25,6 @@ void main()
     vec3 B = lr_gather(v_pos, no, n);
     float eta = lr_material(u_object).eta;
     float Ft = lr_fresnel_transmittance(abs(dot(no, wo)), eta);
-    o_color = vec4(u_intensity * Ft * B / LR_PI, n > 0.0 ? 1.0 : 0.0);
+    vec3 g = u_cavity_gain[clamp(u_object, 0, LR_MAX_OBJECTS - 1)];
+    o_color = vec4(u_intensity * g * Ft * B / LR_PI, n > 0.0 ? 1.0 : 0.0);
 }

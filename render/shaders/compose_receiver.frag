@@ -9,6 +9,8 @@ in vec3 v_pos;
 in vec3 v_nrm;
 uniform vec3 u_albedo;
 uniform vec3 u_intensity;   // I per band
+// Per object: light sent back into a cavity around the light (PIPELINE.md "Energy").
+uniform vec3 u_cavity_gain[LR_MAX_OBJECTS];
 uniform int u_light_type;   // 0 point, 1 spot, 2 directional
 uniform vec2 u_spot_cos;
 uniform bool u_use_vpl;
@@ -79,8 +81,9 @@ void main()
                 continue;
             if (u_vpl_vis && !vpl_visible(p.xyz, nv.xyz, x))
                 continue;
-            float eta = lr_material(int(nv.w + 0.5)).eta;
-            vec3 B = texelFetch(u_vpl_B, ivec2(v, 0), 0).rgb;
+            int id = clamp(int(nv.w + 0.5), 0, LR_MAX_OBJECTS - 1);
+            float eta = lr_material(id).eta;
+            vec3 B = texelFetch(u_vpl_B, ivec2(v, 0), 0).rgb * u_cavity_gain[id];
             E += lr_fresnel_transmittance(cv, eta) * B / LR_PI * p.w * cv * cx / max(d2, p.w);
         }
     }
