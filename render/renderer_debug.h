@@ -40,6 +40,10 @@ void lr_renderer_debug_map_matrix(const lr_renderer *r, int k, double out[16]);
 int lr_renderer_debug_read_map(lr_renderer *r, int k, float *B, float *pos, float *nrm, int *object,
                                lr_err *e);
 
+/* The cavity gain per band composition applies to object `object`'s emission (PIPELINE.md
+ * "Energy"; 1 for objects that do not enclose lights[0]). */
+void lr_renderer_debug_cavity_gain(const lr_renderer *r, int object, double out[3]);
+
 /* ---- virtual point lights (pass 4) -------------------------------------------------------- */
 
 typedef struct lr_debug_vpl {
