@@ -13,8 +13,10 @@
  * pi * int S_d F_t dA_plane (directional):
  *   LR_CPU_PASS       exactly the GPU pass: per band N samples of r ~ exp(sigma_tr) truncated
  *                     at r_max, alpha uniform (seed 003 Eq. 11-12); point/spot through the
- *                     stereographic lookup (Eq. 13-14) with the exact Jacobian J; directional
- *                     through the light's view plane (J = 1). Biased only by the truncation.
+ *                     stereographic lookup (Eq. 13-14) with the exact Jacobian J, mixed
+ *                     (balance heuristic, one sample) with directions uniform in the cone from
+ *                     the light around the bounding sphere, so unbiased; directional through
+ *                     the light's view plane (J = 1), biased only by the truncation.
  *   LR_CPU_REFERENCE  no truncation: a one-sample mixture (balance heuristic) of the pass's
  *                     plane sampling with r_max = Inf and uniform directions over the sphere
  *                     (directional: uniform over the object's projected disk). The mixture
@@ -31,7 +33,7 @@
 #include "render/base/vec3.h"
 #include "render/scene/scene.h"
 
-/* PIPELINE.md: r_max = 20 bounding radii. */
+/* PIPELINE.md: r_max = 20 max(bounding radius, |x_l - x_o|) (directional: 20 radii). */
 #define LR_CPU_RMAX_RADII 20.0
 
 enum lr_cpu_sampler { LR_CPU_PASS = 0, LR_CPU_REFERENCE = 1 };
@@ -39,7 +41,8 @@ enum lr_cpu_sampler { LR_CPU_PASS = 0, LR_CPU_REFERENCE = 1 };
 typedef struct lr_cpu_radiosity_desc {
     int N;                       /* samples per band; 0: 16 */
     enum lr_cpu_sampler sampler; /* default LR_CPU_PASS */
-    double r_max;                /* LR_CPU_PASS: 0 = LR_CPU_RMAX_RADII * object radius */
+    double r_max;                /* LR_CPU_PASS: 0 = LR_CPU_RMAX_RADII * max(object radius,
+                                  * |x_l - x_o|) (directional: * radius) */
     /* Other translucent objects of the scene: the light G-buffer holds the first surface of
      * any of them, and a lookup that meets another object first brings no light (as the GLSL
      * pass). NULL / 0: the object alone. */
