@@ -27,6 +27,8 @@
  *          directory), "scale": 1 (e.g. 1000 for a file in metres)}
  *       "transform": {"translate": [0,0,0], "rotate_deg": [0,0,0] (about x, then y, then z),
  *                     "scale": 1 | [sx, sy, sz] (> 0)}                      (optional)
+ *       "normalize": true (false: the published directional dipole, without the energy
+ *                    normalisation of PIPELINE.md "Energy")                 (optional)
  *     } ]
  *   "lights": [                                    one or more
  *     {"type": "point", "name": string, "position": [x,y,z], "intensity": W/sr (>= 0),
