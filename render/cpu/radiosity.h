@@ -13,10 +13,8 @@
  * pi * int S_d F_t dA_plane (directional):
  *   LR_CPU_PASS       exactly the GPU pass: per band N samples of r ~ exp(sigma_tr) truncated
  *                     at r_max, alpha uniform (seed 003 Eq. 11-12); point/spot through the
- *                     stereographic lookup (Eq. 13-14) with the exact Jacobian J, mixed
- *                     (balance heuristic, one sample) with directions uniform in the cone from
- *                     the light around the bounding sphere, so unbiased; directional through
- *                     the light's view plane (J = 1), biased only by the truncation.
+ *                     stereographic lookup (Eq. 13-14) with the exact Jacobian J; directional
+ *                     through the light's view plane (J = 1). Biased only by the truncation.
  *   LR_CPU_REFERENCE  no truncation: a one-sample mixture (balance heuristic) of the pass's
  *                     plane sampling with r_max = Inf and uniform directions over the sphere
  *                     (directional: uniform over the object's projected disk). The mixture

@@ -88,7 +88,8 @@ static bool odd_crossings(const float *pos, const uint32_t *idx, size_t nt, cons
     for (size_t t = 0; t < nt; t++) {
         if (piece[t] == self || !pclosed[piece[t]])
             continue;
-        lr_vec3 a = fpos(pos, idx[3 * t]), b = fpos(pos, idx[3 * t + 1]), c = fpos(pos, idx[3 * t + 2]);
+        lr_vec3 a = fpos(pos, idx[3 * t]), b = fpos(pos, idx[3 * t + 1]);
+        lr_vec3 c = fpos(pos, idx[3 * t + 2]);
         lr_vec3 e1 = lr_v3_sub(b, a), e2 = lr_v3_sub(c, a), p = lr_v3_cross(d, e2);
         double det = lr_v3_dot(e1, p);
         if (fabs(det) < 1e-300)
@@ -110,7 +111,8 @@ static bool odd_crossings(const float *pos, const uint32_t *idx, size_t nt, cons
 /* Turns faces over so that neighbours agree (breadth-first over two-face edges; each piece
  * keeps the orientation most of its faces already had), then turns closed pieces with negative
  * volume inside out, except those nested inside an odd number of other closed pieces (the
- * inner wall of a hollow object), which get negative volume. Returns the number of faces flipped, or (size_t)-1 on allocation failure.
+ * inner wall of a hollow object), which get negative volume. Returns the number of faces
+ * flipped, or (size_t)-1 on allocation failure.
  */
 static size_t reorient(const float *pos, uint32_t *idx, size_t nt, const lr_mesh_edge *ed)
 {
@@ -122,7 +124,8 @@ static size_t reorient(const float *pos, uint32_t *idx, size_t nt, const lr_mesh
     uint8_t *open = calloc(nt ? nt : 1, 1); /* touches a boundary or non-manifold edge */
     int8_t *flip = malloc(nt ? nt : 1);
     uint32_t *queue = malloc((nt ? nt : 1) * sizeof *queue); /* also: the piece's faces */
-    uint32_t *piece = malloc((nt ? nt : 1) * sizeof *piece), *pseed = malloc((nt ? nt : 1) * sizeof *pseed);
+    uint32_t *piece = malloc((nt ? nt : 1) * sizeof *piece);
+    uint32_t *pseed = malloc((nt ? nt : 1) * sizeof *pseed);
     uint8_t *pclosed = malloc(nt ? nt : 1), *pinvert = malloc(nt ? nt : 1);
     size_t flipped = (size_t)-1;
     if (!start || !nb || !same || !open || !flip || !queue || !piece || !pseed || !pclosed ||

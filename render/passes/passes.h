@@ -92,8 +92,6 @@ struct lr_renderer {
         int K, size;
         lr_vec3 center;
         double radius, r_max;
-        lr_vec3 cone_axis; /* directions from the light around the bounding sphere */
-        double cone_cos;   /* (PIPELINE.md pass 2), -1: the light is inside it */
         lr_vec3 d[LR_MAX_K];
         double vp[LR_MAX_K][16];  /* world -> clip */
         double P[LR_MAX_K][16];   /* world -> texture (Algorithm 1's P_k) */

@@ -67,17 +67,6 @@ static void place_maps(lr_renderer *r)
     r->rad.center = c;
     r->rad.radius = R;
     r->rad.r_max = 20.0 * R;
-    /* Directions from the light around the bounding sphere (PIPELINE.md pass 2's mixture; as
-     * the twin's cone_cos): the whole sphere when the light is inside it. */
-    const lr_light *l = lr_passes_light(r);
-    lr_vec3 to = lr_v3_sub(c, l ? l->position : c);
-    double dist = lr_v3_len(to), Rc = 1.0001 * R;
-    r->rad.cone_axis = lr_v3(0, 0, 1);
-    r->rad.cone_cos = -1.0;
-    if (l && l->type != LR_LIGHT_DIRECTIONAL && dist > Rc) {
-        r->rad.cone_axis = lr_v3_scale(to, 1.0 / dist);
-        r->rad.cone_cos = sqrt(fmax(0.0, 1.0 - (Rc / dist) * (Rc / dist)));
-    }
     double S[16] = {0.5, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, 0.5, 0, 0.5, 0.5, 0.5, 1};
     for (int k = 0; k < r->rad.K; k++) {
         lr_vec3 d = lr_halton_sphere((unsigned)k + 1);
@@ -166,8 +155,6 @@ int lr_pass_radiosity(lr_renderer *r, bool restart, lr_err *e)
         lr_passes_uniform_i(p, "u_N", r->rs.N);
         lr_passes_uniform_f(p, "u_r_max", (float)r->rad.r_max);
         lr_passes_uniform_f(p, "u_r_max_dist", 20.0f);
-        lr_passes_uniform_v3(p, "u_cone_axis", r->rad.cone_axis);
-        lr_passes_uniform_f(p, "u_cone_cos", (float)r->rad.cone_cos);
         lr_passes_uniform_i(p, "u_map_size", r->rad.size);
         lr_passes_uniform_f(p, "u_map_scale", r->rad.scale);
         /* Half floats: stay below 65504 (a light on the surface has B -> Inf at x_o -> x_l). */

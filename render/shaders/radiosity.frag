@@ -15,8 +15,6 @@ uniform vec2 u_spot_cos;    // cos(outer), cos(inner)
 uniform int u_N;
 uniform float u_r_max;      // 20 R; point/spot lights: r_max = max(u_r_max, u_r_max_dist d)
 uniform float u_r_max_dist; // 20 (PIPELINE.md: r_max = 20 max(R, |x_l - x_o|))
-uniform vec3 u_cone_axis;   // directions from the light around the bounding sphere: axis and
-uniform float u_cone_cos;   // cos of the half-angle (-1: the light is inside, whole sphere)
 uniform uint u_seed;
 uniform uint u_map;
 uniform uint u_frame;
@@ -57,13 +55,7 @@ void main()
     float d = length(h);
     vec3 A = u_light_pos + h; // antipode of x_o on the sphere of radius d around the light
 
-    bool dir_light = u_light_type == 2;
-    float r_max = dir_light ? u_r_max : max(u_r_max, u_r_max_dist * d);
-    float cone_pdf = 1.0 / (2.0 * LR_PI * (1.0 - u_cone_cos));
-    vec3 c1 = abs(u_cone_axis.z) < 0.9 ? vec3(0.0, 0.0, 1.0) : vec3(1.0, 0.0, 0.0);
-    vec3 a1 = normalize(cross(c1, u_cone_axis));
-    vec3 a2 = cross(u_cone_axis, a1);
-
+    float r_max = u_light_type == 2 ? u_r_max : max(u_r_max, u_r_max_dist * d);
     vec3 B = vec3(0.0);
     for (int c = 0; c < 3; c++) {
         float sigma_tr = mat.sigma_tr[c];
@@ -73,82 +65,49 @@ void main()
         float mass = flat_r ? 1.0 : -lr_expm1(-sigma_tr * r_max);
         float sum = 0.0;
         for (int j = 0; j < u_N; j++) {
-            float pick = lr_rand(state);
             float xi1 = lr_rand(state);
             float xi2 = lr_rand(state);
+            float r, pr;
+            if (flat_r) {
+                r = xi1 * r_max;
+                pr = 1.0 / r_max;
+            } else {
+                r = min(-lr_log1p(-xi1 * mass) / sigma_tr, r_max);
+                pr = sigma_tr * (1.0 - xi1 * mass) / mass;
+            }
+            float alpha = 2.0 * LR_PI * xi2;
+            // 1 / p_A = 2 pi r / p(r) (density per unit area of the sampling plane).
+            if (!(pr > 0.0) || !(r > 0.0))
+                continue;
+            float inv_pA = 2.0 * LR_PI * r / pr;
+            vec3 xj = xo + r * (cos(alpha) * t1 + sin(alpha) * t2);
             vec3 xi, ni;
             int id;
             vec3 wi;
-            float w; // f / p without S_d F_t: 1 / p per unit area (directional) or solid angle
+            float J;
             float shape = 1.0;
-            if (dir_light) {
-                float r, pr;
-                if (flat_r) {
-                    r = xi1 * r_max;
-                    pr = 1.0 / r_max;
-                } else {
-                    r = min(-lr_log1p(-xi1 * mass) / sigma_tr, r_max);
-                    pr = sigma_tr * (1.0 - xi1 * mass) / mass;
-                }
-                if (!(pr > 0.0) || !(r > 0.0))
-                    continue;
-                float alpha = 2.0 * LR_PI * xi2;
-                vec3 xj = xo + r * (cos(alpha) * t1 + sin(alpha) * t2);
+            if (u_light_type == 2) {
                 if (!lr_gbuffer_fetch(xj, xi, ni, id))
                     continue;
                 wi = -u_light_dir;
-                w = 2.0 * LR_PI * r / pr; // J = 1: cos theta_i dA_i = dA_plane
+                J = 1.0; // cos theta_i dA_i = dA_plane
             } else {
                 if (!(d > 1e-6))
                     continue;
-                // One-sample mixture (balance heuristic) of the plane sampling of seed 003
-                // Eq. 11-14 and directions uniform in the cone around the object (PIPELINE.md
-                // pass 2: the plane alone misses lit surface that it maps far out).
-                vec3 v;
-                if (pick < 0.5) {
-                    float r = flat_r ? xi1 * r_max
-                                     : min(-lr_log1p(-xi1 * mass) / sigma_tr, r_max);
-                    float alpha = 2.0 * LR_PI * xi2;
-                    vec3 xj = xo + r * (cos(alpha) * t1 + sin(alpha) * t2);
-                    vec3 q = xj - A;
-                    float q2 = dot(q, q);
-                    if (!(q2 > 0.0) || !(r > 0.0))
-                        continue;
-                    vec3 l = q * inversesqrt(q2);
-                    v = h - 2.0 * dot(h, l) * l; // seed 003 Eq. 13-14
-                } else {
-                    float z = 1.0 - (1.0 - u_cone_cos) * xi1, phi = 2.0 * LR_PI * xi2;
-                    float sz = sqrt(max(0.0, (1.0 - z) * (1.0 + z)));
-                    v = z * u_cone_axis + sz * (cos(phi) * a1 + sin(phi) * a2);
-                }
-                vec3 vn = normalize(v);
-                // The plane's density per solid angle at vn: p_A / J at the plane point the
-                // stereographic map sends to vn (the Jacobian of PIPELINE.md).
-                float p_plane = 0.0;
-                vec3 pa = u_light_pos + d * vn - A;
-                float den = dot(no, pa);
-                if (den != 0.0) {
-                    vec3 xj = A + pa * (dot(no, xo - A) / den);
-                    float r = length(xj - xo);
-                    vec3 q = xj - A;
-                    float q2 = dot(q, q);
-                    if (r > 0.0 && r <= r_max && q2 > 0.0) {
-                        vec3 l = q * inversesqrt(q2);
-                        float J = 2.0 * abs(2.0 * dot(h, l)) * abs(dot(l, no)) / (d * q2);
-                        float pr = flat_r ? 1.0 / r_max : sigma_tr * exp(-sigma_tr * r) / mass;
-                        if (J > 0.0)
-                            p_plane = pr / (2.0 * LR_PI * r) / J;
-                    }
-                }
-                float p_cone = dot(vn, u_cone_axis) >= u_cone_cos ? cone_pdf : 0.0;
-                float p = 0.5 * p_plane + 0.5 * p_cone;
-                if (!(p > 0.0) || isinf(p))
+                // Seed 003 Eq. 13-14 (stereographic lookup), Jacobian of PIPELINE.md.
+                vec3 q = xj - A;
+                float q2 = dot(q, q);
+                if (!(q2 > 0.0))
                     continue;
-                if (!lr_gbuffer_fetch(vn, xi, ni, id))
+                vec3 l = q * inversesqrt(q2);
+                float hl = dot(h, l);
+                vec3 v = h - 2.0 * hl * l;
+                float t = abs(2.0 * hl);
+                J = 2.0 * t * abs(dot(l, no)) / (d * q2);
+                if (!lr_gbuffer_fetch(v, xi, ni, id))
                     continue;
                 wi = normalize(u_light_pos - xi);
-                shape = spot_shape(vn);
-                w = 1.0 / p;
+                shape = spot_shape(v);
             }
             if (id != u_object)
                 continue; // light does not scatter from one object into another
@@ -157,7 +116,7 @@ void main()
                 continue;
             float Ft = lr_fresnel_transmittance(cos_i, mat.eta);
             float sd = lr_dirpole_sd_band(mat, c, xi, ni, wi, xo, no);
-            sum += sd * Ft * w * shape;
+            sum += sd * Ft * J * inv_pA * shape;
         }
         B[c] = LR_PI * sum / float(u_N) * u_sd_norm[clamp(u_object, 0, LR_MAX_OBJECTS - 1)][c];
     }
