@@ -11,7 +11,7 @@
 
 #include "calib/cv_shim.h"
 #include "calib/image.h"
-#include "calib/json_out.h"
+#include "render/base/json_write.h"
 #include "render/base/json.h"
 
 typedef struct lr_board {

@@ -15,7 +15,7 @@
 
 #include <stddef.h>
 
-#include "calib/json_out.h"
+#include "render/base/json_write.h"
 #include "render/base/json.h"
 
 #define LR_CALFILE_VERSION 1

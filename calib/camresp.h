@@ -14,7 +14,7 @@
 #define LR_CALIB_CAMRESP_H
 
 #include "calib/image.h"
-#include "calib/json_out.h"
+#include "render/base/json_write.h"
 
 #define LR_CAMRESP_KIND "camera_response"
 #define LR_CAMRESP_MAX_STACK 64

@@ -352,6 +352,45 @@ int lr_cv_project_points(int n, const double *X, const double rvec[3], const dou
     }
 }
 
+int lr_cv_solve_pnp(int n, const double *obj, const double *img, const double K[9],
+                    const double dist[5], bool planar, double rvec[3], double tvec[3],
+                    double *rms, lr_err *e)
+{
+    if (n < (planar ? 4 : 6))
+        return lr_err_set(e, LR_EINVAL, "solvePnP: %d points (need at least %d)", n,
+                          planar ? 4 : 6);
+    try {
+        std::vector<cv::Point3d> p((size_t)n);
+        std::vector<cv::Point2d> q((size_t)n);
+        for (int i = 0; i < n; i++) {
+            p[(size_t)i] = cv::Point3d(obj[3 * i], obj[3 * i + 1], obj[3 * i + 2]);
+            q[(size_t)i] = cv::Point2d(img[2 * i], img[2 * i + 1]);
+        }
+        cv::Mat k(3, 3, CV_64F, (void *)K), d(1, 5, CV_64F, (void *)dist);
+        cv::Mat r, t;
+        if (!cv::solvePnP(p, q, k, d, r, t, false,
+                          planar ? cv::SOLVEPNP_IPPE : cv::SOLVEPNP_ITERATIVE))
+            return lr_err_set(e, LR_EINVAL, "solvePnP: no pose found for %d points", n);
+        cv::solvePnPRefineLM(p, q, k, d, r, t);
+        std::vector<cv::Point2d> back;
+        cv::projectPoints(p, r, t, k, d, back);
+        double ss = 0;
+        for (int i = 0; i < n; i++) {
+            cv::Point2d dd = back[(size_t)i] - q[(size_t)i];
+            ss += dd.dot(dd);
+        }
+        for (int i = 0; i < 3; i++) {
+            rvec[i] = r.at<double>(i);
+            tvec[i] = t.at<double>(i);
+        }
+        if (rms)
+            *rms = std::sqrt(ss / n);
+        return LR_OK;
+    } catch (...) {
+        return fail_current(e, "solvePnP");
+    }
+}
+
 int lr_cv_graycode_count(int pw, int ph, int *count, lr_err *e)
 {
     try {

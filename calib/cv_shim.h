@@ -90,6 +90,14 @@ int lr_cv_find_homography(int n, const double *src, const double *dst, double ra
 int lr_cv_project_points(int n, const double *X, const double rvec[3], const double tvec[3],
                          const double K[9], const double dist[5], double *uv, lr_err *e);
 
+/* Pose of an object from n >= 4 point correspondences (cv::solvePnP, then Levenberg-
+ * Marquardt refinement with cv::solvePnPRefineLM): X_dev = R(rvec) X_obj + tvec. planar: the
+ * points lie in the object's z = 0 plane (a board: IPPE start), else any 3-D points, n >= 6
+ * (iterative DLT start). *rms: RMS reprojection error (px) of the refined pose. */
+int lr_cv_solve_pnp(int n, const double *obj, const double *img, const double K[9],
+                    const double dist[5], bool planar, double rvec[3], double tvec[3],
+                    double *rms, lr_err *e);
+
 /* ---- Gray-code structured light (cv::structured_light::GrayCodePattern) ------------- */
 
 /* Number of pattern images for a projector of pw x ph pixels (pattern + inverse for each

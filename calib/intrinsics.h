@@ -15,7 +15,7 @@
 #ifndef LR_CALIB_INTRINSICS_H
 #define LR_CALIB_INTRINSICS_H
 
-#include "calib/json_out.h"
+#include "render/base/json_write.h"
 #include "render/base/json.h"
 
 typedef struct lr_intrinsics {

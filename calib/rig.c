@@ -44,6 +44,11 @@ int lr_rig_calib_load(const char *dir, lr_rig_calib *out, lr_err *e)
             goto fail;
         out->has_color = true;
     }
+    if (present(dir, LR_RIG_POSE, path, sizeof path)) {
+        if ((rc = lr_rig_pose_load(path, &out->pose, e)))
+            goto fail;
+        out->has_pose = true;
+    }
     return LR_OK;
 fail:
     lr_rig_calib_free(out);

@@ -7,6 +7,7 @@
  *   camera_response.json     camera response              (lamprig calib camera-response)
  *   projector_response.json  projector response           (lamprig calib projector-response fit)
  *   color.json               colour matrix                (lamprig calib color)
+ *   pose.json                camera (+ projector) pose in scene coordinates (lamprig calib pose)
  * A missing file is not an error (has_* is false and the conversions below fall back to
  * identity); a present but invalid one is, naming the file: a rig never runs on a
  * calibration it could only half read.
@@ -20,6 +21,7 @@
 #include "calib/camcal.h"
 #include "calib/camresp.h"
 #include "calib/colormatrix.h"
+#include "calib/pose.h"
 #include "calib/procam.h"
 #include "calib/projresp.h"
 
@@ -28,14 +30,16 @@
 #define LR_RIG_CAMERA_RESPONSE "camera_response.json"
 #define LR_RIG_PROJECTOR_RESPONSE "projector_response.json"
 #define LR_RIG_COLOR "color.json"
+#define LR_RIG_POSE "pose.json"
 
 typedef struct lr_rig_calib {
-    bool has_camera, has_procam, has_camresp, has_projresp, has_color;
+    bool has_camera, has_procam, has_camresp, has_projresp, has_color, has_pose;
     lr_camcal camera;
     lr_procam procam;
     lr_camresp camresp;
     lr_projresp projresp;
     lr_colormatrix color;
+    lr_rig_pose pose;
 } lr_rig_calib;
 
 /* out is large (~25 kB): allocate it, do not put it on a small stack. */

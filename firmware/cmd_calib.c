@@ -16,6 +16,7 @@
 #include "calib/calfile.h"
 #include "calib/colormatrix.h"
 #include "calib/graycode.h"
+#include "calib/pose.h"
 #include "calib/procam.h"
 #include "calib/projresp.h"
 #include "firmware/cli.h"
@@ -51,6 +52,15 @@ const char lr_cmd_calib_usage[] =
     "  color --pairs PAIRS.json --out FILE.json\n"
     "  color --checker PHOTO --out FILE.json [--camera-response FILE.json]\n"
     "      3x3 colour matrix, camera linear RGB -> linear sRGB\n"
+    "  pose --image PHOTO --board COLSxROWS --square MM --origin X,Y,Z --x-axis X,Y,Z\n"
+    "       --y-axis X,Y,Z --camera CAMERA.json --out pose.json [--projector PROJECTOR.json]\n"
+    "       [--pattern P]\n"
+    "  pose --points POINTS.json --camera CAMERA.json --out pose.json [--projector P.json]\n"
+    "      the camera's (and projector's) pose in scene coordinates (mm) from a photo of a\n"
+    "      board lying at a known place (its first point at --origin, its +x and +y axes\n"
+    "      along --x-axis / --y-axis), or from pixels of known scene points: POINTS.json is\n"
+    "      {\"version\":1, \"kind\":\"pose_points\", \"points\":[{\"scene\":[x,y,z],\n"
+    "      \"pixel\":[u,v]}, ...]}\n"
     "  check FILE...\n"
     "      load and validate calibration files of any kind, print a summary\n"
     "\n"
@@ -676,6 +686,127 @@ static int cmd_color(int argc, char **argv)
     return LR_EXIT_OK;
 }
 
+/* ---- pose ----------------------------------------------------------------------------- */
+
+static bool parse_vec3(const char *s, double v[3])
+{
+    int n = 0;
+    if (!s || sscanf(s, "%lf,%lf,%lf%n", &v[0], &v[1], &v[2], &n) != 3 || s[n] != '\0')
+        return false;
+    return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
+}
+
+/* {"version":1, "kind":"pose_points", "points":[{"scene":[3], "pixel":[2]}, ...]} */
+static int load_pose_points(const char *path, double **xyz, double **uv, int *n, lr_err *e)
+{
+    lr_json *j;
+    lr_jnode root, arr;
+    int count = 0;
+    int rc = lr_calfile_load(path, "pose_points", &j, &root, e);
+    if (rc)
+        return rc;
+    if ((rc = lr_calfile_array(j, root, NULL, "points", &arr, &count, e))) {
+        lr_json_destroy(j);
+        return rc;
+    }
+    *xyz = malloc((size_t)(count ? count : 1) * 3 * sizeof **xyz);
+    *uv = malloc((size_t)(count ? count : 1) * 2 * sizeof **uv);
+    if (!*xyz || !*uv)
+        rc = lr_err_set(e, LR_ENOMEM, "out of memory");
+    for (int i = 0; i < count && !rc; i++) {
+        lr_jnode p = lr_json_at(j, arr, i);
+        char prefix[32];
+        snprintf(prefix, sizeof prefix, "points[%d]", i);
+        if ((rc = lr_calfile_numbers(j, p, prefix, "scene", 3, -1e5, 1e5, *xyz + 3 * i, e)))
+            break;
+        rc = lr_calfile_numbers(j, p, prefix, "pixel", 2, -1e5, 1e5, *uv + 2 * i, e);
+    }
+    lr_json_destroy(j);
+    if (rc) {
+        free(*xyz);
+        free(*uv);
+        *xyz = *uv = NULL;
+        return rc;
+    }
+    *n = count;
+    return LR_OK;
+}
+
+static int cmd_pose(int argc, char **argv)
+{
+    const char *image = NULL, *size = NULL, *square = NULL, *pattern = NULL, *origin = NULL;
+    const char *xaxis = NULL, *yaxis = NULL, *camera = NULL, *projector = NULL, *out = NULL;
+    const char *points = NULL, *cmd = "pose";
+    const opt opts[] = {{"image", &image, NULL},       {"board", &size, NULL},
+                        {"square", &square, NULL},     {"pattern", &pattern, NULL},
+                        {"origin", &origin, NULL},     {"x-axis", &xaxis, NULL},
+                        {"y-axis", &yaxis, NULL},      {"camera", &camera, NULL},
+                        {"projector", &projector, NULL}, {"out", &out, NULL},
+                        {"points", &points, NULL},     {NULL, NULL, NULL}};
+    int rc = parse(cmd, argc, argv, 2, opts, NULL, 0, NULL);
+    if (rc || (rc = need(cmd, camera, "camera")) || (rc = need(cmd, out, "out")))
+        return rc;
+    if (!image == !points)
+        return usage_error(cmd, "%s", "give exactly one of --image PHOTO or --points FILE");
+    lr_board b = {0};
+    lr_board_placement pl;
+    if (image) {
+        if ((rc = need(cmd, size, "board")) || (rc = need(cmd, square, "square")) ||
+            (rc = need(cmd, origin, "origin")) || (rc = need(cmd, xaxis, "x-axis")) ||
+            (rc = need(cmd, yaxis, "y-axis")) ||
+            (rc = parse_board(cmd, size, square, pattern, &b)))
+            return rc;
+        if (!parse_vec3(origin, pl.origin))
+            return usage_error(cmd, "--origin '%s': expected x,y,z (mm)", origin);
+        if (!parse_vec3(xaxis, pl.x_axis))
+            return usage_error(cmd, "--x-axis '%s': expected x,y,z", xaxis);
+        if (!parse_vec3(yaxis, pl.y_axis))
+            return usage_error(cmd, "--y-axis '%s': expected x,y,z", yaxis);
+    }
+    lr_err e = {0};
+    lr_camcal cc;
+    if (lr_camcal_load(camera, &cc, &e))
+        return fail(cmd, &e);
+    lr_intrinsics k = cc.k;
+    lr_camcal_free(&cc);
+    lr_procam pc;
+    if (projector && lr_procam_load(projector, &pc, &e))
+        return fail(cmd, &e);
+    lr_rig_pose p;
+    if (image) {
+        lr_img gray;
+        if (lr_img_read(image, LR_IMG_GRAY8, &gray, &e)) {
+            rc = LR_EXIT_FAIL;
+        } else {
+            rc = lr_rig_pose_from_board(&gray, &b, &pl, &k, projector ? &pc : NULL, &p, &e);
+            if (rc)
+                lr_err_prefix(&e, "%s", image);
+            lr_img_free(&gray);
+        }
+    } else {
+        double *xyz, *uv;
+        int n;
+        rc = load_pose_points(points, &xyz, &uv, &n, &e);
+        if (!rc) {
+            rc = lr_rig_pose_from_points(n, xyz, uv, &k, projector ? &pc : NULL, &p, &e);
+            free(xyz);
+            free(uv);
+        }
+    }
+    if (projector)
+        lr_procam_free(&pc);
+    if (rc || lr_rig_pose_save(out, &p, &e))
+        return fail(cmd, &e);
+    lr_vec3 c = lr_pose_center(&p.camera);
+    printf("camera at (%.2f, %.2f, %.2f) mm in the scene, %d points, rms %.4f px -> %s\n", c.x,
+           c.y, c.z, p.points, p.rms, out);
+    if (p.has_projector) {
+        lr_vec3 q = lr_pose_center(&p.projector);
+        printf("projector at (%.2f, %.2f, %.2f) mm\n", q.x, q.y, q.z);
+    }
+    return LR_EXIT_OK;
+}
+
 /* ---- check ---------------------------------------------------------------------------- */
 
 static int check_one(const char *path)
@@ -719,6 +850,13 @@ static int check_one(const char *path)
         lr_colormatrix m;
         if (!(rc = lr_colormatrix_load(path, &m, &e)))
             printf("%s: colour matrix from %d patches, rms %.4f\n", path, m.patches, m.rms);
+    } else if (!strcmp(kind, LR_POSE_KIND)) {
+        lr_rig_pose p;
+        if (!(rc = lr_rig_pose_load(path, &p, &e))) {
+            lr_vec3 c = lr_pose_center(&p.camera);
+            printf("%s: pose from %s, camera at (%.2f, %.2f, %.2f) mm, rms %.4f px%s\n", path,
+                   p.source, c.x, c.y, c.z, p.rms, p.has_projector ? ", with projector" : "");
+        }
     } else if (!strcmp(kind, LR_GC_SEQUENCE_KIND)) {
         char dir[4096];
         snprintf(dir, sizeof dir, "%s", path);
@@ -765,6 +903,8 @@ int lr_cmd_calib(int argc, char **argv)
         return cmd_projector_response(argc, argv);
     if (!strcmp(sub, "color"))
         return cmd_color(argc, argv);
+    if (!strcmp(sub, "pose"))
+        return cmd_pose(argc, argv);
     if (!strcmp(sub, "check"))
         return cmd_check(argc, argv);
     fprintf(stderr, "%s\n", lr_cmd_calib_usage);

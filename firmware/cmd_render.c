@@ -10,6 +10,7 @@
 
 #include "firmware/args.h"
 #include "firmware/cli.h"
+#include "firmware/plan_scene.h"
 #include "firmware/render_events.h"
 #include "render/base/atomic_file.h"
 #include "render/gl/gl.h"
@@ -23,7 +24,8 @@ const char lr_render_summary[] = "render a scene headless: PNG, linear PFM, per-
 const char lr_render_usage[] =
     "usage: lamprig render --scene FILE [--frames N] [--width W --height H] [--out F.png]\n"
     "                      [--hdr F.pfm] [--stats F.json] [--no-vpl] [--set key=value ...]\n"
-    "                      [--events FILE] [--vpl-visibility]\n"
+    "                      [--events FILE] [--vpl-visibility] [--fps F] [--no-plan]\n"
+    "                      [--table CSV]\n"
     "\n"
     "Renders FILE (configs/scenes/*.json) with seed 003's passes (light G-buffer, scattered-\n"
     "radiosity maps, virtual point lights, composition) on a headless EGL context.\n"
@@ -35,13 +37,23 @@ const char lr_render_usage[] =
     "  --hdr F.pfm       linear RGB radiance, W/(mm^2 sr), PFM\n"
     "  --stats F.json    {\"scene\",\"width\",\"height\",\"uncovered_pixels\",\"renderer\",\n"
     "                    \"settings\",\"frames\":[{\"index\",\n"
-    "                    \"passes\":[...],\"ms\":{pass:ms},\"total_ms\",\"samples\"},...]}\n"
+    "                    \"passes\":[...],\"ms\":{pass:ms},\"total_ms\",\"samples\",\n"
+    "                    \"converged\",\"time_s\"},...]}\n"
     "  --no-vpl          no emergent light on the receivers (direct light only)\n"
     "  --vpl-visibility  shadow the VPLs' light by the objects (beyond seed 003; slower)\n"
     "  --set key=value   change a scene parameter before rendering (repeatable), names as\n"
     "                    in the scene file: light.intensity=0.01, render.K=8, camera.position=0,-400,200\n"
     "  --events FILE     one change per line, FRAME PARAMETER VALUE (e.g. '4 light.intensity\n"
     "                    0.5'), applied before that frame; '#' starts a comment line\n"
+    "  --fps F           the renderer's clock: frame i is composed at i / F seconds, which\n"
+    "                    drives the lights' flicker (default 30; lights[0].flicker.amplitude=0\n"
+    "                    makes a light steady)\n"
+    "  --no-plan         keep the scene's render settings even when it has a quality budget\n"
+    "  --table CSV       the planner's measured table (default: see `lamprig help plan`)\n"
+    "\n"
+    "A scene with a \"quality\" block (max_error, frame_ms) is planned first (`lamprig plan`):\n"
+    "the chosen settings replace its render settings and one line per object says the choice,\n"
+    "predicted error and time; --set render.* is applied after the plan and wins.\n"
     "\n"
     "Files are written atomically. Exit status: 0 done; 1 rendering or I/O failed; 2 bad\n"
     "arguments (one line on stderr).\n"
@@ -168,10 +180,36 @@ static int write_stats(const char *path, const lr_scene *scene, lr_renderer *r,
             }
         fputs("},\"total_ms\":", f);
         json_ms(f, s->total_ms);
-        fprintf(f, ",\"samples\":%d,\"converged\":%s}", s->samples, s->converged ? "true" : "false");
+        fprintf(f, ",\"samples\":%d,\"converged\":%s,\"time_s\":%.6g}", s->samples,
+                s->converged ? "true" : "false", s->time_s);
     }
     fputs("\n]}\n", f);
     return lr_atomic_file_commit(af, e);
+}
+
+/* The planner (firmware/plan_scene.h) for a scene with a quality budget: applies its settings
+ * and prints its lines. A missing or unusable table is not fatal: the scene's own settings
+ * render, and a "plan: skipped: WHY" line says so. */
+static int plan(lr_scene *scene, const char *table, bool *no_vpl, bool *planned)
+{
+    lr_plan_scene_result *res = calloc(1, sizeof *res);
+    if (!res)
+        return LR_EXIT_FAIL;
+    lr_err e = {0};
+    if (lr_plan_scene(scene, table, res, &e)) {
+        /* Informational like the plan itself (stdout): the render goes on. */
+        printf("plan: skipped: %s; rendering with the scene's settings\n", e.msg);
+    } else if (res->planned) {
+        char *text = lr_plan_scene_text(res);
+        if (text)
+            fputs(text, stdout);
+        free(text);
+        *planned = true;
+        if (!res->vpl)
+            *no_vpl = true;
+    }
+    free(res);
+    return LR_EXIT_OK;
 }
 
 /* Builds an lr_image (rows top to bottom) from the renderer's HDR readback (bottom up). */
@@ -230,7 +268,7 @@ int lr_cmd_render(int argc, char **argv)
     static const lr_argspec specs[] = {
         {"--scene", 1}, {"--frames", 1}, {"--width", 1}, {"--height", 1}, {"--out", 1},
         {"--hdr", 1},   {"--stats", 1},  {"--no-vpl", 0}, {"--events", 1},
-        {"--vpl-visibility", 0}, {NULL, 0}};
+        {"--vpl-visibility", 0}, {"--fps", 1}, {"--no-plan", 0}, {"--table", 1}, {NULL, 0}};
     lr_args a;
     lr_err e = {0};
     if (lr_args_parse(nrest, rest, specs, 0, &a, &e)) {
@@ -248,10 +286,20 @@ int lr_cmd_render(int argc, char **argv)
         status = positive_int("--width", lr_args_get(&a, "--width"), 16384, &width);
     if (!status && lr_args_has(&a, "--height"))
         status = positive_int("--height", lr_args_get(&a, "--height"), 16384, &height);
+    double fps = 30.0;
+    if (!status && lr_args_has(&a, "--fps")) {
+        lr_err fe = {0};
+        if (lr_args_number("--fps", lr_args_get(&a, "--fps"), &fps, &fe))
+            status = usage_error("%s", fe.msg);
+        else if (!(fps > 0.0 && fps <= 1e6))
+            status = usage_error("--fps %s: must be > 0 and <= 1e6", lr_args_get(&a, "--fps"));
+    }
     const char *out = lr_args_get(&a, "--out"), *hdr = lr_args_get(&a, "--hdr");
     const char *stats_path = lr_args_get(&a, "--stats"), *events_path = lr_args_get(&a, "--events");
     bool no_vpl = lr_args_has(&a, "--no-vpl");
     bool vpl_vis = lr_args_has(&a, "--vpl-visibility");
+    bool no_plan = lr_args_has(&a, "--no-plan");
+    const char *table = lr_args_get(&a, "--table");
     free(rest);
     if (status)
         return status;
@@ -270,6 +318,8 @@ int lr_cmd_render(int argc, char **argv)
         status = e.code == LR_EIO ? fail(&e) : usage_error("%s", e.msg);
         goto done;
     }
+    /* --set is checked before the plan (a bad one is a one-line usage error) and applied again
+     * after it, so that an explicit render.* setting wins over the plan. */
     for (int i = 0; i < nsets; i++)
         if (lr_scene_set_assignment(scene, sets[i], NULL, &e)) {
             status = usage_error("--set %s: %s", sets[i], e.msg);
@@ -278,6 +328,17 @@ int lr_cmd_render(int argc, char **argv)
     if (events_path && lr_render_events_load(events_path, &ev, &e)) {
         status = e.code == LR_EIO ? fail(&e) : usage_error("%s", e.msg);
         goto done;
+    }
+    bool planned = false;
+    if (!no_plan && (status = plan(scene, table, &no_vpl, &planned)))
+        goto done;
+    for (int i = 0; planned && i < nsets; i++) {
+        if (lr_scene_set_assignment(scene, sets[i], NULL, &e)) {
+            status = usage_error("--set %s: %s", sets[i], e.msg);
+            goto done;
+        }
+        if (!strncmp(sets[i], "render.", 7))
+            printf("plan: --set %s overrides the plan\n", sets[i]);
     }
     if (lr_gl_create(NULL, &gl, &e) ||
         lr_renderer_create(&(lr_renderer_desc){.gl = gl, .scene = scene, .width = width,
@@ -302,6 +363,9 @@ int lr_cmd_render(int argc, char **argv)
             }
             lr_renderer_invalidate(r, dirty);
         }
+        /* The clock after the stop test: flicker alone never keeps the loop going (without
+         * --frames it ends once the maps converged and the events are applied). */
+        lr_renderer_set_time(r, i / fps);
         lr_frame_stats st;
         if (lr_renderer_frame(r, &st, &e)) {
             status = fail(&e);

@@ -15,7 +15,7 @@ const char lr_run_summary[] = "run the rig: controls (gpio/hid/usb/modbus/sim) d
 
 const char lr_run_usage[] =
     "usage: lamprig run --config FILE [--headless] [--out-dir DIR] [--duration SECONDS]\n"
-    "                   [--stats FILE] [--modbus URL]\n"
+    "                   [--stats FILE] [--modbus URL] [--no-plan] [--table CSV]\n"
     "\n"
     "Runs the rig described by FILE (configs/rig/*.json): opens its devices, maps their\n"
     "controls onto the scene through the control map, writes the dimmer's curved level to the\n"
@@ -30,6 +30,13 @@ const char lr_run_usage[] =
     "                      stats.path), written atomically every stats.period_s and at exit\n"
     "  --modbus URL        the Modbus endpoint instead of the config's: tcp://HOST:PORT or\n"
     "                      rtu:DEVICE?baud=19200&parity=E&data=8&stop=1\n"
+    "  --no-plan           keep the scene's render settings even when it (or the config's\n"
+    "                      scene_set) has a quality budget\n"
+    "  --table CSV         the planner's measured table (default: see `lamprig help plan`)\n"
+    "\n"
+    "A scene with a quality budget is planned at every load (`lamprig plan`): the log has one\n"
+    "line per object with the choice, predicted error and time; the config's scene_set is\n"
+    "applied after the plan and wins.\n"
     "\n"
     "Signals: SIGINT/SIGTERM shut down cleanly (lamp driver to its safe level, devices closed,\n"
     "stats written, exit 0); SIGHUP reloads the config (a broken one is reported with file,\n"
@@ -57,7 +64,7 @@ int lr_cmd_run(int argc, char **argv)
 {
     static const lr_argspec specs[] = {
         {"--config", 1}, {"--headless", 0}, {"--out-dir", 1}, {"--duration", 1},
-        {"--stats", 1},  {"--modbus", 1},   {NULL, 0},
+        {"--stats", 1},  {"--modbus", 1},   {"--no-plan", 0}, {"--table", 1}, {NULL, 0},
     };
     lr_args a;
     lr_err e = {0};
@@ -71,6 +78,8 @@ int lr_cmd_run(int argc, char **argv)
         .out_dir = lr_args_get(&a, "--out-dir"),
         .stats_path = lr_args_get(&a, "--stats"),
         .modbus_url = lr_args_get(&a, "--modbus"),
+        .no_plan = lr_args_has(&a, "--no-plan"),
+        .plan_table = lr_args_get(&a, "--table"),
     };
     const char *d = lr_args_get(&a, "--duration");
     if (d) {

@@ -23,7 +23,8 @@ const char *lr_pass_name(int index)
 static int program(lr_renderer *r, const char *vert, const char *frag, lr_program **out, lr_err *e)
 {
     static const char *const defines[] = {"LR_MAX_OBJECTS " STR(LR_MAX_OBJECTS),
-                                          "LR_MAX_K " STR(LR_MAX_K), NULL};
+                                          "LR_MAX_K " STR(LR_MAX_K),
+                                          "LR_MAX_LIGHTS " STR(LR_MAX_LIGHTS), NULL};
     lr_program_desc d = {.vertex = vert, .fragment = frag, .dir = r->shader_dir, .defines = defines};
     return lr_program_create(&d, out, e);
 }
@@ -164,6 +165,35 @@ void lr_renderer_destroy(lr_renderer *r)
     free(r);
 }
 
+/* Whether light l's intensity changes with time. */
+static bool flickers(const lr_light *l)
+{
+    return l->flicker.amplitude > 0.0 && l->intensity > 0.0;
+}
+
+void lr_renderer_set_time(lr_renderer *r, double t_seconds)
+{
+    if (!isfinite(t_seconds) || (r->clock_set && t_seconds == r->time_s))
+        return;
+    for (int l = 0; l < lr_scene_light_count(r->scene); l++)
+        if (flickers(lr_scene_light_at(r->scene, l)))
+            r->dirty |= LR_DIRTY_INTENSITY; /* composition alone (transport is linear) */
+    r->clock_set = true;
+    r->time_s = t_seconds;
+}
+
+double lr_renderer_flicker(const lr_renderer *r, int l)
+{
+    if (!r->clock_set || l < 0 || l >= lr_scene_light_count(r->scene))
+        return 1.0;
+    const lr_light *light = lr_scene_light_at(r->scene, l);
+    if (!(light->flicker.amplitude > 0.0))
+        return 1.0;
+    double f;
+    lr_light_flicker_at(light, r->time_s, &f, NULL);
+    return f;
+}
+
 void lr_renderer_invalidate(lr_renderer *r, unsigned dirty)
 {
     r->dirty |= dirty;
@@ -254,6 +284,7 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
     st.passes = passes;
     st.samples = r->rad.F;
     st.converged = r->rad.F >= r->rs.frames;
+    st.time_s = r->clock_set ? r->time_s : 0.0;
     if (stats)
         *stats = st;
     return LR_OK;

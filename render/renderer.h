@@ -47,10 +47,29 @@ typedef struct lr_frame_stats {
     double total_ms;
     int samples;                 /* radiosity frames accumulated in the maps after this frame */
     bool converged;              /* samples reached render.frames */
+    double time_s;               /* the clock the frame was composed at (0 without one) */
 } lr_frame_stats;
 
 int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *e);
 void lr_renderer_destroy(lr_renderer *r);
+
+/* The renderer's clock in seconds, given by the caller (`lamprig render`: frame index / fps;
+ * `lamprig run`: the wall clock since start; tests: any value, so frames are reproducible).
+ * Each light's flicker (lr_light.flicker) scales its intensity by lr_light_flicker_at(light,
+ * t): band-limited noise around flicker.frequency_hz (three seeded sines), mean 1, within
+ * 1 +- amplitude. It enters at composition only, like a dimmer: a new time with a flickering
+ * light (amplitude > 0, intensity > 0) marks composition due and never restarts accumulation.
+ * Until the first call the lights are steady (factor 1), as in the CPU twin and the physical
+ * reference. Position jitter (flicker.jitter_mm) is not rendered: the transport is computed at
+ * the light's mean position, because the sway (candle.json: 0.3 mm) is far below the
+ * diffusion length 1/sigma_tr of wax (8-17 mm), so it changes the emergent light by ~sigma_tr
+ * jitter <= 4 %, and the direct light on receivers hundreds of mm away by ~2 jitter / d < 0.3 %;
+ * re-running the light G-buffer and maps for it would restart accumulation at every frame.
+ * A caller that wants a large sway moves the light through lr_scene_set. */
+void lr_renderer_set_time(lr_renderer *r, double t_seconds);
+/* The factor on light l's intensity at the current clock: lr_light_flicker_at's, or 1 before
+ * the first lr_renderer_set_time, for a steady light, or l out of range. */
+double lr_renderer_flicker(const lr_renderer *r, int l);
 
 /* Marks what changed (LR_DIRTY_* bits from lr_scene_set). */
 void lr_renderer_invalidate(lr_renderer *r, unsigned dirty);

@@ -22,8 +22,14 @@ void lr_renderer_debug_map_info(const lr_renderer *r, lr_debug_map_info *out)
 
 void lr_renderer_debug_cavity_gain(const lr_renderer *r, int object, double out[3])
 {
+    lr_renderer_debug_light_cavity_gain(r, 0, object, out);
+}
+
+void lr_renderer_debug_light_cavity_gain(const lr_renderer *r, int l, int object, double out[3])
+{
+    bool ok = l >= 0 && l < LR_MAX_LIGHTS && object >= 0 && object < LR_MAX_OBJECTS;
     for (int c = 0; c < 3; c++)
-        out[c] = object >= 0 && object < LR_MAX_OBJECTS ? r->cavity_gain[3 * object + c] : 1.0;
+        out[c] = ok ? r->cavity_gain[3 * (l * LR_MAX_OBJECTS + object) + c] : 1.0;
 }
 
 lr_vec3 lr_renderer_debug_map_dir(const lr_renderer *r, int k)
@@ -61,13 +67,22 @@ static void copy3(float *dst, const float *src, size_t n)
 int lr_renderer_debug_read_map(lr_renderer *r, int k, float *B, float *pos, float *nrm, int *object,
                                lr_err *e)
 {
+    return lr_renderer_debug_read_light_map(r, 0, k, B, pos, nrm, object, e);
+}
+
+int lr_renderer_debug_read_light_map(lr_renderer *r, int l, int k, float *B, float *pos,
+                                     float *nrm, int *object, lr_err *e)
+{
     if (k < 0 || k >= r->rad.K)
         return lr_err_set(e, LR_EINVAL, "debug: map %d of %d", k, r->rad.K);
+    if (l < 0 || l >= r->n_lights)
+        return lr_err_set(e, LR_EINVAL, "debug: light %d of %d", l, r->n_lights);
     int n = r->rad.size;
     size_t cnt = (size_t)n * n;
-    float *b = read_fb(r->rad.fb[k], 0, n, n, e);
-    float *p = b ? read_fb(r->rad.fb[k], 1, n, n, e) : NULL;
-    float *q = p ? read_fb(r->rad.fb[k], 2, n, n, e) : NULL;
+    lr_fb *fb = r->rad.fb[l * r->rad.K + k];
+    float *b = read_fb(fb, 0, n, n, e);
+    float *p = b ? read_fb(fb, 1, n, n, e) : NULL;
+    float *q = p ? read_fb(fb, 2, n, n, e) : NULL;
     if (!q) {
         free(b);
         free(p);
@@ -76,7 +91,7 @@ int lr_renderer_debug_read_map(lr_renderer *r, int k, float *B, float *pos, floa
     copy3(B, b, cnt);
     if (B)
         for (size_t i = 0; i < 3 * cnt; i++)
-            B[i] /= r->rad.scale;
+            B[i] /= r->rad.scale[l];
     copy3(pos, p, cnt);
     copy3(nrm, q, cnt);
     if (object)
@@ -132,26 +147,34 @@ int lr_renderer_debug_read_vpls(lr_renderer *r, lr_debug_vpl *out, lr_err *e)
 
 void lr_renderer_debug_gbuffer_info(const lr_renderer *r, lr_debug_gbuffer_info *out)
 {
+    lr_renderer_debug_light_gbuffer_info(r, 0, out);
+}
+
+void lr_renderer_debug_light_gbuffer_info(const lr_renderer *r, int l, lr_debug_gbuffer_info *out)
+{
     memset(out, 0, sizeof *out);
-    out->cube = r->gb.mode == LR_GB_CUBE;
-    out->orthographic = r->gb.mode == LR_GB_ORTHO;
-    out->size = r->gb.size;
+    if (l < 0 || l >= r->n_lights)
+        return;
+    const struct lr_light_gbuffer *g = &r->gb[l];
+    out->cube = g->mode == LR_GB_CUBE;
+    out->orthographic = g->mode == LR_GB_ORTHO;
+    out->size = g->size;
     if (out->cube)
-        memcpy(out->vp, r->gb.face_vp, sizeof out->vp);
+        memcpy(out->vp, g->face_vp, sizeof out->vp);
     else
-        memcpy(out->vp[0], r->gb.vp_d, sizeof out->vp[0]);
-    out->light_pos = r->gb.pos;
-    out->light_dir = r->gb.dir;
+        memcpy(out->vp[0], g->vp_d, sizeof out->vp[0]);
+    out->light_pos = g->pos;
+    out->light_dir = g->dir;
 }
 
 int lr_renderer_debug_read_gbuffer(lr_renderer *r, int face, float *pos, float *nrm, int *object,
                                    lr_err *e)
 {
-    bool cube = r->gb.mode == LR_GB_CUBE;
+    bool cube = r->gb[0].mode == LR_GB_CUBE;
     if (face < 0 || face >= (cube ? 6 : 1))
         return lr_err_set(e, LR_EINVAL, "debug: G-buffer face %d", face);
-    lr_fb *fb = cube ? r->gb.fb[face] : r->gb.fb_2d;
-    int n = r->gb.size;
+    lr_fb *fb = cube ? r->gb[0].fb[face] : r->gb[0].fb_2d;
+    int n = r->gb[0].size;
     size_t cnt = (size_t)n * n;
     float *p = read_fb(fb, 0, n, n, e);
     float *q = p ? read_fb(fb, 1, n, n, e) : NULL;

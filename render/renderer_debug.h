@@ -39,10 +39,16 @@ void lr_renderer_debug_map_matrix(const lr_renderer *r, int k, double out[16]);
  * object index, -1 where the map sees no surface (covered == false). */
 int lr_renderer_debug_read_map(lr_renderer *r, int k, float *B, float *pos, float *nrm, int *object,
                                lr_err *e);
+/* The same for light l's map k (each light has its own K maps of B for unit intensity; x_o,
+ * n_o and coverage are shared). lr_renderer_debug_read_map reads light 0's. */
+int lr_renderer_debug_read_light_map(lr_renderer *r, int l, int k, float *B, float *pos,
+                                     float *nrm, int *object, lr_err *e);
 
-/* The cavity gain per band composition applies to object `object`'s emission (PIPELINE.md
- * "Energy"; 1 for objects that do not enclose lights[0]). */
+/* The cavity gain per band composition applies to object `object`'s emission for light 0
+ * (PIPELINE.md "Energy"; 1 for objects that do not enclose the light); the second form for
+ * light l (each light has its own: the gain depends on where the light sits). */
 void lr_renderer_debug_cavity_gain(const lr_renderer *r, int object, double out[3]);
+void lr_renderer_debug_light_cavity_gain(const lr_renderer *r, int l, int object, double out[3]);
 
 /* ---- virtual point lights (pass 4) -------------------------------------------------------- */
 
@@ -51,7 +57,7 @@ typedef struct lr_debug_vpl {
     lr_vec3 u;       /* fixed direction from the bounding-box centre, lr_halton_sphere(v + 1) */
     lr_vec3 pos, nrm;
     double area;     /* A_v, mm^2 */
-    double B[3];     /* B(x_v) from Algorithm 1, unit intensity */
+    double B[3];     /* B(x_v) from Algorithm 1, unit intensity of light 0 */
     double weight;   /* Algorithm 1's visibility weight n (0: fallback map) */
     int object;
 } lr_debug_vpl;
@@ -73,8 +79,10 @@ typedef struct lr_debug_gbuffer_info {
     lr_vec3 light_pos, light_dir;
 } lr_debug_gbuffer_info;
 
+/* Of light 0's G-buffer; the second form of light l's (zeroed for a light that does not exist). */
 void lr_renderer_debug_gbuffer_info(const lr_renderer *r, lr_debug_gbuffer_info *out);
-/* Face `face` (0..5 = +X..-Z; 0 for a 2D map): pos and nrm 3 floats per texel, object the
+void lr_renderer_debug_light_gbuffer_info(const lr_renderer *r, int l, lr_debug_gbuffer_info *out);
+/* Light 0's face `face` (0..5 = +X..-Z; 0 for a 2D map): pos and nrm 3 floats per texel, object the
  * object index or -1 for an empty texel. Any output may be NULL. */
 int lr_renderer_debug_read_gbuffer(lr_renderer *r, int face, float *pos, float *nrm, int *object,
                                    lr_err *e);

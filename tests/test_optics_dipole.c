@@ -8,10 +8,13 @@
 #include <stdint.h>
 
 #include <cmocka.h>
+
+#include "tests/support/near.h"
 #include <math.h>
 #include <string.h>
 
 #include "render/optics/optics.h"
+#include "tests/support/near.h"
 #include "tests/support/quadrature.h"
 
 /* Jensen et al. 2001, Table: marble. */
@@ -61,16 +64,16 @@ static void test_coeffs_marble(void **state)
      * sigma_tr = sqrt(sigma_a / D) agree; z_v = z_r + 4 A D; mfp = 3 D; g = 0 gives
      * sigma_t = sigma_t'. */
     for (int j = 0; j < 3; j++) {
-        assert_true(fabs(c.sigma_tr[j] / sqrt(marble.sigma_a[j] / c.D[j]) - 1.0) <= 1e-15);
-        assert_true(fabs(c.z_v[j] / (c.z_r[j] + 4.0 * c.A * c.D[j]) - 1.0) <= 1e-15);
-        assert_true(fabs(c.mfp[j] / (3.0 * c.D[j]) - 1.0) <= 1e-15);
+        assert_near_rel(c.sigma_tr[j], sqrt(marble.sigma_a[j] / c.D[j]), 1e-15);
+        assert_near_rel(c.z_v[j], (c.z_r[j] + 4.0 * c.A * c.D[j]), 1e-15);
+        assert_near_rel(c.mfp[j], (3.0 * c.D[j]), 1e-15);
         assert_true(c.sigma_t[j] == c.sigma_t_prime[j]);
     }
     /* g = 0.9: sigma_t = sigma_a + sigma_s' / 0.1, the reduced quantities unchanged. */
     lr_medium m = marble;
     m.g = 0.9;
     lr_coeffs cg = derive(&m);
-    assert_true(fabs(cg.sigma_t[0] - (0.0021 + 21.9)) <= 1e-12);
+    assert_near(cg.sigma_t[0], (0.0021 + 21.9), 1e-12);
     assert_true(cg.sigma_tr[0] == c.sigma_tr[0] && cg.de[0] == c.de[0]);
 }
 
@@ -192,10 +195,10 @@ static void test_rd_r_zero(void **state)
                         ((tr * zr + 1.0) * exp(-tr * zr) / (zr * zr) +
                          (tr * zv + 1.0) * exp(-tr * zv) / (zv * zv));
         assert_true(isfinite(at0[j]));
-        assert_true(fabs(at0[j] / expect - 1.0) <= 1e-14);
+        assert_near_rel(at0[j], expect, 1e-14);
     }
     lr_dipole_rd(&c, 1e-6 * c.z_r[0], near);
-    assert_true(fabs(near[0] / at0[0] - 1.0) <= 1e-11);
+    assert_near_rel(near[0], at0[0], 1e-11);
 }
 
 /* ---- Total diffuse reflectance ------------------------------------------------------------ */
@@ -261,7 +264,7 @@ static void test_rd_albedo_one(void **state)
     double total[3];
     assert_true(c.sigma_tr[0] == 0.0);
     lr_dipole_rd_total(&c, total);
-    assert_true(fabs(total[0] - 1.0) <= 1e-15);
+    assert_near(total[0], 1.0, 1e-15);
     const double sas[] = {1e-12, 1e-9, 1e-6};
     for (int k = 0; k < 3; k++) {
         m = uniform_medium(sas[k], 2.0, 1.5);
@@ -269,7 +272,7 @@ static void test_rd_albedo_one(void **state)
         lr_dipole_rd_total(&c, total);
         double s = sqrt(3.0 * sas[k] / 2.0), kk = 1.0 + 4.0 * c.A / 3.0;
         double first = 1.0 - 0.5 * (1.0 + kk) * s;
-        assert_true(fabs(total[0] - first) <= (1.0 + kk * kk) / 4.0 * s * s + 1e-15);
+        assert_near(total[0], first, (1.0 + kk * kk) / 4.0 * s * s + 1e-15);
         assert_true(total[0] < 1.0);
     }
 }
@@ -294,7 +297,7 @@ static void test_rd_albedo_zero(void **state)
     c = derive(&m);
     lr_dipole_rd_total(&c, total);
     double limit = 0.5 * (1.0 + exp(-(4.0 / 3.0) * c.A * sqrt(3.0))) * exp(-sqrt(3.0));
-    assert_true(fabs(total[0] / c.albedo_prime[0] / limit - 1.0) <= 1e-8);
+    assert_near_rel(total[0] / c.albedo_prime[0], limit, 1e-8);
 }
 
 /* Long-double evaluation of the closed form for R_d total. Here 1 - alpha' is formed in long
@@ -327,7 +330,7 @@ static void test_rd_total_range_and_scale(void **state)
             lr_dipole_rd_total(&c, total);
             double ref = (double)rd_total_ref(v[a], v[s], 1.5);
             assert_true(isfinite(total[0]));
-            assert_true(fabs(total[0] - ref) <= 1e-12 * ref + 1e-300);
+            assert_near(total[0], ref, 1e-12 * ref + 1e-300);
         }
     lr_coeffs c_mm = derive(&marble);
     lr_medium m_m = marble;
@@ -342,8 +345,8 @@ static void test_rd_total_range_and_scale(void **state)
     lr_dipole_rd(&c_mm, 1.7, rd_mm);
     lr_dipole_rd(&c_m, 1.7e-3, rd_m);
     for (int j = 0; j < 3; j++) {
-        assert_true(fabs(t_m[j] / t_mm[j] - 1.0) <= 1e-14);
-        assert_true(fabs(rd_m[j] / (rd_mm[j] * 1e6) - 1.0) <= 1e-14);
+        assert_near_rel(t_m[j], t_mm[j], 1e-14);
+        assert_near_rel(rd_m[j], (rd_mm[j] * 1e6), 1e-14);
     }
 }
 
@@ -356,13 +359,51 @@ static void test_eta_one_and_below(void **state)
     (void)state;
     lr_medium m = uniform_medium(0.01, 1.0, 1.0);
     lr_coeffs c = derive(&m);
-    assert_true(fabs(c.A - 1.0) <= 3.3e-3);
+    assert_near(c.A, 1.0, 3.3e-3);
     m.eta = 0.8;
     c = derive(&m);
     assert_true(c.A > 1.0 && c.A < 1.12);
     double out[3];
     lr_dipole_rd(&c, 0.5, out);
     assert_true(isfinite(out[0]) && out[0] > 0.0);
+}
+
+/* The standard dipole as S_d (Jensen 2001 Eq. 5 without the Fresnel factors): R_d(r) / pi at
+ * r = |x_o - x_i| whatever the normals; with F_t(w_i) it is that times 1 - R(cos_i) and 0 for
+ * light from behind; the model switch picks it or the directional dipole exactly (the same
+ * function calls, so equality is exact). */
+static void test_standard_dipole_sd_and_switch(void **state)
+{
+    (void)state;
+    lr_coeffs c = derive(&(lr_medium){{0.0021, 0.0041, 0.0071}, {2.19, 2.62, 3.00}, 1.5, 0.0});
+    lr_vec3 xi = lr_v3(1, 2, 3), ni = lr_v3(0, 0, 1), wi = lr_v3_normalize(lr_v3(0.3, 0, 1));
+    lr_vec3 xo = lr_v3(1 + 0.6, 2 - 0.8, 3), no = lr_v3_normalize(lr_v3(1, 0, 1)); /* r = 1 */
+    double rd[3], sd[3], sdf[3], sw[3], dp[3];
+    lr_dipole_rd(&c, 1.0, rd);
+    lr_dipole_sd(&c, xi, xo, sd);
+    double ft = lr_fresnel_transmittance(lr_v3_dot(wi, ni), 1.5);
+    lr_dipole_sd_fresnel(&c, xi, ni, wi, xo, sdf);
+    for (int j = 0; j < 3; j++) {
+        assert_true(rd[j] > 0.0);
+        assert_near_rel(sd[j], rd[j] / M_PI, 1e-12);
+        assert_near_rel(sdf[j], ft * rd[j] / M_PI, 1e-12);
+    }
+    lr_dipole_sd_fresnel(&c, xi, ni, lr_v3_scale(wi, -1.0), xo, sdf);
+    for (int j = 0; j < 3; j++)
+        assert_true(sdf[j] == 0.0);
+    lr_sss_sd_fresnel(LR_SSS_STANDARD_DIPOLE, &c, xi, ni, wi, xo, no, sw);
+    lr_dipole_sd_fresnel(&c, xi, ni, wi, xo, sdf);
+    for (int j = 0; j < 3; j++)
+        assert_true(sw[j] == sdf[j]);
+    lr_sss_sd_fresnel(LR_SSS_DIRECTIONAL_DIPOLE, &c, xi, ni, wi, xo, no, sw);
+    lr_dirpole_sd_fresnel(&c, xi, ni, wi, xo, no, dp);
+    for (int j = 0; j < 3; j++)
+        assert_true(sw[j] == dp[j] && sw[j] != sdf[j]);
+    enum lr_sss_model m;
+    assert_true(lr_sss_model_parse("standard_dipole", &m) && m == LR_SSS_STANDARD_DIPOLE);
+    assert_true(lr_sss_model_parse("directional_dipole", &m) && m == LR_SSS_DIRECTIONAL_DIPOLE);
+    assert_false(lr_sss_model_parse("dipole", &m) || lr_sss_model_parse(NULL, &m));
+    assert_string_equal(lr_sss_model_name(LR_SSS_STANDARD_DIPOLE), "standard_dipole");
 }
 
 int main(void)
@@ -377,6 +418,7 @@ int main(void)
         cmocka_unit_test(test_rd_albedo_zero),
         cmocka_unit_test(test_rd_total_range_and_scale),
         cmocka_unit_test(test_eta_one_and_below),
+        cmocka_unit_test(test_standard_dipole_sd_and_switch),
     };
     return cmocka_run_group_tests_name("optics_dipole", tests, NULL, NULL);
 }

@@ -9,6 +9,8 @@
 #include <stdint.h>
 
 #include <cmocka.h>
+
+#include "tests/support/near.h"
 #include <math.h>
 #include <string.h>
 
@@ -379,7 +381,7 @@ static void test_r_to_zero(void **state)
     sd_of(&c, O, Z, Z, lr_v3(1e-7, 0.0, 0.0), Z, b);
     for (int j = 0; j < 3; j++) {
         assert_true(isfinite(a[j]) && a[j] > 0.0);
-        assert_true(fabs(b[j] / a[j] - 1.0) <= 1e-5);
+        assert_near_rel(b[j], a[j], 1e-5);
     }
 }
 
@@ -407,7 +409,7 @@ static void test_albedo_limits(void **state)
     sd_of(&c1, O, Z, wi, xo, Z, b);
     for (int j = 0; j < 3; j++) {
         assert_true(isfinite(a[j]) && a[j] > 0.0);
-        assert_true(fabs(b[j] / a[j] - 1.0) <= 1e-6);
+        assert_near_rel(b[j], a[j], 1e-6);
     }
     lr_medium n0 = {{0.5, 1.0, 2.0}, {0.0, 0.0, 0.0}, 1.5, 0.0}, n1 = n0;
     for (int j = 0; j < 3; j++)
@@ -419,7 +421,7 @@ static void test_albedo_limits(void **state)
     sd_of(&c1, O, Z, wi, xo, Z, b);
     for (int j = 0; j < 3; j++) {
         assert_true(isfinite(a[j]) && a[j] > 0.0);
-        assert_true(fabs(b[j] / a[j] - 1.0) <= 1e-9);
+        assert_near_rel(b[j], a[j], 1e-9);
     }
     /* de = Inf at r = 0, straight through a slab and with the mu0 <= 0 branch: finite too. */
     sd_of(&c0, O, Z, wi, O, Z, a);
@@ -457,7 +459,7 @@ static void test_eta_one_and_tir(void **state)
     lr_dirpole_sd(&c, O, Z, w2, xo, Z, b);
     for (int j = 0; j < 3; j++) {
         assert_true(isfinite(a[j]) && a[j] >= 0.0);
-        assert_true(fabs(a[j] - b[j]) <= 1e-12 * (a[j] + b[j]) + 1e-300);
+        assert_near(a[j], b[j], 1e-12 * (a[j] + b[j]) + 1e-300);
     }
     /* Downstream of the (nearly tangential) refracted ray; upstream, at xo, the model's virtual
      * source outweighs the real one in the red band and S_d clamps to 0, as the reference does. */
@@ -483,7 +485,7 @@ static void test_grazing_and_behind(void **state)
     assert_true(ft > 0.0 && ft < 1e-8);
     for (int j = 0; j < 3; j++) {
         assert_true(isfinite(a[j]) && a[j] > 0.0);
-        assert_true(fabs(b[j] - a[j] * ft) <= 1e-15 * a[j] * ft);
+        assert_near(b[j], a[j] * ft, 1e-15 * a[j] * ft);
     }
     lr_dirpole_sd_fresnel(&c, O, Z, lr_v3_normalize(lr_v3(0.3, 0.0, -0.95)), xo, Z, b);
     for (int j = 0; j < 3; j++)
@@ -582,8 +584,8 @@ static void test_checked(void **state)
                                            lr_v3_scale(Z, 0.01), 0, b, &e), LR_OK);
     assert_int_equal(lr_dirpole_sd_checked(&c, O, Z, wi, xo, Z, 1, g, &e), LR_OK);
     for (int j = 0; j < 3; j++) {
-        assert_true(fabs(a[j] - b[j]) <= 1e-14 * a[j]);
-        assert_true(fabs(f[j] - g[j]) <= 1e-14 * f[j]);
+        assert_near(a[j], b[j], 1e-14 * a[j]);
+        assert_near(f[j], g[j], 1e-14 * f[j]);
     }
 }
 

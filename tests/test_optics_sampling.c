@@ -7,6 +7,8 @@
 #include <stdint.h>
 
 #include <cmocka.h>
+
+#include "tests/support/near.h"
 #include <limits.h>
 #include <math.h>
 #include <string.h>
@@ -124,7 +126,7 @@ static void test_density_and_inverse(void **state)
             double xi = (i + 0.5) / 10.0;
             double r = lr_exp_radius_sample(c->sigma_tr, c->r_max, xi);
             assert_true(r >= 0.0 && r <= c->r_max);
-            assert_true(fabs(pdf_mass(c, 0.0, r) - xi) <= 1e-10);
+            assert_near(pdf_mass(c, 0.0, r), xi, 1e-10);
         }
     }
 }
@@ -138,10 +140,10 @@ static void test_closed_forms_and_ends(void **state)
     (void)state;
     for (int i = 0; i <= 20; i++) {
         double r = 0.25 * i;
-        assert_true(fabs(lr_exp_radius_pdf(1.3, INFINITY, r) / (1.3 * exp(-1.3 * r)) - 1.0) <= 1e-15);
+        assert_near_rel(lr_exp_radius_pdf(1.3, INFINITY, r), (1.3 * exp(-1.3 * r)), 1e-15);
         long double ref = 2.0L * expl(-2.0L * r) / -expm1l(-2.0L * 4.0L);
         if (r <= 4.0)
-            assert_true(fabs(lr_exp_radius_pdf(2.0, 4.0, r) / (double)ref - 1.0) <= 1e-15);
+            assert_near_rel(lr_exp_radius_pdf(2.0, 4.0, r), (double)ref, 1e-15);
     }
     double last = nextafter(1.0, 0.0);
     assert_true(lr_exp_radius_sample(2.0, 1.5, 0.0) == 0.0);
@@ -168,10 +170,10 @@ static void test_sigma_tr_to_zero(void **state)
     for (int i = 0; i <= 10; i++) {
         double rr = i;
         double expect = 0.1 * (1.0 + 1e-10 * (5.0 - rr));
-        assert_true(fabs(lr_exp_radius_pdf(1e-10, 10.0, rr) / expect - 1.0) <= 1e-15);
+        assert_near_rel(lr_exp_radius_pdf(1e-10, 10.0, rr), expect, 1e-15);
         /* inverse: r(xi) = xi r_max + O(sigma_tr r_max^2) */
         double xi = i / 10.0;
-        assert_true(fabs(lr_exp_radius_sample(1e-10, 10.0, xi * (1.0 - 1e-16)) - 10.0 * xi) <= 1e-8);
+        assert_near(lr_exp_radius_sample(1e-10, 10.0, xi * (1.0 - 1e-16)), 10.0 * xi, 1e-8);
     }
 }
 
@@ -241,7 +243,7 @@ static void test_halton(void **state)
     const double b3[] = {0.0, 1.0 / 3, 2.0 / 3, 1.0 / 9, 4.0 / 9, 7.0 / 9};
     for (unsigned i = 0; i < 6; i++) {
         assert_true(lr_halton(i, 2) == b2[i]);
-        assert_true(fabs(lr_halton(i, 3) - b3[i]) <= 2e-16);
+        assert_near(lr_halton(i, 3), b3[i], 2e-16);
     }
     assert_true(lr_halton(1, 5) == 0.2);
     assert_true(lr_halton(UINT_MAX, 2) == 1.0 - 0x1.0p-32);
@@ -261,7 +263,7 @@ static void test_halton_sphere(void **state)
     double mx = 0.0, my = 0.0, mz = 0.0;
     for (unsigned i = 0; i < 4096; i++) {
         lr_vec3 d = lr_halton_sphere(i);
-        assert_true(fabs(lr_v3_len(d) - 1.0) <= 1e-15);
+        assert_near(lr_v3_len(d), 1.0, 1e-15);
         mx += d.x;
         my += d.y;
         mz += d.z;
@@ -269,7 +271,7 @@ static void test_halton_sphere(void **state)
     mx /= 4096.0;
     my /= 4096.0;
     mz /= 4096.0;
-    assert_true(fabs(mz - 1.0 / 4096.0) <= 1e-13);
+    assert_near(mz, 1.0 / 4096.0, 1e-13);
     assert_true(fabs(mx) < 0.02 && fabs(my) < 0.02);
 }
 

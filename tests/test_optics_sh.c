@@ -7,6 +7,8 @@
 #include <stdint.h>
 
 #include <cmocka.h>
+
+#include "tests/support/near.h"
 #include <math.h>
 
 #include "render/optics/optics.h"
@@ -54,7 +56,7 @@ static void test_published_constants(void **state)
                               0.315392 * (3.0 * z * z - 1.0), 1.092548 * x * z,
                               0.546274 * (x * x - yy * yy)};
     for (int i = 0; i < 9; i++)
-        assert_true(fabs(y[i] - expect[i]) <= 5e-7);
+        assert_near(y[i], expect[i], 5e-7);
 }
 
 static uint64_t splitmix64(uint64_t *s)
@@ -116,7 +118,7 @@ static void test_irradiance_vs_quadrature(void **state)
     }
     double uniform[9] = {2.0 * sqrt(M_PI)}; /* L(w) = L_00 Y_00 = 1 everywhere */
     double e = lr_sh9_irradiance(uniform, lr_v3(0.6, 0.0, 0.8));
-    assert_true(fabs(e - M_PI) <= 1e-15);
+    assert_near(e, M_PI, 1e-15);
 }
 
 /* Seed 002 Eq. 10-11 (after Ramamoorthi & Hanrahan 2001): E(n) = n^T M n with n = (x, y, z, 1)
@@ -145,7 +147,7 @@ static void test_irradiance_matrix_form(void **state)
         for (int i = 0; i < 4; i++)
             for (int j = 0; j < 4; j++)
                 e += v[i] * M[i][j] * v[j];
-        assert_true(fabs(lr_sh9_irradiance(L, n) - e) <= 1e-6 * norm1);
+        assert_near(lr_sh9_irradiance(L, n), e, 1e-6 * norm1);
     }
 }
 

@@ -82,9 +82,21 @@ static void test_render_writes_images_and_stats(void **state)
     assert_non_null(strstr(js, "\"width\":32,\"height\":24,\"uncovered_pixels\":"));
     assert_non_null(strstr(js, "{\"index\":0,\"passes\":[\"gbuffer\",\"radiosity\",\"vpl\",\"compose\"]"));
     assert_non_null(strstr(js, "{\"index\":1,\"passes\":[\"radiosity\",\"vpl\",\"compose\"]"));
-    /* The event before frame 2: composition alone. Frame 3: nothing left to do. */
+    /* The event before frame 2: composition alone. Frame 3: converged, but the flame
+     * flickers on the renderer's clock (frame i at i / 30 s): composition alone again. */
     assert_non_null(strstr(js, "{\"index\":2,\"passes\":[\"compose\"],\"ms\":{\"compose\":"));
+    assert_non_null(strstr(js, "{\"index\":3,\"passes\":[\"compose\"],\"ms\":{\"compose\":"));
+    assert_non_null(strstr(js, "\"samples\":2,\"converged\":true,\"time_s\":0.1}"));
+    free(js);
+    /* A steady flame (flicker.amplitude 0) at 10 fps: frame 3 has nothing left to do. */
+    st = run("./build/bin/lamprig render --scene configs/scenes/candle.json " SMALL
+             " --frames 4 --fps 10 --set lights[0].flicker.amplitude=0 --events %s --stats %s/s.json",
+             ev, dir);
+    if (st != 0)
+        fail_msg("exit %d (steady flame)", st);
+    js = slurp("s.json");
     assert_non_null(strstr(js, "{\"index\":3,\"passes\":[],\"ms\":{},\"total_ms\":0.0000,\"samples\":2"));
+    assert_non_null(strstr(js, "\"time_s\":0.3}"));
     free(js);
     char path[512];
     lr_image img = {0};
@@ -126,6 +138,7 @@ static void test_bad_arguments(void **state)
     expect_usage("--scene configs/scenes/candle.json --frames 0", "--frames");
     expect_usage("--scene configs/scenes/candle.json --width x", "--width");
     expect_usage("--scene configs/scenes/candle.json --bogus 1", "--bogus");
+    expect_usage("--scene configs/scenes/candle.json --fps 0", "--fps");
     expect_usage("--scene configs/scenes/candle.json --set light.intensity", "key=value");
     expect_usage("--scene configs/scenes/candle.json --set light.intensity=-1", "light.intensity");
     char ev[512];

@@ -91,9 +91,9 @@ static lr_vec3 snap(void *p, lr_vec3 v)
     return g->info.orthographic ? c : lr_v3_sub(c, g->info.light_pos);
 }
 
-static void snap_init(lr_renderer *r, snap_ctx *g)
+static void snap_init(lr_renderer *r, int light, snap_ctx *g)
 {
-    lr_renderer_debug_gbuffer_info(r, &g->info);
+    lr_renderer_debug_light_gbuffer_info(r, light, &g->info);
     for (int f = 0; f < (g->info.cube ? 6 : 1); f++)
         assert_int_equal(lr_mat4_inverse(g->info.vp[f], g->inv[f]), 0);
 }
@@ -106,10 +106,13 @@ typedef struct parity {
     long nf, over3f, over4f;
 } parity;
 
-static void compare_maps(lr_renderer *r, lr_scene *s, int n_cpu, bool emulate, parity *out)
+/* Light `light`'s maps (each light has its own, for unit intensity). */
+static void compare_light_maps(lr_renderer *r, lr_scene *s, int light, int n_cpu, bool emulate,
+                               parity *out)
 {
     snap_ctx g;
-    snap_init(r, &g);
+    snap_init(r, light, &g);
+    const lr_light *L = lr_scene_light_at(s, light);
     lr_debug_map_info info;
     lr_renderer_debug_map_info(r, &info);
     size_t S = (size_t)info.size;
@@ -125,7 +128,7 @@ static void compare_maps(lr_renderer *r, lr_scene *s, int n_cpu, bool emulate, p
     double n_gpu = (double)info.N * info.frames;
     for (int k = 0; k < info.K; k++) {
         lr_err e = {0};
-        if (lr_renderer_debug_read_map(r, k, B, pos, nrm, obj, &e))
+        if (lr_renderer_debug_read_light_map(r, light, k, B, pos, nrm, obj, &e))
             fail_msg("%s", e.msg);
         for (size_t t = 0; t < S * S; t++) {
             if (obj[t] < 0)
@@ -136,7 +139,7 @@ static void compare_maps(lr_renderer *r, lr_scene *s, int n_cpu, bool emulate, p
                                        .n_others = nobj, .snap = emulate ? snap : NULL,
                                        .snap_ctx = &g};
             lr_cpu_estimate est;
-            lr_cpu_radiosity(objs[obj[t]], lr_scene_light_at(s, 0), xo, no, &d,
+            lr_cpu_radiosity(objs[obj[t]], L, xo, no, &d,
                              lr_cpu_key(4242, (uint64_t)k, t, 0), &est);
             for (int c = 0; c < 3; c++) {
                 double gv = B[3 * t + c], v = est.var[c] / n_gpu + est.var[c] / n_cpu;
@@ -148,7 +151,7 @@ static void compare_maps(lr_renderer *r, lr_scene *s, int n_cpu, bool emulate, p
                 double dz = fabs(gv - est.mean[c]);
                 if (getenv("LR_PARITY_DEBUG") && dz > 3.0 * sqrt(v) && out->over3 < 40)
                     print_message("k %d t %zu c %d: gpu %.4g cpu %.4g sd %.3g (cpu sd1 %.3g) n.h %.3f\n", k, t, c, gv, est.mean[c], sqrt(v), sqrt(est.var[c]),
-                        lr_v3_dot(no, lr_v3_normalize(lr_v3_sub(lr_scene_light_at(s, 0)->position, xo))));
+                        lr_v3_dot(no, lr_v3_normalize(lr_v3_sub(L->position, xo))));
                 bool o3, o4;
                 if (v > 0.0) {
                     o3 = dz > 3.0 * sqrt(v);
@@ -158,7 +161,7 @@ static void compare_maps(lr_renderer *r, lr_scene *s, int n_cpu, bool emulate, p
                 }
                 out->over3 += o3;
                 out->over4 += o4;
-                lr_vec3 hl = lr_v3_normalize(lr_v3_sub(lr_scene_light_at(s, 0)->position, xo));
+                lr_vec3 hl = lr_v3_normalize(lr_v3_sub(L->position, xo));
                 if (lr_v3_dot(no, hl) > 0.2) {
                     out->nf++;
                     out->over3f += o3;
@@ -171,6 +174,11 @@ static void compare_maps(lr_renderer *r, lr_scene *s, int n_cpu, bool emulate, p
     free(pos);
     free(nrm);
     free(obj);
+}
+
+static void compare_maps(lr_renderer *r, lr_scene *s, int n_cpu, bool emulate, parity *out)
+{
+    compare_light_maps(r, s, 0, n_cpu, emulate, out);
 }
 
 static void report(const char *what, const parity *p)
@@ -195,12 +203,17 @@ static void report(const char *what, const parity *p)
  * CPU's exact rays, i.e. the model itself) 75 % of the lampshade's lit texel-bands are beyond
  * 4 sigma: the 256^2 G-buffer's quantisation of x_i is a real per-texel error of the GPU at
  * porcelain's scale (seed 003 Sec. 5's 'pearling'), though it averages out (+0.3 %). */
-static void check_parity(const parity *p)
+static void check_parity_at(const parity *p, double over4)
 {
     assert_true(p->nf > 100);
     assert_near(p->sum_gpu, p->sum_cpu, 4.0 * sqrt(p->var_sum));
     assert_true(p->over3f <= 0.02 * p->nf);
-    assert_true(p->over4f <= 0.005 * p->nf);
+    assert_true(p->over4f <= over4 * p->nf);
+}
+
+static void check_parity(const parity *p)
+{
+    check_parity_at(p, 0.005);
 }
 
 static const char *const parity_settings[] = {
@@ -237,6 +250,54 @@ static void test_maps_sphere_outside_light(void **state)
     check_parity(&p);
     compare_maps(r, s, 256, false, &p);
     report("sphere maps (light outside, exact rays)", &p);
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+}
+
+/* The model switch: the same sphere with the standard dipole (objects[ball].model), GPU maps
+ * against the twin evaluating lr_dipole_sd; same assertions as above. The switch must also
+ * reach the GPU: with the directional dipole the maps' sum differs by far more than its
+ * aggregate sigma (measured in the report line: standard / normalised directional 0.89; 0.72
+ * against the raw directional dipole, whose S_d is 1 / 0.81 of the normalised one for marble). */
+static void test_maps_standard_dipole(void **state)
+{
+    (void)state;
+    static const char *const ball[] = {"objects[ball].material=marble", "light.position=0,0,120",
+                                       "objects[ball].model=standard_dipole", NULL};
+    lr_scene *s = lr_test_scene("sphere", parity_settings, ball);
+    lr_renderer *r = lr_test_renderer(gl, s, 16, 12, true, 3);
+    lr_test_converge(r, 20);
+    parity p;
+    compare_maps(r, s, 256, true, &p);
+    report("sphere maps, standard dipole (G-buffer emulated)", &p);
+    check_parity(&p);
+    /* The energy normalisation (PIPELINE.md "Energy") is the directional dipole's alone: the
+     * standard dipole is its reference (factor 1), so "normalize": false re-runs the maps
+     * with the same seeds and the same S_d, bit for bit. */
+    unsigned dirty = 0;
+    lr_err e = {0};
+    if (lr_scene_set(s, "objects[ball].normalize", "false", &dirty, &e))
+        fail_msg("%s", e.msg);
+    lr_renderer_invalidate(r, dirty);
+    lr_test_converge(r, 20);
+    parity raw;
+    compare_maps(r, s, 256, true, &raw);
+    assert_true(raw.sum_gpu == p.sum_gpu && raw.sum_cpu == p.sum_cpu);
+    if (lr_scene_set(s, "objects[ball].normalize", "true", &dirty, &e))
+        fail_msg("%s", e.msg);
+    lr_renderer_invalidate(r, dirty);
+    /* Back to the directional dipole: a material-class change (maps re-run). */
+    if (lr_scene_set(s, "objects[ball].model", "directional_dipole", &dirty, &e))
+        fail_msg("%s", e.msg);
+    assert_int_equal(dirty, LR_DIRTY_MATERIAL);
+    lr_renderer_invalidate(r, dirty);
+    lr_test_converge(r, 20);
+    parity q;
+    compare_maps(r, s, 256, true, &q);
+    report("sphere maps, directional dipole again", &q);
+    check_parity(&q);
+    print_message("standard / directional dipole map sum: %.4f\n", p.sum_gpu / q.sum_gpu);
+    assert_true(fabs(p.sum_gpu - q.sum_gpu) > 10.0 * (sqrt(p.var_sum) + sqrt(q.var_sum)));
     lr_renderer_destroy(r);
     lr_scene_destroy(s);
 }
@@ -326,11 +387,12 @@ static void test_vpls(void **state)
  * over few maps at positions that differ by up to 0.6 cube texels, several VPLs fall back to
  * the nearest texel of one map, and most sit on the candle's side, facing away from the flame,
  * where the texels are heavy-tailed -- so the twin's variance image understates it. */
-static void final_image(bool no_vpl)
+/* recv_direct_tol: relative tolerance on the receivers without VPLs (direct light only). */
+static void final_image_of(const char *scene, bool no_vpl, double recv_direct_tol)
 {
     const int W = 32, H = 24;
     static const char *const more_maps[] = {"render.K=8", NULL};
-    lr_scene *s = lr_test_scene("candle", parity_settings, more_maps);
+    lr_scene *s = lr_test_scene(scene, parity_settings, more_maps);
     lr_renderer *r = lr_test_renderer(gl, s, W, H, no_vpl, 3);
     lr_test_converge(r, 20);
     float *hdr = lr_test_hdr(r); /* rows bottom up */
@@ -360,14 +422,15 @@ static void final_image(bool no_vpl)
         }
     const char *names[2] = {"object", "receivers"};
     for (int i = 0; i < 2; i++) {
-        print_message("final image%s, %s pixels: GPU %.5g, CPU twin %.5g (%+.2f %%, sigma %.2f %%)\n",
-                      no_vpl ? " (no VPL)" : "", names[i], sum_g[i], sum_c[i],
+        print_message("final image of %s%s, %s pixels: GPU %.5g, CPU twin %.5g (%+.2f %%, "
+                      "sigma %.2f %%)\n", scene, no_vpl ? " (no VPL)" : "", names[i], sum_g[i],
+                      sum_c[i],
                       100 * (sum_g[i] / sum_c[i] - 1),
                       100 * sqrt(v[i]) / sum_c[i]);
         if (i == 0)
             assert_near(sum_g[i], sum_c[i], 4.0 * sqrt(v[i]) + 0.05 * sum_c[i]);
         else
-            assert_near_rel(sum_g[i], sum_c[i], no_vpl ? 1e-3 : 0.20);
+            assert_near_rel(sum_g[i], sum_c[i], no_vpl ? recv_direct_tol : 0.20);
     }
     free(hdr);
     lr_image_free(&twin);
@@ -379,8 +442,41 @@ static void final_image(bool no_vpl)
 static void test_final_image(void **state)
 {
     (void)state;
-    final_image(true);
-    final_image(false);
+    final_image_of("candle", true, 1e-3);
+    final_image_of("candle", false, 1e-3);
+}
+
+/* Two lights (configs/scenes/candle_spot.json: the flame's cube G-buffer and a side spot's 2D
+ * one): each light's maps against the twin, with the assertions of the one-light cases, and
+ * the final image with the one-light case's tolerances (the twin sums the lights' transport;
+ * the GPU weights each light's maps, VPL row and direct light at composition). */
+static void test_two_lights(void **state)
+{
+    (void)state;
+    lr_scene *s = lr_test_scene("candle_spot", parity_settings, NULL);
+    lr_renderer *r = lr_test_renderer(gl, s, 16, 12, true, 3);
+    lr_test_converge(r, 20);
+    for (int l = 0; l < 2; l++) {
+        parity p;
+        compare_light_maps(r, s, l, 256, true, &p);
+        char what[160];
+        snprintf(what, sizeof what, "candle_spot maps of light %d (%s)", l,
+                 lr_scene_light_at(s, l)->name);
+        report(what, &p);
+        /* The side spot: 4 of 591 lit texel-bands beyond 4 sigma (0.68 %), all GPU-high by
+         * 40-110 % at z 4.0-4.5: the right tail of 128 GPU samples per texel that s^2 from
+         * 256 CPU samples understates (the aggregate agrees, -1.2 % at sigma 1.0 %). They are
+         * the spot's own: its maps are bit-identical to those of the spot alone (the seeds do
+         * not depend on the light's index; test_render_lights), so 1 % is allowed there. */
+        check_parity_at(&p, l == 1 ? 0.01 : 0.005);
+    }
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+    /* Direct light: the side spot's shadow edges come from its 2D G-buffer (256^2 over a
+     * 61 degree cone: ~1.2 mm texels at the candle) where the twin casts exact shadow rays;
+     * measured -0.13 % (the flame alone: 0.00 %), so 5e-3 here. */
+    final_image_of("candle_spot", true, 5e-3);
+    final_image_of("candle_spot", false, 5e-3);
 }
 
 int main(void)
@@ -390,8 +486,10 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_maps_lampshade),
         cmocka_unit_test(test_maps_sphere_outside_light),
+        cmocka_unit_test(test_maps_standard_dipole),
         cmocka_unit_test(test_vpls),
         cmocka_unit_test(test_final_image),
+        cmocka_unit_test(test_two_lights),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -26,6 +26,7 @@
 #include "render/gl/gl.h"
 #include "render/image/image.h"
 #include "render/scene/scene.h"
+#include "firmware/plan_scene.h"
 
 #define MAX_POLL 128
 #define FLUSH_MS 1000
@@ -39,6 +40,7 @@ typedef struct rigset {
     lr_modbus *lamp[LR_RIG_MAX_DEVICES]; /* modbus devices with a lamp driver */
     int n_devs, n_lamps;
     bool has_hid;
+    bool no_vpl; /* the planner found no receiver that sees any object */
 } rigset;
 
 struct lr_rig {
@@ -190,6 +192,48 @@ static int create_device(lr_rig *r, rigset *s, const lr_rig_device *d, lr_err *e
     return LR_OK;
 }
 
+/* The planner (firmware/plan_scene.h) for a scene with a quality budget (in the scene file
+ * or the config's scene_set), unless --no-plan: its settings are applied, then the config's
+ * scene_set once more so that an explicit render.* setting wins. A missing or unusable table
+ * is logged and the scene's settings stay. *no_vpl: the plan cuts the VPL pass. */
+static int plan_scene(lr_rig *r, const lr_rig_config *cfg, lr_scene *scene, bool *no_vpl,
+                      lr_err *e)
+{
+    *no_vpl = false;
+    if (r->opts.no_plan)
+        return LR_OK;
+    lr_plan_scene_result *res = calloc(1, sizeof *res);
+    if (!res)
+        return lr_err_set(e, LR_ENOMEM, "plan: out of memory");
+    lr_err pe = {0};
+    int rc = LR_OK;
+    if (lr_plan_scene(scene, r->opts.plan_table, res, &pe)) {
+        lr_log_write(&r->log, LR_LOG_WARN, "plan: %s; running with the scene's settings", pe.msg);
+    } else if (res->planned) {
+        char *text = lr_plan_scene_text(res);
+        for (char *line = text, *nl; line && *line; line = nl + 1) {
+            if ((nl = strchr(line, '\n')))
+                *nl = '\0';
+            lr_log_write(&r->log, LR_LOG_INFO, "%s", line);
+            if (!nl)
+                break;
+        }
+        free(text);
+        *no_vpl = !res->vpl;
+        rc = lr_rig_config_apply_sets(cfg, scene, e);
+        const lr_render_settings *now = lr_scene_render(scene), *p = &res->plan.settings;
+        if (!rc && (now->K != p->K || now->N != p->N || now->N_vpl != p->N_vpl ||
+                    now->map_size != p->map_size || now->gbuffer_size != p->gbuffer_size ||
+                    now->frames != p->frames))
+            lr_log_write(&r->log, LR_LOG_INFO,
+                         "plan: the config's scene_set overrides it: render K=%d N=%d N_vpl=%d "
+                         "map_size=%d gbuffer_size=%d frames=%d",
+                         now->K, now->N, now->N_vpl, now->map_size, now->gbuffer_size, now->frames);
+    }
+    free(res);
+    return rc;
+}
+
 /* Config, scene, control map, devices: all or nothing. */
 static int set_build(lr_rig *r, rigset *s, lr_err *e)
 {
@@ -209,6 +253,8 @@ static int set_build(lr_rig *r, rigset *s, lr_err *e)
     if (!rc)
         rc = lr_rig_config_apply_sets(s->cfg, s->scene, e);
     if (!rc)
+        rc = plan_scene(r, s->cfg, s->scene, &s->no_vpl, e);
+    if (!rc)
         rc = lr_control_map_create(s->cfg, s->scene, true, lr_now_ns(), &s->map, e);
     for (int i = 0; !rc && i < s->cfg->n_devices; i++)
         rc = create_device(r, s, &s->cfg->devices[i], e);
@@ -219,11 +265,12 @@ static int set_build(lr_rig *r, rigset *s, lr_err *e)
     return rc;
 }
 
-static int view_build(lr_rig *r, lr_scene *scene, lr_rig_view **out, lr_err *e)
+static int view_build(lr_rig *r, lr_scene *scene, bool no_vpl, lr_rig_view **out, lr_err *e)
 {
     const lr_rig_config *c = r->set.cfg;
     lr_rig_view_desc vd = {.name = c->output.renderer, .gl = r->gl, .scene = scene,
-                           .width = c->output.width, .height = c->output.height};
+                           .width = c->output.width, .height = c->output.height,
+                           .no_vpl = no_vpl};
     if (r->kms)
         lr_gl_size(r->gl, &vd.width, &vd.height);
     return lr_rig_view_create(&vd, out, e);
@@ -268,15 +315,17 @@ static void switch_scene(lr_rig *r, const char *path)
     lr_scene *scene = NULL;
     lr_err e = {0};
     lr_warn_sink warn = {scene_warn, r};
+    bool no_vpl = false;
     if (lr_scene_load(path, &warn, &scene, &e) ||
-        lr_rig_config_apply_sets(r->set.cfg, scene, &e)) {
+        lr_rig_config_apply_sets(r->set.cfg, scene, &e) ||
+        plan_scene(r, r->set.cfg, scene, &no_vpl, &e)) {
         lr_log_write(&r->log, LR_LOG_ERROR, "scene switch: %s; keeping %s", e.msg,
                      lr_scene_path(r->set.scene));
         lr_scene_destroy(scene);
         return;
     }
     lr_rig_view *view;
-    if (view_build(r, scene, &view, &e)) {
+    if (view_build(r, scene, no_vpl, &view, &e)) {
         lr_log_write(&r->log, LR_LOG_ERROR, "scene switch: %s", e.msg);
         lr_scene_destroy(scene);
         return;
@@ -360,10 +409,30 @@ static void frame(lr_rig *r, int64_t now)
     r->next_frame_ns = now + r->frame_interval_ns;
 }
 
+/* Whether something is due, without moving the clock. */
+static bool frame_due(const lr_rig *r)
+{
+    return lr_rig_view_needs_frame(r->view) || r->fading;
+}
+
+/* A running fade does not by itself want a frame: its first step often leaves the level
+ * where it was (nothing dirty), and rendering that would only push the frame that shows the
+ * change one frame interval later. The loop wakes for the fade instead (fade_wake). */
 static bool frame_wanted(lr_rig *r, int64_t now)
 {
-    (void)now;
-    return lr_rig_view_needs_frame(r->view) || r->fading;
+    /* The renderer's clock is the rig's wall clock: a flickering flame wants a frame (a
+     * composition only) at every frame interval. */
+    lr_rig_view_set_time(r->view, (double)(now - r->start_ns) * 1e-9);
+    return lr_rig_view_needs_frame(r->view);
+}
+
+/* When to apply a running fade again: at the next frame slot, but at least FADE_TICK_NS
+ * from now so an unchanged level (a fade clamped at a limit) cannot spin the loop. */
+#define FADE_TICK_NS 4000000LL
+static int64_t fade_wake(const lr_rig *r, int64_t now)
+{
+    int64_t t = now + FADE_TICK_NS;
+    return r->next_frame_ns > t ? r->next_frame_ns : t;
 }
 
 static void write_stats(lr_rig *r, int64_t now)
@@ -462,7 +531,7 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
         rc = open_output(r, e);
     }
     if (!rc)
-        rc = view_build(r, r->set.scene, &r->view, e);
+        rc = view_build(r, r->set.scene, r->set.no_vpl, &r->view, e);
     if (!rc && ensure_rgba(r))
         rc = lr_err_set(e, LR_ENOMEM, "out of memory");
     if (rc) {
@@ -500,7 +569,7 @@ int lr_rig_reload(lr_rig *r, lr_err *e)
                 lr_err_prefix(e, "output: headless GL");
         }
         if (!rc)
-            rc = view_build(r, s.scene, &view, e);
+            rc = view_build(r, s.scene, s.no_vpl, &view, e);
         r->set = old;
         if (rc) {
             r->used_hid |= s.has_hid;
@@ -592,6 +661,8 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
         bool want = frame_wanted(r, now);
         if (want && !(r->kms && lr_gl_flip_pending(r->gl)) && r->next_frame_ns < t)
             t = r->next_frame_ns;
+        if (r->fading && fade_wake(r, now) < t)
+            t = fade_wake(r, now);
         if (r->stats_path[0] && r->next_stats_ns < t)
             t = r->next_stats_ns;
         int timeout;
@@ -699,7 +770,7 @@ void lr_rig_get_info(const lr_rig *r, lr_rig_info *out)
     out->lamp_level = r->lamp_written;
     out->output = r->kms ? "kms" : "headless";
     out->view = r->view ? lr_rig_view_name(r->view) : "";
-    out->idle = r->view && !frame_wanted((lr_rig *)r, lr_now_ns());
+    out->idle = r->view && !frame_due(r);
 }
 
 struct lr_scene *lr_rig_scene(lr_rig *r) { return r->set.scene; }

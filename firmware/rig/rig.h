@@ -40,6 +40,8 @@ typedef struct lr_rig_opts {
     const char *modbus_url; /* overrides every modbus device's url */
     lr_log log;             /* default: stderr */
     bool no_signals;        /* do not block signals or open the signalfd (in-process tests) */
+    bool no_plan;           /* keep the scene's render settings despite a quality budget */
+    const char *plan_table; /* the planner's measured table; NULL: lr_plan_default_table */
 } lr_rig_opts;
 
 typedef struct lr_rig_info {

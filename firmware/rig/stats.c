@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "render/base/atomic_file.h"
+#include "render/base/json_write.h"
 
 #define LOG_MAX 4096
 
@@ -146,29 +147,6 @@ double lr_rig_stats_latency_ms(const lr_rig_stats *s, double q)
     return v;
 }
 
-static void json_str(FILE *f, const char *s)
-{
-    fputc('"', f);
-    for (; *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\')
-            fprintf(f, "\\%c", c);
-        else if (c < 0x20)
-            fprintf(f, "\\u%04x", c);
-        else
-            fputc(c, f);
-    }
-    fputc('"', f);
-}
-
-static void json_num(FILE *f, double v)
-{
-    if (isfinite(v))
-        fprintf(f, "%.6g", v);
-    else
-        fputs("null", f);
-}
-
 int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *config,
                        int64_t now_ns, unsigned garbage, lr_err *e)
 {
@@ -176,17 +154,22 @@ int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *conf
     int rc = lr_atomic_file_open(path, &af, e);
     if (rc)
         return rc;
-    FILE *f = lr_atomic_file_stream(af);
-    fputs("{\n  \"config\": ", f);
+    lr_jw *w = lr_jw_create(lr_atomic_file_stream(af));
+    if (!w) {
+        lr_atomic_file_abort(af);
+        return lr_err_set(e, LR_ENOMEM, "%s: out of memory", path);
+    }
+    lr_jw_object(w, NULL);
     if (config)
-        json_str(f, config);
+        lr_jw_string(w, "config", config);
     else
-        fputs("null", f);
-    fprintf(f, ",\n  \"duration_s\": %.6f,\n", (double)(now_ns - s->start_ns) * 1e-9);
-    fprintf(f, "  \"frames\": %llu,\n  \"events\": %llu,\n  \"events_pending\": %d,\n",
-            (unsigned long long)s->n_frames, (unsigned long long)s->n_events, s->n_pending);
-    fprintf(f, "  \"events_unmatched\": %llu,\n  \"garbage\": %u,\n",
-            (unsigned long long)s->unmatched, garbage);
+        lr_jw_null(w, "config");
+    lr_jw_number(w, "duration_s", (double)(now_ns - s->start_ns) * 1e-9);
+    lr_jw_int(w, "frames", (long)s->n_frames);
+    lr_jw_int(w, "events", (long)s->n_events);
+    lr_jw_int(w, "events_pending", s->n_pending);
+    lr_jw_int(w, "events_unmatched", (long)s->unmatched);
+    lr_jw_int(w, "garbage", (long)garbage);
     double *tmp = s->n_lat ? malloc(s->n_lat * sizeof *tmp) : NULL;
     double mean = NAN;
     if (tmp) {
@@ -198,55 +181,56 @@ int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *conf
         mean /= (double)s->n_lat;
     }
     size_t n = tmp ? s->n_lat : 0;
-    fprintf(f, "  \"latency_ms\": {\"n\": %zu, \"min\": ", n);
-    json_num(f, n ? tmp[0] : NAN);
-    fputs(", \"median\": ", f);
-    json_num(f, tmp ? quantile(tmp, n, 0.5) : NAN);
-    fputs(", \"p99\": ", f);
-    json_num(f, tmp ? quantile(tmp, n, 0.99) : NAN);
-    fputs(", \"max\": ", f);
-    json_num(f, n ? tmp[n - 1] : NAN);
-    fputs(", \"mean\": ", f);
-    json_num(f, mean);
-    fputs("},\n  \"event_log\": [", f);
+    lr_jw_object(w, "latency_ms");
+    lr_jw_int(w, "n", (long)n);
+    lr_jw_number_or_null(w, "min", n ? tmp[0] : NAN);
+    lr_jw_number_or_null(w, "median", tmp ? quantile(tmp, n, 0.5) : NAN);
+    lr_jw_number_or_null(w, "p99", tmp ? quantile(tmp, n, 0.99) : NAN);
+    lr_jw_number_or_null(w, "max", n ? tmp[n - 1] : NAN);
+    lr_jw_number_or_null(w, "mean", mean);
+    lr_jw_object_end(w);
     free(tmp);
+    lr_jw_array(w, "event_log");
     uint64_t first = s->n_events > LOG_MAX ? s->n_events - LOG_MAX : 0;
     for (uint64_t i = first; i < s->n_events; i++) {
         const ev_rec *r = &s->events[i % LOG_MAX];
-        fputs(i > first ? ",\n    {" : "\n    {", f);
-        fputs("\"source\": ", f);
-        json_str(f, r->ev.source);
-        fputs(", \"control\": ", f);
-        json_str(f, r->ev.control);
-        fprintf(f, ", \"kind\": \"%s\", \"value\": ", lr_event_kind_name(r->ev.kind));
-        json_num(f, r->ev.value);
-        fprintf(f, ", \"t_s\": %.6f, \"frame\": %llu, \"latency_ms\": %.6f}",
-                (double)(r->ev.t_ns - s->start_ns) * 1e-9, (unsigned long long)r->frame,
-                r->latency_ms);
+        lr_jw_object(w, NULL);
+        lr_jw_string(w, "source", r->ev.source);
+        lr_jw_string(w, "control", r->ev.control);
+        lr_jw_string(w, "kind", lr_event_kind_name(r->ev.kind));
+        lr_jw_number_or_null(w, "value", r->ev.value);
+        lr_jw_number(w, "t_s", (double)(r->ev.t_ns - s->start_ns) * 1e-9);
+        lr_jw_int(w, "frame", (long)r->frame);
+        lr_jw_number_or_null(w, "latency_ms", r->latency_ms);
+        lr_jw_object_end(w);
     }
-    fputs("\n  ],\n  \"frame_log\": [", f);
+    lr_jw_array_end(w);
+    lr_jw_array(w, "frame_log");
     first = s->n_frames > LOG_MAX ? s->n_frames - LOG_MAX : 0;
     for (uint64_t i = first; i < s->n_frames; i++) {
         const fr_rec *r = &s->frames[i % LOG_MAX];
-        fprintf(f, "%s{\"index\": %d, \"t_s\": %.6f, \"passes\": [", i > first ? ",\n    " : "\n    ",
-                r->f.index, (double)(r->t_ns - s->start_ns) * 1e-9);
-        bool any = false;
+        lr_jw_object(w, NULL);
+        lr_jw_int(w, "index", r->f.index);
+        lr_jw_number(w, "t_s", (double)(r->t_ns - s->start_ns) * 1e-9);
+        lr_jw_array(w, "passes");
         for (int p = 0; p < LR_PASS_COUNT; p++)
-            if (r->f.passes & (1u << p)) {
-                fprintf(f, "%s\"%s\"", any ? ", " : "", pass_names[p]);
-                any = true;
-            }
-        fputs("], \"ms\": [", f);
-        for (int p = 0; p < LR_PASS_COUNT; p++) {
-            if (p)
-                fputs(", ", f);
-            json_num(f, r->f.ms[p]);
-        }
-        fputs("], \"total_ms\": ", f);
-        json_num(f, r->f.total_ms);
-        fprintf(f, ", \"samples\": %d, \"converged\": %s}", r->f.samples,
-                r->f.converged ? "true" : "false");
+            if (r->f.passes & (1u << p))
+                lr_jw_string(w, NULL, pass_names[p]);
+        lr_jw_array_end(w);
+        lr_jw_array(w, "ms");
+        for (int p = 0; p < LR_PASS_COUNT; p++)
+            lr_jw_number_or_null(w, NULL, r->f.ms[p]);
+        lr_jw_array_end(w);
+        lr_jw_number_or_null(w, "total_ms", r->f.total_ms);
+        lr_jw_int(w, "samples", r->f.samples);
+        lr_jw_bool(w, "converged", r->f.converged);
+        lr_jw_object_end(w);
     }
-    fputs("\n  ]\n}\n", f);
+    lr_jw_array_end(w);
+    lr_jw_object_end(w);
+    if ((rc = lr_jw_finish(w, e))) {
+        lr_atomic_file_abort(af);
+        return rc;
+    }
     return lr_atomic_file_commit(af, e);
 }

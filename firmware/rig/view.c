@@ -68,6 +68,12 @@ const char *lr_rig_view_name(const lr_rig_view *v) { return v->ops->name; }
 void lr_rig_view_invalidate(lr_rig_view *v, unsigned dirty) { v->ops->invalidate(v->impl, dirty); }
 bool lr_rig_view_needs_frame(const lr_rig_view *v) { return v->ops->needs_frame(v->impl); }
 
+void lr_rig_view_set_time(lr_rig_view *v, double t_seconds)
+{
+    if (v->ops->set_time)
+        v->ops->set_time(v->impl, t_seconds);
+}
+
 int lr_rig_view_frame(lr_rig_view *v, lr_frame_stats *stats, lr_err *e)
 {
     return v->ops->frame(v->impl, stats, e);

@@ -28,6 +28,7 @@ typedef struct lr_rig_view_desc {
     lr_gl *gl;        /* may be NULL for "preview" headless */
     lr_scene *scene;  /* read at every frame; owned by the caller */
     int width, height;
+    bool no_vpl;      /* "passes": skip the VPL pass (the planner found no receiver in sight) */
 } lr_rig_view_desc;
 
 /* Comma-separated names of the back ends built in, default first ("passes, preview"). */
@@ -40,6 +41,9 @@ void lr_rig_view_destroy(lr_rig_view *v);
 const char *lr_rig_view_name(const lr_rig_view *v);
 void lr_rig_view_invalidate(lr_rig_view *v, unsigned dirty);
 bool lr_rig_view_needs_frame(const lr_rig_view *v);
+/* The view's clock, seconds since the rig started (the renderer's flicker,
+ * lr_renderer_set_time); back ends without one ignore it. */
+void lr_rig_view_set_time(lr_rig_view *v, double t_seconds);
 int lr_rig_view_frame(lr_rig_view *v, lr_frame_stats *stats, lr_err *e);
 /* width*height*4 bytes, rows top to bottom. */
 int lr_rig_view_read_rgba8(lr_rig_view *v, unsigned char *rgba, lr_err *e);
@@ -54,6 +58,7 @@ typedef struct lr_rig_view_ops {
     void (*destroy)(void *impl);
     void (*invalidate)(void *impl, unsigned dirty);
     bool (*needs_frame)(const void *impl);
+    void (*set_time)(void *impl, double t_seconds); /* may be NULL */
     int (*frame)(void *impl, lr_frame_stats *stats, lr_err *e);
     int (*read_rgba8)(void *impl, unsigned char *rgba, lr_err *e);
     int (*present)(void *impl, lr_err *e);

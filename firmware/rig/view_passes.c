@@ -8,7 +8,7 @@ static int v_create(const lr_rig_view_desc *d, void **impl, lr_err *e)
     if (!d->gl)
         return lr_err_set(e, LR_EINVAL, "renderer 'passes' needs a GL context");
     lr_renderer_desc rd = {.gl = d->gl, .scene = d->scene, .width = d->width,
-                           .height = d->height};
+                           .height = d->height, .no_vpl = d->no_vpl};
     lr_renderer *r;
     int rc = lr_renderer_create(&rd, &r, e);
     if (rc)
@@ -20,6 +20,7 @@ static int v_create(const lr_rig_view_desc *d, void **impl, lr_err *e)
 static void v_destroy(void *impl) { lr_renderer_destroy(impl); }
 static void v_invalidate(void *impl, unsigned dirty) { lr_renderer_invalidate(impl, dirty); }
 static bool v_needs_frame(const void *impl) { return lr_renderer_needs_frame(impl); }
+static void v_set_time(void *impl, double t) { lr_renderer_set_time(impl, t); }
 
 static int v_frame(void *impl, lr_frame_stats *st, lr_err *e)
 {
@@ -40,6 +41,7 @@ const lr_rig_view_ops lr_rig_view_passes = {
     .destroy = v_destroy,
     .invalidate = v_invalidate,
     .needs_frame = v_needs_frame,
+    .set_time = v_set_time,
     .frame = v_frame,
     .read_rgba8 = v_read,
     .present = v_present,

@@ -83,8 +83,10 @@ int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
     int N = d && d->N > 0 ? d->N : 64;
     unsigned seed = d && d->seed ? d->seed : 1;
     *out = (lr_cpu_cavity){.gain = {1.0, 1.0, 1.0}};
+    /* Not for the raw directional dipole (its total exceeds 1); the standard dipole is the
+     * normalisation's reference, so "normalize" does not change it (lr_scene_object_sd_norm). */
     out->applies = enclosure == LR_ENCLOSURE_HULL && l->type != LR_LIGHT_DIRECTIONAL &&
-                   !obj->sd_raw;
+                   !(obj->sd_raw && obj->sss_model == LR_SSS_DIRECTIONAL_DIPOLE);
     if (!out->applies)
         return LR_OK;
 

@@ -22,7 +22,8 @@
  * object (F = 1, A = 1) the unlit surface then emits exactly the light's power whatever a is;
  * the half-space model's own cavity-side B (which double counts in a thin wall) is not used
  * for b. Only for point and spot lights inside the object's hull (LR_ENCLOSURE_HULL); the raw
- * model ("normalize": false) has no closure (A > 1 there: the series would diverge). */
+ * model ("normalize": false with the directional dipole) has no closure (A > 1 there: the
+ * series would diverge); the standard dipole ("model": "standard_dipole") has it either way. */
 #ifndef LR_CPU_CAVITY_H
 #define LR_CPU_CAVITY_H
 

@@ -1,6 +1,7 @@
 /* Shared by the passes: meshes on the GPU, material coefficients, the light G-buffer and
  * Algorithm 1 bindings, small uniform helpers. */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "render/base/mat4.h"
@@ -102,12 +103,27 @@ void lr_passes_pack_coeffs(const lr_coeffs *c, float b[20])
     b[19] = (float)c->A_dir;
 }
 
+void lr_passes_pack_sss(const lr_coeffs *c, enum lr_sss_model model, float b[12])
+{
+    for (int j = 0; j < 3; j++) {
+        b[0 + j] = (float)c->albedo_prime[j];
+        b[4 + j] = (float)c->z_r[j];
+        b[8 + j] = (float)c->z_v[j];
+    }
+    b[3] = (float)model;
+    b[7] = b[11] = 0.0f;
+}
+
 void lr_passes_update_coeffs(lr_renderer *r)
 {
     memset(r->coef, 0, sizeof r->coef);
+    memset(r->sss, 0, sizeof r->sss);
     int no = lr_scene_object_count(r->scene);
-    for (int i = 0; i < no && i < LR_MAX_OBJECTS; i++)
-        lr_passes_pack_coeffs(&lr_scene_object_at(r->scene, i)->coeffs, r->coef + 20 * i);
+    for (int i = 0; i < no && i < LR_MAX_OBJECTS; i++) {
+        const lr_scene_object *o = lr_scene_object_at(r->scene, i);
+        lr_passes_pack_coeffs(&o->coeffs, r->coef + 20 * i);
+        lr_passes_pack_sss(&o->coeffs, o->sss_model, r->sss + 12 * i);
+    }
     for (int i = 0; i < LR_MAX_OBJECTS; i++)
         for (int c = 0; c < 3; c++)
             r->sd_norm[3 * i + c] =
@@ -116,15 +132,25 @@ void lr_passes_update_coeffs(lr_renderer *r)
 
 int lr_passes_update_cavity(lr_renderer *r, lr_err *e)
 {
-    double g[LR_MAX_OBJECTS][3];
-    int no = lr_scene_object_count(r->scene);
+    /* One measurement per light (the closure depends on where the light sits in the cavity),
+     * the same numbers lr_cpu_render applies per light (render/cpu/frame.c). */
+    for (int k = 0; k < 3 * LR_MAX_LIGHTS * LR_MAX_OBJECTS; k++)
+        r->cavity_gain[k] = 1.0f;
+    int no = lr_scene_object_count(r->scene), nl = lr_scene_light_count(r->scene);
     if (no > LR_MAX_OBJECTS)
         no = LR_MAX_OBJECTS;
-    int rc = lr_cpu_cavity_scene_gains(r->scene, 0, 0, g, no, e);
-    for (int i = 0; i < LR_MAX_OBJECTS; i++)
-        for (int c = 0; c < 3; c++)
-            r->cavity_gain[3 * i + c] = !rc && i < no ? (float)g[i][c] : 1.0f;
-    return rc;
+    if (nl > LR_MAX_LIGHTS)
+        nl = LR_MAX_LIGHTS;
+    for (int l = 0; l < nl; l++) {
+        double g[LR_MAX_OBJECTS][3];
+        int rc = lr_cpu_cavity_scene_gains(r->scene, l, 0, g, no, e);
+        if (rc)
+            return rc;
+        for (int i = 0; i < no; i++)
+            for (int c = 0; c < 3; c++)
+                r->cavity_gain[3 * (l * LR_MAX_OBJECTS + i) + c] = (float)g[i][c];
+    }
+    return LR_OK;
 }
 
 void lr_passes_set_coeffs(lr_renderer *r, const lr_program *p)
@@ -134,6 +160,11 @@ void lr_passes_set_coeffs(lr_renderer *r, const lr_program *p)
         loc = lr_program_uniform(p, "u_coef[0]");
     if (loc >= 0)
         glUniform4fv(loc, 5 * LR_MAX_OBJECTS, r->coef);
+    loc = lr_program_uniform(p, "u_sss");
+    if (loc < 0)
+        loc = lr_program_uniform(p, "u_sss[0]");
+    if (loc >= 0)
+        glUniform4fv(loc, 3 * LR_MAX_OBJECTS, r->sss);
     loc = lr_program_uniform(p, "u_sd_norm");
     if (loc < 0)
         loc = lr_program_uniform(p, "u_sd_norm[0]");
@@ -143,7 +174,7 @@ void lr_passes_set_coeffs(lr_renderer *r, const lr_program *p)
     if (loc < 0)
         loc = lr_program_uniform(p, "u_cavity_gain[0]");
     if (loc >= 0)
-        glUniform3fv(loc, LR_MAX_OBJECTS, r->cavity_gain);
+        glUniform3fv(loc, LR_MAX_LIGHTS * LR_MAX_OBJECTS, r->cavity_gain);
 }
 
 void lr_passes_uniform_mat4(const lr_program *p, const char *name, const double m[16])
@@ -184,33 +215,80 @@ void lr_passes_bind_tex(const lr_program *p, const char *name, int unit, const l
     lr_passes_uniform_i(p, name, unit);
 }
 
-void lr_passes_bind_gbuffer(lr_renderer *r, const lr_program *p)
+void lr_passes_bind_gbuffer(lr_renderer *r, const lr_program *p, int l)
 {
-    if (r->gb.mode == LR_GB_CUBE) {
-        lr_passes_bind_tex(p, "u_gb_cube_pos", 0, r->gb.pos_cube);
-        lr_passes_bind_tex(p, "u_gb_cube_nrm", 1, r->gb.nrm_cube);
+    const struct lr_light_gbuffer *g = &r->gb[l];
+    if (g->mode == LR_GB_CUBE) {
+        lr_passes_bind_tex(p, "u_gb_cube_pos", 0, g->pos_cube);
+        lr_passes_bind_tex(p, "u_gb_cube_nrm", 1, g->nrm_cube);
         /* Units of the unused sampler type must differ from the used ones. */
         lr_passes_uniform_i(p, "u_gb_pos", 2);
         lr_passes_uniform_i(p, "u_gb_nrm", 3);
     } else {
         lr_passes_uniform_i(p, "u_gb_cube_pos", 0);
         lr_passes_uniform_i(p, "u_gb_cube_nrm", 1);
-        lr_passes_bind_tex(p, "u_gb_pos", 2, r->gb.pos_2d);
-        lr_passes_bind_tex(p, "u_gb_nrm", 3, r->gb.nrm_2d);
+        lr_passes_bind_tex(p, "u_gb_pos", 2, g->pos_2d);
+        lr_passes_bind_tex(p, "u_gb_nrm", 3, g->nrm_2d);
     }
-    lr_passes_uniform_i(p, "u_gb_mode", r->gb.mode);
+    lr_passes_uniform_i(p, "u_gb_mode", g->mode);
     GLint loc = lr_program_uniform(p, "u_gb_vp");
     if (loc >= 0)
-        glUniformMatrix4fv(loc, 1, GL_FALSE, r->gb.vp);
-    lr_passes_uniform_v3(p, "u_light_pos", r->gb.pos);
-    lr_passes_uniform_v3(p, "u_light_dir", r->gb.dir);
-    lr_passes_uniform_i(p, "u_light_type", r->gb.type);
+        glUniformMatrix4fv(loc, 1, GL_FALSE, g->vp);
+    lr_passes_uniform_v3(p, "u_light_pos", g->pos);
+    lr_passes_uniform_v3(p, "u_light_dir", g->dir);
+    lr_passes_uniform_i(p, "u_light_type", g->type);
     loc = lr_program_uniform(p, "u_spot_cos");
     if (loc >= 0)
-        glUniform2f(loc, r->gb.spot_cos[0], r->gb.spot_cos[1]);
+        glUniform2f(loc, g->spot_cos[0], g->spot_cos[1]);
 }
 
-void lr_passes_bind_gather(lr_renderer *r, const lr_program *p)
+/* Element i of uniform array `name` ("u_x[2]"). */
+static GLint array_loc(const lr_program *p, const char *name, int i)
+{
+    char n[64];
+    snprintf(n, sizeof n, "%s[%d]", name, i);
+    return lr_program_uniform(p, n);
+}
+
+void lr_passes_bind_lights(lr_renderer *r, const lr_program *p)
+{
+    /* Every array element gets its own unit, used or not: a cube and a 2D sampler must never
+     * share one (units 4..10 belong to the gather and the VPLs). */
+    for (int l = 0; l < LR_MAX_LIGHTS; l++) {
+        const struct lr_light_gbuffer *g = &r->gb[l];
+        bool on = l < r->n_lights;
+        glActiveTexture(GL_TEXTURE0 + (GLenum)l);
+        glBindTexture(GL_TEXTURE_CUBE_MAP, on && g->mode == LR_GB_CUBE ? lr_tex_id(g->pos_cube) : 0);
+        glActiveTexture(GL_TEXTURE11 + (GLenum)l);
+        glBindTexture(GL_TEXTURE_2D, on && g->mode != LR_GB_CUBE ? lr_tex_id(g->pos_2d) : 0);
+        GLint loc;
+        if ((loc = array_loc(p, "u_lights_cube", l)) >= 0)
+            glUniform1i(loc, l);
+        if ((loc = array_loc(p, "u_lights_2d", l)) >= 0)
+            glUniform1i(loc, 11 + l);
+        if (!on)
+            continue;
+        if ((loc = array_loc(p, "u_lights_mode", l)) >= 0)
+            glUniform1i(loc, g->mode);
+        if ((loc = array_loc(p, "u_lights_type", l)) >= 0)
+            glUniform1i(loc, g->type);
+        if ((loc = array_loc(p, "u_lights_vp", l)) >= 0)
+            glUniformMatrix4fv(loc, 1, GL_FALSE, g->vp);
+        if ((loc = array_loc(p, "u_lights_pos", l)) >= 0)
+            glUniform3f(loc, (float)g->pos.x, (float)g->pos.y, (float)g->pos.z);
+        if ((loc = array_loc(p, "u_lights_dir", l)) >= 0)
+            glUniform3f(loc, (float)g->dir.x, (float)g->dir.y, (float)g->dir.z);
+        if ((loc = array_loc(p, "u_lights_spot_cos", l)) >= 0)
+            glUniform2f(loc, g->spot_cos[0], g->spot_cos[1]);
+        double I[3];
+        lr_passes_light_rgb(r, l, I);
+        if ((loc = array_loc(p, "u_lights_I", l)) >= 0)
+            glUniform3f(loc, (float)I[0], (float)I[1], (float)I[2]);
+    }
+    lr_passes_uniform_i(p, "u_n_lights", r->n_lights);
+}
+
+void lr_passes_bind_gather(lr_renderer *r, const lr_program *p, const double w[][3])
 {
     lr_passes_bind_tex(p, "u_map_B", 4, r->rad.B);
     lr_passes_bind_tex(p, "u_map_nrm", 5, r->rad.nrm);
@@ -228,7 +306,23 @@ void lr_passes_bind_gather(lr_renderer *r, const lr_program *p)
     lr_passes_uniform_i(p, "u_K", r->rad.K);
     lr_passes_uniform_f(p, "u_eps_bias", r->rad.eps_bias);
     lr_passes_uniform_f(p, "u_eps_comb", r->rad.eps_comb);
-    lr_passes_uniform_f(p, "u_map_scale", r->rad.scale);
+    lr_passes_set_light_w(r, p, w);
+}
+
+void lr_passes_set_light_w(lr_renderer *r, const lr_program *p, const double w[][3])
+{
+    /* The maps store B * scale[l]: the weight divides it out. */
+    GLint loc;
+    float wf[3 * LR_MAX_LIGHTS] = {0};
+    for (int l = 0; l < r->n_lights; l++)
+        for (int c = 0; c < 3; c++)
+            wf[3 * l + c] = (float)(w[l][c] / r->rad.scale[l]);
+    loc = lr_program_uniform(p, "u_light_w");
+    if (loc < 0)
+        loc = lr_program_uniform(p, "u_light_w[0]");
+    if (loc >= 0)
+        glUniform3fv(loc, LR_MAX_LIGHTS, wf);
+    lr_passes_uniform_i(p, "u_n_lights", r->n_lights);
 }
 
 void lr_passes_cube_face_vp(lr_vec3 at, int f, double znear, double zfar, double out[16])
@@ -242,7 +336,15 @@ void lr_passes_cube_face_vp(lr_vec3 at, int f, double znear, double zfar, double
     lr_mat4_mul(proj, view, out);
 }
 
-const lr_light *lr_passes_light(const lr_renderer *r)
+const lr_light *lr_passes_light(const lr_renderer *r, int l)
 {
-    return lr_scene_light_at(r->scene, 0);
+    return lr_scene_light_at(r->scene, l);
+}
+
+void lr_passes_light_rgb(const lr_renderer *r, int l, double out[3])
+{
+    lr_light_rgb(lr_passes_light(r, l), out);
+    double f = lr_renderer_flicker(r, l);
+    for (int c = 0; c < 3; c++)
+        out[c] *= f;
 }

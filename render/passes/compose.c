@@ -1,8 +1,10 @@
 /* Pass 3 — composition (render/passes/PIPELINE.md): the camera's view of the objects
  * (Algorithm 1 over the K maps, L_o = I F_t B / pi) and of the receivers (direct light
  * shadowed through the light G-buffer, plus the VPLs), into a linear RGBA32F target; then
- * exposure, tone curve and sRGB into an RGBA8 target. The light's intensity I enters here and
- * only here, so a dimmer change re-runs this pass alone. */
+ * exposure, tone curve and sRGB into an RGBA8 target. The lights' intensities I_l (and the
+ * cavity gains per light and object, PIPELINE.md "Energy") enter here and only here (each
+ * light's maps and VPL row hold its unit-intensity transport, summed with weights I_l), so a
+ * dimmer change re-runs this pass alone. */
 #include <math.h>
 
 #include "render/base/mat4.h"
@@ -34,13 +36,14 @@ void lr_compose_free(lr_renderer *r)
     r->hdr = r->ldr = NULL;
 }
 
-static void set_intensity(const lr_renderer *r, const lr_program *p)
+/* Per light and band: intensity * color (the gather's weights for the objects). */
+static void intensities(const lr_renderer *r, double I[LR_MAX_LIGHTS][3])
 {
-    double I[3];
-    lr_light_rgb(lr_passes_light(r), I);
-    GLint loc = lr_program_uniform(p, "u_intensity");
-    if (loc >= 0)
-        glUniform3f(loc, (float)I[0], (float)I[1], (float)I[2]);
+    for (int l = 0; l < LR_MAX_LIGHTS; l++)
+        for (int c = 0; c < 3; c++)
+            I[l][c] = 0.0;
+    for (int l = 0; l < r->n_lights; l++)
+        lr_passes_light_rgb(r, l, I[l]);
 }
 
 int lr_pass_compose(lr_renderer *r, lr_err *e)
@@ -68,13 +71,21 @@ int lr_pass_compose(lr_renderer *r, lr_err *e)
     const lr_program *p = r->p_obj;
     glUseProgram(lr_program_id(p));
     lr_passes_set_coeffs(r, p);
-    lr_passes_bind_gather(r, p);
+    double I[LR_MAX_LIGHTS][3];
+    intensities(r, I);
+    lr_passes_bind_gather(r, p, I);
     lr_passes_uniform_mat4(p, "u_vp", vp);
     lr_passes_uniform_v3(p, "u_eye", cam->position);
     lr_passes_uniform_v3(p, "u_view_dir", fwd);
     lr_passes_uniform_i(p, "u_ortho", cam->orthographic);
-    set_intensity(r, p);
     for (int i = 0; i < r->n_objects; i++) {
+        /* Object i's emission for light l times its cavity gain for l (PIPELINE.md "Energy"):
+         * folded into the gather's per-light weights. */
+        double w[LR_MAX_LIGHTS][3];
+        for (int l = 0; l < LR_MAX_LIGHTS; l++)
+            for (int c = 0; c < 3; c++)
+                w[l][c] = I[l][c] * r->cavity_gain[3 * (l * LR_MAX_OBJECTS + i) + c];
+        lr_passes_set_light_w(r, p, w);
         lr_passes_uniform_i(p, "u_object", i);
         lr_passes_uniform_i(p, "u_two_sided", r->two_sided[i]);
         lr_passes_draw(&r->obj[i]);
@@ -83,9 +94,8 @@ int lr_pass_compose(lr_renderer *r, lr_err *e)
     p = r->p_recv;
     glUseProgram(lr_program_id(p));
     lr_passes_set_coeffs(r, p);
-    lr_passes_bind_gbuffer(r, p);
+    lr_passes_bind_lights(r, p);
     lr_passes_uniform_mat4(p, "u_vp", vp);
-    set_intensity(r, p);
     bool use_vpl = !r->no_vpl && r->vpl.fb;
     lr_passes_uniform_i(p, "u_use_vpl", use_vpl);
     lr_passes_uniform_i(p, "u_n_vpl", r->vpl.n);

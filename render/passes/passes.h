@@ -23,6 +23,9 @@
 #define LR_MAX_K 32
 #define LR_MAX_RECEIVERS 16
 #define LR_MAX_VPL 4096
+/* Lights with their own G-buffer and radiosity maps (render/shaders/lib/lights.glsl unrolls
+ * its sampler arrays for exactly this many); the scene loader refuses more. */
+#define LR_MAX_LIGHTS LR_SCENE_MAX_LIGHTS
 /* Frames accumulated at most in RGBA16F maps. Drivers may round the blended result toward
  * zero when storing half floats (llvmpipe does): the running mean then loses ~2^-13 of
  * itself per frame, 1.1% after 64 frames, 16% after 1024 (measured, tests/test_render_hard.c).
@@ -66,15 +69,22 @@ struct lr_renderer {
     lr_gpu_mesh recv[LR_MAX_RECEIVERS];
     bool two_sided[LR_MAX_OBJECTS];
     float coef[5 * 4 * LR_MAX_OBJECTS];
-    /* Per object: the S_d energy normalisation (coeffs.sd_norm, or 1 for "normalize": false),
-     * radiosity.frag's u_sd_norm (PIPELINE.md "Energy"). */
+    float sss[3 * 4 * LR_MAX_OBJECTS]; /* lr_passes_pack_sss per object */
+    /* Per object: the S_d energy normalisation (lr_scene_object_sd_norm: coeffs.sd_norm, or 1
+     * for "normalize": false and for the standard dipole), radiosity.frag's u_sd_norm
+     * (PIPELINE.md "Energy"). */
     float sd_norm[3 * LR_MAX_OBJECTS];
-    /* Per object: the cavity gain for lights[0] (render/cpu/cavity.h, measured on the CPU when
-     * the maps restart), compose's u_cavity_gain: multiplies the object's and its VPLs' B. */
-    float cavity_gain[3 * LR_MAX_OBJECTS];
+    /* Per light and object, [3 (l LR_MAX_OBJECTS + i) + c]: the cavity gain of object i for
+     * light l (render/cpu/cavity.h, measured on the CPU when the maps restart; 1 for lights
+     * beyond n_lights). Composition multiplies light l's B of object i by it: folded into the
+     * gather's weights per object (compose_object) and compose_receiver's u_cavity_gain for
+     * the VPLs. */
+    float cavity_gain[3 * LR_MAX_LIGHTS * LR_MAX_OBJECTS];
 
-    /* The light of the transport (lights[0]) as seen by the last gbuffer pass. */
-    struct {
+    /* One light G-buffer per light of the scene (lights[l] as seen by the last gbuffer
+     * pass). */
+    int n_lights;
+    struct lr_light_gbuffer {
         int type;  /* 0 point, 1 spot, 2 directional */
         lr_vec3 pos, dir;
         float spot_cos[2]; /* cos(outer), cos(inner) */
@@ -85,7 +95,7 @@ struct lr_renderer {
         float vp[16]; /* 2D map: world -> clip */
         double vp_d[16];
         double face_vp[6][16];
-    } gb;
+    } gb[LR_MAX_LIGHTS];
 
     /* Scattered-radiosity maps. */
     struct {
@@ -98,9 +108,11 @@ struct lr_renderer {
         float Pf[LR_MAX_K * 16];
         float df[LR_MAX_K * 3];
         float eps_bias, eps_comb; /* depth units, mm */
+        /* B: K maps per light, layer l K + k for light l's map k (unit intensity); x_o, n_o
+         * and depth: K layers shared by all lights (the map cameras do not depend on them). */
         lr_tex *B, *pos, *nrm, *depth;
-        lr_fb *fb[LR_MAX_K];
-        float scale; /* the maps store B * scale (see radiosity.c place_maps) */
+        lr_fb *fb[LR_MAX_LIGHTS * LR_MAX_K]; /* [l K + k] */
+        float scale[LR_MAX_LIGHTS]; /* light l's maps store B * scale[l] (radiosity.c) */
         int F; /* frames accumulated */
     } rad;
 
@@ -110,7 +122,7 @@ struct lr_renderer {
         lr_vec3 center;
         lr_tex *outer_pos, *outer_nrm, *dirs;
         lr_fb *outer_fb[6];
-        lr_tex *pos, *nrm, *B;
+        lr_tex *pos, *nrm, *B; /* N_vpl x 1; B: N_vpl x n_lights, row l for light l */
         lr_fb *fb;
         bool outer_valid;
     } vpl;
@@ -121,6 +133,10 @@ struct lr_renderer {
 
     unsigned dirty;
     int frame_index;
+
+    /* The clock of lr_renderer_set_time (flicker at composition). */
+    bool clock_set;
+    double time_s;
 };
 
 /* common.c */
@@ -129,15 +145,24 @@ void lr_passes_free_meshes(lr_renderer *r);
 void lr_passes_draw(const lr_gpu_mesh *m);
 /* One object's block of render/shaders/lib/material.glsl's u_coef (20 floats). */
 void lr_passes_pack_coeffs(const lr_coeffs *c, float out[20]);
-/* Coefficient block of every object (render/shaders/lib/material.glsl). */
+/* One object's block of render/shaders/lib/material.glsl's u_sss (12 floats): the model
+ * switch and the standard dipole's albedo', z_r, z_v. */
+void lr_passes_pack_sss(const lr_coeffs *c, enum lr_sss_model model, float out[12]);
+/* Coefficient blocks (u_coef, u_sss) of every object (render/shaders/lib/material.glsl). */
 void lr_passes_update_coeffs(lr_renderer *r);
 void lr_passes_set_coeffs(lr_renderer *r, const lr_program *p);
-/* Measures r->cavity_gain for the current scene (PIPELINE.md "Energy"). */
+/* Measures r->cavity_gain for every light of the current scene (PIPELINE.md "Energy"). */
 int lr_passes_update_cavity(lr_renderer *r, lr_err *e);
-/* Light G-buffer samplers and uniforms on units 0..3. */
-void lr_passes_bind_gbuffer(lr_renderer *r, const lr_program *p);
-/* Algorithm 1 uniforms and samplers (units 4..6). */
-void lr_passes_bind_gather(lr_renderer *r, const lr_program *p);
+/* Light l's G-buffer samplers and uniforms on units 0..3 (render/shaders/lib/gbuffer.glsl). */
+void lr_passes_bind_gbuffer(lr_renderer *r, const lr_program *p, int l);
+/* Every light's G-buffer positions and light uniforms (render/shaders/lib/lights.glsl):
+ * cube maps on units 0..3, 2D maps on units 11..14. */
+void lr_passes_bind_lights(lr_renderer *r, const lr_program *p);
+/* Algorithm 1 uniforms and samplers (units 4..6); the gather returns
+ * sum_l w[l] B_l (render/shaders/lib/gather.glsl u_light_w), w per light and band. */
+void lr_passes_bind_gather(lr_renderer *r, const lr_program *p, const double w[][3]);
+/* Only the gather's weights u_light_w (w[l] / rad.scale[l]), for a per-object change. */
+void lr_passes_set_light_w(lr_renderer *r, const lr_program *p, const double w[][3]);
 void lr_passes_uniform_mat4(const lr_program *p, const char *name, const double m[16]);
 void lr_passes_uniform_v3(const lr_program *p, const char *name, lr_vec3 v);
 void lr_passes_uniform_i(const lr_program *p, const char *name, int v);
@@ -145,8 +170,10 @@ void lr_passes_uniform_f(const lr_program *p, const char *name, float v);
 void lr_passes_bind_tex(const lr_program *p, const char *name, int unit, const lr_tex *t);
 /* View-projection of cube face f (0..5 = +X..-Z) around `at`. */
 void lr_passes_cube_face_vp(lr_vec3 at, int f, double znear, double zfar, double out[16]);
-/* The light of the transport (lights[0]) and its per-band intensity I (unit-scaled). */
-const lr_light *lr_passes_light(const lr_renderer *r);
+/* Light l of the scene. */
+const lr_light *lr_passes_light(const lr_renderer *r, int l);
+/* Light l's per-band intensity at composition: intensity * color. */
+void lr_passes_light_rgb(const lr_renderer *r, int l, double out[3]);
 
 /* The passes. */
 int lr_pass_gbuffer(lr_renderer *r, lr_err *e);

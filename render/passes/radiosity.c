@@ -3,7 +3,14 @@
  * estimate per texel and colour band; the maps keep the running mean through the constant
  * blend colour 1/F (GL_CONSTANT_ALPHA), so values stay O(B) over any number of frames.
  * A depth-only prepass at restart fixes each texel's visible surface (seed 003 Sec. 3.2);
- * the depth stays for composition's visibility test. */
+ * the depth stays for composition's visibility test.
+ *
+ * Several lights: each light l has its own K maps of B for unit intensity (layers l K + k of
+ * one 2D array texture; x_o, n_o and depth are shared), so that a dimmer change still
+ * re-weights them at composition only (transport is linear in each light's intensity). Memory:
+ * K map_size^2 RGBA32F texels per light (16 MB at K = 16, 256^2). The per-texel seeds do not
+ * depend on the light's index: light l's maps are the same whether or not the other lights
+ * exist, so a two-light render is the sum of the two one-light renders. */
 #include <math.h>
 
 #include "render/base/mat4.h"
@@ -17,8 +24,9 @@ int lr_radiosity_alloc(lr_renderer *r, lr_err *e)
         return lr_err_set(e, LR_EUNSUPPORTED, "render.K = %d: at most %d maps", K, LR_MAX_K);
     r->rad.K = K;
     r->rad.size = n;
+    int L = r->n_lights;
     lr_tex_desc d = {.type = LR_TEX_2D_ARRAY, .format = r->map_format, .width = n, .height = n,
-                     .layers = K, .label = "radiosity maps"};
+                     .layers = K * L, .label = "radiosity maps"};
     if ((rc = lr_tex_create(r->gl, &d, &r->rad.B, e)))
         return rc;
     d.format = LR_TEX_RGBA32F;
@@ -32,19 +40,20 @@ int lr_radiosity_alloc(lr_renderer *r, lr_err *e)
     d.label = "radiosity map depth";
     if ((rc = lr_tex_create(r->gl, &d, &r->rad.depth, e)))
         return rc;
-    for (int k = 0; k < K; k++) {
-        lr_fb_desc fd = {.color = {{r->rad.B, k}, {r->rad.pos, k}, {r->rad.nrm, k}},
-                         .depth = {r->rad.depth, k}, .label = "radiosity map"};
-        if ((rc = lr_fb_create(r->gl, &fd, &r->rad.fb[k], e)))
-            return rc;
-    }
+    for (int l = 0; l < L; l++)
+        for (int k = 0; k < K; k++) {
+            lr_fb_desc fd = {.color = {{r->rad.B, l * K + k}, {r->rad.pos, k}, {r->rad.nrm, k}},
+                             .depth = {r->rad.depth, k}, .label = "radiosity map"};
+            if ((rc = lr_fb_create(r->gl, &fd, &r->rad.fb[l * K + k], e)))
+                return rc;
+        }
     r->rad.F = 0;
     return LR_OK;
 }
 
 void lr_radiosity_free(lr_renderer *r)
 {
-    for (int k = 0; k < LR_MAX_K; k++) {
+    for (int k = 0; k < LR_MAX_LIGHTS * LR_MAX_K; k++) {
         lr_fb_destroy(r->rad.fb[k]);
         r->rad.fb[k] = NULL;
     }
@@ -86,7 +95,8 @@ static void place_maps(lr_renderer *r)
      * the shipped scenes, below half floats' normal range (6e-5) and flushed to zero by some
      * drivers. They store B R^2 instead (O(1) at the bounding radius); directional lights
      * (unit radiance, B ~ 1) store B. */
-    r->rad.scale = r->gb.type == 2 ? 1.0f : (float)(R * R);
+    for (int l = 0; l < r->n_lights; l++)
+        r->rad.scale[l] = r->gb[l].type == 2 ? 1.0f : (float)(R * R);
     double texel = 2.0 * R / r->rad.size;
     r->rad.eps_comb = (float)texel;
     r->rad.eps_bias = (float)(2.0 * texel / (2.0 * R)); /* two texels, in depth units */
@@ -117,57 +127,64 @@ int lr_pass_radiosity(lr_renderer *r, bool restart, lr_err *e)
         r->rad.F = 0;
     }
     int F = r->rad.F + 1;
+    int K = r->rad.K;
     glDisable(GL_CULL_FACE);
     glEnable(GL_DEPTH_TEST);
-    for (int k = 0; k < r->rad.K; k++) {
-        lr_fb_bind(r->rad.fb[k]);
-        if (F == 1) {
-            glDrawBuffers(3, all);
-            glClearBufferfv(GL_COLOR, 0, zero);
-            glClearBufferfv(GL_COLOR, 1, zero);
-            glClearBufferfv(GL_COLOR, 2, zero);
-            glDepthMask(GL_TRUE);
-            glClearDepthf(1.0f);
-            glClear(GL_DEPTH_BUFFER_BIT);
-            /* Depth-only prepass. */
-            glUseProgram(lr_program_id(r->p_depth));
-            glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-            glDepthFunc(GL_LESS);
-            lr_passes_uniform_mat4(r->p_depth, "u_vp", r->rad.vp[k]);
-            for (int i = 0; i < r->n_objects; i++)
+    for (int k = 0; k < K; k++)
+        for (int l = 0; l < r->n_lights; l++) {
+            lr_fb_bind(r->rad.fb[l * K + k]);
+            if (F == 1 && l == 0) {
+                glDrawBuffers(3, all);
+                glClearBufferfv(GL_COLOR, 0, zero);
+                glClearBufferfv(GL_COLOR, 1, zero);
+                glClearBufferfv(GL_COLOR, 2, zero);
+                glDepthMask(GL_TRUE);
+                glClearDepthf(1.0f);
+                glClear(GL_DEPTH_BUFFER_BIT);
+                /* Depth-only prepass. */
+                glUseProgram(lr_program_id(r->p_depth));
+                glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+                glDepthFunc(GL_LESS);
+                lr_passes_uniform_mat4(r->p_depth, "u_vp", r->rad.vp[k]);
+                for (int i = 0; i < r->n_objects; i++)
+                    lr_passes_draw(&r->obj[i]);
+                glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+                glDisable(GL_BLEND);
+            } else if (F == 1) {
+                /* Further lights: x_o, n_o and depth are light 0's. */
+                glDrawBuffers(3, first);
+                glClearBufferfv(GL_COLOR, 0, zero);
+                glDisable(GL_BLEND);
+            } else {
+                glDrawBuffers(3, first);
+                glEnable(GL_BLEND);
+                glBlendEquation(GL_FUNC_ADD);
+                glBlendColor(0.0f, 0.0f, 0.0f, blend_weight(r->map_format, F));
+                glBlendFunc(GL_CONSTANT_ALPHA, GL_ONE_MINUS_CONSTANT_ALPHA);
+            }
+            glDepthMask(GL_FALSE);
+            glDepthFunc(GL_LEQUAL);
+            const lr_program *p = r->p_radiosity;
+            glUseProgram(lr_program_id(p));
+            lr_passes_set_coeffs(r, p);
+            lr_passes_bind_gbuffer(r, p, l);
+            lr_passes_uniform_mat4(p, "u_vp", r->rad.vp[k]);
+            lr_passes_uniform_i(p, "u_N", r->rs.N);
+            lr_passes_uniform_f(p, "u_r_max", (float)r->rad.r_max);
+            lr_passes_uniform_f(p, "u_r_max_dist", 20.0f);
+            lr_passes_uniform_i(p, "u_map_size", r->rad.size);
+            lr_passes_uniform_f(p, "u_map_scale", r->rad.scale[l]);
+            /* Half floats: stay below 65504 (a light on the surface has B -> Inf at x_o -> x_l). */
+            lr_passes_uniform_f(p, "u_map_max", r->map_format == LR_TEX_RGBA16F ? 6.0e4f : 3.0e38f);
+            glUniform1ui(lr_program_uniform(p, "u_seed"), r->seed);
+            glUniform1ui(lr_program_uniform(p, "u_map"), (GLuint)k);
+            glUniform1ui(lr_program_uniform(p, "u_frame"), (GLuint)F);
+            for (int i = 0; i < r->n_objects; i++) {
+                lr_passes_uniform_i(p, "u_object", i);
+                lr_passes_uniform_i(p, "u_two_sided", r->two_sided[i]);
                 lr_passes_draw(&r->obj[i]);
-            glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-            glDisable(GL_BLEND);
-        } else {
-            glDrawBuffers(3, first);
-            glEnable(GL_BLEND);
-            glBlendEquation(GL_FUNC_ADD);
-            glBlendColor(0.0f, 0.0f, 0.0f, blend_weight(r->map_format, F));
-            glBlendFunc(GL_CONSTANT_ALPHA, GL_ONE_MINUS_CONSTANT_ALPHA);
+            }
         }
-        glDepthMask(GL_FALSE);
-        glDepthFunc(GL_LEQUAL);
-        const lr_program *p = r->p_radiosity;
-        glUseProgram(lr_program_id(p));
-        lr_passes_set_coeffs(r, p);
-        lr_passes_bind_gbuffer(r, p);
-        lr_passes_uniform_mat4(p, "u_vp", r->rad.vp[k]);
-        lr_passes_uniform_i(p, "u_N", r->rs.N);
-        lr_passes_uniform_f(p, "u_r_max", (float)r->rad.r_max);
-        lr_passes_uniform_f(p, "u_r_max_dist", 20.0f);
-        lr_passes_uniform_i(p, "u_map_size", r->rad.size);
-        lr_passes_uniform_f(p, "u_map_scale", r->rad.scale);
-        /* Half floats: stay below 65504 (a light on the surface has B -> Inf at x_o -> x_l). */
-        lr_passes_uniform_f(p, "u_map_max", r->map_format == LR_TEX_RGBA16F ? 6.0e4f : 3.0e38f);
-        glUniform1ui(lr_program_uniform(p, "u_seed"), r->seed);
-        glUniform1ui(lr_program_uniform(p, "u_map"), (GLuint)k);
-        glUniform1ui(lr_program_uniform(p, "u_frame"), (GLuint)F);
-        for (int i = 0; i < r->n_objects; i++) {
-            lr_passes_uniform_i(p, "u_object", i);
-            lr_passes_uniform_i(p, "u_two_sided", r->two_sided[i]);
-            lr_passes_draw(&r->obj[i]);
-        }
-    }
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);

@@ -3,7 +3,9 @@
  * bounding-box centre keeping the *farthest* depth (cleared to 0, GL_GREATER); VPL v is that
  * cube map's surface in the fixed direction u_v = lr_halton_sphere(v + 1). Each frame the VPLs
  * re-read B through Algorithm 1 (the maps keep converging); the cube map is redrawn only when
- * the geometry changed. */
+ * the geometry changed. With several lights the VPLs carry B per light for unit intensity
+ * (row l of the B target, N_vpl x n_lights), drawn one row per light, so that composition
+ * weights them by the lights' current intensities. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -29,10 +31,12 @@ int lr_vpl_alloc(lr_renderer *r, lr_err *e)
             return rc;
     }
     lr_tex_desc line = {.format = LR_TEX_RGBA32F, .width = n, .height = 1, .label = "VPLs"};
+    lr_tex_desc rows = line;
+    rows.height = r->n_lights;
     if ((rc = lr_tex_create(r->gl, &line, &r->vpl.dirs, e)) ||
-        (rc = lr_tex_create(r->gl, &line, &r->vpl.pos, e)) ||
-        (rc = lr_tex_create(r->gl, &line, &r->vpl.nrm, e)) ||
-        (rc = lr_tex_create(r->gl, &line, &r->vpl.B, e)))
+        (rc = lr_tex_create(r->gl, &rows, &r->vpl.pos, e)) ||
+        (rc = lr_tex_create(r->gl, &rows, &r->vpl.nrm, e)) ||
+        (rc = lr_tex_create(r->gl, &rows, &r->vpl.B, e)))
         return rc;
     float *dirs = malloc((size_t)n * 4 * sizeof *dirs);
     if (!dirs)
@@ -116,12 +120,18 @@ int lr_pass_vpl(lr_renderer *r, bool geometry_changed, lr_err *e)
     glDisable(GL_BLEND);
     glUseProgram(lr_program_id(p));
     lr_passes_set_coeffs(r, p);
-    lr_passes_bind_gather(r, p);
     lr_passes_bind_tex(p, "u_outer_pos", 0, r->vpl.outer_pos);
     lr_passes_bind_tex(p, "u_outer_nrm", 1, r->vpl.outer_nrm);
     lr_passes_bind_tex(p, "u_vpl_dirs", 2, r->vpl.dirs);
     lr_passes_uniform_v3(p, "u_center", r->vpl.center);
     lr_passes_uniform_i(p, "u_n_vpl", r->vpl.n);
-    lr_gl_draw_fullscreen(r->gl);
+    for (int l = 0; l < r->n_lights; l++) {
+        /* Row l: Algorithm 1 over light l's maps alone, unit intensity. */
+        double w[LR_MAX_LIGHTS][3] = {{0}};
+        w[l][0] = w[l][1] = w[l][2] = 1.0;
+        lr_passes_bind_gather(r, p, w);
+        glViewport(0, l, r->vpl.n, 1);
+        lr_gl_draw_fullscreen(r->gl);
+    }
     return lr_gl_check("vpl pass", e);
 }

@@ -7,10 +7,11 @@
 #define LR_DIRTY_H
 
 enum lr_dirty {
-    /* Light intensity or colour (the dimmer): light transport is linear in it, so only the
-     * final composition rescales. */
+    /* Light intensity, colour or flicker (the dimmer): light transport is linear in it, so
+     * only the final composition rescales. */
     LR_DIRTY_INTENSITY = 1u << 0,
-    /* A light moved, turned, changed its cone or the shape of its flicker: everything. */
+    /* A light moved, turned or changed its cone: everything. (Flicker fields are
+     * LR_DIRTY_INTENSITY: the renderer applies flicker at composition.) */
     LR_DIRTY_LIGHT_GEOMETRY = 1u << 1,
     /* Optical properties of an object: scattered-radiosity maps, VPLs, composition. */
     LR_DIRTY_MATERIAL = 1u << 2,

@@ -244,22 +244,23 @@ static int light_field(op *o, lr_light *l, const char *f, unsigned *d)
     }
     if (!dir && strncmp(f, "flicker.", 8) == 0) {
         const char *g = f + 8;
-        /* The intensity wobble only rescales; a swaying flame moves the light. */
-        unsigned moves = l->flicker.jitter_mm > 0.0 ? LR_DIRTY_LIGHT_GEOMETRY : 0;
+        /* Flicker is applied by the renderer at composition on its clock (render/renderer.h
+         * lr_renderer_set_time), the sway included: the transport stays at the light's mean
+         * position (jitter << 1/sigma_tr), so every flicker field is composition-only. */
         if (strcmp(g, "amplitude") == 0) {
             *d = LR_DIRTY_INTENSITY;
             return num_field(o, &l->flicker.amplitude);
         }
         if (strcmp(g, "frequency_hz") == 0) {
-            *d = LR_DIRTY_INTENSITY | moves;
+            *d = LR_DIRTY_INTENSITY;
             return num_field(o, &l->flicker.frequency_hz);
         }
         if (strcmp(g, "jitter_mm") == 0) {
-            *d = LR_DIRTY_LIGHT_GEOMETRY;
+            *d = LR_DIRTY_INTENSITY;
             return num_field(o, &l->flicker.jitter_mm);
         }
         if (strcmp(g, "seed") == 0) {
-            *d = LR_DIRTY_INTENSITY | moves;
+            *d = LR_DIRTY_INTENSITY;
             int seed = (int)l->flicker.seed;
             int rc = int_field(o, &seed);
             if (!rc && seed < 0)
@@ -632,6 +633,15 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
         *d = LR_DIRTY_MATERIAL; /* the radiosity maps restart */
         return LR_OK;
     }
+    if (strcmp(f, "model") == 0) {
+        enum lr_sss_model m;
+        if (!lr_sss_model_parse(o->value, &m))
+            return fail(o, LR_EINVAL, "expected directional_dipole or standard_dipole, got '%s'",
+                        o->value);
+        rec->pub.sss_model = m;
+        *d = LR_DIRTY_MATERIAL; /* another S_d: maps, VPLs, composition */
+        return LR_OK;
+    }
     mesh_spec ms = rec->mesh;
     xform_spec xf = rec->xf;
     const char *bad = NULL;
@@ -646,7 +656,8 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
         if ((rc = lr_scene_check_transform(&xf, &bad, &inner)))
             return check_failed(o, f, bad, rc, &inner);
     } else {
-        return unknown(o, "an object", f, "material, material.*, mesh.*, transform.*, normalize");
+        return unknown(o, "an object", f,
+                       "material, material.*, mesh.*, transform.*, model, normalize");
     }
     lr_mesh *world;
     lr_bvh *bvh;
@@ -686,11 +697,14 @@ static int object_get(op *o, const lr_scene *s, int i, const char *f)
         return mesh_field(o, &rec.mesh, f + 5);
     if (strncmp(f, "transform.", 10) == 0)
         return transform_field(o, &rec.xf, f + 10);
+    if (strcmp(f, "model") == 0)
+        return out(o, "%s", lr_sss_model_name(rec.pub.sss_model));
     if (strcmp(f, "normalize") == 0) {
         bool normalize = !rec.pub.sd_raw;
         return bool_field(o, &normalize);
     }
-    return unknown(o, "an object", f, "material, material.*, mesh.*, transform.*, normalize");
+    return unknown(o, "an object", f,
+                   "material, material.*, mesh.*, transform.*, model, normalize");
 }
 
 /* ---- keys ------------------------------------------------------------------------------------- */

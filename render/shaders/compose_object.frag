@@ -1,5 +1,7 @@
-// Pass 3 for the translucent objects: B from the K maps (Algorithm 1), then
-// L_o = I F_t(w_o) B / pi (seed 003 Eq. 5); I = intensity * colour of the light.
+// Pass 3 for the translucent objects: I B = sum_l I_l B_l from every light's K maps (Algorithm
+// 1, the gather weighted by the intensities I_l = intensity * colour, each times this object's
+// cavity gain for light l, PIPELINE.md "Energy": render/passes/compose.c sets u_light_w per
+// object), then L_o = F_t(w_o) I B / pi (seed 003 Eq. 5).
 #include "lib/material.glsl"
 #include "lib/gather.glsl"
 
@@ -10,9 +12,6 @@ uniform bool u_two_sided;
 uniform vec3 u_eye;          // camera position (perspective)
 uniform vec3 u_view_dir;     // camera forward (orthographic)
 uniform bool u_ortho;
-uniform vec3 u_intensity;    // I per band
-// Per object: light sent back into a cavity around the light (PIPELINE.md "Energy").
-uniform vec3 u_cavity_gain[LR_MAX_OBJECTS];
 layout(location = 0) out vec4 o_color;
 
 void main()
@@ -25,6 +24,5 @@ void main()
     vec3 B = lr_gather(v_pos, no, n);
     float eta = lr_material(u_object).eta;
     float Ft = lr_fresnel_transmittance(abs(dot(no, wo)), eta);
-    vec3 g = u_cavity_gain[clamp(u_object, 0, LR_MAX_OBJECTS - 1)];
-    o_color = vec4(u_intensity * g * Ft * B / LR_PI, n > 0.0 ? 1.0 : 0.0);
+    o_color = vec4(Ft * B / LR_PI, n > 0.0 ? 1.0 : 0.0);
 }

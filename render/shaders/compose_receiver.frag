@@ -1,22 +1,21 @@
 // Pass 3 for the diffuse receivers (table, wall): L = albedo / pi (E_direct + E_vpl)
-// (render/passes/PIPELINE.md, pass 4). E_direct: the light's intensity / distance^2 * cos,
-// shadowed by the objects through the light G-buffer. E_vpl: the VPLs with the bounded
-// geometry term, A_v bounding the singularity.
+// (render/passes/PIPELINE.md, pass 4), summed over the lights. E_direct: each light's
+// intensity / distance^2 * cos, shadowed by the objects through that light's G-buffer. E_vpl:
+// the VPLs with the bounded geometry term, A_v bounding the singularity; VPL v carries B per
+// light for unit intensity (row l of u_vpl_B), weighted by I_l.
 #include "lib/material.glsl"
-#include "lib/gbuffer.glsl"
+#include "lib/lights.glsl"
 
 in vec3 v_pos;
 in vec3 v_nrm;
 uniform vec3 u_albedo;
-uniform vec3 u_intensity;   // I per band
-// Per object: light sent back into a cavity around the light (PIPELINE.md "Energy").
-uniform vec3 u_cavity_gain[LR_MAX_OBJECTS];
-uniform int u_light_type;   // 0 point, 1 spot, 2 directional
-uniform vec2 u_spot_cos;
+// Per light l and object i, element l LR_MAX_OBJECTS + i: light sent back into a cavity
+// around light l (PIPELINE.md "Energy"); multiplies light l's B of the VPLs of object i.
+uniform vec3 u_cavity_gain[LR_MAX_LIGHTS * LR_MAX_OBJECTS];
 uniform bool u_use_vpl;
 uniform highp sampler2D u_vpl_pos; // x_v, A_v
 uniform highp sampler2D u_vpl_nrm; // n_v, object id
-uniform highp sampler2D u_vpl_B;   // B_v
+uniform highp sampler2D u_vpl_B;   // B_v per light (row l), unit intensity
 uniform int u_n_vpl;
 // VPL visibility (beyond seed 003, whose VPLs have none): the segment from the VPL to x is
 // blocked where it passes inside the objects' outer envelope, i.e. nearer to the VPL centre c
@@ -49,23 +48,12 @@ void main()
 {
     vec3 x = v_pos;
     vec3 nx = normalize(v_nrm);
-    float E_direct = 0.0;
-    if (u_light_type == 2) {
-        float c = dot(nx, -u_light_dir);
-        if (c > 0.0 && lr_gbuffer_lit(x, 0.0))
-            E_direct = c;
-    } else {
-        vec3 to_l = u_light_pos - x;
-        float d2 = dot(to_l, to_l);
-        float c = dot(nx, to_l) * inversesqrt(d2);
-        if (c > 0.0 && lr_gbuffer_lit(x, 0.0)) {
-            float shape = 1.0;
-            if (u_light_type == 1)
-                shape = smoothstep(u_spot_cos.x, u_spot_cos.y, dot(-to_l, u_light_dir) * inversesqrt(d2));
-            E_direct = shape * c / d2;
-        }
+    vec3 E = vec3(0.0);
+    for (int l = 0; l < LR_MAX_LIGHTS; l++) {
+        if (l >= u_n_lights)
+            break;
+        E += u_lights_I[l] * lr_lights_direct(l, x, nx);
     }
-    vec3 E = vec3(E_direct);
     if (u_use_vpl) {
         for (int v = 0; v < u_n_vpl; v++) {
             vec4 p = texelFetch(u_vpl_pos, ivec2(v, 0), 0);
@@ -83,9 +71,15 @@ void main()
                 continue;
             int id = clamp(int(nv.w + 0.5), 0, LR_MAX_OBJECTS - 1);
             float eta = lr_material(id).eta;
-            vec3 B = texelFetch(u_vpl_B, ivec2(v, 0), 0).rgb * u_cavity_gain[id];
+            vec3 B = vec3(0.0);
+            for (int l = 0; l < LR_MAX_LIGHTS; l++) {
+                if (l >= u_n_lights)
+                    break;
+                B += u_lights_I[l] * u_cavity_gain[l * LR_MAX_OBJECTS + id] *
+                     texelFetch(u_vpl_B, ivec2(v, l), 0).rgb;
+            }
             E += lr_fresnel_transmittance(cv, eta) * B / LR_PI * p.w * cv * cx / max(d2, p.w);
         }
     }
-    o_color = vec4(u_intensity * u_albedo / LR_PI * E, 1.0);
+    o_color = vec4(u_albedo / LR_PI * E, 1.0);
 }

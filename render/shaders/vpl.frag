@@ -13,11 +13,11 @@ uniform vec3 u_center;
 uniform int u_n_vpl;
 layout(location = 0) out vec4 o_pos; // x_v, A_v (0: no surface in that direction)
 layout(location = 1) out vec4 o_nrm; // n_v, object id (-1: none)
-layout(location = 2) out vec4 o_B;   // B(x_v) for unit intensity, visibility weight
+layout(location = 2) out vec4 o_B;   // B(x_v) for unit intensity of this row's light, weight
 
 void main()
 {
-    int v = int(gl_FragCoord.x);
+    int v = int(gl_FragCoord.x); // row gl_FragCoord.y: the light whose maps the gather weighs
     vec3 u = texelFetch(u_vpl_dirs, ivec2(v, 0), 0).xyz;
     vec4 p = texture(u_outer_pos, u);
     if (!(p.w > 0.5)) {

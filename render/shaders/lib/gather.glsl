@@ -20,9 +20,27 @@ uniform vec3 u_map_d[LR_MAX_K];
 uniform int u_K;
 uniform float u_eps_bias; // in map depth units
 uniform float u_eps_comb; // mm
-uniform float u_map_scale; // the maps store B * scale
+#ifndef LR_MAX_LIGHTS
+#define LR_MAX_LIGHTS 4
+#endif
+// Light l's map k is layer l K + k of u_map_B; the gather returns sum_l u_light_w[l] B_l,
+// the weights per band carrying the maps' scale (render/passes/common.c lr_passes_bind_gather):
+// intensities at composition, one light at a time for the VPLs.
+uniform vec3 u_light_w[LR_MAX_LIGHTS];
+uniform int u_n_lights;
 
-// Returns B; *n receives the summed visibility weight (0: no map sees x_o, in which case the
+vec3 lr_map_B(ivec2 ti, int k)
+{
+    vec3 b = vec3(0.0);
+    for (int l = 0; l < LR_MAX_LIGHTS; l++) {
+        if (l >= u_n_lights)
+            break;
+        b += u_light_w[l] * texelFetch(u_map_B, ivec3(ti, l * u_K + k), 0).rgb;
+    }
+    return b;
+}
+
+// Returns the weighted B; *n receives the summed visibility weight (0: no map sees x_o, in which case the
 // map with the largest n_o . d_k is used without visibility).
 vec3 lr_gather(vec3 xo, vec3 no, out float n)
 {
@@ -58,15 +76,15 @@ vec3 lr_gather(vec3 xo, vec3 no, out float n)
             vec4 nm = texelFetch(u_map_nrm, ivec3(ti, k), 0);
             if (dot(nm.xyz, no) <= 0.0)
                 continue;
-            color += wq * texelFetch(u_map_B, ivec3(ti, k), 0).rgb;
+            color += wq * lr_map_B(ti, k);
             n += wq;
         }
     }
     if (n > 1e-6)
-        return color / (n * u_map_scale);
+        return color / n;
     // No map sees x_o: the one that faces it most, nearest texel, no visibility test.
     vec3 t = (u_map_P[best] * vec4(xo, 1.0)).xyz;
     ivec2 ti = clamp(ivec2(t.xy * vec2(sz)), ivec2(0), sz - 1);
     n = 0.0;
-    return texelFetch(u_map_B, ivec3(ti, best), 0).rgb / u_map_scale;
+    return lr_map_B(ti, best);
 }

@@ -3,6 +3,8 @@
 // 1: one perspective 2D map (point/spot light, lookup by direction); 2: orthographic 2D map
 // (directional light, lookup by world point). Position texels hold (x, id + 1), 0 = empty.
 
+#include "gbuffer_texel.glsl"
+
 uniform highp samplerCube u_gb_cube_pos;
 uniform highp samplerCube u_gb_cube_nrm;
 uniform highp sampler2D u_gb_pos;
@@ -22,14 +24,9 @@ bool lr_gbuffer_fetch(vec3 v, out vec3 xi, out vec3 ni, out int id)
         p = texture(u_gb_cube_pos, v);
         n = texture(u_gb_cube_nrm, v);
     } else {
-        vec4 clip = u_gb_vp * vec4(u_gb_mode == 1 ? u_light_pos + v : v, 1.0);
-        if (!(clip.w > 0.0))
+        ivec2 t;
+        if (!lr_gbuffer_texel(u_gb_mode, u_gb_vp, u_light_pos, v, textureSize(u_gb_pos, 0), t))
             return false;
-        vec3 ndc = clip.xyz / clip.w;
-        if (any(greaterThan(abs(ndc.xy), vec2(1.0))))
-            return false;
-        ivec2 sz = textureSize(u_gb_pos, 0);
-        ivec2 t = clamp(ivec2((ndc.xy * 0.5 + 0.5) * vec2(sz)), ivec2(0), sz - 1);
         p = texelFetch(u_gb_pos, t, 0);
         n = texelFetch(u_gb_nrm, t, 0);
     }

@@ -1,4 +1,4 @@
-#include "calib/json_out.h"
+#include "render/base/json_write.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -142,6 +142,20 @@ void lr_jw_number(lr_jw *w, const char *key, double v)
 {
     if (check_finite(w, key, v) && begin_value(w, key))
         put_number(w->f, v);
+}
+
+void lr_jw_number_or_null(lr_jw *w, const char *key, double v)
+{
+    if (!isfinite(v))
+        lr_jw_null(w, key);
+    else
+        lr_jw_number(w, key, v);
+}
+
+void lr_jw_null(lr_jw *w, const char *key)
+{
+    if (begin_value(w, key))
+        fputs("null", w->f);
 }
 
 void lr_jw_int(lr_jw *w, const char *key, long v)

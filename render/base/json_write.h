@@ -1,4 +1,4 @@
-/* lamprig calib — writing JSON documents (render/base/json.h only reads them).
+/* lamprig — writing JSON documents (render/base/json.h reads them).
  *
  * A small streaming writer: objects and arrays nest, members are keyed, commas and
  * indentation are automatic, numbers are written with the fewest digits that read back to
@@ -6,8 +6,8 @@
  * infinity, mismatched nesting, a stream error) are sticky: later calls do nothing and
  * lr_jw_finish reports the first one with the key it concerned.
  */
-#ifndef LR_CALIB_JSON_OUT_H
-#define LR_CALIB_JSON_OUT_H
+#ifndef LR_BASE_JSON_WRITE_H
+#define LR_BASE_JSON_WRITE_H
 
 #include <stdbool.h>
 #include <stdio.h>
@@ -27,6 +27,10 @@ void lr_jw_object_end(lr_jw *w);
 void lr_jw_array(lr_jw *w, const char *key);
 void lr_jw_array_end(lr_jw *w);
 void lr_jw_number(lr_jw *w, const char *key, double v);
+/* A measurement that may be missing (NaN/Inf, e.g. a median of no samples) as null; plain
+ * lr_jw_number treats a non-finite value as an error. */
+void lr_jw_number_or_null(lr_jw *w, const char *key, double v);
+void lr_jw_null(lr_jw *w, const char *key);
 void lr_jw_int(lr_jw *w, const char *key, long v);
 void lr_jw_bool(lr_jw *w, const char *key, bool v);
 void lr_jw_string(lr_jw *w, const char *key, const char *s);

@@ -1,0 +1,47 @@
+/* lamprig — applying the planner to a scene (see plan_scene.h). */
+#include "firmware/plan_scene.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+int lr_plan_scene(lr_scene *scene, const char *table, lr_plan_scene_result *res, lr_err *e)
+{
+    memset(res, 0, sizeof *res);
+    res->vpl = true;
+    lr_plan_budget b;
+    if (!lr_plan_budget_from_scene(scene, &b))
+        return LR_OK;
+    int rc;
+    if (table) {
+        snprintf(res->table, sizeof res->table, "%s", table);
+        res->table_why = "given";
+    } else if ((rc = lr_plan_default_table(res->table, sizeof res->table, &res->table_why, e))) {
+        return rc;
+    }
+    lr_plan_table *t;
+    if ((rc = lr_plan_table_load(res->table, &t, e)))
+        return rc;
+    rc = lr_plan_create(scene, t, &b, NULL, &res->plan, e);
+    lr_plan_table_destroy(t);
+    if (!rc)
+        rc = lr_plan_apply(&res->plan, scene, NULL, e);
+    if (rc)
+        return rc;
+    res->planned = true;
+    res->vpl = res->plan.vpl;
+    return LR_OK;
+}
+
+char *lr_plan_scene_text(const lr_plan_scene_result *res)
+{
+    size_t need = lr_plan_format(&res->plan, NULL, 0);
+    size_t head = strlen(res->table) + 64;
+    char *buf = malloc(head + need + 1);
+    if (!buf)
+        return NULL;
+    int n = snprintf(buf, head, "plan: table %s (%s)\n", res->table,
+                     res->table_why ? res->table_why : "given");
+    lr_plan_format(&res->plan, buf + n, need + 1);
+    return buf;
+}

@@ -1,0 +1,32 @@
+/* lamprig — the planner as `lamprig render` and `lamprig run` use it: when a scene has a
+ * quality budget, plan it from the measured table (render/plan/plan.h) and apply the
+ * choice to the scene before the explicit settings (--set, the rig's scene_set), which win. */
+#ifndef LR_PLAN_SCENE_H
+#define LR_PLAN_SCENE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "render/base/err.h"
+#include "render/plan/plan.h"
+#include "render/scene/scene.h"
+
+typedef struct lr_plan_scene_result {
+    bool planned;  /* the scene had a budget and the plan was applied */
+    bool vpl;      /* the plan keeps the VPL pass (true when not planned) */
+    lr_plan plan;  /* when planned */
+    char table[1024];
+    const char *table_why; /* "given", "newest bench run", "committed front" */
+} lr_plan_scene_result;
+
+/* Plans `scene` when its quality block sets a budget (nothing to do otherwise: *res says
+ * planned = false) and applies the settings. table: a CSV path, or NULL for
+ * lr_plan_default_table. Errors (no table, bad table, no usable row) leave the scene as it
+ * was; the caller decides whether that is fatal. */
+int lr_plan_scene(lr_scene *scene, const char *table, lr_plan_scene_result *res, lr_err *e);
+
+/* The plan's lines (lr_plan_format) preceded by "plan: table PATH (WHY)". Returns a malloc'd
+ * string, NULL when out of memory. */
+char *lr_plan_scene_text(const lr_plan_scene_result *res);
+
+#endif

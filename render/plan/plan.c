@@ -1,0 +1,455 @@
+/* lamprig planner — choosing, per object, a measured row that meets the budget.
+ *
+ * Cost is time to converge: the renderer accumulates render.frames frames and then runs no
+ * pass until something changes (render/renderer.c, lr_renderer_needs_frame), so the time a
+ * designer waits for the measured error is ms_gbuffer + frames x frame_ms (the first frame
+ * adds the light G-buffer; later ones are accumulation frames of frame_ms each). A frame_ms
+ * budget bounds one accumulation frame: the rate at which the preview refreshes while it
+ * converges. */
+#include "render/plan/plan.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render/base/paths.h"
+
+#define MAX_SCENES 32
+
+static void reason(lr_plan_choice *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void reason(lr_plan_choice *c, const char *fmt, ...)
+{
+    if (c->nreasons >= LR_PLAN_REASONS)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(c->reasons[c->nreasons++], LR_PLAN_REASON_MAX, fmt, ap);
+    va_end(ap);
+}
+
+bool lr_plan_budget_from_scene(const lr_scene *s, lr_plan_budget *out)
+{
+    const lr_quality *q = lr_scene_quality(s);
+    out->max_error = q->max_error;
+    out->frame_ms = q->frame_ms;
+    return q->max_error > 0 || q->frame_ms > 0;
+}
+
+/* The scene file's base name without extension: what the bench writes in `scene`. */
+static void scene_key(const lr_scene *s, char *buf, size_t cap)
+{
+    const char *p = lr_scene_path(s);
+    if (!p || !*p)
+        p = lr_scene_name(s);
+    const char *slash = strrchr(p, '/');
+    snprintf(buf, cap, "%s", slash ? slash + 1 : p);
+    char *dot = strrchr(buf, '.');
+    if (dot && dot != buf)
+        *dot = '\0';
+}
+
+static double feature_distance(const lr_plan_features *a, const lr_plan_features *b)
+{
+    /* Light inside or outside and solid or shell change which paths dominate (seed 003's
+     * stereographic lookup; transmission through a wall); convexity changes coverage; the
+     * size in diffusion lengths changes how far light spreads. Weights order these. */
+    double d = 4.0 * (a->enclosed != b->enclosed) + 4.0 * (a->shell != b->shell) +
+               2.0 * (a->convex != b->convex);
+    if (a->size_tr > 0 && b->size_tr > 0)
+        d += fabs(log(a->size_tr / b->size_tr));
+    return d;
+}
+
+static const char *features_text(const lr_plan_features *f, char *buf, size_t cap)
+{
+    snprintf(buf, cap, "%s, %s, %s, %.1f diffusion lengths",
+             f->enclosed ? "light enclosed" : "light outside", f->shell ? "thin shell" : "solid",
+             f->convex ? "convex" : "not convex", f->size_tr);
+    return buf;
+}
+
+/* The measured scene nearest to object `index` by features (see feature_distance). */
+static int nearest_scene(const lr_scene *s, int index, const lr_plan_table *t,
+                         const char *configs, char *out, size_t cap, char *why,
+                         char *why_theirs, size_t whycap, lr_err *e)
+{
+    const char *names[MAX_SCENES];
+    int n = 0;
+    for (int i = 0; i < lr_plan_table_count(t) && n < MAX_SCENES; i++) {
+        const char *nm = lr_plan_table_row(t, i)->scene;
+        bool seen = false;
+        for (int j = 0; j < n && !seen; j++)
+            seen = !strcmp(names[j], nm);
+        if (!seen)
+            names[n++] = nm;
+    }
+    lr_plan_features mine;
+    lr_plan_features_of(s, index, &mine);
+    double best = INFINITY;
+    lr_plan_features best_f = {0};
+    char skipped[200] = "";
+    for (int i = 0; i < n; i++) {
+        char path[1024];
+        char leaf[LR_PLAN_TEXT_MAX + 8];
+        snprintf(leaf, sizeof leaf, "%s.json", names[i]);
+        lr_scene *ms = NULL;
+        lr_err le = {0};
+        if (lr_path_join(path, sizeof path, configs, "scenes", leaf) ||
+            lr_scene_load(path, NULL, &ms, &le)) {
+            size_t l = strlen(skipped);
+            snprintf(skipped + l, sizeof skipped - l, "%s%s", l ? ", " : "", names[i]);
+            continue;
+        }
+        lr_plan_features f;
+        lr_plan_features_of(ms, 0, &f);
+        lr_scene_destroy(ms);
+        double d = feature_distance(&mine, &f);
+        if (d < best) {
+            best = d;
+            best_f = f;
+            snprintf(out, cap, "%s", names[i]);
+        }
+    }
+    if (!isfinite(best))
+        return lr_err_set(e, LR_EINVAL,
+                          "planner: scene '%s' is not in %s and none of its measured scenes "
+                          "could be loaded from %s/scenes to compare features (%s)",
+                          lr_scene_name(s), lr_plan_table_name(t), configs, skipped);
+    features_text(&mine, why, whycap);
+    features_text(&best_f, why_theirs, whycap);
+    return LR_OK;
+}
+
+typedef struct cand {
+    const lr_plan_row *row;
+    double err, fms, conv;
+} cand;
+
+/* Whether a is better than b under the budget (both feasible). */
+static bool better(const cand *a, const cand *b, const lr_plan_budget *bu)
+{
+    if (bu->max_error > 0) { /* soonest converged, then lower error, then faster frames */
+        if (a->conv != b->conv)
+            return a->conv < b->conv;
+        if (a->err != b->err)
+            return a->err < b->err;
+        return a->fms < b->fms;
+    }
+    if (a->err != b->err) /* frame_ms only: lowest error */
+        return a->err < b->err;
+    if (a->conv != b->conv)
+        return a->conv < b->conv;
+    return a->fms < b->fms;
+}
+
+static double shortfall(const cand *c, const lr_plan_budget *b)
+{
+    double r = 0.0;
+    if (b->max_error > 0)
+        r = fmax(r, c->err / b->max_error);
+    if (b->frame_ms > 0)
+        r = fmax(r, c->fms / b->frame_ms);
+    return r;
+}
+
+static bool model_ok(const char *model, unsigned models)
+{
+    if (!strcmp(model, "directional_dipole"))
+        return models & LR_PLAN_MODEL_DIRECTIONAL;
+    if (!strcmp(model, "standard_dipole"))
+        return models & LR_PLAN_MODEL_STANDARD;
+    return false;
+}
+
+static int plan_object(const lr_scene *s, int index, const lr_plan_table *t,
+                       const lr_plan_budget *b, const char *configs, unsigned models,
+                       lr_plan_choice *c, lr_err *e)
+{
+    memset(c, 0, sizeof *c);
+    const lr_scene_object *o = lr_scene_object_at(s, index);
+    snprintf(c->object, sizeof c->object, "%s", o->name);
+    int rc = lr_plan_analyze(s, index, &c->analysis, e);
+    if (rc)
+        return rc;
+    const lr_plan_analysis *a = &c->analysis;
+
+    char key[LR_PLAN_TEXT_MAX];
+    scene_key(s, key, sizeof key);
+    if (lr_plan_table_has_scene(t, key)) {
+        snprintf(c->table_scene, sizeof c->table_scene, "%s", key);
+        c->scene_matched = true;
+        reason(c, "measured on '%s'", key);
+    } else {
+        char mine[128], theirs[128];
+        if ((rc = nearest_scene(s, index, t, configs, c->table_scene, sizeof c->table_scene, mine,
+                                theirs, sizeof mine, e)))
+            return rc;
+        reason(c, "scene '%s' is not in the table: nearest measured scene '%s' by features "
+                  "(%s; '%s': %s)", key, c->table_scene, mine, c->table_scene, theirs);
+    }
+
+    /* VPLs carry emergent light to receivers; with none in sight they light nothing. */
+    bool need_vpl = a->receivers_seeing != 0;
+    if (!need_vpl)
+        reason(c, "no receiver sees %s%s: VPL pass off", o->name,
+               a->receivers_checked ? "" : " (the scene has none)");
+
+    if (a->features.convex)
+        reason(c, "convex: %d map%s cover %.1f %% of the surface (no self-occlusion)", a->K_cover,
+               a->K_cover == 1 ? "" : "s", 100.0 * a->coverage[a->K_cover - 1]);
+    else
+        reason(c, "not convex (vertices up to %.1f mm outside a face plane): %d maps to cover %.1f %%",
+               a->convex_violation_mm, a->K_cover, 100.0 * a->coverage[a->K_cover - 1]);
+
+    /* Candidates: the measured scene's rows with a model the renderer runs and at least
+     * K_cover maps (the bench measures one view; coverage must hold for every view). */
+    int n = lr_plan_table_count(t), ncand = 0, nscene = 0, kmax = 0;
+    cand *cs = malloc((size_t)n * sizeof *cs);
+    if (!cs)
+        return lr_err_set(e, LR_ENOMEM, "planner: out of memory");
+    for (int pass = 0; pass < 2 && !ncand; pass++) {
+        for (int i = 0; i < n; i++) {
+            const lr_plan_row *r = lr_plan_table_row(t, i);
+            if (strcmp(r->scene, c->table_scene) || !model_ok(r->model, models))
+                continue;
+            if (!pass) {
+                nscene++;
+                if (r->K > kmax)
+                    kmax = r->K;
+            }
+            /* pass 0: K >= K_cover; pass 1 (none had that many maps): the most maps measured */
+            if (pass == 0 ? r->K < a->K_cover : r->K < kmax)
+                continue;
+            cand x = {.row = r, .err = r->rel_rmse, .fms = r->frame_ms};
+            if (!need_vpl && r->vpl && isfinite(r->ms_vpl))
+                x.fms = fmax(r->frame_ms - r->ms_vpl, 0.0);
+            x.conv = (isfinite(r->ms_gbuffer) ? r->ms_gbuffer : 0.0) + r->frames * x.fms;
+            cs[ncand++] = x;
+        }
+        if (!ncand && nscene && !pass)
+            reason(c, "no measured row has K >= %d: using the most maps measured (K = %d)",
+                   a->K_cover, kmax);
+        if (!nscene)
+            break;
+    }
+    if (!ncand) {
+        free(cs);
+        return lr_err_set(e, LR_EINVAL, "planner: %s: no row of scene '%s' in %s with model %s",
+                          o->name, c->table_scene, lr_plan_table_name(t),
+                          models == LR_PLAN_MODEL_DIRECTIONAL ? "directional_dipole" : "allowed");
+    }
+
+    const cand *best = NULL;
+    int nfeas = 0;
+    for (int i = 0; i < ncand; i++) {
+        const cand *x = &cs[i];
+        bool ok = (b->max_error <= 0 || x->err <= b->max_error) &&
+                  (b->frame_ms <= 0 || x->fms <= b->frame_ms);
+        if (!ok)
+            continue;
+        nfeas++;
+        if (!best || better(x, best, b))
+            best = x;
+    }
+    c->feasible = best != NULL;
+    if (best) {
+        reason(c, "%s of %d measured settings meeting the budget (of %d)",
+               b->max_error > 0 ? "soonest converged" : "lowest error", nfeas, ncand);
+    } else {
+        for (int i = 0; i < ncand; i++)
+            if (!best || shortfall(&cs[i], b) < shortfall(best, b) ||
+                (shortfall(&cs[i], b) == shortfall(best, b) && better(&cs[i], best, b)))
+                best = &cs[i];
+        reason(c, "INFEASIBLE: none of %d measured settings meets the budget; closest picked "
+                  "(%.2fx the budget)", ncand, shortfall(best, b));
+    }
+    c->row = *best->row;
+    c->vpl = need_vpl && best->row->vpl;
+    c->predicted_error = best->err;
+    c->predicted_frame_ms = best->fms;
+    c->predicted_converge_ms = best->conv;
+    free(cs);
+    return LR_OK;
+}
+
+int lr_plan_create(const lr_scene *s, const lr_plan_table *t, const lr_plan_budget *b,
+                   const lr_plan_options *opt, lr_plan *out, lr_err *e)
+{
+    memset(out, 0, sizeof *out);
+    if (!(b->max_error > 0) && !(b->frame_ms > 0))
+        return lr_err_set(e, LR_EINVAL, "planner: no budget (quality.max_error or "
+                                        "quality.frame_ms, > 0)");
+    if (!isfinite(b->max_error) || !isfinite(b->frame_ms) || b->max_error < 0 || b->frame_ms < 0)
+        return lr_err_set(e, LR_EINVAL, "planner: budget must be finite and >= 0");
+    int no = lr_scene_object_count(s);
+    if (no > LR_PLAN_MAX_OBJECTS)
+        return lr_err_set(e, LR_EINVAL, "planner: %d objects, at most %d", no,
+                          LR_PLAN_MAX_OBJECTS);
+    const char *configs = opt && opt->configs_dir ? opt->configs_dir : lr_configs_dir();
+    unsigned models = opt && opt->models ? opt->models : LR_PLAN_MODEL_DIRECTIONAL;
+    snprintf(out->scene, sizeof out->scene, "%s", lr_scene_name(s));
+    out->budget = *b;
+    out->nobjects = no;
+    out->settings = *lr_scene_render(s);
+    lr_render_settings *rs = &out->settings;
+    rs->K = rs->N = rs->N_vpl = rs->map_size = rs->gbuffer_size = rs->frames = 0;
+    out->feasible = true;
+    for (int i = 0; i < no; i++) {
+        lr_plan_choice *c = &out->objects[i];
+        int rc = plan_object(s, i, t, b, configs, models, c, e);
+        if (rc)
+            return rc;
+        /* One settings block drives every object: the most demanding choice wins. */
+        const lr_plan_row *r = &c->row;
+        rs->K = r->K > rs->K ? r->K : rs->K;
+        rs->N = r->N > rs->N ? r->N : rs->N;
+        rs->map_size = r->map_size > rs->map_size ? r->map_size : rs->map_size;
+        rs->gbuffer_size = r->gbuffer_size > rs->gbuffer_size ? r->gbuffer_size : rs->gbuffer_size;
+        rs->frames = r->frames > rs->frames ? r->frames : rs->frames;
+        if (c->vpl) {
+            out->vpl = true;
+            rs->N_vpl = r->N_vpl > rs->N_vpl ? r->N_vpl : rs->N_vpl;
+        }
+        out->feasible &= c->feasible;
+    }
+    if (!out->vpl) /* the renderer needs a valid count even with the pass off */
+        rs->N_vpl = lr_scene_render(s)->N_vpl;
+    return LR_OK;
+}
+
+int lr_plan_apply(const lr_plan *p, lr_scene *s, unsigned *dirty, lr_err *e)
+{
+    const struct {
+        const char *key;
+        int v;
+    } sets[] = {{"render.K", p->settings.K},
+                {"render.N", p->settings.N},
+                {"render.N_vpl", p->settings.N_vpl},
+                {"render.map_size", p->settings.map_size},
+                {"render.gbuffer_size", p->settings.gbuffer_size},
+                {"render.frames", p->settings.frames}};
+    for (size_t i = 0; i < sizeof sets / sizeof *sets; i++) {
+        char v[32];
+        snprintf(v, sizeof v, "%d", sets[i].v);
+        int rc = lr_scene_set(s, sets[i].key, v, dirty, e);
+        if (rc)
+            return lr_err_prefix(e, "applying the plan");
+    }
+    return LR_OK;
+}
+
+/* ---- output ---- */
+
+typedef struct out {
+    char *buf;
+    size_t cap, len;
+} out;
+
+static void put(out *o, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void put(out *o, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    size_t room = o->len < o->cap ? o->cap - o->len : 0;
+    int n = vsnprintf(room ? o->buf + o->len : NULL, room, fmt, ap);
+    va_end(ap);
+    if (n > 0)
+        o->len += (size_t)n;
+}
+
+static void put_budget(out *o, const lr_plan_budget *b)
+{
+    if (b->max_error > 0 && b->frame_ms > 0)
+        put(o, "error <= %g and <= %g ms/frame", b->max_error, b->frame_ms);
+    else if (b->max_error > 0)
+        put(o, "error <= %g", b->max_error);
+    else
+        put(o, "<= %g ms/frame", b->frame_ms);
+}
+
+size_t lr_plan_format(const lr_plan *p, char *buf, size_t cap)
+{
+    out o = {buf, cap, 0};
+    if (cap)
+        buf[0] = '\0';
+    for (int i = 0; i < p->nobjects; i++) {
+        const lr_plan_choice *c = &p->objects[i];
+        const lr_plan_row *r = &c->row;
+        put(&o, "plan: %s: %s K=%d N=%d N_vpl=%d map=%d gbuffer=%d frames=%d vpl=%s, error %.3g, "
+                "%.0f ms/frame, converged in %.1f s%s",
+            c->object, r->model, r->K, r->N, c->vpl ? r->N_vpl : 0, r->map_size, r->gbuffer_size,
+            r->frames, c->vpl ? "on" : "off", c->predicted_error, c->predicted_frame_ms,
+            c->predicted_converge_ms / 1000.0, c->feasible ? "" : " [INFEASIBLE]");
+        for (int k = 0; k < c->nreasons; k++)
+            put(&o, "%s%s", k ? "; " : " (", c->reasons[k]);
+        put(&o, "%s\n", c->nreasons ? ")" : "");
+    }
+    const lr_render_settings *s = &p->settings;
+    put(&o, "plan: %s: budget ", p->scene);
+    put_budget(&o, &p->budget);
+    put(&o, "%s; render K=%d N=%d N_vpl=%d map_size=%d gbuffer_size=%d frames=%d, VPL pass %s; "
+            "after %d frames no pass runs until something changes\n",
+        p->feasible ? " met" : " NOT MET (infeasible: closest settings chosen)", s->K, s->N,
+        p->vpl ? s->N_vpl : 0, s->map_size, s->gbuffer_size, s->frames, p->vpl ? "on" : "off",
+        s->frames);
+    return o.len;
+}
+
+static void put_json_string(out *o, const char *s)
+{
+    put(o, "\"");
+    for (; *s; s++) {
+        unsigned char ch = (unsigned char)*s;
+        if (ch == '"' || ch == '\\')
+            put(o, "\\%c", ch);
+        else if (ch < 0x20)
+            put(o, "\\u%04x", ch);
+        else
+            put(o, "%c", ch);
+    }
+    put(o, "\"");
+}
+
+size_t lr_plan_format_json(const lr_plan *p, char *buf, size_t cap)
+{
+    out o = {buf, cap, 0};
+    if (cap)
+        buf[0] = '\0';
+    put(&o, "{\"scene\":");
+    put_json_string(&o, p->scene);
+    put(&o, ",\"budget\":{\"max_error\":%.17g,\"frame_ms\":%.17g},\"feasible\":%s,\"objects\":[",
+        p->budget.max_error, p->budget.frame_ms, p->feasible ? "true" : "false");
+    for (int i = 0; i < p->nobjects; i++) {
+        const lr_plan_choice *c = &p->objects[i];
+        const lr_plan_row *r = &c->row;
+        const lr_plan_analysis *a = &c->analysis;
+        put(&o, "%s{\"object\":", i ? "," : "");
+        put_json_string(&o, c->object);
+        put(&o, ",\"table_scene\":");
+        put_json_string(&o, c->table_scene);
+        put(&o, ",\"scene_matched\":%s,\"model\":\"%s\",\"K\":%d,\"N\":%d,\"N_vpl\":%d,"
+                "\"map_size\":%d,\"gbuffer_size\":%d,\"frames\":%d,\"vpl\":%s,\"table_line\":%d,"
+                "\"predicted_error\":%.6g,\"predicted_frame_ms\":%.6g,"
+                "\"predicted_converge_ms\":%.6g,\"feasible\":%s,",
+            c->scene_matched ? "true" : "false", r->model, r->K, r->N, r->N_vpl, r->map_size,
+            r->gbuffer_size, r->frames, c->vpl ? "true" : "false", r->line, c->predicted_error,
+            c->predicted_frame_ms, c->predicted_converge_ms, c->feasible ? "true" : "false");
+        put(&o, "\"convex\":%s,\"shell\":%s,\"enclosed\":%s,\"K_cover\":%d,\"coverage\":%.4f,"
+                "\"receivers_seeing\":%d,\"reasons\":[",
+            a->features.convex ? "true" : "false", a->features.shell ? "true" : "false",
+            a->features.enclosed ? "true" : "false", a->K_cover, a->coverage[LR_PLAN_KMAX - 1],
+            __builtin_popcount(a->receivers_seeing));
+        for (int k = 0; k < c->nreasons; k++) {
+            put(&o, "%s", k ? "," : "");
+            put_json_string(&o, c->reasons[k]);
+        }
+        put(&o, "]}");
+    }
+    const lr_render_settings *s = &p->settings;
+    put(&o, "],\"settings\":{\"K\":%d,\"N\":%d,\"N_vpl\":%d,\"map_size\":%d,\"gbuffer_size\":%d,"
+            "\"frames\":%d,\"vpl\":%s}}\n",
+        s->K, s->N, s->N_vpl, s->map_size, s->gbuffer_size, s->frames, p->vpl ? "true" : "false");
+    return o.len;
+}

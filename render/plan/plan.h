@@ -1,0 +1,191 @@
+/* lamprig — the planner: per object, the cheapest measured model and settings that meet the
+ * scene's quality budget, and what the scene does not need (DESIGN.md, "A planner picks, per
+ * object, the cheapest model and parameters (K, N, N_vpl, map sizes) that meet the scene's
+ * error budget, from measured speed/error tables, and says what it chose").
+ *
+ * Three parts, pure C (no GL):
+ *   table    the measured speed/error front: a CSV written by the bench sweep
+ *            (build/bench/results.csv, committed as configs/bench/front.csv), one row per
+ *            measured (scene, model, settings); columns are found by their header name.
+ *   analysis what each object of a scene needs, from its geometry: whether any receiver
+ *            sees it (else its VPLs light nothing), whether it is convex, how many radiosity
+ *            maps cover its surface (Algorithm 1 of seed 003 composes a point from the maps
+ *            that see it), and the features used to match a scene the table does not hold.
+ *   plan     per object, the chosen row, its predicted error and time, and reasons; the
+ *            scene-wide settings the renderer takes (one settings block for all objects).
+ */
+#ifndef LR_PLAN_H
+#define LR_PLAN_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "render/base/err.h"
+#include "render/scene/scene.h"
+
+/* ---- The measured table --------------------------------------------------------------- */
+
+#define LR_PLAN_TEXT_MAX 64
+
+/* One measured setting. Errors are relative RMSE against the physical reference after
+ * `frames` accumulation frames; optional columns absent from the file (or empty cells) are
+ * NaN. */
+typedef struct lr_plan_row {
+    int line; /* in the CSV file, for messages */
+    char scene[LR_PLAN_TEXT_MAX]; /* scene file base name ("candle") */
+    char model[LR_PLAN_TEXT_MAX]; /* "directional_dipole" | "standard_dipole" */
+    char params[LR_PLAN_TEXT_MAX];
+    double frame_ms;            /* median ms of one accumulation frame */
+    double rel_rmse;            /* whole image */
+    double rel_rmse_object, rel_rmse_receivers;
+    int K, N, N_vpl, map_size, gbuffer_size, frames;
+    bool vpl;
+    double ms_gbuffer, ms_radiosity, ms_vpl, ms_compose; /* optional */
+    int width, height; /* optional, 0 when absent */
+} lr_plan_row;
+
+typedef struct lr_plan_table lr_plan_table;
+
+/* Parses CSV text. The first line is the header; columns are looked up by name, in any order;
+ * unknown columns are ignored. Required: scene, model, frame_ms, rel_rmse, K, N, N_vpl,
+ * map_size, gbuffer_size, frames, vpl. Errors name "NAME:LINE: column 'C': what" (a missing
+ * column names line 1). Blank lines and lines starting with '#' are skipped. */
+int lr_plan_table_parse(const char *text, size_t len, const char *name, lr_plan_table **out,
+                        lr_err *e);
+int lr_plan_table_load(const char *path, lr_plan_table **out, lr_err *e);
+void lr_plan_table_destroy(lr_plan_table *t);
+int lr_plan_table_count(const lr_plan_table *t);
+const lr_plan_row *lr_plan_table_row(const lr_plan_table *t, int i);
+const char *lr_plan_table_name(const lr_plan_table *t);
+/* Whether any row measures `scene`. */
+bool lr_plan_table_has_scene(const lr_plan_table *t, const char *scene);
+
+/* The default table: ROOT/build/bench/results.csv when it exists and is at least as new as
+ * CONFIGS/bench/front.csv (or that one is missing), else CONFIGS/bench/front.csv, where
+ * CONFIGS is lr_configs_dir() and ROOT its parent (the source tree). Writes the path to buf
+ * and a short reason ("newest bench run" | "committed front") to *why. LR_EIO when neither
+ * exists. */
+int lr_plan_default_table(char *buf, size_t cap, const char **why, lr_err *e);
+
+/* ---- Scene analysis ------------------------------------------------------------------- */
+
+#define LR_PLAN_MAX_OBJECTS 8
+#define LR_PLAN_KMAX 32 /* the renderer's map limit */
+
+typedef struct lr_plan_features {
+    bool enclosed;   /* lights[0] lies inside the object's hull or material */
+    bool shell;      /* thin wall: mean thickness 2 V / A below radius / 10, or open */
+    bool convex;
+    double size_tr;  /* bounding radius x mean sigma_tr: the object's size in diffusion lengths */
+} lr_plan_features;
+
+typedef struct lr_plan_analysis {
+    lr_plan_features features;
+    /* Receivers with an unoccluded line of sight to the object's surface, both sides facing
+     * each other: a bit per receiver. 0: the object's VPLs light nothing. */
+    unsigned receivers_seeing;
+    int receivers_checked;
+    /* Fraction of the surface (area samples) the first k maps see, k = 1..LR_PLAN_KMAX:
+     * coverage[k-1]. A point is seen by map k when its normal faces d_k (n.d_k > 0.1) and the
+     * ray toward d_k leaves the object without a hit (the map's depth test). */
+    double coverage[LR_PLAN_KMAX];
+    /* The fewest maps whose coverage is within 0.2 % (2 of the 1024 samples:
+     * sampling noise, not a hole) of what all LR_PLAN_KMAX maps see. */
+    int K_cover;
+    double convex_violation_mm; /* largest distance of a vertex outside a face plane */
+} lr_plan_analysis;
+
+/* Analyses object `index` of the scene. Deterministic (fixed quasi-random samples). */
+int lr_plan_analyze(const lr_scene *s, int index, lr_plan_analysis *out, lr_err *e);
+/* The features alone (no sampling): for matching scenes. */
+void lr_plan_features_of(const lr_scene *s, int index, lr_plan_features *out);
+/* All vertices on the inner side of every face plane, within tol (mm); closed meshes only
+ * (an open surface is a shell, never convex). *violation receives the largest distance of a
+ * vertex beyond a face plane (within tol of 0 when convex; 0 for an open mesh). */
+bool lr_plan_mesh_convex(const lr_mesh *m, bool closed, double tol, double *violation);
+
+/* ---- The plan --------------------------------------------------------------------------- */
+
+typedef struct lr_plan_budget {
+    double max_error; /* relative RMSE; 0: none */
+    double frame_ms;  /* ms per accumulation frame; 0: none */
+} lr_plan_budget;
+
+#define LR_PLAN_REASONS 6
+#define LR_PLAN_REASON_MAX 320
+
+typedef struct lr_plan_choice {
+    char object[LR_SCENE_NAME_MAX];
+    char table_scene[LR_PLAN_TEXT_MAX]; /* the measured scene the rows come from */
+    bool scene_matched;                 /* the scene itself is in the table */
+    lr_plan_row row;                    /* the chosen measured row */
+    bool vpl;                           /* VPL pass for this object */
+    double predicted_error;             /* rel_rmse of the row */
+    double predicted_frame_ms;          /* the row's frame_ms (less ms_vpl when VPLs are cut) */
+    double predicted_converge_ms;       /* ms_gbuffer (0 when not measured) + frames x
+                                         * predicted_frame_ms */
+    bool feasible;                      /* meets every budget given */
+    lr_plan_analysis analysis;
+    int nreasons;
+    char reasons[LR_PLAN_REASONS][LR_PLAN_REASON_MAX];
+} lr_plan_choice;
+
+typedef struct lr_plan {
+    char scene[LR_SCENE_NAME_MAX];
+    lr_plan_budget budget;
+    int nobjects;
+    lr_plan_choice objects[LR_PLAN_MAX_OBJECTS];
+    /* What the renderer takes (one settings block for every object): the largest K, N,
+     * N_vpl, map and G-buffer sizes and frames of the choices; VPLs off only when no object
+     * needs them. */
+    lr_render_settings settings;
+    bool vpl;
+    bool feasible; /* every object's choice meets the budget */
+} lr_plan;
+
+/* Models the planner may choose. The GLES renderer implements the directional dipole only,
+ * so that is the default; `lamprig plan --models all` shows what the table would pick. */
+enum lr_plan_models {
+    LR_PLAN_MODEL_DIRECTIONAL = 1u << 0, /* "directional_dipole" */
+    LR_PLAN_MODEL_STANDARD = 1u << 1,    /* "standard_dipole" */
+};
+
+typedef struct lr_plan_options {
+    /* Where the scenes the table names are found, to match a scene the table lacks by
+     * features: CONFIGS/scenes/NAME.json. NULL: lr_configs_dir(). */
+    const char *configs_dir;
+    unsigned models; /* lr_plan_models; 0: LR_PLAN_MODEL_DIRECTIONAL */
+} lr_plan_options;
+
+/* Chooses, per object, among the rows of the scene (or of the measured scene nearest by
+ * features when the table has no row for it):
+ *   max_error only: the row with error <= max_error that converges soonest
+ *                   (ms_gbuffer + frames x frame_ms), ties to the lower error;
+ *   frame_ms only:  the lowest error with frame_ms <= budget, ties to the sooner converging;
+ *   both:           the soonest converging row meeting both; none: infeasible, the row
+ *                   nearest to both (smallest max(error / max_error, frame_ms / budget)),
+ *                   said in the reasons;
+ *   neither:        LR_EINVAL (no budget to plan for).
+ * Rows with fewer maps than the object's K_cover are left out (the bench measures one view;
+ * coverage must hold for every view). VPLs are cut for an object no receiver sees.
+ * LR_EINVAL when no row is usable. */
+int lr_plan_create(const lr_scene *s, const lr_plan_table *t, const lr_plan_budget *b,
+                   const lr_plan_options *opt, lr_plan *out, lr_err *e);
+
+/* The budget of a scene's "quality" block; false when it sets none. */
+bool lr_plan_budget_from_scene(const lr_scene *s, lr_plan_budget *out);
+
+/* Applies plan->settings to the scene through lr_scene_set (render.K, N, N_vpl, map_size,
+ * gbuffer_size, frames), ORing dirty flags. */
+int lr_plan_apply(const lr_plan *p, lr_scene *s, unsigned *dirty, lr_err *e);
+
+/* One line per object, "plan: OBJECT: MODEL K=.. N=.. N_vpl=.. map=.. gbuffer=.. frames=..
+ * vpl=on|off, error 0.05, 150 ms/frame, converged in 4.8 s[ [INFEASIBLE]] (reason; ...)",
+ * then the scene line (budget met or NOT MET, the settings applied, and that no pass runs
+ * after the planned frames until something changes); written to buf (truncated to cap,
+ * which may be 0). Returns the length it needed, without the NUL. */
+size_t lr_plan_format(const lr_plan *p, char *buf, size_t cap);
+/* The same as one JSON object. */
+size_t lr_plan_format_json(const lr_plan *p, char *buf, size_t cap);
+
+#endif

@@ -1,0 +1,338 @@
+/* lamprig planner — the measured speed/error table (CSV from the bench sweep).
+ *
+ * Header-driven: the first non-comment line names the columns, each row is looked up by
+ * name, so a bench that adds or reorders columns does not break the planner. Cells are plain
+ * (the bench writes no quotes or commas inside a field); a quoted cell is an error rather
+ * than something half-understood. */
+#include "render/plan/plan.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "render/base/file.h"
+#include "render/base/paths.h"
+
+struct lr_plan_table {
+    char name[256];
+    lr_plan_row *rows;
+    int n, cap;
+};
+
+enum col {
+    C_SCENE, C_MODEL, C_PARAMS, C_FRAME_MS, C_RMSE, C_RMSE_OBJ, C_RMSE_REC, C_K, C_N, C_NVPL,
+    C_MAP, C_GBUF, C_FRAMES, C_VPL, C_MS_G, C_MS_R, C_MS_V, C_MS_C, C_W, C_H, C_COUNT
+};
+
+static const struct {
+    const char *name;
+    bool required;
+} cols[C_COUNT] = {
+    [C_SCENE] = {"scene", true},          [C_MODEL] = {"model", true},
+    [C_PARAMS] = {"params", false},       [C_FRAME_MS] = {"frame_ms", true},
+    [C_RMSE] = {"rel_rmse", true},        [C_RMSE_OBJ] = {"rel_rmse_object", false},
+    [C_RMSE_REC] = {"rel_rmse_receivers", false},
+    [C_K] = {"K", true},                  [C_N] = {"N", true},
+    [C_NVPL] = {"N_vpl", true},           [C_MAP] = {"map_size", true},
+    [C_GBUF] = {"gbuffer_size", true},    [C_FRAMES] = {"frames", true},
+    [C_VPL] = {"vpl", true},              [C_MS_G] = {"ms_gbuffer", false},
+    [C_MS_R] = {"ms_radiosity", false},   [C_MS_V] = {"ms_vpl", false},
+    [C_MS_C] = {"ms_compose", false},     [C_W] = {"width", false},
+    [C_H] = {"height", false},
+};
+
+#define MAX_FIELDS 64
+
+/* Splits line (modified in place) at commas; trims spaces and a trailing '\r'. */
+static int split(char *line, char **f, int max)
+{
+    int n = 0;
+    char *p = line;
+    for (;;) {
+        char *c = strchr(p, ',');
+        if (c)
+            *c = '\0';
+        while (*p == ' ' || *p == '\t')
+            p++;
+        char *end = p + strlen(p);
+        while (end > p && (end[-1] == ' ' || end[-1] == '\t' || end[-1] == '\r'))
+            *--end = '\0';
+        if (n < max)
+            f[n] = p;
+        n++;
+        if (!c)
+            break;
+        p = c + 1;
+    }
+    return n;
+}
+
+static int cell_err(const char *name, int line, const char *col, lr_err *e, const char *what,
+                    const char *text)
+{
+    return lr_err_set(e, LR_EPARSE, "%s:%d: column '%s': %s, got '%.40s'", name, line, col, what,
+                      text);
+}
+
+static int cell_number(const char *name, int line, const char *col, const char *text,
+                       bool required, double *out, lr_err *e)
+{
+    if (!*text) {
+        if (required)
+            return lr_err_set(e, LR_EPARSE, "%s:%d: column '%s': empty", name, line, col);
+        *out = NAN;
+        return LR_OK;
+    }
+    char *end;
+    errno = 0;
+    double v = strtod(text, &end);
+    /* strtod reads "nan", "inf" and hex: a measured value is a finite decimal. */
+    bool decimal = strspn(text, "0123456789+-.eE") == strlen(text);
+    if (*end || errno || !decimal || !isfinite(v))
+        return cell_err(name, line, col, e, "expected a finite number", text);
+    if (v < 0)
+        return cell_err(name, line, col, e, "must be >= 0", text);
+    *out = v;
+    return LR_OK;
+}
+
+static int cell_int(const char *name, int line, const char *col, const char *text, bool required,
+                    int min, int *out, lr_err *e)
+{
+    double v;
+    int rc = cell_number(name, line, col, text, required, &v, e);
+    if (rc)
+        return rc;
+    if (isnan(v)) {
+        *out = 0;
+        return LR_OK;
+    }
+    if (v != floor(v) || v < min || v > 1e7)
+        return lr_err_set(e, LR_EPARSE, "%s:%d: column '%s': expected a whole number >= %d, got '%.40s'",
+                          name, line, col, min, text);
+    *out = (int)v;
+    return LR_OK;
+}
+
+static int cell_text(const char *name, int line, const char *col, const char *text, char *buf,
+                     size_t cap, bool required, lr_err *e)
+{
+    if (required && !*text)
+        return lr_err_set(e, LR_EPARSE, "%s:%d: column '%s': empty", name, line, col);
+    if (strchr(text, '"'))
+        return cell_err(name, line, col, e, "quoted cells are not supported", text);
+    if (strlen(text) >= cap)
+        return cell_err(name, line, col, e, "too long", text);
+    strcpy(buf, text);
+    return LR_OK;
+}
+
+static int parse_row(const char *name, int line, char **f, const int *at, lr_plan_row *r,
+                     lr_err *e)
+{
+    memset(r, 0, sizeof *r);
+    r->line = line;
+#define TXT(c, field, req) \
+    if ((rc = cell_text(name, line, cols[c].name, at[c] >= 0 ? f[at[c]] : "", r->field, \
+                        sizeof r->field, req, e))) \
+        return rc
+#define NUM(c, field) \
+    if ((rc = cell_number(name, line, cols[c].name, at[c] >= 0 ? f[at[c]] : "", cols[c].required, \
+                          &r->field, e))) \
+        return rc
+#define INT(c, field, min) \
+    if ((rc = cell_int(name, line, cols[c].name, at[c] >= 0 ? f[at[c]] : "", cols[c].required, \
+                       min, &r->field, e))) \
+        return rc
+    int rc;
+    TXT(C_SCENE, scene, true);
+    TXT(C_MODEL, model, true);
+    TXT(C_PARAMS, params, false);
+    if (strcmp(r->model, "directional_dipole") && strcmp(r->model, "standard_dipole"))
+        return cell_err(name, line, "model", e, "expected directional_dipole or standard_dipole",
+                        r->model);
+    NUM(C_FRAME_MS, frame_ms);
+    NUM(C_RMSE, rel_rmse);
+    NUM(C_RMSE_OBJ, rel_rmse_object);
+    NUM(C_RMSE_REC, rel_rmse_receivers);
+    INT(C_K, K, 1);
+    INT(C_N, N, 1);
+    INT(C_NVPL, N_vpl, 0);
+    INT(C_MAP, map_size, 1);
+    INT(C_GBUF, gbuffer_size, 1);
+    INT(C_FRAMES, frames, 1);
+    NUM(C_MS_G, ms_gbuffer);
+    NUM(C_MS_R, ms_radiosity);
+    NUM(C_MS_V, ms_vpl);
+    NUM(C_MS_C, ms_compose);
+    INT(C_W, width, 0);
+    INT(C_H, height, 0);
+#undef TXT
+#undef NUM
+#undef INT
+    const char *v = f[at[C_VPL]];
+    if (!strcmp(v, "on"))
+        r->vpl = true;
+    else if (strcmp(v, "off"))
+        return cell_err(name, line, "vpl", e, "expected on or off", v);
+    if (r->frame_ms <= 0)
+        return cell_err(name, line, "frame_ms", e, "must be > 0", f[at[C_FRAME_MS]]);
+    return LR_OK;
+}
+
+int lr_plan_table_parse(const char *text, size_t len, const char *name, lr_plan_table **out,
+                        lr_err *e)
+{
+    *out = NULL;
+    if (!name)
+        name = "table";
+    lr_plan_table *t = calloc(1, sizeof *t);
+    char *buf = malloc(len + 1);
+    if (!t || !buf) {
+        free(t);
+        free(buf);
+        return lr_err_set(e, LR_ENOMEM, "%s: out of memory", name);
+    }
+    snprintf(t->name, sizeof t->name, "%s", name);
+    memcpy(buf, text, len);
+    buf[len] = '\0';
+    int at[C_COUNT], nheader = 0, rc = LR_OK, line = 0;
+    char *f[MAX_FIELDS];
+    char *p = buf;
+    while (p && !rc) {
+        char *nl = strchr(p, '\n');
+        if (nl)
+            *nl = '\0';
+        line++;
+        char *s = p;
+        p = nl ? nl + 1 : NULL;
+        while (*s == ' ' || *s == '\t' || *s == '\r')
+            s++;
+        if (!*s || *s == '#')
+            continue;
+        int n = split(s, f, MAX_FIELDS);
+        if (n > MAX_FIELDS) {
+            rc = lr_err_set(e, LR_EPARSE, "%s:%d: more than %d columns", name, line, MAX_FIELDS);
+            break;
+        }
+        if (!nheader) {
+            for (int c = 0; c < C_COUNT; c++) {
+                at[c] = -1;
+                for (int i = 0; i < n; i++)
+                    if (!strcmp(f[i], cols[c].name)) {
+                        if (at[c] >= 0) {
+                            rc = lr_err_set(e, LR_EPARSE, "%s:%d: column '%s': given twice", name,
+                                            line, cols[c].name);
+                            break;
+                        }
+                        at[c] = i;
+                    }
+                if (!rc && at[c] < 0 && cols[c].required)
+                    rc = lr_err_set(e, LR_EPARSE, "%s:%d: column '%s': missing from the header",
+                                    name, line, cols[c].name);
+                if (rc)
+                    break;
+            }
+            nheader = n;
+            continue;
+        }
+        if (n != nheader) {
+            rc = lr_err_set(e, LR_EPARSE, "%s:%d: %d cells, the header has %d", name, line, n,
+                            nheader);
+            break;
+        }
+        if (t->n == t->cap) {
+            int cap = t->cap ? 2 * t->cap : 32;
+            lr_plan_row *r = realloc(t->rows, (size_t)cap * sizeof *r);
+            if (!r) {
+                rc = lr_err_set(e, LR_ENOMEM, "%s: out of memory", name);
+                break;
+            }
+            t->rows = r;
+            t->cap = cap;
+        }
+        if (!(rc = parse_row(name, line, f, at, &t->rows[t->n], e)))
+            t->n++;
+    }
+    free(buf);
+    if (!rc && !nheader)
+        rc = lr_err_set(e, LR_EPARSE, "%s:1: no header line", name);
+    if (!rc && !t->n)
+        rc = lr_err_set(e, LR_EPARSE, "%s:%d: no rows", name, line);
+    if (rc) {
+        lr_plan_table_destroy(t);
+        return rc;
+    }
+    *out = t;
+    return LR_OK;
+}
+
+int lr_plan_table_load(const char *path, lr_plan_table **out, lr_err *e)
+{
+    char *data;
+    size_t len;
+    *out = NULL;
+    int rc = lr_file_read(path, &data, &len, e);
+    if (rc)
+        return rc;
+    rc = lr_plan_table_parse(data, len, path, out, e);
+    free(data);
+    return rc;
+}
+
+void lr_plan_table_destroy(lr_plan_table *t)
+{
+    if (!t)
+        return;
+    free(t->rows);
+    free(t);
+}
+
+int lr_plan_table_count(const lr_plan_table *t) { return t->n; }
+const lr_plan_row *lr_plan_table_row(const lr_plan_table *t, int i) { return &t->rows[i]; }
+const char *lr_plan_table_name(const lr_plan_table *t) { return t->name; }
+
+bool lr_plan_table_has_scene(const lr_plan_table *t, const char *scene)
+{
+    for (int i = 0; i < t->n; i++)
+        if (!strcmp(t->rows[i].scene, scene))
+            return true;
+    return false;
+}
+
+int lr_plan_default_table(char *buf, size_t cap, const char **why, lr_err *e)
+{
+    /* The committed front sits in the configs directory; a bench run's results in the build
+     * directory beside it (the source tree's layout). */
+    const char *configs = lr_configs_dir();
+    char root[1024], results[1200], front[1200];
+    snprintf(root, sizeof root, "%s", configs);
+    char *slash = strrchr(root, '/');
+    if (slash && slash != root)
+        *slash = '\0';
+    else
+        snprintf(root, sizeof root, "%s", slash ? "/" : ".");
+    if (lr_path_join(results, sizeof results, root, "build/bench", "results.csv") ||
+        lr_path_join(front, sizeof front, configs, "bench", "front.csv"))
+        return lr_err_set(e, LR_EINVAL, "configs path too long");
+    struct stat sr, sf;
+    bool have_r = stat(results, &sr) == 0, have_f = stat(front, &sf) == 0;
+    const char *pick = NULL;
+    if (have_r && (!have_f || sr.st_mtime >= sf.st_mtime)) {
+        pick = results;
+        *why = "newest bench run";
+    } else if (have_f) {
+        pick = front;
+        *why = "committed front";
+    } else {
+        return lr_err_set(e, LR_EIO, "no measured table: neither %s nor %s exists (run `make bench`)",
+                          results, front);
+    }
+    if (strlen(pick) >= cap)
+        return lr_err_set(e, LR_EINVAL, "%s: path too long", pick);
+    strcpy(buf, pick);
+    return LR_OK;
+}

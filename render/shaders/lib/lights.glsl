@@ -1,0 +1,98 @@
+// Every light of the scene at composition (render/passes/common.c lr_passes_bind_lights):
+// direct irradiance on a receiver, shadowed through each light's own G-buffer. GLSL ES 3.10
+// indexes sampler arrays with constant expressions only, so the per-light lookups below are
+// unrolled for LR_MAX_LIGHTS = 4 (render/passes/passes.h).
+#include "gbuffer_texel.glsl"
+
+#ifndef LR_MAX_LIGHTS
+#define LR_MAX_LIGHTS 4
+#endif
+#if LR_MAX_LIGHTS != 4
+#error "lights.glsl unrolls its sampler arrays for 4 lights"
+#endif
+
+uniform highp samplerCube u_lights_cube[LR_MAX_LIGHTS]; // G-buffer positions, cube mode
+uniform highp sampler2D u_lights_2d[LR_MAX_LIGHTS];     // G-buffer positions, 2D modes
+uniform int u_lights_mode[LR_MAX_LIGHTS];               // gbuffer.glsl u_gb_mode
+uniform mat4 u_lights_vp[LR_MAX_LIGHTS];
+uniform int u_lights_type[LR_MAX_LIGHTS];               // 0 point, 1 spot, 2 directional
+uniform vec3 u_lights_pos[LR_MAX_LIGHTS];
+uniform vec3 u_lights_dir[LR_MAX_LIGHTS];
+uniform vec2 u_lights_spot_cos[LR_MAX_LIGHTS];          // cos(outer), cos(inner)
+uniform vec3 u_lights_I[LR_MAX_LIGHTS];                 // intensity per band (with flicker)
+uniform int u_n_lights;
+
+vec4 lr_lights_cube_pos(int l, vec3 v)
+{
+    if (l == 0)
+        return texture(u_lights_cube[0], v);
+    if (l == 1)
+        return texture(u_lights_cube[1], v);
+    if (l == 2)
+        return texture(u_lights_cube[2], v);
+    return texture(u_lights_cube[3], v);
+}
+
+ivec2 lr_lights_2d_size(int l)
+{
+    if (l == 0)
+        return textureSize(u_lights_2d[0], 0);
+    if (l == 1)
+        return textureSize(u_lights_2d[1], 0);
+    if (l == 2)
+        return textureSize(u_lights_2d[2], 0);
+    return textureSize(u_lights_2d[3], 0);
+}
+
+vec4 lr_lights_2d_pos(int l, ivec2 t)
+{
+    if (l == 0)
+        return texelFetch(u_lights_2d[0], t, 0);
+    if (l == 1)
+        return texelFetch(u_lights_2d[1], t, 0);
+    if (l == 2)
+        return texelFetch(u_lights_2d[2], t, 0);
+    return texelFetch(u_lights_2d[3], t, 0);
+}
+
+// gbuffer.glsl lr_gbuffer_lit for light l: x nearer to the light than the G-buffer's surface
+// in its direction, or no surface there.
+bool lr_lights_lit(int l, vec3 x)
+{
+    int mode = u_lights_mode[l];
+    vec3 v = mode == 2 ? x : x - u_lights_pos[l];
+    vec4 p;
+    if (mode == 0) {
+        p = lr_lights_cube_pos(l, v);
+    } else {
+        ivec2 t;
+        if (!lr_gbuffer_texel(mode, u_lights_vp[l], u_lights_pos[l], v, lr_lights_2d_size(l), t))
+            return true;
+        p = lr_lights_2d_pos(l, t);
+    }
+    if (!(p.w > 0.5))
+        return true;
+    if (mode == 2)
+        return dot(x - p.xyz, u_lights_dir[l]) < 0.0;
+    return length(v) < length(p.xyz - u_lights_pos[l]);
+}
+
+// Irradiance at receiver point x (normal nx) from light l for unit intensity (PIPELINE.md
+// pass 4): cos / distance^2 times the spot's profile (directional: cos), 0 in shadow.
+float lr_lights_direct(int l, vec3 x, vec3 nx)
+{
+    if (u_lights_type[l] == 2) {
+        float c = dot(nx, -u_lights_dir[l]);
+        return c > 0.0 && lr_lights_lit(l, x) ? c : 0.0;
+    }
+    vec3 to_l = u_lights_pos[l] - x;
+    float d2 = dot(to_l, to_l);
+    float c = dot(nx, to_l) * inversesqrt(d2);
+    if (!(c > 0.0) || !lr_lights_lit(l, x))
+        return 0.0;
+    float shape = 1.0;
+    if (u_lights_type[l] == 1)
+        shape = smoothstep(u_lights_spot_cos[l].x, u_lights_spot_cos[l].y,
+                           dot(-to_l, u_lights_dir[l]) * inversesqrt(d2));
+    return shape * c / d2;
+}

@@ -1,0 +1,234 @@
+/* The capture simulator's sensor model (calib/capture_sim.h): the noise-free chain inverts
+ * through the rig's own linearisation (lr_rig_camera_to_linear) to the radiance times
+ * gain * t * V; noise statistics match shot + read noise; vignetting; determinism per seed;
+ * bad parameters are refused naming the field. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "calib/capture_sim.h"
+#include "calib/rig.h"
+#include "tests/support/near.h"
+
+/* A w x h image of one colour. */
+static lr_image flat(int w, int h, float r, float g, float b)
+{
+    lr_image img;
+    lr_err e = {0};
+    assert_int_equal(lr_image_alloc(&img, w, h, &e), LR_OK);
+    for (int i = 0; i < w * h; i++) {
+        img.rgb[3 * i] = r;
+        img.rgb[3 * i + 1] = g;
+        img.rgb[3 * i + 2] = b;
+    }
+    return img;
+}
+
+/* Noise-free, 8-bit, through a fitted-style response (the gamma curve as lr_camresp) and a
+ * colour matrix: the rig's linearisation gives back gain * t * L. The only error is 8-bit
+ * quantisation, half a step: |dX| <= 0.5 * max slope of the curve between neighbours. */
+static void test_chain_inverts_through_rig(void **state)
+{
+    (void)state;
+    lr_rig_calib *rig = calloc(1, sizeof *rig);
+    assert_non_null(rig);
+    lr_camresp_gamma(&rig->camresp, 2.2);
+    rig->has_camresp = true;
+    const double M[9] = {1.2, -0.1, -0.1, -0.05, 1.1, -0.05, 0.0, -0.2, 1.2};
+    memcpy(rig->color.m, M, sizeof M);
+    rig->has_color = true;
+    lr_sensor s = {.exposure_s = 0.5, .gain = 3.0, .response = &rig->camresp,
+                   .color = &rig->color};
+    lr_image L = flat(8, 8, 0, 0, 0);
+    for (int i = 0; i < 64; i++)
+        for (int c = 0; c < 3; c++)
+            L.rgb[3 * i + c] = (float)(0.05 + 0.012 * i + 0.03 * c); /* X from 0.07 to 1.4 */
+    lr_img cap;
+    lr_err e = {0};
+    assert_int_equal(lr_sensor_capture(&s, &L, &cap, &e), LR_OK);
+    assert_int_equal(cap.depth, 1);
+    /* Largest step of the curve over the range used, times |M| row sum (the matrix mixes
+     * the three channels' quantisation errors). */
+    double step = 0;
+    for (int z = 1; z < 256; z++)
+        step = fmax(step, rig->camresp.curve[0][z] - rig->camresp.curve[0][z - 1]);
+    for (int i = 0; i < 64; i++) {
+        double lin[3];
+        lr_rig_camera_to_linear(rig, (const uint8_t *)cap.px + 3 * i, lin);
+        for (int c = 0; c < 3; c++) {
+            double want = 1.5 * L.rgb[3 * i + c];
+            double rowsum = fabs(M[3 * c]) + fabs(M[3 * c + 1]) + fabs(M[3 * c + 2]);
+            assert_near(lin[c], want, 0.5 * step * rowsum + 1e-9);
+        }
+    }
+    lr_img_free(&cap);
+    lr_image_free(&L);
+    free(rig);
+}
+
+/* The analytic gamma path (no response given) and the lr_camresp_gamma table agree, and
+ * 16-bit output resolves what 8 bits cannot. */
+static void test_gamma_and_16bit(void **state)
+{
+    (void)state;
+    lr_sensor s = {.gamma = 2.2, .bits = 16};
+    lr_camresp table;
+    lr_camresp_gamma(&table, 2.2);
+    for (double X = 0.01; X < 4.0; X *= 1.37) {
+        double z = lr_sensor_encode(&s, 1, X);
+        /* Inverting through the table (linear between entries) is exact at the nodes and
+         * off by at most the curvature between them: relative 2 % is far above that for
+         * z > 10 and far below any value a wrong exponent would give. */
+        if (z > 10)
+            assert_near_rel(lr_camresp_linear(&table, 1, z), X, 0.02);
+    }
+    lr_image L = flat(4, 4, 0.2f, 0.2f, 0.2f);
+    lr_img cap;
+    lr_err e = {0};
+    assert_int_equal(lr_sensor_capture(&s, &L, &cap, &e), LR_OK);
+    assert_int_equal(cap.depth, 2);
+    double z = lr_sensor_encode(&s, 0, 0.2);
+    assert_near(((uint16_t *)cap.px)[0], z * 65535.0 / 255.0, 0.5 + 1e-9);
+    lr_img_free(&cap);
+    lr_image_free(&L);
+}
+
+/* Linear response (gamma 1), flat field. z = 255 X / X_sat and X = el / FW * X_sat, so
+ * z = 255 el / FW and
+ *   var(z) = (255 / FW)^2 (e + read^2) + 1/12     (shot + read noise, then rounding).
+ * 40000 samples estimate a standard deviation to 1/sqrt(2 * 40000) = 0.35 %; 3 % is ~8
+ * sigma, and a missing noise term (read or shot) would change it by > 10 %. */
+static void test_noise_statistics(void **state)
+{
+    (void)state;
+    const int W = 200, H = 200;
+    lr_sensor s = {.gamma = 1.0, .full_well_e = 2000, .read_noise_e = 12, .seed = 7, .bits = 8};
+    double sat = lr_sensor_saturation(&s, 0);
+    double X = 0.4 * sat; /* 40 % of full scale: 800 electrons */
+    lr_image L = flat(W, H, (float)X, (float)X, (float)X);
+    lr_img cap;
+    lr_err e = {0};
+    assert_int_equal(lr_sensor_capture(&s, &L, &cap, &e), LR_OK);
+    double sum = 0, sum2 = 0;
+    int n = W * H;
+    for (int i = 0; i < n; i++) {
+        double z = ((uint8_t *)cap.px)[3 * i + 1];
+        sum += z;
+        sum2 += z * z;
+    }
+    double mean = sum / n, var = sum2 / n - mean * mean;
+    double el = 0.4 * 2000;
+    double want_var = (255.0 / 2000) * (255.0 / 2000) * (el + 12.0 * 12.0) + 1.0 / 12.0;
+    assert_near(mean, 0.4 * 255, 0.05);
+    assert_near_rel(sqrt(var), sqrt(want_var), 0.03);
+
+    /* Same seed: identical capture; another seed: a different one. */
+    lr_img again, other;
+    assert_int_equal(lr_sensor_capture(&s, &L, &again, &e), LR_OK);
+    assert_memory_equal(cap.px, again.px, (size_t)n * 3);
+    s.seed = 8;
+    assert_int_equal(lr_sensor_capture(&s, &L, &other, &e), LR_OK);
+    assert_true(memcmp(cap.px, other.px, (size_t)n * 3) != 0);
+    lr_img_free(&cap);
+    lr_img_free(&again);
+    lr_img_free(&other);
+    lr_image_free(&L);
+}
+
+/* Low signal: exact Poisson, mean = variance = lambda (3 electrons), read noise off. With
+ * 40000 samples the mean is known to sqrt(3/40000) = 0.009 and the variance to
+ * ~ sqrt((lambda + 2 lambda^2)/n) = 0.023; tolerances 0.05 and 0.12 are > 5 sigma. A 16-bit
+ * linear sensor with FW 65535 e: one electron is one digital step. */
+static void test_poisson_low_light(void **state)
+{
+    (void)state;
+    const int W = 200, H = 200;
+    lr_sensor s = {.gamma = 1.0, .full_well_e = 65535, .seed = 3, .bits = 16};
+    double sat = lr_sensor_saturation(&s, 0);
+    double X = 3.0 / 65535 * sat;
+    lr_image L = flat(W, H, (float)X, (float)X, (float)X);
+    lr_img cap;
+    lr_err e = {0};
+    assert_int_equal(lr_sensor_capture(&s, &L, &cap, &e), LR_OK);
+    double sum = 0, sum2 = 0;
+    int n = W * H;
+    for (int i = 0; i < n; i++) {
+        double z = ((uint16_t *)cap.px)[3 * i];
+        sum += z;
+        sum2 += z * z;
+    }
+    double mean = sum / n, var = sum2 / n - mean * mean;
+    assert_near(mean, 3.0, 0.05);
+    assert_near(var, 3.0, 0.12);
+    lr_img_free(&cap);
+    lr_image_free(&L);
+}
+
+static void test_vignetting(void **state)
+{
+    (void)state;
+    lr_sensor s = {.vignette = LR_VIGNETTE_COS4, .focal_px = 100};
+    /* At r = f from the centre theta = 45 deg: cos^4 = 1/4. */
+    assert_near(lr_sensor_vignette(&s, 101, 101, 50, 50), 1.0, 1e-12);
+    assert_near(lr_sensor_vignette(&s, 101, 101, 150, 50), 0.25, 1e-12);
+    s = (lr_sensor){.vignette = LR_VIGNETTE_POLY, .vignette_poly = {-0.3, 0.05, 0},
+                    .cx = 10, .cy = 10};
+    /* Corner of a 20 x 20 image measured from (10, 10): rho = |(10,10)| / |(10,10)| = 1. */
+    assert_near(lr_sensor_vignette(&s, 20, 20, 20, 20), 1 - 0.3 + 0.05, 1e-12);
+    /* Through the whole chain: exposure at the corner is V times the centre's. */
+    lr_image L = flat(20, 20, 0.5f, 0.5f, 0.5f);
+    double *X = malloc(20 * 20 * 3 * sizeof *X);
+    lr_err e = {0};
+    assert_int_equal(lr_sensor_exposure(&s, &L, X, &e), LR_OK);
+    assert_near(X[3 * (19 * 20 + 19)] / X[3 * (10 * 20 + 10)],
+                lr_sensor_vignette(&s, 20, 20, 19, 19), 1e-12);
+    free(X);
+    lr_image_free(&L);
+}
+
+static void test_bad_parameters(void **state)
+{
+    (void)state;
+    lr_err e = {0};
+    lr_sensor s = {.gain = -1};
+    assert_int_equal(lr_sensor_check(&s, &e), LR_EINVAL);
+    assert_non_null(strstr(e.msg, "sensor.gain"));
+    s = (lr_sensor){.vignette = LR_VIGNETTE_COS4};
+    assert_int_equal(lr_sensor_check(&s, &e), LR_EINVAL);
+    assert_non_null(strstr(e.msg, "sensor.focal_px"));
+    s = (lr_sensor){.read_noise_e = 3};
+    assert_int_equal(lr_sensor_check(&s, &e), LR_EINVAL);
+    assert_non_null(strstr(e.msg, "full_well_e"));
+    s = (lr_sensor){.bits = 12};
+    assert_int_equal(lr_sensor_check(&s, &e), LR_EINVAL);
+    assert_non_null(strstr(e.msg, "sensor.bits"));
+    lr_colormatrix singular = {{1, 2, 3, 2, 4, 6, 0, 0, 1}, 0, 0, 0, ""};
+    s = (lr_sensor){.color = &singular};
+    assert_int_equal(lr_sensor_check(&s, &e), LR_EINVAL);
+    assert_non_null(strstr(e.msg, "singular"));
+    lr_image L = flat(2, 2, 0.1f, 0.1f, 0.1f);
+    lr_img cap;
+    assert_int_equal(lr_sensor_capture(&s, &L, &cap, &e), LR_EINVAL);
+    assert_null(cap.px);
+    lr_image_free(&L);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_chain_inverts_through_rig),
+        cmocka_unit_test(test_gamma_and_16bit),
+        cmocka_unit_test(test_noise_statistics),
+        cmocka_unit_test(test_poisson_low_light),
+        cmocka_unit_test(test_vignetting),
+        cmocka_unit_test(test_bad_parameters),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,219 @@
+/* Several lights in the GPU transport (render/passes: a G-buffer, K radiosity maps and a VPL
+ * row per light, weighted by the intensities at composition).
+ *
+ *  - Linearity: a two-light scene renders the sum of the two one-light renders. The per-texel
+ *    seeds do not depend on the light's index (render/passes/radiosity.c), each light's
+ *    G-buffer and maps depend on that light and the geometry alone, so the two sides compute
+ *    the same numbers and differ only by float rounding in the sums (gather over lights, E over
+ *    lights): asserted to 1e-5 relative per pixel plus 1e-6 of the image's largest value.
+ *  - Dimming one of two lights runs composition alone and changes the image by exactly that
+ *    light's share: same tolerance.
+ *  - Different G-buffer kinds at once (the flame's cube map, the side spot's 2D map), so the
+ *    per-light sampler arrays of render/shaders/lib/lights.glsl see both.
+ *  - The cavity gain is per light (PIPELINE.md "Energy"): the flame sits in the candle's hull
+ *    (gain ~1.04), the side spot does not (gain 1). Linearity holds with either light first,
+ *    and the renderer's gains are lr_cpu_cavity_scene_gains' for each light.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render/cpu/cavity.h"
+#include "render/renderer.h"
+#include "render/renderer_debug.h"
+#include "tests/support/gl.h"
+#include "tests/support/near.h"
+#include "tests/support/render.h"
+
+static lr_gl *gl;
+
+static int setup(void **state)
+{
+    (void)state;
+    return lr_test_gl_create(&gl) ? -1 : 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    lr_gl_destroy(gl);
+    return 0;
+}
+
+enum { W = 48, H = 36 };
+
+static const char *const flame =
+    "{\"type\": \"point\", \"name\": \"flame\", \"position\": [0, 0, 117], \"intensity\": 0.005,"
+    " \"color\": [1.0, 0.55, 0.2]}";
+static const char *const side =
+    "{\"type\": \"spot\", \"name\": \"side\", \"position\": [160, -160, 170], \"direction\":"
+    " [-0.6, 0.6, -0.5], \"inner_deg\": 20, \"outer_deg\": 30, \"intensity\": 0.02,"
+    " \"color\": [0.6, 0.7, 1.0]}";
+
+/* The candle on a table before a wall, lit by the given lights (JSON objects). */
+static lr_scene *scene(const char *l0, const char *l1)
+{
+    char t[4096];
+    snprintf(t, sizeof t,
+             "{\"objects\": [{\"name\": \"pillar\", \"material\": \"candle_wax\", \"mesh\": "
+             "{\"type\": \"candle\", \"radius\": 35, \"height\": 120, \"pool_depth\": 8}}],\n"
+             " \"lights\": [%s%s%s],\n"
+             " \"camera\": {\"position\": [0, -450, 230], \"target\": [0, 40, 70], \"fov_deg\": 40},\n"
+             " \"receivers\": [{\"name\": \"table\", \"type\": \"plane\", \"center\": [0, -75, 0],"
+             " \"normal\": [0, 0, 1], \"size\": [1200, 650], \"albedo\": [0.75, 0.72, 0.68]},\n"
+             "  {\"name\": \"wall\", \"type\": \"plane\", \"center\": [0, 250, 400], \"normal\":"
+             " [0, -1, 0], \"size\": [1200, 800], \"albedo\": [0.85, 0.85, 0.83]}]}",
+             l0, l1 ? ", " : "", l1 ? l1 : "");
+    return lr_test_scene_text(t, lr_test_small_settings);
+}
+
+/* Renders to convergence; returns the HDR image (caller frees). */
+static float *render(lr_scene *s, lr_renderer **keep)
+{
+    lr_renderer *r = lr_test_renderer(gl, s, W, H, false, 7);
+    lr_test_converge(r, 20);
+    float *h = lr_test_hdr(r);
+    if (keep)
+        *keep = r;
+    else
+        lr_renderer_destroy(r);
+    return h;
+}
+
+static double image_max(const float *a)
+{
+    double m = 0.0;
+    for (int i = 0; i < W * H * 3; i++)
+        m = fmax(m, a[i]);
+    return m;
+}
+
+static double image_sum(const float *a)
+{
+    double m = 0.0;
+    for (int i = 0; i < W * H * 3; i++)
+        m += a[i];
+    return m;
+}
+
+/* got == a + wb * b per value, to the rounding allowance of the file comment. */
+static void assert_sum(const char *what, const float *got, const float *a, const float *b,
+                       double wb)
+{
+    double mx = fmax(image_max(a), image_max(b)), worst = 0.0;
+    for (int i = 0; i < W * H * 3; i++) {
+        double want = a[i] + wb * b[i];
+        double tol = 1e-5 * fabs(want) + 1e-6 * mx;
+        assert_true(isfinite(got[i]) && got[i] >= 0.0f);
+        if (!(fabs(got[i] - want) <= tol))
+            fail_msg("%s: value %d: %.9g, expected %.9g (a %.6g + %.3g b %.6g)", what, i,
+                     got[i], want, a[i], wb, b[i]);
+        worst = fmax(worst, fabs(got[i] - want) / mx);
+    }
+    print_message("%s: worst difference %.3g of the largest value\n", what, worst);
+}
+
+static void test_two_lights_are_the_sum_of_one_light_each(void **state)
+{
+    (void)state;
+    lr_scene *sa = scene(flame, NULL), *sb = scene(side, NULL), *s2 = scene(flame, side);
+    float *ha = render(sa, NULL), *hb = render(sb, NULL), *h2 = render(s2, NULL);
+    /* Both lights matter (a renderer ignoring one of them fails the sum by far). */
+    double ta = image_sum(ha), tb = image_sum(hb);
+    print_message("flame alone %.4g, side spot alone %.4g\n", ta, tb);
+    assert_true(ta > 0.05 * (ta + tb) && tb > 0.05 * (ta + tb));
+    assert_sum("flame + side spot", h2, ha, hb, 1.0);
+    free(ha);
+    free(hb);
+    free(h2);
+    lr_scene_destroy(sa);
+    lr_scene_destroy(sb);
+    lr_scene_destroy(s2);
+}
+
+/* The enclosed light second: its cavity gain must still reach its emission and its VPLs (a
+ * gain taken from lights[0] alone would give the flame's share gain 1, 4 % low on the candle,
+ * and the spot's share the flame's gain). */
+static void test_cavity_gain_per_light(void **state)
+{
+    (void)state;
+    lr_scene *sa = scene(flame, NULL), *sb = scene(side, NULL), *s2 = scene(side, flame);
+    float *ha = render(sa, NULL), *hb = render(sb, NULL);
+    lr_renderer *r;
+    float *h2 = render(s2, &r);
+    double want[1][3];
+    lr_err e = {0};
+    for (int l = 0; l < 2; l++) {
+        if (lr_cpu_cavity_scene_gains(s2, l, 0, want, 1, &e))
+            fail_msg("%s", e.msg);
+        double got[3];
+        lr_renderer_debug_light_cavity_gain(r, l, 0, got);
+        print_message("light %d (%s): cavity gain %.4f %.4f %.4f\n", l,
+                      lr_scene_light_at(s2, l)->name, got[0], got[1], got[2]);
+        for (int c = 0; c < 3; c++) {
+            assert_near(got[c], want[0][c], 1e-6 * want[0][c]); /* stored as float */
+            if (l == 0)
+                assert_true(got[c] == 1.0);
+            else
+                assert_true(got[c] > 1.0);
+        }
+    }
+    assert_sum("side spot + flame (the enclosed light second)", h2, hb, ha, 1.0);
+    free(ha);
+    free(hb);
+    free(h2);
+    lr_renderer_destroy(r);
+    lr_scene_destroy(sa);
+    lr_scene_destroy(sb);
+    lr_scene_destroy(s2);
+}
+
+static void test_dimming_one_light_runs_compose_only(void **state)
+{
+    (void)state;
+    lr_scene *sa = scene(flame, NULL), *sb = scene(side, NULL), *s2 = scene(flame, side);
+    float *ha = render(sa, NULL), *hb = render(sb, NULL);
+    lr_renderer *r;
+    float *h2 = render(s2, &r);
+    assert_false(lr_renderer_needs_frame(r));
+    /* A quarter of the side spot: 0.02 -> 0.005. */
+    lr_test_set(s2, r, "lights[side].intensity", "0.005");
+    lr_frame_stats st = lr_test_frame(r);
+    assert_int_equal(st.passes, LR_PASS_COMPOSE);
+    float *hd = lr_test_hdr(r);
+    assert_sum("flame + side spot at 1/4", hd, ha, hb, 0.25);
+    /* The flame's colour: also composition alone, and the side spot's share is unchanged. */
+    lr_test_set(s2, r, "lights[flame].intensity", "0");
+    st = lr_test_frame(r);
+    assert_int_equal(st.passes, LR_PASS_COMPOSE);
+    float *hz = lr_test_hdr(r);
+    float *zero = calloc((size_t)W * H * 3, sizeof *zero);
+    assert_sum("side spot at 1/4 alone", hz, zero, hb, 0.25);
+    free(zero);
+    free(hz);
+    free(hd);
+    free(h2);
+    free(ha);
+    free(hb);
+    lr_renderer_destroy(r);
+    lr_scene_destroy(sa);
+    lr_scene_destroy(sb);
+    lr_scene_destroy(s2);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_two_lights_are_the_sum_of_one_light_each),
+        cmocka_unit_test(test_cavity_gain_per_light),
+        cmocka_unit_test(test_dimming_one_light_runs_compose_only),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
