@@ -243,6 +243,10 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
         if ((rc = lr_passes_upload_meshes(r, e)))
             return rc;
     lr_passes_update_coeffs(r);
+    /* The cavity gain depends on the light, the geometry and the material: measured (a few
+     * ms on the CPU) whenever the maps restart. */
+    if (restart && (rc = lr_passes_update_cavity(r, e)))
+        return rc;
     if (!restart && r->rad.F < r->rs.frames)
         passes |= LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_COMPOSE;
     if (passes & LR_PASS_RADIOSITY)

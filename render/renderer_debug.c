@@ -20,6 +20,18 @@ void lr_renderer_debug_map_info(const lr_renderer *r, lr_debug_map_info *out)
     out->seed = r->seed;
 }
 
+void lr_renderer_debug_cavity_gain(const lr_renderer *r, int object, double out[3])
+{
+    lr_renderer_debug_light_cavity_gain(r, 0, object, out);
+}
+
+void lr_renderer_debug_light_cavity_gain(const lr_renderer *r, int l, int object, double out[3])
+{
+    bool ok = l >= 0 && l < LR_MAX_LIGHTS && object >= 0 && object < LR_MAX_OBJECTS;
+    for (int c = 0; c < 3; c++)
+        out[c] = ok ? r->cavity_gain[3 * (l * LR_MAX_OBJECTS + object) + c] : 1.0;
+}
+
 lr_vec3 lr_renderer_debug_map_dir(const lr_renderer *r, int k)
 {
     return k >= 0 && k < r->rad.K ? r->rad.d[k] : lr_v3(0, 0, 0);

@@ -44,6 +44,12 @@ int lr_renderer_debug_read_map(lr_renderer *r, int k, float *B, float *pos, floa
 int lr_renderer_debug_read_light_map(lr_renderer *r, int l, int k, float *B, float *pos,
                                      float *nrm, int *object, lr_err *e);
 
+/* The cavity gain per band composition applies to object `object`'s emission for light 0
+ * (PIPELINE.md "Energy"; 1 for objects that do not enclose the light); the second form for
+ * light l (each light has its own: the gain depends on where the light sits). */
+void lr_renderer_debug_cavity_gain(const lr_renderer *r, int object, double out[3]);
+void lr_renderer_debug_light_cavity_gain(const lr_renderer *r, int l, int object, double out[3]);
+
 /* ---- virtual point lights (pass 4) -------------------------------------------------------- */
 
 typedef struct lr_debug_vpl {

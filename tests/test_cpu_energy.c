@@ -1,27 +1,22 @@
 /* Energy (issue 3): "a closed sphere of non-absorbing material around a point light emits the
- * light's power within 5 %". What the model of PIPELINE.md (directional dipole S_d, B of seed
- * 003 Eq. 4, L_o = F_t B / pi) gives, measured with the CPU twin:
+ * light's power within 5 %". The model of PIPELINE.md (directional dipole S_d, B of seed 003
+ * Eq. 4, L_o = F_t B / pi) emits
  *
- *   emitted power  Phi = int_A int_2pi L_o cos d(omega) dA = T_hem int_A B dA,
- *   T_hem = 2 int_0^1 F_t(mu, eta) mu d(mu)   (1 for eta = 1; 0.908 for eta = 1.5),
+ *   Phi = int_A int_2pi L_o cos d(omega) dA = T_hem int_A B dA,
+ *   T_hem = 2 int_0^1 F_t(mu, eta) mu d(mu)   (1 for eta = 1; 0.908 for eta = 1.5).
  *
- * against 4 pi I. Findings (each asserted below):
- *  1. The directional dipole is not energy conserving at albedo 1: on a half-space at normal
- *     incidence T_hem pi int S_d dA = 1.340 (eta = 1), 1.240 (1.3), 1.197 (1.5) times the power
- *     that entered, where the standard dipole's total diffuse reflectance is exactly 1.
- *  2. The shipped sphere.json has the light INSIDE the material (enclosure SOLID). Every ray
- *     from the light meets the surface from behind (n_i . w_i < 0), which PIPELINE.md counts as
- *     no light: Phi = 0 exactly. A surface-incidence BSSRDF has no term for a source embedded in
- *     the medium.
- *  3. With the light in a cavity (a hollow sphere, the lamp-shade/votive configuration), the
- *     model's bookkeeping is right: power out of the outer surface plus power back into the
- *     cavity = 4 pi I F_t(0) x (the half-space albedo of 1.) within 5 % for a thick shell
- *     (curvature and finite thickness are the remaining model error). But the outer surface
- *     alone emits far less than 4 pi I: the model has no inter-reflection in the cavity, where
- *     most of the light comes back out (and, since the albedo of 1. exceeds 1, a bounce series
- *     would diverge instead of converging to 4 pi I).
- * So no configuration of this model meets "4 pi I within 5 %" at sigma_a = 0; the test below
- * that does hold to 5 % is the bookkeeping identity 3. */
+ * Asserted below:
+ *  1. [14]'s S_d as published is not energy conserving: its half-space albedo at albedo' 1 is
+ *     1.340 / 1.240 / 1.197 (eta 1 / 1.3 / 1.5). The default S_d is multiplied per band by
+ *     coeffs.sd_norm, after which the half-space total is the standard dipole's R_d total
+ *     (exactly 1 at albedo' 1).
+ *  2. sphere.json has the light INSIDE the material: every ray from it meets the surface from
+ *     behind, so Phi = 0; the scene loader warns about it (never silently).
+ *  3. Bookkeeping: in a thick shell, power out + power back into the cavity = 4 pi I F_t(0)
+ *     (normalised model, albedo 1) within 5 %.
+ *  4. With the cavity closure (render/cpu/cavity.h) the outer surface of a closed hollow
+ *     non-absorbing sphere emits 4 pi I within 5 %: 2 mm, 3 mm and 20 mm walls, eta 1 and 1.5,
+ *     for the pass (the twin) and the untruncated reference sampler. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -34,6 +29,7 @@
 #include <string.h>
 
 #include "render/base/paths.h"
+#include "render/cpu/cavity.h"
 #include "render/cpu/radiosity.h"
 #include "render/cpu/rng.h"
 #include "render/material/material.h"
@@ -110,6 +106,35 @@ static void test_dirpole_planar_albedo(void **state)
         lr_dipole_rd_total(&c, rd);
         assert_near(rd[0], 1.0, 1e-12);
     }
+    /* The library's quadrature (dirpole_norm.c, 8-point rule on 320 panels) agrees with this
+     * one (16-point on 400 panels) to 1e-5, and sd_norm brings the total to the standard
+     * dipole's R_d total: 1 at albedo' 1, and for every preset's bands (albedo' < 1). */
+    for (int i = 0; i < 3; i++) {
+        lr_medium m = white(eta[i]);
+        lr_coeffs c;
+        assert_int_equal(lr_coeffs_derive(&m, &c, NULL), 0);
+        double lib[3];
+        lr_dirpole_halfspace_albedo(&c, lib);
+        assert_near_rel(lib[0], planar_albedo(eta[i]), 1e-5);
+        assert_near(c.sd_norm[0] * lib[0], 1.0, 1e-9);
+    }
+    static const char *const presets[] = {"marble", "porcelain", "skin1", "ketchup",
+                                          "wholemilk", "apple", "spectralon"};
+    for (size_t i = 0; i < sizeof presets / sizeof presets[0]; i++) {
+        lr_material pm;
+        lr_coeffs c;
+        if (lr_material_find(presets[i], &pm, NULL) || lr_coeffs_derive(&pm.medium, &c, NULL))
+            fail_msg("preset %s", presets[i]);
+        double lib[3], rd[3];
+        lr_dirpole_halfspace_albedo(&c, lib);
+        lr_dipole_rd_total(&c, rd);
+        print_message("%-10s sd_norm %.4f %.4f %.4f\n", presets[i], c.sd_norm[0], c.sd_norm[1],
+                      c.sd_norm[2]);
+        for (int b = 0; b < 3; b++) {
+            assert_true(c.sd_norm[b] > 0.0 && c.sd_norm[b] <= 1.0); /* [14] overshoots */
+            assert_near_rel(c.sd_norm[b] * lib[b], rd[b], 1e-9);
+        }
+    }
     /* T_hem is the directional dipole's own normalisation 1 - 2 C1(1/eta). */
     lr_medium m = white(1.5);
     lr_coeffs c;
@@ -147,6 +172,11 @@ static void surface_power(const lrt_object *o, const lr_light *l, double radius,
     }
 }
 
+static void keep_warning(void *user, const char *msg)
+{
+    snprintf(user, LR_ERR_MSG_MAX, "%s", msg);
+}
+
 /* Finding 2: the shipped scene. */
 static void test_sphere_scene_light_in_medium(void **state)
 {
@@ -155,8 +185,14 @@ static void test_sphere_scene_light_in_medium(void **state)
     snprintf(path, sizeof path, "%s/scenes/sphere.json", lr_configs_dir());
     lr_scene *s;
     lr_err e = {0};
-    if (lr_scene_load(path, NULL, &s, &e))
+    char warned[LR_ERR_MSG_MAX] = "";
+    lr_warn_sink sink = {keep_warning, warned};
+    if (lr_scene_load(path, &sink, &s, &e))
         fail_msg("%s", e.msg);
+    /* Never silently dark: the loader names the light, the object and the file:line. */
+    print_message("warning: %s\n", warned);
+    assert_non_null(strstr(warned, "sphere.json:"));
+    assert_non_null(strstr(warned, "lights[0] 'core' is inside the material of objects[0] 'ball'"));
     int obj = -1;
     assert_int_equal(lr_scene_light_enclosure(s, 0, &obj), LR_ENCLOSURE_SOLID);
     const lr_scene_object *o = lr_scene_object_at(s, 0);
@@ -180,8 +216,8 @@ static void test_sphere_scene_light_in_medium(void **state)
     lr_scene_destroy(s);
 }
 
-/* Finding 3, the bookkeeping that holds: a thick shell (R 40, cavity 20), the light at the
- * centre, eta = 1 and 1.5. Out + cavity = 4 pi I F_t(0) albedo_plane(eta) within 5 %; the
+/* Finding 3, the bookkeeping: a thick shell (R 40, cavity 20), the light at the centre, eta = 1
+ * and 1.5, without the cavity closure. Out + cavity = 4 pi I F_t(0) within 5 %; the
  * Monte Carlo error (4 standard errors) is required to be below 2 % so that the test
  * discriminates. The outer surface alone: < 10 % of 4 pi I. */
 static void test_shell_energy_bookkeeping(void **state)
@@ -197,7 +233,9 @@ static void test_shell_energy_bookkeeping(void **state)
         double out[3], sout[3], cav[3], scav[3];
         surface_power(&o, &l, 40, false, 32, 6000, LR_CPU_REFERENCE, eta, out, sout);
         surface_power(&o, &l, 20, true, 32, 6000, LR_CPU_REFERENCE, eta, cav, scav);
-        double want = lr_fresnel_transmittance(1.0, eta) * planar_albedo(eta);
+        /* Normalised model: the half-space total is sd_norm x planar_albedo = 1. */
+        double want = lr_fresnel_transmittance(1.0, eta) * planar_albedo(eta) *
+                      o.obj.coeffs.sd_norm[0];
         for (int c = 0; c < 3; c++) {
             double tot = out[c] + cav[c], se = sqrt(sout[c] * sout[c] + scav[c] * scav[c]);
             print_message("eta %.1f band %d: Phi_out %.4f, Phi_cavity %.4f (x 4 pi I), sum %.4f "
@@ -211,24 +249,93 @@ static void test_shell_energy_bookkeeping(void **state)
     }
 }
 
-/* A thin shell (R 40, 2 mm wall, eta 1.5: a votive or porcelain globe): the outer surface emits
- * 0.30-0.50 of 4 pi I (measured 0.46, 0.40, 0.35 for marble's three bands, whose mean free paths
- * differ), the cavity gets more than 1 x 4 pi I back. Asserted as ranges. */
-static void test_thin_shell_outward_power(void **state)
+/* Finding 4, issue 3's requirement: a closed hollow sphere (R 40) of non-absorbing material
+ * around a point light at its centre, power out of the outer surface with the cavity gain =
+ * 4 pi I within 5 %, for walls of 2 mm (a porcelain globe), 3 mm and 20 mm, eta 1.5 and 1.
+ * The gain comes from lr_cpu_cavity_measure (its own 256 random points, stratified by area);
+ * the power is integrated here over 32 Halton points (a fixed quadrature: the sphere's area
+ * per solid angle is uniform), with the twin's pass sampler and with the untruncated
+ * reference sampler. The reference's Monte Carlo error (4 standard errors, times the gain) is
+ * required to be below 2.5 % so that the test discriminates. */
+static void check_closed_shell(double ri, double eta)
+{
+    lr_medium m = white(eta);
+    lrt_object o;
+    lrt_object_make(lrt_shell_mesh(40, ri, 4), &m, &o);
+    lr_light l = lrt_point_light(lr_v3(0, 0, 0));
+    lr_cpu_cavity cav;
+    lr_err e = {0};
+    if (lr_cpu_cavity_measure(&o.obj, &l, LR_ENCLOSURE_HULL, NULL, &cav, &e))
+        fail_msg("%s", e.msg);
+    assert_true(cav.applies);
+    assert_near(cav.C, 1.0, 1e-12); /* every direction meets the closed shell */
+    assert_near(cav.F, 1.0, 1e-12); /* and everything it sends back meets it again */
+    assert_near(cav.R1, lr_fresnel_reflectance(1.0, eta), 0.01); /* near-normal incidence */
+    double Pm[2][3], Sm[2][3];
+    for (int mode = 0; mode < 2; mode++) {
+        enum lr_cpu_sampler smp = mode ? LR_CPU_REFERENCE : LR_CPU_PASS;
+        double out[3], sout[3];
+        surface_power(&o, &l, 40, false, 32, 4000, smp, eta, out, sout);
+        for (int c = 0; c < 3; c++) {
+            Pm[mode][c] = out[c] * cav.gain[c];
+            Sm[mode][c] = sout[c] * cav.gain[c];
+        }
+        for (int c = 0; c < 3; c++) {
+            double P = out[c] * cav.gain[c], se = sout[c] * cav.gain[c];
+            print_message("wall %4.1f mm eta %.1f %s band %d: direct out %.4f (a %.4f), C %.3f "
+                          "R1 %.4f gain %.3f -> Phi_out %.4f +- %.4f x 4 pi I\n", 40 - ri, eta,
+                          mode ? "ref " : "pass", c, out[c], cav.a[c], cav.C, cav.R1,
+                          cav.gain[c], P, se);
+            if (mode) {
+                /* The gain (up to 25 here) multiplies the error: 4 se < 2.5 % still
+                 * separates 1 from 0.95. */
+                assert_true(4.0 * se < 0.025);
+                assert_near(P, 1.0, 0.05);
+            }
+        }
+    }
+    /* The pass (the twin) estimates the same power: its outer points face away from the
+     * light, where its weights are heavy-tailed (render/cpu/README.md finding 2), so its
+     * standard error at this N is 1-4 %; it agrees with the reference within 4 sigma. */
+    for (int c = 0; c < 3; c++)
+        assert_near(Pm[0][c], Pm[1][c], 4.0 * sqrt(Sm[0][c] * Sm[0][c] + Sm[1][c] * Sm[1][c]));
+    lrt_object_free(&o);
+}
+
+static void test_closed_shell_emits_light_power(void **state)
+{
+    (void)state;
+    check_closed_shell(38, 1.5);
+    check_closed_shell(37, 1.5);
+    check_closed_shell(20, 1.5);
+    check_closed_shell(38, 1.0);
+}
+
+/* The raw model ("normalize": false) has no closure: gain 1, and the pass gives the published
+ * model's B (1 / sd_norm times the default's). A light outside the hull gets no gain. */
+static void test_closure_only_where_it_applies(void **state)
 {
     (void)state;
     lr_medium m = white(1.5);
     lrt_object o;
-    lrt_object_make(lrt_shell_mesh(40, 38, 4), &m, &o);
+    lrt_object_make(lrt_shell_mesh(40, 38, 3), &m, &o);
     lr_light l = lrt_point_light(lr_v3(0, 0, 0));
-    double out[3], sout[3], cav[3], scav[3];
-    surface_power(&o, &l, 40, false, 24, 2000, LR_CPU_REFERENCE, 1.5, out, sout);
-    surface_power(&o, &l, 38, true, 24, 2000, LR_CPU_REFERENCE, 1.5, cav, scav);
+    lr_cpu_cavity cav;
+    lr_cpu_cavity_desc d = {.points = 16, .N = 16};
+    assert_int_equal(lr_cpu_cavity_measure(&o.obj, &l, LR_ENCLOSURE_NONE, &d, &cav, NULL), 0);
+    assert_false(cav.applies);
+    lr_vec3 xo = lr_v3(0, 0, 40), no = lr_v3(0, 0, 1);
+    lr_cpu_radiosity_desc rd = {.N = 64};
+    lr_cpu_estimate norm, raw;
+    lr_cpu_radiosity(&o.obj, &l, xo, no, &rd, lr_cpu_key(5, 0, 0, 0), &norm);
+    o.obj.sd_raw = true;
+    assert_int_equal(lr_cpu_cavity_measure(&o.obj, &l, LR_ENCLOSURE_HULL, &d, &cav, NULL), 0);
+    assert_false(cav.applies);
+    lr_cpu_radiosity(&o.obj, &l, xo, no, &rd, lr_cpu_key(5, 0, 0, 0), &raw);
     for (int c = 0; c < 3; c++) {
-        print_message("2 mm shell band %d: Phi_out %.4f +- %.4f, Phi_cavity %.4f +- %.4f "
-                      "(x 4 pi I)\n", c, out[c], sout[c], cav[c], scav[c]);
-        assert_true(out[c] > 0.28 && out[c] < 0.52);
-        assert_true(cav[c] > 1.0);
+        assert_true(cav.gain[c] == 1.0);
+        /* Same random stream: exactly the factor, to rounding. */
+        assert_near_rel(norm.mean[c], raw.mean[c] * o.obj.coeffs.sd_norm[c], 1e-12);
     }
     lrt_object_free(&o);
 }
@@ -241,7 +348,8 @@ int main(void)
         cmocka_unit_test(test_dirpole_planar_albedo),
         cmocka_unit_test(test_sphere_scene_light_in_medium),
         cmocka_unit_test(test_shell_energy_bookkeeping),
-        cmocka_unit_test(test_thin_shell_outward_power),
+        cmocka_unit_test(test_closed_shell_emits_light_power),
+        cmocka_unit_test(test_closure_only_where_it_applies),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

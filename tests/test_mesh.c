@@ -560,6 +560,45 @@ static void test_winding_repair(void **state)
     lr_mesh_destroy(m);
 }
 
+/* A hollow cube (a 2-unit cube with a 1-unit cavity, two closed pieces): whatever the input
+ * winding of each piece, the outer one ends with positive volume and the nested one with
+ * negative volume (its normals point into the cavity, out of the material), so the total is
+ * 8 - 1 = 7. Before the nesting rule each piece was turned outward (total 9), and a light in
+ * the cavity was taken to sit inside solid material. */
+static void test_nested_cavity_orientation(void **state)
+{
+    (void)state;
+    double v[16][3];
+    uint32_t t[24][3];
+    for (int piece = 0; piece < 2; piece++) {
+        double h = piece ? 0.5 : 1.0; /* half size */
+        for (int k = 0; k < 8; k++)
+            for (int c = 0; c < 3; c++)
+                v[8 * piece + k][c] = (cube_v[k][c] - 0.5) * 2.0 * h;
+    }
+    for (int mode = 0; mode < 4; mode++) {
+        bool outer_rev = mode & 1, inner_rev = mode & 2;
+        for (int k = 0; k < 12; k++) {
+            t[k][0] = cube_t[k][0];
+            t[k][1] = outer_rev ? cube_t[k][2] : cube_t[k][1];
+            t[k][2] = outer_rev ? cube_t[k][1] : cube_t[k][2];
+            t[12 + k][0] = 8 + cube_t[k][0];
+            t[12 + k][1] = 8 + (inner_rev ? cube_t[k][2] : cube_t[k][1]);
+            t[12 + k][2] = 8 + (inner_rev ? cube_t[k][1] : cube_t[k][2]);
+        }
+        lr_mesh *m;
+        lr_err e = {0};
+        lr_mesh_desc d = {.name = "hollow", .vertex_count = 16, .positions = &v[0][0],
+                          .triangle_count = 24, .indices = &t[0][0]};
+        assert_int_equal(lr_mesh_create(&d, &m, &e), LR_OK);
+        assert_true(fabs(lr_mesh_volume(m) - 7.0) < 1e-12);
+        /* The cavity's centre is outside the material: winding number 0. */
+        assert_true(fabs(lr_mesh_winding_number(m, lr_v3(0, 0, 0))) < 1e-9);
+        assert_true(fabs(lr_mesh_winding_number(m, lr_v3(0.75, 0, 0)) - 1.0) < 1e-9);
+        lr_mesh_destroy(m);
+    }
+}
+
 static void test_nonmanifold_and_open(void **state)
 {
     (void)state;
@@ -1066,6 +1105,7 @@ int main(void)
         cmocka_unit_test(test_bvh_matches_brute_force),
         cmocka_unit_test(test_closest_point_and_hits_exact),
         cmocka_unit_test(test_winding_and_hull),
+        cmocka_unit_test(test_nested_cavity_orientation),
     };
     return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
 }

@@ -41,9 +41,10 @@ typedef struct probe {
 } probe;
 
 /* E_vpl for unit intensity at x with normal n from the renderer's VPL list, the formula of
- * PIPELINE.md pass 4 evaluated in double. */
-static void vpl_irradiance(const lr_scene *s, const lr_debug_vpl *v, int n, lr_vec3 x, lr_vec3 nx,
-                           double E[3])
+ * PIPELINE.md pass 4 evaluated in double; each VPL's B times the cavity gain composition
+ * applies to its object (PIPELINE.md "Energy"). */
+static void vpl_irradiance(lr_renderer *r, const lr_scene *s, const lr_debug_vpl *v, int n,
+                           lr_vec3 x, lr_vec3 nx, double E[3])
 {
     E[0] = E[1] = E[2] = 0.0;
     for (int i = 0; i < n; i++) {
@@ -57,8 +58,10 @@ static void vpl_irradiance(const lr_scene *s, const lr_debug_vpl *v, int n, lr_v
             continue;
         double eta = lr_scene_object_at(s, v[i].object)->coeffs.eta;
         double g = lr_fresnel_transmittance(cv, eta) / M_PI * v[i].area * cv * cx / fmax(d2, v[i].area);
+        double gain[3];
+        lr_renderer_debug_cavity_gain(r, v[i].object, gain);
         for (int c = 0; c < 3; c++)
-            E[c] += g * v[i].B[c];
+            E[c] += g * v[i].B[c] * gain[c];
     }
 }
 
@@ -89,7 +92,7 @@ static void check_scene(const char *name, const probe *probes, int np)
         lr_vec3 p = lr_test_pixel_on_plane(s, W, H, x, y, rc->center, rc->normal);
         size_t k = 3 * ((size_t)y * W + x);
         double E[3];
-        vpl_irradiance(s, v, nv, p, rc->normal, E);
+        vpl_irradiance(lit, s, v, nv, p, rc->normal, E);
         double d = lr_v3_len(lr_v3_sub(p, l->position));
         for (int c = 0; c < 3; c++) {
             /* No VPLs: the light cannot see the point, so exactly nothing arrives. */

@@ -7,6 +7,7 @@
 #include <time.h>
 
 #include "render/base/mat4.h"
+#include "render/cpu/cavity.h"
 #include "render/cpu/maps.h"
 #include "render/cpu/parallel.h"
 #include "render/cpu/rng.h"
@@ -37,11 +38,22 @@ typedef struct rctx {
     const lr_scene_object **objs; /* every object: occluders of each other's light lookups */
     lr_cpu_vpl *vpl;     /* [obj * nvpl + v]; B per band already summed over lights with I */
     double (*I)[3];      /* per light: intensity * color */
+    double (*gain)[3];   /* [obj * nlight + light]: cavity gain (render/cpu/cavity.h) */
     lr_image *rgb, *var;
     long *object_px, *fallback_px; /* per pixel flags, summed at the end */
 } rctx;
 
 static uint64_t seed_of(const rctx *r) { return r->d->seed ? r->d->seed : 1; }
+
+/* Light sent back into a cavity around the light (PIPELINE.md "Energy"): B times the gain. */
+static void cavity(const rctx *r, int o, int l, double B[3], double var[3])
+{
+    const double *g = r->gain[o * r->nlight + l];
+    for (int c = 0; c < 3; c++) {
+        B[c] *= g[c];
+        var[c] *= g[c] * g[c];
+    }
+}
 
 /* B at (x, n) of object o for light l, per unit intensity, with the variance of the mean. */
 static void radiosity_at(const rctx *r, int o, int l, lr_vec3 x, lr_vec3 n, uint64_t key,
@@ -59,9 +71,11 @@ static void radiosity_at(const rctx *r, int o, int l, lr_vec3 x, lr_vec3 n, uint
         }
         if (fallback)
             *fallback = false;
+        cavity(r, o, l, B, var);
         return;
     }
     lr_cpu_maps_compose(r->maps[o * r->nlight + l], x, n, B, var, fallback);
+    cavity(r, o, l, B, var);
 }
 
 static void vpl_item(void *p, long item)
@@ -210,7 +224,8 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
     r.object_px = calloc((size_t)r.W * r.H, sizeof *r.object_px);
     r.fallback_px = calloc((size_t)r.W * r.H, sizeof *r.fallback_px);
     r.objs = calloc((size_t)r.nobj, sizeof *r.objs);
-    if (!r.I || !r.objs || !r.maps || !r.vpl || !r.object_px || !r.fallback_px) {
+    r.gain = calloc((size_t)r.nobj * r.nlight + 1, sizeof *r.gain);
+    if (!r.I || !r.objs || !r.gain || !r.maps || !r.vpl || !r.object_px || !r.fallback_px) {
         rc = lr_err_set(e, LR_ENOMEM, "cpu render: out of memory");
         goto fail;
     }
@@ -218,6 +233,20 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
         lr_light_rgb(lr_scene_light_at(s, l), r.I[l]);
     for (int o = 0; o < r.nobj; o++)
         r.objs[o] = lr_scene_object_at(s, o);
+    for (int l = 0; l < r.nlight; l++) {
+        double(*g)[3] = calloc((size_t)r.nobj + 1, sizeof *g);
+        if (!g) {
+            rc = lr_err_set(e, LR_ENOMEM, "cpu render: out of memory");
+            goto fail;
+        }
+        rc = lr_cpu_cavity_scene_gains(s, l, d->threads, g, r.nobj, e);
+        for (int o = 0; o < r.nobj && !rc; o++)
+            for (int c = 0; c < 3; c++)
+                r.gain[o * r.nlight + l][c] = g[o][c];
+        free(g);
+        if (rc)
+            goto fail;
+    }
     double samples = 0.0;
     if (!ref) {
         for (int o = 0; o < r.nobj; o++)
@@ -278,6 +307,7 @@ fail:
     free(r.maps);
     free(r.vpl);
     free(r.I);
+    free(r.gain);
     free(r.object_px);
     free(r.fallback_px);
     free(r.objs);

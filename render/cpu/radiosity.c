@@ -290,7 +290,10 @@ void lr_cpu_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3
 {
     int N = d && d->N > 0 ? d->N : 16;
     enum lr_cpu_sampler mode = d ? d->sampler : LR_CPU_PASS;
+    /* PIPELINE.md: r_max = 20 max(R, |x_l - x_o|) (20 R for directional lights). */
     double rmax = d && d->r_max > 0.0 ? d->r_max : LR_CPU_RMAX_RADII * obj->radius;
+    if (!(d && d->r_max > 0.0) && light->type != LR_LIGHT_DIRECTIONAL)
+        rmax = LR_CPU_RMAX_RADII * fmax(obj->radius, lr_v3_len(lr_v3_sub(light->position, xo)));
 
     ctx k = {.obj = obj, .light = light, .xo = xo, .no = no, .tmin = LR_CPU_TMIN * obj->radius,
              .others = d ? d->others : NULL, .n_others = d ? d->n_others : 0,
@@ -324,7 +327,9 @@ void lr_cpu_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3
             mean += delta / (j + 1);
             m2 += delta * (f - mean);
         }
-        out->mean[c] = mean;
-        out->var[c] = N > 1 ? m2 / (N - 1) : 0.0;
+        /* PIPELINE.md "Energy": S_d times its per-band normalisation (1 for the raw model). */
+        double g = lr_scene_object_sd_norm(obj, c);
+        out->mean[c] = g * mean;
+        out->var[c] = N > 1 ? g * g * m2 / (N - 1) : 0.0;
     }
 }

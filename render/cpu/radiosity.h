@@ -31,7 +31,7 @@
 #include "render/base/vec3.h"
 #include "render/scene/scene.h"
 
-/* PIPELINE.md: r_max = 20 bounding radii. */
+/* PIPELINE.md: r_max = 20 max(bounding radius, |x_l - x_o|) (directional: 20 radii). */
 #define LR_CPU_RMAX_RADII 20.0
 
 enum lr_cpu_sampler { LR_CPU_PASS = 0, LR_CPU_REFERENCE = 1 };
@@ -39,7 +39,8 @@ enum lr_cpu_sampler { LR_CPU_PASS = 0, LR_CPU_REFERENCE = 1 };
 typedef struct lr_cpu_radiosity_desc {
     int N;                       /* samples per band; 0: 16 */
     enum lr_cpu_sampler sampler; /* default LR_CPU_PASS */
-    double r_max;                /* LR_CPU_PASS: 0 = LR_CPU_RMAX_RADII * object radius */
+    double r_max;                /* LR_CPU_PASS: 0 = LR_CPU_RMAX_RADII * max(object radius,
+                                  * |x_l - x_o|) (directional: * radius) */
     /* Other translucent objects of the scene: the light G-buffer holds the first surface of
      * any of them, and a lookup that meets another object first brings no light (as the GLSL
      * pass). NULL / 0: the object alone. */

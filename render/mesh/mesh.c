@@ -78,9 +78,41 @@ static void sort3(uint32_t k[3])
     if (k[0] > k[1]) { t = k[0]; k[0] = k[1]; k[1] = t; }
 }
 
+/* Whether the ray from o along a fixed, generic direction crosses the triangles of closed
+ * pieces other than `self` an odd number of times (Moller-Trumbore). */
+static bool odd_crossings(const float *pos, const uint32_t *idx, size_t nt, const uint32_t *piece,
+                          const uint8_t *pclosed, uint32_t self, lr_vec3 o)
+{
+    const lr_vec3 d = lr_v3_normalize(lr_v3(0.5773, 0.5801, 0.5749));
+    unsigned count = 0;
+    for (size_t t = 0; t < nt; t++) {
+        if (piece[t] == self || !pclosed[piece[t]])
+            continue;
+        lr_vec3 a = fpos(pos, idx[3 * t]), b = fpos(pos, idx[3 * t + 1]);
+        lr_vec3 c = fpos(pos, idx[3 * t + 2]);
+        lr_vec3 e1 = lr_v3_sub(b, a), e2 = lr_v3_sub(c, a), p = lr_v3_cross(d, e2);
+        double det = lr_v3_dot(e1, p);
+        if (fabs(det) < 1e-300)
+            continue;
+        lr_vec3 s = lr_v3_sub(o, a);
+        double u = lr_v3_dot(s, p) / det;
+        if (u < 0.0 || u > 1.0)
+            continue;
+        lr_vec3 q = lr_v3_cross(s, e1);
+        double v = lr_v3_dot(d, q) / det;
+        if (v < 0.0 || u + v > 1.0)
+            continue;
+        if (lr_v3_dot(e2, q) / det > 0.0)
+            count++;
+    }
+    return count & 1u;
+}
+
 /* Turns faces over so that neighbours agree (breadth-first over two-face edges; each piece
  * keeps the orientation most of its faces already had), then turns closed pieces with negative
- * volume inside out. Returns the number of faces flipped, or (size_t)-1 on allocation failure.
+ * volume inside out, except those nested inside an odd number of other closed pieces (the
+ * inner wall of a hollow object), which get negative volume. Returns the number of faces
+ * flipped, or (size_t)-1 on allocation failure.
  */
 static size_t reorient(const float *pos, uint32_t *idx, size_t nt, const lr_mesh_edge *ed)
 {
@@ -92,8 +124,12 @@ static size_t reorient(const float *pos, uint32_t *idx, size_t nt, const lr_mesh
     uint8_t *open = calloc(nt ? nt : 1, 1); /* touches a boundary or non-manifold edge */
     int8_t *flip = malloc(nt ? nt : 1);
     uint32_t *queue = malloc((nt ? nt : 1) * sizeof *queue); /* also: the piece's faces */
+    uint32_t *piece = malloc((nt ? nt : 1) * sizeof *piece);
+    uint32_t *pseed = malloc((nt ? nt : 1) * sizeof *pseed);
+    uint8_t *pclosed = malloc(nt ? nt : 1), *pinvert = malloc(nt ? nt : 1);
     size_t flipped = (size_t)-1;
-    if (!start || !nb || !same || !open || !flip || !queue)
+    if (!start || !nb || !same || !open || !flip || !queue || !piece || !pseed || !pclosed ||
+        !pinvert)
         goto done;
     for (size_t i = 0; i < ne;) {
         size_t j = i + 1;
@@ -132,6 +168,9 @@ static size_t reorient(const float *pos, uint32_t *idx, size_t nt, const lr_mesh
     }
     memset(flip, -1, nt);
     flipped = 0;
+    /* Pass 1: pieces (consistent orientation inside each; piece[t], its closedness and the
+     * inversion that gives it positive volume). */
+    size_t npiece = 0;
     for (size_t seed = 0; seed < nt; seed++) {
         if (flip[seed] >= 0)
             continue;
@@ -141,6 +180,7 @@ static size_t reorient(const float *pos, uint32_t *idx, size_t nt, const lr_mesh
         queue[tail++] = (uint32_t)seed;
         while (head < tail) {
             uint32_t t = queue[head++];
+            piece[t] = (uint32_t)npiece;
             if (open[t])
                 closed = false;
             for (size_t k = start[t]; k < start[t + 1]; k++) {
@@ -166,17 +206,41 @@ static size_t reorient(const float *pos, uint32_t *idx, size_t nt, const lr_mesh
             if (vol < 0.0)
                 invert = !invert;
         }
-        for (size_t i = 0; i < n; i++) {
-            uint32_t t = queue[i];
-            if (flip[t] ^ invert) {
-                uint32_t tmp = idx[3 * t + 1];
-                idx[3 * t + 1] = idx[3 * t + 2];
-                idx[3 * t + 2] = tmp;
-                flipped++;
-            }
+        pclosed[npiece] = closed;
+        pinvert[npiece] = invert;
+        pseed[npiece] = (uint32_t)seed;
+        npiece++;
+    }
+    /* Pass 2: a closed piece inside an odd number of other closed pieces bounds a cavity (the
+     * inner wall of a hollow sphere): its normals point into the cavity, out of the material,
+     * so its volume is negative. Nesting by ray parity from a point of the piece. */
+    size_t nclosed = 0;
+    for (size_t p = 0; p < npiece; p++)
+        nclosed += pclosed[p];
+    if (nclosed > 1)
+        for (size_t p = 0; p < npiece; p++) {
+            if (!pclosed[p])
+                continue;
+            uint32_t *tri = &idx[3 * pseed[p]];
+            lr_vec3 o = lr_v3_scale(lr_v3_add(fpos(pos, tri[0]), lr_v3_add(fpos(pos, tri[1]),
+                                                                       fpos(pos, tri[2]))),
+                                    1.0 / 3.0);
+            if (odd_crossings(pos, idx, nt, piece, pclosed, (uint32_t)p, o))
+                pinvert[p] = !pinvert[p];
+        }
+    for (size_t t = 0; t < nt; t++) {
+        if (flip[t] ^ pinvert[piece[t]]) {
+            uint32_t tmp = idx[3 * t + 1];
+            idx[3 * t + 1] = idx[3 * t + 2];
+            idx[3 * t + 2] = tmp;
+            flipped++;
         }
     }
 done:
+    free(piece);
+    free(pseed);
+    free(pclosed);
+    free(pinvert);
     free(start);
     free(nb);
     free(same);

@@ -87,6 +87,9 @@ typedef struct lr_coeffs {
     double C_E;              /* (1 - 3 C2(eta)) / 2 */
     double A_dir;            /* (1 - C_E) / (2 C_phi) */
     double eta;
+    /* Energy normalisation of the directional dipole per band (lr_dirpole_energy_norm): the
+     * passes multiply S_d by it unless the object asks for the raw model. */
+    double sd_norm[3];
 } lr_coeffs;
 
 /* Rejects NaN, Inf, negative coefficients, sigma_t' outside [LR_SIGMA_T_PRIME_MIN,
@@ -154,6 +157,20 @@ void lr_dirpole_sd_fresnel(const lr_coeffs *c, lr_vec3 xi, lr_vec3 ni, lr_vec3 w
  * "w_i", "n_o"); directions need not be unit length, they are normalised here. */
 int lr_dirpole_sd_checked(const lr_coeffs *c, lr_vec3 xi, lr_vec3 ni, lr_vec3 wi, lr_vec3 xo,
                           lr_vec3 no, int with_fresnel, double out[3], lr_err *e);
+
+/* ---- Energy normalisation of the directional dipole (dirpole_norm.c) ------------------ */
+
+/* Hemispherical cosine-weighted boundary transmittance 2 int_0^1 F_t(mu, eta) mu d(mu): the
+ * fraction of radiosity B that leaves as L_o = F_t B / pi (1 for eta 1, 0.908 for eta 1.5). */
+double lr_hemi_transmittance(double eta);
+/* The directional dipole's half-space total at normal incidence, per band: power out / power
+ * that entered = T_hem pi int S_d dA (1.340 / 1.240 / 1.197 at albedo' 1 for eta 1 / 1.3 /
+ * 1.5), by quadrature in log r (relative error < 1e-5). */
+void lr_dirpole_halfspace_albedo(const lr_coeffs *c, double out[3]);
+/* Per-band factor lr_dipole_rd_total / lr_dirpole_halfspace_albedo (1 where both vanish):
+ * times it, S_d's half-space total equals the standard dipole's (exactly 1 at albedo' 1).
+ * lr_coeffs_derive stores it in sd_norm (a few thousand S_d evaluations, once per material). */
+void lr_dirpole_energy_norm(const lr_coeffs *c, double out[3]);
 
 /* ---- Sampling (sampling.c) ------------------------------------------------------------- */
 

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "render/base/mat4.h"
+#include "render/cpu/cavity.h"
 #include "render/passes/passes.h"
 
 static int upload(lr_gpu_mesh *g, const lr_mesh *m, lr_err *e)
@@ -123,6 +124,33 @@ void lr_passes_update_coeffs(lr_renderer *r)
         lr_passes_pack_coeffs(&o->coeffs, r->coef + 20 * i);
         lr_passes_pack_sss(&o->coeffs, o->sss_model, r->sss + 12 * i);
     }
+    for (int i = 0; i < LR_MAX_OBJECTS; i++)
+        for (int c = 0; c < 3; c++)
+            r->sd_norm[3 * i + c] =
+                i < no ? (float)lr_scene_object_sd_norm(lr_scene_object_at(r->scene, i), c) : 1.0f;
+}
+
+int lr_passes_update_cavity(lr_renderer *r, lr_err *e)
+{
+    /* One measurement per light (the closure depends on where the light sits in the cavity),
+     * the same numbers lr_cpu_render applies per light (render/cpu/frame.c). */
+    for (int k = 0; k < 3 * LR_MAX_LIGHTS * LR_MAX_OBJECTS; k++)
+        r->cavity_gain[k] = 1.0f;
+    int no = lr_scene_object_count(r->scene), nl = lr_scene_light_count(r->scene);
+    if (no > LR_MAX_OBJECTS)
+        no = LR_MAX_OBJECTS;
+    if (nl > LR_MAX_LIGHTS)
+        nl = LR_MAX_LIGHTS;
+    for (int l = 0; l < nl; l++) {
+        double g[LR_MAX_OBJECTS][3];
+        int rc = lr_cpu_cavity_scene_gains(r->scene, l, 0, g, no, e);
+        if (rc)
+            return rc;
+        for (int i = 0; i < no; i++)
+            for (int c = 0; c < 3; c++)
+                r->cavity_gain[3 * (l * LR_MAX_OBJECTS + i) + c] = (float)g[i][c];
+    }
+    return LR_OK;
 }
 
 void lr_passes_set_coeffs(lr_renderer *r, const lr_program *p)
@@ -137,6 +165,16 @@ void lr_passes_set_coeffs(lr_renderer *r, const lr_program *p)
         loc = lr_program_uniform(p, "u_sss[0]");
     if (loc >= 0)
         glUniform4fv(loc, 3 * LR_MAX_OBJECTS, r->sss);
+    loc = lr_program_uniform(p, "u_sd_norm");
+    if (loc < 0)
+        loc = lr_program_uniform(p, "u_sd_norm[0]");
+    if (loc >= 0)
+        glUniform3fv(loc, LR_MAX_OBJECTS, r->sd_norm);
+    loc = lr_program_uniform(p, "u_cavity_gain");
+    if (loc < 0)
+        loc = lr_program_uniform(p, "u_cavity_gain[0]");
+    if (loc >= 0)
+        glUniform3fv(loc, LR_MAX_LIGHTS * LR_MAX_OBJECTS, r->cavity_gain);
 }
 
 void lr_passes_uniform_mat4(const lr_program *p, const char *name, const double m[16])
@@ -268,7 +306,13 @@ void lr_passes_bind_gather(lr_renderer *r, const lr_program *p, const double w[]
     lr_passes_uniform_i(p, "u_K", r->rad.K);
     lr_passes_uniform_f(p, "u_eps_bias", r->rad.eps_bias);
     lr_passes_uniform_f(p, "u_eps_comb", r->rad.eps_comb);
+    lr_passes_set_light_w(r, p, w);
+}
+
+void lr_passes_set_light_w(lr_renderer *r, const lr_program *p, const double w[][3])
+{
     /* The maps store B * scale[l]: the weight divides it out. */
+    GLint loc;
     float wf[3 * LR_MAX_LIGHTS] = {0};
     for (int l = 0; l < r->n_lights; l++)
         for (int c = 0; c < 3; c++)

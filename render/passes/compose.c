@@ -1,9 +1,10 @@
 /* Pass 3 — composition (render/passes/PIPELINE.md): the camera's view of the objects
  * (Algorithm 1 over the K maps, L_o = I F_t B / pi) and of the receivers (direct light
  * shadowed through the light G-buffer, plus the VPLs), into a linear RGBA32F target; then
- * exposure, tone curve and sRGB into an RGBA8 target. The lights' intensities I_l enter here
- * and only here (each light's maps and VPL row hold its unit-intensity transport, summed with
- * weights I_l), so a dimmer change re-runs this pass alone. */
+ * exposure, tone curve and sRGB into an RGBA8 target. The lights' intensities I_l (and the
+ * cavity gains per light and object, PIPELINE.md "Energy") enter here and only here (each
+ * light's maps and VPL row hold its unit-intensity transport, summed with weights I_l), so a
+ * dimmer change re-runs this pass alone. */
 #include <math.h>
 
 #include "render/base/mat4.h"
@@ -78,6 +79,13 @@ int lr_pass_compose(lr_renderer *r, lr_err *e)
     lr_passes_uniform_v3(p, "u_view_dir", fwd);
     lr_passes_uniform_i(p, "u_ortho", cam->orthographic);
     for (int i = 0; i < r->n_objects; i++) {
+        /* Object i's emission for light l times its cavity gain for l (PIPELINE.md "Energy"):
+         * folded into the gather's per-light weights. */
+        double w[LR_MAX_LIGHTS][3];
+        for (int l = 0; l < LR_MAX_LIGHTS; l++)
+            for (int c = 0; c < 3; c++)
+                w[l][c] = I[l][c] * r->cavity_gain[3 * (l * LR_MAX_OBJECTS + i) + c];
+        lr_passes_set_light_w(r, p, w);
         lr_passes_uniform_i(p, "u_object", i);
         lr_passes_uniform_i(p, "u_two_sided", r->two_sided[i]);
         lr_passes_draw(&r->obj[i]);

@@ -70,6 +70,16 @@ struct lr_renderer {
     bool two_sided[LR_MAX_OBJECTS];
     float coef[5 * 4 * LR_MAX_OBJECTS];
     float sss[3 * 4 * LR_MAX_OBJECTS]; /* lr_passes_pack_sss per object */
+    /* Per object: the S_d energy normalisation (lr_scene_object_sd_norm: coeffs.sd_norm, or 1
+     * for "normalize": false and for the standard dipole), radiosity.frag's u_sd_norm
+     * (PIPELINE.md "Energy"). */
+    float sd_norm[3 * LR_MAX_OBJECTS];
+    /* Per light and object, [3 (l LR_MAX_OBJECTS + i) + c]: the cavity gain of object i for
+     * light l (render/cpu/cavity.h, measured on the CPU when the maps restart; 1 for lights
+     * beyond n_lights). Composition multiplies light l's B of object i by it: folded into the
+     * gather's weights per object (compose_object) and compose_receiver's u_cavity_gain for
+     * the VPLs. */
+    float cavity_gain[3 * LR_MAX_LIGHTS * LR_MAX_OBJECTS];
 
     /* One light G-buffer per light of the scene (lights[l] as seen by the last gbuffer
      * pass). */
@@ -141,6 +151,8 @@ void lr_passes_pack_sss(const lr_coeffs *c, enum lr_sss_model model, float out[1
 /* Coefficient blocks (u_coef, u_sss) of every object (render/shaders/lib/material.glsl). */
 void lr_passes_update_coeffs(lr_renderer *r);
 void lr_passes_set_coeffs(lr_renderer *r, const lr_program *p);
+/* Measures r->cavity_gain for every light of the current scene (PIPELINE.md "Energy"). */
+int lr_passes_update_cavity(lr_renderer *r, lr_err *e);
 /* Light l's G-buffer samplers and uniforms on units 0..3 (render/shaders/lib/gbuffer.glsl). */
 void lr_passes_bind_gbuffer(lr_renderer *r, const lr_program *p, int l);
 /* Every light's G-buffer positions and light uniforms (render/shaders/lib/lights.glsl):
@@ -149,6 +161,8 @@ void lr_passes_bind_lights(lr_renderer *r, const lr_program *p);
 /* Algorithm 1 uniforms and samplers (units 4..6); the gather returns
  * sum_l w[l] B_l (render/shaders/lib/gather.glsl u_light_w), w per light and band. */
 void lr_passes_bind_gather(lr_renderer *r, const lr_program *p, const double w[][3]);
+/* Only the gather's weights u_light_w (w[l] / rad.scale[l]), for a per-object change. */
+void lr_passes_set_light_w(lr_renderer *r, const lr_program *p, const double w[][3]);
 void lr_passes_uniform_mat4(const lr_program *p, const char *name, const double m[16]);
 void lr_passes_uniform_v3(const lr_program *p, const char *name, lr_vec3 v);
 void lr_passes_uniform_i(const lr_program *p, const char *name, int v);

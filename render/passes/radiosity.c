@@ -171,6 +171,7 @@ int lr_pass_radiosity(lr_renderer *r, bool restart, lr_err *e)
             lr_passes_uniform_mat4(p, "u_vp", r->rad.vp[k]);
             lr_passes_uniform_i(p, "u_N", r->rs.N);
             lr_passes_uniform_f(p, "u_r_max", (float)r->rad.r_max);
+            lr_passes_uniform_f(p, "u_r_max_dist", 20.0f);
             lr_passes_uniform_i(p, "u_map_size", r->rad.size);
             lr_passes_uniform_f(p, "u_map_scale", r->rad.scale[l]);
             /* Half floats: stay below 65504 (a light on the surface has B -> Inf at x_o -> x_l). */

@@ -505,11 +505,19 @@ static int parse_object(ctx *c, lr_jnode obj, int i, obj_rec *o)
     snprintf(where, sizeof where, "objects[%d]", i);
     if (lr_json_type(c->j, obj) != LR_JSON_OBJECT)
         return lr_json_fail(c->j, obj, where, c->e, LR_EPARSE, "expected an object");
-    static const char *const keys[] = {"name", "material", "mesh", "transform", "model", NULL};
+    static const char *const keys[] = {"name", "material", "mesh", "transform", "model",
+                                       "normalize", NULL};
     int rc;
+    bool normalize = true; /* PIPELINE.md "Energy": S_d energy-normalised unless false */
     if ((rc = lr_json_check_keys(c->j, obj, where, keys, c->e)) ||
         (rc = get_name(c, obj, where, "object", i, o->pub.name)))
         return rc;
+    lr_jnode nz = lr_json_get(c->j, obj, "normalize");
+    char nf[96];
+    if (nz != LR_JNONE &&
+        (rc = lr_json_bool(c->j, nz, cat(nf, sizeof nf, where, "normalize"), &normalize, c->e)))
+        return rc;
+    o->pub.sd_raw = !normalize;
     char f[256];
     o->pub.sss_model = LR_SSS_DIRECTIONAL_DIPOLE;
     lr_jnode model = lr_json_get(c->j, obj, "model");
@@ -711,7 +719,22 @@ static int parse_document(ctx *c)
         if (rc)
             return rc;
     }
-    return unique_names(c, objs, "objects", obj_name, no);
+    if ((rc = unique_names(c, objs, "objects", obj_name, no)))
+        return rc;
+    /* A light inside solid material: every ray from it meets the surface from behind, which
+     * the surface-incidence BSSRDF (PIPELINE.md) counts as no light, so that object stays dark
+     * for this light. Say so rather than render 0 silently (issue 3). */
+    for (int i = 0; i < nl; i++) {
+        int k = -1;
+        if (lr_scene_light_enclosure(s, i, &k) == LR_ENCLOSURE_SOLID && k >= 0)
+            lr_warn(&s->warn,
+                    "%s:%d: lights[%d] '%s' is inside the material of objects[%d] '%s': the "
+                    "model has no term for a source embedded in the medium, so that object "
+                    "gets no light from it (put the light in a cavity: a hollow object)",
+                    s->path, lr_json_line(j, lr_json_at(j, lights, i)), i, s->light[i].name, k,
+                    s->obj[k].pub.name);
+    }
+    return LR_OK;
 }
 
 static int load_common(const char *name, lr_json *j, const lr_warn_sink *warn, lr_scene **out,

@@ -29,6 +29,9 @@
  *                     "scale": 1 | [sx, sy, sz] (> 0)}                      (optional)
  *       "model":     "directional_dipole" (default; seed 003) | "standard_dipole" (Jensen
  *                    2001: S_d = R_d(r) / pi): the diffusion term of the radiosity maps
+ *       "normalize": true (false: the published directional dipole, without the energy
+ *                    normalisation of PIPELINE.md "Energy"; no effect on the standard
+ *                    dipole, whose total is the reference of that normalisation) (optional)
  *     } ]
  *   "lights": [                                    one to LR_SCENE_MAX_LIGHTS (4)
  *     {"type": "point", "name": string, "position": [x,y,z], "intensity": W/sr (>= 0),
@@ -104,7 +107,18 @@ typedef struct lr_scene_object {
     double area;          /* world surface area, mm^2 */
     bool closed;          /* watertight (a shade with rims is; one without is not) */
     enum lr_sss_model sss_model; /* "model": the S_d the radiosity estimator evaluates */
+    bool sd_raw;          /* scene "normalize": false: [14]'s S_d as published, without
+                           * coeffs.sd_norm (PIPELINE.md "Energy"); default: normalised */
 } lr_scene_object;
+
+/* The factor S_d is multiplied by for band c (0..2): coeffs.sd_norm[c] for the directional
+ * dipole, 1 for the raw model (sd_raw) and for the standard dipole (sd_norm scales the
+ * directional dipole's half-space total to the standard dipole's R_d total, so the standard
+ * dipole is its own reference: factor 1). The GLSL pass and the CPU twin both use it. */
+static inline double lr_scene_object_sd_norm(const lr_scene_object *o, int c)
+{
+    return o->sd_raw || o->sss_model != LR_SSS_DIRECTIONAL_DIPOLE ? 1.0 : o->coeffs.sd_norm[c];
+}
 
 /* ---- Lights ------------------------------------------------------------------------------- */
 

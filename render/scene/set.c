@@ -625,6 +625,14 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
         *d = LR_DIRTY_MATERIAL;
         return LR_OK;
     }
+    if (strcmp(f, "normalize") == 0) {
+        bool normalize = !rec->pub.sd_raw;
+        if ((rc = bool_field(o, &normalize)))
+            return rc;
+        rec->pub.sd_raw = !normalize;
+        *d = LR_DIRTY_MATERIAL; /* the radiosity maps restart */
+        return LR_OK;
+    }
     if (strcmp(f, "model") == 0) {
         enum lr_sss_model m;
         if (!lr_sss_model_parse(o->value, &m))
@@ -648,7 +656,8 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
         if ((rc = lr_scene_check_transform(&xf, &bad, &inner)))
             return check_failed(o, f, bad, rc, &inner);
     } else {
-        return unknown(o, "an object", f, "material, material.*, mesh.*, transform.*, model");
+        return unknown(o, "an object", f,
+                       "material, material.*, mesh.*, transform.*, model, normalize");
     }
     lr_mesh *world;
     lr_bvh *bvh;
@@ -690,7 +699,12 @@ static int object_get(op *o, const lr_scene *s, int i, const char *f)
         return transform_field(o, &rec.xf, f + 10);
     if (strcmp(f, "model") == 0)
         return out(o, "%s", lr_sss_model_name(rec.pub.sss_model));
-    return unknown(o, "an object", f, "material, material.*, mesh.*, transform.*, model");
+    if (strcmp(f, "normalize") == 0) {
+        bool normalize = !rec.pub.sd_raw;
+        return bool_field(o, &normalize);
+    }
+    return unknown(o, "an object", f,
+                   "material, material.*, mesh.*, transform.*, model, normalize");
 }
 
 /* ---- keys ------------------------------------------------------------------------------------- */

@@ -1,6 +1,7 @@
 // Pass 3 for the translucent objects: I B = sum_l I_l B_l from every light's K maps (Algorithm
-// 1, the gather weighted by the intensities I_l = intensity * colour), then
-// L_o = F_t(w_o) I B / pi (seed 003 Eq. 5).
+// 1, the gather weighted by the intensities I_l = intensity * colour, each times this object's
+// cavity gain for light l, PIPELINE.md "Energy": render/passes/compose.c sets u_light_w per
+// object), then L_o = F_t(w_o) I B / pi (seed 003 Eq. 5).
 #include "lib/material.glsl"
 #include "lib/gather.glsl"
 

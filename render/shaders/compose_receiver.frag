@@ -9,6 +9,9 @@
 in vec3 v_pos;
 in vec3 v_nrm;
 uniform vec3 u_albedo;
+// Per light l and object i, element l LR_MAX_OBJECTS + i: light sent back into a cavity
+// around light l (PIPELINE.md "Energy"); multiplies light l's B of the VPLs of object i.
+uniform vec3 u_cavity_gain[LR_MAX_LIGHTS * LR_MAX_OBJECTS];
 uniform bool u_use_vpl;
 uniform highp sampler2D u_vpl_pos; // x_v, A_v
 uniform highp sampler2D u_vpl_nrm; // n_v, object id
@@ -66,12 +69,14 @@ void main()
                 continue;
             if (u_vpl_vis && !vpl_visible(p.xyz, nv.xyz, x))
                 continue;
-            float eta = lr_material(int(nv.w + 0.5)).eta;
+            int id = clamp(int(nv.w + 0.5), 0, LR_MAX_OBJECTS - 1);
+            float eta = lr_material(id).eta;
             vec3 B = vec3(0.0);
             for (int l = 0; l < LR_MAX_LIGHTS; l++) {
                 if (l >= u_n_lights)
                     break;
-                B += u_lights_I[l] * texelFetch(u_vpl_B, ivec2(v, l), 0).rgb;
+                B += u_lights_I[l] * u_cavity_gain[l * LR_MAX_OBJECTS + id] *
+                     texelFetch(u_vpl_B, ivec2(v, l), 0).rgb;
             }
             E += lr_fresnel_transmittance(cv, eta) * B / LR_PI * p.w * cv * cx / max(d2, p.w);
         }

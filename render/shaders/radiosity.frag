@@ -13,13 +13,16 @@ uniform bool u_two_sided;
 uniform int u_light_type;   // 0 point, 1 spot, 2 directional
 uniform vec2 u_spot_cos;    // cos(outer), cos(inner)
 uniform int u_N;
-uniform float u_r_max;
+uniform float u_r_max;      // 20 R; point/spot lights: r_max = max(u_r_max, u_r_max_dist d)
+uniform float u_r_max_dist; // 20 (PIPELINE.md: r_max = 20 max(R, |x_l - x_o|))
 uniform uint u_seed;
 uniform uint u_map;
 uniform uint u_frame;
 uniform int u_map_size;
 uniform float u_map_scale; // stored value = B * scale (render/passes/radiosity.c)
 uniform float u_map_max;   // largest stored value (half-float maps: below the fp16 maximum)
+// Per object: S_d's energy normalisation per band (PIPELINE.md "Energy"; 1: the raw model).
+uniform vec3 u_sd_norm[LR_MAX_OBJECTS];
 layout(location = 0) out vec4 o_B;
 layout(location = 1) out vec4 o_pos;
 layout(location = 2) out vec4 o_nrm;
@@ -53,23 +56,24 @@ void main()
     float d = length(h);
     vec3 A = u_light_pos + h; // antipode of x_o on the sphere of radius d around the light
 
+    float r_max = u_light_type == 2 ? u_r_max : max(u_r_max, u_r_max_dist * d);
     vec3 B = vec3(0.0);
     for (int c = 0; c < 3; c++) {
         float sigma_tr = mat.sigma_tr[c];
         // lr_exp_radius_sample / _pdf with the per-band constant hoisted: for the inverted
         // CDF, e^{-sigma_tr r} = 1 - xi mass, so p(r) = sigma_tr (1 - xi mass) / mass.
-        bool flat_r = sigma_tr * u_r_max < 1e-30;
-        float mass = flat_r ? 1.0 : -lr_expm1(-sigma_tr * u_r_max);
+        bool flat_r = sigma_tr * r_max < 1e-30;
+        float mass = flat_r ? 1.0 : -lr_expm1(-sigma_tr * r_max);
         float sum = 0.0;
         for (int j = 0; j < u_N; j++) {
             float xi1 = lr_rand(state);
             float xi2 = lr_rand(state);
             float r, pr;
             if (flat_r) {
-                r = xi1 * u_r_max;
-                pr = 1.0 / u_r_max;
+                r = xi1 * r_max;
+                pr = 1.0 / r_max;
             } else {
-                r = min(-lr_log1p(-xi1 * mass) / sigma_tr, u_r_max);
+                r = min(-lr_log1p(-xi1 * mass) / sigma_tr, r_max);
                 pr = sigma_tr * (1.0 - xi1 * mass) / mass;
             }
             float alpha = 2.0 * LR_PI * xi2;
@@ -115,7 +119,7 @@ void main()
             float sd = lr_sss_sd_band(mat, sss, c, xi, ni, wi, xo, no);
             sum += sd * Ft * J * inv_pA * shape;
         }
-        B[c] = LR_PI * sum / float(u_N);
+        B[c] = LR_PI * sum / float(u_N) * u_sd_norm[clamp(u_object, 0, LR_MAX_OBJECTS - 1)][c];
     }
     o_B = vec4(min(B * u_map_scale, vec3(u_map_max)), 1.0);
     o_pos = vec4(xo, 1.0);

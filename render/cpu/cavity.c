@@ -1,0 +1,191 @@
+/* Cavity gain: see cavity.h. */
+#include "render/cpu/cavity.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "render/cpu/parallel.h"
+#include "render/cpu/radiosity.h"
+#include "render/cpu/rng.h"
+#include "render/mesh/bvh.h"
+#include "render/optics/optics.h"
+
+typedef struct point_ctx {
+    const lr_scene_object *obj;
+    const lr_light *light;
+    const double *cdf; /* triangle area CDF, last = 1 */
+    size_t nt;
+    int npts, N;
+    unsigned seed;
+    double (*P)[3];    /* per point: B of its unlit side(s) */
+} point_ctx;
+
+/* Whether the light sees side n of surface point x (the light G-buffer's first surface there,
+ * facing the light). */
+static bool lit_side(const lr_scene_object *o, lr_vec3 xl, lr_vec3 x, lr_vec3 n)
+{
+    lr_vec3 to = lr_v3_sub(x, xl);
+    double d = lr_v3_len(to);
+    if (!(d > 0.0) || !(lr_v3_dot(n, to) < 0.0))
+        return false;
+    lr_vec3 u = lr_v3_scale(to, 1.0 / d);
+    return !lr_bvh_occluded(o->bvh, xl, u, 1e-9 * o->radius, d - 1e-6 * o->radius);
+}
+
+static void point_item(void *p, long i)
+{
+    point_ctx *k = p;
+    const lr_scene_object *o = k->obj;
+    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(k->seed, 0xCA71, (uint64_t)i, 0));
+    /* Stratified over the area CDF (point i in the i-th 1/npts of the surface's area, in the
+     * mesh's triangle order), which keeps the points spread over the whole surface. */
+    double pick = (i + lr_cpu_rng_next(&rng)) / k->npts;
+    double s = lr_cpu_rng_next(&rng), t = lr_cpu_rng_next(&rng);
+    size_t lo = 0, hi = k->nt - 1; /* first triangle with cdf > pick */
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (k->cdf[mid] > pick)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    lr_vec3 v[3];
+    lr_mesh_triangle(o->mesh, lo, v);
+    if (s + t > 1.0) {
+        s = 1.0 - s;
+        t = 1.0 - t;
+    }
+    lr_vec3 x = lr_v3_add(v[0], lr_v3_add(lr_v3_scale(lr_v3_sub(v[1], v[0]), s),
+                                          lr_v3_scale(lr_v3_sub(v[2], v[0]), t)));
+    lr_vec3 n = lr_v3_normalize(lr_v3_cross(lr_v3_sub(v[1], v[0]), lr_v3_sub(v[2], v[0])));
+    /* Closed: the outward side only. Open (two-sided): both sides emit. */
+    for (int side = 0; side < (o->closed ? 1 : 2); side++) {
+        lr_vec3 ns = side ? lr_v3_scale(n, -1.0) : n;
+        if (lit_side(o, k->light->position, x, ns))
+            continue;
+        lr_cpu_radiosity_desc d = {.N = k->N, .sampler = LR_CPU_REFERENCE};
+        lr_cpu_estimate est;
+        lr_cpu_radiosity(o, k->light, x, ns, &d,
+                         lr_cpu_key(k->seed, 0xCA72, (uint64_t)i, (uint64_t)side), &est);
+        for (int c = 0; c < 3; c++)
+            k->P[i][c] += est.mean[c];
+    }
+}
+
+int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
+                          enum lr_enclosure enclosure, const lr_cpu_cavity_desc *d,
+                          lr_cpu_cavity *out, lr_err *e)
+{
+    if (!obj || !l || !out)
+        return lr_err_set(e, LR_EINVAL, "cavity: NULL %s", !obj ? "object" : !l ? "light" : "out");
+    int ndir = d && d->directions > 0 ? d->directions : 4096;
+    int npts = d && d->points > 0 ? d->points : 256;
+    int N = d && d->N > 0 ? d->N : 64;
+    unsigned seed = d && d->seed ? d->seed : 1;
+    *out = (lr_cpu_cavity){.gain = {1.0, 1.0, 1.0}};
+    /* Not for the raw directional dipole (its total exceeds 1); the standard dipole is the
+     * normalisation's reference, so "normalize" does not change it (lr_scene_object_sd_norm). */
+    out->applies = enclosure == LR_ENCLOSURE_HULL && l->type != LR_LIGHT_DIRECTIONAL &&
+                   !(obj->sd_raw && obj->sss_model == LR_SSS_DIRECTIONAL_DIPOLE);
+    if (!out->applies)
+        return LR_OK;
+
+    /* C, R_1 and F: the light's power per unit intensity over Halton directions (4 pi / ndir
+     * each, weighted by the spot profile) where the first surface is the object's front; from
+     * each such point one cosine-distributed ray into the cavity tells whether the light it
+     * sends back meets the object again. */
+    double eta = obj->coeffs.eta, hit = 0.0, entered = 0.0, rehit = 0.0, w = 4.0 * M_PI / ndir;
+    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(seed, 0xCA70, 0, 0));
+    for (int i = 0; i < ndir; i++) {
+        lr_vec3 u = lr_halton_sphere((unsigned)i + 1), xi, ni;
+        double shape = lr_light_shape(l, u);
+        double xi1 = lr_cpu_rng_next(&rng), xi2 = lr_cpu_rng_next(&rng);
+        if (!(shape > 0.0) ||
+            !lr_cpu_first_surface(obj, l->position, u, 1e-9 * obj->radius, &xi, &ni))
+            continue;
+        if (!obj->closed && lr_v3_dot(ni, u) > 0.0)
+            ni = lr_v3_scale(ni, -1.0); /* open surfaces are two-sided */
+        double mu = -lr_v3_dot(ni, u);
+        if (!(mu > 0.0))
+            continue; /* met from behind: no light enters (PIPELINE.md) */
+        hit += w * shape;
+        entered += w * shape * lr_fresnel_transmittance(mu, eta);
+        lr_vec3 t1, t2;
+        lr_cpu_tangents(ni, &t1, &t2);
+        double rr = sqrt(xi1), ph = 2.0 * M_PI * xi2, z = sqrt(fmax(0.0, 1.0 - xi1));
+        lr_vec3 dir = lr_v3_add(lr_v3_scale(ni, z), lr_v3_add(lr_v3_scale(t1, rr * cos(ph)),
+                                                               lr_v3_scale(t2, rr * sin(ph))));
+        if (lr_bvh_occluded(obj->bvh, xi, dir, 1e-6 * obj->radius, INFINITY))
+            rehit += w * shape;
+    }
+    out->C = hit / (4.0 * M_PI);
+    out->R1 = hit > 0.0 ? 1.0 - entered / hit : 0.0;
+    out->F = hit > 0.0 ? rehit / hit : 0.0;
+    out->entered = entered;
+    if (!(entered > 0.0))
+        return LR_OK;
+
+    /* a: power out of the surface the light does not see, T_hem int B dA, by points uniform
+     * over the surface's area. */
+    size_t nt = lr_mesh_triangle_count(obj->mesh);
+    double *cdf = malloc((nt ? nt : 1) * sizeof *cdf);
+    double(*P)[3] = calloc((size_t)npts, sizeof *P);
+    if (!cdf || !P || nt == 0) {
+        free(cdf);
+        free(P);
+        return nt ? lr_err_set(e, LR_ENOMEM, "cavity: out of memory for %d points", npts)
+                  : lr_err_set(e, LR_EINVAL, "cavity: object '%s' has no triangles", obj->name);
+    }
+    double area = 0.0;
+    for (size_t t = 0; t < nt; t++) {
+        lr_vec3 v[3];
+        lr_mesh_triangle(obj->mesh, t, v);
+        area += 0.5 * lr_v3_len(lr_v3_cross(lr_v3_sub(v[1], v[0]), lr_v3_sub(v[2], v[0])));
+        cdf[t] = area;
+    }
+    for (size_t t = 0; t < nt; t++)
+        cdf[t] /= area;
+    cdf[nt - 1] = 1.0;
+    point_ctx pc = {obj, l, cdf, nt, npts, N, seed, P};
+    lr_cpu_parallel_for(npts, d ? d->threads : 0, point_item, &pc);
+    double T = lr_hemi_transmittance(eta), A[3];
+    lr_dipole_rd_total(&obj->coeffs, A); /* the normalised model's half-space total */
+    for (int c = 0; c < 3; c++) {
+        double sum = 0.0;
+        for (int i = 0; i < npts; i++)
+            sum += P[i][c];
+        out->out[c] = T * sum * area / npts;
+        out->a[c] = out->out[c] / entered;
+        out->b[c] = fmax(0.0, A[c] - out->a[c]);
+        double R1 = out->R1, F = out->F;
+        double rho1 = R1 + (1.0 - R1) * out->b[c];
+        double rhod = (1.0 - T) + T * out->b[c];
+        double den = (1.0 - R1) * (1.0 - rhod * F);
+        double g = den > 0.0 ? 1.0 + T * rho1 * F / den : LR_CAVITY_GAIN_MAX;
+        out->gain[c] = isfinite(g) ? fmin(fmax(g, 1.0), LR_CAVITY_GAIN_MAX) : LR_CAVITY_GAIN_MAX;
+    }
+    free(cdf);
+    free(P);
+    return LR_OK;
+}
+
+int lr_cpu_cavity_scene_gains(const lr_scene *s, int light, int threads, double (*gain)[3],
+                              int nobj, lr_err *e)
+{
+    for (int o = 0; o < nobj; o++)
+        gain[o][0] = gain[o][1] = gain[o][2] = 1.0;
+    const lr_light *l = lr_scene_light_at(s, light);
+    int k = -1;
+    enum lr_enclosure enc = l ? lr_scene_light_enclosure(s, light, &k) : LR_ENCLOSURE_NONE;
+    if (enc != LR_ENCLOSURE_HULL || k < 0 || k >= nobj)
+        return LR_OK;
+    lr_cpu_cavity_desc d = LR_CAVITY_SCENE_DESC;
+    d.threads = threads;
+    lr_cpu_cavity cav;
+    int rc = lr_cpu_cavity_measure(lr_scene_object_at(s, k), l, enc, &d, &cav, e);
+    if (rc)
+        return rc;
+    for (int c = 0; c < 3; c++)
+        gain[k][c] = cav.gain[c];
+    return LR_OK;
+}
