@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "render/optics/optics.h"
+#include "tests/support/near.h"
 #include "tests/support/quadrature.h"
 
 /* Jensen et al. 2001, Table: marble. */
@@ -365,6 +366,44 @@ static void test_eta_one_and_below(void **state)
     assert_true(isfinite(out[0]) && out[0] > 0.0);
 }
 
+/* The standard dipole as S_d (Jensen 2001 Eq. 5 without the Fresnel factors): R_d(r) / pi at
+ * r = |x_o - x_i| whatever the normals; with F_t(w_i) it is that times 1 - R(cos_i) and 0 for
+ * light from behind; the model switch picks it or the directional dipole exactly (the same
+ * function calls, so equality is exact). */
+static void test_standard_dipole_sd_and_switch(void **state)
+{
+    (void)state;
+    lr_coeffs c = derive(&(lr_medium){{0.0021, 0.0041, 0.0071}, {2.19, 2.62, 3.00}, 1.5, 0.0});
+    lr_vec3 xi = lr_v3(1, 2, 3), ni = lr_v3(0, 0, 1), wi = lr_v3_normalize(lr_v3(0.3, 0, 1));
+    lr_vec3 xo = lr_v3(1 + 0.6, 2 - 0.8, 3), no = lr_v3_normalize(lr_v3(1, 0, 1)); /* r = 1 */
+    double rd[3], sd[3], sdf[3], sw[3], dp[3];
+    lr_dipole_rd(&c, 1.0, rd);
+    lr_dipole_sd(&c, xi, xo, sd);
+    double ft = lr_fresnel_transmittance(lr_v3_dot(wi, ni), 1.5);
+    lr_dipole_sd_fresnel(&c, xi, ni, wi, xo, sdf);
+    for (int j = 0; j < 3; j++) {
+        assert_true(rd[j] > 0.0);
+        assert_near_rel(sd[j], rd[j] / M_PI, 1e-12);
+        assert_near_rel(sdf[j], ft * rd[j] / M_PI, 1e-12);
+    }
+    lr_dipole_sd_fresnel(&c, xi, ni, lr_v3_scale(wi, -1.0), xo, sdf);
+    for (int j = 0; j < 3; j++)
+        assert_true(sdf[j] == 0.0);
+    lr_sss_sd_fresnel(LR_SSS_STANDARD_DIPOLE, &c, xi, ni, wi, xo, no, sw);
+    lr_dipole_sd_fresnel(&c, xi, ni, wi, xo, sdf);
+    for (int j = 0; j < 3; j++)
+        assert_true(sw[j] == sdf[j]);
+    lr_sss_sd_fresnel(LR_SSS_DIRECTIONAL_DIPOLE, &c, xi, ni, wi, xo, no, sw);
+    lr_dirpole_sd_fresnel(&c, xi, ni, wi, xo, no, dp);
+    for (int j = 0; j < 3; j++)
+        assert_true(sw[j] == dp[j] && sw[j] != sdf[j]);
+    enum lr_sss_model m;
+    assert_true(lr_sss_model_parse("standard_dipole", &m) && m == LR_SSS_STANDARD_DIPOLE);
+    assert_true(lr_sss_model_parse("directional_dipole", &m) && m == LR_SSS_DIRECTIONAL_DIPOLE);
+    assert_false(lr_sss_model_parse("dipole", &m) || lr_sss_model_parse(NULL, &m));
+    assert_string_equal(lr_sss_model_name(LR_SSS_STANDARD_DIPOLE), "standard_dipole");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -377,6 +416,7 @@ int main(void)
         cmocka_unit_test(test_rd_albedo_zero),
         cmocka_unit_test(test_rd_total_range_and_scale),
         cmocka_unit_test(test_eta_one_and_below),
+        cmocka_unit_test(test_standard_dipole_sd_and_switch),
     };
     return cmocka_run_group_tests_name("optics_dipole", tests, NULL, NULL);
 }

@@ -11,7 +11,13 @@
  * (x_o at >= 0.05 mfp from x_i) stays below ~20: 20 * 1.5e-5 = 3e-4. We assert 1e-3 relative
  * plus an absolute floor of 1e-5 times the case's largest band (a band that cancels to nearly
  * 0 while the others do not). Fresnel: a handful of operations, 1e-5 absolute. Sampling:
- * the float log1p/expm1 forms of the shader keep 1e-5 relative. */
+ * the float log1p/expm1 forms of the shader keep 1e-5 relative.
+ *
+ * Standard dipole (the model switch's other S_d, Jensen 2001 R_d(r) / pi): a sum of two
+ * positive source terms, each exp(-s) with s <= 87 (<= 177 ULP = 1.1e-5) and ~10 roundings, no
+ * cancellation: 1e-4 relative, with the same absolute floor (1e-5 of the largest band) for a
+ * band near float underflow. The switch is checked for both models (even materials standard,
+ * odd directional) against lr_sss_sd_fresnel. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -80,6 +86,12 @@ static void load_coeffs(lr_coeffs c[NMAT])
         fail_msg("%s", e.msg);
 }
 
+/* The model switch's choice per test material: even standard, odd directional. */
+static enum lr_sss_model model_of(int m)
+{
+    return m % 2 == 0 ? LR_SSS_STANDARD_DIPOLE : LR_SSS_DIRECTIONAL_DIPOLE;
+}
+
 static void test_optics_glsl_matches_c(void **state)
 {
     lr_coeffs co[NMAT];
@@ -134,28 +146,32 @@ static void test_optics_glsl_matches_c(void **state)
     lr_program *p = NULL;
     if (lr_tex_create(gl, &(lr_tex_desc){.width = 6, .height = n}, &tin, &e) ||
         lr_tex_upload(tin, 0, in, &e) ||
-        lr_tex_create(gl, &(lr_tex_desc){.width = 3, .height = n}, &tout, &e) ||
+        lr_tex_create(gl, &(lr_tex_desc){.width = 5, .height = n}, &tout, &e) ||
         lr_fb_create(gl, &(lr_fb_desc){.color = {{tout, 0}}}, &fb, &e) ||
         lr_program_create(&(lr_program_desc){.vertex = "render/shaders/fullscreen.vert",
                                              .fragment = "tests/shaders/optics_eval.frag"},
                           &p, &e))
         fail_msg("%s", e.msg);
     float coef[5 * 4 * LR_MAX_OBJECTS] = {0};
-    for (int m = 0; m < NMAT; m++)
+    float sss[3 * 4 * LR_MAX_OBJECTS] = {0};
+    for (int m = 0; m < NMAT; m++) {
         lr_passes_pack_coeffs(&co[m], coef + 20 * m);
+        lr_passes_pack_sss(&co[m], model_of(m), sss + 12 * m);
+    }
     lr_fb_bind(fb);
     glUseProgram(lr_program_id(p));
     glUniform4fv(lr_program_uniform(p, "u_coef"), 5 * LR_MAX_OBJECTS, coef);
+    glUniform4fv(lr_program_uniform(p, "u_sss"), 3 * LR_MAX_OBJECTS, sss);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, lr_tex_id(tin));
     glUniform1i(lr_program_uniform(p, "u_cases"), 0);
     lr_gl_draw_fullscreen(gl);
-    float *out = calloc((size_t)n * 3 * 4, sizeof *out);
-    if (lr_fb_read(fb, 0, 0, 0, 3, n, out, &e))
+    float *out = calloc((size_t)n * 5 * 4, sizeof *out);
+    if (lr_fb_read(fb, 0, 0, 0, 5, n, out, &e))
         fail_msg("%s", e.msg);
 
-    double worst_sd = 0.0;
-    int nonzero = 0;
+    double worst_sd = 0.0, worst_std = 0.0;
+    int nonzero = 0, nonzero_std = 0;
     for (int i = 0; i < n; i++) {
         tcase cr = cs[i];
         const tcase *c = &cr;
@@ -170,7 +186,7 @@ static void test_optics_glsl_matches_c(void **state)
         double sd[3], sdf[3];
         lr_dirpole_sd(cf, c->xi, c->ni, c->wi, c->xo, c->no, sd);
         lr_dirpole_sd_fresnel(cf, c->xi, c->ni, c->wi, c->xo, c->no, sdf);
-        const float *g = out + (size_t)i * 3 * 4;
+        const float *g = out + (size_t)i * 5 * 4;
         double mx = fmax(sd[0], fmax(sd[1], sd[2]));
         for (int j = 0; j < 3; j++) {
             double tol = 1e-3 * fabs(sd[j]) + 1e-5 * mx;
@@ -188,12 +204,27 @@ static void test_optics_glsl_matches_c(void **state)
             assert_near(g[4 + j], sdf[j], 1e-3 * fabs(sdf[j]) + 1e-5 * mf);
         }
         assert_near(g[8], lr_fresnel_reflectance(c->cos_i, c->eta), 1e-5);
+        double sw[3], st[3];
+        lr_sss_sd_fresnel(model_of(c->mat), cf, c->xi, c->ni, c->wi, c->xo, c->no, sw);
+        lr_dipole_sd(cf, c->xi, c->xo, st);
+        double mw = fmax(sw[0], fmax(sw[1], sw[2])), mt = fmax(st[0], fmax(st[1], st[2]));
+        for (int j = 0; j < 3; j++) {
+            /* The directional model keeps its own tolerance (above); the standard 1e-4. */
+            double rel = model_of(c->mat) == LR_SSS_STANDARD_DIPOLE ? 1e-4 : 1e-3;
+            assert_near(g[12 + j], sw[j], rel * fabs(sw[j]) + 1e-5 * mw);
+            assert_near(g[16 + j], st[j], 1e-4 * fabs(st[j]) + 1e-5 * mt);
+            if (st[j] > 0.0)
+                worst_std = fmax(worst_std, fabs(g[16 + j] - st[j]) / st[j]);
+            nonzero_std += st[j] > 1e-30;
+        }
         double rs = lr_exp_radius_sample(cf->sigma_tr[0], c->r_max, (float)c->xi_s);
         assert_near(g[9], rs, 1e-5 * rs + 1e-6);
         assert_near_rel(g[10], lr_exp_radius_pdf(cf->sigma_tr[0], c->r_max, rs), 1e-4);
     }
     /* The grid must exercise the model, not compare zeros. */
     assert_true(nonzero > n);
+    assert_true(nonzero_std > n);
+    printf("GLSL vs C standard dipole: worst relative S_d difference %.3g\n", worst_std);
     printf("GLSL vs C optics: %d cases, worst relative S_d difference %.3g\n", n, worst_sd);
     lr_program_destroy(p);
     lr_fb_destroy(fb);

@@ -241,6 +241,40 @@ static void test_maps_sphere_outside_light(void **state)
     lr_scene_destroy(s);
 }
 
+/* The model switch: the same sphere with the standard dipole (objects[ball].model), GPU maps
+ * against the twin evaluating lr_dipole_sd; same assertions as above. The switch must also
+ * reach the GPU: with the directional dipole the maps' sum differs by far more than its
+ * aggregate sigma (measured in the report line). */
+static void test_maps_standard_dipole(void **state)
+{
+    (void)state;
+    static const char *const ball[] = {"objects[ball].material=marble", "light.position=0,0,120",
+                                       "objects[ball].model=standard_dipole", NULL};
+    lr_scene *s = lr_test_scene("sphere", parity_settings, ball);
+    lr_renderer *r = lr_test_renderer(gl, s, 16, 12, true, 3);
+    lr_test_converge(r, 20);
+    parity p;
+    compare_maps(r, s, 256, true, &p);
+    report("sphere maps, standard dipole (G-buffer emulated)", &p);
+    check_parity(&p);
+    /* Back to the directional dipole: a material-class change (maps re-run). */
+    unsigned dirty = 0;
+    lr_err e = {0};
+    if (lr_scene_set(s, "objects[ball].model", "directional_dipole", &dirty, &e))
+        fail_msg("%s", e.msg);
+    assert_int_equal(dirty, LR_DIRTY_MATERIAL);
+    lr_renderer_invalidate(r, dirty);
+    lr_test_converge(r, 20);
+    parity q;
+    compare_maps(r, s, 256, true, &q);
+    report("sphere maps, directional dipole again", &q);
+    check_parity(&q);
+    print_message("standard / directional dipole map sum: %.4f\n", p.sum_gpu / q.sum_gpu);
+    assert_true(fabs(p.sum_gpu - q.sum_gpu) > 10.0 * (sqrt(p.var_sum) + sqrt(q.var_sum)));
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+}
+
 /* VPLs: the GPU places them from a cube map of the outer surface (vpl_map_size^2 faces), the
  * CPU by exact rays along the same directions u_v = lr_halton_sphere(v + 1) from the same
  * centre. Same validity; positions within 1.5 cube texels (|x_v - c| * 2 / size * 1.5 /
@@ -390,6 +424,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_maps_lampshade),
         cmocka_unit_test(test_maps_sphere_outside_light),
+        cmocka_unit_test(test_maps_standard_dipole),
         cmocka_unit_test(test_vpls),
         cmocka_unit_test(test_final_image),
     };

@@ -645,6 +645,53 @@ static void test_set_shade_and_file_mesh(void **state)
     lr_scene_destroy(s);
 }
 
+/* objects[i].model (the diffusion-model switch) and the cap on lights. */
+static void test_model_switch_and_light_cap(void **state)
+{
+    (void)state;
+    char t[2048];
+    lr_scene *s;
+    lr_err e = {0};
+    scene_text(t, sizeof t, "", "", NULL);
+    assert_int_equal(parse(t, &s, &e), LR_OK);
+    assert_int_equal(lr_scene_object_at(s, 0)->sss_model, LR_SSS_DIRECTIONAL_DIPOLE);
+    get(s, "objects[0].model", "directional_dipole");
+    set_ok(s, "objects[c].model", "standard_dipole", LR_DIRTY_MATERIAL);
+    assert_int_equal(lr_scene_object_at(s, 0)->sss_model, LR_SSS_STANDARD_DIPOLE);
+    get(s, "objects[0].model", "standard_dipole");
+    set_bad(s, "objects[0].model", "jensen", "expected directional_dipole or standard_dipole");
+    lr_scene_destroy(s);
+
+    scene_text(t, sizeof t, ",\n     \"model\": \"standard_dipole\"", "", NULL);
+    assert_int_equal(parse(t, &s, &e), LR_OK);
+    assert_int_equal(lr_scene_object_at(s, 0)->sss_model, LR_SSS_STANDARD_DIPOLE);
+    lr_scene_destroy(s);
+    scene_text(t, sizeof t, ",\n     \"model\": \"dipole\"", "", NULL);
+    expect_scene_error(t, LR_EINVAL, "t.json:6: field 'objects[0].model': 'dipole': expected "
+                                     "directional_dipole or standard_dipole");
+    scene_text(t, sizeof t, ",\n     \"model\": 1", "", NULL);
+    expect_scene_error(t, LR_EPARSE, "t.json:6: field 'objects[0].model'");
+
+    /* LR_SCENE_MAX_LIGHTS lights load; one more is refused at the lights array. */
+    for (int n = LR_SCENE_MAX_LIGHTS; n <= LR_SCENE_MAX_LIGHTS + 1; n++) {
+        int len = snprintf(t, sizeof t, "{\"objects\": [{\"material\": \"candle_wax\", "
+                           "\"mesh\": {\"type\": \"sphere\"}}],\n \"lights\": [");
+        for (int i = 0; i < n; i++)
+            len += snprintf(t + len, sizeof t - (size_t)len, "%s{\"type\": \"point\", "
+                            "\"position\": [0,0,%d], \"intensity\": 1}", i ? ", " : "",
+                            100 + i);
+        snprintf(t + len, sizeof t - (size_t)len, "],\n \"camera\": {\"position\": [0,-1,0], "
+                 "\"target\": [0,0,0]}}");
+        if (n == LR_SCENE_MAX_LIGHTS) {
+            assert_int_equal(parse(t, &s, &e), LR_OK);
+            assert_int_equal(lr_scene_light_count(s), n);
+            lr_scene_destroy(s);
+        } else {
+            expect_scene_error(t, LR_EINVAL, "t.json:2: field 'lights': 5 lights; at most 4");
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -657,6 +704,7 @@ int main(void)
         cmocka_unit_test(test_set_dirty_flags),
         cmocka_unit_test(test_set_rejects_bad_values),
         cmocka_unit_test(test_set_shade_and_file_mesh),
+        cmocka_unit_test(test_model_switch_and_light_cap),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -49,3 +49,26 @@ void lr_dipole_rd_total(const lr_coeffs *c, double out[3])
         out[j] = 0.5 * c->albedo_prime[j] * (1.0 + exp(-(4.0 / 3.0) * c->A * s)) * exp(-s);
     }
 }
+
+void lr_dipole_sd(const lr_coeffs *c, lr_vec3 xi, lr_vec3 xo, double out[3])
+{
+    /* Jensen et al. 2001, Eq. 5: S_d = (1/pi) F_t(w_i) R_d(|x_i - x_o|) F_t(w_o); the Fresnel
+     * factors are applied by the caller (F_t(w_i): lr_dipole_sd_fresnel; F_t(w_o): composition). */
+    lr_dipole_rd(c, lr_v3_len(lr_v3_sub(xo, xi)), out);
+    for (int j = 0; j < 3; j++)
+        out[j] /= M_PI;
+}
+
+void lr_dipole_sd_fresnel(const lr_coeffs *c, lr_vec3 xi, lr_vec3 ni, lr_vec3 wi, lr_vec3 xo,
+                          double out[3])
+{
+    double cos_i = lr_v3_dot(wi, ni);
+    double t = cos_i > 0.0 ? lr_fresnel_transmittance(cos_i, c->eta) : 0.0;
+    if (!(t > 0.0)) {
+        out[0] = out[1] = out[2] = 0.0;
+        return;
+    }
+    lr_dipole_sd(c, xi, xo, out);
+    for (int j = 0; j < 3; j++)
+        out[j] *= t;
+}

@@ -18,6 +18,8 @@
 #ifndef LR_OPTICS_H
 #define LR_OPTICS_H
 
+#include <stdbool.h>
+
 #include "render/base/err.h"
 #include "render/base/vec3.h"
 
@@ -105,6 +107,29 @@ int lr_dipole_rd_checked(const lr_coeffs *c, double r, double out[3], lr_err *e)
  * (alpha'/2) (1 + exp(-(4/3) A sqrt(3 (1 - alpha')))) exp(-sqrt(3 (1 - alpha'))), with
  * sqrt(3 (1 - alpha')) evaluated as sqrt(3 sigma_a / sigma_t') (no cancellation as alpha' -> 1). */
 void lr_dipole_rd_total(const lr_coeffs *c, double out[3]);
+
+/* The standard dipole as a BSSRDF's diffusion term (Jensen et al. 2001, Eq. 5):
+ * S_d(x_i, x_o) = R_d(|x_o - x_i|) / pi per band, mm^-2 sr^-1, without the two Fresnel
+ * transmission factors (Jensen's S_d = F_t(w_i) R_d F_t(w_o) / pi; composition applies F_t(w_o),
+ * seed 003 Eq. 5). Depends on the distance alone: no normals, no incident direction. */
+void lr_dipole_sd(const lr_coeffs *c, lr_vec3 xi, lr_vec3 xo, double out[3]);
+/* The same times F_t(w_i) = 1 - R(w_i . n_i, eta); 0 when w_i . n_i <= 0. */
+void lr_dipole_sd_fresnel(const lr_coeffs *c, lr_vec3 xi, lr_vec3 ni, lr_vec3 wi, lr_vec3 xo,
+                          double out[3]);
+
+/* ---- Model switch (model.c) ------------------------------------------------------------- */
+
+/* The diffusion model an object's radiosity estimator evaluates (scene: objects[i].model). */
+enum lr_sss_model { LR_SSS_DIRECTIONAL_DIPOLE = 0, LR_SSS_STANDARD_DIPOLE = 1 };
+#define LR_SSS_MODEL_COUNT 2
+/* "directional_dipole", "standard_dipole". */
+const char *lr_sss_model_name(enum lr_sss_model m);
+/* Inverse of lr_sss_model_name; false for any other text. */
+bool lr_sss_model_parse(const char *name, enum lr_sss_model *out);
+/* S_d F_t(w_i) of the chosen model: lr_dirpole_sd_fresnel or lr_dipole_sd_fresnel (the
+ * integrand of seed 003 Eq. 4 with either diffusion term). */
+void lr_sss_sd_fresnel(enum lr_sss_model m, const lr_coeffs *c, lr_vec3 xi, lr_vec3 ni,
+                       lr_vec3 wi, lr_vec3 xo, lr_vec3 no, double out[3]);
 
 /* ---- Directional dipole, Frisvad, Hachisuka, Kjeldsen 2014 (dirpole.c) ----------------- */
 

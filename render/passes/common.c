@@ -101,12 +101,27 @@ void lr_passes_pack_coeffs(const lr_coeffs *c, float b[20])
     b[19] = (float)c->A_dir;
 }
 
+void lr_passes_pack_sss(const lr_coeffs *c, enum lr_sss_model model, float b[12])
+{
+    for (int j = 0; j < 3; j++) {
+        b[0 + j] = (float)c->albedo_prime[j];
+        b[4 + j] = (float)c->z_r[j];
+        b[8 + j] = (float)c->z_v[j];
+    }
+    b[3] = (float)model;
+    b[7] = b[11] = 0.0f;
+}
+
 void lr_passes_update_coeffs(lr_renderer *r)
 {
     memset(r->coef, 0, sizeof r->coef);
+    memset(r->sss, 0, sizeof r->sss);
     int no = lr_scene_object_count(r->scene);
-    for (int i = 0; i < no && i < LR_MAX_OBJECTS; i++)
-        lr_passes_pack_coeffs(&lr_scene_object_at(r->scene, i)->coeffs, r->coef + 20 * i);
+    for (int i = 0; i < no && i < LR_MAX_OBJECTS; i++) {
+        const lr_scene_object *o = lr_scene_object_at(r->scene, i);
+        lr_passes_pack_coeffs(&o->coeffs, r->coef + 20 * i);
+        lr_passes_pack_sss(&o->coeffs, o->sss_model, r->sss + 12 * i);
+    }
 }
 
 void lr_passes_set_coeffs(lr_renderer *r, const lr_program *p)
@@ -116,6 +131,11 @@ void lr_passes_set_coeffs(lr_renderer *r, const lr_program *p)
         loc = lr_program_uniform(p, "u_coef[0]");
     if (loc >= 0)
         glUniform4fv(loc, 5 * LR_MAX_OBJECTS, r->coef);
+    loc = lr_program_uniform(p, "u_sss");
+    if (loc < 0)
+        loc = lr_program_uniform(p, "u_sss[0]");
+    if (loc >= 0)
+        glUniform4fv(loc, 3 * LR_MAX_OBJECTS, r->sss);
 }
 
 void lr_passes_uniform_mat4(const lr_program *p, const char *name, const double m[16])

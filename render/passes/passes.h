@@ -66,6 +66,7 @@ struct lr_renderer {
     lr_gpu_mesh recv[LR_MAX_RECEIVERS];
     bool two_sided[LR_MAX_OBJECTS];
     float coef[5 * 4 * LR_MAX_OBJECTS];
+    float sss[3 * 4 * LR_MAX_OBJECTS]; /* lr_passes_pack_sss per object */
 
     /* The light of the transport (lights[0]) as seen by the last gbuffer pass. */
     struct {
@@ -123,7 +124,10 @@ void lr_passes_free_meshes(lr_renderer *r);
 void lr_passes_draw(const lr_gpu_mesh *m);
 /* One object's block of render/shaders/lib/material.glsl's u_coef (20 floats). */
 void lr_passes_pack_coeffs(const lr_coeffs *c, float out[20]);
-/* Coefficient block of every object (render/shaders/lib/material.glsl). */
+/* One object's block of render/shaders/lib/material.glsl's u_sss (12 floats): the model
+ * switch and the standard dipole's albedo', z_r, z_v. */
+void lr_passes_pack_sss(const lr_coeffs *c, enum lr_sss_model model, float out[12]);
+/* Coefficient blocks (u_coef, u_sss) of every object (render/shaders/lib/material.glsl). */
 void lr_passes_update_coeffs(lr_renderer *r);
 void lr_passes_set_coeffs(lr_renderer *r, const lr_program *p);
 /* Light G-buffer samplers and uniforms on units 0..3. */

@@ -505,12 +505,23 @@ static int parse_object(ctx *c, lr_jnode obj, int i, obj_rec *o)
     snprintf(where, sizeof where, "objects[%d]", i);
     if (lr_json_type(c->j, obj) != LR_JSON_OBJECT)
         return lr_json_fail(c->j, obj, where, c->e, LR_EPARSE, "expected an object");
-    static const char *const keys[] = {"name", "material", "mesh", "transform", NULL};
+    static const char *const keys[] = {"name", "material", "mesh", "transform", "model", NULL};
     int rc;
     if ((rc = lr_json_check_keys(c->j, obj, where, keys, c->e)) ||
         (rc = get_name(c, obj, where, "object", i, o->pub.name)))
         return rc;
     char f[256];
+    o->pub.sss_model = LR_SSS_DIRECTIONAL_DIPOLE;
+    lr_jnode model = lr_json_get(c->j, obj, "model");
+    if (model != LR_JNONE) {
+        char name[32];
+        if ((rc = lr_json_string(c->j, model, cat(f, sizeof f, where, "model"), name,
+                                 sizeof name, c->e)))
+            return rc;
+        if (!lr_sss_model_parse(name, &o->pub.sss_model))
+            return lr_json_fail(c->j, model, f, c->e, LR_EINVAL,
+                                "'%s': expected directional_dipole or standard_dipole", name);
+    }
     lr_jnode mat = lr_json_get(c->j, obj, "material"), mesh = lr_json_get(c->j, obj, "mesh");
     if (mat == LR_JNONE)
         return lr_json_fail(c->j, obj, cat(f, sizeof f, where, "material"), c->e, LR_EPARSE,
@@ -652,6 +663,10 @@ static int parse_document(ctx *c)
         (rc = array_of(c, root, "receivers", false, &recvs)))
         return rc;
     int no = lr_json_count(j, objs), nl = lr_json_count(j, lights);
+    if (nl > LR_SCENE_MAX_LIGHTS)
+        return lr_json_fail(j, lights, "lights", c->e, LR_EINVAL,
+                            "%d lights; at most %d (each has its own G-buffer and radiosity maps)",
+                            nl, LR_SCENE_MAX_LIGHTS);
     int nr = recvs == LR_JNONE ? 0 : lr_json_count(j, recvs);
     s->obj = calloc((size_t)no, sizeof *s->obj);
     s->light = calloc((size_t)nl, sizeof *s->light);

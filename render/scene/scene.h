@@ -27,8 +27,10 @@
  *          directory), "scale": 1 (e.g. 1000 for a file in metres)}
  *       "transform": {"translate": [0,0,0], "rotate_deg": [0,0,0] (about x, then y, then z),
  *                     "scale": 1 | [sx, sy, sz] (> 0)}                      (optional)
+ *       "model":     "directional_dipole" (default; seed 003) | "standard_dipole" (Jensen
+ *                    2001: S_d = R_d(r) / pi): the diffusion term of the radiosity maps
  *     } ]
- *   "lights": [                                    one or more
+ *   "lights": [                                    one to LR_SCENE_MAX_LIGHTS (4)
  *     {"type": "point", "name": string, "position": [x,y,z], "intensity": W/sr (>= 0),
  *      "color": [1,1,1] (relative, per band: I_band = intensity * color[band]),
  *      "flicker": {"amplitude": 0..1 (relative intensity), "frequency_hz": 8,
@@ -81,6 +83,9 @@
 typedef struct lr_scene lr_scene;
 
 #define LR_SCENE_NAME_MAX 64
+/* Lights per scene: the GPU transport keeps a G-buffer and radiosity maps per light
+ * (render/passes/PIPELINE.md), so their number is bounded; more is a load-time error. */
+#define LR_SCENE_MAX_LIGHTS 4
 
 /* ---- Objects ------------------------------------------------------------------------------ */
 
@@ -98,6 +103,7 @@ typedef struct lr_scene_object {
     double radius;        /*   cameras sit on it */
     double area;          /* world surface area, mm^2 */
     bool closed;          /* watertight (a shade with rims is; one without is not) */
+    enum lr_sss_model sss_model; /* "model": the S_d the radiosity estimator evaluates */
 } lr_scene_object;
 
 /* ---- Lights ------------------------------------------------------------------------------- */

@@ -624,6 +624,15 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
         *d = LR_DIRTY_MATERIAL;
         return LR_OK;
     }
+    if (strcmp(f, "model") == 0) {
+        enum lr_sss_model m;
+        if (!lr_sss_model_parse(o->value, &m))
+            return fail(o, LR_EINVAL, "expected directional_dipole or standard_dipole, got '%s'",
+                        o->value);
+        rec->pub.sss_model = m;
+        *d = LR_DIRTY_MATERIAL; /* another S_d: maps, VPLs, composition */
+        return LR_OK;
+    }
     mesh_spec ms = rec->mesh;
     xform_spec xf = rec->xf;
     const char *bad = NULL;
@@ -638,7 +647,7 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
         if ((rc = lr_scene_check_transform(&xf, &bad, &inner)))
             return check_failed(o, f, bad, rc, &inner);
     } else {
-        return unknown(o, "an object", f, "material, material.*, mesh.*, transform.*");
+        return unknown(o, "an object", f, "material, material.*, mesh.*, transform.*, model");
     }
     lr_mesh *world;
     lr_bvh *bvh;
@@ -678,7 +687,9 @@ static int object_get(op *o, const lr_scene *s, int i, const char *f)
         return mesh_field(o, &rec.mesh, f + 5);
     if (strncmp(f, "transform.", 10) == 0)
         return transform_field(o, &rec.xf, f + 10);
-    return unknown(o, "an object", f, "material, material.*, mesh.*, transform.*");
+    if (strcmp(f, "model") == 0)
+        return out(o, "%s", lr_sss_model_name(rec.pub.sss_model));
+    return unknown(o, "an object", f, "material, material.*, mesh.*, transform.*, model");
 }
 
 /* ---- keys ------------------------------------------------------------------------------------- */

@@ -39,6 +39,7 @@ void main()
     if (u_two_sided && !gl_FrontFacing)
         no = -no;
     lr_coeffs_gl mat = lr_material(u_object);
+    lr_sss_gl sss = lr_material_sss(u_object);
     ivec2 tx = ivec2(gl_FragCoord.xy);
     uint state = lr_seed(uint(tx.y * u_map_size + tx.x), u_map, u_frame, u_seed);
 
@@ -111,7 +112,7 @@ void main()
             if (!(cos_i > 0.0))
                 continue;
             float Ft = lr_fresnel_transmittance(cos_i, mat.eta);
-            float sd = lr_dirpole_sd_band(mat, c, xi, ni, wi, xo, no);
+            float sd = lr_sss_sd_band(mat, sss, c, xi, ni, wi, xo, no);
             sum += sd * Ft * J * inv_pA * shape;
         }
         B[c] = LR_PI * sum / float(u_N);

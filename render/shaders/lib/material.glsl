@@ -9,6 +9,9 @@
 #endif
 
 uniform vec4 u_coef[5 * LR_MAX_OBJECTS];
+// The diffusion model and standard-dipole coefficients, three vec4 per object (common.c
+// lr_passes_pack_sss): [0] albedo'.rgb, model   [1] z_r.rgb   [2] z_v.rgb
+uniform vec4 u_sss[3 * LR_MAX_OBJECTS];
 
 lr_coeffs_gl lr_material(int id)
 {
@@ -25,4 +28,15 @@ lr_coeffs_gl lr_material(int id)
     c.mfp = u_coef[b + 4].xyz;
     c.A_dir = u_coef[b + 4].w;
     return c;
+}
+
+lr_sss_gl lr_material_sss(int id)
+{
+    int b = 3 * clamp(id, 0, LR_MAX_OBJECTS - 1);
+    lr_sss_gl s;
+    s.model = int(u_sss[b].w + 0.5);
+    s.albedo_prime = u_sss[b].xyz;
+    s.z_r = u_sss[b + 1].xyz;
+    s.z_v = u_sss[b + 2].xyz;
+    return s;
 }

@@ -1,4 +1,4 @@
-// GLSL port of render/optics/{fresnel,dirpole,sampling}.c (the C versions are the reference;
+// GLSL port of render/optics/{fresnel,dirpole,dipole,model,sampling}.c (the C versions are the reference;
 // tests/test_render_optics_glsl.c compares the two on a grid). Float instead of double: the
 // guards that the C code needs for the double range are kept with float thresholds.
 
@@ -159,4 +159,42 @@ vec3 lr_dirpole_sd_fresnel(lr_coeffs_gl c, vec3 xi, vec3 ni, vec3 wi, vec3 xo, v
     if (!(t > 0.0))
         return vec3(0.0);
     return t * lr_dirpole_sd(c, xi, ni, wi, xo, no);
+}
+
+// Standard dipole (render/optics/dipole.c): the coefficients lr_coeffs_gl lacks, per object,
+// and the model switch (render/optics/model.c; 0 directional dipole, 1 standard dipole).
+struct lr_sss_gl {
+    int model;
+    vec3 albedo_prime;
+    vec3 z_r;
+    vec3 z_v;
+};
+
+// dipole.c source_term: z (sigma_tr d + 1) e^{-sigma_tr d} / d^3, d = sqrt(r^2 + z^2).
+float lr_dipole_source(float sigma_tr, float z, float r)
+{
+    float d = sqrt(r * r + z * z);
+    float s = sigma_tr * d;
+    if (!(s < 87.0)) // e^-87: below the smallest normal float (as lr_sp_d)
+        return 0.0;
+    return z * (s + 1.0) * exp(-s) / (d * d * d);
+}
+
+// lr_dipole_sd for band j: R_d(|x_o - x_i|) / pi (Jensen et al. 2001, Eq. 5 without F_t).
+float lr_dipole_sd_band(lr_coeffs_gl c, lr_sss_gl s, int j, vec3 xi, vec3 xo)
+{
+    float r = length(xo - xi);
+    float rd = s.albedo_prime[j] / (4.0 * LR_PI) *
+               (lr_dipole_source(c.sigma_tr[j], s.z_r[j], r) +
+                lr_dipole_source(c.sigma_tr[j], s.z_v[j], r));
+    return rd / LR_PI;
+}
+
+// The model switch (lr_sss_sd_fresnel without the F_t(w_i) factor), band j.
+float lr_sss_sd_band(lr_coeffs_gl c, lr_sss_gl s, int j, vec3 xi, vec3 ni, vec3 wi, vec3 xo,
+                     vec3 no)
+{
+    if (s.model == 1)
+        return lr_dipole_sd_band(c, s, j, xi, xo);
+    return lr_dirpole_sd_band(c, j, xi, ni, wi, xo, no);
 }

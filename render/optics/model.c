@@ -1,0 +1,33 @@
+/* The diffusion-model switch: which S_d an object's scattered-radiosity estimator evaluates
+ * (directional dipole [14], seed 003's choice, or the standard dipole of Jensen et al. 2001,
+ * for comparison as in seed 003 Fig. 6). The sampling is the same for both (seed 003 Eq. 11-12:
+ * both decay as exp(-sigma_tr d)). */
+#include "render/optics/optics.h"
+
+#include <string.h>
+
+static const char *const names[LR_SSS_MODEL_COUNT] = {"directional_dipole", "standard_dipole"};
+
+const char *lr_sss_model_name(enum lr_sss_model m)
+{
+    return (unsigned)m < LR_SSS_MODEL_COUNT ? names[m] : "?";
+}
+
+bool lr_sss_model_parse(const char *name, enum lr_sss_model *out)
+{
+    for (int i = 0; i < LR_SSS_MODEL_COUNT; i++)
+        if (name && strcmp(name, names[i]) == 0) {
+            *out = (enum lr_sss_model)i;
+            return true;
+        }
+    return false;
+}
+
+void lr_sss_sd_fresnel(enum lr_sss_model m, const lr_coeffs *c, lr_vec3 xi, lr_vec3 ni,
+                       lr_vec3 wi, lr_vec3 xo, lr_vec3 no, double out[3])
+{
+    if (m == LR_SSS_STANDARD_DIPOLE)
+        lr_dipole_sd_fresnel(c, xi, ni, wi, xo, out);
+    else
+        lr_dirpole_sd_fresnel(c, xi, ni, wi, xo, no, out);
+}
