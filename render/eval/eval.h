@@ -102,6 +102,7 @@ typedef struct lr_eval_series_desc {
     const int *checkpoints;
     int ncheck; /* at most 8 */
     int converge_frames;
+    unsigned seed; /* lr_renderer_desc.seed: 0 = the renderer's default */
 } lr_eval_series_desc;
 
 typedef struct lr_eval_series {

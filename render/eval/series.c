@@ -72,7 +72,8 @@ int lr_eval_series_run(const lr_eval_series_desc *d, lr_eval_series *out, lr_err
         goto done;
     }
     if ((rc = lr_renderer_create(&(lr_renderer_desc){.gl = d->gl, .scene = d->scene, .width = w,
-                                                      .height = h, .no_vpl = d->no_vpl},
+                                                      .height = h, .no_vpl = d->no_vpl,
+                                                      .seed = d->seed},
                                  &r, e)))
         goto done;
     lr_frame_stats st = {0};

@@ -44,6 +44,19 @@ typedef struct lrb_scene_result {
     int row0, nrows; /* the scene's rows in the table */
 } lrb_scene_result;
 
+/* Applies a setting to a scene (render.* and every object's model). */
+int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e);
+
+/* Frame times of the base setting at 640x480 (sweep_table.c). */
+typedef struct lrb_timing_640 {
+    char scene[64];
+    bool ok;
+    int w, h;
+    double pass_ms[LR_PASS_COUNT]; /* full update, median of 3 */
+    double full_ms, accum_ms, dimmer_ms; /* medians of 3, 4, 5 frames */
+} lrb_timing_640;
+int lrb_sweep_time_640(lr_gl *gl, const char *name, lrb_timing_640 *out);
+
 /* Runs every setting on one scene, appending rows (at most cap in all). */
 int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, int cap,
                     lrb_scene_result *res);
@@ -53,8 +66,13 @@ int lrb_sweep_plot(const char *path, const lr_eval_row *rows, int nrows,
                    const lrb_scene_result *scenes, int nscenes, lr_err *e);
 /* build/bench/summary.md (sweep_summary.c); load[0..2] before and after the run. */
 int lrb_sweep_summary(const char *path, const lr_eval_row *rows, int nrows,
-                      const lrb_scene_result *scenes, int nscenes, const double load[2][3],
-                      double total_s, const char *renderer, lr_err *e);
+                      const lrb_scene_result *scenes, int nscenes, const lrb_timing_640 *t640,
+                      int nt640, const double load[2][3], double total_s, const char *renderer,
+                      lr_err *e);
+
+/* The 640x480 table (markdown) with the base rows' errors. */
+void lrb_sweep_table_md(FILE *f, const lr_eval_row *rows, int nrows, const lrb_timing_640 *t,
+                        int nt);
 
 /* Time to reach a row's error: its frames times the accumulation frame time, ms. */
 double lrb_sweep_time_ms(const lr_eval_row *r);

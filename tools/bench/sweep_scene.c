@@ -16,7 +16,7 @@ static int set_int(lr_scene *s, const char *key, int v, lr_err *e)
     return lr_scene_set(s, key, val, NULL, e);
 }
 
-static int apply(lr_scene *s, const lrb_setting *st, lr_err *e)
+int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e)
 {
     int rc;
     if ((rc = set_int(s, "render.K", st->K, e)) || (rc = set_int(s, "render.N", st->N, e)) ||
@@ -24,9 +24,13 @@ static int apply(lr_scene *s, const lrb_setting *st, lr_err *e)
         (rc = set_int(s, "render.map_size", st->map_size, e)) ||
         (rc = set_int(s, "render.gbuffer_size", st->gbuffer_size, e)))
         return rc;
-    if (strcmp(st->model, "directional_dipole") != 0)
-        return lr_err_set(e, LR_EUNSUPPORTED, "model %s: no per-object model switch in this "
-                          "build", st->model);
+    /* The model is per object; the sweep switches every object at once. */
+    for (int k = 0; k < lr_scene_object_count(s); k++) {
+        char key[64];
+        snprintf(key, sizeof key, "objects[%d].model", k);
+        if ((rc = lr_scene_set(s, key, st->model, NULL, e)))
+            return rc;
+    }
     return LR_OK;
 }
 
@@ -92,7 +96,7 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
     for (int k = 0; k < nset; k++) {
         const lrb_setting *st = &set[k];
         lr_eval_series ser = {0};
-        if ((rc = apply(s, st, &e)) ||
+        if ((rc = lrb_sweep_apply(s, st, &e)) ||
             (rc = lr_eval_series_run(&(lr_eval_series_desc){.gl = gl, .scene = s, .width = w,
                                                             .height = h, .no_vpl = !st->vpl,
                                                             .checkpoints = st->checkpoints,
