@@ -133,16 +133,16 @@ static int gl_teardown(void **state)
 
 /* The candle at the bench's resolution (64x48) against its physical reference, read from the
  * bench's committed cache (configs/bench/references; rendered there, slowly, if the scene or
- * the transport changed). Settings chosen so that sampling noise dominates the first frames:
- * K 4 maps of 64^2, N 1. The error over the object pixels after F frames is
- * e(F)^2 = b^2 + sigma^2/F (+ the reference's noise, the same for every F), so from F to 4F it
- * must fall by e(F)^2 - e(4F)^2 = 0.75 sigma^2/F. sigma is measured independently, as the
- * noise of the 1-frame image about the 64-frame one; the test asks for at least half the
- * predicted drop (the estimate of sigma^2 over ~900 correlated pixels is good to far better than
- * a factor 2), which also makes the fall strict with that margin. */
+ * the transport changed). Settings chosen so that sampling noise is large: K 4 maps of 64^2,
+ * N 1. For independent frames the noise about the converged (C-frame) image has
+ * E[noise(F)^2] = sigma^2 (1/F - 1/C), so from F to 4F it must fall by sigma^2 (1/F - 1/4F);
+ * sigma^2 is measured from the 1-frame noise. The candle's noise is heavy-tailed (dipole
+ * samples next to the flame), so the squares are averaged over SEEDS independent sample
+ * sequences (lr_renderer_desc.seed), and each fall is asked for at half its predicted size:
+ * strict, with a margin from the noise. */
 static void test_error_falls_with_frames(void **state)
 {
-    enum { W = 64, H = 48, SEEDS = 2 };
+    enum { W = 64, H = 48, SEEDS = 4, C = 64 };
     char path[1024], refdir[1024];
     snprintf(path, sizeof path, "%s/scenes/candle.json", lr_configs_dir());
     snprintf(refdir, sizeof refdir, "%s/bench/references", lr_configs_dir());
@@ -169,53 +169,59 @@ static void test_error_falls_with_frames(void **state)
         assert_int_equal(lr_scene_set_assignment(s, sets[i], NULL, &e), LR_OK);
     const int checks[] = {1, 4, 16};
     const size_t n = (size_t)W * H;
-    double e2[3] = {0}, sigma2 = 0.0;
+    unsigned char *both = malloc(n);
+    assert_non_null(both);
+    for (size_t i = 0; i < n; i++)
+        both[i] = m.object[i] | m.receivers[i];
+    /* Means over seeds of: the error against the physical reference (objects), and the noise
+     * about the converged model (objects and receivers), both squared; and sigma^2. */
+    double e2[3] = {0}, n2[3] = {0}, o2 = 0.0, sigma2 = 0.0;
     for (int seed = 1; seed <= SEEDS; seed++) {
         lr_eval_series ser;
         assert_int_equal(lr_eval_series_run(&(lr_eval_series_desc){.gl = gl, .scene = s,
                                                                    .width = W, .height = H,
                                                                    .checkpoints = checks,
                                                                    .ncheck = 3,
-                                                                   .converge_frames = 64,
+                                                                   .converge_frames = C,
                                                                    .seed = (unsigned)seed},
                                             &ser, &e),
                          LR_OK);
         for (int c = 0; c < 3; c++) {
             double x = lr_eval_rel_rmse(ser.image[c], mean.rgb, m.object, n);
+            double y = lr_eval_rel_rmse(ser.image[c], ser.converged, both, n);
             e2[c] += x * x / SEEDS;
+            n2[c] += y * y / SEEDS;
         }
-        /* sigma^2 (relative, one frame): noise of frame 1 about the 64-frame mean, whose own
-         * part is removed: Var(mean_1 - mean_64) = sigma^2 (1 - 1/64). */
-        double n1 = lr_eval_rel_rmse(ser.image[0], ser.converged, m.object, n);
-        sigma2 += n1 * n1 / (1.0 - 1.0 / 64.0) / SEEDS;
-        print_message("seed %d: receivers %.4f %.4f %.4f; noise obj %.4f %.4f %.4f rec %.4f %.4f %.4f\n", seed,
-                      lr_eval_rel_rmse(ser.image[0], mean.rgb, m.receivers, n),
-                      lr_eval_rel_rmse(ser.image[1], mean.rgb, m.receivers, n),
-                      lr_eval_rel_rmse(ser.image[2], mean.rgb, m.receivers, n),
-                      lr_eval_rel_rmse(ser.image[0], ser.converged, m.object, n),
-                      lr_eval_rel_rmse(ser.image[1], ser.converged, m.object, n),
-                      lr_eval_rel_rmse(ser.image[2], ser.converged, m.object, n),
-                      lr_eval_rel_rmse(ser.image[0], ser.converged, m.receivers, n),
-                      lr_eval_rel_rmse(ser.image[1], ser.converged, m.receivers, n),
-                      lr_eval_rel_rmse(ser.image[2], ser.converged, m.receivers, n));
-        print_message("seed %d: error %.4f %.4f %.4f\n", seed,
-                      lr_eval_rel_rmse(ser.image[0], mean.rgb, m.object, n),
-                      lr_eval_rel_rmse(ser.image[1], mean.rgb, m.object, n),
-                      lr_eval_rel_rmse(ser.image[2], mean.rgb, m.object, n));
+        double z = lr_eval_rel_rmse(ser.image[0], ser.converged, m.object, n);
+        o2 += z * z / SEEDS / (1.0 - 1.0 / C);
         lr_eval_series_free(&ser);
     }
-    print_message("candle objects: mean error^2 %.4f %.4f %.4f after 1, 4, 16 frames; sigma^2 "
-                  "%.4f; reference SE %.4f\n", e2[0], e2[1], e2[2], sigma2,
+    /* Var(mean_F - mean_C) = sigma^2 (1/F - 1/C) for independent frames. */
+    sigma2 = n2[0] / (1.0 - 1.0 / C);
+    print_message("candle: objects error^2 vs physical %.4f %.4f %.4f, noise^2 (all pixels) "
+                  "%.5f %.5f %.5f after 1, 4, 16 frames (mean of %d seeds); reference SE %.4f\n",
+                  e2[0], e2[1], e2[2], n2[0], n2[1], n2[2], SEEDS,
                   lr_eval_rel_stderr(var.rgb, mean.rgb, m.object, n));
     assert_true(sigma2 > 0.0);
     for (int c = 0; c < 2; c++) {
-        double F = checks[c];
-        double predicted = 0.75 * sigma2 / F;
-        double drop = e2[c] - e2[c + 1];
+        double F = checks[c], F4 = checks[c + 1];
+        double predicted = sigma2 * (1.0 / F - 1.0 / F4);
+        double drop = n2[c] - n2[c + 1];
         if (!(drop >= 0.5 * predicted))
-            fail_msg("error^2 fell by %.5f from %d to %d frames; predicted %.5f", drop, checks[c],
-                     checks[c + 1], predicted);
+            fail_msg("noise^2 fell by %.5f from %d to %d frames; predicted %.5f", drop,
+                     checks[c], checks[c + 1], predicted);
     }
+    /* Against the physical reference the model's bias stays (on the candle's object pixels it
+     * is larger than the noise: README "Speed against error"), and the cross term between
+     * bias and noise fluctuates, so 1 -> 4 need not fall; what must fall from 1 to 16 frames
+     * is the objects' sigma^2 (1 - 1/16), asked for at half its predicted size. */
+    double drop = e2[0] - e2[2], predicted = o2 * (1.0 - 1.0 / 16.0);
+    print_message("objects: error^2 fell by %.4f from 1 to 16 frames; noise predicts %.4f\n",
+                  drop, predicted);
+    if (!(drop >= 0.5 * predicted))
+        fail_msg("error^2 against the physical reference fell by %.5f from 1 to 16 frames; "
+                 "predicted %.5f", drop, predicted);
+    free(both);
     lr_eval_masks_free(&m);
     lr_ref_image_free(&mean);
     lr_ref_image_free(&var);
