@@ -58,7 +58,8 @@ static void panel(cairo_t *cr, double x0, double y0, const lrb_scene_result *sc,
     cairo_set_source_rgb(cr, 0, 0, 0);
     cairo_set_font_size(cr, 15);
     char title[160];
-    snprintf(title, sizeof title, "%s%s", sc->name, sc->ok ? "" : " (failed)");
+    snprintf(title, sizeof title, "%s%s: all settings (grey), Pareto front (red)", sc->name,
+             sc->ok ? "" : " (failed)");
     text(cr, x0 + PANEL_W / 2.0, y0 + 22, title, 0.5);
     double xmin = INFINITY, xmax = 0, ymin = INFINITY, ymax = 0;
     for (int i = 0; c && er && i < n; i++) {
@@ -108,7 +109,7 @@ static void panel(cairo_t *cr, double x0, double y0, const lrb_scene_result *sc,
     text(cr, x0 + (ML + PANEL_W - MR) / 2.0, y0 + PANEL_H - 12,
          "time to reach the error: frames x frame time (ms)", 0.5);
     cairo_save(cr);
-    cairo_move_to(cr, x0 + 16, y0 + PANEL_H / 2.0);
+    cairo_translate(cr, x0 + 16, y0 + PANEL_H / 2.0);
     cairo_rotate(cr, -M_PI / 2);
     text(cr, 0, 0, "relative RMSE vs physical reference", 0.5);
     cairo_restore(cr);
