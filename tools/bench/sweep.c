@@ -156,7 +156,7 @@ static int run_opts(FILE *out, const lrb_options *opt)
     lrb_sweep_table_md(out, rows, nrows, t640, nt);
     for (int k = 0; k < ns; k++)
         fprintf(out, "- %s: %s; reference SE %.4f (objects) / %.4f (receivers); units check "
-                     "%.3f ± %.3f\n",
+                     "%.4f ± %.4f\n",
                 res[k].name, res[k].ok ? "ok" : res[k].error, res[k].ref_se_object,
                 res[k].ref_se_receivers, res[k].units_ratio, res[k].units_se);
     fprintf(out, "\n");

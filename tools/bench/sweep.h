@@ -36,10 +36,13 @@ typedef struct lrb_scene_result {
     bool ref_hit;
     double ref_s;
     long object_px, receiver_px;
-    /* Units check: GPU (no VPLs, converged) over reference on directly lit receiver pixels,
-     * with the reference's standard error of that ratio; NaN when none. */
+    /* Units check (lrb_sweep_units); NaN when it failed. */
     double units_ratio, units_se;
     long units_px;
+    /* GPU without VPLs (converged) / reference on the receiver pixels the light reaches
+     * directly in the full scene: how much of the receivers' light the VPL-free model has. */
+    double direct_ratio, direct_se;
+    long direct_px;
     double sweep_s;
     int row0, nrows; /* the scene's rows in the table */
 } lrb_scene_result;
@@ -56,6 +59,10 @@ typedef struct lrb_timing_640 {
     double full_ms, accum_ms, dimmer_ms; /* medians of 3, 4, 5 frames */
 } lrb_timing_640;
 int lrb_sweep_time_640(lr_gl *gl, const char *name, lrb_timing_640 *out);
+
+/* The units check (sweep_units.c): GPU / reference on the receivers lit by the light alone
+ * (objects moved away, receivers' albedo 0.05), with the reference's standard error. */
+int lrb_sweep_units(lr_gl *gl, const char *name, double *ratio, double *se, long *px);
 
 /* Runs every setting on one scene, appending rows (at most cap in all). */
 int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, int cap,

@@ -48,7 +48,8 @@ static double debias(double rmse, double se)
 int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, int cap,
                     lrb_scene_result *res)
 {
-    *res = (lrb_scene_result){.units_ratio = NAN, .units_se = NAN, .row0 = *nrows};
+    *res = (lrb_scene_result){.units_ratio = NAN, .units_se = NAN, .direct_ratio = NAN,
+                              .direct_se = NAN, .row0 = *nrows};
     snprintf(res->name, sizeof res->name, "%s", name);
     const int w = LRB_SWEEP_W, h = LRB_SWEEP_H;
     const size_t n = (size_t)w * h;
@@ -148,20 +149,19 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
             memcpy(r.ms, ser.ms, sizeof r.ms);
             rows[(*nrows)++] = r;
         }
-        /* Units check on the VPL-free run: receiver pixels the light reaches directly
-         * (non-zero without VPLs) must match the reference there, up to the emergent light
-         * the reference adds on them and its noise. */
+        /* On the VPL-free run: receiver pixels the light reaches directly (non-zero without
+         * VPLs); the reference adds the emergent light and interreflection there. */
         if (!st->vpl) {
             double vs = 0.0, rs_sum = 0.0;
             for (size_t i = 0; i < n; i++) {
                 direct[i] = m.receivers[i] && (C[3 * i] > 0.0f || C[3 * i + 1] > 0.0f ||
                                                C[3 * i + 2] > 0.0f);
-                res->units_px += direct[i];
+                res->direct_px += direct[i];
                 for (int b = 0; direct[i] && b < 3; b++)
                     vs += var.rgb[3 * i + b], rs_sum += mean.rgb[3 * i + b];
             }
-            res->units_ratio = lr_eval_sum_ratio(C, mean.rgb, direct, n);
-            res->units_se = rs_sum > 0.0 ? res->units_ratio * sqrt(vs) / rs_sum : NAN;
+            res->direct_ratio = lr_eval_sum_ratio(C, mean.rgb, direct, n);
+            res->direct_se = rs_sum > 0.0 ? res->direct_ratio * sqrt(vs) / rs_sum : NAN;
         }
         fprintf(stderr, "bench sweep: %s %-10s frame %.1f ms, error after %d frames %.4f\n",
                 name, st->label, ser.frame_ms, st->checkpoints[st->ncheck - 1],
@@ -169,6 +169,7 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
         lr_eval_series_free(&ser);
     }
     res->sweep_s = lrb_now() - t1;
+    lrb_sweep_units(gl, name, &res->units_ratio, &res->units_se, &res->units_px);
     res->ok = true;
 done:
     if (rc)
