@@ -153,8 +153,8 @@ static void test_pfm_roundtrip(void **state)
     float px[2 * 3 * 3] = {0.0f, 1.5f, -2.0f, 1e-30f, 3e30f, (float)NAN, INFINITY, 7, 8,
                            9, 10, 11, 12, 13, 14, 15, 16, 17};
     lr_ref_image img = {.width = 3, .height = 2, .rgb = px}, back;
-    assert_int_equal(lr_ref_pfm_write(path, &img, NULL), LR_OK);
-    assert_int_equal(lr_ref_pfm_read(path, &back, NULL), LR_OK);
+    assert_int_equal(lr_image_write_pfm(path, &img, NULL), LR_OK);
+    assert_int_equal(lr_image_read_pfm(path, &back, NULL), LR_OK);
     assert_int_equal(back.width, 3);
     assert_int_equal(back.height, 2);
     assert_memory_equal(back.rgb, px, sizeof px);
@@ -165,7 +165,7 @@ static void test_pfm_roundtrip(void **state)
     assert_int_equal(ftruncate(fileno(f), 20), 0);
     fclose(f);
     lr_err e = {0};
-    assert_int_equal(lr_ref_pfm_read(path, &back, &e), LR_EPARSE);
+    assert_int_equal(lr_image_read_pfm(path, &back, &e), LR_EPARSE);
     assert_non_null(strstr(e.msg, "a.pfm"));
     assert_null(back.rgb);
     unlink(path);

@@ -55,7 +55,7 @@ static int make_dirs(const char *dir, lr_err *e)
 static bool load(const char *mean_path, const char *var_path, int w, int h, lr_ref_image *mean,
                  lr_ref_image *var)
 {
-    if (lr_ref_pfm_read(mean_path, mean, NULL) || lr_ref_pfm_read(var_path, var, NULL) ||
+    if (lr_image_read_pfm(mean_path, mean, NULL) || lr_image_read_pfm(var_path, var, NULL) ||
         mean->width != w || mean->height != h || var->width != w || var->height != h) {
         lr_ref_image_free(mean);
         lr_ref_image_free(var);
@@ -111,8 +111,8 @@ int lr_ref_render_cached(const lr_ref_scene *s, const lr_ref_camera *cam,
         !(rc = lr_ref_render_mean(r, mean, e)) && !(rc = lr_ref_render_variance(r, var, e)) &&
         /* The mean goes last: a reader takes the pair only when both are complete, and a
          * crash in between leaves a variance without a mean, which is a miss. */
-        !(rc = lr_ref_pfm_write(vp, var, e)) && !(rc = write_meta(jp, key, r, e)))
-        rc = lr_ref_pfm_write(mp, mean, e);
+        !(rc = lr_image_write_pfm(vp, var, e)) && !(rc = write_meta(jp, key, r, e)))
+        rc = lr_image_write_pfm(mp, mean, e);
     lr_ref_render_destroy(r);
     if (rc) {
         lr_ref_image_free(mean);

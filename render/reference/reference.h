@@ -48,6 +48,7 @@
 
 #include "render/base/err.h"
 #include "render/base/vec3.h"
+#include "render/image/image.h"
 #include "render/reference/rng.h"
 
 /* Version of the transport code; part of every cache key. Bump it whenever a change alters
@@ -330,16 +331,13 @@ int lr_ref_cpu_count(void);
 
 /* ---- images and the progressive renderer ------------------------------------------------ */
 
-/* Linear RGB floats, rows top to bottom (the layout of render/image's lr_image). */
-typedef struct lr_ref_image {
-    int width, height;
-    float *rgb; /* width * height * 3, owned */
-} lr_ref_image;
+/* Linear RGB floats, rows top to bottom: render/image's lr_image, so references are read
+ * and written with its PFM functions (lr_image_read_pfm, lr_image_write_pfm; one PFM
+ * implementation in the project). */
+typedef lr_image lr_ref_image;
 
+/* lr_image_free. */
 void lr_ref_image_free(lr_ref_image *img);
-/* Portable float map "PF", little-endian, rows bottom to top; written atomically. */
-int lr_ref_pfm_write(const char *path, const lr_ref_image *img, lr_err *e);
-int lr_ref_pfm_read(const char *path, lr_ref_image *out, lr_err *e);
 
 typedef struct lr_ref_camera {
     lr_vec3 position, look_at;

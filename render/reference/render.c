@@ -308,8 +308,6 @@ int lr_ref_render_variance(const lr_ref_render *r, lr_ref_image *out, lr_err *e)
 
 void lr_ref_image_free(lr_ref_image *img)
 {
-    if (!img)
-        return;
-    free(img->rgb);
-    *img = (lr_ref_image){0};
+    if (img)
+        lr_image_free(img);
 }

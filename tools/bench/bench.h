@@ -4,13 +4,21 @@
 #ifndef LRB_BENCH_H
 #define LRB_BENCH_H
 
+#include <stdbool.h>
 #include <stdio.h>
+
+/* Command-line options that sections may read. */
+typedef struct lrb_options {
+    bool update_front; /* --update-front: sweep also writes configs/bench/front.csv */
+} lrb_options;
 
 typedef struct lrb_section {
     const char *name;    /* selects the section on the command line */
     const char *summary; /* one line for --list */
     /* Prints the section's markdown to out; returns 0 or a nonzero exit status. */
     int (*run)(FILE *out);
+    /* The same with the options; used instead of run when set. */
+    int (*run_opts)(FILE *out, const lrb_options *opt);
 } lrb_section;
 
 /* Sections (one file each). */
@@ -18,6 +26,7 @@ extern const lrb_section lrb_optics_section;
 extern const lrb_section lrb_cpu_section;
 extern const lrb_section lrb_render_section;
 extern const lrb_section lrb_rig_section;
+extern const lrb_section lrb_sweep_section;
 
 /* Shared timing helpers (timing.c). */
 

@@ -1,5 +1,6 @@
 /* lamprig-bench: `lamprig-bench` runs every section; `lamprig-bench NAME...` runs those;
- * `lamprig-bench --list` lists them. Output is markdown, ready for the README. */
+ * `lamprig-bench --list` lists them; `--update-front` makes the sweep also write
+ * configs/bench/front.csv. Output is markdown, ready for the README. */
 #include "tools/bench/bench.h"
 
 #include <string.h>
@@ -9,6 +10,7 @@ static const lrb_section *const sections[] = {
     &lrb_cpu_section,
     &lrb_render_section,
     &lrb_rig_section,
+    &lrb_sweep_section,
 };
 #define NSECTIONS (sizeof sections / sizeof sections[0])
 
@@ -20,28 +22,43 @@ static const lrb_section *find(const char *name)
     return NULL;
 }
 
+static int run_one(const lrb_section *s, const lrb_options *opt)
+{
+    return s->run_opts ? s->run_opts(stdout, opt) : s->run(stdout);
+}
+
 int main(int argc, char **argv)
 {
     if (argc >= 2 && (!strcmp(argv[1], "--list") || !strcmp(argv[1], "--help") ||
                       !strcmp(argv[1], "-h"))) {
-        printf("usage: lamprig-bench [SECTION...]\n\nsections:\n");
+        printf("usage: lamprig-bench [--update-front] [SECTION...]\n\nsections:\n");
         for (size_t k = 0; k < NSECTIONS; k++)
             printf("  %-10s %s\n", sections[k]->name, sections[k]->summary);
         return 0;
     }
-    for (int i = 1; i < argc; i++)
+    lrb_options opt = {0};
+    const char *names[64];
+    int n = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--update-front")) {
+            opt.update_front = true;
+            continue;
+        }
         if (!find(argv[i])) {
             fprintf(stderr, "lamprig-bench: unknown section '%s' (see --list)\n", argv[i]);
             return 2;
         }
+        if (n < 64)
+            names[n++] = argv[i];
+    }
     int status = 0;
-    if (argc < 2) {
+    if (!n) {
         for (size_t k = 0; k < NSECTIONS; k++)
-            if (sections[k]->run(stdout))
+            if (run_one(sections[k], &opt))
                 status = 1;
     } else {
-        for (int i = 1; i < argc; i++)
-            if (find(argv[i])->run(stdout))
+        for (int i = 0; i < n; i++)
+            if (run_one(find(names[i]), &opt))
                 status = 1;
     }
     return status;

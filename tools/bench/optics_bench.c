@@ -136,7 +136,7 @@ static int run(FILE *out)
 }
 
 const lrb_section lrb_optics_section = {
-    "optics",
-    "directional and standard dipole evaluations per second (one core)",
-    run,
+    .name = "optics",
+    .summary = "directional and standard dipole evaluations per second (one core)",
+    .run = run,
 };

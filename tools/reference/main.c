@@ -180,7 +180,7 @@ static int cmd_render(int argc, char **argv)
             stats = *lr_ref_render_stats(r);
         lr_ref_render_destroy(r);
     }
-    if (!status && (lr_ref_pfm_write(out, &mean, &e) || lr_ref_pfm_write(var, &vimg, &e)))
+    if (!status && (lr_image_write_pfm(out, &mean, &e) || lr_image_write_pfm(var, &vimg, &e)))
         status = 1;
     if (status) {
         fprintf(stderr, "lamprig-reference: %s\n", e.msg);

@@ -1,0 +1,120 @@
+/* lamprig — the error of a rendering against a reference, and the speed-against-error front
+ * (issue 6: `lamprig-bench sweep`, README "Speed against error").
+ *
+ * Images here are linear RGB floats, rows top to bottom (lr_image / lr_ref_image layout).
+ * Errors are relative RMSEs in linear light over a pixel mask, all three bands pooled:
+ *
+ *     rel_rmse(g, r) = sqrt( sum_mask sum_band (g - r)^2 / sum_mask sum_band r^2 )
+ *
+ * so one number weighs bright pixels as the eye-independent energy measure does, and a
+ * uniform scale error s gives exactly |s - 1|.
+ */
+#ifndef LR_EVAL_H
+#define LR_EVAL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdio.h>
+
+#include "render/base/err.h"
+#include "render/gl/gl.h"
+#include "render/renderer.h"
+#include "render/scene/scene.h"
+
+/* ---- metrics ------------------------------------------------------------------------------ */
+
+/* rel_rmse above over the n pixels where mask is non-zero (mask NULL: all). NaN when the
+ * reference is zero on the mask. */
+double lr_eval_rel_rmse(const float *img, const float *ref, const unsigned char *mask, size_t n);
+/* Relative standard error of a Monte Carlo image from its variance image (variance of each
+ * pixel's mean): sqrt(sum var / sum ref^2) over the mask. It is what a perfect image's
+ * rel_rmse against this reference would be, on average: E[rel_rmse^2] = true^2 + this^2. */
+double lr_eval_rel_stderr(const float *var, const float *ref, const unsigned char *mask,
+                          size_t n);
+/* Sum of img over the mask and bands, divided by the same sum of ref (a units check: 1 when
+ * the two agree in scale). NaN when ref sums to zero. */
+double lr_eval_sum_ratio(const float *img, const float *ref, const unsigned char *mask,
+                         size_t n);
+
+/* ---- masks -------------------------------------------------------------------------------- */
+
+/* Which pixels of the scene's camera image see an object and which a receiver, by casting
+ * the camera ray of each pixel centre (lr_cpu_camera_ray) against every object's and
+ * receiver's BVH: the nearest hit decides. Pixels that see neither are in neither mask. */
+typedef struct lr_eval_masks {
+    int width, height;
+    unsigned char *object, *receivers; /* width * height, 1 = in the mask */
+    long object_px, receiver_px;
+} lr_eval_masks;
+
+int lr_eval_masks_create(const lr_scene *s, int width, int height, lr_eval_masks *out,
+                         lr_err *e);
+void lr_eval_masks_free(lr_eval_masks *m);
+
+/* ---- Pareto front --------------------------------------------------------------------------- */
+
+/* Marks on_front[i] for each point that no other point dominates (another point with
+ * cost <= and error <=, one of them strictly). Points with a non-finite coordinate are never on
+ * the front and dominate nothing. Of exact duplicates, the first is kept. Returns the number of
+ * points on the front. */
+int lr_eval_pareto(const double *cost, const double *error, int n, bool *on_front);
+
+/* ---- results table (build/bench/results.csv) ------------------------------------------------- */
+
+/* One setting of one scene after `frames` accumulated frames. */
+typedef struct lr_eval_row {
+    char scene[64]; /* scene file base name: "candle" */
+    char model[32]; /* "directional_dipole" or "standard_dipole" */
+    int K, N, N_vpl, map_size, gbuffer_size, frames;
+    bool vpl;
+    double frame_ms; /* median ms of one accumulation frame (radiosity + vpl + compose) */
+    double rel_rmse, rel_rmse_object, rel_rmse_receivers; /* against the physical reference */
+    double ms[LR_PASS_COUNT]; /* per pass: gbuffer (full update), radiosity, vpl, compose */
+    double bias_object, bias_receivers;   /* converged model vs physical reference */
+    double noise_object, noise_receivers; /* `frames` frames vs converged model */
+    int width, height;
+} lr_eval_row;
+
+/* The columns, in order (the planner reads them by name; the first seven are issue 6's). */
+#define LR_EVAL_CSV_HEADER                                                                   \
+    "scene,model,params,frame_ms,rel_rmse,rel_rmse_object,rel_rmse_receivers,K,N,N_vpl,"     \
+    "map_size,gbuffer_size,frames,vpl,ms_gbuffer,ms_radiosity,ms_vpl,ms_compose,bias_object," \
+    "bias_receivers,noise_object,noise_receivers,width,height"
+
+/* "K=16 N=16 N_vpl=64 map=256 gbuf=256 frames=16 vpl=on". */
+void lr_eval_row_params(const lr_eval_row *r, char *buf, size_t cap);
+/* Writes the header and one line per row (NaN as "nan"). */
+void lr_eval_csv_print(FILE *f, const lr_eval_row *rows, int n);
+/* The same into path, atomically. */
+int lr_eval_csv_write(const char *path, const lr_eval_row *rows, int n, lr_err *e);
+
+/* ---- a GPU frame series ---------------------------------------------------------------------- */
+
+/* Renders the scene at its current settings: three full updates (every pass; the maps restart
+ * each time, so the third leaves one frame in the maps), then accumulation frames until
+ * `converge_frames` are in the maps (render.frames is set to that). The HDR image is read
+ * after each checkpoint frame count (ascending, each <= converge_frames) and at the end. */
+typedef struct lr_eval_series_desc {
+    lr_gl *gl;
+    lr_scene *scene; /* render.frames is changed */
+    int width, height;
+    bool no_vpl;
+    const int *checkpoints;
+    int ncheck; /* at most 8 */
+    int converge_frames;
+    unsigned seed; /* lr_renderer_desc.seed: 0 = the renderer's default */
+} lr_eval_series_desc;
+
+typedef struct lr_eval_series {
+    float *image[8];  /* per checkpoint, rows top to bottom */
+    float *converged; /* after converge_frames */
+    double ms[LR_PASS_COUNT]; /* medians: gbuffer over the full updates, the others over the
+                               * accumulation frames */
+    double frame_ms;  /* median total of the accumulation frames */
+    int accum_frames; /* how many accumulation frames the medians are over */
+} lr_eval_series;
+
+int lr_eval_series_run(const lr_eval_series_desc *d, lr_eval_series *out, lr_err *e);
+void lr_eval_series_free(lr_eval_series *s);
+
+#endif

@@ -1,0 +1,58 @@
+/* build/bench/results.csv (eval.h): one line per (scene, model, setting, frames). */
+#include "render/eval/eval.h"
+
+#include <math.h>
+
+#include "render/base/atomic_file.h"
+
+void lr_eval_row_params(const lr_eval_row *r, char *buf, size_t cap)
+{
+    snprintf(buf, cap, "K=%d N=%d N_vpl=%d map=%d gbuf=%d frames=%d vpl=%s", r->K, r->N, r->N_vpl,
+             r->map_size, r->gbuffer_size, r->frames, r->vpl ? "on" : "off");
+}
+
+/* %g with NaN spelt "nan" on every libc. */
+static void num(FILE *f, double v, const char *fmt)
+{
+    if (isnan(v))
+        fputs(",nan", f);
+    else {
+        fputc(',', f);
+        fprintf(f, fmt, v);
+    }
+}
+
+void lr_eval_csv_print(FILE *f, const lr_eval_row *rows, int n)
+{
+    fputs(LR_EVAL_CSV_HEADER "\n", f);
+    for (int i = 0; i < n; i++) {
+        const lr_eval_row *r = &rows[i];
+        char params[160];
+        lr_eval_row_params(r, params, sizeof params);
+        /* Scene and model names are identifiers (no commas or quotes); params has none. */
+        fprintf(f, "%s,%s,%s", r->scene, r->model, params);
+        num(f, r->frame_ms, "%.3f");
+        num(f, r->rel_rmse, "%.5f");
+        num(f, r->rel_rmse_object, "%.5f");
+        num(f, r->rel_rmse_receivers, "%.5f");
+        fprintf(f, ",%d,%d,%d,%d,%d,%d,%s", r->K, r->N, r->N_vpl, r->map_size, r->gbuffer_size,
+                r->frames, r->vpl ? "on" : "off");
+        for (int p = 0; p < LR_PASS_COUNT; p++)
+            num(f, r->ms[p], "%.3f");
+        num(f, r->bias_object, "%.5f");
+        num(f, r->bias_receivers, "%.5f");
+        num(f, r->noise_object, "%.5f");
+        num(f, r->noise_receivers, "%.5f");
+        fprintf(f, ",%d,%d\n", r->width, r->height);
+    }
+}
+
+int lr_eval_csv_write(const char *path, const lr_eval_row *rows, int n, lr_err *e)
+{
+    lr_atomic_file *af;
+    int rc = lr_atomic_file_open(path, &af, e);
+    if (rc)
+        return rc;
+    lr_eval_csv_print(lr_atomic_file_stream(af), rows, n);
+    return lr_atomic_file_commit(af, e);
+}

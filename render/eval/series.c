@@ -1,0 +1,134 @@
+/* A GPU frame series for the bench (eval.h): full updates timed, then accumulation up to
+ * convergence with the image read at the checkpoints. */
+#include "render/eval/eval.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { FULL_UPDATES = 3 };
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+    if (n < 1)
+        return NAN;
+    qsort(v, (size_t)n, sizeof v[0], cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* The renderer's HDR (rows bottom up) into a new top-down buffer. */
+static int read_top_down(lr_renderer *r, int w, int h, float *tmp, float **out, lr_err *e)
+{
+    int rc = lr_renderer_read_hdr(r, tmp, e);
+    if (rc)
+        return rc;
+    size_t row = (size_t)w * 3;
+    if (!(*out = malloc(row * (size_t)h * sizeof **out)))
+        return lr_err_set(e, LR_ENOMEM, "series: out of memory");
+    for (int y = 0; y < h; y++)
+        memcpy(*out + (size_t)y * row, tmp + (size_t)(h - 1 - y) * row, row * sizeof **out);
+    return LR_OK;
+}
+
+void lr_eval_series_free(lr_eval_series *s)
+{
+    for (int i = 0; i < 8; i++)
+        free(s->image[i]);
+    free(s->converged);
+    *s = (lr_eval_series){0};
+}
+
+int lr_eval_series_run(const lr_eval_series_desc *d, lr_eval_series *out, lr_err *e)
+{
+    *out = (lr_eval_series){0};
+    if (d->ncheck < 0 || d->ncheck > 8 || d->converge_frames < 4)
+        return lr_err_set(e, LR_EINVAL, "series: %d checkpoints (at most 8), %d frames (at "
+                          "least 4: three accumulation frames to time)", d->ncheck,
+                          d->converge_frames);
+    for (int i = 0; i < d->ncheck; i++)
+        if (d->checkpoints[i] < 1 || d->checkpoints[i] > d->converge_frames ||
+            (i && d->checkpoints[i] <= d->checkpoints[i - 1]))
+            return lr_err_set(e, LR_EINVAL, "series: checkpoints must ascend within 1..%d",
+                              d->converge_frames);
+    char val[32];
+    snprintf(val, sizeof val, "%d", d->converge_frames);
+    int rc = lr_scene_set(d->scene, "render.frames", val, NULL, e);
+    if (rc)
+        return rc;
+    const int w = d->width, h = d->height;
+    float *tmp = malloc((size_t)w * h * 3 * sizeof *tmp);
+    double *acc[LR_PASS_COUNT + 1] = {0}, full[FULL_UPDATES];
+    for (int p = 0; p <= LR_PASS_COUNT; p++)
+        acc[p] = malloc((size_t)d->converge_frames * sizeof(double));
+    lr_renderer *r = NULL;
+    if (!tmp || !acc[0] || !acc[1] || !acc[2] || !acc[3] || !acc[4]) {
+        rc = lr_err_set(e, LR_ENOMEM, "series: out of memory");
+        goto done;
+    }
+    if ((rc = lr_renderer_create(&(lr_renderer_desc){.gl = d->gl, .scene = d->scene, .width = w,
+                                                      .height = h, .no_vpl = d->no_vpl,
+                                                      .seed = d->seed},
+                                 &r, e)))
+        goto done;
+    lr_frame_stats st = {0};
+    /* Full updates: each restarts the maps, so after the last one they hold one frame. */
+    for (int i = 0; i < FULL_UPDATES; i++) {
+        if (i)
+            lr_renderer_invalidate(r, LR_DIRTY_LIGHT_GEOMETRY);
+        if ((rc = lr_renderer_frame(r, &st, e)))
+            goto done;
+        full[i] = (st.passes & 1u) ? st.ms[0] : NAN;
+    }
+    int next = 0, nacc = 0;
+    for (;;) {
+        if (next < d->ncheck && st.samples == d->checkpoints[next]) {
+            if ((rc = read_top_down(r, w, h, tmp, &out->image[next], e)))
+                goto done;
+            next++;
+        }
+        if (st.samples >= d->converge_frames)
+            break;
+        if (st.index > 2 * d->converge_frames + FULL_UPDATES) {
+            rc = lr_err_set(e, LR_EINVAL, "series: accumulation stalled at %d frames",
+                            st.samples);
+            goto done;
+        }
+        if ((rc = lr_renderer_frame(r, &st, e)))
+            goto done;
+        for (int p = 0; p < LR_PASS_COUNT; p++)
+            acc[p][nacc] = (st.passes & (1u << p)) ? st.ms[p] : NAN;
+        acc[LR_PASS_COUNT][nacc] = st.total_ms;
+        nacc++;
+    }
+    if (next < d->ncheck) {
+        rc = lr_err_set(e, LR_EINVAL, "series: checkpoint %d frames never reached",
+                        d->checkpoints[next]);
+        goto done;
+    }
+    if ((rc = read_top_down(r, w, h, tmp, &out->converged, e)))
+        goto done;
+    out->ms[0] = median(full, FULL_UPDATES);
+    for (int p = 1; p < LR_PASS_COUNT; p++) {
+        int m = 0;
+        for (int i = 0; i < nacc; i++)
+            if (isfinite(acc[p][i]))
+                acc[p][m++] = acc[p][i];
+        out->ms[p] = median(acc[p], m);
+    }
+    out->frame_ms = median(acc[LR_PASS_COUNT], nacc);
+    out->accum_frames = nacc;
+done:
+    lr_renderer_destroy(r);
+    free(tmp);
+    for (int p = 0; p <= LR_PASS_COUNT; p++)
+        free(acc[p]);
+    if (rc)
+        lr_eval_series_free(out);
+    return rc;
+}

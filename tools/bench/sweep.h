@@ -1,0 +1,87 @@
+/* Section "sweep": speed against error for every scene in configs/scenes/ (issue 6 items 2
+ * and 4; README "Speed against error"). Internal to the bench; the metrics, masks, Pareto
+ * front, CSV and GPU frame series are in render/eval/eval.h (unit-tested there). */
+#ifndef LRB_SWEEP_H_INCLUDED
+#define LRB_SWEEP_H_INCLUDED
+
+#include <stdbool.h>
+
+#include "render/eval/eval.h"
+#include "tools/bench/bench.h"
+
+/* Bench resolution and the physical reference's sample count (see sweep.c for why). */
+enum { LRB_SWEEP_W = 64, LRB_SWEEP_H = 48, LRB_SWEEP_SPP = 512 };
+/* Where the references are cached (committed: generating them takes longer than the bench). */
+#define LRB_SWEEP_REF_DIR "configs/bench/references"
+
+/* One setting of the sweep: the base with at most one parameter changed. */
+typedef struct lrb_setting {
+    const char *label; /* "base", "K=4", ... */
+    int K, N, N_vpl, map_size, gbuffer_size;
+    bool vpl;
+    const char *model; /* "directional_dipole" or "standard_dipole" */
+    int checkpoints[4], ncheck;
+    int converge_frames;
+} lrb_setting;
+
+/* The settings (sweep_settings.c): the base, then one-at-a-time changes. Returns the count. */
+int lrb_sweep_settings(lrb_setting *out, int cap);
+
+/* What one scene's sweep produced. */
+typedef struct lrb_scene_result {
+    char name[64];
+    bool ok;
+    char error[512];
+    double ref_se_object, ref_se_receivers, ref_se_all; /* reference's relative standard error */
+    bool ref_hit;
+    double ref_s;
+    long object_px, receiver_px;
+    /* Units check (lrb_sweep_units); NaN when it failed. */
+    double units_ratio, units_se;
+    long units_px;
+    /* GPU without VPLs (converged) / reference on the receiver pixels the light reaches
+     * directly in the full scene: how much of the receivers' light the VPL-free model has. */
+    double direct_ratio, direct_se;
+    long direct_px;
+    double sweep_s;
+    int row0, nrows; /* the scene's rows in the table */
+} lrb_scene_result;
+
+/* Applies a setting to a scene (render.* and every object's model). */
+int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e);
+
+/* Frame times of the base setting at 640x480 (sweep_table.c). */
+typedef struct lrb_timing_640 {
+    char scene[64];
+    bool ok;
+    int w, h;
+    double pass_ms[LR_PASS_COUNT]; /* full update, median of 3 */
+    double full_ms, accum_ms, dimmer_ms; /* medians of 3, 4, 5 frames */
+} lrb_timing_640;
+int lrb_sweep_time_640(lr_gl *gl, const char *name, lrb_timing_640 *out);
+
+/* The units check (sweep_units.c): GPU / reference on the receivers lit by the light alone
+ * (objects moved away, receivers' albedo 0.05), with the reference's standard error. */
+int lrb_sweep_units(lr_gl *gl, const char *name, double *ratio, double *se, long *px);
+
+/* Runs every setting on one scene, appending rows (at most cap in all). */
+int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, int cap,
+                    lrb_scene_result *res);
+
+/* build/bench/pareto.png (sweep_plot.c). */
+int lrb_sweep_plot(const char *path, const lr_eval_row *rows, int nrows,
+                   const lrb_scene_result *scenes, int nscenes, lr_err *e);
+/* build/bench/summary.md (sweep_summary.c); load[0..2] before and after the run. */
+int lrb_sweep_summary(const char *path, const lr_eval_row *rows, int nrows,
+                      const lrb_scene_result *scenes, int nscenes, const lrb_timing_640 *t640,
+                      int nt640, const double load[2][3], double total_s, const char *renderer,
+                      lr_err *e);
+
+/* The 640x480 table (markdown) with the base rows' errors. */
+void lrb_sweep_table_md(FILE *f, const lr_eval_row *rows, int nrows, const lrb_timing_640 *t,
+                        int nt);
+
+/* Time to reach a row's error: its frames times the accumulation frame time, ms. */
+double lrb_sweep_time_ms(const lr_eval_row *r);
+
+#endif
