@@ -288,7 +288,7 @@ int lr_plan_create(const lr_scene *s, const lr_plan_table *t, const lr_plan_budg
         return lr_err_set(e, LR_EINVAL, "planner: %d objects, at most %d", no,
                           LR_PLAN_MAX_OBJECTS);
     const char *configs = opt && opt->configs_dir ? opt->configs_dir : lr_configs_dir();
-    unsigned models = opt && opt->models ? opt->models : LR_PLAN_MODEL_DIRECTIONAL;
+    unsigned models = opt && opt->models ? opt->models : LR_PLAN_MODEL_ALL;
     snprintf(out->scene, sizeof out->scene, "%s", lr_scene_name(s));
     out->budget = *b;
     out->nobjects = no;
@@ -334,6 +334,14 @@ int lr_plan_apply(const lr_plan *p, lr_scene *s, unsigned *dirty, lr_err *e)
         char v[32];
         snprintf(v, sizeof v, "%d", sets[i].v);
         int rc = lr_scene_set(s, sets[i].key, v, dirty, e);
+        if (rc)
+            return lr_err_prefix(e, "applying the plan");
+    }
+    /* The model is the one per-object choice the renderer takes as it is. */
+    for (int i = 0; i < p->nobjects; i++) {
+        char key[32];
+        snprintf(key, sizeof key, "objects[%d].model", i);
+        int rc = lr_scene_set(s, key, p->objects[i].row.model, dirty, e);
         if (rc)
             return lr_err_prefix(e, "applying the plan");
     }

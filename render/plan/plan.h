@@ -143,18 +143,19 @@ typedef struct lr_plan {
     bool feasible; /* every object's choice meets the budget */
 } lr_plan;
 
-/* Models the planner may choose. The GLES renderer implements the directional dipole only,
- * so that is the default; `lamprig plan --models all` shows what the table would pick. */
+/* Models the planner may choose; the renderer runs both (objects[i].model), so the default
+ * is both. `lamprig plan --models directional_dipole` restricts the choice. */
 enum lr_plan_models {
     LR_PLAN_MODEL_DIRECTIONAL = 1u << 0, /* "directional_dipole" */
     LR_PLAN_MODEL_STANDARD = 1u << 1,    /* "standard_dipole" */
+    LR_PLAN_MODEL_ALL = LR_PLAN_MODEL_DIRECTIONAL | LR_PLAN_MODEL_STANDARD,
 };
 
 typedef struct lr_plan_options {
     /* Where the scenes the table names are found, to match a scene the table lacks by
      * features: CONFIGS/scenes/NAME.json. NULL: lr_configs_dir(). */
     const char *configs_dir;
-    unsigned models; /* lr_plan_models; 0: LR_PLAN_MODEL_DIRECTIONAL */
+    unsigned models; /* lr_plan_models; 0: LR_PLAN_MODEL_ALL */
 } lr_plan_options;
 
 /* Chooses, per object, among the rows of the scene (or of the measured scene nearest by
@@ -176,7 +177,8 @@ int lr_plan_create(const lr_scene *s, const lr_plan_table *t, const lr_plan_budg
 bool lr_plan_budget_from_scene(const lr_scene *s, lr_plan_budget *out);
 
 /* Applies plan->settings to the scene through lr_scene_set (render.K, N, N_vpl, map_size,
- * gbuffer_size, frames), ORing dirty flags. */
+ * gbuffer_size, frames) and each object's chosen model (objects[i].model), ORing dirty
+ * flags. */
 int lr_plan_apply(const lr_plan *p, lr_scene *s, unsigned *dirty, lr_err *e);
 
 /* One line per object, "plan: OBJECT: MODEL K=.. N=.. N_vpl=.. map=.. gbuffer=.. frames=..

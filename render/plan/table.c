@@ -80,7 +80,9 @@ static int cell_err(const char *name, int line, const char *col, lr_err *e, cons
 static int cell_number(const char *name, int line, const char *col, const char *text,
                        bool required, double *out, lr_err *e)
 {
-    if (!*text) {
+    /* An optional measurement the bench did not take (ms_vpl of a row without VPLs) is
+     * written "nan" by the bench's CSV writer, or left empty. */
+    if (!*text || (!required && !strcmp(text, "nan"))) {
         if (required)
             return lr_err_set(e, LR_EPARSE, "%s:%d: column '%s': empty", name, line, col);
         *out = NAN;

@@ -69,6 +69,22 @@ static bool skipped(const char *name)
     return !strcmp(name, "sphere");
 }
 
+/* Whether `name` is one of the comma-separated names of `list` (whole names: "candle" must
+ * not select "candle_spot"). */
+static bool listed(const char *list, const char *name)
+{
+    size_t n = strlen(name);
+    for (const char *p = list; *p;) {
+        size_t len = strcspn(p, ",");
+        if (len == n && !strncmp(p, name, n))
+            return true;
+        p += len;
+        if (*p == ',')
+            p++;
+    }
+    return false;
+}
+
 static int run_opts(FILE *out, const lrb_options *opt)
 {
     double t0 = lrb_now(), load[2][3] = {{0}};
@@ -96,7 +112,7 @@ static int run_opts(FILE *out, const lrb_options *opt)
     const char *only = getenv("LRB_SWEEP_SCENES");
     int ns = 0;
     for (int k = 0; k < nscenes; k++) {
-        if (only && !strstr(only, names[k]))
+        if (only && !listed(only, names[k]))
             continue;
         if (!only && skipped(names[k]))
             continue;
@@ -111,7 +127,7 @@ static int run_opts(FILE *out, const lrb_options *opt)
     int nt = 0;
     const char *table_scenes[] = {"candle", "lampshade"};
     for (int k = 0; k < 2; k++)
-        if (!only || strstr(only, table_scenes[k])) {
+        if (!only || listed(only, table_scenes[k])) {
             if (lrb_sweep_time_640(gl, table_scenes[k], &t640[nt]))
                 status = 1;
             nt++;
