@@ -22,10 +22,12 @@
  *   "stats":    {"path": "PATH" (default none), "period_s": 10 (0: only at exit)}
  *   "calib":    "DIR"                  a calibration folder (calib/rig.h) with projector.json
  *                                      and pose.json's projector pose (albedo.json optional):
- *                                      spatial AR, headless only -- each change of the scene
- *                                      also renders a compensated projector frame
- *                                      (calib/ar_frame.h), written to out_dir/ar_NNNNNN.png,
- *                                      its clipping logged and counted in the stats
+ *                                      spatial AR -- each change of the scene also renders a
+ *                                      compensated projector frame (calib/ar_frame.h),
+ *                                      written to out_dir/ar_NNNNNN.png and, with kms, shown
+ *                                      on the projector instead of the view
+ *                                      (firmware/rig/ar_present.h), its clipping logged and
+ *                                      counted in the stats
  *   "ar_samples": 16                   CPU reference samples per band and pixel for it
  * }
  *

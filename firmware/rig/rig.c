@@ -14,6 +14,7 @@
 
 #include "calib/albedo.h"
 #include "calib/ar_frame.h"
+#include "firmware/rig/ar_present.h"
 #include "firmware/rig/config.h"
 #include "firmware/rig/control_map.h"
 #include "firmware/rig/stats.h"
@@ -76,6 +77,8 @@ struct lr_rig {
     bool used_hid; /* hidapi's process-wide state is released once, at the very end */
     bool ar_dirty; /* spatial AR: the scene changed since the last projector frame */
     uint64_t ar_frames;
+    lr_ar_present *ar_out; /* KMS + calib: draws the compensated frames on the projector */
+    bool ar_size_logged;   /* the frame/mode size mismatch was logged */
 };
 
 static void set_free(rigset *s)
@@ -439,9 +442,7 @@ static void ar_frame(lr_rig *r)
     if (r->out_dir[0]) {
         lr_img png;
         if (lr_img_alloc(&png, levels.width, levels.height, 3, 1, &e) == LR_OK) {
-            uint8_t *px = png.px;
-            for (size_t k = 0; k < (size_t)levels.width * levels.height * 3; k++)
-                px[k] = (uint8_t)lrint(255 * fmin(1.0, fmax(0.0, levels.rgb[k])));
+            lr_ar_levels_to_rgb8(&levels, png.px);
             char path[LR_RIG_PATH_MAX + 32];
             snprintf(path, sizeof path, "%s/ar_%06llu.png", r->out_dir,
                      (unsigned long long)r->ar_frames);
@@ -450,8 +451,24 @@ static void ar_frame(lr_rig *r)
             lr_img_free(&png);
         }
     }
-    lr_log_write(&r->log, LR_LOG_INFO, "spatial AR frame %llu: %dx%d, %s",
-                 (unsigned long long)r->ar_frames, levels.width, levels.height, msg);
+    if (r->ar_out) {
+        /* On the projector: only when a new frame was computed (the loop stays idle). */
+        int mw, mh;
+        lr_gl_size(r->gl, &mw, &mh);
+        if ((mw != levels.width || mh != levels.height) && !r->ar_size_logged) {
+            lr_log_write(&r->log, LR_LOG_WARN,
+                         "spatial AR: frame %dx%d (the calibrated projector) differs from the "
+                         "KMS mode %dx%d; stretched to fill the mode (set output.mode_size to "
+                         "the calibrated size for pixel-exact levels)",
+                         levels.width, levels.height, mw, mh);
+            r->ar_size_logged = true;
+        }
+        if (lr_ar_present_show(r->ar_out, &levels, &e))
+            lr_log_write(&r->log, LR_LOG_ERROR, "spatial AR: %s", e.msg);
+    }
+    lr_log_write(&r->log, LR_LOG_INFO, "spatial AR frame %llu: %dx%d, %s%s",
+                 (unsigned long long)r->ar_frames, levels.width, levels.height, msg,
+                 r->ar_out ? ", on the projector" : "");
     r->ar_frames++;
     lr_image_free(&levels);
 }
@@ -461,7 +478,8 @@ static void frame(lr_rig *r, int64_t now)
     lr_frame_stats st;
     lr_err e = {0};
     int rc = lr_rig_view_frame(r->view, &st, &e);
-    if (!rc && r->kms)
+    /* With spatial AR the projector shows the compensated frame (ar_frame), not the view. */
+    if (!rc && r->kms && !r->set.calib)
         rc = lr_rig_view_present(r->view, &e);
     if (!rc && r->out_dir[0]) {
         rc = lr_rig_view_read_rgba8(r->view, r->rgba, &e);
@@ -560,6 +578,24 @@ static int open_output(lr_rig *r, lr_err *e)
     return LR_OK;
 }
 
+/* KMS + spatial AR: the presenter of the compensated frames (kept across reloads). */
+static int ar_output(lr_rig *r, lr_err *e)
+{
+    int rc = lr_ar_present_create(r->gl, &r->ar_out, e);
+    if (rc)
+        return lr_err_prefix(e, "field 'calib'");
+    lr_log_write(&r->log, LR_LOG_INFO, "spatial AR: the projector shows the compensated frames; "
+                 "the render view is not shown while AR is active");
+    return LR_OK;
+}
+
+/* Frames are paced by the flips only when the view itself is on the projector; with spatial
+ * AR (the projector shows only new compensated frames) and headless, by output.fps. */
+static int64_t frame_interval(const lr_rig *r)
+{
+    return r->kms && !r->set.calib ? 0 : (int64_t)(1e9 / r->set.cfg->output.fps);
+}
+
 int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
 {
     if (!opts || !opts->config)
@@ -613,10 +649,7 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
         rc = open_output(r, e);
     }
     if (!rc && r->kms && r->set.calib)
-        rc = lr_err_set(e, LR_EUNSUPPORTED,
-                        "%s: field 'calib': spatial AR frames are written headless only (KMS "
-                        "output of compensated frames is not built yet); run with --headless",
-                        r->set.cfg->path);
+        rc = ar_output(r, e);
     if (!rc)
         rc = view_build(r, r->set.scene, r->set.no_vpl, &r->view, e);
     r->ar_dirty = true;
@@ -627,7 +660,7 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
         return rc;
     }
     const lr_rig_config *c = r->set.cfg;
-    r->frame_interval_ns = r->kms ? 0 : (int64_t)(1e9 / c->output.fps);
+    r->frame_interval_ns = frame_interval(r);
     r->end_ns = opts->duration_s > 0 ? r->start_ns + (int64_t)(opts->duration_s * 1e9)
                                      : INT64_MAX;
     r->next_stats_ns = c->stats_period_s > 0 ? r->start_ns + (int64_t)(c->stats_period_s * 1e9)
@@ -645,10 +678,7 @@ int lr_rig_reload(lr_rig *r, lr_err *e)
     rigset s;
     int rc = set_build(r, &s, e);
     lr_rig_view *view = NULL;
-    if (!rc && r->kms && s.calib) {
-        rc = lr_err_set(e, LR_EUNSUPPORTED,
-                        "%s: field 'calib': spatial AR frames are written headless only",
-                        s.cfg->path);
+    if (!rc && r->kms && s.calib && !r->ar_out && (rc = ar_output(r, e))) {
         r->used_hid |= s.has_hid;
         set_free(&s);
     }
@@ -692,8 +722,7 @@ int lr_rig_reload(lr_rig *r, lr_err *e)
     const lr_rig_config *c = r->set.cfg;
     if (!r->opts.stats_path)
         snprintf(r->stats_path, sizeof r->stats_path, "%s", c->stats_path);
-    if (!r->kms)
-        r->frame_interval_ns = (int64_t)(1e9 / c->output.fps);
+    r->frame_interval_ns = frame_interval(r);
     lr_log_write(&r->log, LR_LOG_INFO, "reloaded %s: scene %s, %d devices, %d controls",
                  r->config_path, c->scene, c->n_devices, c->n_bindings);
     apply(r, lr_now_ns());
@@ -841,6 +870,7 @@ void lr_rig_destroy(lr_rig *r)
     if (r->stats && r->set.cfg)
         write_stats(r, lr_now_ns());
     lr_rig_view_destroy(r->view);
+    lr_ar_present_destroy(r->ar_out);
     if (r->gl)
         lr_gl_destroy(r->gl);
     r->used_hid |= r->set.has_hid;
