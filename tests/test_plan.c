@@ -83,9 +83,11 @@ static void test_table_fixture(void **state)
     const lr_plan_row *r = lr_plan_table_row(table, 0);
     assert_string_equal(r->scene, "candle");
     assert_string_equal(r->model, "directional_dipole");
-    assert_int_equal(r->line, 4); /* two comment lines and the header before it */
+    assert_int_equal(r->line, 5); /* three comment lines and the header before it */
     assert_near(r->frame_ms, 40.0, 0.0);
     assert_near(r->rel_rmse, 0.12, 1e-15);
+    /* no bias/noise columns: the predicted error is the measured rel_rmse */
+    assert_near(lr_plan_row_error(r), 0.12, 0.0);
     assert_int_equal(r->K, 4);
     assert_int_equal(r->frames, 8);
     assert_true(r->vpl);
@@ -94,6 +96,25 @@ static void test_table_fixture(void **state)
     assert_true(isnan(novpl->ms_vpl)); /* an empty optional cell */
     assert_true(lr_plan_table_has_scene(table, "lampshade"));
     assert_false(lr_plan_table_has_scene(table, "votive"));
+}
+
+static void test_predicted_error_from_split(void **state)
+{
+    /* With the bench's split the predicted error is sqrt(bias^2 + noise^2) per region, the
+     * larger region deciding: objects 3-4-5 (0.5), receivers 0.3 / 0.4 (0.5) and 0.6 / 0 (0.6). */
+    const char *csv =
+        "scene,model,frame_ms,rel_rmse,K,N,N_vpl,map_size,gbuffer_size,frames,vpl,"
+        "bias_object,noise_object,bias_receivers,noise_receivers\n"
+        "candle,directional_dipole,10,0.1,4,4,16,64,64,8,on,0.3,0.4,0.1,0.1\n"
+        "candle,directional_dipole,10,0.1,4,4,16,64,64,8,on,0.3,0.4,0.6,0\n"
+        "candle,directional_dipole,10,0.1,4,4,16,64,64,8,off,0.3,0.4,nan,nan\n";
+    lr_plan_table *t;
+    lr_err e = {0};
+    assert_int_equal(lr_plan_table_parse(csv, strlen(csv), "split.csv", &t, &e), LR_OK);
+    assert_near(lr_plan_row_error(lr_plan_table_row(t, 0)), 0.5, 1e-15);
+    assert_near(lr_plan_row_error(lr_plan_table_row(t, 1)), 0.6, 1e-15);
+    assert_near(lr_plan_row_error(lr_plan_table_row(t, 2)), 0.5, 1e-15);
+    lr_plan_table_destroy(t);
 }
 
 static void test_table_header_driven(void **state)
@@ -173,7 +194,7 @@ static const lr_plan_row *brute_force_in(const lr_plan_table *t, const char *sce
     double best_t = INFINITY;
     for (int i = 0; i < lr_plan_table_count(t); i++) {
         const lr_plan_row *r = lr_plan_table_row(t, i);
-        if (strcmp(r->scene, scene) || r->K < K_cover || r->rel_rmse > max_error)
+        if (strcmp(r->scene, scene) || r->K < K_cover || lr_plan_row_error(r) > max_error)
             continue;
         double ms = (isnan(r->ms_gbuffer) ? 0.0 : r->ms_gbuffer) + r->frames * r->frame_ms;
         if (ms < best_t) {
@@ -251,13 +272,16 @@ static void test_committed_front_both_scenes(void **state)
             const lr_plan_row *r = lr_plan_table_row(t, i);
             if (strcmp(r->scene, names[s]) || r->K < a.K_cover)
                 continue;
+            /* The committed front has the bias/noise split: the predicted error is
+             * sqrt(bias^2 + noise^2), never below the larger region's bias. */
+            double err = lr_plan_row_error(r);
+            assert_true(err >= fmax(r->bias_object, isnan(r->bias_receivers) ? 0.0 : r->bias_receivers));
             lr_plan p;
-            assert_int_equal(lr_plan_create(scenes[s], t, &(lr_plan_budget){r->rel_rmse, 0}, NULL,
-                                            &p, &e),
+            assert_int_equal(lr_plan_create(scenes[s], t, &(lr_plan_budget){err, 0}, NULL, &p, &e),
                              LR_OK);
             assert_true(p.feasible);
-            assert_true(p.objects[0].predicted_error <= r->rel_rmse);
-            const lr_plan_row *want = brute_force_in(t, names[s], a.K_cover, r->rel_rmse);
+            assert_true(p.objects[0].predicted_error <= err);
+            const lr_plan_row *want = brute_force_in(t, names[s], a.K_cover, err);
             double want_ms = (isnan(want->ms_gbuffer) ? 0.0 : want->ms_gbuffer) +
                              want->frames * want->frame_ms;
             assert_near(p.objects[0].predicted_converge_ms, want_ms, 1e-9 * want_ms);
@@ -712,6 +736,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_table_fixture),
+        cmocka_unit_test(test_predicted_error_from_split),
         cmocka_unit_test(test_table_header_driven),
         cmocka_unit_test(test_table_errors),
         cmocka_unit_test(test_max_error_both_scenes),

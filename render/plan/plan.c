@@ -222,7 +222,7 @@ static int plan_object(const lr_scene *s, int index, const lr_plan_table *t,
             /* pass 0: K >= K_cover; pass 1 (none had that many maps): the most maps measured */
             if (pass == 0 ? r->K < a->K_cover : r->K < kmax)
                 continue;
-            cand x = {.row = r, .err = r->rel_rmse, .fms = r->frame_ms};
+            cand x = {.row = r, .err = lr_plan_row_error(r), .fms = r->frame_ms};
             if (!need_vpl && r->vpl && isfinite(r->ms_vpl))
                 x.fms = fmax(r->frame_ms - r->ms_vpl, 0.0);
             x.conv = (isfinite(r->ms_gbuffer) ? r->ms_gbuffer : 0.0) + r->frames * x.fms;

@@ -41,10 +41,15 @@ typedef struct lr_plan_row {
     int K, N, N_vpl, map_size, gbuffer_size, frames;
     bool vpl;
     double ms_gbuffer, ms_radiosity, ms_vpl, ms_compose; /* optional */
+    double bias_object, bias_receivers, noise_object, noise_receivers; /* optional */
     int width, height; /* optional, 0 when absent */
 } lr_plan_row;
 
 typedef struct lr_plan_table lr_plan_table;
+
+/* The error the planner predicts for a row: sqrt(bias^2 + noise^2) from the bench's split,
+ * the larger of objects and receivers; rel_rmse for rows without the split. */
+double lr_plan_row_error(const lr_plan_row *r);
 
 /* Parses CSV text. The first line is the header; columns are looked up by name, in any order;
  * unknown columns are ignored. Required: scene, model, frame_ms, rel_rmse, K, N, N_vpl,
