@@ -5,7 +5,7 @@
 #include <stdio.h>
 
 #include "calib/compare.h"
-#include "render/base/atomic_file.h"
+#include "render/image/cairo_png.h"
 
 enum { BAR_W = 90, TOP = 28 };
 
@@ -21,11 +21,6 @@ static void colormap(double t, double rgb[3])
     f -= i;
     for (int c = 0; c < 3; c++)
         rgb[c] = stops[i][c] * (1 - f) + stops[i + 1][c] * f;
-}
-
-static cairo_status_t write_stream(void *closure, const unsigned char *data, unsigned int len)
-{
-    return fwrite(data, 1, len, closure) == len ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
 }
 
 int lr_heatmap_png(const char *path, const float *v, int w, int h, double vmax,
@@ -81,24 +76,5 @@ int lr_heatmap_png(const char *path, const float *v, int w, int h, double vmax,
     cairo_set_font_size(cr, 13);
     cairo_move_to(cr, 4, 18);
     cairo_show_text(cr, title ? title : "");
-    cairo_status_t st = cairo_status(cr);
-    cairo_destroy(cr);
-    if (st != CAIRO_STATUS_SUCCESS) {
-        cairo_surface_destroy(s);
-        return lr_err_set(e, LR_EIO, "%s: drawing failed: %s", path, cairo_status_to_string(st));
-    }
-    lr_atomic_file *f = NULL;
-    int rc = lr_atomic_file_open(path, &f, e);
-    if (rc) {
-        cairo_surface_destroy(s);
-        return rc;
-    }
-    st = cairo_surface_write_to_png_stream(s, write_stream, lr_atomic_file_stream(f));
-    cairo_surface_destroy(s);
-    if (st != CAIRO_STATUS_SUCCESS) {
-        lr_atomic_file_abort(f);
-        return lr_err_set(e, LR_EIO, "%s: PNG encoding failed: %s", path,
-                          cairo_status_to_string(st));
-    }
-    return lr_atomic_file_commit(f, e);
+    return lr_cairo_finish_png(cr, s, path, e);
 }

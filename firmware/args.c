@@ -136,3 +136,32 @@ int lr_args_triple(const char *flag, const char *text, double out[3], lr_err *e)
     int n = 0;
     return lr_args_numbers(flag, text, out, 3, 3, &n, e);
 }
+
+int lr_args_times(const char *s, double *t, int cap)
+{
+    int n = 0;
+    while (*s) {
+        if (n >= cap)
+            return -1;
+        char *end;
+        double a = strtod(s, &end);
+        if (end == s)
+            return -1;
+        if (*end == '/') {
+            const char *d = end + 1;
+            double b = strtod(d, &end);
+            if (end == d || !(b > 0))
+                return -1;
+            a /= b;
+        }
+        if (!(a > 0) || !isfinite(a))
+            return -1;
+        t[n++] = a;
+        if (*end == ',')
+            end++;
+        else if (*end != '\0')
+            return -1;
+        s = end;
+    }
+    return n;
+}

@@ -42,5 +42,8 @@ int lr_args_numbers(const char *flag, const char *text, double *out, int min, in
                     int *count, lr_err *e);
 /* Exactly three numbers (an RGB triple, a position, a direction). */
 int lr_args_triple(const char *flag, const char *text, double out[3], lr_err *e);
+/* Exposure times "1/30,0.5,2" (fractions allowed, each > 0 and finite) into t[cap]: the
+ * count, or -1 when malformed or more than cap. */
+int lr_args_times(const char *s, double *t, int cap);
 
 #endif

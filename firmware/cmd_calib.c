@@ -22,6 +22,7 @@
 #include "calib/procam.h"
 #include "calib/projresp.h"
 #include "calib/rig.h"
+#include "firmware/args.h"
 #include "firmware/cli.h"
 
 const char lr_cmd_calib_usage[] =
@@ -161,36 +162,6 @@ static bool parse_double(const char *s, double lo, double hi, double *out)
         return false;
     *out = v;
     return true;
-}
-
-/* "1/30,0.5,2" */
-static int parse_times(const char *s, double *t, int cap)
-{
-    int n = 0;
-    while (*s) {
-        if (n >= cap)
-            return -1;
-        char *end;
-        double a = strtod(s, &end);
-        if (end == s)
-            return -1;
-        if (*end == '/') {
-            const char *d = end + 1;
-            double b = strtod(d, &end);
-            if (end == d || !(b > 0))
-                return -1;
-            a /= b;
-        }
-        if (!(a > 0) || !isfinite(a))
-            return -1;
-        t[n++] = a;
-        if (*end == ',')
-            end++;
-        else if (*end != '\0')
-            return -1;
-        s = end;
-    }
-    return n;
 }
 
 static int parse_board(const char *cmd, const char *size, const char *square, const char *pattern,
@@ -545,7 +516,7 @@ static int cmd_camera_response(int argc, char **argv)
         (rc = need(cmd, out, "out")))
         return rc;
     double t[LR_CAMRESP_MAX_STACK];
-    int nt = parse_times(times, t, LR_CAMRESP_MAX_STACK);
+    int nt = lr_args_times(times, t, LR_CAMRESP_MAX_STACK);
     if (nt < 2)
         return usage_error(cmd, "--times '%s': expected 2 or more exposure times, e.g. "
                                 "1/30,1/8,0.5", times);

@@ -14,6 +14,7 @@
 #include "calib/calfile.h" /* the JSON writer (lr_jw), wherever it lives */
 #include "calib/rig.h"
 #include "calib/view_render.h"
+#include "firmware/args.h"
 #include "firmware/cli.h"
 #include "render/base/atomic_file.h"
 #include "render/scene/scene.h"
@@ -66,36 +67,6 @@ static int parse_number(const char *s, double lo, double hi, double *out)
         return -1;
     *out = v;
     return 0;
-}
-
-/* "1/30,0.5,2" */
-static int parse_times(const char *s, double *t, int cap)
-{
-    int n = 0;
-    while (*s) {
-        if (n >= cap)
-            return -1;
-        char *end;
-        double a = strtod(s, &end);
-        if (end == s)
-            return -1;
-        if (*end == '/') {
-            const char *d = end + 1;
-            double b = strtod(d, &end);
-            if (end == d || !(b > 0))
-                return -1;
-            a /= b;
-        }
-        if (!(a > 0) || !isfinite(a))
-            return -1;
-        t[n++] = a;
-        if (*end == ',')
-            end++;
-        else if (*end != '\0')
-            return -1;
-        s = end;
-    }
-    return n;
 }
 
 typedef struct report {
@@ -236,7 +207,7 @@ int lr_cmd_compare(int argc, char **argv)
         return usage_error("%s", "missing --capture IMG [IMG...]");
     double times[MAX_CAPTURES];
     if (times_s) {
-        int nt = parse_times(times_s, times, MAX_CAPTURES);
+        int nt = lr_args_times(times_s, times, MAX_CAPTURES);
         if (nt != ncap)
             return usage_error("--times '%s': expected one exposure time (s) per capture", times_s);
     } else if (ncap > 1) {

@@ -4,7 +4,7 @@
 #include <math.h>
 #include <stdio.h>
 
-#include "render/base/atomic_file.h"
+#include "render/image/cairo_png.h"
 
 const double lr_profile_plot_colour[3][3] = {
     {0.85, 0.10, 0.10},
@@ -166,12 +166,6 @@ static void draw_curves(cairo_t *cr, const axes *a, const double *x, const doubl
     }
 }
 
-static cairo_status_t write_stream(void *closure, const unsigned char *data, unsigned int len)
-{
-    return fwrite(data, 1, len, (FILE *)closure) == len ? CAIRO_STATUS_SUCCESS
-                                                        : CAIRO_STATUS_WRITE_ERROR;
-}
-
 int lr_profile_plot_png(const char *path, const char *title, const char *x_label,
                         const char *y_label, const double *x, const double (*y)[3], int n,
                         lr_err *e)
@@ -218,25 +212,5 @@ int lr_profile_plot_png(const char *path, const char *title, const char *x_label
     cairo_text_extents(cr, title, &t);
     cairo_move_to(cr, (PX0 + PX1) / 2.0 - t.x_advance / 2, PY0 - 16);
     cairo_show_text(cr, title);
-    cairo_status_t st = cairo_status(cr);
-    cairo_destroy(cr);
-    if (st != CAIRO_STATUS_SUCCESS) {
-        cairo_surface_destroy(s);
-        return lr_err_set(e, LR_EIO, "%s: drawing failed: %s", path, cairo_status_to_string(st));
-    }
-
-    lr_atomic_file *f = NULL;
-    int rc = lr_atomic_file_open(path, &f, e);
-    if (rc) {
-        cairo_surface_destroy(s);
-        return rc;
-    }
-    st = cairo_surface_write_to_png_stream(s, write_stream, lr_atomic_file_stream(f));
-    cairo_surface_destroy(s);
-    if (st != CAIRO_STATUS_SUCCESS) {
-        lr_atomic_file_abort(f);
-        return lr_err_set(e, LR_EIO, "%s: PNG encoding failed: %s", path,
-                          cairo_status_to_string(st));
-    }
-    return lr_atomic_file_commit(f, e);
+    return lr_cairo_finish_png(cr, s, path, e);
 }

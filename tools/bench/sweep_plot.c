@@ -7,7 +7,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "render/base/atomic_file.h"
+#include "render/image/cairo_png.h"
 
 enum { PANEL_W = 520, PANEL_H = 400, COLS = 2 };
 enum { ML = 70, MR = 20, MT = 40, MB = 50 }; /* panel margins */
@@ -15,11 +15,6 @@ enum { ML = 70, MR = 20, MT = 40, MB = 50 }; /* panel margins */
 double lrb_sweep_time_ms(const lr_eval_row *r)
 {
     return r->frames * r->frame_ms;
-}
-
-static cairo_status_t write_stream(void *closure, const unsigned char *data, unsigned int len)
-{
-    return fwrite(data, 1, len, closure) == len ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
 }
 
 static bool usable(double v)
@@ -160,24 +155,5 @@ int lrb_sweep_plot(const char *path, const lr_eval_row *rows, int nrows,
     cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
     for (int k = 0; k < nscenes; k++)
         panel(cr, (k % COLS) * PANEL_W, (k / COLS) * PANEL_H, &scenes[k], rows + scenes[k].row0);
-    cairo_status_t st = cairo_status(cr);
-    cairo_destroy(cr);
-    if (st != CAIRO_STATUS_SUCCESS) {
-        cairo_surface_destroy(s);
-        return lr_err_set(e, LR_EIO, "%s: drawing failed: %s", path, cairo_status_to_string(st));
-    }
-    lr_atomic_file *f = NULL;
-    int rc = lr_atomic_file_open(path, &f, e);
-    if (rc) {
-        cairo_surface_destroy(s);
-        return rc;
-    }
-    st = cairo_surface_write_to_png_stream(s, write_stream, lr_atomic_file_stream(f));
-    cairo_surface_destroy(s);
-    if (st != CAIRO_STATUS_SUCCESS) {
-        lr_atomic_file_abort(f);
-        return lr_err_set(e, LR_EIO, "%s: PNG encoding failed: %s", path,
-                          cairo_status_to_string(st));
-    }
-    return lr_atomic_file_commit(f, e);
+    return lr_cairo_finish_png(cr, s, path, e);
 }
