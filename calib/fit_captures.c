@@ -45,11 +45,6 @@ int lr_fit_load_captures(const char *const *paths, const double *times, int n,
         return lr_err_set(e, LR_EINVAL, "fit: no captures");
     if (n > 1 && !times)
         return lr_err_set(e, LR_EINVAL, "fit: %d captures need their exposure times", n);
-    if (n > 1 && !calib->has_camresp)
-        return lr_err_set(e, LR_EINVAL,
-                          "fit: merging %d exposures needs the camera response "
-                          "(camera_response.json in the calibration folder)",
-                          n);
     if (!(scale > 0 && isfinite(scale)))
         return lr_err_set(e, LR_EINVAL, "fit: capture scale %g must be > 0", scale);
     for (int i = 0; i < n && times; i++)
@@ -91,7 +86,15 @@ int lr_fit_load_captures(const char *const *paths, const double *times, int n,
         }
     } else {
         lr_img hdr;
-        if ((rc = lr_camresp_merge(&calib->camresp, imgs, times, n, &hdr, e)))
+        lr_camresp *resp = malloc(sizeof *resp);
+        if (!resp) {
+            rc = lr_err_set(e, LR_ENOMEM, "fit: out of memory");
+            goto done;
+        }
+        lr_rig_camera_response(calib, resp);
+        rc = lr_camresp_merge(resp, imgs, times, n, &hdr, e);
+        free(resp);
+        if (rc)
             goto done;
         const float *p = hdr.px;
         for (size_t k = 0; k < (size_t)cw * ch; k++) {

@@ -1,8 +1,10 @@
 /* Material fitting (issue 5 item 5): captures simulated from a render at known sigma through
  * the capture simulator's sensor model (calib/capture_sim.h: exposure, shot and read noise,
- * gamma response, 8 bits), linearised as the rig does (lr_rig_camera_to_linear with the
- * camera response), then lr_fit_run from a start 4x off must recover the sigma; and a scene
- * whose camera does not see the object fails clearly. Also the optimiser on its own. */
+ * its default gamma response, 8 bits) and written as a PNG, read back as `lamprig fit` reads
+ * them (lr_fit_load_captures) with a calibration folder WITHOUT camera_response.json, then
+ * lr_fit_run from a start 4x off must recover the sigma (issue 10 item 4: fit used to read
+ * such captures as linear, and fitted sigma_s' 100x too low); and a scene whose camera does
+ * not see the object fails clearly. Also the optimiser on its own. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -21,6 +23,7 @@
 #include "calib/nelder_mead.h"
 #include "calib/rig.h"
 #include "render/cpu/frame.h"
+#include "tests/support/fs.h"
 #include "tests/support/near.h"
 
 /* Rosenbrock's valley: the classic hard case for the simplex; minimum 0 at (1, 1). */
@@ -93,7 +96,9 @@ static void set_sigma(lr_scene *s, const double sa[3], const double ss[3])
 /* The simulated capture, linearised back to radiance: the truth rendered with another seed
  * and 4x the fit's samples (so the model's and the truth's Monte Carlo noise differ, as a
  * real capture's would), captured at an exposure putting the brightest pixel at 60 % of
- * saturation, read back through the same gamma response. */
+ * saturation with the simulator's default response (lamprig-capsim's without
+ * camera_response.json), saved as an 8-bit PNG and read back as lamprig fit does with a
+ * calibration folder that has no response file: the rig's one rule must read it back. */
 static void simulate(lr_image *target, double *noise_rel)
 {
     lr_scene *s = load_slab(NULL);
@@ -109,27 +114,28 @@ static void simulate(lr_image *target, double *noise_rel)
     for (int i = 0; i < W * H * 3; i++)
         lmax = fmax(lmax, L.rgb[i]);
     assert_true(lmax > 0);
-    lr_camresp resp;
-    lr_camresp_gamma(&resp, 2.2);
-    lr_sensor sen = {.exposure_s = 1, .response = &resp, .full_well_e = 20000,
-                     .read_noise_e = 5, .seed = 1234};
+    lr_sensor sen = {.exposure_s = 1, .full_well_e = 20000, .read_noise_e = 5, .seed = 1234};
     sen.gain = 0.6 * lr_sensor_saturation(&sen, 0) / lmax;
     lr_img cap;
     if (lr_sensor_capture(&sen, &L, &cap, &e))
         fail_msg("capture: %s", e.msg);
+    assert_int_equal(cap.depth, 1);
+    char *dir = lr_test_tmpdir(); /* the capture and an (empty) calibration folder */
+    char *png = lr_test_path(dir, "capture.png");
+    if (lr_img_write(png, &cap, &e))
+        fail_msg("%s", e.msg);
     lr_rig_calib *cal = calloc(1, sizeof *cal);
-    cal->has_camresp = true;
-    cal->camresp = resp;
-    assert_int_equal(lr_image_alloc(target, W, H, NULL), 0);
-    const uint8_t *px = cap.px;
-    for (int i = 0; i < W * H; i++) {
-        double lin[3];
-        lr_rig_camera_to_linear(cal, px + 3 * i, lin);
-        for (int c = 0; c < 3; c++)
-            target->rgb[3 * i + c] = (float)(lin[c] / sen.gain);
-    }
+    if (lr_rig_calib_load(dir, cal, &e))
+        fail_msg("%s", e.msg);
+    assert_false(cal->has_camresp);
+    const char *paths[1] = {png};
+    if (lr_fit_load_captures(paths, NULL, 1, cal, W, H, sen.gain, target, &e))
+        fail_msg("captures: %s", e.msg);
     *noise_rel = lr_fit_rel_rmse(target, &L, NULL, NULL);
+    lr_rig_calib_free(cal);
     free(cal);
+    free(png);
+    lr_test_rmtree(dir);
     lr_img_free(&cap);
     lr_image_free(&L);
     lr_scene_destroy(s);
