@@ -8,7 +8,10 @@
  * exposure time. Several (an exposure stack, times given): the per-channel HDR merge
  * (lr_camresp_merge with the same response), then the colour matrix. Then an
  * area-weighted box filter down to the fit's size (the photo and the fit must have the same
- * aspect ratio to 1 %: the scene's camera is the rig's camera) and the scale to radiance,
+ * aspect ratio to 1 %: the scene's camera is the rig's camera) and the scale to radiance.
+ * Fit pixels touching a capture pixel that is clipped in every capture (some channel >= 250,
+ * or all channels 0) are NaN: a clipped value says only "at least" (or "at most"), and
+ * lr_fit_run leaves NaN pixels out of its mask. The radiance scale:
  *     L = X / (scale)      X: relative exposure per second, scale: the camera's
  *                          exposure units per W/(mm^2 sr) (the capture simulator's `gain`;
  *                          the scene's render.exposure when it was captured like a render).

@@ -277,6 +277,19 @@ int lr_cmd_fit(int argc, char **argv)
         status = fail(&e);
         goto done;
     }
+    unsigned char *om = malloc((size_t)w * h);
+    if (!om) {
+        status = LR_EXIT_FAIL;
+        goto done;
+    }
+    long inside = lr_fit_object_mask(scene, d.object, w, h, om), clipped = 0;
+    for (size_t p = 0; p < (size_t)w * h; p++)
+        clipped += om[p] && !isfinite(target.rgb[3 * p]);
+    free(om);
+    if (clipped) /* said: a mostly clipped object is fitted from what is left */
+        printf("lamprig fit: %ld of the object's %ld pixels left out: they touch capture "
+               "pixels clipped (some channel >= 250, or black) in every capture\n",
+               clipped, inside);
     d.scene = scene;
     d.target = &target;
     lr_fit_result r;

@@ -12,6 +12,7 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -261,6 +262,31 @@ static void test_fit_captures(void **state)
     }
     lr_image t;
     lr_err e = {0};
+    /* Clipped pixels: one saturated channel at (3, 5), all black at (12, 1), in the first
+     * shot only (saved as shot2.png beside it). */
+    assert_int_equal(lr_img_read(p1, LR_IMG_RGB8, &img, NULL), 0);
+    ((uint8_t *)img.px)[3 * (5 * 16 + 3) + 1] = 252;
+    memset((uint8_t *)img.px + 3 * (1 * 16 + 12), 0, 3);
+    char p3[4096];
+    snprintf(p3, sizeof p3, "%s/shot2.png", dir);
+    assert_int_equal(lr_img_write(p3, &img, NULL), 0);
+    lr_img_free(&img);
+    const char *clip_paths[2] = {p3, p2};
+    if (lr_fit_load_captures(clip_paths, NULL, 1, cal, 8, 4, 2.0, &t, &e))
+        fail_msg("captures: %s", e.msg);
+    /* exactly the fit pixels whose 2 x 2 footprint holds them are NaN (left out by the fit) */
+    for (int y = 0; y < 4; y++)
+        for (int x = 0; x < 8; x++) {
+            bool out = (x == 1 && y == 2) || (x == 6 && y == 0);
+            assert_true(isfinite(t.rgb[3 * (8 * y + x)]) == !out);
+        }
+    lr_image_free(&t);
+    /* in a stack, a value clipped in one shot only is merged from the other */
+    if (lr_fit_load_captures(clip_paths, times, 2, cal, 8, 4, 1.0, &t, &e))
+        fail_msg("stack: %s", e.msg);
+    for (int i = 0; i < 8 * 4 * 3; i++)
+        assert_true(isfinite(t.rgb[i]));
+    lr_image_free(&t);
     if (lr_fit_load_captures(paths, NULL, 1, cal, 8, 4, 2.0, &t, &e))
         fail_msg("captures: %s", e.msg);
     /* pixel (x, y) of the target averages source columns 2x and 2x+1 (rows alike):
@@ -284,6 +310,7 @@ static void test_fit_captures(void **state)
     free(cal);
     unlink(p1);
     unlink(p2);
+    unlink(p3);
     rmdir(dir);
 }
 

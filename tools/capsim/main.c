@@ -176,9 +176,10 @@ int main(int argc, char **argv)
         lr_sensor_capture(&s, &rad, &cap, &e) || lr_img_write(out, &cap, &e))
         goto fail;
     char rname[256];
-    printf("capture %dx%d (%d-bit) of %s through %s (response %s): render %.2f s (%s) -> %s\n",
-           cap.w, cap.h, cap.depth * 8, scene_path, calib,
-           lr_rig_response_name(rig, rname, sizeof rname), secs, cpu ? "CPU twin" : "GPU", out);
+    printf("capture %dx%d (%d-bit) of %s through %s: render %.2f s (%s) -> %s\n"
+           "written with the response %s\n",
+           cap.w, cap.h, cap.depth * 8, scene_path, calib, secs, cpu ? "CPU twin" : "GPU", out,
+           lr_rig_response_name(rig, rname, sizeof rname));
     status = 0;
     goto done;
 fail:
