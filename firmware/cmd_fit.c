@@ -38,8 +38,9 @@ const char lr_fit_usage[] =
     "\n"
     "  --captures IMG,...  8-bit photos of the lit object (one, or an exposure stack)\n"
     "  --gamma G           the camera's response when DIR has no camera_response.json (or\n"
-    "                      there is no --calib): value = 255 x^(1/G); default 2.2 (an sRGB\n"
-    "                      camera), as lamprig compare and lamprig-capsim read captures\n"
+    "                      there is no --calib): value v is exposure (v/128)^G; default 2.2\n"
+    "                      (an sRGB camera), the rule lamprig compare and lamprig-capsim use;\n"
+    "                      refused beside camera_response.json\n"
     "  --times T,...       their exposure times, s (default 1)\n"
     "  --object NAME       the object fitted (default the first)\n"
     "  --size WxH          model resolution (default 64x48; the captures' aspect)\n"
@@ -279,7 +280,8 @@ int lr_cmd_fit(int argc, char **argv)
     }
     unsigned char *om = malloc((size_t)w * h);
     if (!om) {
-        status = LR_EXIT_FAIL;
+        lr_err_set(&e, LR_ENOMEM, "out of memory");
+        status = fail(&e);
         goto done;
     }
     long inside = lr_fit_object_mask(scene, d.object, w, h, om), clipped = 0;
