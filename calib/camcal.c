@@ -81,6 +81,12 @@ static void detections_free(detections *d)
     free(d->img);
 }
 
+/* Searches every image; the image size of the calibration is the size of the FIRST GOOD
+ * VIEW (the first image in which the board is found), not of the first image read: a glob
+ * sorts a stray photo of another size (or one without the board) first as easily as last,
+ * and it must not decide the size the others are checked against. Each image that is not
+ * used gets one entry in out->rejected (unreadable, board not found, another size); the
+ * order of the views is the order of the images. */
 static int detect_all(const lr_camcal_desc *d, lr_camcal *out, detections *det, int *w, int *h,
                       lr_err *e)
 {
@@ -105,13 +111,10 @@ static int detect_all(const lr_camcal_desc *d, lr_camcal *out, detections *det, 
             continue;
         }
         char reason[LR_ERR_MSG_MAX] = "";
-        if (*w == 0) {
-            *w = gray.w;
-            *h = gray.h;
-        } else if (gray.w != *w || gray.h != *h) {
-            snprintf(reason, sizeof reason, "size %dx%d differs from the first image's %dx%d",
-                     gray.w, gray.h, *w, *h);
-        }
+        if (det->n > 0 && (gray.w != *w || gray.h != *h))
+            snprintf(reason, sizeof reason,
+                     "size %dx%d differs from the first good view's %dx%d (%s)", gray.w,
+                     gray.h, *w, *h, det->names[0]);
         bool found = false;
         if (!reason[0]) {
             rc = lr_board_detect(&d->board, &gray, d->subpix_window == 0 ? 11 : d->subpix_window,
@@ -123,11 +126,16 @@ static int detect_all(const lr_camcal_desc *d, lr_camcal *out, detections *det, 
                 snprintf(reason, sizeof reason, "%dx%d %s not found", d->board.cols,
                          d->board.rows, lr_board_pattern_name(d->board.pattern));
         }
+        int gw = gray.w, gh = gray.h;
         lr_img_free(&gray);
         if (reason[0]) {
             if ((rc = add_reject(out, path, reason, e)))
                 return rc;
             continue;
+        }
+        if (det->n == 0) {
+            *w = gw;
+            *h = gh;
         }
         if (!(det->names[det->n] = strdup(path)))
             return lr_err_set(e, LR_ENOMEM, "out of memory");
@@ -207,8 +215,9 @@ int lr_camcal_run(const lr_camcal_desc *d, lr_camcal *out, lr_err *e)
         goto fail;
     if (det.n < min_views) {
         rc = lr_err_set(e, LR_EINVAL,
-                        "board found in %d of %d images; need at least %d (first failure: %s: %s)",
-                        det.n, d->nimages, min_views,
+                        "%d of %d images usable (board found, same size); need at least %d "
+                        "(%d skipped, first: %s: %s)",
+                        det.n, d->nimages, min_views, out->nrejected,
                         out->nrejected ? out->rejected[0].image : "-",
                         out->nrejected ? out->rejected[0].reason : "-");
         goto fail;
@@ -280,7 +289,15 @@ fail:
     free(outlier);
     free(err);
     free(tmp);
+    /* The skipped images stay listed (the caller prints them and frees with
+     * lr_camcal_free); nothing else of a failed run is kept. */
+    lr_camcal_reject *rej = out->rejected;
+    int nrej = out->nrejected;
+    out->rejected = NULL;
+    out->nrejected = 0;
     lr_camcal_free(out);
+    out->rejected = rej;
+    out->nrejected = nrej;
     return rc;
 }
 

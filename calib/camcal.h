@@ -1,8 +1,12 @@
 /* lamprig calib — camera intrinsics from photographs of a planar board (Zhang 1999, as
  * seed 001 section 4.1 calibrates its camera; OpenCV's calibrateCamera).
  *
- * Every photograph is searched for the board; those where it is not found are listed with
- * the reason and skipped (fatal only when fewer than min_views remain). Corners are refined
+ * Every photograph is searched for the board; those where it is not found, that cannot be
+ * read, or whose size differs from the FIRST GOOD VIEW (the first image, in the order given,
+ * where the board is found) are listed with the reason and skipped; the calibration uses all
+ * the others (fatal only when fewer than min_views remain). Which image comes first therefore
+ * does not matter: a stray photo of another size sorting first is one skipped line, not the
+ * size every other view is refused against. Corners are refined
  * to subpixel precision. After the fit, each view's RMS reprojection error is compared with
  * the median over the views:
  *
@@ -34,7 +38,8 @@ typedef struct lr_camcal_view {
 
 typedef struct lr_camcal_reject {
     char *image;
-    char *reason; /* "board not found", "size 640x480 differs from 800x600", read error */
+    char *reason; /* "9x6 chessboard not found", "size 612x459 differs from the first good
+                   * view's 640x480 (NAME)", or the read error */
 } lr_camcal_reject;
 
 typedef struct lr_camcal {
@@ -66,7 +71,9 @@ typedef struct lr_camcal_desc {
     const lr_progress *progress;
 } lr_camcal_desc;
 
-/* Runs the calibration; on success *out holds the result (free with lr_camcal_free). */
+/* Runs the calibration; on success *out holds the result. On failure out->rejected still
+ * lists the images skipped so far (with the reasons), so a caller can show them; free *out
+ * with lr_camcal_free in both cases. */
 int lr_camcal_run(const lr_camcal_desc *d, lr_camcal *out, lr_err *e);
 void lr_camcal_free(lr_camcal *c);
 

@@ -66,15 +66,19 @@ int lr_camresp_fit(const lr_camresp_desc *d, lr_camresp *out, lr_err *e)
     return LR_OK;
 }
 
+double lr_camresp_gamma_at(double gamma, int z)
+{
+    /* z = 0 maps to a tiny positive value: the file format requires > 0, and a zero pixel
+     * only bounds the exposure from above anyway. */
+    return pow((z > 0 ? z : 0.25) / 255.0, gamma) / pow(128.0 / 255.0, gamma);
+}
+
 void lr_camresp_gamma(lr_camresp *r, double gamma)
 {
     memset(r, 0, sizeof *r);
-    double ref = pow(128.0 / 255.0, gamma);
     for (int c = 0; c < 3; c++)
         for (int z = 0; z < 256; z++)
-            /* z = 0 maps to a tiny positive value: the file format requires > 0, and a zero
-             * pixel only bounds the exposure from above anyway. */
-            r->curve[c][z] = pow((z > 0 ? z : 0.25) / 255.0, gamma) / ref;
+            r->curve[c][z] = lr_camresp_gamma_at(gamma, z);
 }
 
 double lr_camresp_linear(const lr_camresp *r, int c, double z)

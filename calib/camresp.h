@@ -37,9 +37,17 @@ typedef struct lr_camresp_desc {
 
 int lr_camresp_fit(const lr_camresp_desc *d, lr_camresp *out, lr_err *e);
 
+/* The response assumed for 8-bit captures when a rig has no measured one (calib/rig.h,
+ * lr_rig_camera_response): a camera delivering roughly sRGB-encoded frames, as nearly all
+ * cameras do by default (sRGB's curve is within 1.5 % of gamma 2.2 above value 40). */
+#define LR_CAMRESP_DEFAULT_GAMMA 2.2
+
 /* A camera whose pixel values are (value / 255)^gamma times exposure (gamma = 1: linear raw
- * data; 2.2: a camera delivering roughly sRGB-encoded frames). */
+ * data; 2.2: a camera delivering roughly sRGB-encoded frames), normalised like a fitted
+ * curve: curve[c][z] = lr_camresp_gamma_at(gamma, z), 1 at z = 128. */
 void lr_camresp_gamma(lr_camresp *r, double gamma);
+/* One entry of that table: ((z > 0 ? z : 0.25) / 255)^gamma / (128 / 255)^gamma. */
+double lr_camresp_gamma_at(double gamma, int z);
 
 /* Relative exposure for a (possibly fractional) value z in [0, 255], linear between
  * entries. */

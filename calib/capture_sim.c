@@ -8,7 +8,10 @@
 
 #include "render/cpu/rng.h"
 
-static double gamma_of(const lr_sensor *s) { return s->gamma > 0 ? s->gamma : 2.2; }
+static double gamma_of(const lr_sensor *s)
+{
+    return s->gamma > 0 ? s->gamma : LR_CAMRESP_DEFAULT_GAMMA;
+}
 static double gain_of(const lr_sensor *s) { return s->gain > 0 ? s->gain : 1.0; }
 static double time_of(const lr_sensor *s) { return s->exposure_s > 0 ? s->exposure_s : 1.0; }
 

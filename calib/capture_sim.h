@@ -50,8 +50,9 @@ typedef struct lr_sensor {
     double vignette_poly[3];       /* v1 v2 v3 (POLY) */
     double focal_px;               /* COS4: focal length in pixels (> 0 required) */
     double cx, cy;                 /* optical centre (pixels); both 0 -> the image centre */
-    const lr_camresp *response;    /* NULL -> gamma */
-    double gamma;                  /* 0 -> 2.2 */
+    const lr_camresp *response;    /* NULL -> gamma (lamprig-capsim passes the rig's rule,
+                                    * lr_rig_camera_response, as a table) */
+    double gamma;                  /* 0 -> LR_CAMRESP_DEFAULT_GAMMA (2.2) */
     const lr_colormatrix *color;   /* NULL -> identity; must be invertible */
     double full_well_e;            /* electrons at X_sat; 0 -> no shot noise */
     double read_noise_e;           /* read noise sigma, electrons (needs full_well_e > 0) */

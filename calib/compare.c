@@ -338,7 +338,7 @@ int lr_compare_capture_mask(const lr_img *images, int n, double sat, double dark
 }
 
 int lr_compare_linearise(const lr_rig_calib *rig, const lr_img *images, const double *times,
-                         int n, double gain, double gamma, lr_image *out, lr_err *e)
+                         int n, double gain, lr_image *out, lr_err *e)
 {
     memset(out, 0, sizeof *out);
     int rc = check_stack(images, n, e);
@@ -353,10 +353,7 @@ int lr_compare_linearise(const lr_rig_calib *rig, const lr_img *images, const do
     lr_camresp *resp = malloc(sizeof *resp);
     if (!resp)
         return lr_err_set(e, LR_ENOMEM, "out of memory");
-    if (rig->has_camresp)
-        *resp = rig->camresp;
-    else
-        lr_camresp_gamma(resp, gamma > 0 ? gamma : 2.2);
+    lr_rig_camera_response(rig, resp);
     int w = images[0].w, h = images[0].h;
     if ((rc = lr_image_alloc(out, w, h, e))) {
         free(resp);

@@ -95,13 +95,12 @@ int lr_compare_capture_mask(const lr_img *images, int n, double sat, double dark
                             uint8_t *exclude, lr_err *e);
 
 /* A capture (n = 1) or an exposure stack (n > 1, 8-bit, times in seconds) in the render's
- * units: the rig's camera response and colour matrix (lr_rig_camera_to_linear; 16-bit values
- * are read as fractional 8-bit codes), the stack merged by lr_camresp_merge (Debevec & Malik
- * Eq. 6, hat weights), then divided by gain x time. Without camera_response.json the
- * response is the gamma curve lr_camresp_gamma(gamma) (gamma 0 -> 2.2; the capture
- * simulator's default), so simulated captures linearise consistently. */
+ * units: the rig's camera response (lr_rig_camera_response: camera_response.json, else the
+ * gamma curve, rig->gamma or 2.2; the rule fit and lamprig-capsim use too) and colour matrix
+ * (16-bit values are read as fractional 8-bit codes), the stack merged by lr_camresp_merge
+ * (Debevec & Malik Eq. 6, hat weights), then divided by gain x time. */
 int lr_compare_linearise(const lr_rig_calib *rig, const lr_img *images, const double *times,
-                         int n, double gain, double gamma, lr_image *out, lr_err *e);
+                         int n, double gain, lr_image *out, lr_err *e);
 
 /* Per-pixel map as PNG: values 0..vmax colour-mapped (dark blue -> red -> yellow), NaN grey,
  * with a colour bar and its scale on the right, `title` on top. Written atomically. */

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "calib/camresp.h"
+#include "calib/compare.h"
 #include "calib/image.h"
 
 int lr_image_resample_box(const lr_image *src, int w, int h, lr_image *out, lr_err *e)
@@ -45,11 +46,6 @@ int lr_fit_load_captures(const char *const *paths, const double *times, int n,
         return lr_err_set(e, LR_EINVAL, "fit: no captures");
     if (n > 1 && !times)
         return lr_err_set(e, LR_EINVAL, "fit: %d captures need their exposure times", n);
-    if (n > 1 && !calib->has_camresp)
-        return lr_err_set(e, LR_EINVAL,
-                          "fit: merging %d exposures needs the camera response "
-                          "(camera_response.json in the calibration folder)",
-                          n);
     if (!(scale > 0 && isfinite(scale)))
         return lr_err_set(e, LR_EINVAL, "fit: capture scale %g must be > 0", scale);
     for (int i = 0; i < n && times; i++)
@@ -91,7 +87,15 @@ int lr_fit_load_captures(const char *const *paths, const double *times, int n,
         }
     } else {
         lr_img hdr;
-        if ((rc = lr_camresp_merge(&calib->camresp, imgs, times, n, &hdr, e)))
+        lr_camresp *resp = malloc(sizeof *resp);
+        if (!resp) {
+            rc = lr_err_set(e, LR_ENOMEM, "fit: out of memory");
+            goto done;
+        }
+        lr_rig_camera_response(calib, resp);
+        rc = lr_camresp_merge(resp, imgs, times, n, &hdr, e);
+        free(resp);
+        if (rc)
             goto done;
         const float *p = hdr.px;
         for (size_t k = 0; k < (size_t)cw * ch; k++) {
@@ -105,7 +109,21 @@ int lr_fit_load_captures(const char *const *paths, const double *times, int n,
         }
         lr_img_free(&hdr);
     }
-    if ((rc = lr_image_resample_box(&lin, width, height, out, e)))
+    /* A clipped value bounds the radiance from below only (and 0 from above): the pixels
+     * saturated (some channel >= 250) or black in every capture are NaN here, the box filter
+     * carries NaN into every fit pixel they touch, and lr_fit_run leaves those out, as
+     * compare leaves them out of its metrics (lr_compare_capture_mask, same threshold). */
+    uint8_t *clipped = malloc((size_t)cw * ch);
+    if (!clipped) {
+        rc = lr_err_set(e, LR_ENOMEM, "fit: out of memory");
+        goto done;
+    }
+    if (!(rc = lr_compare_capture_mask(imgs, n, 0, 0.5 / 255.0, clipped, e)))
+        for (size_t k = 0; k < (size_t)cw * ch; k++)
+            if (clipped[k])
+                lin.rgb[3 * k] = lin.rgb[3 * k + 1] = lin.rgb[3 * k + 2] = NAN;
+    free(clipped);
+    if (rc || (rc = lr_image_resample_box(&lin, width, height, out, e)))
         goto done;
     for (size_t k = 0; k < (size_t)width * height * 3; k++)
         out->rgb[k] = (float)(out->rgb[k] / scale);

@@ -67,11 +67,47 @@ void lr_rig_calib_free(lr_rig_calib *r)
     memset(r, 0, sizeof *r);
 }
 
+static double gamma_of(const lr_rig_calib *r)
+{
+    return r->gamma > 0 ? r->gamma : LR_CAMRESP_DEFAULT_GAMMA;
+}
+
+void lr_rig_camera_response(const lr_rig_calib *r, lr_camresp *out)
+{
+    if (r->has_camresp)
+        *out = r->camresp;
+    else
+        lr_camresp_gamma(out, gamma_of(r));
+}
+
+int lr_rig_set_gamma(lr_rig_calib *r, double gamma, lr_err *e)
+{
+    if (!(gamma >= 0.1 && gamma <= 10))
+        return lr_err_set(e, LR_EINVAL, "gamma %g: expected 0.1..10", gamma);
+    if (r->has_camresp)
+        return lr_err_set(e, LR_EINVAL,
+                          "gamma %g: the calibration folder has %s, the measured camera response, "
+                          "and captures are read with it; drop --gamma (or the file)",
+                          gamma, LR_RIG_CAMERA_RESPONSE);
+    r->gamma = gamma;
+    return LR_OK;
+}
+
+const char *lr_rig_response_name(const lr_rig_calib *r, char *buf, size_t cap)
+{
+    if (r->has_camresp)
+        snprintf(buf, cap, "%s", LR_RIG_CAMERA_RESPONSE);
+    else
+        snprintf(buf, cap, "gamma %g (%s: no %s; --gamma G to change)", gamma_of(r),
+                 r->gamma > 0 ? "given" : "assumed", LR_RIG_CAMERA_RESPONSE);
+    return buf;
+}
+
 void lr_rig_camera_to_linear(const lr_rig_calib *r, const uint8_t rgb[3], double out[3])
 {
-    double lin[3];
-    for (int c = 0; c < 3; c++)
-        lin[c] = r->has_camresp ? r->camresp.curve[c][rgb[c]] : rgb[c] / 255.0;
+    double lin[3], g = gamma_of(r);
+    for (int c = 0; c < 3; c++) /* the table's entries, without building the table per pixel */
+        lin[c] = r->has_camresp ? r->camresp.curve[c][rgb[c]] : lr_camresp_gamma_at(g, rgb[c]);
     if (r->has_color)
         lr_colormatrix_apply(&r->color, lin, out);
     else

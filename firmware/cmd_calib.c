@@ -271,13 +271,15 @@ static int cmd_camera(int argc, char **argv)
     d.progress = &progress;
     lr_camcal c;
     lr_err e = {0};
-    if (lr_camcal_run(&d, &c, &e)) {
-        globfree(&g);
-        return fail(cmd, &e);
-    }
+    rc = lr_camcal_run(&d, &c, &e);
     globfree(&g);
+    /* One line per image left out, also when too few remain: they say why. */
     for (int i = 0; i < c.nrejected; i++)
         fprintf(stderr, "skipped %s: %s\n", c.rejected[i].image, c.rejected[i].reason);
+    if (rc) {
+        lr_camcal_free(&c);
+        return fail(cmd, &e);
+    }
     double med = lr_camcal_median_error(&c);
     for (int i = 0; i < c.nviews; i++)
         if (c.views[i].outlier)

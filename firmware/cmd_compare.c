@@ -31,7 +31,8 @@ const char lr_compare_usage[] =
     "\n"
     "Renders the camera's view of the scene with the calibrated intrinsics and pose (DIR:\n"
     "camera.json and pose.json required; camera_response.json and color.json used when\n"
-    "present, else a gamma curve, --gamma, default 2.2), linearises the captures (several\n"
+    "present; without camera_response.json captures are read as gamma --gamma, default 2.2,\n"
+    "the rule lamprig fit and lamprig-capsim use), linearises the captures (several\n"
     "captures are an exposure stack with --times in seconds, merged to HDR; one capture has\n"
     "time 1 s unless --times says otherwise), divides by --gain (default: the scene's\n"
     "render.exposure, as lamprig-capsim assumes) and reports per region (object, receivers,\n"
@@ -70,7 +71,7 @@ static int parse_number(const char *s, double lo, double hi, double *out)
 }
 
 typedef struct report {
-    const char *scene, *calib;
+    const char *scene, *calib, *response;
     const char *const *captures;
     const double *times;
     int ncaptures, width, height, render_w, render_h;
@@ -103,6 +104,8 @@ static int write_report(const char *path, const report *r, lr_err *e)
         lr_jw_object_end(w);
     }
     lr_jw_array_end(w);
+    /* How the captures were linearised (lr_rig_response_name). */
+    lr_jw_string(w, "response", r->response);
     lr_jw_string(w, "renderer", r->cpu ? "cpu" : "gpu");
     lr_jw_numbers(w, "image_size", (const double[]){r->width, r->height}, 2);
     /* The undistorted pinhole render behind the camera's view (calib/camview.h). */
@@ -240,6 +243,10 @@ int lr_cmd_compare(int argc, char **argv)
     }
     if (lr_rig_calib_load(calib, rig, &e))
         goto fail;
+    if (gamma > 0 && lr_rig_set_gamma(rig, gamma, &e)) {
+        status = usage_error("--gamma: %s", e.msg);
+        goto done;
+    }
     if (!rig->has_camera || !rig->has_pose) {
         lr_err_set(&e, LR_EINVAL,
                    "%s: a comparison needs camera.json (lamprig calib camera) and pose.json "
@@ -273,7 +280,7 @@ int lr_cmd_compare(int argc, char **argv)
         lr_err_set(&e, LR_ENOMEM, "out of memory");
         goto fail;
     }
-    if (lr_compare_linearise(rig, imgs, times, ncap, gain, gamma, &cap, &e) ||
+    if (lr_compare_linearise(rig, imgs, times, ncap, gain, &cap, &e) ||
         lr_compare_capture_mask(imgs, ncap, 0, 0, exclude, &e))
         goto fail;
     if (vig.vignette != LR_VIGNETTE_NONE) {
@@ -304,8 +311,9 @@ int lr_cmd_compare(int argc, char **argv)
         goto fail;
     int rw, rh;
     lr_camview_render_size(view, &rw, &rh);
-    report r = {scene_path, calib, captures, times, ncap, k->width, k->height, rw, rh, cpu,
-                render_s, now_s() - t0, &res};
+    char resp[256];
+    report r = {scene_path, calib, lr_rig_response_name(rig, resp, sizeof resp), captures,
+                times, ncap, k->width, k->height, rw, rh, cpu, render_s, now_s() - t0, &res};
     if ((render_out && lr_image_write_pfm(render_out, &ren, &e)) ||
         (heatmap && lr_heatmap_png(heatmap, demap, k->width, k->height, hmax,
                                    "CIEDE2000, render vs capture (grey: not compared)", &e)) ||
@@ -320,6 +328,7 @@ int lr_cmd_compare(int argc, char **argv)
                    lr_compare_region_name(g), s->pixels, s->rel_rmse, s->ssim, s->delta_e,
                    s->delta_e_p95);
     }
+    printf("captures read with %s\n", resp);
     printf("render %.2f s (%s, %dx%d undistorted), total %.2f s -> %s\n", render_s,
            cpu ? "CPU twin" : "GPU", rw, rh, r.total_s, report_path);
     status = LR_EXIT_OK;

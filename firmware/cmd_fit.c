@@ -23,7 +23,7 @@ const char lr_fit_summary[] = "fit a material (sigma_a, sigma_s' per band, or tw
 
 const char lr_fit_usage[] =
     "usage: lamprig fit --scene FILE --captures IMG[,IMG...] --out MATERIAL.json\n"
-    "                   [--calib DIR] [--times T1,T2,...] [--object NAME]\n"
+    "                   [--calib DIR] [--gamma G] [--times T1,T2,...] [--object NAME]\n"
     "                   [--scale-preset NAME] [--start-sigma-a R,G,B --start-sigma-s R,G,B]\n"
     "                   [--size WxH] [--samples N] [--capture-scale S] [--huber H]\n"
     "                   [--max-evals N] [--seed N] [--threads N] [--name NAME] [--no-gpu-check]\n"
@@ -37,6 +37,10 @@ const char lr_fit_usage[] =
     "material preset (configs/materials format) atomically.\n"
     "\n"
     "  --captures IMG,...  8-bit photos of the lit object (one, or an exposure stack)\n"
+    "  --gamma G           the camera's response when DIR has no camera_response.json (or\n"
+    "                      there is no --calib): value v is exposure (v/128)^G; default 2.2\n"
+    "                      (an sRGB camera), the rule lamprig compare and lamprig-capsim use;\n"
+    "                      refused beside camera_response.json\n"
     "  --times T,...       their exposure times, s (default 1)\n"
     "  --object NAME       the object fitted (default the first)\n"
     "  --size WxH          model resolution (default 64x48; the captures' aspect)\n"
@@ -163,7 +167,8 @@ int lr_cmd_fit(int argc, char **argv)
         {"--times", 1},   {"--object", 1},        {"--scale-preset", 1},
         {"--start-sigma-a", 1}, {"--start-sigma-s", 1}, {"--size", 1}, {"--samples", 1},
         {"--capture-scale", 1}, {"--huber", 1},   {"--max-evals", 1}, {"--seed", 1},
-        {"--threads", 1}, {"--name", 1},          {"--no-gpu-check", 0}, {NULL, 0},
+        {"--threads", 1}, {"--name", 1},          {"--no-gpu-check", 0}, {"--gamma", 1},
+        {NULL, 0},
     };
     lr_args a;
     lr_err e = {0};
@@ -175,7 +180,7 @@ int lr_cmd_fit(int argc, char **argv)
         return usage_error("--scene, --captures and --out are required");
     lr_fit_desc d = {.samples = 128};
     int w = 64, h = 48;
-    double times[16], scale = 0;
+    double times[16], scale = 0, gamma = 0;
     int ntimes = 0;
     const char *v;
     if ((v = lr_args_get(&a, "--size")) && (sscanf(v, "%dx%d", &w, &h) != 2 || w < 2 ||
@@ -188,6 +193,7 @@ int lr_cmd_fit(int argc, char **argv)
         ((v = lr_args_get(&a, "--times")) && lr_args_numbers("--times", v, times, 1, 16, &ntimes, &e)) ||
         ((v = lr_args_get(&a, "--capture-scale")) && lr_args_number("--capture-scale", v, &scale, &e)) ||
         ((v = lr_args_get(&a, "--huber")) && lr_args_number("--huber", v, &d.huber, &e)) ||
+        ((v = lr_args_get(&a, "--gamma")) && lr_args_number("--gamma", v, &gamma, &e)) ||
         ((v = lr_args_get(&a, "--start-sigma-a")) && lr_args_triple("--start-sigma-a", v, d.sigma_a_start, &e)) ||
         ((v = lr_args_get(&a, "--start-sigma-s")) && lr_args_triple("--start-sigma-s", v, d.sigma_s_start, &e)))
         return usage_error(e.msg);
@@ -201,6 +207,8 @@ int lr_cmd_fit(int argc, char **argv)
         return usage_error("--capture-scale must be > 0");
     if (lr_args_has(&a, "--huber") && !(d.huber > 0))
         return usage_error("--huber must be > 0");
+    if (lr_args_has(&a, "--gamma") && !(gamma >= 0.1 && gamma <= 10))
+        return usage_error("--gamma: expected 0.1..10");
     if (lr_args_has(&a, "--start-sigma-a") != lr_args_has(&a, "--start-sigma-s"))
         return usage_error("--start-sigma-a and --start-sigma-s go together");
     for (int b = 0; b < 3; b++)
@@ -257,12 +265,33 @@ int lr_cmd_fit(int argc, char **argv)
         status = fail(&e);
         goto done;
     }
+    if (gamma > 0 && lr_rig_set_gamma(cal, gamma, &e)) {
+        status = usage_error(e.msg);
+        goto done;
+    }
+    /* Said before the work: an assumed response is the first suspect of a bad fit. */
+    char resp[256];
+    printf("lamprig fit: captures read with %s\n", lr_rig_response_name(cal, resp, sizeof resp));
     if (!scale)
         scale = lr_scene_render(scene)->exposure;
     if (lr_fit_load_captures(paths, ntimes ? times : NULL, n, cal, w, h, scale, &target, &e)) {
         status = fail(&e);
         goto done;
     }
+    unsigned char *om = malloc((size_t)w * h);
+    if (!om) {
+        lr_err_set(&e, LR_ENOMEM, "out of memory");
+        status = fail(&e);
+        goto done;
+    }
+    long inside = lr_fit_object_mask(scene, d.object, w, h, om), clipped = 0;
+    for (size_t p = 0; p < (size_t)w * h; p++)
+        clipped += om[p] && !isfinite(target.rgb[3 * p]);
+    free(om);
+    if (clipped) /* said: a mostly clipped object is fitted from what is left */
+        printf("lamprig fit: %ld of the object's %ld pixels left out: they touch capture "
+               "pixels clipped (some channel >= 250, or black) in every capture\n",
+               clipped, inside);
     d.scene = scene;
     d.target = &target;
     lr_fit_result r;
@@ -313,9 +342,9 @@ int lr_cmd_fit(int argc, char **argv)
     }
     char source[512];
     snprintf(source, sizeof source,
-             "lamprig fit: %s, object '%s', %d capture(s) from %s, %s, relative RMSE %.4f over "
-             "%ld pixels at %d x %d",
-             scene_path, o->name, n, paths[0],
+             "lamprig fit: %s, object '%s', %d capture(s) from %s read with %s, %s, relative "
+             "RMSE %.4f over %ld pixels at %d x %d",
+             scene_path, o->name, n, paths[0], resp,
              d.mode == LR_FIT_SCALE ? "two scales on a preset" : "sigma per band",
              r.rel_rmse_all, r.mask_pixels, w, h);
     if (write_material(out, nm, source, &o->material.medium, &e)) {

@@ -19,6 +19,7 @@
 #include "calib/camcal.h"
 #include "calib/cv_shim.h"
 #include "calib/intrinsics.h"
+#include "tests/support/fs.h"
 #include "tests/support/near.h"
 
 #define DATA "/usr/share/doc/opencv-doc/examples/data"
@@ -229,7 +230,7 @@ static void test_rejected_images(void **state)
     assert_string_equal(c.rejected[0].image, blank);
     assert_non_null(strstr(c.rejected[0].reason, "9x6 chessboard not found"));
     assert_non_null(strstr(c.rejected[1].image, "fruits.jpg"));
-    assert_non_null(strstr(c.rejected[1].reason, "differs from the first image's 640x480"));
+    assert_non_null(strstr(c.rejected[1].reason, "differs from the first good view's 640x480"));
     assert_non_null(strstr(c.rejected[2].reason, "no such image"));
     lr_camcal_free(&c);
 
@@ -239,8 +240,10 @@ static void test_rejected_images(void **state)
     d.nimages = 3;
     rc = lr_camcal_run(&d, &c, &e);
     assert_int_equal(rc, LR_EINVAL);
-    assert_non_null(strstr(e.msg, "found in 2 of 3"));
+    assert_non_null(strstr(e.msg, "2 of 3 images usable"));
     assert_non_null(strstr(e.msg, blank));
+    assert_int_equal(c.nrejected, 1); /* kept for the caller to list */
+    lr_camcal_free(&c);
     unlink(blank);
 
     /* A square chessboard is refused before any work (orientation ambiguity). */
@@ -446,6 +449,149 @@ static void test_circle_grids(void **state)
     circles_case(&asym);
 }
 
+/* ---- chessboards of a known camera: order and size of the views do not matter ---------- */
+
+/* A 9x6 chessboard (inner corners; 10x7 squares of square_mm, the first corner at the board
+ * origin) on white paper, seen by the distortion-free camera k from pose (R, T), 4x4
+ * supersampled; 8-bit grey PNG. */
+static void render_chessboard(const lr_intrinsics *k, const lr_board *b, const double R[9],
+                              const double T[3], const char *path)
+{
+    lr_img img;
+    lr_err e = {0};
+    assert_int_equal(lr_img_alloc(&img, k->width, k->height, 1, 1, &e), LR_OK);
+    uint8_t *o = img.px;
+    double n[3] = {R[2], R[5], R[8]}, nd = n[0] * T[0] + n[1] * T[1] + n[2] * T[2];
+    double sq = b->square_mm;
+    for (int y = 0; y < k->height; y++)
+        for (int x = 0; x < k->width; x++) {
+            double acc = 0;
+            for (int s = 0; s < 16; s++) {
+                /* the ray through the sample; the board plane n.X = n.T in camera space */
+                double xy[2] = {(x + (s % 4 - 1.5) / 4 - k->cx) / k->fx,
+                                (y + (s / 4 - 1.5) / 4 - k->cy) / k->fy};
+                double t = nd / (n[0] * xy[0] + n[1] * xy[1] + n[2]);
+                double X[3] = {t * xy[0] - T[0], t * xy[1] - T[1], t - T[2]};
+                double u = (R[0] * X[0] + R[3] * X[1] + R[6] * X[2]) / sq;
+                double v = (R[1] * X[0] + R[4] * X[1] + R[7] * X[2]) / sq;
+                double albedo = 0.9;
+                if (u >= -1 && u < b->cols && v >= -1 && v < b->rows &&
+                    ((int)floor(u) + (int)floor(v)) % 2 == 0)
+                    albedo = 0.1;
+                acc += albedo;
+            }
+            o[y * k->width + x] = (uint8_t)lround(255 * acc / 16);
+        }
+    assert_int_equal(lr_img_write(path, &img, &e), LR_OK);
+    lr_img_free(&img);
+}
+
+static void test_view_order_and_size(void **state)
+{
+    (void)state;
+    /* Six views of a 640x480 pinhole camera; a blank frame of another size that comes first
+     * (as a stray photo sorting first in a glob does: the bug made its size the one every
+     * other view was refused against); a view WITH the board from another camera (400x300)
+     * after the first good view. Wanted: the blank and the other size skipped, one entry each
+     * with the reason, all six views used, whatever the order. */
+    const lr_intrinsics truth = {640, 480, 620.0, 620.0, 324.0, 236.0, {0}};
+    const lr_intrinsics other = {400, 300, 380.0, 380.0, 200.0, 150.0, {0}};
+    const lr_board b = {9, 6, 20.0, LR_BOARD_CHESSBOARD};
+    static const double rv[6][3] = {{0.1, 0.05, 0.02}, {0.45, -0.1, 0.1}, {-0.4, 0.3, -0.05},
+                                    {0.15, 0.5, 0.2},  {-0.3, -0.4, 0.1}, {0.35, 0.35, -0.3}};
+    static const double tv[6][3] = {{-80, -50, 430}, {-90, -40, 450}, {-70, -60, 420},
+                                    {-85, -45, 400}, {-75, -55, 460}, {-80, -50, 430}};
+    char *dir = lr_test_tmpdir();
+    char *views[6];
+    for (int i = 0; i < 6; i++) {
+        char name[32];
+        snprintf(name, sizeof name, "left%02d.png", i + 1);
+        views[i] = lr_test_path(dir, name);
+        double R[9];
+        rotation(rv[i], R);
+        render_chessboard(&truth, &b, R, tv[i], views[i]);
+    }
+    char *small = lr_test_path(dir, "left.png"), *big = lr_test_path(dir, "left03b.png");
+    lr_img img;
+    lr_err e = {0};
+    assert_int_equal(lr_img_alloc(&img, 612, 459, 1, 1, &e), LR_OK);
+    memset(img.px, 128, 612 * 459);
+    assert_int_equal(lr_img_write(small, &img, &e), LR_OK);
+    lr_img_free(&img);
+    double R[9];
+    rotation(rv[0], R);
+    render_chessboard(&other, &b, R, (double[3]){-80, -50, 400}, big);
+
+    /* glob order: left.png, left01, left02, left03, left03b, left04..06; then reversed */
+    const char *order[8] = {small,    views[0], views[1], views[2],
+                            big,      views[3], views[4], views[5]};
+    const char *reversed[8];
+    for (int i = 0; i < 8; i++)
+        reversed[i] = order[7 - i];
+    lr_camcal c[2];
+    for (int run = 0; run < 2; run++) {
+        lr_camcal_desc d = {.images = run ? reversed : order, .nimages = 8, .board = b};
+        int rc = lr_camcal_run(&d, &c[run], &e);
+        if (rc)
+            fail_msg("run %d: %s", run, e.msg);
+        print_message("run %d: fx %.3f fy %.3f cx %.3f cy %.3f k1 %.4f rms %.4f\n", run,
+                      c[run].k.fx, c[run].k.fy, c[run].k.cx, c[run].k.cy, c[run].k.dist[0],
+                      c[run].rms);
+        assert_int_equal(c[run].nviews, 6);
+        assert_int_equal(c[run].k.width, 640);
+        assert_int_equal(c[run].k.height, 480);
+        assert_int_equal(c[run].nrejected, 2);
+        /* one entry each, naming the file and the reason, in the order given */
+        const lr_camcal_reject *blank = &c[run].rejected[run ? 1 : 0];
+        const lr_camcal_reject *size = &c[run].rejected[run ? 0 : 1];
+        assert_string_equal(blank->image, small);
+        /* first: no board; last (after the first good view): its size is checked first */
+        if (run)
+            assert_non_null(strstr(blank->reason, "size 612x459 differs from the first good "
+                                                  "view's 640x480"));
+        else
+            assert_string_equal(blank->reason, "9x6 chessboard not found");
+        assert_string_equal(size->image, big);
+        assert_non_null(strstr(size->reason, "size 400x300 differs from the first good view's "
+                                             "640x480"));
+        assert_non_null(strstr(size->reason, run ? views[5] : views[0]));
+        /* Corners of 4x4-supersampled edges are good to a few hundredths of a pixel; six
+         * tilted views pin f to ~0.1 % (the circle grids' bounds: 1.5 px on f, 2 px on the
+         * principal point) and the distortion the truth does not have to ~0.01. */
+        assert_near(c[run].k.fx, truth.fx, 1.5);
+        assert_near(c[run].k.fy, truth.fy, 1.5);
+        assert_near(c[run].k.cx, truth.cx, 2.0);
+        assert_near(c[run].k.cy, truth.cy, 2.0);
+        assert_near(c[run].k.dist[0], 0.0, 0.01);
+        assert_true(c[run].rms < 0.1);
+    }
+    /* The same views, so the same fit: the order changes only the arithmetic's order. */
+    assert_near(c[1].k.fx, c[0].k.fx, 1e-3);
+    assert_near(c[1].k.cx, c[0].k.cx, 1e-3);
+    assert_near(c[1].rms, c[0].rms, 1e-6);
+    lr_camcal_free(&c[0]);
+    lr_camcal_free(&c[1]);
+
+    /* Too few usable: the error counts them, and the skipped images are still listed for
+     * the caller to show (one line each), the other-size view among them. */
+    const char *few[4] = {small, views[0], big, views[1]};
+    lr_camcal_desc d = {.images = few, .nimages = 4, .board = b};
+    lr_camcal f;
+    assert_int_equal(lr_camcal_run(&d, &f, &e), LR_EINVAL);
+    assert_non_null(strstr(e.msg, "2 of 4 images usable"));
+    assert_int_equal(f.nviews, 0);
+    assert_int_equal(f.nrejected, 2);
+    assert_string_equal(f.rejected[0].image, small);
+    assert_string_equal(f.rejected[1].image, big);
+    lr_camcal_free(&f);
+
+    for (int i = 0; i < 6; i++)
+        free(views[i]);
+    free(small);
+    free(big);
+    lr_test_rmtree(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -454,6 +600,7 @@ int main(void)
         cmocka_unit_test(test_projection_matches_opencv),
         cmocka_unit_test(test_gl_matrices),
         cmocka_unit_test(test_circle_grids),
+        cmocka_unit_test(test_view_order_and_size),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

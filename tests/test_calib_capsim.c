@@ -14,7 +14,10 @@
 #include <string.h>
 
 #include "calib/capture_sim.h"
+#include "calib/compare.h"
+#include "calib/fit_captures.h"
 #include "calib/rig.h"
+#include "tests/support/fs.h"
 #include "tests/support/near.h"
 
 /* A w x h image of one colour. */
@@ -220,6 +223,92 @@ static void test_bad_parameters(void **state)
     lr_image_free(&L);
 }
 
+/* ONE rule for 8-bit captures without camera_response.json (issue 10 item 4): a noise-free
+ * 8-bit PNG from the simulator as lamprig-capsim makes it (the rig's response table,
+ * lr_rig_camera_response) reads back, from a calibration folder without a response file,
+ * to the same values through lamprig fit's reader (lr_fit_load_captures), lamprig compare's
+ * (lr_compare_linearise) and the per-pixel conversion calib albedo uses
+ * (lr_rig_camera_to_linear), and those values are the radiance x gain x t up to 8-bit
+ * quantisation: the simulator inverts the table (linear between codes) and rounds to the
+ * nearest code z, so X is off by at most half the curve's step on the side it was rounded
+ * from: relative to X, 0.5 a with a = (1 + 1/z)^g - 1 (rounded down), or 0.5 b / (1 - 0.5 b)
+ * with b = 1 - (1 - 1/z)^g (rounded up; the larger one for g < 2), 2.8 % at z = 40, g = 2.2.
+ * The old fit read such captures as value / 255: off by a factor 1.2-4.5 across this range.
+ * Also with --gamma 1.8, and --gamma refused beside a measured response. */
+static void test_one_rule_without_response(void **state)
+{
+    (void)state;
+    char *dir = lr_test_tmpdir();
+    lr_rig_calib *rig = calloc(1, sizeof *rig);
+    lr_err e = {0};
+    assert_int_equal(lr_rig_calib_load(dir, rig, &e), LR_OK);
+    assert_false(rig->has_camresp);
+    const int w = 16, h = 4;
+    const double gain = 2.5, t = 1.0;
+    for (int pass = 0; pass < 2; pass++) {
+        double g = pass ? 1.8 : LR_CAMRESP_DEFAULT_GAMMA;
+        if (pass)
+            assert_int_equal(lr_rig_set_gamma(rig, 1.8, &e), LR_OK);
+        lr_camresp table;
+        lr_rig_camera_response(rig, &table);
+        /* the table is the gamma curve named, normalised to 1 at value 128 */
+        assert_near(table.curve[1][128], 1.0, 1e-12);
+        assert_near_rel(table.curve[0][255], pow(255.0 / 128.0, g), 1e-12);
+        lr_sensor s = {.exposure_s = t, .gain = gain, .response = &table};
+        lr_image L = flat(w, h, 0, 0, 0);
+        for (int i = 0; i < w * h; i++)
+            for (int c = 0; c < 3; c++) /* X = gain L from 0.06 to 3.1: value ~36 to 240,
+                                          * below the clipping fit leaves out (>= 250) */
+                L.rgb[3 * i + c] = (float)(0.024 * pow(1.064, i + 0.3 * c));
+        lr_img cap;
+        assert_int_equal(lr_sensor_capture(&s, &L, &cap, &e), LR_OK);
+        char *png = lr_test_path(dir, "shot.png");
+        assert_int_equal(lr_img_write(png, &cap, &e), LR_OK);
+        lr_image fit, cmp;
+        const char *paths[1] = {png};
+        if (lr_fit_load_captures(paths, NULL, 1, rig, w, h, gain, &fit, &e))
+            fail_msg("fit reader: %s", e.msg);
+        lr_img back;
+        assert_int_equal(lr_img_read(png, LR_IMG_AS_IS, &back, &e), LR_OK);
+        if (lr_compare_linearise(rig, &back, &t, 1, gain, &cmp, &e))
+            fail_msg("compare reader: %s", e.msg);
+        const uint8_t *px = back.px;
+        int checked = 0;
+        for (int i = 0; i < w * h; i++) {
+            double lin[3];
+            lr_rig_camera_to_linear(rig, px + 3 * i, lin);
+            for (int c = 0; c < 3; c++) {
+                int z = px[3 * i + c];
+                /* the same curve, three ways: equal to float storage */
+                assert_near_rel(fit.rgb[3 * i + c], lin[c] / gain, 1e-6);
+                assert_near_rel(cmp.rgb[3 * i + c], lin[c] / gain, 1e-6);
+                assert_near_rel(lin[c], table.curve[c][z], 1e-12);
+                if (z < 40 || z > 250)
+                    continue;
+                double a = pow(1.0 + 1.0 / z, g) - 1, b = 1 - pow(1.0 - 1.0 / z, g);
+                assert_near_rel(fit.rgb[3 * i + c], L.rgb[3 * i + c],
+                                fmax(0.5 * a, 0.5 * b / (1 - 0.5 * b)) + 1e-6);
+                checked++;
+            }
+        }
+        assert_true(checked > 100);
+        lr_image_free(&fit);
+        lr_image_free(&cmp);
+        lr_img_free(&back);
+        lr_img_free(&cap);
+        lr_image_free(&L);
+        free(png);
+    }
+    /* A measured response is the rule where there is one: --gamma beside it is refused. */
+    rig->has_camresp = true;
+    lr_camresp_gamma(&rig->camresp, 2.0);
+    assert_int_equal(lr_rig_set_gamma(rig, 1.8, &e), LR_EINVAL);
+    assert_non_null(strstr(e.msg, "camera_response.json"));
+    assert_int_equal(lr_rig_set_gamma(rig, 0.01, &e), LR_EINVAL);
+    free(rig);
+    lr_test_rmtree(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -229,6 +318,7 @@ int main(void)
         cmocka_unit_test(test_poisson_low_light),
         cmocka_unit_test(test_vignetting),
         cmocka_unit_test(test_bad_parameters),
+        cmocka_unit_test(test_one_rule_without_response),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

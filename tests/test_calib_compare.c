@@ -274,7 +274,7 @@ static void test_simulated_capture(void **state)
     lr_rig_calib *rig = calloc(1, sizeof *rig); /* no response / colour files: gamma 2.2 */
     lr_image lin;
     uint8_t *ex = malloc(CW * CH);
-    assert_int_equal(lr_compare_linearise(rig, &cap, &t, 1, gain, 0, &lin, &e), LR_OK);
+    assert_int_equal(lr_compare_linearise(rig, &cap, &t, 1, gain, &lin, &e), LR_OK);
     assert_int_equal(lr_compare_capture_mask(&cap, 1, 0, 0, ex, &e), LR_OK);
     lr_compare_desc d = {.render = &wax, .capture = &lin, .labels = labels, .exclude = ex};
     lr_compare_result same;
@@ -323,7 +323,7 @@ static void test_simulated_capture(void **state)
         }
         lr_image hdr;
         uint8_t *ex3 = malloc(CW * CH);
-        assert_int_equal(lr_compare_linearise(rig, stack, times, 3, gain, 0, &hdr, &e), LR_OK);
+        assert_int_equal(lr_compare_linearise(rig, stack, times, 3, gain, &hdr, &e), LR_OK);
         assert_int_equal(lr_compare_capture_mask(stack, 3, 0, 0, ex3, &e), LR_OK);
         lr_compare_desc d3 = {.render = &wax, .capture = &hdr, .labels = labels, .exclude = ex3};
         lr_compare_result r3;
@@ -343,7 +343,7 @@ static void test_simulated_capture(void **state)
     lr_img cap2;
     lr_image lin2;
     assert_int_equal(lr_sensor_capture(&s, &marble, &cap2, &e), LR_OK);
-    assert_int_equal(lr_compare_linearise(rig, &cap2, &t, 1, gain, 0, &lin2, &e), LR_OK);
+    assert_int_equal(lr_compare_linearise(rig, &cap2, &t, 1, gain, &lin2, &e), LR_OK);
     assert_int_equal(lr_compare_capture_mask(&cap2, 1, 0, 0, ex, &e), LR_OK);
     d.capture = &lin2;
     lr_compare_result other;

@@ -1,8 +1,10 @@
 /* Material fitting (issue 5 item 5): captures simulated from a render at known sigma through
  * the capture simulator's sensor model (calib/capture_sim.h: exposure, shot and read noise,
- * gamma response, 8 bits), linearised as the rig does (lr_rig_camera_to_linear with the
- * camera response), then lr_fit_run from a start 4x off must recover the sigma; and a scene
- * whose camera does not see the object fails clearly. Also the optimiser on its own. */
+ * its default gamma response, 8 bits) and written as a PNG, read back as `lamprig fit` reads
+ * them (lr_fit_load_captures) with a calibration folder WITHOUT camera_response.json, then
+ * lr_fit_run from a start 4x off must recover the sigma (issue 10 item 4: fit used to read
+ * such captures as linear, and fitted sigma_s' 100x too low); and a scene whose camera does
+ * not see the object fails clearly. Also the optimiser on its own. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -10,6 +12,7 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,6 +24,7 @@
 #include "calib/nelder_mead.h"
 #include "calib/rig.h"
 #include "render/cpu/frame.h"
+#include "tests/support/fs.h"
 #include "tests/support/near.h"
 
 /* Rosenbrock's valley: the classic hard case for the simplex; minimum 0 at (1, 1). */
@@ -93,7 +97,9 @@ static void set_sigma(lr_scene *s, const double sa[3], const double ss[3])
 /* The simulated capture, linearised back to radiance: the truth rendered with another seed
  * and 4x the fit's samples (so the model's and the truth's Monte Carlo noise differ, as a
  * real capture's would), captured at an exposure putting the brightest pixel at 60 % of
- * saturation, read back through the same gamma response. */
+ * saturation with the simulator's default response (lamprig-capsim's without
+ * camera_response.json), saved as an 8-bit PNG and read back as lamprig fit does with a
+ * calibration folder that has no response file: the rig's one rule must read it back. */
 static void simulate(lr_image *target, double *noise_rel)
 {
     lr_scene *s = load_slab(NULL);
@@ -109,27 +115,28 @@ static void simulate(lr_image *target, double *noise_rel)
     for (int i = 0; i < W * H * 3; i++)
         lmax = fmax(lmax, L.rgb[i]);
     assert_true(lmax > 0);
-    lr_camresp resp;
-    lr_camresp_gamma(&resp, 2.2);
-    lr_sensor sen = {.exposure_s = 1, .response = &resp, .full_well_e = 20000,
-                     .read_noise_e = 5, .seed = 1234};
+    lr_sensor sen = {.exposure_s = 1, .full_well_e = 20000, .read_noise_e = 5, .seed = 1234};
     sen.gain = 0.6 * lr_sensor_saturation(&sen, 0) / lmax;
     lr_img cap;
     if (lr_sensor_capture(&sen, &L, &cap, &e))
         fail_msg("capture: %s", e.msg);
+    assert_int_equal(cap.depth, 1);
+    char *dir = lr_test_tmpdir(); /* the capture and an (empty) calibration folder */
+    char *png = lr_test_path(dir, "capture.png");
+    if (lr_img_write(png, &cap, &e))
+        fail_msg("%s", e.msg);
     lr_rig_calib *cal = calloc(1, sizeof *cal);
-    cal->has_camresp = true;
-    cal->camresp = resp;
-    assert_int_equal(lr_image_alloc(target, W, H, NULL), 0);
-    const uint8_t *px = cap.px;
-    for (int i = 0; i < W * H; i++) {
-        double lin[3];
-        lr_rig_camera_to_linear(cal, px + 3 * i, lin);
-        for (int c = 0; c < 3; c++)
-            target->rgb[3 * i + c] = (float)(lin[c] / sen.gain);
-    }
+    if (lr_rig_calib_load(dir, cal, &e))
+        fail_msg("%s", e.msg);
+    assert_false(cal->has_camresp);
+    const char *paths[1] = {png};
+    if (lr_fit_load_captures(paths, NULL, 1, cal, W, H, sen.gain, target, &e))
+        fail_msg("captures: %s", e.msg);
     *noise_rel = lr_fit_rel_rmse(target, &L, NULL, NULL);
+    lr_rig_calib_free(cal);
     free(cal);
+    free(png);
+    lr_test_rmtree(dir);
     lr_img_free(&cap);
     lr_image_free(&L);
     lr_scene_destroy(s);
@@ -255,6 +262,31 @@ static void test_fit_captures(void **state)
     }
     lr_image t;
     lr_err e = {0};
+    /* Clipped pixels: one saturated channel at (3, 5), all black at (12, 1), in the first
+     * shot only (saved as shot2.png beside it). */
+    assert_int_equal(lr_img_read(p1, LR_IMG_RGB8, &img, NULL), 0);
+    ((uint8_t *)img.px)[3 * (5 * 16 + 3) + 1] = 252;
+    memset((uint8_t *)img.px + 3 * (1 * 16 + 12), 0, 3);
+    char p3[4096];
+    snprintf(p3, sizeof p3, "%s/shot2.png", dir);
+    assert_int_equal(lr_img_write(p3, &img, NULL), 0);
+    lr_img_free(&img);
+    const char *clip_paths[2] = {p3, p2};
+    if (lr_fit_load_captures(clip_paths, NULL, 1, cal, 8, 4, 2.0, &t, &e))
+        fail_msg("captures: %s", e.msg);
+    /* exactly the fit pixels whose 2 x 2 footprint holds them are NaN (left out by the fit) */
+    for (int y = 0; y < 4; y++)
+        for (int x = 0; x < 8; x++) {
+            bool out = (x == 1 && y == 2) || (x == 6 && y == 0);
+            assert_true(isfinite(t.rgb[3 * (8 * y + x)]) == !out);
+        }
+    lr_image_free(&t);
+    /* in a stack, a value clipped in one shot only is merged from the other */
+    if (lr_fit_load_captures(clip_paths, times, 2, cal, 8, 4, 1.0, &t, &e))
+        fail_msg("stack: %s", e.msg);
+    for (int i = 0; i < 8 * 4 * 3; i++)
+        assert_true(isfinite(t.rgb[i]));
+    lr_image_free(&t);
     if (lr_fit_load_captures(paths, NULL, 1, cal, 8, 4, 2.0, &t, &e))
         fail_msg("captures: %s", e.msg);
     /* pixel (x, y) of the target averages source columns 2x and 2x+1 (rows alike):
@@ -278,6 +310,7 @@ static void test_fit_captures(void **state)
     free(cal);
     unlink(p1);
     unlink(p2);
+    unlink(p3);
     rmdir(dir);
 }
 

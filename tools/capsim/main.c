@@ -1,8 +1,10 @@
 /* lamprig-capsim: what the rig's camera would record for a scene and a calibration folder
  * (issue 5 item 6): the calibrated camera's view (calib/camview.h, pose from pose.json,
  * intrinsics from camera.json) rendered by the GPU renderer (or the CPU twin with --cpu),
- * then the sensor model of calib/capture_sim.h (exposure, vignetting, the inverse of
- * camera_response.json or a gamma, the inverse of color.json, shot + read noise, 8/16-bit).
+ * then the sensor model of calib/capture_sim.h (exposure, vignetting, the inverse of the
+ * rig's camera response: camera_response.json or, without it, the gamma curve --gamma
+ * (default 2.2), lr_rig_camera_response, the rule compare and fit read captures with; the
+ * inverse of color.json, shot + read noise, 8/16-bit).
  *
  *   lamprig-capsim --scene FILE --calib DIR --out IMG.png [--exposure S] [--gain G]
  *                  [--noise FULL_WELL,READ | none] [--seed N] [--bits 8|16]
@@ -58,7 +60,7 @@ int main(int argc, char **argv)
     int nsets = 0;
     lr_sensor s = {.full_well_e = 10000, .read_noise_e = 4, .seed = 1};
     bool cpu = false, gain_given = false;
-    double frames = 0, seed = 1;
+    double frames = 0, seed = 1, gamma = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--cpu")) {
@@ -90,7 +92,7 @@ int main(int argc, char **argv)
                 return usage("--gain '%s': expected a number > 0", v);
             gain_given = true;
         } else if (!strcmp(a, "--gamma")) {
-            if (number(v, 0.1, 10, &s.gamma))
+            if (number(v, 0.1, 10, &gamma))
                 return usage("--gamma '%s': expected 0.1..10", v);
         } else if (!strcmp(a, "--seed")) {
             if (number(v, 0, 4294967295.0, &seed) || seed != floor(seed))
@@ -147,8 +149,14 @@ int main(int argc, char **argv)
         }
     if (!gain_given)
         s.gain = lr_scene_render(scene)->exposure;
-    if (rig->has_camresp)
-        s.response = &rig->camresp;
+    if (gamma > 0 && lr_rig_set_gamma(rig, gamma, &e)) {
+        lr_err_prefix(&e, "--gamma");
+        goto fail;
+    }
+    /* The rule every reader of captures uses; the simulator writes its inverse. */
+    lr_camresp response;
+    lr_rig_camera_response(rig, &response);
+    s.response = &response;
     if (rig->has_color)
         s.color = &rig->color;
     if (s.vignette == LR_VIGNETTE_COS4) {
@@ -167,8 +175,11 @@ int main(int argc, char **argv)
     if (lr_view_render(&vd, &rad, &secs, &e) || (hdr && lr_image_write_pfm(hdr, &rad, &e)) ||
         lr_sensor_capture(&s, &rad, &cap, &e) || lr_img_write(out, &cap, &e))
         goto fail;
-    printf("capture %dx%d (%d-bit) of %s through %s: render %.2f s (%s) -> %s\n", cap.w, cap.h,
-           cap.depth * 8, scene_path, calib, secs, cpu ? "CPU twin" : "GPU", out);
+    char rname[256];
+    printf("capture %dx%d (%d-bit) of %s through %s: render %.2f s (%s) -> %s\n"
+           "written with the response %s\n",
+           cap.w, cap.h, cap.depth * 8, scene_path, calib, secs, cpu ? "CPU twin" : "GPU", out,
+           lr_rig_response_name(rig, rname, sizeof rname));
     status = 0;
     goto done;
 fail:
