@@ -399,7 +399,8 @@ static void test_file_errors_name_file_line_field(void **state)
                                      "got a string");
     /* A duplicate field (the second would silently win in a lax reader). */
     scene_text(t, sizeof t, "", ",\n     \"intensity\": -1", NULL);
-    expect_scene_error(t, LR_EPARSE, "t.json:11: field 'intensity': duplicate field in lights[0]");
+    expect_scene_error(t, LR_EPARSE, "t.json:11: field 'lights[0].intensity': duplicate key "
+                                     "(first on line 10)");
     /* A value out of range, at its own line. */
     snprintf(t, sizeof t, "{\"objects\": [{\"material\": \"candle_wax\", \"mesh\": {\"type\": "
              "\"sphere\"}}],\n \"lights\": [{\"type\": \"point\", \"position\": [0,0,0],\n"
