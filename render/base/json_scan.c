@@ -388,8 +388,8 @@ static int scan_number(scan *sc, int *idx)
     if (isinf(v))
         return fail(sc, "number '%.*s%s' overflows a double (largest about 1.8e308)", SHOWN(n), t,
                     MORE(n));
-    /* A subnormal result is kept (it is a finite double, within a relative 2^-52 of the
-     * text only down to 2.2e-308, but never 0 where the text is not). */
+    /* A subnormal result (below 2.2e-308) is kept: a finite double with fewer significant
+     * bits. A nonzero number that rounds to 0 is refused: it would silently read as 0. */
     if (v == 0 && nonzero)
         return fail(sc, "number '%.*s%s' underflows a double (it would read as 0; the smallest "
                         "is about 4.9e-324)", SHOWN(n), t, MORE(n));
