@@ -312,7 +312,7 @@ static void test_errors_name_file_line_field(void **state)
              "  \"eta\": 1.4\n}\n",
              good_head);
     write_file(tmpdir, "dup.json", text);
-    expect_load_error("dup.json", LR_EPARSE, ":7: field 'eta': duplicate field in material");
+    expect_load_error("dup.json", LR_EPARSE, ":7: field 'eta': duplicate key (first on line 6)");
     /* Malformed JSON: file and line (there is no field to name). */
     write_file(tmpdir, "malformed.json", "{\n  \"name\": \"x\",\n  \"eta\": ,\n}\n");
     lr_material m;

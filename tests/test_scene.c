@@ -399,7 +399,8 @@ static void test_file_errors_name_file_line_field(void **state)
                                      "got a string");
     /* A duplicate field (the second would silently win in a lax reader). */
     scene_text(t, sizeof t, "", ",\n     \"intensity\": -1", NULL);
-    expect_scene_error(t, LR_EPARSE, "t.json:11: field 'intensity': duplicate field in lights[0]");
+    expect_scene_error(t, LR_EPARSE, "t.json:11: field 'lights[0].intensity': duplicate key "
+                                     "(first on line 10)");
     /* A value out of range, at its own line. */
     snprintf(t, sizeof t, "{\"objects\": [{\"material\": \"candle_wax\", \"mesh\": {\"type\": "
              "\"sphere\"}}],\n \"lights\": [{\"type\": \"point\", \"position\": [0,0,0],\n"
@@ -466,7 +467,7 @@ static void test_file_errors_name_file_line_field(void **state)
              "\"target\": [0,0,0]}}");
     expect_scene_error(t, LR_EPARSE, "t.json:2: field 'lights': must not be empty");
     /* Not JSON at all. */
-    expect_scene_error("{\"objects\": [", LR_EPARSE, "t.json:1: unexpected end of file");
+    expect_scene_error("{\"objects\": [", LR_EPARSE, "t.json:1: field 'objects': unexpected end of file");
     /* A file that is not there. */
     assert_int_equal(lr_scene_load("configs/scenes/no_such.json", NULL, &s, &e), LR_EIO);
     expect_msg(&e, "configs/scenes/no_such.json: cannot open");

@@ -10,7 +10,7 @@ libgpiod-dev libhidapi-dev libusb-1.0-0-dev libmodbus-dev
 libegl-dev libgles-dev libgbm-dev libdrm-dev libegl-mesa0 libgl1-mesa-dri libgbm1
 libopencv-dev libopencv-contrib-dev
 opencv-doc
-libpng-dev libcairo2-dev liblcms2-dev libjsmn-dev libcmocka-dev"
+libpng-dev libcairo2-dev liblcms2-dev libcmocka-dev"
 
 missing=""
 for p in $PKGS; do

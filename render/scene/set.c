@@ -70,8 +70,8 @@ static lr_json *value_json(op *o)
     return j;
 }
 
-/* The value as one JSON number; jsmn's strict mode cannot end a document on a bare number,
- * so it is read as the only element of an array. */
+/* The value as one JSON number, read as the only element of an array (the same path as
+ * value_json, so "1,2" is two numbers and refused here). */
 static bool value_number(op *o, double *v)
 {
     char text[512];
