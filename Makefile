@@ -145,11 +145,12 @@ install: $(INSTALL_BINS:%=build/bin/%)
 	    $(DESTDIR)$(SYSCONFDIR)/lamprig $(DESTDIR)$(UNITDIR) $(DESTDIR)$(UDEVDIR) \
 	    $(DESTDIR)$(SYSUSERSDIR)
 	install -m 0755 $(INSTALL_BINS:%=build/bin/%) $(DESTDIR)$(BINDIR)/
-	for f in $(DATA_FILES); do \
+	@echo "  INSTALL configs, shaders -> $(DESTDIR)$(DATADIR)"
+	@for f in $(DATA_FILES); do \
 	    [ -f "$$f" ] && install -D -m 0644 "$$f" "$(DESTDIR)$(DATADIR)/$$f" || exit 1; done
-	for f in $(SHADER_FILES); do [ -d "$$f" ] || \
+	@for f in $(SHADER_FILES); do [ -d "$$f" ] || \
 	    install -D -m 0644 "$$f" "$(DESTDIR)$(DATADIR)/shaders/$${f#render/shaders/}" || exit 1; done
-	install -m 0644 tools/install/lamprig.1 $(DESTDIR)$(MANDIR)/man1/lamprig.1
+	install -m 0644 $(INSTALL_BINS:%=tools/install/%.1) $(DESTDIR)$(MANDIR)/man1/
 	$(SUBST) tools/install/lamprig.service.in > $(DESTDIR)$(UNITDIR)/lamprig.service
 	install -m 0644 tools/install/60-lamprig.rules $(DESTDIR)$(UDEVDIR)/60-lamprig.rules
 	install -m 0644 tools/install/sysusers.conf $(DESTDIR)$(SYSUSERSDIR)/lamprig.conf
