@@ -128,7 +128,8 @@ DATADIR     ?= $(PREFIX)/share/lamprig
 MANDIR      ?= $(PREFIX)/share/man
 SYSCONFDIR  ?= $(if $(filter /usr,$(PREFIX)),/etc,$(PREFIX)/etc)
 UNITDIR     ?= $(PREFIX)/lib/systemd/system
-UDEVDIR     ?= $(PREFIX)/lib/udev/rules.d
+# udev reads rules only from /etc, /run and /usr/lib (/lib): not from /usr/local.
+UDEVDIR     ?= $(if $(filter /usr,$(PREFIX)),$(PREFIX)/lib/udev/rules.d,/etc/udev/rules.d)
 SYSUSERSDIR ?= $(PREFIX)/lib/sysusers.d
 STATEDIR    ?= /var/lib/lamprig
 INSTALL_BINS := lamprig lamprig-modbus-sim
