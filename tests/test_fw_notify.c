@@ -362,8 +362,9 @@ static void test_stalled_process_stops_pings(void **state)
     assert_true(wait_for(&l, "STOPPING=1", NULL));
     assert_int_equal(waitpid(pid, &st, 0), pid);
     if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) {
-        unsigned char *log = lr_test_read(out, NULL);
-        print_error("%s\n", log ? (char *)log : "");
+        size_t n;
+        unsigned char *log = lr_test_read(out, &n);
+        print_error("%s\n", (char *)log);
         free(log);
         fail_msg("lamprig run: status %d", st);
     }
