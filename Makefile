@@ -5,13 +5,16 @@
 #   make test    build with -Werror + ASan + UBSan and run every test binary
 #   make run     render the default candle scene headless
 #   make bench   speed and error figures
+#   make install  PREFIX=/usr/local DESTDIR= (see "Install on a Raspberry Pi" in README.md)
+#   make deb      build/lamprig_VERSION_ARCH.deb from a staged install (tools/debian/)
+#   make test-install  the package, its lintian, unit, udev rules and installed binary
 #   make clean
 #
 # Sources are found by wildcard: every .c under render/ hal/ calib/ and firmware/ (except
 # firmware/main.c) goes into the library; tools/NAME/*.c builds build/bin/lamprig-NAME;
 # tests/test_NAME.c (plus tests/support/*.c) builds one test binary per area.
 
-PUBLIC_TARGETS := all build test run bench
+PUBLIC_TARGETS := all build test run bench install deb test-install
 
 ifndef LAMPRIG_INNER
 # Outer make: install dependencies first, then re-enter with pkg-config available.
@@ -28,7 +31,8 @@ else
 
 CC      ?= cc
 CXX     ?= c++
-PKGS    := egl glesv2 gbm libdrm libgpiod hidapi-libusb libusb-1.0 libmodbus libpng cairo lcms2
+PKGS    := egl glesv2 gbm libdrm libgpiod hidapi-libusb libusb-1.0 libmodbus libpng cairo lcms2 \
+           libsystemd
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS))
 PKG_LIBS   := $(shell pkg-config --libs $(PKGS))
 CV_CFLAGS  := $(shell pkg-config --cflags opencv4)
@@ -113,6 +117,58 @@ build/test/test_%: build/obj/asan/tests/test_%.o $(SUPPORT:%.c=build/obj/asan/%.
 
 test: $(TESTS:%=build/test/%) build/bin/lamprig $(TOOLS:%=build/bin/lamprig-%)
 	@sh tests/run.sh $(TESTS:%=build/test/%)
+	@$(MAKE) --no-print-directory test-install
+
+# ---- install, package ----
+# The layout paths.h looks for: BINDIR/lamprig finds BINDIR/../share/lamprig/{configs,shaders}
+# (so keep BINDIR and DATADIR under one PREFIX, or set LAMPRIG_CONFIGS/LAMPRIG_SHADERS).
+PREFIX      ?= /usr/local
+BINDIR      ?= $(PREFIX)/bin
+DATADIR     ?= $(PREFIX)/share/lamprig
+MANDIR      ?= $(PREFIX)/share/man
+SYSCONFDIR  ?= $(if $(filter /usr,$(PREFIX)),/etc,$(PREFIX)/etc)
+UNITDIR     ?= $(PREFIX)/lib/systemd/system
+# udev reads rules only from /etc, /run and /usr/lib (/lib): not from /usr/local.
+UDEVDIR     ?= $(if $(filter /usr,$(PREFIX)),$(PREFIX)/lib/udev/rules.d,/etc/udev/rules.d)
+SYSUSERSDIR ?= $(PREFIX)/lib/sysusers.d
+STATEDIR    ?= /var/lib/lamprig
+INSTALL_BINS := lamprig lamprig-modbus-sim
+# configs/bench/references only serve `make bench`; the planner needs bench/front.csv.
+DATA_FILES  := $(sort $(wildcard configs/materials/*.json configs/scenes/*.json configs/meshes/* \
+                 configs/rig/* configs/controls/* configs/reference/*) configs/bench/front.csv)
+SHADER_FILES := $(sort $(wildcard render/shaders/* render/shaders/*/*))
+SUBST = sed -e 's|@BINDIR@|$(BINDIR)|g' -e 's|@DATADIR@|$(DATADIR)|g' \
+            -e 's|@SYSCONFDIR@|$(SYSCONFDIR)|g' -e 's|@STATEDIR@|$(STATEDIR)|g'
+
+.PHONY: install deb test-install
+install: $(INSTALL_BINS:%=build/bin/%)
+	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(DATADIR) $(DESTDIR)$(MANDIR)/man1 \
+	    $(DESTDIR)$(SYSCONFDIR)/lamprig $(DESTDIR)$(UNITDIR) $(DESTDIR)$(UDEVDIR) \
+	    $(DESTDIR)$(SYSUSERSDIR)
+	install -m 0755 $(INSTALL_BINS:%=build/bin/%) $(DESTDIR)$(BINDIR)/
+	@echo "  INSTALL configs, shaders -> $(DESTDIR)$(DATADIR)"
+	@for f in $(DATA_FILES); do \
+	    [ -f "$$f" ] && install -D -m 0644 "$$f" "$(DESTDIR)$(DATADIR)/$$f" || exit 1; done
+	@for f in $(SHADER_FILES); do [ -d "$$f" ] || \
+	    install -D -m 0644 "$$f" "$(DESTDIR)$(DATADIR)/shaders/$${f#render/shaders/}" || exit 1; done
+	install -m 0644 $(INSTALL_BINS:%=tools/install/%.1) $(DESTDIR)$(MANDIR)/man1/
+	$(SUBST) tools/install/lamprig.service.in > $(DESTDIR)$(UNITDIR)/lamprig.service
+	install -m 0644 tools/install/60-lamprig.rules $(DESTDIR)$(UDEVDIR)/60-lamprig.rules
+	install -m 0644 tools/install/sysusers.conf $(DESTDIR)$(SYSUSERSDIR)/lamprig.conf
+	@# An existing rig config is the user's: never overwritten.
+	[ -e $(DESTDIR)$(SYSCONFDIR)/lamprig/rig.json ] || \
+	    $(SUBST) tools/install/rig.json.in > $(DESTDIR)$(SYSCONFDIR)/lamprig/rig.json
+	chmod 0644 $(DESTDIR)$(UNITDIR)/lamprig.service $(DESTDIR)$(SYSCONFDIR)/lamprig/rig.json
+
+# Debian 12 puts units and udev rules under /lib (lintian expects them there).
+deb: $(INSTALL_BINS:%=build/bin/%)
+	rm -rf build/deb
+	$(MAKE) --no-print-directory install DESTDIR=$(CURDIR)/build/deb/root PREFIX=/usr \
+	    UNITDIR=/lib/systemd/system UDEVDIR=/lib/udev/rules.d SYSUSERSDIR=/usr/lib/sysusers.d
+	sh tools/debian/build-deb.sh build/deb build
+
+test-install: deb
+	sh tests/install.sh build
 
 # 8 progressive frames (the scene converges at 64): about a minute on llvmpipe; leave out
 # --frames to render until render.frames are accumulated. --no-plan: the demo shows the scene

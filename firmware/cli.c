@@ -1,14 +1,24 @@
 #include "firmware/cli.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+
+#include "render/base/paths.h"
 
 static void print_help(FILE *f)
 {
-    fprintf(f, "usage: lamprig COMMAND [ARGS...]\n\ncommands:\n");
+    fprintf(f, "usage: lamprig [--configs DIR] [--shaders DIR] COMMAND [ARGS...]\n\ncommands:\n");
     for (const lr_command *c = lr_commands; c->name; c++)
         fprintf(f, "  %-10s %s\n", c->name, c->summary);
-    fprintf(f, "\n`lamprig help COMMAND` shows a command's arguments.\n");
+    char shaders[1024];
+    if (lr_shaders_dir(shaders, sizeof shaders) != 0)
+        snprintf(shaders, sizeof shaders, "(path too long)");
+    fprintf(f, "\n`lamprig help COMMAND` shows a command's arguments.\n"
+               "\nData (presets, scenes, example rigs; GLSL shaders), found in this order:\n"
+               "--configs/--shaders, $LAMPRIG_CONFIGS/$LAMPRIG_SHADERS, ./configs, the installed\n"
+               "PREFIX/share/lamprig beside the binary, the source tree it was built in.\n"
+               "  configs  %s\n  shaders  %s\n", lr_configs_dir(), shaders);
 }
 
 static const lr_command *find(const char *name)
@@ -19,8 +29,28 @@ static const lr_command *find(const char *name)
     return NULL;
 }
 
+/* The global data options come before the command; they set the environment the library
+ * reads (render/base/paths.h), so child processes see the same data. */
+static int data_options(int *argc, char ***argv)
+{
+    while (*argc >= 2 && (!strcmp((*argv)[1], "--configs") || !strcmp((*argv)[1], "--shaders"))) {
+        const char *opt = (*argv)[1];
+        if (*argc < 3 || !(*argv)[2][0]) {
+            fprintf(stderr, "lamprig: %s needs a directory (see `lamprig help`)\n", opt);
+            return -1;
+        }
+        setenv(!strcmp(opt, "--configs") ? "LAMPRIG_CONFIGS" : "LAMPRIG_SHADERS", (*argv)[2], 1);
+        (*argv)[2] = (*argv)[0];
+        *argv += 2;
+        *argc -= 2;
+    }
+    return 0;
+}
+
 int lr_cli_main(int argc, char **argv)
 {
+    if (data_options(&argc, &argv))
+        return LR_EXIT_USAGE;
     if (argc < 2) {
         print_help(stderr);
         return LR_EXIT_USAGE;

@@ -29,16 +29,14 @@ static int program(lr_renderer *r, const char *vert, const char *frag, lr_progra
     return lr_program_create(&d, out, e);
 }
 
-/* render/shaders beside the configs directory (./render/shaders from the source tree, or the
- * tree the Makefile compiled in); $LAMPRIG_SHADERS overrides. */
-static void find_shaders(lr_renderer *r)
+/* The shader directory (render/base/paths.h: $LAMPRIG_SHADERS, the source tree's or the
+ * installed prefix's). */
+static int find_shaders(lr_renderer *r, lr_err *e)
 {
-    const char *env = getenv("LAMPRIG_SHADERS");
-    if (env && *env) {
-        snprintf(r->shader_dir, sizeof r->shader_dir, "%s", env);
-        return;
-    }
-    snprintf(r->shader_dir, sizeof r->shader_dir, "%s/../render/shaders", lr_configs_dir());
+    if (lr_shaders_dir(r->shader_dir, sizeof r->shader_dir) != 0)
+        return lr_err_set(e, LR_EINVAL, "shader directory path too long (configs: %s)",
+                          lr_configs_dir());
+    return LR_OK;
 }
 
 static void free_resources(lr_renderer *r)
@@ -118,7 +116,8 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
         maps = "RGBA16F maps (EXT_float_blend missing; accumulation capped at " STR(
             LR_HALF_MAX_FRAMES) " frames)";
     }
-    find_shaders(r);
+    if ((rc = find_shaders(r, e)))
+        goto fail;
     if ((rc = lr_timer_create(r->gl, NULL, &r->timer, e)))
         goto fail;
     snprintf(r->info, sizeof r->info, "%s; %s; %s timers", caps->renderer, maps,

@@ -11,8 +11,13 @@
 #include <string.h>
 #include <unistd.h>
 
+#include <sys/stat.h>
+
+#include "firmware/cli.h"
 #include "render/base/atomic_file.h"
 #include "render/base/err.h"
+#include "render/base/paths.h"
+#include "tests/support/fs.h"
 
 static void test_err_prefix(void **state)
 {
@@ -90,11 +95,56 @@ static void test_atomic_replace_and_failure_keeps_old(void **state)
     rmdir(dir);
 }
 
+/* Data lookup (render/base/paths.h): the env overrides; shaders beside the source tree's
+ * configs (render/shaders) or an installed prefix's (PREFIX/share/lamprig/shaders); the
+ * global --configs/--shaders options set the env for the command; a missing DIR is a usage
+ * error. The binary-relative installed lookup is tested on the package (tests/install.sh). */
+static void test_data_paths(void **state)
+{
+    (void)state;
+    char buf[1024];
+    unsetenv("LAMPRIG_CONFIGS");
+    unsetenv("LAMPRIG_SHADERS");
+    /* The test runs from the source tree (or finds it compiled in): its own layout. */
+    assert_int_equal(lr_shaders_dir(buf, sizeof buf), 0);
+    char want[1024];
+    snprintf(want, sizeof want, "%s/../render/shaders", lr_configs_dir());
+    assert_string_equal(buf, want);
+    /* An installed layout named by LAMPRIG_CONFIGS: shaders are its sibling. */
+    char *dir = lr_test_tmpdir();
+    char *cfg = lr_test_path(dir, "configs");
+    assert_int_equal(mkdir(cfg, 0755), 0);
+    setenv("LAMPRIG_CONFIGS", cfg, 1);
+    assert_string_equal(lr_configs_dir(), cfg);
+    assert_int_equal(lr_shaders_dir(buf, sizeof buf), 0);
+    snprintf(want, sizeof want, "%s/../shaders", cfg);
+    assert_string_equal(buf, want);
+    setenv("LAMPRIG_SHADERS", "/opt/glsl", 1);
+    assert_int_equal(lr_shaders_dir(buf, sizeof buf), 0);
+    assert_string_equal(buf, "/opt/glsl");
+    assert_int_equal(lr_shaders_dir(buf, 5), -1); /* does not fit */
+    /* lamprig --configs DIR --shaders DIR help */
+    char *argv[] = {"lamprig", "--configs", "/a/configs", "--shaders", "/b/shaders", "help", NULL};
+    assert_int_equal(lr_cli_main(6, argv), LR_EXIT_OK);
+    assert_string_equal(getenv("LAMPRIG_CONFIGS"), "/a/configs");
+    assert_string_equal(getenv("LAMPRIG_SHADERS"), "/b/shaders");
+    char *bad[] = {"lamprig", "--configs", NULL};
+    assert_int_equal(lr_cli_main(2, bad), LR_EXIT_USAGE);
+    char *empty[] = {"lamprig", "--shaders", "", "help", NULL};
+    assert_int_equal(lr_cli_main(4, empty), LR_EXIT_USAGE);
+    unsetenv("LAMPRIG_CONFIGS");
+    unsetenv("LAMPRIG_SHADERS");
+    rmdir(cfg);
+    free(cfg);
+    lr_test_rmtree(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_err_prefix),
         cmocka_unit_test(test_atomic_replace_and_failure_keeps_old),
+        cmocka_unit_test(test_data_paths),
     };
     return cmocka_run_group_tests_name("base", tests, NULL, NULL);
 }

@@ -5,12 +5,16 @@ set -eu
 
 # opencv-doc ships OpenCV's sample chessboard photos and OpenCV's own calibration of them
 # (examples/data/left*.jpg, left_intrinsics.yml): tests/test_calib_camera.c checks against them.
+# libsystemd-dev: sd_notify from the rig loop. lintian and systemd (systemd-analyze verify)
+# check `make deb`'s package and unit in tests/install.sh; dpkg-dev comes with build-essential.
 PKGS="build-essential pkg-config
 libgpiod-dev libhidapi-dev libusb-1.0-0-dev libmodbus-dev
 libegl-dev libgles-dev libgbm-dev libdrm-dev libegl-mesa0 libgl1-mesa-dri libgbm1
 libopencv-dev libopencv-contrib-dev
 opencv-doc
-libpng-dev libcairo2-dev liblcms2-dev libcmocka-dev"
+libpng-dev libcairo2-dev liblcms2-dev libcmocka-dev
+libsystemd-dev
+lintian systemd"
 
 missing=""
 for p in $PKGS; do

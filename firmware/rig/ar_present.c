@@ -25,11 +25,10 @@ int lr_ar_present_create(lr_gl *gl, lr_ar_present **out, lr_err *e)
         return lr_err_set(e, LR_ENOMEM, "out of memory");
     p->gl = gl;
     char dir[512];
-    const char *env = getenv("LAMPRIG_SHADERS");
-    if (env && *env)
-        snprintf(dir, sizeof dir, "%s", env);
-    else
-        snprintf(dir, sizeof dir, "%s/../render/shaders", lr_configs_dir());
+    if (lr_shaders_dir(dir, sizeof dir) != 0) {
+        free(p);
+        return lr_err_set(e, LR_EINVAL, "spatial AR output: shader path too long");
+    }
     lr_program_desc d = {.vertex = "fullscreen.vert", .fragment = "blit.frag", .dir = dir};
     int rc = lr_program_create(&d, &p->blit, e);
     if (rc) {

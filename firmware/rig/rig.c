@@ -17,6 +17,7 @@
 #include "firmware/rig/ar_present.h"
 #include "firmware/rig/config.h"
 #include "firmware/rig/control_map.h"
+#include "firmware/rig/notify.h"
 #include "firmware/rig/stats.h"
 #include "firmware/rig/view.h"
 #include "hal/dev.h"
@@ -79,6 +80,8 @@ struct lr_rig {
     uint64_t ar_frames;
     lr_ar_present *ar_out; /* KMS + calib: draws the compensated frames on the projector */
     bool ar_size_logged;   /* the frame/mode size mismatch was logged */
+    lr_notify *notify;     /* sd_notify: READY, watchdog pings, RELOADING, STOPPING */
+    bool ready_sent;
 };
 
 static void set_free(rigset *s)
@@ -621,6 +624,8 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
     }
     r->start_ns = lr_now_ns();
     if (!rc)
+        rc = lr_notify_create(r->start_ns, &r->notify, e);
+    if (!rc)
         rc = lr_event_ring_create(1024, &r->ring, e);
     if (!rc)
         rc = lr_rig_stats_create(r->start_ns, &r->stats, e);
@@ -673,7 +678,37 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
     return LR_OK;
 }
 
+/* One line for `systemctl status` (STATUS=). */
+static const char *status_line(const lr_rig *r, char *buf, size_t cap)
+{
+    const char *scene = r->set.cfg ? r->set.cfg->scene : "";
+    const char *slash = strrchr(scene, '/');
+    int w = snprintf(buf, cap, "%s, %s; %llu frames, %llu events, %llu reloads (%llu failed)",
+                     slash ? slash + 1 : scene, r->kms ? "kms" : "headless",
+                     (unsigned long long)r->frames, (unsigned long long)r->events,
+                     (unsigned long long)r->reloads, (unsigned long long)r->reload_failures);
+    if (w > 0 && r->lamp_written >= 0 && (size_t)w < cap)
+        snprintf(buf + w, cap - (size_t)w, ", lamp %.3f", r->lamp_written);
+    return buf;
+}
+
+static int reload(lr_rig *r, lr_err *e);
+
 int lr_rig_reload(lr_rig *r, lr_err *e)
+{
+    /* The service manager sees the reload start and end (a failed one too: the old config
+     * runs on, ready as before). */
+    if (r->ready_sent)
+        lr_notify_reloading(r->notify, lr_now_ns());
+    int rc = reload(r, e);
+    if (r->ready_sent) {
+        char st[256];
+        lr_notify_ready(r->notify, status_line(r, st, sizeof st));
+    }
+    return rc;
+}
+
+static int reload(lr_rig *r, lr_err *e)
 {
     rigset s;
     int rc = set_build(r, &s, e);
@@ -750,8 +785,17 @@ static void read_signals(lr_rig *r)
 int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
 {
     (void)e;
+    char st[256];
+    if (!r->ready_sent) {
+        lr_notify_ready(r->notify, status_line(r, st, sizeof st));
+        r->ready_sent = true;
+    }
     while (!r->stop) {
         int64_t now = lr_now_ns();
+        /* The watchdog ping comes from here, the top of the loop, and nowhere else: a loop
+         * stuck in a device, a frame or a reload stops the pings and systemd restarts us. */
+        if (now >= lr_notify_deadline(r->notify))
+            lr_notify_tick(r->notify, now, status_line(r, st, sizeof st));
         if (now >= r->end_ns) {
             lr_log_write(&r->log, LR_LOG_INFO, "duration reached: shutting down");
             r->stop = true;
@@ -790,6 +834,8 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             t = fade_wake(r, now);
         if (r->stats_path[0] && r->next_stats_ns < t)
             t = r->next_stats_ns;
+        if (lr_notify_deadline(r->notify) < t)
+            t = lr_notify_deadline(r->notify);
         int timeout;
         if (t == INT64_MAX)
             timeout = -1;
@@ -855,6 +901,8 @@ void lr_rig_destroy(lr_rig *r)
 {
     if (!r)
         return;
+    if (r->ready_sent)
+        lr_notify_stopping(r->notify);
     /* The lamp driver goes to its safe level first, and we wait for the acknowledgement. */
     if (r->set.cfg) {
         for (int i = 0; i < r->set.n_lamps; i++) {
@@ -880,6 +928,7 @@ void lr_rig_destroy(lr_rig *r)
     free(r->rgba);
     lr_rig_stats_destroy(r->stats);
     lr_event_ring_destroy(r->ring);
+    lr_notify_destroy(r->notify);
     if (r->sigfd >= 0)
         close(r->sigfd);
     if (r->masked)

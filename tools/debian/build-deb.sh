@@ -1,0 +1,46 @@
+#!/bin/sh
+# Builds the lamprig .deb from a staged install with Debian's own tools (`make deb` runs it
+# after `make install DESTDIR=STAGE/root PREFIX=/usr`):
+#   dpkg-shlibdeps  the Depends of the libraries the binaries link
+#   dpkg-gencontrol DEBIAN/control from tools/debian/control + changelog, Installed-Size
+#   dpkg-deb        the package (root:root owned, without fakeroot)
+# usage: build-deb.sh STAGE OUTDIR
+set -eu
+stage=$1
+out=$2
+here=$(cd "$(dirname "$0")" && pwd)
+root=$stage/root
+src=$stage/src
+
+# What dh_strip, dh_installman, dh_installchangelogs and dh_installdocs would do.
+for b in "$root"/usr/bin/*; do
+    strip --strip-unneeded --remove-section=.comment --remove-section=.note "$b"
+done
+gzip -9n "$root"/usr/share/man/man1/*.1
+install -d "$root/usr/share/doc/lamprig"
+install -m 0644 "$here/copyright" "$root/usr/share/doc/lamprig/copyright"
+gzip -9nc "$here/changelog" > "$root/usr/share/doc/lamprig/changelog.gz"
+chmod 0644 "$root/usr/share/doc/lamprig/changelog.gz"
+
+install -d "$root/DEBIAN"
+for s in postinst postrm prerm; do
+    install -m 0755 "$here/$s" "$root/DEBIAN/$s"
+done
+install -m 0644 "$here/conffiles" "$root/DEBIAN/conffiles"
+
+# dpkg-shlibdeps and dpkg-gencontrol read ./debian/: a scratch source directory.
+install -d "$src/debian"
+cp "$here/control" "$here/changelog" "$src/debian/"
+abs_root=$(cd "$root" && pwd)
+(
+    cd "$src"
+    dpkg-shlibdeps -Tdebian/substvars "$abs_root"/usr/bin/*
+    dpkg-gencontrol -plamprig -Vmisc:Depends= -Tdebian/substvars -fdebian/files -P"$abs_root"
+)
+
+(cd "$root" && find . -path ./DEBIAN -prune -o -type f -printf '%P\0' | sort -z |
+    xargs -0 md5sum) > "$root/DEBIAN/md5sums"
+chmod 0644 "$root/DEBIAN/md5sums" "$root/DEBIAN/control"
+# Directories 0755, files as installed: a umask of the builder must not leak in.
+find "$root" -type d -exec chmod 0755 {} +
+dpkg-deb --root-owner-group -Zxz --build "$root" "$out"
