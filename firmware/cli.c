@@ -3,12 +3,15 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "firmware/version.h"
+
 static void print_help(FILE *f)
 {
     fprintf(f, "usage: lamprig COMMAND [ARGS...]\n\ncommands:\n");
     for (const lr_command *c = lr_commands; c->name; c++)
         fprintf(f, "  %-10s %s\n", c->name, c->summary);
-    fprintf(f, "\n`lamprig help COMMAND` shows a command's arguments.\n");
+    fprintf(f, "\n`lamprig help COMMAND` shows a command's arguments; `lamprig --version` "
+               "(or `lamprig version`) prints the version.\n");
 }
 
 static const lr_command *find(const char *name)
@@ -26,6 +29,10 @@ int lr_cli_main(int argc, char **argv)
         return LR_EXIT_USAGE;
     }
     const char *name = argv[1];
+    if (!strcmp(name, "--version") || !strcmp(name, "version")) {
+        printf("lamprig %s\n", lr_version());
+        return LR_EXIT_OK;
+    }
     if (!strcmp(name, "help") || !strcmp(name, "--help") || !strcmp(name, "-h")) {
         if (argc >= 3) {
             const lr_command *c = find(argv[2]);
