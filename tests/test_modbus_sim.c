@@ -141,35 +141,65 @@ static long cpu_ticks(pid_t pid)
     return (long)(ut + st);
 }
 
+/* Per test: the scratch dir and the simulator, both cleaned up by teardown even when the test
+ * fails half-way (a spinning simulator must not outlive a failed test). */
+typedef struct fixture {
+    char *dir;
+    pid_t pid;
+} fixture;
+
+static int setup(void **state)
+{
+    fixture *f = calloc(1, sizeof *f);
+    if (!f)
+        return -1;
+    f->dir = lr_test_tmpdir();
+    *state = f;
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    fixture *f = *state;
+    if (f->pid > 0 && waitpid(f->pid, NULL, WNOHANG) == 0) {
+        kill(f->pid, SIGKILL);
+        waitpid(f->pid, NULL, 0);
+    }
+    lr_test_rmtree(f->dir);
+    free(f);
+    return 0;
+}
+
 static void test_stdin_dev_null_serves_until_sigterm(void **state)
 {
-    char *dir = lr_test_tmpdir();
+    fixture *f = *state;
+    char *dir = f->dir;
     char *log = lr_test_path(dir, "sim.log");
     int null = open("/dev/null", O_RDONLY);
     assert_true(null >= 0);
     int port = free_port();
-    pid_t pid = spawn_sim(port, 321, null, log);
+    pid_t pid = f->pid = spawn_sim(port, 321, null, log);
     close(null);
     wait_log(pid, log, "stdin closed");
     talk(port, log, pid, 321, 128);
     stop(pid, log);
     free(log);
-    lr_test_rmtree(dir);
 }
 
 static void test_closed_stdin_pipe_does_not_spin(void **state)
 {
-    char *dir = lr_test_tmpdir();
+    fixture *f = *state;
+    char *dir = f->dir;
     char *log = lr_test_path(dir, "sim.log");
     int p[2];
     assert_int_equal(pipe2(p, O_CLOEXEC), 0); /* the child keeps no write end open */
     int port = free_port();
-    pid_t pid = spawn_sim(port, 500, p[0], log);
+    pid_t pid = f->pid = spawn_sim(port, 500, p[0], log);
     close(p[0]);
     /* A panel move typed on stdin, then the pipe closes. */
     assert_int_equal(write(p[1], "700\n", 4), 4);
     close(p[1]);
-    wait_log(pid, log, "stdin closed");
+    wait_log(pid, log, "panel 700");
     talk(port, log, pid, 700, 64);
     /* Blocked in poll() with nothing to do: no CPU over a second. A spinning loop (poll
      * returning POLLHUP at once, again and again) takes every tick the scheduler gives it,
@@ -179,17 +209,18 @@ static void test_closed_stdin_pipe_does_not_spin(void **state)
     long used = cpu_ticks(pid) - t0;
     if (used > 2)
         fail_msg("lamprig-modbus-sim used %ld ticks in 1 s with nothing to do (spinning)", used);
+    assert_true(log_has(log, "stdin closed"));
     stop(pid, log);
     free(log);
-    lr_test_rmtree(dir);
 }
 
 int main(void)
 {
     signal(SIGPIPE, SIG_IGN);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_stdin_dev_null_serves_until_sigterm),
-        cmocka_unit_test(test_closed_stdin_pipe_does_not_spin),
+        cmocka_unit_test_setup_teardown(test_stdin_dev_null_serves_until_sigterm, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(test_closed_stdin_pipe_does_not_spin, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
