@@ -60,6 +60,14 @@ TOOLS   := $(sort $(patsubst tools/%/,%,$(dir $(wildcard tools/*/*.c))))
 TESTS   := $(sort $(patsubst tests/%.c,%,$(wildcard tests/test_*.c)))
 SUPPORT := $(sort $(wildcard tests/support/*.c))
 
+# The version, from one place: the VERSION file (one line), compiled into firmware/version.c
+# only, so a new version rebuilds that one object.
+LR_VERSION := $(shell cat VERSION 2>/dev/null || echo unknown)
+VERSION_OBJ := build/obj/rel/firmware/version.o build/obj/asan/firmware/version.o
+$(VERSION_OBJ): VERSION
+build/obj/rel/firmware/version.o: REL_CFLAGS += -DLR_VERSION='"$(LR_VERSION)"'
+build/obj/asan/firmware/version.o: TEST_CFLAGS += -DLR_VERSION='"$(LR_VERSION)"'
+
 REL_OBJ  := $(LIB_C:%.c=build/obj/rel/%.o) $(LIB_CXX:%.cpp=build/obj/rel/%.o)
 TEST_OBJ := $(LIB_C:%.c=build/obj/asan/%.o) $(LIB_CXX:%.cpp=build/obj/asan/%.o)
 

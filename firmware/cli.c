@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "firmware/version.h"
 #include "render/base/paths.h"
 
 static void print_help(FILE *f)
@@ -14,7 +15,8 @@ static void print_help(FILE *f)
     char shaders[1024];
     if (lr_shaders_dir(shaders, sizeof shaders) != 0)
         snprintf(shaders, sizeof shaders, "(path too long)");
-    fprintf(f, "\n`lamprig help COMMAND` shows a command's arguments.\n"
+    fprintf(f, "\n`lamprig help COMMAND` shows a command's arguments; `lamprig --version` "
+               "(or `lamprig version`) prints the version.\n"
                "\nData (presets, scenes, example rigs; GLSL shaders), found in this order:\n"
                "--configs/--shaders, $LAMPRIG_CONFIGS/$LAMPRIG_SHADERS, ./configs, the installed\n"
                "PREFIX/share/lamprig beside the binary, the source tree it was built in.\n"
@@ -56,6 +58,10 @@ int lr_cli_main(int argc, char **argv)
         return LR_EXIT_USAGE;
     }
     const char *name = argv[1];
+    if (!strcmp(name, "--version") || !strcmp(name, "version")) {
+        printf("lamprig %s\n", lr_version());
+        return LR_EXIT_OK;
+    }
     if (!strcmp(name, "help") || !strcmp(name, "--help") || !strcmp(name, "-h")) {
         if (argc >= 3) {
             const lr_command *c = find(argv[2]);

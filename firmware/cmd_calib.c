@@ -77,7 +77,10 @@ const char lr_cmd_calib_usage[] =
     "      white mockup of the scene's geometry), clipped, through the inverse projector\n"
     "      response; prints how much was clipped\n"
     "  check FILE...\n"
-    "      load and validate calibration files of any kind, print a summary\n"
+    "      load and validate calibration files of any kind, print a summary; a JSON file\n"
+    "      that is not a calibration file (no \"kind\", e.g. a rig config) is named and\n"
+    "      skipped; exit status 1 only when a file cannot be read, is not JSON or is a\n"
+    "      calibration file that does not load\n"
     "\n"
     "Exit status: 0 success, 1 failure (the output file is left as it was), 2 bad arguments.";
 
@@ -796,13 +799,55 @@ static int cmd_pose(int argc, char **argv)
 
 /* ---- check ---------------------------------------------------------------------------- */
 
+enum { CHECK_VALID, CHECK_INVALID, CHECK_SKIPPED };
+
+/* Whether path is a calibration file at all: a JSON object with a top-level "kind" (every
+ * calibration file has one; rig configs, scenes and materials have none). 1 yes, 0 no, -1 it
+ * cannot be read or is not JSON (message in e). */
+static int has_kind(const char *path, lr_err *e)
+{
+    lr_json *j;
+    if (lr_json_load(path, &j, e))
+        return -1;
+    lr_jnode root = lr_json_root(j);
+    int yes = lr_json_type(j, root) == LR_JSON_OBJECT && lr_json_get(j, root, "kind") != LR_JNONE;
+    lr_json_destroy(j);
+    return yes;
+}
+
+static bool known_kind(const char *kind)
+{
+    static const char *const kinds[] = {LR_CAMCAL_KIND,      LR_PROCAM_KIND,  LR_CAMRESP_KIND,
+                                        LR_PROJRESP_KIND,    LR_COLORMATRIX_KIND, LR_POSE_KIND,
+                                        LR_ALBEDO_KIND,      LR_GC_SEQUENCE_KIND};
+    for (size_t k = 0; k < sizeof kinds / sizeof kinds[0]; k++)
+        if (!strcmp(kind, kinds[k]))
+            return true;
+    return false;
+}
+
+/* Checks one file: CHECK_VALID (summary on stdout), CHECK_INVALID (the error on stderr) or
+ * CHECK_SKIPPED (valid JSON but not a calibration file: one line on stdout). */
 static int check_one(const char *path)
 {
     char kind[64];
     lr_err e = {0};
+    int k = has_kind(path, &e);
+    if (k < 0) {
+        fprintf(stderr, "%s\n", e.msg);
+        return CHECK_INVALID;
+    }
+    if (k == 0) {
+        printf("%s: not a calibration file (no \"kind\"), skipped\n", path);
+        return CHECK_SKIPPED;
+    }
     if (lr_calfile_peek_kind(path, kind, sizeof kind, &e)) {
         fprintf(stderr, "%s\n", e.msg);
-        return LR_EXIT_FAIL;
+        return CHECK_INVALID;
+    }
+    if (!known_kind(kind)) {
+        printf("%s: not a calibration file (kind '%s'), skipped\n", path, kind);
+        return CHECK_SKIPPED;
     }
     int rc = LR_OK;
     if (!strcmp(kind, LR_CAMCAL_KIND)) {
@@ -862,15 +907,12 @@ static int check_one(const char *path)
         int pw, ph;
         if (!(rc = lr_gc_read_sequence(dir, &pw, &ph, &e)))
             printf("%s: Gray-code sequence for a %dx%d projector\n", path, pw, ph);
-    } else {
-        fprintf(stderr, "%s: unknown kind '%s'\n", path, kind);
-        return LR_EXIT_FAIL;
     }
     if (rc) {
         fprintf(stderr, "%s\n", e.msg);
-        return LR_EXIT_FAIL;
+        return CHECK_INVALID;
     }
-    return LR_EXIT_OK;
+    return CHECK_VALID;
 }
 
 /* Linear camera image of an 8-bit capture (the calibration's response and colour matrix). */
@@ -1049,11 +1091,15 @@ static int cmd_check(int argc, char **argv)
 {
     if (argc < 3)
         return usage_error("check", "%s", "expected one or more calibration files");
-    int rc = LR_EXIT_OK;
+    int count[3] = {0};
     for (int i = 2; i < argc; i++)
-        if (check_one(argv[i]) != LR_EXIT_OK)
-            rc = LR_EXIT_FAIL;
-    return rc;
+        count[check_one(argv[i])]++;
+    if (argc > 3)
+        printf("%d valid, %d invalid, %d not calibration files\n", count[CHECK_VALID],
+               count[CHECK_INVALID], count[CHECK_SKIPPED]);
+    /* Files that are not calibration files (a glob over a folder that also holds rig configs)
+     * do not fail the check; one that is, or claims to be, and does not load does. */
+    return count[CHECK_INVALID] ? LR_EXIT_FAIL : LR_EXIT_OK;
 }
 
 int lr_cmd_calib(int argc, char **argv)

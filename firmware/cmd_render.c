@@ -56,8 +56,9 @@ const char lr_render_usage[] =
     "the chosen settings replace its render settings and one line per object says the choice,\n"
     "predicted error and time; --set render.* is applied after the plan and wins.\n"
     "\n"
-    "Files are written atomically. Exit status: 0 done; 1 rendering or I/O failed; 2 bad\n"
-    "arguments (one line on stderr).\n"
+    "Files are written atomically. Output paths (--out, --hdr, --stats) are checked before\n"
+    "anything renders: a directory or a missing folder is a bad argument.\n"
+    "Exit status: 0 done; 1 rendering or I/O failed; 2 bad arguments (one line on stderr).\n"
     "\n"
     "Example:\n"
     "  lamprig render --scene configs/scenes/candle.json --out candle.png --stats s.json";
@@ -299,6 +300,12 @@ int lr_cmd_render(int argc, char **argv)
     for (int i = 0; i < nsets; i++)
         if (!strchr(sets[i], '='))
             return usage_error("--set %s: expected key=value", sets[i]);
+    /* Output paths are checked before the scene loads and the frames render: a directory or a
+     * folder that does not exist is a bad argument now, not an I/O failure after the work. */
+    const char *const outputs[][2] = {{"--out", out}, {"--hdr", hdr}, {"--stats", stats_path}};
+    for (size_t k = 0; k < sizeof outputs / sizeof outputs[0]; k++)
+        if (outputs[k][1] && lr_atomic_file_check(outputs[k][1], &e))
+            return usage_error("%s %s", outputs[k][0], e.msg);
 
     lr_scene *scene = NULL;
     lr_gl *gl = NULL;

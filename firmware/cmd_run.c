@@ -9,6 +9,7 @@
 #include "firmware/args.h"
 #include "firmware/cli.h"
 #include "firmware/rig/rig.h"
+#include "render/base/out_dir.h"
 
 const char lr_run_summary[] = "run the rig: controls (gpio/hid/usb/modbus/sim) drive the scene, "
                               "frames to the projector or headless";
@@ -43,7 +44,8 @@ const char lr_run_usage[] =
     "line and field, and the running one stays).\n"
     "\n"
     "Exit status: 0 clean shutdown; 1 the config, scene or output could not be set up (the\n"
-    "message names the file, line and field, or the device); 2 bad arguments.\n"
+    "message names the file, line and field, or the device); 2 bad arguments, among them an\n"
+    "--out-dir that is not a folder or cannot be created or written (checked at start).\n"
     "\n"
     "Examples:\n"
     "  lamprig run --config configs/rig/sim.json --headless --duration 10 --out-dir /tmp/f\n"
@@ -87,6 +89,12 @@ int lr_cmd_run(int argc, char **argv)
             return usage_error(e.msg);
         if (!(o.duration_s > 0) || o.duration_s > 1e7)
             return usage_error("--duration: must be > 0 seconds");
+    }
+    /* A folder that cannot take the frames is a bad argument, refused before anything opens
+     * (the rig would otherwise log one failed write per frame). */
+    if (o.out_dir && lr_out_dir_prepare(o.out_dir, &e)) {
+        lr_err_prefix(&e, "--out-dir");
+        return usage_error(e.msg);
     }
     /* A peer that closes its socket must be an error return, never a fatal signal. */
     signal(SIGPIPE, SIG_IGN);

@@ -280,13 +280,23 @@ static bool wait_file_has(const char *path, const char *needle, int guard_ms)
 #define LEAK_FLAG "--as-leaker"        /* argv[1] of the control child that leaks on purpose */
 #define LEAK_EXIT 86                   /* exitcode given to LSan/ASan in the child */
 
-/* The child's sanitizer settings: a leak or an ASan error makes the exit status LEAK_EXIT,
- * a UBSan error aborts; the driver's own leaks are suppressed as in tests/run.sh. */
+/* The child's sanitizer settings: tests/run.sh's own, inherited (the same suppressions: the
+ * driver's own leaks suppressed, ours never), with a leak or an ASan error
+ * making the exit status LEAK_EXIT; a UBSan error aborts. Outside run.sh, its defaults. */
+static void append_env(const char *name, const char *fallback, const char *extra)
+{
+    char buf[2048];
+    const char *v = getenv(name);
+    snprintf(buf, sizeof buf, "%s:%s", v && *v ? v : fallback, extra);
+    setenv(name, buf, 1);
+}
+
 static void child_env(void)
 {
-    setenv("ASAN_OPTIONS", "detect_leaks=1:abort_on_error=0:exitcode=86", 1);
-    setenv("LSAN_OPTIONS", "suppressions=" LR_SOURCE_CONFIGS "/../tests/lsan.supp:"
-                           "print_suppressions=0:exitcode=86", 1);
+    append_env("ASAN_OPTIONS", "detect_leaks=1:abort_on_error=0", "exitcode=86");
+    append_env("LSAN_OPTIONS",
+               "suppressions=" LR_SOURCE_CONFIGS "/../tests/lsan.supp:print_suppressions=0",
+               "exitcode=86");
     setenv("UBSAN_OPTIONS", "print_stacktrace=1:halt_on_error=1", 1);
 }
 

@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include "render/base/file.h"
 #include "render/base/json.h"
@@ -33,7 +34,7 @@ static int setup(void **state)
 
 static int teardown(void **state)
 {
-    free(dir);
+    lr_test_rmtree(dir); /* free(dir) alone left /tmp/lamprig-test-* behind */
     return 0;
 }
 
@@ -217,11 +218,38 @@ static void test_bad_arguments(void **state)
     expect_usage(args, needle);
 }
 
+/* Output paths are checked before anything renders: a directory, or a file in a folder that
+ * does not exist, is a bad argument (exit 2, one line naming the flag), and no frame is
+ * rendered (stdout has no summary line) and no other output is written. */
+static void test_output_paths_checked_first(void **state)
+{
+    char args[2048], ok[600];
+    snprintf(ok, sizeof ok, "%s/ok.png", dir);
+    const char *cases[][2] = {
+        {"--out %s", "is a directory"},
+        {"--out %s/ok.png --hdr %s/missing/x.pfm", "--hdr"},
+        {"--out %s/ok.png --stats %s", "--stats"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char paths[1400];
+        snprintf(paths, sizeof paths, cases[k][0], dir, dir);
+        snprintf(args, sizeof args, "--scene configs/scenes/candle.json " SMALL " --frames 1 %s",
+                 paths);
+        expect_usage(args, cases[k][1]);
+        char *out = slurp("out");
+        if (strstr(out, "lamprig render:"))
+            fail_msg("'%s': rendered before refusing its output: '%s'", args, out);
+        free(out);
+        assert_int_equal(access(ok, F_OK), -1);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_render_writes_images_and_stats),
         cmocka_unit_test(test_bad_arguments),
+        cmocka_unit_test(test_output_paths_checked_first),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -27,6 +27,7 @@
 #include "hal/modbus.h"
 #include "hal/sim.h"
 #include "hal/usb.h"
+#include "render/base/out_dir.h"
 #include "render/gl/gl.h"
 #include "render/image/image.h"
 #include "render/scene/scene.h"
@@ -642,8 +643,8 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
         if (r->sigfd < 0)
             rc = lr_err_set(e, LR_EIO, "signalfd: %s", strerror(errno));
     }
-    if (!rc && r->out_dir[0] && mkdir(r->out_dir, 0777) != 0 && errno != EEXIST)
-        rc = lr_err_set(e, LR_EIO, "--out-dir %s: %s", r->out_dir, strerror(errno));
+    if (!rc && r->out_dir[0] && (rc = lr_out_dir_prepare(r->out_dir, e)))
+        lr_err_prefix(e, "--out-dir");
     if (!rc)
         rc = set_build(r, &r->set, e);
     if (!rc) {

@@ -98,6 +98,22 @@ void lr_atomic_file_abort(lr_atomic_file *f)
     release(f);
 }
 
+int lr_atomic_file_check(const char *path, lr_err *e)
+{
+    struct stat st;
+    if (!path || !path[0])
+        return lr_err_set(e, LR_EINVAL, "empty output path");
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+        return lr_err_set(e, LR_EINVAL, "%s: is a directory (expected a file name)", path);
+    /* The same temp file the write will make: proves the directory exists and is writable. */
+    lr_atomic_file *f;
+    int rc = lr_atomic_file_open(path, &f, e);
+    if (rc)
+        return rc;
+    lr_atomic_file_abort(f);
+    return LR_OK;
+}
+
 int lr_atomic_write(const char *path, const void *data, size_t len, lr_err *e)
 {
     lr_atomic_file *f;

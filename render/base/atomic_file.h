@@ -19,6 +19,12 @@ int lr_atomic_file_commit(lr_atomic_file *f, lr_err *e);
 /* Discards the temp file (on an error path); frees f. */
 void lr_atomic_file_abort(lr_atomic_file *f);
 
+/* Checks, before the work that produces it, that `path` can be written atomically: it is not
+ * a directory, and a temp file can be created beside it (created and removed at once). So a
+ * command refuses `--out DIR` or `--out missing/dir/f.png` at start, not after rendering.
+ * LR_EINVAL "path: is a directory", LR_EIO "path: cannot create a file beside it: ...". */
+int lr_atomic_file_check(const char *path, lr_err *e);
+
 /* Whole-buffer convenience. */
 int lr_atomic_write(const char *path, const void *data, size_t len, lr_err *e);
 

@@ -9,7 +9,8 @@
  * returns the error code; for cmocka setup functions. */
 int lr_test_gl_create(lr_gl **out);
 
-/* Marks every shared library loaded so far RTLD_NODELETE. Mesa dlcloses its driver at
+/* Marks every shared library loaded so far RTLD_NODELETE. Done after every eglInitialize in a
+ * test binary (tests/support/gl.c defines it over libEGL's), so any context creation pins. Mesa dlcloses its driver at
  * eglTerminate; leaks inside the driver would then be reported from "<unknown module>" and
  * tests/lsan.supp could not name them. Pinned, they keep their library name and stay
  * suppressed, while leaks in our own code are reported as ever. */

@@ -12,6 +12,15 @@ here=$(cd "$(dirname "$0")" && pwd)
 root=$stage/root
 src=$stage/src
 
+# One version: the VERSION file (what `lamprig --version` prints) and the changelog's top entry
+# must agree, or the package would claim a version the binary does not.
+version=$(cat "$here/../../VERSION")
+changelog_version=$(dpkg-parsechangelog -l "$here/changelog" -S Version)
+if [ "$version" != "$changelog_version" ]; then
+    echo "build-deb.sh: VERSION says $version, tools/debian/changelog says $changelog_version" >&2
+    exit 1
+fi
+
 # What dh_strip, dh_installman, dh_installchangelogs and dh_installdocs would do.
 for b in "$root"/usr/bin/*; do
     strip --strip-unneeded --remove-section=.comment --remove-section=.note "$b"

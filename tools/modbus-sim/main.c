@@ -7,7 +7,11 @@
  *
  * Type a number 0..1000 and Enter to move the panel; every change of the driver register is
  * printed ("driver 128 (50.2 %)"). --sweep turns the panel 0 → 1000 → 0 over SECONDS, again
- * and again. One thread, one poll loop; Ctrl-C ends it. */
+ * and again. One thread, one poll loop; SIGINT (Ctrl-C) or SIGTERM ends it (exit 0).
+ *
+ * Runs like a daemon when stdin is not a terminal: at end of input (stdin /dev/null, a closed
+ * pipe) it stops reading stdin and goes on serving; poll() then waits on the sockets (and
+ * the signals) alone, so a hung-up stdin never makes the loop spin. */
 #include <arpa/inet.h>
 #include <errno.h>
 #include <math.h>
@@ -18,6 +22,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/signalfd.h>
 #include <sys/socket.h>
 #include <time.h>
 #include <unistd.h>
@@ -58,6 +63,19 @@ int main(int argc, char **argv)
             return usage();
     }
     signal(SIGPIPE, SIG_IGN);
+    /* SIGINT/SIGTERM arrive as a readable fd in the poll set: no handler, no race with
+     * poll(), and the loop ends through the same cleanup as at any other exit. */
+    sigset_t stop;
+    sigemptyset(&stop);
+    sigaddset(&stop, SIGINT);
+    sigaddset(&stop, SIGTERM);
+    int sfd = -1;
+    if (sigprocmask(SIG_BLOCK, &stop, NULL) == 0)
+        sfd = signalfd(-1, &stop, SFD_CLOEXEC);
+    if (sfd < 0) {
+        fprintf(stderr, "lamprig-modbus-sim: signalfd: %s\n", strerror(errno));
+        return 1;
+    }
     modbus_mapping_t *units[3] = {NULL, modbus_mapping_new(0, 0, 10, 0),
                                   modbus_mapping_new(0, 0, 10, 0)};
     modbus_t *ctx = modbus_new_tcp("127.0.0.1", port);
@@ -79,27 +97,47 @@ int main(int argc, char **argv)
         printf("type 0..1000 + Enter to move the panel\n");
     fflush(stdout);
     int clients[MAX_CLIENTS], nc = 0, last_driver = -1;
+    /* stdin while it can still give lines; -1 (ignored by poll) after end of input. */
+    int in_fd = 0;
     double t0 = now_s();
     for (;;) {
-        struct pollfd p[2 + MAX_CLIENTS] = {{0, POLLIN, 0}, {lfd, POLLIN, 0}};
+        enum { IN, LISTEN, SIG, FIRST_CLIENT };
+        struct pollfd p[FIRST_CLIENT + MAX_CLIENTS] = {
+            [IN] = {in_fd, POLLIN, 0}, [LISTEN] = {lfd, POLLIN, 0}, [SIG] = {sfd, POLLIN, 0}};
         for (int i = 0; i < nc; i++)
-            p[2 + i] = (struct pollfd){clients[i], POLLIN, 0};
-        if (poll(p, (nfds_t)(2 + nc), sweep ? 20 : -1) < 0 && errno != EINTR)
+            p[FIRST_CLIENT + i] = (struct pollfd){clients[i], POLLIN, 0};
+        if (poll(p, (nfds_t)(FIRST_CLIENT + nc), sweep ? 20 : -1) < 0) {
+            if (errno == EINTR)
+                continue;
+            fprintf(stderr, "lamprig-modbus-sim: poll: %s\n", strerror(errno));
             break;
+        }
+        if (p[SIG].revents & POLLIN) {
+            struct signalfd_siginfo si;
+            if (read(sfd, &si, sizeof si) == (ssize_t)sizeof si)
+                printf("signal %u: stopping\n", si.ssi_signo);
+            break;
+        }
         if (sweep) {
             double ph = fmod((now_s() - t0) / sweep, 1.0);
             units[1]->tab_registers[0] = (uint16_t)lround(1000 * (ph < 0.5 ? 2 * ph : 2 - 2 * ph));
         }
-        if (p[0].revents & POLLIN) {
+        /* A closed pipe reports POLLHUP without POLLIN; /dev/null POLLIN and then EOF. */
+        if (p[IN].revents & (POLLIN | POLLHUP | POLLERR | POLLNVAL)) {
             char line[64];
-            if (!fgets(line, sizeof line, stdin))
-                break;
-            int v = atoi(line);
-            if (v >= 0 && v <= 1000)
-                units[1]->tab_registers[0] = (uint16_t)v;
-            printf("panel %d\n", units[1]->tab_registers[0]);
+            if ((p[IN].revents & POLLNVAL) || !fgets(line, sizeof line, stdin)) {
+                in_fd = -1;
+                printf("stdin closed: panel stays at %d, serving until SIGTERM\n",
+                       units[1]->tab_registers[0]);
+            } else {
+                int v = atoi(line);
+                if (v >= 0 && v <= 1000)
+                    units[1]->tab_registers[0] = (uint16_t)v;
+                printf("panel %d\n", units[1]->tab_registers[0]);
+            }
+            fflush(stdout);
         }
-        if (p[1].revents & POLLIN) {
+        if (p[LISTEN].revents & POLLIN) {
             int c = accept(lfd, NULL, NULL);
             if (c >= 0 && nc < MAX_CLIENTS)
                 clients[nc++] = c;
@@ -107,7 +145,7 @@ int main(int argc, char **argv)
                 close(c);
         }
         for (int i = 0; i < nc; i++) {
-            if (!p[2 + i].revents)
+            if (!p[FIRST_CLIENT + i].revents)
                 continue;
             uint8_t q[MODBUS_TCP_MAX_ADU_LENGTH];
             modbus_set_socket(ctx, clients[i]);
@@ -132,6 +170,7 @@ int main(int argc, char **argv)
     for (int i = 0; i < nc; i++)
         close(clients[i]);
     close(lfd);
+    close(sfd);
     modbus_set_socket(ctx, -1);
     modbus_free(ctx);
     modbus_mapping_free(units[1]);

@@ -1,0 +1,160 @@
+/* The lamprig program's top level and the checks it makes before any work: `--version` prints
+ * the VERSION file's line; `run --out-dir FILE` is refused at start (exit 2, one line) like a
+ * folder that cannot be created; `calib check` names and skips JSON files that are not
+ * calibration files (rig configs) with exit 0, still checks the calibration files among them
+ * and still fails (exit 1) for one that does not load. Runs build/bin/lamprig (built by
+ * `make test` before the tests). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include "calib/colormatrix.h"
+#include "tests/support/fs.h"
+
+static char *dir;
+
+static int setup(void **state)
+{
+    dir = lr_test_tmpdir();
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    lr_test_rmtree(dir);
+    return 0;
+}
+
+/* Runs a shell command, stdout to dir/out and stderr to dir/err; returns the exit status. */
+static int run(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static int run(const char *fmt, ...)
+{
+    char cmd[2048], full[2400];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(cmd, sizeof cmd, fmt, ap);
+    va_end(ap);
+    snprintf(full, sizeof full, "%s >%s/out 2>%s/err </dev/null", cmd, dir, dir);
+    int st = system(full);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static char *slurp(const char *name)
+{
+    char *path = lr_test_path(dir, name);
+    size_t n;
+    char *t = (char *)lr_test_read(path, &n);
+    free(path);
+    return t;
+}
+
+static int lines(const char *text)
+{
+    int n = 0;
+    for (const char *c = text; *c; c++)
+        n += *c == '\n';
+    return n;
+}
+
+static void test_version_is_the_version_file(void **state)
+{
+    size_t n;
+    char *want = (char *)lr_test_read("VERSION", &n);
+    want[strcspn(want, "\n")] = '\0';
+    assert_true(want[0] != '\0');
+    char line[256];
+    snprintf(line, sizeof line, "lamprig %s\n", want);
+    const char *forms[] = {"--version", "version"};
+    for (int k = 0; k < 2; k++) {
+        assert_int_equal(run("./build/bin/lamprig %s", forms[k]), 0);
+        char *out = slurp("out");
+        assert_string_equal(out, line);
+        free(out);
+    }
+    /* `lamprig help` says how to get it. */
+    assert_int_equal(run("./build/bin/lamprig help"), 0);
+    char *out = slurp("out");
+    assert_non_null(strstr(out, "--version"));
+    free(out);
+    free(want);
+}
+
+/* A file where the frames' folder should be: one line naming the flag and the path, exit 2,
+ * before the rig opens anything (no log line: the config line comes after set-up). */
+static void test_run_out_dir_must_be_a_folder(void **state)
+{
+    char *file = lr_test_write(dir, "not-a-folder", "x", (size_t)-1);
+    const char *bad[2] = {file, NULL};
+    char *missing = lr_test_path(dir, "no/such/folder");
+    bad[1] = missing;
+    for (int k = 0; k < 2; k++) {
+        int st = run("./build/bin/lamprig run --config configs/rig/sim.json --headless "
+                     "--duration 0.2 --out-dir %s", bad[k]);
+        char *err = slurp("err");
+        if (st != 2 || !strstr(err, "--out-dir") || !strstr(err, bad[k]) || lines(err) != 1)
+            fail_msg("--out-dir %s: exit %d, stderr '%s' (expected 2 and one line)", bad[k], st,
+                     err);
+        free(err);
+    }
+    struct stat sb;
+    assert_int_equal(stat(file, &sb), 0);
+    assert_true(S_ISREG(sb.st_mode)); /* left as it was */
+    free(file);
+    free(missing);
+}
+
+static void test_calib_check_skips_rig_configs(void **state)
+{
+    /* A valid colour matrix, an invalid one (a required field missing) and the rig configs. */
+    lr_colormatrix m = {.m = {1, 0, 0, 0, 1, 0, 0, 0, 1}, .rms = 0.01, .max_err = 0.02,
+                        .patches = 24};
+    char *good = lr_test_path(dir, "color.json");
+    lr_err e = {0};
+    if (lr_colormatrix_save(good, &m, &e))
+        fail_msg("%s", e.msg);
+    char *broken = lr_test_write(dir, "broken.json",
+                                 "{\"version\": 1, \"kind\": \"color_matrix\"}\n", (size_t)-1);
+
+    assert_int_equal(run("./build/bin/lamprig calib check configs/rig/sim.json "
+                         "configs/rig/modbus-demo.json %s", good), 0);
+    char *out = slurp("out");
+    assert_non_null(strstr(out, "configs/rig/sim.json: not a calibration file"));
+    assert_non_null(strstr(out, "configs/rig/modbus-demo.json: not a calibration file"));
+    assert_non_null(strstr(out, "colour matrix from 24 patches"));
+    assert_non_null(strstr(out, "1 valid, 0 invalid, 2 not calibration files"));
+    free(out);
+
+    /* A calibration file that does not load still fails the run, with the rig configs beside it. */
+    assert_int_equal(run("./build/bin/lamprig calib check configs/rig/sim.json %s", broken), 1);
+    char *err = slurp("err");
+    assert_non_null(strstr(err, "broken.json"));
+    free(err);
+    out = slurp("out");
+    assert_non_null(strstr(out, "0 valid, 1 invalid, 1 not calibration files"));
+    free(out);
+
+    /* Not JSON at all: it cannot be told apart from a damaged calibration file, so it fails. */
+    char *text = lr_test_write(dir, "notes.txt", "hello\n", (size_t)-1);
+    assert_int_equal(run("./build/bin/lamprig calib check %s", text), 1);
+    free(text);
+    free(good);
+    free(broken);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_version_is_the_version_file),
+        cmocka_unit_test(test_run_out_dir_must_be_a_folder),
+        cmocka_unit_test(test_calib_check_skips_rig_configs),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
