@@ -111,7 +111,7 @@ static void test_sim_in_process(void **state)
     int64_t t0 = lr_now_ns();
     if (lr_rig_create(&o, &r, &e))
         fail_msg("%s", e.msg);
-    assert_int_equal(lr_rig_run(r, &e), LR_OK); /* returns at --duration (from create) */
+    assert_int_equal(lr_rig_run(r, &e), LR_OK); /* returns at --duration (from the end of create) */
     double took = (double)(lr_now_ns() - t0) * 1e-9;
     assert_true(took >= 0.8 && took < 5.0);
     assert_near(scene_num(r, "light.intensity"), 0.01, 1e-12);

@@ -277,8 +277,16 @@ static int ar_load(rigset *s, lr_err *e)
     return LR_OK;
 }
 
-/* Config, scene, control map, devices: all or nothing. */
-static int set_build(lr_rig *r, rigset *s, lr_err *e)
+static int set_devices(lr_rig *r, rigset *s, lr_err *e)
+{
+    int rc = LR_OK;
+    for (int i = 0; !rc && i < s->cfg->n_devices; i++)
+        rc = create_device(r, s, &s->cfg->devices[i], e);
+    return rc;
+}
+
+/* Config, scene, control map and (with_devices) devices: all or nothing. */
+static int set_build(lr_rig *r, rigset *s, bool with_devices, lr_err *e)
 {
     memset(s, 0, sizeof *s);
     int rc = lr_rig_config_load(r->config_path, &s->cfg, e);
@@ -301,8 +309,8 @@ static int set_build(lr_rig *r, rigset *s, lr_err *e)
         rc = lr_control_map_create(s->cfg, s->scene, true, lr_now_ns(), &s->map, e);
     if (!rc && s->cfg->calib[0])
         rc = ar_load(s, e);
-    for (int i = 0; !rc && i < s->cfg->n_devices; i++)
-        rc = create_device(r, s, &s->cfg->devices[i], e);
+    if (!rc && with_devices)
+        rc = set_devices(r, s, e);
     if (rc) {
         r->used_hid |= s->has_hid;
         set_free(s);
@@ -646,7 +654,7 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
     if (!rc && r->out_dir[0] && (rc = lr_out_dir_prepare(r->out_dir, e)))
         lr_err_prefix(e, "--out-dir");
     if (!rc)
-        rc = set_build(r, &r->set, e);
+        rc = set_build(r, &r->set, false, e);
     if (!rc) {
         if (opts->stats_path)
             snprintf(r->stats_path, sizeof r->stats_path, "%s", opts->stats_path);
@@ -661,13 +669,19 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
     r->ar_dirty = true;
     if (!rc && ensure_rgba(r))
         rc = lr_err_set(e, LR_ENOMEM, "out of memory");
+    /* The devices come last, and --duration counts from then: a sim script's time 0 and the
+     * duration's start are the same instant, however long the GL set-up above took (0.2 s on
+     * an idle machine, seconds on a loaded one), so a run plays the same part of the script. */
+    if (!rc)
+        rc = set_devices(r, &r->set, e);
     if (rc) {
         lr_rig_destroy(r);
         return rc;
     }
     const lr_rig_config *c = r->set.cfg;
     r->frame_interval_ns = frame_interval(r);
-    r->end_ns = opts->duration_s > 0 ? r->start_ns + (int64_t)(opts->duration_s * 1e9)
+    int64_t devices_ns = lr_now_ns();
+    r->end_ns = opts->duration_s > 0 ? devices_ns + (int64_t)(opts->duration_s * 1e9)
                                      : INT64_MAX;
     r->next_stats_ns = c->stats_period_s > 0 ? r->start_ns + (int64_t)(c->stats_period_s * 1e9)
                                              : INT64_MAX;
@@ -712,7 +726,7 @@ int lr_rig_reload(lr_rig *r, lr_err *e)
 static int reload(lr_rig *r, lr_err *e)
 {
     rigset s;
-    int rc = set_build(r, &s, e);
+    int rc = set_build(r, &s, true, e);
     lr_rig_view *view = NULL;
     if (!rc && r->kms && s.calib && !r->ar_out && (rc = ar_output(r, e))) {
         r->used_hid |= s.has_hid;

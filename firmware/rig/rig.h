@@ -35,7 +35,8 @@ typedef struct lr_rig_opts {
     const char *config;     /* required: the rig config file */
     bool headless;          /* force headless whatever output.mode says */
     const char *out_dir;    /* headless: write every frame as a PNG here (created) */
-    double duration_s;      /* > 0: clean exit after this long */
+    double duration_s;      /* > 0: clean exit this long after the devices start (the end of
+                             * lr_rig_create, when a sim script's time 0 is) */
     const char *stats_path; /* overrides the config's stats.path */
     const char *modbus_url; /* overrides every modbus device's url */
     lr_log log;             /* default: stderr */
