@@ -194,7 +194,12 @@ int lr_renderer_debug_read_gbuffer(lr_renderer *r, int face, float *pos, float *
 
 int lr_renderer_debug_uncovered(lr_renderer *r, int *count, lr_err *e)
 {
-    float *p = read_fb(r->fb_hdr, 0, r->width, r->height, e);
+    lr_fb *hdr;
+    int rc = r->blend ? lr_blend_hdr(r->blend, &hdr, e)
+                      : lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
+    if (rc)
+        return rc;
+    float *p = read_fb(hdr, 0, r->width, r->height, e);
     if (!p)
         return e ? e->code : LR_EIO;
     int n = 0;

@@ -15,6 +15,7 @@
 #include "render/gl/tex.h"
 #include "render/gl/timer.h"
 #include "render/image/image.h"
+#include "render/passes/blend.h"
 #include "render/renderer.h"
 #include "render/scene/scene.h"
 
@@ -57,7 +58,7 @@ struct lr_renderer {
     char shader_dir[512];
     lr_timer *timer;
 
-    lr_program *p_surface, *p_depth, *p_radiosity, *p_vpl, *p_obj, *p_recv, *p_tonemap, *p_blit;
+    lr_program *p_surface, *p_depth, *p_radiosity, *p_vpl, *p_obj, *p_recv, *p_blit;
 
     /* Settings the resources were made for. */
     lr_render_settings rs;
@@ -127,9 +128,18 @@ struct lr_renderer {
         bool outer_valid;
     } vpl;
 
-    /* Output. */
-    lr_tex *hdr, *ldr;
-    lr_fb *fb_hdr, *fb_ldr;
+    /* Composition's output, owned by compose.c: one linear image per light for unit
+     * intensity (layer l of `images`, colour attachment l of `fb`), alpha 0 on object pixels
+     * no map sees. Valid until the view, the receivers or the transport change. */
+    struct {
+        lr_tex *images;
+        lr_fb *fb;
+        int n;      /* layers (the scene's lights when allocated) */
+        bool valid; /* composed since the last (re)allocation */
+    } img;
+
+    /* The blend pass (render/passes/blend.h): tone-mapped output and HDR sum. */
+    lr_blend *blend;
 
     unsigned dirty;
     int frame_index;
@@ -140,6 +150,8 @@ struct lr_renderer {
 };
 
 /* common.c */
+/* The shaders' defines (LR_MAX_OBJECTS, LR_MAX_K, LR_MAX_LIGHTS), NULL-terminated. */
+const char *const *lr_passes_defines(void);
 int lr_passes_upload_meshes(lr_renderer *r, lr_err *e);
 void lr_passes_free_meshes(lr_renderer *r);
 void lr_passes_draw(const lr_gpu_mesh *m);
@@ -180,6 +192,8 @@ int lr_pass_gbuffer(lr_renderer *r, lr_err *e);
 int lr_pass_radiosity(lr_renderer *r, bool restart, lr_err *e);
 int lr_pass_vpl(lr_renderer *r, bool geometry_changed, lr_err *e);
 int lr_pass_compose(lr_renderer *r, lr_err *e);
+/* The blend of r->img with the lights' intensity x colour x flicker (render/passes/blend.h). */
+int lr_pass_blend(lr_renderer *r, lr_err *e);
 
 /* Resources of each pass (allocated for r->rs). */
 int lr_gbuffer_alloc(lr_renderer *r, lr_err *e);

@@ -1,8 +1,8 @@
-// Pass 3 for the diffuse receivers (table, wall): L = albedo / pi (E_direct + E_vpl)
-// (render/passes/PIPELINE.md, pass 4), summed over the lights. E_direct: each light's
-// intensity / distance^2 * cos, shadowed by the objects through that light's G-buffer. E_vpl:
-// the VPLs with the bounded geometry term, A_v bounding the singularity; VPL v carries B per
-// light for unit intensity (row l of u_vpl_B), weighted by I_l.
+// Pass 3 for the diffuse receivers (table, wall): L_l = albedo / pi (E_direct,l + E_vpl,l)
+// (render/passes/PIPELINE.md, pass 4), one image per light l at unit intensity (the blend pass
+// weights them). E_direct,l: 1 / distance^2 * cos, shadowed by the objects through light l's
+// G-buffer. E_vpl,l: the VPLs with the bounded geometry term, A_v bounding the singularity;
+// VPL v carries B per light for unit intensity (row l of u_vpl_B).
 #include "lib/material.glsl"
 #include "lib/lights.glsl"
 
@@ -26,7 +26,8 @@ uniform bool u_vpl_vis;
 uniform highp samplerCube u_outer_pos;
 uniform vec3 u_center;
 uniform float u_vis_eps; // mm: the start is moved this far off the surface along n_v
-layout(location = 0) out vec4 o_color;
+// Output l is light l's image (unrolled writes: GLSL ES indexes outputs by constants only).
+layout(location = 0) out vec4 o_light[LR_MAX_LIGHTS];
 
 #define LR_VIS_STEPS 8
 
@@ -48,12 +49,9 @@ void main()
 {
     vec3 x = v_pos;
     vec3 nx = normalize(v_nrm);
-    vec3 E = vec3(0.0);
-    for (int l = 0; l < LR_MAX_LIGHTS; l++) {
-        if (l >= u_n_lights)
-            break;
-        E += u_lights_I[l] * lr_lights_direct(l, x, nx);
-    }
+    vec3 E[LR_MAX_LIGHTS];
+    for (int l = 0; l < LR_MAX_LIGHTS; l++)
+        E[l] = vec3(l < u_n_lights ? lr_lights_direct(l, x, nx) : 0.0);
     if (u_use_vpl) {
         for (int v = 0; v < u_n_vpl; v++) {
             vec4 p = texelFetch(u_vpl_pos, ivec2(v, 0), 0);
@@ -71,15 +69,18 @@ void main()
                 continue;
             int id = clamp(int(nv.w + 0.5), 0, LR_MAX_OBJECTS - 1);
             float eta = lr_material(id).eta;
-            vec3 B = vec3(0.0);
+            float g = lr_fresnel_transmittance(cv, eta) / LR_PI * p.w * cv * cx / max(d2, p.w);
             for (int l = 0; l < LR_MAX_LIGHTS; l++) {
                 if (l >= u_n_lights)
                     break;
-                B += u_lights_I[l] * u_cavity_gain[l * LR_MAX_OBJECTS + id] *
-                     texelFetch(u_vpl_B, ivec2(v, l), 0).rgb;
+                E[l] += g * u_cavity_gain[l * LR_MAX_OBJECTS + id] *
+                        texelFetch(u_vpl_B, ivec2(v, l), 0).rgb;
             }
-            E += lr_fresnel_transmittance(cv, eta) * B / LR_PI * p.w * cv * cx / max(d2, p.w);
         }
     }
-    o_color = vec4(u_albedo / LR_PI * E, 1.0);
+    vec3 a = u_albedo / LR_PI;
+    o_light[0] = vec4(a * E[0], 1.0);
+    o_light[1] = vec4(a * E[1], 1.0);
+    o_light[2] = vec4(a * E[2], 1.0);
+    o_light[3] = vec4(a * E[3], 1.0);
 }
