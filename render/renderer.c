@@ -14,7 +14,9 @@
 #define STR(x) STR_(x)
 
 static const char *const pass_names[LR_PASS_COUNT] = {"gbuffer", "radiosity", "vpl", "compose",
-                                                      "blend"};
+                                                      "blend",   "irradiance"};
+/* The order the passes run in (bit indices). */
+static const int pass_order[LR_PASS_COUNT] = {0, 1, 2, 5, 3, 4};
 
 const char *lr_pass_name(int index)
 {
@@ -46,6 +48,7 @@ static void free_resources(lr_renderer *r)
     lr_radiosity_free(r);
     lr_vpl_free(r);
     lr_compose_free(r);
+    lr_irradiance_free(r);
     r->allocated = false;
 }
 
@@ -128,7 +131,8 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
         (rc = program(r, "fullscreen.vert", "vpl.frag", &r->p_vpl, e)) ||
         (rc = program(r, "mesh.vert", "compose_object.frag", &r->p_obj, e)) ||
         (rc = program(r, "mesh.vert", "compose_receiver.frag", &r->p_recv, e)) ||
-        (rc = program(r, "fullscreen.vert", "blit.frag", &r->p_blit, e)))
+        (rc = program(r, "fullscreen.vert", "blit.frag", &r->p_blit, e)) ||
+        (rc = program(r, "fullscreen.vert", "irradiance.frag", &r->p_irr, e)))
         goto fail;
     if ((rc = alloc_resources(r, e)) || (rc = lr_passes_upload_meshes(r, e)))
         goto fail;
@@ -156,7 +160,7 @@ void lr_renderer_destroy(lr_renderer *r)
     free_resources(r);
     lr_passes_free_meshes(r);
     lr_program *ps[] = {r->p_surface, r->p_depth, r->p_radiosity, r->p_vpl,
-                        r->p_obj,     r->p_recv,  r->p_blit};
+                        r->p_obj,     r->p_recv,  r->p_blit,      r->p_irr};
     for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
         lr_program_destroy(ps[i]);
     lr_timer_destroy(r->timer);
@@ -237,9 +241,11 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
     r->rs.exposure = lr_scene_render(r->scene)->exposure;
     r->rs.frames = frames_target(r);
     r->rs.N = lr_scene_render(r->scene)->N;
-    if (dirty & (LR_DIRTY_GEOMETRY | LR_DIRTY_SETTINGS | LR_DIRTY_RECEIVERS | LR_DIRTY_MATERIAL))
+    if (dirty & (LR_DIRTY_GEOMETRY | LR_DIRTY_SETTINGS | LR_DIRTY_RECEIVERS | LR_DIRTY_MATERIAL)) {
         if ((rc = lr_passes_upload_meshes(r, e)))
             return rc;
+        lr_irradiance_free(r); /* receivers may have changed kind: grids laid out again */
+    }
     lr_passes_update_coeffs(r);
     /* The cavity gain depends on the light, the geometry and the material: measured (a few
      * ms on the CPU) whenever the maps restart. */
@@ -250,17 +256,25 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
         passes |= LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_COMPOSE;
     if (passes & LR_PASS_RADIOSITY)
         passes |= LR_PASS_VPL | LR_PASS_COMPOSE;
+    /* New VPL radiosity: the receivers' grids again. */
+    if (passes & LR_PASS_VPL)
+        passes |= LR_PASS_IRRADIANCE;
+    if (!r->irr.valid && !r->no_vpl)
+        passes |= LR_PASS_IRRADIANCE;
+    if (passes & LR_PASS_IRRADIANCE)
+        passes |= LR_PASS_COMPOSE;
     /* The images are composed for as many lights as the scene has now. */
     if (!r->img.valid)
         passes |= LR_PASS_COMPOSE;
     if (passes & LR_PASS_COMPOSE)
         passes |= LR_PASS_BLEND;
     if (r->no_vpl)
-        passes &= ~(unsigned)LR_PASS_VPL;
+        passes &= ~(unsigned)(LR_PASS_VPL | LR_PASS_IRRADIANCE);
 
     lr_frame_stats st = {0};
     lr_timer_reset(r->timer);
-    for (int i = 0; i < LR_PASS_COUNT; i++) {
+    for (int oi = 0; oi < LR_PASS_COUNT; oi++) {
+        int i = pass_order[oi];
         if (!(passes & (1u << i)))
             continue;
         if ((rc = lr_timer_begin(r->timer, pass_names[i], e)))
@@ -269,6 +283,7 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
         case LR_PASS_GBUFFER: rc = lr_pass_gbuffer(r, e); break;
         case LR_PASS_RADIOSITY: rc = lr_pass_radiosity(r, restart, e); break;
         case LR_PASS_VPL: rc = lr_pass_vpl(r, geometry, e); break;
+        case LR_PASS_IRRADIANCE: rc = lr_pass_irradiance(r, e); break;
         case LR_PASS_COMPOSE: rc = lr_pass_compose(r, e); break;
         default: rc = lr_pass_blend(r, e); break;
         }

@@ -41,7 +41,9 @@ typedef struct lr_renderer_desc {
                             * fallback for drivers without EXT_float_blend; for its tests) */
 } lr_renderer_desc;
 
-enum { LR_PASS_COUNT = 5 }; /* gbuffer, radiosity, vpl, compose, blend (render/scene/dirty.h) */
+/* gbuffer, radiosity, vpl, compose, blend, irradiance (render/scene/dirty.h; bit index order,
+ * not the order they run in: irradiance runs before compose). */
+enum { LR_PASS_COUNT = 6 };
 
 typedef struct lr_frame_stats {
     int index;                   /* frames rendered since create */
@@ -97,7 +99,7 @@ void lr_renderer_size(const lr_renderer *r, int *width, int *height);
  * from lr_renderer_read_hdr matches lr_renderer_read_rgba8. */
 void lr_renderer_tonemap(const lr_renderer *r, lr_tonemap *tm);
 
-/* "gbuffer", "radiosity", "vpl", "compose", "blend" for bit index 0..4. */
+/* "gbuffer", "radiosity", "vpl", "compose", "blend", "irradiance" for bit index 0..5. */
 const char *lr_pass_name(int index);
 
 #endif

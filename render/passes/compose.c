@@ -127,17 +127,9 @@ int lr_pass_compose(lr_renderer *r, lr_err *e)
     lr_passes_set_coeffs(r, p);
     lr_passes_bind_lights(r, p);
     lr_passes_uniform_mat4(p, "u_vp", vp);
-    bool use_vpl = !r->no_vpl && r->vpl.fb;
-    lr_passes_uniform_i(p, "u_use_vpl", use_vpl);
-    lr_passes_uniform_i(p, "u_n_vpl", r->vpl.n);
-    lr_passes_bind_tex(p, "u_vpl_pos", 7, use_vpl ? r->vpl.pos : NULL);
-    lr_passes_bind_tex(p, "u_vpl_nrm", 8, use_vpl ? r->vpl.nrm : NULL);
-    lr_passes_bind_tex(p, "u_vpl_B", 9, use_vpl ? r->vpl.B : NULL);
-    lr_passes_uniform_i(p, "u_vpl_vis", use_vpl && r->vpl_visibility);
-    lr_passes_bind_tex(p, "u_outer_pos", 10, use_vpl ? r->vpl.outer_pos : NULL);
-    lr_passes_uniform_v3(p, "u_center", r->vpl.center);
-    lr_passes_uniform_f(p, "u_vis_eps", (float)(2.0 * r->rad.radius / (r->vpl.size > 0 ? r->vpl.size : 1)));
+    lr_passes_bind_vpls(r, p);
     for (int i = 0; i < r->n_receivers; i++) {
+        lr_passes_bind_irradiance(r, p, i);
         const lr_receiver *rcv = lr_scene_receiver_at(r->scene, i);
         GLint loc = lr_program_uniform(p, "u_albedo");
         if (loc >= 0)

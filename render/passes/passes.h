@@ -58,7 +58,7 @@ struct lr_renderer {
     char shader_dir[512];
     lr_timer *timer;
 
-    lr_program *p_surface, *p_depth, *p_radiosity, *p_vpl, *p_obj, *p_recv, *p_blit;
+    lr_program *p_surface, *p_depth, *p_radiosity, *p_vpl, *p_obj, *p_recv, *p_blit, *p_irr;
 
     /* Settings the resources were made for. */
     lr_render_settings rs;
@@ -128,6 +128,16 @@ struct lr_renderer {
         bool outer_valid;
     } vpl;
 
+    /* Receiver irradiance grids (irradiance.c, render/cpu/recv_grid.h): E_vpl per light at
+     * unit intensity, layers layer[i] + l for plane receiver i (-1: not cached). */
+    struct {
+        lr_tex *grid;
+        lr_fb *fb[LR_MAX_RECEIVERS];
+        int layer[LR_MAX_RECEIVERS];
+        int n_receivers, n_lights; /* what the grids were allocated for */
+        bool valid;                /* drawn from the current VPLs */
+    } irr;
+
     /* Composition's output, owned by compose.c: one linear image per light for unit
      * intensity (layer l of `images`, colour attachment l of `fb`), alpha 0 on object pixels
      * no map sees. Valid until the view, the receivers or the transport change. */
@@ -192,6 +202,13 @@ int lr_pass_gbuffer(lr_renderer *r, lr_err *e);
 int lr_pass_radiosity(lr_renderer *r, bool restart, lr_err *e);
 int lr_pass_vpl(lr_renderer *r, bool geometry_changed, lr_err *e);
 int lr_pass_compose(lr_renderer *r, lr_err *e);
+/* Receiver irradiance grids from the VPLs (irradiance.c). */
+int lr_pass_irradiance(lr_renderer *r, lr_err *e);
+void lr_irradiance_free(lr_renderer *r);
+/* The VPL inputs of lib/vpl_irradiance.glsl (units 7..10). */
+void lr_passes_bind_vpls(lr_renderer *r, const lr_program *p);
+/* Receiver i's grid for compose_receiver.frag (unit 15), or u_cached = false. */
+void lr_passes_bind_irradiance(lr_renderer *r, const lr_program *p, int receiver);
 /* The blend of r->img with the lights' intensity x colour x flicker (render/passes/blend.h). */
 int lr_pass_blend(lr_renderer *r, lr_err *e);
 
