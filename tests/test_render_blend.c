@@ -152,7 +152,8 @@ static void test_one_light_dimmer(void **state)
     lr_test_frame(r);
     lr_test_set(s, r, "lights[flame].intensity", "0.002");
     st = lr_test_frame(r);
-    assert_int_equal(st.passes, LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_COMPOSE | LR_PASS_BLEND);
+    assert_int_equal(st.passes, LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_IRRADIANCE |
+                                    LR_PASS_COMPOSE | LR_PASS_BLEND);
     assert_true(st.converged);
     assert_same("dimmed during accumulation", r, want, want_bytes);
     lr_renderer_destroy(r);

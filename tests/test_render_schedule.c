@@ -20,8 +20,9 @@
 #define H 36
 
 enum {
-    ALL = LR_PASS_GBUFFER | LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_COMPOSE | LR_PASS_BLEND,
-    MAPS = LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_COMPOSE | LR_PASS_BLEND,
+    ALL = LR_PASS_GBUFFER | LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_IRRADIANCE |
+          LR_PASS_COMPOSE | LR_PASS_BLEND,
+    MAPS = LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_IRRADIANCE | LR_PASS_COMPOSE | LR_PASS_BLEND,
     VIEW = LR_PASS_COMPOSE | LR_PASS_BLEND,
 };
 
@@ -125,8 +126,9 @@ static void test_camera_runs_compose_only(void **state)
     assert_int_equal(st.samples, 2);
     lr_test_set(f->s, f->r, "render.exposure", "1e6");
     assert_int_equal(lr_test_frame(f->r).passes, LR_PASS_BLEND);
+    /* Receivers: their irradiance grids, then the view. */
     lr_test_set(f->s, f->r, "receivers[table].albedo", "0.5,0.5,0.5");
-    assert_int_equal(lr_test_frame(f->r).passes, VIEW);
+    assert_int_equal(lr_test_frame(f->r).passes, LR_PASS_IRRADIANCE | VIEW);
 }
 
 static void test_material_runs_maps_vpl_compose(void **state)
