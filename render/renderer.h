@@ -10,9 +10,10 @@
  * linear image per light at unit intensity for the current view (objects and receivers); the
  * blend pass sums them with the lights' intensity x colour x flicker, tone-maps and writes the
  * output. So a dimmer, colour, flicker or exposure change runs the blend alone (one fullscreen
- * pass; transport is linear in intensity); a camera change composition and the blend; a
- * material change the radiosity maps, VPLs, composition and blend; light or geometry changes
- * everything. With nothing dirty, frames keep accumulating radiosity samples until
+ * pass; transport is linear in intensity); a camera change composition and the blend (the
+ * receivers' emergent light comes from view-independent irradiance grids, redrawn only with
+ * the VPLs or the receivers); a material change the radiosity maps, VPLs, grids, composition
+ * and blend; light or geometry changes everything. With nothing dirty, frames keep accumulating radiosity samples until
  * `render.frames` have been accumulated, then lr_renderer_needs_frame() turns false and the
  * caller only re-presents.
  */
