@@ -234,7 +234,7 @@ static double idle_cpu(char *const argv[], const char *log)
  * blend pass alone once converged) every frame interval, so the process never goes quiet:
  * instead of waiting for quiet, wait SETTLE_S (the 8-frame scene converges well within it),
  * then the CPU % over IDLE_WINDOW_S; -1 on failure. */
-#define SETTLE_S 6.0
+#define SETTLE_S 10.0
 static double idle_cpu_settled(char *const argv[], const char *log)
 {
     pid_t pid = spawn(argv, log);
