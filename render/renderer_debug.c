@@ -198,7 +198,7 @@ int lr_renderer_debug_uncovered(lr_renderer *r, int *count, lr_err *e)
 {
     lr_fb *hdr;
     int rc = r->blend ? lr_blend_hdr(r->blend, &hdr, e)
-                      : lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
+                      : lr_err_set(e, LR_EINVAL, "renderer: no image (no resources)");
     if (rc)
         return rc;
     float *p = read_fb(hdr, 0, r->width, r->height, e);

@@ -131,7 +131,8 @@ static void test_interpolation_error_candle(void **state)
         double sum_exact = 0.0, sum_diff = 0.0, worst = 0.0, Emax = 0.0;
         const int P = 4000;
         for (int i = 0; i < P; i++) {
-            double u = (lr_cpu_rng_next(&rng) - 0.5) * f.w, w2 = (lr_cpu_rng_next(&rng) - 0.5) * f.h;
+            double u = (lr_cpu_rng_next(&rng) - 0.5) * f.w;
+            double w2 = (lr_cpu_rng_next(&rng) - 0.5) * f.h;
             lr_vec3 x = lr_v3_add(f.c, lr_v3_add(lr_v3_scale(f.a, u), lr_v3_scale(f.b, w2)));
             double E[3], G = 0.0, Eq[3];
             exact_E(s, v, n, x, rc->normal, E);

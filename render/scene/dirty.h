@@ -37,8 +37,8 @@ enum lr_pass {
     LR_PASS_RADIOSITY = 1u << 1, /* K scattered-radiosity maps (restart accumulation) */
     LR_PASS_VPL = 1u << 2,       /* virtual point lights on the outer surface */
     LR_PASS_COMPOSE = 1u << 3,   /* composition: one unit-intensity linear image per light */
-    LR_PASS_BLEND = 1u << 4,     /* sum_l I_l image_l, tone mapping, output (render/passes/blend.h) */
-    LR_PASS_IRRADIANCE = 1u << 5, /* receiver irradiance grids from the VPLs (runs before compose) */
+    LR_PASS_BLEND = 1u << 4,     /* sum_l I_l image_l, tone mapping, output (passes/blend.h) */
+    LR_PASS_IRRADIANCE = 1u << 5, /* receiver irradiance grids from the VPLs (before compose) */
 };
 
 /* The passes a dirty mask requires (0 for an empty mask: keep accumulating). */
