@@ -13,7 +13,10 @@
 #define STR_(x) #x
 #define STR(x) STR_(x)
 
-static const char *const pass_names[LR_PASS_COUNT] = {"gbuffer", "radiosity", "vpl", "compose"};
+static const char *const pass_names[LR_PASS_COUNT] = {"gbuffer", "radiosity", "vpl", "compose",
+                                                      "blend",   "irradiance"};
+/* The order the passes run in (bit indices). */
+static const int pass_order[LR_PASS_COUNT] = {0, 1, 2, 5, 3, 4};
 
 const char *lr_pass_name(int index)
 {
@@ -22,10 +25,8 @@ const char *lr_pass_name(int index)
 
 static int program(lr_renderer *r, const char *vert, const char *frag, lr_program **out, lr_err *e)
 {
-    static const char *const defines[] = {"LR_MAX_OBJECTS " STR(LR_MAX_OBJECTS),
-                                          "LR_MAX_K " STR(LR_MAX_K),
-                                          "LR_MAX_LIGHTS " STR(LR_MAX_LIGHTS), NULL};
-    lr_program_desc d = {.vertex = vert, .fragment = frag, .dir = r->shader_dir, .defines = defines};
+    lr_program_desc d = {.vertex = vert, .fragment = frag, .dir = r->shader_dir,
+                         .defines = lr_passes_defines()};
     return lr_program_create(&d, out, e);
 }
 
@@ -45,6 +46,7 @@ static void free_resources(lr_renderer *r)
     lr_radiosity_free(r);
     lr_vpl_free(r);
     lr_compose_free(r);
+    lr_irradiance_free(r);
     r->allocated = false;
 }
 
@@ -128,15 +130,15 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
         (rc = program(r, "fullscreen.vert", "vpl.frag", &r->p_vpl, e)) ||
         (rc = program(r, "mesh.vert", "compose_object.frag", &r->p_obj, e)) ||
         (rc = program(r, "mesh.vert", "compose_receiver.frag", &r->p_recv, e)) ||
-        (rc = program(r, "fullscreen.vert", "tonemap.frag", &r->p_tonemap, e)) ||
-        (rc = program(r, "fullscreen.vert", "blit.frag", &r->p_blit, e)))
+        (rc = program(r, "fullscreen.vert", "blit.frag", &r->p_blit, e)) ||
+        (rc = program(r, "fullscreen.vert", "irradiance.frag", &r->p_irr, e)))
         goto fail;
     if ((rc = alloc_resources(r, e)) || (rc = lr_passes_upload_meshes(r, e)))
         goto fail;
     /* Warm-up section: llvmpipe's first time-elapsed query reports time since the context
      * was made (seconds), not the section; one throw-away query absorbs that. */
     if (!lr_timer_begin(r->timer, "warmup", NULL)) {
-        lr_fb_bind(r->fb_ldr);
+        lr_fb_bind(lr_blend_ldr_fb(r->blend));
         glClear(GL_COLOR_BUFFER_BIT);
         lr_timer_end(r->timer, NULL);
         lr_timer_collect(r->timer, NULL);
@@ -157,7 +159,7 @@ void lr_renderer_destroy(lr_renderer *r)
     free_resources(r);
     lr_passes_free_meshes(r);
     lr_program *ps[] = {r->p_surface, r->p_depth, r->p_radiosity, r->p_vpl,
-                        r->p_obj,     r->p_recv,  r->p_tonemap,   r->p_blit};
+                        r->p_obj,     r->p_recv,  r->p_blit,      r->p_irr};
     for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
         lr_program_destroy(ps[i]);
     lr_timer_destroy(r->timer);
@@ -176,7 +178,7 @@ void lr_renderer_set_time(lr_renderer *r, double t_seconds)
         return;
     for (int l = 0; l < lr_scene_light_count(r->scene); l++)
         if (flickers(lr_scene_light_at(r->scene, l)))
-            r->dirty |= LR_DIRTY_INTENSITY; /* composition alone (transport is linear) */
+            r->dirty |= LR_DIRTY_INTENSITY; /* the blend alone (transport is linear) */
     r->clock_set = true;
     r->time_s = t_seconds;
 }
@@ -238,24 +240,40 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
     r->rs.exposure = lr_scene_render(r->scene)->exposure;
     r->rs.frames = frames_target(r);
     r->rs.N = lr_scene_render(r->scene)->N;
-    if (dirty & (LR_DIRTY_GEOMETRY | LR_DIRTY_SETTINGS | LR_DIRTY_RECEIVERS | LR_DIRTY_MATERIAL))
+    if (dirty & (LR_DIRTY_GEOMETRY | LR_DIRTY_SETTINGS | LR_DIRTY_RECEIVERS | LR_DIRTY_MATERIAL)) {
         if ((rc = lr_passes_upload_meshes(r, e)))
             return rc;
+        lr_irradiance_free(r); /* receivers may have changed kind: grids laid out again */
+    }
     lr_passes_update_coeffs(r);
     /* The cavity gain depends on the light, the geometry and the material: measured (a few
      * ms on the CPU) whenever the maps restart. */
     if (restart && (rc = lr_passes_update_cavity(r, e)))
         return rc;
+    /* Accumulation frames update the per-light images with the new maps (then the blend). */
     if (!restart && r->rad.F < r->rs.frames)
         passes |= LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_COMPOSE;
     if (passes & LR_PASS_RADIOSITY)
         passes |= LR_PASS_VPL | LR_PASS_COMPOSE;
+    /* New VPL radiosity: the receivers' grids again. */
+    if (passes & LR_PASS_VPL)
+        passes |= LR_PASS_IRRADIANCE;
+    if (!r->irr.valid && !r->no_vpl)
+        passes |= LR_PASS_IRRADIANCE;
+    if (passes & LR_PASS_IRRADIANCE)
+        passes |= LR_PASS_COMPOSE;
+    /* The images are composed for as many lights as the scene has now. */
+    if (!r->img.valid)
+        passes |= LR_PASS_COMPOSE;
+    if (passes & LR_PASS_COMPOSE)
+        passes |= LR_PASS_BLEND;
     if (r->no_vpl)
-        passes &= ~(unsigned)LR_PASS_VPL;
+        passes &= ~(unsigned)(LR_PASS_VPL | LR_PASS_IRRADIANCE);
 
     lr_frame_stats st = {0};
     lr_timer_reset(r->timer);
-    for (int i = 0; i < LR_PASS_COUNT; i++) {
+    for (int oi = 0; oi < LR_PASS_COUNT; oi++) {
+        int i = pass_order[oi];
         if (!(passes & (1u << i)))
             continue;
         if ((rc = lr_timer_begin(r->timer, pass_names[i], e)))
@@ -264,7 +282,9 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
         case LR_PASS_GBUFFER: rc = lr_pass_gbuffer(r, e); break;
         case LR_PASS_RADIOSITY: rc = lr_pass_radiosity(r, restart, e); break;
         case LR_PASS_VPL: rc = lr_pass_vpl(r, geometry, e); break;
-        default: rc = lr_pass_compose(r, e); break;
+        case LR_PASS_IRRADIANCE: rc = lr_pass_irradiance(r, e); break;
+        case LR_PASS_COMPOSE: rc = lr_pass_compose(r, e); break;
+        default: rc = lr_pass_blend(r, e); break;
         }
         int rc2 = lr_timer_end(r->timer, e);
         if (rc || (rc = rc2))
@@ -291,13 +311,17 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
 
 int lr_renderer_read_hdr(lr_renderer *r, float *rgb, lr_err *e)
 {
-    if (!r->fb_hdr)
+    if (!r->blend)
         return lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
+    lr_fb *hdr;
+    int rc = lr_blend_hdr(r->blend, &hdr, e);
+    if (rc)
+        return rc;
     size_t n = (size_t)r->width * (size_t)r->height;
     float *rgba = malloc(n * 4 * sizeof *rgba);
     if (!rgba)
         return lr_err_set(e, LR_ENOMEM, "renderer: HDR readback: out of memory");
-    int rc = lr_fb_read(r->fb_hdr, 0, 0, 0, r->width, r->height, rgba, e);
+    rc = lr_fb_read(hdr, 0, 0, 0, r->width, r->height, rgba, e);
     if (!rc)
         for (size_t i = 0; i < n; i++)
             memcpy(rgb + 3 * i, rgba + 4 * i, 3 * sizeof *rgb);
@@ -307,13 +331,13 @@ int lr_renderer_read_hdr(lr_renderer *r, float *rgb, lr_err *e)
 
 int lr_renderer_read_rgba8(lr_renderer *r, unsigned char *out, lr_err *e)
 {
-    if (!r->fb_ldr)
+    if (!r->blend)
         return lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
     size_t n = (size_t)r->width * (size_t)r->height;
     float *rgba = malloc(n * 4 * sizeof *rgba);
     if (!rgba)
         return lr_err_set(e, LR_ENOMEM, "renderer: readback: out of memory");
-    int rc = lr_fb_read(r->fb_ldr, 0, 0, 0, r->width, r->height, rgba, e);
+    int rc = lr_fb_read(lr_blend_ldr_fb(r->blend), 0, 0, 0, r->width, r->height, rgba, e);
     if (!rc)
         for (int y = 0; y < r->height; y++) {
             const float *src = rgba + (size_t)(r->height - 1 - y) * r->width * 4;
@@ -330,7 +354,7 @@ int lr_renderer_read_rgba8(lr_renderer *r, unsigned char *out, lr_err *e)
 int lr_renderer_present(lr_renderer *r, lr_err *e)
 {
     int w, h;
-    if (!r->ldr)
+    if (!r->blend)
         return lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
     lr_gl_size(r->gl, &w, &h);
     if (w > 0 && h > 0) {
@@ -338,7 +362,7 @@ int lr_renderer_present(lr_renderer *r, lr_err *e)
         glDisable(GL_DEPTH_TEST);
         glDisable(GL_BLEND);
         glUseProgram(lr_program_id(r->p_blit));
-        lr_passes_bind_tex(r->p_blit, "u_src", 0, r->ldr);
+        lr_passes_bind_tex(r->p_blit, "u_src", 0, lr_blend_ldr(r->blend));
         lr_gl_draw_fullscreen(r->gl);
     }
     return lr_gl_present(r->gl, e);

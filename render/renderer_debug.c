@@ -1,8 +1,10 @@
 /* Readback of the passes' intermediate results (render/renderer_debug.h). */
 #include "render/renderer_debug.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "render/optics/optics.h"
 #include "render/passes/passes.h"
@@ -194,7 +196,12 @@ int lr_renderer_debug_read_gbuffer(lr_renderer *r, int face, float *pos, float *
 
 int lr_renderer_debug_uncovered(lr_renderer *r, int *count, lr_err *e)
 {
-    float *p = read_fb(r->fb_hdr, 0, r->width, r->height, e);
+    lr_fb *hdr;
+    int rc = r->blend ? lr_blend_hdr(r->blend, &hdr, e)
+                      : lr_err_set(e, LR_EINVAL, "renderer: no image (no resources)");
+    if (rc)
+        return rc;
+    float *p = read_fb(hdr, 0, r->width, r->height, e);
     if (!p)
         return e ? e->code : LR_EIO;
     int n = 0;
@@ -203,4 +210,54 @@ int lr_renderer_debug_uncovered(lr_renderer *r, int *count, lr_err *e)
     free(p);
     *count = n;
     return LR_OK;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+int lr_renderer_debug_floor_ms(lr_renderer *r, int reps, double *ms, lr_err *e)
+{
+    *ms = NAN;
+    if (reps < 1 || reps > 64)
+        return lr_err_set(e, LR_EINVAL, "floor pass: reps = %d: must be 1..64", reps);
+    if (!r->blend)
+        return lr_err_set(e, LR_EINVAL, "renderer: no output (resources failed to allocate)");
+    lr_program *p = NULL;
+    lr_tex *src = NULL;
+    lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "floor.frag",
+                          .dir = r->shader_dir, .defines = lr_passes_defines()};
+    lr_tex_desc td = {.format = LR_TEX_RGBA16F, .width = r->width, .height = r->height,
+                      .label = "floor pass source"};
+    int rc;
+    if ((rc = lr_program_create(&pd, &p, e)) || (rc = lr_tex_create(r->gl, &td, &src, e)))
+        goto done;
+    double t[64];
+    int n = 0;
+    for (int i = 0; i < reps; i++) {
+        struct timespec t0, t1;
+        glFinish();
+        clock_gettime(CLOCK_MONOTONIC, &t0);
+        lr_fb_bind(lr_blend_ldr_fb(r->blend));
+        glDisable(GL_DEPTH_TEST);
+        glDisable(GL_BLEND);
+        glUseProgram(lr_program_id(p));
+        lr_passes_bind_tex(p, "u_src", 0, src);
+        lr_gl_draw_fullscreen(r->gl);
+        glFinish();
+        clock_gettime(CLOCK_MONOTONIC, &t1);
+        t[n++] = (double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) * 1e-6;
+    }
+    if ((rc = lr_gl_check("floor pass", e)))
+        goto done;
+    if (n) {
+        qsort(t, (size_t)n, sizeof t[0], cmp_double);
+        *ms = n % 2 ? t[n / 2] : 0.5 * (t[n / 2 - 1] + t[n / 2]);
+    }
+done:
+    lr_tex_destroy(src);
+    lr_program_destroy(p);
+    return rc;
 }

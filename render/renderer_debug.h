@@ -93,4 +93,13 @@ int lr_renderer_debug_read_gbuffer(lr_renderer *r, int face, float *pos, float *
  * they took the map facing them most, without visibility; PIPELINE.md pass 3). */
 int lr_renderer_debug_uncovered(lr_renderer *r, int *count, lr_err *e);
 
+/* ---- the bench's floor (issue 11) ---------------------------------------------------------- */
+
+/* Times `reps` (1..64) runs of the cheapest fullscreen pass that reads one RGBA16F texture of
+ * the output size and writes the tone-mapped output target (render/shaders/floor.frag): wall
+ * time from glFinish to glFinish around the draw, the way a caller waits for a frame; *ms the
+ * median. The blend pass is measured against it. The
+ * output target is overwritten: render a frame before reading the image again. */
+int lr_renderer_debug_floor_ms(lr_renderer *r, int reps, double *ms, lr_err *e);
+
 #endif

@@ -524,12 +524,12 @@ static void test_no_pass_after_convergence(void **state)
         assert_int_equal(lr_renderer_frame(r, &st, &e), LR_OK);
         assert_int_equal(st.passes, 0u);
     }
-    /* The dimmer: composition only, maps untouched. */
+    /* The dimmer: the blend pass only, maps and per-light images untouched. */
     unsigned dirty = 0;
     assert_int_equal(lr_scene_set(s, "light.intensity", "0.0025", &dirty, &e), LR_OK);
     lr_renderer_invalidate(r, dirty);
     assert_int_equal(lr_renderer_frame(r, &st, &e), LR_OK);
-    assert_int_equal(st.passes, (unsigned)LR_PASS_COMPOSE);
+    assert_int_equal(st.passes, (unsigned)LR_PASS_BLEND);
     assert_false(lr_renderer_needs_frame(r));
     free(p);
     lr_renderer_destroy(r);
@@ -698,7 +698,7 @@ static void test_cli_render_applies_plan(void **state)
                          sp, stats), 0);
     expect_in("out", "no receiver sees ball: VPL pass off");
     expect_in("out", "nearest measured scene 'candle'");
-    expect_first_passes(LR_PASS_GBUFFER | LR_PASS_RADIOSITY | LR_PASS_COMPOSE);
+    expect_first_passes(LR_PASS_GBUFFER | LR_PASS_RADIOSITY | LR_PASS_COMPOSE | LR_PASS_BLEND);
     free(sp);
 }
 

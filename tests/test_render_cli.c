@@ -140,12 +140,13 @@ static void test_render_writes_images_and_stats(void **state)
     assert_int_equal(wh[0], 32);
     assert_int_equal(wh[1], 24);
     assert_int_not_equal(lr_json_get(j, lr_json_root(j), "uncovered_pixels"), LR_JNONE);
-    expect_frame(j, 0, "gbuffer,radiosity,vpl,compose", -1, false, 0);
-    expect_frame(j, 1, "radiosity,vpl,compose", -1, false, 0);
-    /* The event before frame 2: composition alone. Frame 3: converged, but the flame
-     * flickers on the renderer's clock (frame i at i / 30 s): composition alone again. */
-    expect_frame(j, 2, "compose", -1, false, 0);
-    expect_frame(j, 3, "compose", 2, true, 0.1);
+    /* Passes are listed in bit order (render/renderer.h), not the order they ran in. */
+    expect_frame(j, 0, "gbuffer,radiosity,vpl,compose,blend,irradiance", -1, false, 0);
+    expect_frame(j, 1, "radiosity,vpl,compose,blend,irradiance", -1, false, 0);
+    /* The event before frame 2: the blend alone. Frame 3: converged, but the flame flickers
+     * on the renderer's clock (frame i at i / 30 s): the blend alone again. */
+    expect_frame(j, 2, "blend", -1, false, 0);
+    expect_frame(j, 3, "blend", 2, true, 0.1);
     lr_json_destroy(j);
     /* A steady flame (flicker.amplitude 0) at 10 fps: frame 3 has nothing left to do. */
     st = run("./build/bin/lamprig render --scene configs/scenes/candle.json " SMALL

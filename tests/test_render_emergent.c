@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "render/cpu/recv_grid.h"
 #include "render/optics/optics.h"
 #include "render/renderer.h"
 #include "render/renderer_debug.h"
@@ -65,6 +66,26 @@ static void vpl_irradiance(lr_renderer *r, const lr_scene *s, const lr_debug_vpl
     }
 }
 
+/* The same read the way composition reads it on a plane receiver: bilinear over the receiver
+ * irradiance grid's texel centres (render/cpu/recv_grid.h), each evaluated as above. */
+static void grid_irradiance(lr_renderer *r, const lr_scene *s, const lr_debug_vpl *v, int n,
+                            const lr_receiver *rc, lr_vec3 x, double E[3])
+{
+    lr_recv_grid_frame f;
+    assert_true(lr_recv_grid_frame_of(rc, &f));
+    int idx[4];
+    double w[4];
+    lr_recv_grid_taps(&f, x, idx, w);
+    E[0] = E[1] = E[2] = 0.0;
+    for (int q = 0; q < 4; q++) {
+        double Eq[3];
+        lr_vec3 p = lr_recv_grid_point(&f, idx[q] % LR_RECV_GRID, idx[q] / LR_RECV_GRID);
+        vpl_irradiance(r, s, v, n, p, rc->normal, Eq);
+        for (int c = 0; c < 3; c++)
+            E[c] += w[q] * Eq[c];
+    }
+}
+
 static void check_scene(const char *name, const probe *probes, int np)
 {
     lr_scene *s = lr_test_scene(name, lr_test_small_settings, NULL);
@@ -91,16 +112,21 @@ static void check_scene(const char *name, const probe *probes, int np)
         assert_true(lr_test_project(s, W, H, probes[i].point, &x, &y));
         lr_vec3 p = lr_test_pixel_on_plane(s, W, H, x, y, rc->center, rc->normal);
         size_t k = 3 * ((size_t)y * W + x);
-        double E[3];
-        vpl_irradiance(lit, s, v, nv, p, rc->normal, E);
+        double E[3], Ex[3];
+        grid_irradiance(lit, s, v, nv, rc, p, E);
+        vpl_irradiance(lit, s, v, nv, p, rc->normal, Ex);
         double d = lr_v3_len(lr_v3_sub(p, l->position));
         for (int c = 0; c < 3; c++) {
             /* No VPLs: the light cannot see the point, so exactly nothing arrives. */
             assert_true(hd[k + c] == 0.0f);
-            /* With VPLs: what PIPELINE.md's sum gives over the renderer's own VPLs (float
+            /* With VPLs: what PIPELINE.md's sum gives over the renderer's own VPLs at the
+             * receiver grid's texel centres, interpolated as composition does (float
              * arithmetic on the GPU, 48 terms: 1e-4 relative)... */
             double L = I[c] * rc->albedo[c] / M_PI * E[c];
             assert_near(hl[k + c], L, 1e-4 * L + 1e-30);
+            /* ... within 5 % of the sum at the pixel itself (the grid's interpolation error;
+             * tests/test_cpu_recv_grid.c bounds it on the whole plane)... */
+            assert_near(E[c], Ex[c], 0.05 * Ex[c]);
             /* ... and at least 1e-4 of what the bare light would give there,
              * albedo/pi * 1e-4 I / d^2 (d from the light). Derivation for the candle (the
              * harder case): light enters through the melt pool and inner rim, ~35 mm from the

@@ -193,7 +193,7 @@ static void test_renderer_applies_flicker_at_composition(void **state)
         lr_renderer_set_time(r, times[i]);
         assert_true(lr_renderer_needs_frame(r));
         st = lr_test_frame(r);
-        assert_int_equal(st.passes, LR_PASS_COMPOSE);
+        assert_int_equal(st.passes, LR_PASS_BLEND);
         assert_int_equal(st.samples, 2);
         assert_near(st.time_s, times[i], 0.0);
         double f = lr_renderer_flicker(r, 0);
@@ -219,7 +219,7 @@ static void test_renderer_applies_flicker_at_composition(void **state)
      * for no frame. */
     lr_test_set(s, r, "lights[0].flicker.amplitude", "0");
     st = lr_test_frame(r);
-    assert_int_equal(st.passes, LR_PASS_COMPOSE);
+    assert_int_equal(st.passes, LR_PASS_BLEND);
     assert_true(lr_renderer_flicker(r, 0) == 1.0);
     float *steady = lr_test_hdr(r);
     assert_scaled(steady, h1, 1.0 / f1);

@@ -186,13 +186,13 @@ static void test_dimming_one_light_runs_compose_only(void **state)
     /* A quarter of the side spot: 0.02 -> 0.005. */
     lr_test_set(s2, r, "lights[side].intensity", "0.005");
     lr_frame_stats st = lr_test_frame(r);
-    assert_int_equal(st.passes, LR_PASS_COMPOSE);
+    assert_int_equal(st.passes, LR_PASS_BLEND);
     float *hd = lr_test_hdr(r);
     assert_sum("flame + side spot at 1/4", hd, ha, hb, 0.25);
     /* The flame's colour: also composition alone, and the side spot's share is unchanged. */
     lr_test_set(s2, r, "lights[flame].intensity", "0");
     st = lr_test_frame(r);
-    assert_int_equal(st.passes, LR_PASS_COMPOSE);
+    assert_int_equal(st.passes, LR_PASS_BLEND);
     float *hz = lr_test_hdr(r);
     float *zero = calloc((size_t)W * H * 3, sizeof *zero);
     assert_sum("side spot at 1/4 alone", hz, zero, hb, 0.25);

@@ -383,10 +383,11 @@ static void test_vpls(void **state)
  * finite and >= 0. Object pixels (summed): within 4 sigma (twin's variance image, taken for
  * both) + 5 %; measured +3.1 % (sigma 3.0 %). Receivers without VPLs (direct light and the
  * candle's shadow): the same to 1e-3 (measured 0.00 %). Receivers with VPLs: within 20 %;
- * measured +4.4 % (K = 8; +13 % in the VPL part alone): the VPLs' B comes from Algorithm 1
- * over few maps at positions that differ by up to 0.6 cube texels, several VPLs fall back to
- * the nearest texel of one map, and most sit on the candle's side, facing away from the flame,
- * where the texels are heavy-tailed -- so the twin's variance image understates it. */
+ * measured +3.9 % (K = 8; +4.4 % before the receiver irradiance grid, which both sides
+ * share): the VPLs' B comes from Algorithm 1 over few maps at positions that differ by up
+ * to 0.6 cube texels, several VPLs fall back to the nearest texel of one map, and most sit
+ * on the candle's side, facing away from the flame, where the texels are heavy-tailed -- so
+ * the twin's variance image understates it. */
 /* recv_direct_tol: relative tolerance on the receivers without VPLs (direct light only). */
 static void final_image_of(const char *scene, bool no_vpl, double recv_direct_tol)
 {

@@ -20,8 +20,10 @@
 #define H 36
 
 enum {
-    ALL = LR_PASS_GBUFFER | LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_COMPOSE,
-    MAPS = LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_COMPOSE,
+    ALL = LR_PASS_GBUFFER | LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_IRRADIANCE |
+          LR_PASS_COMPOSE | LR_PASS_BLEND,
+    MAPS = LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_IRRADIANCE | LR_PASS_COMPOSE | LR_PASS_BLEND,
+    VIEW = LR_PASS_COMPOSE | LR_PASS_BLEND,
 };
 
 typedef struct fixture {
@@ -87,11 +89,11 @@ static void test_accumulates_until_converged(void **state)
     assert_int_equal(c.samples, 2);
 }
 
-/* The dimmer: composition alone, and the HDR image scales by the intensity ratio. The GPU
+/* The dimmer: the blend pass alone, and the HDR image scales by the intensity ratio. The GPU
  * multiplies the float intensity into products of three or four float factors; the ratio of
  * two such images differs from the ratio of the intensities by at most ~8 roundings of 2^-24:
  * 5e-7 relative; we allow 1e-6. */
-static void test_dimmer_runs_compose_only_and_scales(void **state)
+static void test_dimmer_runs_blend_only_and_scales(void **state)
 {
     fixture *f = *state;
     lr_test_converge(f->r, 8);
@@ -99,7 +101,7 @@ static void test_dimmer_runs_compose_only_and_scales(void **state)
     lr_test_set(f->s, f->r, "light.intensity", "0.002"); /* from 0.005 */
     assert_true(lr_renderer_needs_frame(f->r));
     lr_frame_stats st = lr_test_frame(f->r);
-    assert_int_equal(st.passes, LR_PASS_COMPOSE);
+    assert_int_equal(st.passes, LR_PASS_BLEND);
     assert_int_equal(st.samples, 2);
     assert_false(lr_renderer_needs_frame(f->r));
     float *after = lr_test_hdr(f->r);
@@ -120,12 +122,13 @@ static void test_camera_runs_compose_only(void **state)
     lr_test_converge(f->r, 8);
     lr_test_set(f->s, f->r, "camera.position", "100,-400,250");
     lr_frame_stats st = lr_test_frame(f->r);
-    assert_int_equal(st.passes, LR_PASS_COMPOSE);
+    assert_int_equal(st.passes, VIEW);
     assert_int_equal(st.samples, 2);
     lr_test_set(f->s, f->r, "render.exposure", "1e6");
-    assert_int_equal(lr_test_frame(f->r).passes, LR_PASS_COMPOSE);
+    assert_int_equal(lr_test_frame(f->r).passes, LR_PASS_BLEND);
+    /* Receivers: their irradiance grids, then the view. */
     lr_test_set(f->s, f->r, "receivers[table].albedo", "0.5,0.5,0.5");
-    assert_int_equal(lr_test_frame(f->r).passes, LR_PASS_COMPOSE);
+    assert_int_equal(lr_test_frame(f->r).passes, LR_PASS_IRRADIANCE | VIEW);
 }
 
 static void test_material_runs_maps_vpl_compose(void **state)
@@ -157,7 +160,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_accumulates_until_converged, each_setup, each_teardown),
-        cmocka_unit_test_setup_teardown(test_dimmer_runs_compose_only_and_scales, each_setup, each_teardown),
+        cmocka_unit_test_setup_teardown(test_dimmer_runs_blend_only_and_scales, each_setup, each_teardown),
         cmocka_unit_test_setup_teardown(test_camera_runs_compose_only, each_setup, each_teardown),
         cmocka_unit_test_setup_teardown(test_material_runs_maps_vpl_compose, each_setup, each_teardown),
         cmocka_unit_test_setup_teardown(test_light_move_runs_everything, each_setup, each_teardown),

@@ -486,7 +486,7 @@ static void test_set_dirty_flags(void **state)
     set_ok(s, "light.intensity", "0.0025", LR_DIRTY_INTENSITY);
     assert_true(l->intensity == 0.0025);
     get(s, "lights[0].intensity", "0.0025");
-    assert_int_equal(lr_dirty_passes(LR_DIRTY_INTENSITY), LR_PASS_COMPOSE);
+    assert_int_equal(lr_dirty_passes(LR_DIRTY_INTENSITY), LR_PASS_BLEND);
     set_ok(s, "lights[flame].color", "1,0.5,0.25", LR_DIRTY_INTENSITY);
     assert_true(l->color[1] == 0.5);
     set_ok(s, "lights[0].flicker.amplitude", "0.2", LR_DIRTY_INTENSITY);
@@ -499,7 +499,8 @@ static void test_set_dirty_flags(void **state)
     set_ok(s, "lights[0].flicker.frequency_hz", "9", LR_DIRTY_INTENSITY);
     set_ok(s, "lights[0].flicker.seed", "4", LR_DIRTY_INTENSITY);
     assert_int_equal(lr_dirty_passes(LR_DIRTY_LIGHT_GEOMETRY),
-                     LR_PASS_GBUFFER | LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_COMPOSE);
+                     LR_PASS_GBUFFER | LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_IRRADIANCE |
+                         LR_PASS_COMPOSE | LR_PASS_BLEND);
 
     /* Materials: maps, VPLs and composition, not the light's G-buffer. */
     lr_material marble;
@@ -524,18 +525,20 @@ static void test_set_dirty_flags(void **state)
     set_ok(s, "objects[0].material", "candle_wax", LR_DIRTY_MATERIAL);
     get(s, "objects[0].material.scale", "1");
     assert_int_equal(lr_dirty_passes(LR_DIRTY_MATERIAL),
-                     LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_COMPOSE);
+                     LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_IRRADIANCE | LR_PASS_COMPOSE |
+                         LR_PASS_BLEND);
 
     /* View and receivers: composition only. */
     set_ok(s, "camera.position", "0,-500,250", LR_DIRTY_CAMERA);
     set_ok(s, "camera.fov_deg", "30", LR_DIRTY_CAMERA);
-    assert_int_equal(lr_dirty_passes(LR_DIRTY_CAMERA), LR_PASS_COMPOSE);
+    assert_int_equal(lr_dirty_passes(LR_DIRTY_CAMERA), LR_PASS_COMPOSE | LR_PASS_BLEND);
     set_ok(s, "receivers[wall].albedo", "0.5,0.5,0.5", LR_DIRTY_RECEIVERS);
     set_ok(s, "receivers[table].center", "0,-75,-1", LR_DIRTY_RECEIVERS);
     assert_true(lr_mesh_vertex(lr_scene_receiver_at(s, 0)->mesh, 0).z == -1.0);
-    assert_int_equal(lr_dirty_passes(LR_DIRTY_RECEIVERS), LR_PASS_COMPOSE);
+    assert_int_equal(lr_dirty_passes(LR_DIRTY_RECEIVERS),
+                     LR_PASS_IRRADIANCE | LR_PASS_COMPOSE | LR_PASS_BLEND);
     set_ok(s, "render.exposure", "1e6", LR_DIRTY_DISPLAY);
-    assert_int_equal(lr_dirty_passes(LR_DIRTY_DISPLAY), LR_PASS_COMPOSE);
+    assert_int_equal(lr_dirty_passes(LR_DIRTY_DISPLAY), LR_PASS_BLEND);
     set_ok(s, "render.K", "32", LR_DIRTY_SETTINGS);
     assert_int_equal(lr_scene_render(s)->K, 32);
     set_ok(s, "render.K", "0", LR_DIRTY_SETTINGS); /* 0: the default, as in the file */
@@ -552,7 +555,8 @@ static void test_set_dirty_flags(void **state)
     set_ok(s, "objects[0].transform.translate", "100,0,0", LR_DIRTY_GEOMETRY);
     assert_true(fabs(o->center.x - 100) < 1e-4);
     assert_int_equal(lr_dirty_passes(LR_DIRTY_GEOMETRY),
-                     LR_PASS_GBUFFER | LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_COMPOSE);
+                     LR_PASS_GBUFFER | LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_IRRADIANCE |
+                         LR_PASS_COMPOSE | LR_PASS_BLEND);
     /* The flame stayed at the origin: now outside the moved candle's hull. */
     assert_int_equal(lr_scene_light_enclosure(s, 0, NULL), LR_ENCLOSURE_NONE);
     set_ok(s, "light.position", "100,0,60", LR_DIRTY_LIGHT_GEOMETRY); /* in the wax */
@@ -565,7 +569,7 @@ static void test_set_dirty_flags(void **state)
     assert_int_equal(lr_scene_set(s, "light.intensity", "0.005", &d, &e), LR_OK);
     assert_int_equal(lr_scene_set(s, "camera.far", "5000", &d, &e), LR_OK);
     assert_int_equal(d, LR_DIRTY_INTENSITY | LR_DIRTY_CAMERA);
-    assert_int_equal(lr_dirty_passes(d), LR_PASS_COMPOSE);
+    assert_int_equal(lr_dirty_passes(d), LR_PASS_COMPOSE | LR_PASS_BLEND);
     assert_int_equal(lr_dirty_passes(0), 0);
     assert_string_equal(lr_dirty_name(LR_DIRTY_MATERIAL), "material");
     /* --set KEY=VALUE: split at the first '='. */

@@ -13,7 +13,8 @@
 
 /* The pass names of render/renderer.h's lr_pass_name, kept here so that the stats do not
  * depend on which renderer is linked. */
-static const char *const pass_names[LR_PASS_COUNT] = {"gbuffer", "radiosity", "vpl", "compose"};
+static const char *const pass_names[LR_PASS_COUNT] = {"gbuffer", "radiosity", "vpl", "compose",
+                                                      "blend",   "irradiance"};
 #define PENDING_MAX 1024
 
 typedef struct ev_rec {

@@ -10,6 +10,7 @@
 #include "render/cpu/cavity.h"
 #include "render/cpu/maps.h"
 #include "render/cpu/parallel.h"
+#include "render/cpu/recv_grid.h"
 #include "render/cpu/rng.h"
 #include "render/cpu/vpl.h"
 
@@ -41,6 +42,11 @@ typedef struct rctx {
     double (*gain)[3];   /* [obj * nlight + light]: cavity gain (render/cpu/cavity.h) */
     lr_image *rgb, *var;
     long *object_px, *fallback_px; /* per pixel flags, summed at the end */
+    /* PASS: per receiver, E_vpl and its variance at the grid's texel centres (6 doubles per
+     * texel; render/cpu/recv_grid.h, the GPU's receiver irradiance grid), NULL for a receiver
+     * without a grid. */
+    double **grid;
+    int nrecv;
 } rctx;
 
 static uint64_t seed_of(const rctx *r) { return r->d->seed ? r->d->seed : 1; }
@@ -94,6 +100,24 @@ static void vpl_item(void *p, long item)
             v->var[c] += r->I[l][c] * r->I[l][c] * var[c];
         }
     }
+}
+
+/* E_vpl at texel (item mod R^2) of receiver (item / R^2)'s grid. */
+static void grid_item(void *p, long item)
+{
+    rctx *r = p;
+    const long n = (long)LR_RECV_GRID * LR_RECV_GRID;
+    int i = (int)(item / n), k = (int)(item % n);
+    if (!r->grid[i])
+        return;
+    const lr_receiver *rc = lr_scene_receiver_at(r->s, i);
+    lr_recv_grid_frame f;
+    lr_recv_grid_frame_of(rc, &f);
+    lr_vec3 x = lr_recv_grid_point(&f, k % LR_RECV_GRID, k / LR_RECV_GRID);
+    double *E = r->grid[i] + 6 * (size_t)k;
+    for (int o = 0; o < r->nobj; o++)
+        lr_cpu_vpl_irradiance(r->vpl + (size_t)o * r->nvpl, r->nvpl,
+                              lr_scene_object_at(r->s, o)->coeffs.eta, x, rc->normal, E, E + 3);
 }
 
 /* Nearest hit of the camera ray among objects (kind 0) and receivers (kind 1). */
@@ -170,10 +194,23 @@ static void pixel_item(void *p, long item)
             for (int c = 0; c < 3; c++)
                 E[c] += r->I[l][c] * ed;
         }
-        if (!r->d->no_vpl)
+        if (!r->d->no_vpl && r->grid && r->grid[idx]) {
+            /* The GPU's receiver irradiance grid: bilinear over texel centres. */
+            lr_recv_grid_frame f;
+            lr_recv_grid_frame_of(rc, &f);
+            int ti[4];
+            double tw[4];
+            lr_recv_grid_taps(&f, x, ti, tw);
+            for (int q = 0; q < 4; q++)
+                for (int c = 0; c < 3; c++) {
+                    E[c] += tw[q] * r->grid[idx][6 * (size_t)ti[q] + c];
+                    EV[c] += tw[q] * r->grid[idx][6 * (size_t)ti[q] + 3 + c];
+                }
+        } else if (!r->d->no_vpl) {
             for (int o = 0; o < r->nobj; o++)
                 lr_cpu_vpl_irradiance(r->vpl + (size_t)o * r->nvpl, r->nvpl,
                                       lr_scene_object_at(r->s, o)->coeffs.eta, x, n, E, EV);
+        }
         for (int c = 0; c < 3; c++) {
             L[c] = rc->albedo[c] / M_PI * E[c];
             V[c] = rc->albedo[c] * rc->albedo[c] / (M_PI * M_PI) * EV[c];
@@ -283,6 +320,27 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
         if (ref)
             samples += 3.0 * r.samples * nv * r.nlight;
     }
+    /* The twin of the GPU's receiver irradiance grids (PASS only: the reference sums the VPLs
+     * at every pixel). The variance is interpolated like E (the taps share their VPLs). */
+    r.nrecv = lr_scene_receiver_count(s);
+    if (!ref && r.nvpl > 0 && r.nrecv > 0) {
+        const size_t n = (size_t)LR_RECV_GRID * LR_RECV_GRID;
+        r.grid = calloc((size_t)r.nrecv, sizeof *r.grid);
+        if (!r.grid) {
+            rc = lr_err_set(e, LR_ENOMEM, "cpu render: out of memory");
+            goto fail;
+        }
+        for (int i = 0; i < r.nrecv; i++) {
+            lr_recv_grid_frame f;
+            if (!lr_recv_grid_frame_of(lr_scene_receiver_at(s, i), &f))
+                continue;
+            if (!(r.grid[i] = calloc(6 * n, sizeof **r.grid))) {
+                rc = lr_err_set(e, LR_ENOMEM, "cpu render: receiver grid: out of memory");
+                goto fail;
+            }
+        }
+        lr_cpu_parallel_for((long)(r.nrecv * n), d->threads, grid_item, &r);
+    }
     lr_cpu_parallel_for((long)r.W * r.H, d->threads, pixel_item, &r);
     long objpx = 0, fbpx = 0;
     for (long i = 0; i < (long)r.W * r.H; i++) {
@@ -301,6 +359,10 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
         stats->vpls = nv;
     }
 fail:
+    if (r.grid)
+        for (int i = 0; i < r.nrecv; i++)
+            free(r.grid[i]);
+    free(r.grid);
     if (r.maps)
         for (int i = 0; i < r.nobj * r.nlight; i++)
             lr_cpu_maps_destroy(r.maps[i]);

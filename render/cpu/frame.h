@@ -3,7 +3,9 @@
  *   LR_CPU_PASS       the CPU twin of the GPU renderer: per object and light, K radiosity maps
  *                     accumulated over `frames` frames (maps.h), Algorithm 1 per camera pixel,
  *                     L_o = I F_t(w_o) B / pi; receivers lit directly (shadow rays) and by the
- *                     scene's N_vpl VPLs with B from Algorithm 1 (vpl.h).
+ *                     scene's N_vpl VPLs with B from Algorithm 1 (vpl.h), on plane receivers
+ *                     through the GPU's receiver irradiance grid (recv_grid.h: E_vpl at its
+ *                     texel centres, bilinear in between).
  *   LR_CPU_REFERENCE  the converged reference of the same model: per pixel x_o is ray-cast and B
  *                     is evaluated there with the untruncated estimator (radiosity.h,
  *                     `samples` per band), no maps; receivers by direct light plus many VPLs

@@ -69,11 +69,16 @@ typedef struct lr_eval_row {
     bool vpl;
     double frame_ms; /* median ms of one accumulation frame (radiosity + vpl + compose) */
     double rel_rmse, rel_rmse_object, rel_rmse_receivers; /* against the physical reference */
-    double ms[LR_PASS_COUNT]; /* per pass: gbuffer (full update), radiosity, vpl, compose */
+    double ms[LR_PASS_COUNT]; /* per pass: gbuffer (full update), radiosity, vpl, compose, blend
+                               * (the CSV has the first LR_EVAL_CSV_PASSES: the blend is in
+                               * frame_ms) */
     double bias_object, bias_receivers;   /* converged model vs physical reference */
     double noise_object, noise_receivers; /* `frames` frames vs converged model */
     int width, height;
 } lr_eval_row;
+
+/* Pass columns of the CSV: ms_gbuffer .. ms_compose. */
+enum { LR_EVAL_CSV_PASSES = 4 };
 
 /* The columns, in order (the planner reads them by name; the first seven are issue 6's). */
 #define LR_EVAL_CSV_HEADER                                                                   \

@@ -37,7 +37,7 @@ void lr_eval_csv_print(FILE *f, const lr_eval_row *rows, int n)
         num(f, r->rel_rmse_receivers, "%.5f");
         fprintf(f, ",%d,%d,%d,%d,%d,%d,%s", r->K, r->N, r->N_vpl, r->map_size, r->gbuffer_size,
                 r->frames, r->vpl ? "on" : "off");
-        for (int p = 0; p < LR_PASS_COUNT; p++)
+        for (int p = 0; p < LR_EVAL_CSV_PASSES; p++)
             num(f, r->ms[p], "%.3f");
         num(f, r->bias_object, "%.5f");
         num(f, r->bias_receivers, "%.5f");

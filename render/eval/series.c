@@ -67,7 +67,10 @@ int lr_eval_series_run(const lr_eval_series_desc *d, lr_eval_series *out, lr_err
     for (int p = 0; p <= LR_PASS_COUNT; p++)
         acc[p] = malloc((size_t)d->converge_frames * sizeof(double));
     lr_renderer *r = NULL;
-    if (!tmp || !acc[0] || !acc[1] || !acc[2] || !acc[3] || !acc[4]) {
+    bool oom = !tmp;
+    for (int p = 0; p <= LR_PASS_COUNT; p++)
+        oom |= !acc[p];
+    if (oom) {
         rc = lr_err_set(e, LR_ENOMEM, "series: out of memory");
         goto done;
     }

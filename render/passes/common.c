@@ -8,6 +8,17 @@
 #include "render/cpu/cavity.h"
 #include "render/passes/passes.h"
 
+#define STR_(x) #x
+#define STR(x) STR_(x)
+
+const char *const *lr_passes_defines(void)
+{
+    static const char *const defines[] = {"LR_MAX_OBJECTS " STR(LR_MAX_OBJECTS),
+                                          "LR_MAX_K " STR(LR_MAX_K),
+                                          "LR_MAX_LIGHTS " STR(LR_MAX_LIGHTS), NULL};
+    return defines;
+}
+
 static int upload(lr_gpu_mesh *g, const lr_mesh *m, lr_err *e)
 {
     size_t nv = lr_mesh_vertex_count(m), nt = lr_mesh_triangle_count(m);

@@ -15,6 +15,7 @@
 #include "render/gl/tex.h"
 #include "render/gl/timer.h"
 #include "render/image/image.h"
+#include "render/passes/blend.h"
 #include "render/renderer.h"
 #include "render/scene/scene.h"
 
@@ -57,7 +58,7 @@ struct lr_renderer {
     char shader_dir[512];
     lr_timer *timer;
 
-    lr_program *p_surface, *p_depth, *p_radiosity, *p_vpl, *p_obj, *p_recv, *p_tonemap, *p_blit;
+    lr_program *p_surface, *p_depth, *p_radiosity, *p_vpl, *p_obj, *p_recv, *p_blit, *p_irr;
 
     /* Settings the resources were made for. */
     lr_render_settings rs;
@@ -127,9 +128,28 @@ struct lr_renderer {
         bool outer_valid;
     } vpl;
 
-    /* Output. */
-    lr_tex *hdr, *ldr;
-    lr_fb *fb_hdr, *fb_ldr;
+    /* Receiver irradiance grids (irradiance.c, render/cpu/recv_grid.h): E_vpl per light at
+     * unit intensity, layers layer[i] + l for plane receiver i (-1: not cached). */
+    struct {
+        lr_tex *grid;
+        lr_fb *fb[LR_MAX_RECEIVERS];
+        int layer[LR_MAX_RECEIVERS];
+        int n_receivers, n_lights; /* what the grids were allocated for */
+        bool valid;                /* drawn from the current VPLs */
+    } irr;
+
+    /* Composition's output, owned by compose.c: one linear image per light for unit
+     * intensity (layer l of `images`, colour attachment l of `fb`), alpha 0 on object pixels
+     * no map sees. Valid until the view, the receivers or the transport change. */
+    struct {
+        lr_tex *images;
+        lr_fb *fb;
+        int n;      /* layers (the scene's lights when allocated) */
+        bool valid; /* composed since the last (re)allocation */
+    } img;
+
+    /* The blend pass (render/passes/blend.h): tone-mapped output and HDR sum. */
+    lr_blend *blend;
 
     unsigned dirty;
     int frame_index;
@@ -140,6 +160,8 @@ struct lr_renderer {
 };
 
 /* common.c */
+/* The shaders' defines (LR_MAX_OBJECTS, LR_MAX_K, LR_MAX_LIGHTS), NULL-terminated. */
+const char *const *lr_passes_defines(void);
 int lr_passes_upload_meshes(lr_renderer *r, lr_err *e);
 void lr_passes_free_meshes(lr_renderer *r);
 void lr_passes_draw(const lr_gpu_mesh *m);
@@ -180,6 +202,15 @@ int lr_pass_gbuffer(lr_renderer *r, lr_err *e);
 int lr_pass_radiosity(lr_renderer *r, bool restart, lr_err *e);
 int lr_pass_vpl(lr_renderer *r, bool geometry_changed, lr_err *e);
 int lr_pass_compose(lr_renderer *r, lr_err *e);
+/* Receiver irradiance grids from the VPLs (irradiance.c). */
+int lr_pass_irradiance(lr_renderer *r, lr_err *e);
+void lr_irradiance_free(lr_renderer *r);
+/* The VPL inputs of lib/vpl_irradiance.glsl (units 7..10). */
+void lr_passes_bind_vpls(lr_renderer *r, const lr_program *p);
+/* Receiver i's grid for compose_receiver.frag (unit 15), or u_cached = false. */
+void lr_passes_bind_irradiance(lr_renderer *r, const lr_program *p, int receiver);
+/* The blend of r->img with the lights' intensity x colour x flicker (render/passes/blend.h). */
+int lr_pass_blend(lr_renderer *r, lr_err *e);
 
 /* Resources of each pass (allocated for r->rs). */
 int lr_gbuffer_alloc(lr_renderer *r, lr_err *e);

@@ -8,7 +8,7 @@
 
 enum lr_dirty {
     /* Light intensity, colour or flicker (the dimmer): light transport is linear in it, so
-     * only the final composition rescales. */
+     * only the blend of the per-light unit-intensity images runs. */
     LR_DIRTY_INTENSITY = 1u << 0,
     /* A light moved, turned or changed its cone: everything. (Flicker fields are
      * LR_DIRTY_INTENSITY: the renderer applies flicker at composition.) */
@@ -24,7 +24,7 @@ enum lr_dirty {
      * and the light at composition time and take no part in the transport through the
      * object. */
     LR_DIRTY_RECEIVERS = 1u << 5,
-    /* Exposure (tone mapping): composition only. */
+    /* Exposure (tone mapping): the blend only. */
     LR_DIRTY_DISPLAY = 1u << 6,
     /* Render settings (K, N, map sizes, frames) or the quality budget: the renderer
      * reallocates and restarts accumulation; everything. */
@@ -36,7 +36,9 @@ enum lr_pass {
     LR_PASS_GBUFFER = 1u << 0,   /* light G-buffer */
     LR_PASS_RADIOSITY = 1u << 1, /* K scattered-radiosity maps (restart accumulation) */
     LR_PASS_VPL = 1u << 2,       /* virtual point lights on the outer surface */
-    LR_PASS_COMPOSE = 1u << 3,   /* composition, tone mapping, output */
+    LR_PASS_COMPOSE = 1u << 3,   /* composition: one unit-intensity linear image per light */
+    LR_PASS_BLEND = 1u << 4,     /* sum_l I_l image_l, tone mapping, output (passes/blend.h) */
+    LR_PASS_IRRADIANCE = 1u << 5, /* receiver irradiance grids from the VPLs (before compose) */
 };
 
 /* The passes a dirty mask requires (0 for an empty mask: keep accumulating). */

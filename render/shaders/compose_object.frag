@@ -1,7 +1,8 @@
-// Pass 3 for the translucent objects: I B = sum_l I_l B_l from every light's K maps (Algorithm
-// 1, the gather weighted by the intensities I_l = intensity * colour, each times this object's
-// cavity gain for light l, PIPELINE.md "Energy": render/passes/compose.c sets u_light_w per
-// object), then L_o = F_t(w_o) I B / pi (seed 003 Eq. 5).
+// Pass 3 for the translucent objects, one image per light at unit intensity: B_l from light
+// l's K maps (Algorithm 1 with the same taps for every light, lr_gather_each; each times this
+// object's cavity gain for light l, PIPELINE.md "Energy": render/passes/compose.c sets
+// u_light_w per object), then L_o,l = F_t(w_o) B_l / pi (seed 003 Eq. 5). The blend pass
+// weights the images with the lights' intensities (render/passes/blend.h).
 #include "lib/material.glsl"
 #include "lib/gather.glsl"
 
@@ -12,7 +13,10 @@ uniform bool u_two_sided;
 uniform vec3 u_eye;          // camera position (perspective)
 uniform vec3 u_view_dir;     // camera forward (orthographic)
 uniform bool u_ortho;
-layout(location = 0) out vec4 o_color;
+// Output i is light i's image (colour attachment i; those beyond the scene's lights are not
+// attached and their writes are dropped). GLSL ES indexes outputs by constants only, hence
+// the unrolled writes for LR_MAX_LIGHTS = 4 (render/passes/passes.h).
+layout(location = 0) out vec4 o_light[LR_MAX_LIGHTS];
 
 void main()
 {
@@ -21,8 +25,13 @@ void main()
         no = -no;
     vec3 wo = u_ortho ? -u_view_dir : normalize(u_eye - v_pos);
     float n;
-    vec3 B = lr_gather(v_pos, no, n);
+    vec3 Bl[LR_MAX_LIGHTS];
+    lr_gather_each(v_pos, no, n, Bl);
     float eta = lr_material(u_object).eta;
-    float Ft = lr_fresnel_transmittance(abs(dot(no, wo)), eta);
-    o_color = vec4(Ft * B / LR_PI, n > 0.0 ? 1.0 : 0.0);
+    float s = lr_fresnel_transmittance(abs(dot(no, wo)), eta) / LR_PI;
+    float a = n > 0.0 ? 1.0 : 0.0;
+    o_light[0] = vec4(s * Bl[0], a);
+    o_light[1] = vec4(s * Bl[1], a);
+    o_light[2] = vec4(s * Bl[2], a);
+    o_light[3] = vec4(s * Bl[3], a);
 }

@@ -1,85 +1,54 @@
-// Pass 3 for the diffuse receivers (table, wall): L = albedo / pi (E_direct + E_vpl)
-// (render/passes/PIPELINE.md, pass 4), summed over the lights. E_direct: each light's
-// intensity / distance^2 * cos, shadowed by the objects through that light's G-buffer. E_vpl:
-// the VPLs with the bounded geometry term, A_v bounding the singularity; VPL v carries B per
-// light for unit intensity (row l of u_vpl_B), weighted by I_l.
+// Pass 3 for the diffuse receivers (table, wall): L_l = albedo / pi (E_direct,l + E_vpl,l)
+// (render/passes/PIPELINE.md, pass 4), one image per light l at unit intensity (the blend pass
+// weights them). E_direct,l: 1 / distance^2 * cos, shadowed by the objects through light l's
+// G-buffer, per pixel. E_vpl,l: from the receiver irradiance grid where the receiver has one
+// (a plane: irradiance.frag filled it, render/cpu/recv_grid.h; bilinear over texel centres,
+// clamped at the edges), else the sum over the VPLs here (lib/vpl_irradiance.glsl).
 #include "lib/material.glsl"
 #include "lib/lights.glsl"
+#include "lib/vpl_irradiance.glsl"
 
 in vec3 v_pos;
 in vec3 v_nrm;
 uniform vec3 u_albedo;
-// Per light l and object i, element l LR_MAX_OBJECTS + i: light sent back into a cavity
-// around light l (PIPELINE.md "Energy"); multiplies light l's B of the VPLs of object i.
-uniform vec3 u_cavity_gain[LR_MAX_LIGHTS * LR_MAX_OBJECTS];
 uniform bool u_use_vpl;
-uniform highp sampler2D u_vpl_pos; // x_v, A_v
-uniform highp sampler2D u_vpl_nrm; // n_v, object id
-uniform highp sampler2D u_vpl_B;   // B_v per light (row l), unit intensity
-uniform int u_n_vpl;
-// VPL visibility (beyond seed 003, whose VPLs have none): the segment from the VPL to x is
-// blocked where it passes inside the objects' outer envelope, i.e. nearer to the VPL centre c
-// than the outermost surface in that direction (the VPL pass's cube map; exact for objects
-// star-shaped around c, and a hollow shade counts as solid, which is right for light leaving
-// its outer surface: it would have to cross the wall again).
-uniform bool u_vpl_vis;
-uniform highp samplerCube u_outer_pos;
-uniform vec3 u_center;
-uniform float u_vis_eps; // mm: the start is moved this far off the surface along n_v
-layout(location = 0) out vec4 o_color;
-
-#define LR_VIS_STEPS 8
-
-bool vpl_visible(vec3 xv, vec3 nv, vec3 x)
-{
-    vec3 a = xv + u_vis_eps * nv;
-    for (int s = 1; s <= LR_VIS_STEPS; s++) {
-        vec3 p = mix(a, x, float(s) / float(LR_VIS_STEPS + 1));
-        vec3 d = p - u_center;
-        vec4 o = texture(u_outer_pos, d);
-        vec3 od = o.xyz - u_center;
-        if (o.w > 0.5 && dot(d, d) < dot(od, od))
-            return false;
-    }
-    return true;
-}
+uniform bool u_cached;               // this receiver has a grid
+uniform highp sampler2DArray u_irr;  // grids, layer u_irr_layer + l for light l
+uniform int u_irr_layer;
+uniform vec3 u_grid_c, u_grid_a, u_grid_b; // centre; axes divided by the plane's w and h
+// Output l is light l's image (unrolled writes: GLSL ES indexes outputs by constants only).
+layout(location = 0) out vec4 o_light[LR_MAX_LIGHTS];
 
 void main()
 {
     vec3 x = v_pos;
     vec3 nx = normalize(v_nrm);
-    vec3 E = vec3(0.0);
-    for (int l = 0; l < LR_MAX_LIGHTS; l++) {
-        if (l >= u_n_lights)
-            break;
-        E += u_lights_I[l] * lr_lights_direct(l, x, nx);
-    }
-    if (u_use_vpl) {
-        for (int v = 0; v < u_n_vpl; v++) {
-            vec4 p = texelFetch(u_vpl_pos, ivec2(v, 0), 0);
-            if (!(p.w > 0.0))
-                continue;
-            vec4 nv = texelFetch(u_vpl_nrm, ivec2(v, 0), 0);
-            vec3 dv = x - p.xyz;
-            float d2 = dot(dv, dv);
-            vec3 w = dv * inversesqrt(max(d2, 1e-30));
-            float cv = dot(nv.xyz, w);
-            float cx = -dot(nx, w);
-            if (!(cv > 0.0 && cx > 0.0))
-                continue;
-            if (u_vpl_vis && !vpl_visible(p.xyz, nv.xyz, x))
-                continue;
-            int id = clamp(int(nv.w + 0.5), 0, LR_MAX_OBJECTS - 1);
-            float eta = lr_material(id).eta;
-            vec3 B = vec3(0.0);
-            for (int l = 0; l < LR_MAX_LIGHTS; l++) {
-                if (l >= u_n_lights)
-                    break;
-                B += u_lights_I[l] * u_cavity_gain[l * LR_MAX_OBJECTS + id] *
-                     texelFetch(u_vpl_B, ivec2(v, l), 0).rgb;
-            }
-            E += lr_fresnel_transmittance(cv, eta) * B / LR_PI * p.w * cv * cx / max(d2, p.w);
+    vec3 E[LR_MAX_LIGHTS];
+    for (int l = 0; l < LR_MAX_LIGHTS; l++)
+        E[l] = vec3(l < u_n_lights ? lr_lights_direct(l, x, nx) : 0.0);
+    if (u_use_vpl && u_cached) {
+        int R = textureSize(u_irr, 0).x;
+        vec3 d = x - u_grid_c;
+        vec2 f = (vec2(dot(d, u_grid_a), dot(d, u_grid_b)) + 0.5) * float(R) - 0.5;
+        vec2 i0 = floor(f);
+        vec2 w = f - i0;
+        ivec2 a = clamp(ivec2(i0), ivec2(0), ivec2(R - 1));
+        ivec2 b = clamp(ivec2(i0) + 1, ivec2(0), ivec2(R - 1));
+        for (int l = 0; l < LR_MAX_LIGHTS; l++) {
+            if (l >= u_n_lights)
+                break;
+            int z = u_irr_layer + l;
+            E[l] += (1.0 - w.y) * ((1.0 - w.x) * texelFetch(u_irr, ivec3(a.x, a.y, z), 0).rgb +
+                                   w.x * texelFetch(u_irr, ivec3(b.x, a.y, z), 0).rgb) +
+                    w.y * ((1.0 - w.x) * texelFetch(u_irr, ivec3(a.x, b.y, z), 0).rgb +
+                           w.x * texelFetch(u_irr, ivec3(b.x, b.y, z), 0).rgb);
         }
+    } else if (u_use_vpl) {
+        lr_vpl_irradiance(x, nx, E);
     }
-    o_color = vec4(u_albedo / LR_PI * E, 1.0);
+    vec3 alb = u_albedo / LR_PI;
+    o_light[0] = vec4(alb * E[0], 1.0);
+    o_light[1] = vec4(alb * E[1], 1.0);
+    o_light[2] = vec4(alb * E[2], 1.0);
+    o_light[3] = vec4(alb * E[3], 1.0);
 }

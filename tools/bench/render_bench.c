@@ -5,8 +5,11 @@
  *     maps restart), median per pass and of the total; ACCUM_FRAMES accumulation frames
  *     (nothing dirty: radiosity + vpl + compose; render.frames is set to 1 + ACCUM_FRAMES so
  *     that the maps have converged after them), median total; DIMMER_FRAMES dimmer-only frames
- *     (light.intensity alternately halved and restored: compose alone), median total. The
- *     ratio is full update / dimmer-only.
+ *     (light.intensity alternately halved and restored: the blend pass alone), median total;
+ *     CAMERA_FRAMES camera-only frames (compose + blend); the floor (issue 11): a fullscreen
+ *     pass reading one RGBA16F texture into the output (lr_renderer_debug_floor_ms). Ratios:
+ *     full update / dimmer, compose / dimmer (the dimmer against a composition), dimmer /
+ *     floor, compose / camera.
  * (2) Error against accumulated frames, at ERR_W x ERR_H with reduced settings (ERR_K maps of
  *     ERR_MAP^2, ERR_N samples): relative RMSE of the GPU image after 1, 4, 16 and 64 frames,
  *     sqrt(sum (g - r)^2 / sum r^2) over the bands of the masked pixels, in linear light,
@@ -24,6 +27,7 @@
  * 6 minutes on 2 shared cores with llvmpipe (timing 3.3, error 2.5). */
 #include "tools/bench/bench.h"
 
+#include <GLES3/gl31.h>
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
@@ -37,9 +41,10 @@
 #include "render/mesh/bvh.h"
 #include "render/image/image.h"
 #include "render/renderer.h"
+#include "render/renderer_debug.h"
 #include "render/scene/scene.h"
 
-enum { FULL_FRAMES = 3, ACCUM_FRAMES = 4, DIMMER_FRAMES = 5 };
+enum { FULL_FRAMES = 3, ACCUM_FRAMES = 4, DIMMER_FRAMES = 5, CAMERA_FRAMES = 3, FLOOR_REPS = 9 };
 enum { ERR_W = 160, ERR_H = 120, ERR_K = 8, ERR_MAP = 64, ERR_N = 4, SELF_FRAMES = 256,
        REF_SAMPLES = 4096 };
 
@@ -107,6 +112,10 @@ typedef struct timing_row {
     const char *scene;
     int w, h;
     double pass_ms[LR_PASS_COUNT], total_ms, accum_ms, dimmer_ms;
+    double floor_ms;  /* one RGBA16F fetch per pixel into the output (the floor, issue 11),
+                       * wall time glFinish to glFinish */
+    double dimmer_wall_ms; /* a dimmer frame the same way: lr_renderer_frame + glFinish */
+    double camera_ms; /* camera-only change (composition of the per-light images + blend) */
 } timing_row;
 
 static int frame(lr_renderer *r, lr_frame_stats *st)
@@ -138,7 +147,7 @@ static int time_one(lr_gl *gl, const char *name, int w, int h, timing_row *row)
     }
     *row = (timing_row){.scene = name, .w = w, .h = h};
     double full[LR_PASS_COUNT][FULL_FRAMES], total[FULL_FRAMES], acc[ACCUM_FRAMES],
-        dim[DIMMER_FRAMES];
+        dim[DIMMER_FRAMES], dimw[DIMMER_FRAMES];
     lr_frame_stats st;
     for (int i = 0; i < FULL_FRAMES; i++) {
         lr_renderer_invalidate(r, LR_DIRTY_LIGHT_GEOMETRY);
@@ -159,13 +168,39 @@ static int time_one(lr_gl *gl, const char *name, int w, int h, timing_row *row)
         if (set_num(s, "light.intensity", i % 2 ? I0 : 0.5 * I0, &dirty))
             goto done;
         lr_renderer_invalidate(r, dirty);
+        glFinish();
+        double w0 = lrb_now();
         if (frame(r, &st))
             goto done;
-        if (st.passes != LR_PASS_COMPOSE)
-            fprintf(stderr, "bench render: dimmer frame ran passes 0x%x, not compose alone\n",
+        glFinish();
+        dimw[i] = (lrb_now() - w0) * 1e3;
+        if (st.passes != LR_PASS_BLEND)
+            fprintf(stderr, "bench render: dimmer frame ran passes 0x%x, not the blend alone\n",
                     st.passes);
         dim[i] = st.total_ms;
     }
+    /* Camera-only changes: the camera moved 1 mm sideways and back. */
+    double cam[CAMERA_FRAMES];
+    lr_vec3 c0 = lr_scene_camera(s)->position;
+    for (int i = 0; i < CAMERA_FRAMES; i++) {
+        char val[96];
+        snprintf(val, sizeof val, "%.17g,%.17g,%.17g", c0.x + (i % 2 ? 0.0 : 1.0), c0.y, c0.z);
+        unsigned dirty = 0;
+        if (lr_scene_set(s, "camera.position", val, &dirty, &e)) {
+            fprintf(stderr, "bench render: camera.position: %s\n", e.msg);
+            goto done;
+        }
+        lr_renderer_invalidate(r, dirty);
+        if (frame(r, &st))
+            goto done;
+        cam[i] = st.total_ms;
+    }
+    if (lr_renderer_debug_floor_ms(r, FLOOR_REPS, &row->floor_ms, &e)) {
+        fprintf(stderr, "bench render: floor pass: %s\n", e.msg);
+        goto done;
+    }
+    row->camera_ms = median(cam, CAMERA_FRAMES);
+    row->dimmer_wall_ms = median(dimw, DIMMER_FRAMES);
     for (int p = 0; p < LR_PASS_COUNT; p++)
         row->pass_ms[p] = median(full[p], FULL_FRAMES);
     row->total_ms = median(total, FULL_FRAMES);
@@ -357,11 +392,13 @@ static int write_csvs(const timing_row *t, int nt, const error_row *er, int ne)
         goto fail;
     f = lr_atomic_file_stream(af);
     fprintf(f, "scene,resolution,gbuffer_ms,radiosity_ms,vpl_ms,compose_ms,total_ms,accum_ms,"
-               "dimmer_ms,ratio\n");
+               "dimmer_ms,ratio,blend_ms,floor_ms,camera_ms,dimmer_wall_ms\n");
     for (int i = 0; i < nt; i++)
-        fprintf(f, "%s,%dx%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.2f\n", t[i].scene, t[i].w,
-                t[i].h, t[i].pass_ms[0], t[i].pass_ms[1], t[i].pass_ms[2], t[i].pass_ms[3],
-                t[i].total_ms, t[i].accum_ms, t[i].dimmer_ms, t[i].total_ms / t[i].dimmer_ms);
+        fprintf(f, "%s,%dx%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.2f,%.3f,%.3f,%.3f,%.3f\n", t[i].scene,
+                t[i].w, t[i].h, t[i].pass_ms[0], t[i].pass_ms[1], t[i].pass_ms[2],
+                t[i].pass_ms[3], t[i].total_ms, t[i].accum_ms, t[i].dimmer_ms,
+                t[i].total_ms / t[i].dimmer_ms, t[i].pass_ms[4], t[i].floor_ms, t[i].camera_ms,
+                t[i].dimmer_wall_ms);
     if (lr_atomic_file_commit(af, &e))
         goto fail;
 errors:
@@ -431,17 +468,25 @@ static int run(FILE *out)
     fprintf(out, "## Renderer (`lamprig-bench render`)\n\n");
     if (nt) {
         fprintf(out, "Frame times, ms (full update: every pass, median of %d; accumulation: radiosity "
-                     "+ vpl + compose, median of %d; dimmer: compose alone, median of %d). Scenes' own "
-                     "settings (K 16, N 16, 256² maps).\n\n",
-                FULL_FRAMES, ACCUM_FRAMES, DIMMER_FRAMES);
-        fprintf(out, "| scene | size | gbuffer | radiosity | vpl | compose | full update | "
-                     "accumulation | dimmer | full / dimmer |\n");
-        fprintf(out, "|---|---|---|---|---|---|---|---|---|---|\n");
+                     "+ vpl + compose + blend, median of %d; dimmer: the blend alone, median of %d; "
+                     "camera: a camera move, compose + blend, median of %d; floor: a fullscreen "
+                     "pass reading one RGBA16F texture into the output, median of %d). Pass times "
+                     "are the renderer's timers; \"dimmer wall\" and \"floor\" are wall time "
+                     "from glFinish to glFinish (what a caller waits), so dimmer / floor compares "
+                     "like with like. Scenes' own settings (K 16, N 16, 256² maps).\n\n",
+                FULL_FRAMES, ACCUM_FRAMES, DIMMER_FRAMES, CAMERA_FRAMES, FLOOR_REPS);
+        fprintf(out, "| scene | size | gbuffer | radiosity | vpl | compose | blend | full update | "
+                     "accumulation | dimmer | dimmer wall | floor | camera | full / dimmer | "
+                     "compose / dimmer | dimmer wall / floor | compose / camera |\n");
+        fprintf(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
         for (int i = 0; i < nt; i++)
-            fprintf(out, "| %s | %d×%d | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.0f |\n",
+            fprintf(out, "| %s | %d×%d | %.1f | %.1f | %.1f | %.1f | %.2f | %.1f | %.1f | %.2f | "
+                         "%.2f | %.2f | %.1f | %.0f | %.0f | %.2f | %.2f |\n",
                     t[i].scene, t[i].w, t[i].h, t[i].pass_ms[0], t[i].pass_ms[1], t[i].pass_ms[2],
-                    t[i].pass_ms[3], t[i].total_ms, t[i].accum_ms, t[i].dimmer_ms,
-                    t[i].total_ms / t[i].dimmer_ms);
+                    t[i].pass_ms[3], t[i].pass_ms[4], t[i].total_ms, t[i].accum_ms, t[i].dimmer_ms,
+                    t[i].dimmer_wall_ms, t[i].floor_ms, t[i].camera_ms,
+                    t[i].total_ms / t[i].dimmer_ms, t[i].pass_ms[3] / t[i].dimmer_ms,
+                    t[i].dimmer_wall_ms / t[i].floor_ms, t[i].pass_ms[3] / t[i].camera_ms);
     }
     fprintf(out, "\nRenderer: %s.\n\n", info_line);
     fprintf(out, "Relative RMSE (linear light, sqrt(Σ(g−r)²/Σr²) over the bands of the masked "

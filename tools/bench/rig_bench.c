@@ -97,9 +97,8 @@ static int write_file(const char *path, const char *text)
 }
 
 /* A rig config with the shipped sim rig's budget, output and control map, driven by script;
- * steady: the flame's flicker off (the candle flickers by default, and a flickering light
- * composes a frame every frame interval, so the rig is never idle). */
-static int write_rig(const char *path, const char *script, bool steady)
+ * extra_set: more scene_set entries (", \"key\": value"), or "". */
+static int write_rig_set(const char *path, const char *script, const char *extra_set)
 {
     char text[3 * PATH_MAX + 1024];
     snprintf(text, sizeof text,
@@ -111,8 +110,15 @@ static int write_rig(const char *path, const char *script, bool steady)
              " \"controls\": \"%s/controls/candle.json\",\n"
              " \"output\": {\"mode\": \"headless\", \"width\": 320, \"height\": 240, \"fps\": 30},\n"
              " \"safe_level\": 0, \"stats\": {\"period_s\": 60}}\n",
-             configs, steady ? ", \"lights[0].flicker.amplitude\": 0" : "", script, configs);
+             configs, extra_set, script, configs);
     return write_file(path, text);
+}
+
+/* steady: the flame's flicker off (the candle flickers by default, and a flickering light
+ * wants a frame every frame interval, so the rig is never idle). */
+static int write_rig(const char *path, const char *script, bool steady)
+{
+    return write_rig_set(path, script, steady ? ", \"lights[0].flicker.amplitude\": 0" : "");
 }
 
 static int reap(pid_t pid, double guard_s)
@@ -200,7 +206,16 @@ typedef struct idle_row {
  * flickering flame composes every frame and is never quiet). Returns 1 on a real error (it
  * could not start, exited on its own, or did not exit cleanly on SIGTERM; the log goes to
  * stderr), else 0 with the figure or the reason in *row. */
+static int idle_cpu_after(char *const argv[], const char *log, bool wait_quiet, double warm_s,
+                          idle_row *row);
 static int idle_cpu(char *const argv[], const char *log, bool wait_quiet, idle_row *row)
+{
+    return idle_cpu_after(argv, log, wait_quiet, wait_quiet ? 30.0 : 3.0, row);
+}
+
+/* As idle_cpu, with the longest wait for quiet (wait_quiet) or the fixed warm-up given. */
+static int idle_cpu_after(char *const argv[], const char *log, bool wait_quiet, double warm_s,
+                          idle_row *row)
 {
     *row = (idle_row){.pct = -1};
     pid_t pid = spawn(argv, log);
@@ -210,7 +225,7 @@ static int idle_cpu(char *const argv[], const char *log, bool wait_quiet, idle_r
     }
     long prev = -1;
     bool alive = true;
-    for (int i = 0; i < (wait_quiet ? 60 : 6); i++) { /* 30 s, or the 3 s warm-up */
+    for (int i = 0; i < (int)(warm_s / 0.5 + 0.5); i++) {
         sleep_s(0.5);
         long t = cpu_ticks(pid);
         if (t < 0) {
@@ -273,6 +288,37 @@ static void print_idle_row(FILE *out, const char *rig, const idle_row *row)
         fprintf(out, "| %s | not measured: %s |\n", rig, row->why[0] ? row->why : "unknown");
 }
 
+/* Issue 11: idle CPU with the flame flickering or steady. A flickering flame wants a frame (the
+ * blend pass alone once converged) every frame interval, so the process never goes quiet:
+ * instead of waiting for quiet, wait SETTLE_S (the 8-frame scene converges well within it),
+ * then the CPU % over IDLE_WINDOW_S. */
+#define SETTLE_S 10.0
+
+/* configs/rig/modbus-demo.json with its scene path made absolute and the flame's flicker
+ * amplitude set to amp (the demo ships it at 0). */
+static int write_modbus_flicker(const char *src, const char *path, double amp)
+{
+    FILE *f = fopen(src, "r");
+    if (!f)
+        return 1;
+    char in[8192], out[8192 + PATH_MAX];
+    size_t n = fread(in, 1, sizeof in - 1, f);
+    fclose(f);
+    in[n] = '\0';
+    const char *key = "\"lights[0].flicker.amplitude\": 0", *scn = "\"../scenes/candle.json\"";
+    char *k = strstr(in, key), *sc = strstr(in, scn);
+    if (!k || !sc || sc > k)
+        return 1;
+    *sc = '\0';
+    *k = '\0';
+    int m = snprintf(out, sizeof out,
+                     "%s\"%s/scenes/candle.json\"%s\"lights[0].flicker.amplitude\": %g%s", in,
+                     configs, sc + strlen(scn), amp, k + strlen(key));
+    if (m < 0 || (size_t)m >= sizeof out)
+        return 1;
+    return write_file(path, out);
+}
+
 static int free_port(void)
 {
     int fd = socket(AF_INET, SOCK_STREAM, 0);
@@ -315,7 +361,7 @@ static int run(FILE *out)
     snprintf(cfg, sizeof cfg, "%s/once.json", dir);
     snprintf(log, sizeof log, "%s/idle.log", dir);
     /* The idle rows: the scene steady (flicker off) and as shipped (the flame flickering). */
-    idle_row idle_sim = {.pct = -1}, idle_flicker = {.pct = -1}, idle_mb = {.pct = -1};
+    idle_row idle_sim = {.pct = -1}, idle_mb = {.pct = -1};
     int real_error = 0;
     char *argv[] = {lamprig, "run", "--config", cfg, "--headless", NULL};
     if (write_file(script, "0.0 dimmer absolute 0.6\n0.1 end\n") || write_rig(cfg, script, true)) {
@@ -323,12 +369,6 @@ static int run(FILE *out)
         real_error = 1;
     } else {
         real_error |= idle_cpu(argv, log, true, &idle_sim);
-    }
-    if (write_rig(cfg, script, false)) {
-        snprintf(idle_flicker.why, sizeof idle_flicker.why, "cannot write the scratch rig config");
-        real_error = 1;
-    } else {
-        real_error |= idle_cpu(argv, log, false, &idle_flicker);
     }
     /* The Modbus demo rig against the simulator: a converged scene, the panel still polled. */
     int port = free_port();
@@ -355,6 +395,34 @@ static int run(FILE *out)
             real_error = 1;
         }
     }
+    /* Issue 11: both sim rigs converged, flame flickering (candle.json: amplitude 0.08) and
+     * steady. [rig][flicker off, on]. */
+    idle_row idle_fl[2][2];
+    for (int on = 0; on < 2; on++) {
+        idle_fl[0][on] = (idle_row){.pct = -1, .why = "cannot write the scratch rig config"};
+        idle_fl[1][on] = idle_mb.pct >= 0 ? (idle_row){.pct = -1, .why = "cannot write the "
+                                                       "scratch rig config"}
+                                          : idle_mb;
+    }
+    for (int on = 0; on < 2; on++) {
+        char fcfg[PATH_MAX + 32];
+        snprintf(fcfg, sizeof fcfg, "%s/flicker%d.json", dir, on);
+        if (!write_rig_set(fcfg, script, on ? "" : ", \"lights[0].flicker.amplitude\": 0")) {
+            char *fargv[] = {lamprig, "run", "--config", fcfg, "--headless", NULL};
+            real_error |= idle_cpu_after(fargv, log, false, SETTLE_S, &idle_fl[0][on]);
+        }
+        snprintf(fcfg, sizeof fcfg, "%s/modbus-flicker%d.json", dir, on);
+        if (port > 0 && access(sim_bin, X_OK) == 0 &&
+            !write_modbus_flicker(mb_cfg, fcfg, on ? 0.08 : 0.0)) {
+            char *sargv[] = {sim_bin, "--port", port_s, "--panel", "600", NULL};
+            pid_t sim = spawn(sargv, sim_log);
+            sleep_s(0.5);
+            char *fargv[] = {lamprig, "run", "--config", fcfg, "--modbus", url, "--headless", NULL};
+            real_error |= idle_cpu_after(fargv, log, false, SETTLE_S, &idle_fl[1][on]);
+            kill(sim, SIGTERM);
+            reap(sim, 5);
+        }
+    }
 
     if (rc == 0) {
         fprintf(out, "Control-to-frame latency of a dimmer turn: %d absolute dimmer moves, one "
@@ -374,16 +442,30 @@ static int run(FILE *out)
         fprintf(out, "Dimmer latency: the run failed.\n\n");
     }
     fprintf(out, "Idle CPU of `lamprig run` once converged, with nothing changing "
-                 "(utime + stime from /proc/PID/stat over %.0f s); the shipped candle's flame "
-                 "flickers, which composes a frame every frame interval, so its row is the "
-                 "steady cost of the flicker (after a 3 s warm-up), not an idle figure:\n\n"
+                 "(utime + stime from /proc/PID/stat over %.0f s):\n\n"
                  "| rig | idle CPU |\n|---|---|\n",
             IDLE_WINDOW_S);
     print_idle_row(out, "sim rig, flame steady (flicker amplitude 0), script ended", &idle_sim);
-    print_idle_row(out, "sim rig as shipped, flame flickering (a composition every frame, 30 fps)",
-                   &idle_flicker);
     print_idle_row(out, "modbus-demo against lamprig-modbus-sim (panel polled every 50 ms)",
                    &idle_mb);
+    fprintf(out, "\nIdle CPU once converged with the flame flickering (candle.json: amplitude "
+                 "0.08; one blend pass per frame at the 30 fps cap) and steady (amplitude 0), "
+                 "measured %.0f s after start over %.0f s (issue 11 targets: < 10 %% and < 2 %% "
+                 "of one core):\n\n| rig | flicker on | flicker off |\n|---|---|---|\n",
+            SETTLE_S, IDLE_WINDOW_S);
+    const char *rig_names[2] = {"sim rig (320×240)", "modbus-demo against lamprig-modbus-sim"};
+    for (int i = 0; i < 2; i++) {
+        char on_s[256], off_s[256];
+        for (int on = 0; on < 2; on++) {
+            const idle_row *row = &idle_fl[i][on];
+            char *dst = on ? on_s : off_s;
+            if (row->pct >= 0)
+                snprintf(dst, 256, "%.2f %% of one core", row->pct);
+            else
+                snprintf(dst, 256, "not measured: %s", row->why[0] ? row->why : "unknown");
+        }
+        fprintf(out, "| %s | %s | %s |\n", rig_names[i], on_s, off_s);
+    }
     char cpu[256];
     lrb_cpu_name(cpu, sizeof cpu);
     long ncpu = sysconf(_SC_NPROCESSORS_ONLN);

@@ -29,22 +29,24 @@ uniform float u_eps_comb; // mm
 uniform vec3 u_light_w[LR_MAX_LIGHTS];
 uniform int u_n_lights;
 
-vec3 lr_map_B(ivec2 ti, int k)
+// Adds wq u_light_w[l] B_l at texel ti of map k to each light's sum.
+void lr_map_B_add(ivec2 ti, int k, float wq, inout vec3 Bl[LR_MAX_LIGHTS])
 {
-    vec3 b = vec3(0.0);
     for (int l = 0; l < LR_MAX_LIGHTS; l++) {
         if (l >= u_n_lights)
             break;
-        b += u_light_w[l] * texelFetch(u_map_B, ivec3(ti, l * u_K + k), 0).rgb;
+        Bl[l] += wq * u_light_w[l] * texelFetch(u_map_B, ivec3(ti, l * u_K + k), 0).rgb;
     }
-    return b;
 }
 
-// Returns the weighted B; *n receives the summed visibility weight (0: no map sees x_o, in which case the
-// map with the largest n_o . d_k is used without visibility).
-vec3 lr_gather(vec3 xo, vec3 no, out float n)
+// Algorithm 1 per light: Bl[l] = u_light_w[l] B_l (the same taps and visibility weights for
+// every light, so sum_l Bl[l] is lr_gather's result); *n receives the summed visibility weight
+// (0: no map sees x_o, in which case the map with the largest n_o . d_k is used without
+// visibility). Composition writes one image per light from it.
+void lr_gather_each(vec3 xo, vec3 no, out float n, out vec3 Bl[LR_MAX_LIGHTS])
 {
-    vec3 color = vec3(0.0);
+    for (int l = 0; l < LR_MAX_LIGHTS; l++)
+        Bl[l] = vec3(0.0);
     n = 0.0;
     ivec2 sz = textureSize(u_map_B, 0).xy;
     int best = 0;
@@ -76,15 +78,31 @@ vec3 lr_gather(vec3 xo, vec3 no, out float n)
             vec4 nm = texelFetch(u_map_nrm, ivec3(ti, k), 0);
             if (dot(nm.xyz, no) <= 0.0)
                 continue;
-            color += wq * lr_map_B(ti, k);
+            lr_map_B_add(ti, k, wq, Bl);
             n += wq;
         }
     }
-    if (n > 1e-6)
-        return color / n;
+    if (n > 1e-6) {
+        for (int l = 0; l < LR_MAX_LIGHTS; l++)
+            Bl[l] /= n;
+        return;
+    }
     // No map sees x_o: the one that faces it most, nearest texel, no visibility test.
     vec3 t = (u_map_P[best] * vec4(xo, 1.0)).xyz;
     ivec2 ti = clamp(ivec2(t.xy * vec2(sz)), ivec2(0), sz - 1);
     n = 0.0;
-    return lr_map_B(ti, best);
+    for (int l = 0; l < LR_MAX_LIGHTS; l++)
+        Bl[l] = vec3(0.0);
+    lr_map_B_add(ti, best, 1.0, Bl);
+}
+
+// The weighted sum sum_l u_light_w[l] B_l (the VPL pass sets one light's weight at a time).
+vec3 lr_gather(vec3 xo, vec3 no, out float n)
+{
+    vec3 Bl[LR_MAX_LIGHTS];
+    lr_gather_each(xo, no, n, Bl);
+    vec3 b = vec3(0.0);
+    for (int l = 0; l < LR_MAX_LIGHTS; l++)
+        b += Bl[l];
+    return b;
 }

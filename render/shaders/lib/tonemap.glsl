@@ -1,12 +1,9 @@
-// Exposure, tone curve and sRGB encoding of the HDR target (the GPU twin of
-// lr_tonemap_apply + lr_srgb_encode, render/image/image.c).
-in vec2 v_uv;
-uniform highp sampler2D u_hdr;
+// Exposure, tone curve and sRGB encoding (the GPU twin of lr_tonemap_apply + lr_srgb_encode,
+// render/image/image.c). Shared by tonemap.frag and blend.frag.
 uniform float u_exposure;
 uniform int u_op; // 0 clamp, 1 Reinhard, 2 ACES (lr_tonemap_op)
-layout(location = 0) out vec4 o_color;
 
-float tone(float v)
+float lr_tone(float v)
 {
     v *= u_exposure;
     if (!(v > 0.0))
@@ -18,7 +15,7 @@ float tone(float v)
     return min(v, 1.0);
 }
 
-float srgb(float l)
+float lr_srgb(float l)
 {
     if (!(l > 0.0))
         return 0.0;
@@ -27,8 +24,7 @@ float srgb(float l)
     return l <= 0.0031308 ? 12.92 * l : 1.055 * pow(l, 1.0 / 2.4) - 0.055;
 }
 
-void main()
+vec4 lr_tonemap_srgb(vec3 c)
 {
-    vec3 c = texelFetch(u_hdr, ivec2(gl_FragCoord.xy), 0).rgb;
-    o_color = vec4(srgb(tone(c.r)), srgb(tone(c.g)), srgb(tone(c.b)), 1.0);
+    return vec4(lr_srgb(lr_tone(c.r)), lr_srgb(lr_tone(c.g)), lr_srgb(lr_tone(c.b)), 1.0);
 }

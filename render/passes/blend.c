@@ -1,0 +1,126 @@
+/* The blend pass (render/passes/blend.h). */
+#include "render/passes/blend.h"
+
+#include <GLES3/gl31.h>
+#include <stdbool.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render/gl/shader.h"
+
+struct lr_blend {
+    lr_gl *gl;
+    lr_program *prog;
+    lr_tex *ldr, *hdr;
+    lr_fb *fb_ldr, *fb_hdr;
+    lr_blend_input in; /* of the last run */
+    bool have_input, hdr_valid;
+};
+
+int lr_blend_create(const lr_blend_desc *d, lr_blend **out, lr_err *e)
+{
+    *out = NULL;
+    if (!d || !d->gl || d->width < 1 || d->height < 1)
+        return lr_err_set(e, LR_EINVAL, "blend pass: a GL context and a size are required");
+    lr_blend *b = calloc(1, sizeof *b);
+    if (!b)
+        return lr_err_set(e, LR_ENOMEM, "blend pass: out of memory");
+    b->gl = d->gl;
+    lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "blend.frag",
+                          .dir = d->shader_dir, .defines = d->defines};
+    lr_tex_desc hdr = {.format = LR_TEX_RGBA32F, .width = d->width, .height = d->height,
+                       .label = "HDR output"};
+    lr_tex_desc ldr = {.format = LR_TEX_RGBA8, .width = d->width, .height = d->height,
+                       .linear = true, .label = "tone-mapped output"};
+    int rc;
+    if ((rc = lr_program_create(&pd, &b->prog, e)) ||
+        (rc = lr_tex_create(d->gl, &hdr, &b->hdr, e)) ||
+        (rc = lr_tex_create(d->gl, &ldr, &b->ldr, e)) ||
+        (rc = lr_fb_create(d->gl, &(lr_fb_desc){.color = {{b->hdr, 0}}, .label = "HDR output"},
+                           &b->fb_hdr, e)) ||
+        (rc = lr_fb_create(d->gl,
+                           &(lr_fb_desc){.color = {{b->ldr, 0}}, .label = "tone-mapped output"},
+                           &b->fb_ldr, e))) {
+        lr_blend_destroy(b);
+        return rc;
+    }
+    *out = b;
+    return LR_OK;
+}
+
+void lr_blend_destroy(lr_blend *b)
+{
+    if (!b)
+        return;
+    lr_fb_destroy(b->fb_ldr);
+    lr_fb_destroy(b->fb_hdr);
+    lr_tex_destroy(b->ldr);
+    lr_tex_destroy(b->hdr);
+    lr_program_destroy(b->prog);
+    free(b);
+}
+
+static void uniform_i(const lr_program *p, const char *name, int v)
+{
+    GLint loc = lr_program_uniform(p, name);
+    if (loc >= 0)
+        glUniform1i(loc, v);
+}
+
+static int draw(lr_blend *b, lr_fb *fb, bool linear, lr_err *e)
+{
+    const lr_blend_input *in = &b->in;
+    const lr_program *p = b->prog;
+    float w[3 * LR_BLEND_MAX_IMAGES] = {0};
+    for (int l = 0; l < in->n; l++)
+        for (int c = 0; c < 3; c++)
+            w[3 * l + c] = (float)in->w[l][c];
+    lr_fb_bind(fb);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    glUseProgram(lr_program_id(p));
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, lr_tex_id(in->images));
+    uniform_i(p, "u_images", 0);
+    GLint loc = lr_program_uniform(p, "u_w");
+    if (loc < 0)
+        loc = lr_program_uniform(p, "u_w[0]");
+    if (loc >= 0)
+        glUniform3fv(loc, LR_BLEND_MAX_IMAGES, w);
+    uniform_i(p, "u_n", in->n);
+    uniform_i(p, "u_linear", linear);
+    uniform_i(p, "u_op", in->tonemap_op);
+    if ((loc = lr_program_uniform(p, "u_exposure")) >= 0)
+        glUniform1f(loc, in->exposure);
+    lr_gl_draw_fullscreen(b->gl);
+    return lr_gl_check(linear ? "blend pass (HDR sum)" : "blend pass", e);
+}
+
+int lr_blend_run(lr_blend *b, const lr_blend_input *in, lr_err *e)
+{
+    if (!in || !in->images || in->n < 1 || in->n > LR_BLEND_MAX_IMAGES)
+        return lr_err_set(e, LR_EINVAL, "blend pass: %d images; takes 1..%d",
+                          in && in->images ? in->n : 0, LR_BLEND_MAX_IMAGES);
+    b->in = *in;
+    b->have_input = true;
+    b->hdr_valid = false;
+    return draw(b, b->fb_ldr, false, e);
+}
+
+int lr_blend_hdr(lr_blend *b, lr_fb **out, lr_err *e)
+{
+    *out = NULL;
+    if (!b->have_input)
+        return lr_err_set(e, LR_EINVAL, "blend pass: no frame rendered yet");
+    if (!b->hdr_valid) {
+        int rc = draw(b, b->fb_hdr, true, e);
+        if (rc)
+            return rc;
+        b->hdr_valid = true;
+    }
+    *out = b->fb_hdr;
+    return LR_OK;
+}
+
+lr_tex *lr_blend_ldr(const lr_blend *b) { return b->ldr; }
+lr_fb *lr_blend_ldr_fb(const lr_blend *b) { return b->fb_ldr; }
