@@ -7,10 +7,17 @@
 #include <string.h>
 
 #include "render/gl/shader.h"
+#include "render/image/tonelut.h"
 
 struct lr_blend {
     lr_gl *gl;
-    lr_program *prog;
+    /* prog[n]: the pass for n images of non-zero weight (LR_BLEND_N = n), built on first use:
+     * a candle's frame reads one image and runs no per-pixel loop. */
+    lr_program *prog[LR_BLEND_MAX_IMAGES + 1];
+    const char *shader_dir;
+    const char *const *defines;
+    lr_tex *lut;    /* the output curve (render/image/tonelut.h) for lut_op */
+    int lut_op;     /* -1: not built yet */
     lr_tex *ldr, *hdr;
     lr_fb *fb_ldr, *fb_hdr;
     lr_blend_input in; /* of the last run */
@@ -26,14 +33,17 @@ int lr_blend_create(const lr_blend_desc *d, lr_blend **out, lr_err *e)
     if (!b)
         return lr_err_set(e, LR_ENOMEM, "blend pass: out of memory");
     b->gl = d->gl;
-    lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "blend.frag",
-                          .dir = d->shader_dir, .defines = d->defines};
+    b->shader_dir = d->shader_dir;
+    b->defines = d->defines;
+    b->lut_op = -1;
+    lr_tex_desc lut = {.format = LR_TEX_RGBA32F, .width = LR_TONELUT_N, .height = 1,
+                       .label = "output curve table"};
     lr_tex_desc hdr = {.format = LR_TEX_RGBA32F, .width = d->width, .height = d->height,
                        .label = "HDR output"};
     lr_tex_desc ldr = {.format = LR_TEX_RGBA8, .width = d->width, .height = d->height,
                        .linear = true, .label = "tone-mapped output"};
     int rc;
-    if ((rc = lr_program_create(&pd, &b->prog, e)) ||
+    if ((rc = lr_tex_create(d->gl, &lut, &b->lut, e)) ||
         (rc = lr_tex_create(d->gl, &hdr, &b->hdr, e)) ||
         (rc = lr_tex_create(d->gl, &ldr, &b->ldr, e)) ||
         (rc = lr_fb_create(d->gl, &(lr_fb_desc){.color = {{b->hdr, 0}}, .label = "HDR output"},
@@ -56,7 +66,9 @@ void lr_blend_destroy(lr_blend *b)
     lr_fb_destroy(b->fb_hdr);
     lr_tex_destroy(b->ldr);
     lr_tex_destroy(b->hdr);
-    lr_program_destroy(b->prog);
+    lr_tex_destroy(b->lut);
+    for (int n = 0; n <= LR_BLEND_MAX_IMAGES; n++)
+        lr_program_destroy(b->prog[n]);
     free(b);
 }
 
@@ -67,14 +79,68 @@ static void uniform_i(const lr_program *p, const char *name, int v)
         glUniform1i(loc, v);
 }
 
+static void uniform_f(const lr_program *p, const char *name, float v)
+{
+    GLint loc = lr_program_uniform(p, name);
+    if (loc >= 0)
+        glUniform1f(loc, v);
+}
+
+/* The program for n images of non-zero weight: the caller's defines plus LR_BLEND_N. */
+static int program(lr_blend *b, int n, lr_program **out, lr_err *e)
+{
+    if (!b->prog[n]) {
+        const char *defs[16];
+        int k = 0;
+        for (; k < 14 && b->defines && b->defines[k]; k++)
+            defs[k] = b->defines[k];
+        static const char *const ns[] = {"LR_BLEND_N 0", "LR_BLEND_N 1", "LR_BLEND_N 2",
+                                         "LR_BLEND_N 3", "LR_BLEND_N 4"};
+        defs[k++] = ns[n];
+        defs[k] = NULL;
+        lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "blend.frag",
+                              .dir = b->shader_dir, .defines = defs};
+        int rc = lr_program_create(&pd, &b->prog[n], e);
+        if (rc)
+            return rc;
+    }
+    *out = b->prog[n];
+    return LR_OK;
+}
+
+/* The output curve's table for op, uploaded when the op changes (once per renderer). */
+static int lut_for(lr_blend *b, int op, lr_err *e)
+{
+    if (b->lut_op == op)
+        return LR_OK;
+    float *lut = malloc(sizeof(float) * 4 * LR_TONELUT_N);
+    if (!lut)
+        return lr_err_set(e, LR_ENOMEM, "blend pass: out of memory");
+    lr_tonelut_build((lr_tonemap_op)op, lut);
+    int rc = lr_tex_upload(b->lut, 0, lut, e);
+    free(lut);
+    if (!rc)
+        b->lut_op = op;
+    return rc;
+}
+
 static int draw(lr_blend *b, lr_fb *fb, bool linear, lr_err *e)
 {
     const lr_blend_input *in = &b->in;
-    const lr_program *p = b->prog;
+    /* Only the images whose weight is not zero are read (a light switched off costs nothing). */
     float w[3 * LR_BLEND_MAX_IMAGES] = {0};
-    for (int l = 0; l < in->n; l++)
+    int layer[LR_BLEND_MAX_IMAGES] = {0}, n = 0;
+    for (int l = 0; l < in->n; l++) {
+        if (in->w[l][0] == 0.0 && in->w[l][1] == 0.0 && in->w[l][2] == 0.0)
+            continue;
         for (int c = 0; c < 3; c++)
-            w[3 * l + c] = (float)in->w[l][c];
+            w[3 * n + c] = (float)in->w[l][c];
+        layer[n++] = l;
+    }
+    lr_program *p = NULL;
+    int rc;
+    if ((rc = program(b, n, &p, e)) || (!linear && (rc = lut_for(b, in->tonemap_op, e))))
+        return rc;
     lr_fb_bind(fb);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
@@ -82,17 +148,24 @@ static int draw(lr_blend *b, lr_fb *fb, bool linear, lr_err *e)
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D_ARRAY, lr_tex_id(in->images));
     uniform_i(p, "u_images", 0);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, lr_tex_id(b->lut));
+    uniform_i(p, "u_lut", 1);
     GLint loc = lr_program_uniform(p, "u_w");
     if (loc < 0)
         loc = lr_program_uniform(p, "u_w[0]");
     if (loc >= 0)
         glUniform3fv(loc, LR_BLEND_MAX_IMAGES, w);
-    uniform_i(p, "u_n", in->n);
+    if ((loc = lr_program_uniform(p, "u_layer")) >= 0 ||
+        (loc = lr_program_uniform(p, "u_layer[0]")) >= 0)
+        glUniform1iv(loc, LR_BLEND_MAX_IMAGES, layer);
+    uniform_i(p, "u_alpha_layer", 0);
     uniform_i(p, "u_linear", linear);
-    uniform_i(p, "u_op", in->tonemap_op);
-    if ((loc = lr_program_uniform(p, "u_exposure")) >= 0)
-        glUniform1f(loc, in->exposure);
+    uniform_f(p, "u_lut_scale", (float)LR_TONELUT_STEPS);
+    uniform_f(p, "u_lut_offset", lr_tonelut_offset(in->exposure));
+    uniform_f(p, "u_lut_max", (float)(LR_TONELUT_N - 1));
     lr_gl_draw_fullscreen(b->gl);
+    glActiveTexture(GL_TEXTURE0);
     return lr_gl_check(linear ? "blend pass (HDR sum)" : "blend pass", e);
 }
 
