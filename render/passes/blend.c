@@ -7,17 +7,15 @@
 #include <string.h>
 
 #include "render/gl/shader.h"
-#include "render/image/tonelut.h"
 
 struct lr_blend {
     lr_gl *gl;
-    /* prog[n]: the pass for n images of non-zero weight (LR_BLEND_N = n), built on first use:
-     * a candle's frame reads one image and runs no per-pixel loop. */
-    lr_program *prog[LR_BLEND_MAX_IMAGES + 1];
+    /* prog[op][n]: the pass for tone curve op and n images of non-zero weight (LR_BLEND_OP,
+     * LR_BLEND_N), built on first use: a candle's frame reads one image and runs no per-pixel
+     * loop or curve branch. */
+    lr_program *prog[LR_BLEND_OPS][LR_BLEND_MAX_IMAGES + 1];
     const char *shader_dir;
     const char *const *defines;
-    lr_tex *lut;    /* the output curve (render/image/tonelut.h) for lut_op */
-    int lut_op;     /* -1: not built yet */
     lr_tex *ldr, *hdr;
     lr_fb *fb_ldr, *fb_hdr;
     lr_blend_input in; /* of the last run */
@@ -35,16 +33,12 @@ int lr_blend_create(const lr_blend_desc *d, lr_blend **out, lr_err *e)
     b->gl = d->gl;
     b->shader_dir = d->shader_dir;
     b->defines = d->defines;
-    b->lut_op = -1;
-    lr_tex_desc lut = {.format = LR_TEX_RGBA32F, .width = LR_TONELUT_N, .height = 1,
-                       .label = "output curve table"};
     lr_tex_desc hdr = {.format = LR_TEX_RGBA32F, .width = d->width, .height = d->height,
                        .label = "HDR output"};
     lr_tex_desc ldr = {.format = LR_TEX_RGBA8, .width = d->width, .height = d->height,
                        .linear = true, .label = "tone-mapped output"};
     int rc;
-    if ((rc = lr_tex_create(d->gl, &lut, &b->lut, e)) ||
-        (rc = lr_tex_create(d->gl, &hdr, &b->hdr, e)) ||
+    if ((rc = lr_tex_create(d->gl, &hdr, &b->hdr, e)) ||
         (rc = lr_tex_create(d->gl, &ldr, &b->ldr, e)) ||
         (rc = lr_fb_create(d->gl, &(lr_fb_desc){.color = {{b->hdr, 0}}, .label = "HDR output"},
                            &b->fb_hdr, e)) ||
@@ -66,9 +60,9 @@ void lr_blend_destroy(lr_blend *b)
     lr_fb_destroy(b->fb_hdr);
     lr_tex_destroy(b->ldr);
     lr_tex_destroy(b->hdr);
-    lr_tex_destroy(b->lut);
-    for (int n = 0; n <= LR_BLEND_MAX_IMAGES; n++)
-        lr_program_destroy(b->prog[n]);
+    for (int op = 0; op < LR_BLEND_OPS; op++)
+        for (int n = 0; n <= LR_BLEND_MAX_IMAGES; n++)
+            lr_program_destroy(b->prog[op][n]);
     free(b);
 }
 
@@ -86,42 +80,29 @@ static void uniform_f(const lr_program *p, const char *name, float v)
         glUniform1f(loc, v);
 }
 
-/* The program for n images of non-zero weight: the caller's defines plus LR_BLEND_N. */
-static int program(lr_blend *b, int n, lr_program **out, lr_err *e)
+/* The program for tone curve op and n images of non-zero weight: the caller's defines plus
+ * LR_BLEND_OP and LR_BLEND_N. */
+static int program(lr_blend *b, int op, int n, lr_program **out, lr_err *e)
 {
-    if (!b->prog[n]) {
-        const char *defs[16];
-        int k = 0;
-        for (; k < 14 && b->defines && b->defines[k]; k++)
-            defs[k] = b->defines[k];
+    if (!b->prog[op][n]) {
+        static const char *const ops[] = {"LR_BLEND_OP 0", "LR_BLEND_OP 1", "LR_BLEND_OP 2"};
         static const char *const ns[] = {"LR_BLEND_N 0", "LR_BLEND_N 1", "LR_BLEND_N 2",
                                          "LR_BLEND_N 3", "LR_BLEND_N 4"};
+        const char *defs[16];
+        int k = 0;
+        for (; k < 13 && b->defines && b->defines[k]; k++)
+            defs[k] = b->defines[k];
+        defs[k++] = ops[op];
         defs[k++] = ns[n];
         defs[k] = NULL;
         lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "blend.frag",
                               .dir = b->shader_dir, .defines = defs};
-        int rc = lr_program_create(&pd, &b->prog[n], e);
+        int rc = lr_program_create(&pd, &b->prog[op][n], e);
         if (rc)
             return rc;
     }
-    *out = b->prog[n];
+    *out = b->prog[op][n];
     return LR_OK;
-}
-
-/* The output curve's table for op, uploaded when the op changes (once per renderer). */
-static int lut_for(lr_blend *b, int op, lr_err *e)
-{
-    if (b->lut_op == op)
-        return LR_OK;
-    float *lut = malloc(sizeof(float) * 4 * LR_TONELUT_N);
-    if (!lut)
-        return lr_err_set(e, LR_ENOMEM, "blend pass: out of memory");
-    lr_tonelut_build((lr_tonemap_op)op, lut);
-    int rc = lr_tex_upload(b->lut, 0, lut, e);
-    free(lut);
-    if (!rc)
-        b->lut_op = op;
-    return rc;
 }
 
 static int draw(lr_blend *b, lr_fb *fb, bool linear, lr_err *e)
@@ -137,9 +118,10 @@ static int draw(lr_blend *b, lr_fb *fb, bool linear, lr_err *e)
             w[3 * n + c] = (float)in->w[l][c];
         layer[n++] = l;
     }
+    int op = in->tonemap_op >= 0 && in->tonemap_op < LR_BLEND_OPS ? in->tonemap_op : 0;
     lr_program *p = NULL;
-    int rc;
-    if ((rc = program(b, n, &p, e)) || (!linear && (rc = lut_for(b, in->tonemap_op, e))))
+    int rc = program(b, op, n, &p, e);
+    if (rc)
         return rc;
     lr_fb_bind(fb);
     glDisable(GL_DEPTH_TEST);
@@ -148,9 +130,6 @@ static int draw(lr_blend *b, lr_fb *fb, bool linear, lr_err *e)
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D_ARRAY, lr_tex_id(in->images));
     uniform_i(p, "u_images", 0);
-    glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, lr_tex_id(b->lut));
-    uniform_i(p, "u_lut", 1);
     GLint loc = lr_program_uniform(p, "u_w");
     if (loc < 0)
         loc = lr_program_uniform(p, "u_w[0]");
@@ -159,13 +138,10 @@ static int draw(lr_blend *b, lr_fb *fb, bool linear, lr_err *e)
     if ((loc = lr_program_uniform(p, "u_layer")) >= 0 ||
         (loc = lr_program_uniform(p, "u_layer[0]")) >= 0)
         glUniform1iv(loc, LR_BLEND_MAX_IMAGES, layer);
-    uniform_i(p, "u_alpha_layer", 0);
     uniform_i(p, "u_linear", linear);
-    uniform_f(p, "u_lut_scale", (float)LR_TONELUT_STEPS);
-    uniform_f(p, "u_lut_offset", lr_tonelut_offset(in->exposure));
-    uniform_f(p, "u_lut_max", (float)(LR_TONELUT_N - 1));
+    /* lr_tonemap_apply's rule: exposure 0 means 1. */
+    uniform_f(p, "u_exposure", in->exposure != 0.0f ? in->exposure : 1.0f);
     lr_gl_draw_fullscreen(b->gl);
-    glActiveTexture(GL_TEXTURE0);
     return lr_gl_check(linear ? "blend pass (HDR sum)" : "blend pass", e);
 }
 

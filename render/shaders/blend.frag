@@ -1,27 +1,17 @@
 // The blend pass (render/passes/blend.h): sum_k u_w[k] image_{u_layer[k]} over the per-light
 // unit-intensity linear images whose weight is not zero (LR_BLEND_N of them, a compile-time
-// count: no loop, no branch per pixel), then the output curve (exposure, tone curve, sRGB)
-// through the lookup table of render/image/tonelut.h, or, with u_linear, the linear sum for
-// readback. One fetch per active light and pixel and one per channel into the table.
+// count: no loop, no branch per pixel), then exposure, the tone curve (LR_BLEND_OP, an
+// lr_tonemap_op, compile-time) and the sRGB encode, or, with u_linear, the linear sum for
+// readback. The encode is lr_srgb_encode_fast (render/image/image.h): three square roots
+// instead of pow, within a quarter of an 8-bit step of IEC 61966-2-1. This pass is the whole
+// of a dimmer or flicker frame; on llvmpipe pow (log2 + exp2) per channel and a per-channel
+// table fetch (a gather per lane) each cost more than the fetch of the image itself.
 uniform highp sampler2DArray u_images;
-uniform highp sampler2D u_lut;   // LR_TONELUT_N x 1 RGBA32F: (f_i, f_{i+1} - f_i, 0, 0)
 uniform vec3 u_w[4];
 uniform int u_layer[4];
-uniform int u_alpha_layer;       // layer 0 (its alpha: coverage, copied to the HDR sum)
-uniform float u_lut_scale;       // LR_TONELUT_STEPS
-uniform float u_lut_offset;      // lr_tonelut_offset(exposure)
-uniform float u_lut_max;         // LR_TONELUT_N - 1
+uniform float u_exposure;
 uniform bool u_linear;
 layout(location = 0) out vec4 o_color;
-
-float lr_lut(float u)
-{
-    // -inf (a zero value) clamps to texel 0 (tonelut.c lr_tonelut_apply is the CPU twin).
-    u = clamp(u, 0.0, u_lut_max);
-    int i = int(u);
-    vec2 fd = texelFetch(u_lut, ivec2(i, 0), 0).xy;
-    return fd.x + fd.y * (u - float(i));
-}
 
 void main()
 {
@@ -40,10 +30,21 @@ void main()
     c += u_w[3] * texelFetch(u_images, ivec3(p, u_layer[3]), 0).rgb;
 #endif
     if (u_linear) {
-        o_color = vec4(c, texelFetch(u_images, ivec3(p, u_alpha_layer), 0).a);
+        // Alpha of layer 0: coverage (compose_object.frag), whichever lights are lit.
+        o_color = vec4(c, texelFetch(u_images, ivec3(p, 0), 0).a);
         return;
     }
-    // log2 of 0 or less is undefined in GLSL ES: 1e-30 is far below the table (texel 0: 0).
-    vec3 u = log2(max(c, vec3(1e-30))) * u_lut_scale + u_lut_offset;
-    o_color = vec4(lr_lut(u.r), lr_lut(u.g), lr_lut(u.b), 1.0);
+    // lr_tonemap_apply (render/image/image.c): exposure, curve, clip to [0, 1].
+    vec3 v = max(c * u_exposure, vec3(0.0));
+#if LR_BLEND_OP == 1
+    v = v / (1.0 + v);
+#elif LR_BLEND_OP == 2
+    v = (v * (2.51 * v + 0.03)) / (v * (2.43 * v + 0.59) + 0.14); // Narkowicz 2015
+#endif
+    v = min(v, vec3(1.0));
+    // lr_srgb_encode_fast: the linear segment below 0.0031308, else Taylor's fit in
+    // l^(1/2), l^(1/4), l^(1/8).
+    vec3 s1 = sqrt(v), s2 = sqrt(s1), s3 = sqrt(s2);
+    vec3 fit = 0.662002687 * s1 + 0.684122060 * s2 - 0.323583601 * s3 - 0.0225411470 * v;
+    o_color = vec4(mix(fit, 12.92 * v, lessThanEqual(v, vec3(0.0031308))), 1.0);
 }
