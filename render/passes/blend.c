@@ -10,10 +10,10 @@
 
 struct lr_blend {
     lr_gl *gl;
-    /* prog[op][n]: the pass for tone curve op and n images of non-zero weight (LR_BLEND_OP,
-     * LR_BLEND_N), built on first use: a candle's frame reads one image and runs no per-pixel
-     * loop or curve branch. */
-    lr_program *prog[LR_BLEND_OPS][LR_BLEND_MAX_IMAGES + 1];
+    /* prog[op][n]: the pass for tone curve op (LR_BLEND_OPS: the linear sum) and n images of
+     * non-zero weight (LR_BLEND_OP, LR_BLEND_N), built on first use: a candle's frame reads
+     * one image and runs no per-pixel loop or branch. */
+    lr_program *prog[LR_BLEND_OPS + 1][LR_BLEND_MAX_IMAGES + 1];
     const char *shader_dir;
     const char *const *defines;
     lr_tex *ldr, *hdr;
@@ -60,7 +60,7 @@ void lr_blend_destroy(lr_blend *b)
     lr_fb_destroy(b->fb_hdr);
     lr_tex_destroy(b->ldr);
     lr_tex_destroy(b->hdr);
-    for (int op = 0; op < LR_BLEND_OPS; op++)
+    for (int op = 0; op <= LR_BLEND_OPS; op++)
         for (int n = 0; n <= LR_BLEND_MAX_IMAGES; n++)
             lr_program_destroy(b->prog[op][n]);
     free(b);
@@ -80,12 +80,13 @@ static void uniform_f(const lr_program *p, const char *name, float v)
         glUniform1f(loc, v);
 }
 
-/* The program for tone curve op and n images of non-zero weight: the caller's defines plus
+/* The program for tone curve op (LR_BLEND_OPS: the linear sum) and n images of non-zero weight: the caller's defines plus
  * LR_BLEND_OP and LR_BLEND_N. */
 static int program(lr_blend *b, int op, int n, lr_program **out, lr_err *e)
 {
     if (!b->prog[op][n]) {
-        static const char *const ops[] = {"LR_BLEND_OP 0", "LR_BLEND_OP 1", "LR_BLEND_OP 2"};
+        static const char *const ops[] = {"LR_BLEND_OP 0", "LR_BLEND_OP 1", "LR_BLEND_OP 2",
+                                          "LR_BLEND_OP 3"};
         static const char *const ns[] = {"LR_BLEND_N 0", "LR_BLEND_N 1", "LR_BLEND_N 2",
                                          "LR_BLEND_N 3", "LR_BLEND_N 4"};
         const char *defs[16];
@@ -118,7 +119,8 @@ static int draw(lr_blend *b, lr_fb *fb, bool linear, lr_err *e)
             w[3 * n + c] = (float)in->w[l][c];
         layer[n++] = l;
     }
-    int op = in->tonemap_op >= 0 && in->tonemap_op < LR_BLEND_OPS ? in->tonemap_op : 0;
+    int op = linear ? LR_BLEND_OPS
+                    : in->tonemap_op >= 0 && in->tonemap_op < LR_BLEND_OPS ? in->tonemap_op : 0;
     lr_program *p = NULL;
     int rc = program(b, op, n, &p, e);
     if (rc)
@@ -138,7 +140,6 @@ static int draw(lr_blend *b, lr_fb *fb, bool linear, lr_err *e)
     if ((loc = lr_program_uniform(p, "u_layer")) >= 0 ||
         (loc = lr_program_uniform(p, "u_layer[0]")) >= 0)
         glUniform1iv(loc, LR_BLEND_MAX_IMAGES, layer);
-    uniform_i(p, "u_linear", linear);
     /* lr_tonemap_apply's rule: exposure 0 means 1. */
     uniform_f(p, "u_exposure", in->exposure != 0.0f ? in->exposure : 1.0f);
     lr_gl_draw_fullscreen(b->gl);

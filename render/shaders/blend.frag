@@ -1,8 +1,9 @@
 // The blend pass (render/passes/blend.h): sum_k u_w[k] image_{u_layer[k]} over the per-light
 // unit-intensity linear images whose weight is not zero (LR_BLEND_N of them, a compile-time
 // count: no loop, no branch per pixel), then exposure, the tone curve (LR_BLEND_OP, an
-// lr_tonemap_op, compile-time) and the sRGB encode, or, with u_linear, the linear sum for
-// readback. The encode is lr_srgb_encode_fast (render/image/image.h): three square roots
+// lr_tonemap_op, compile-time) and the sRGB encode, or, with LR_BLEND_OP 3, the linear sum
+// for readback (a define, not a uniform: llvmpipe runs both sides of a uniform branch under a
+// mask, and the other side's fetch would cost as much as the image's). The encode is lr_srgb_encode_fast (render/image/image.h): three square roots
 // instead of pow, within a quarter of an 8-bit step of IEC 61966-2-1. This pass is the whole
 // of a dimmer or flicker frame; on llvmpipe pow (log2 + exp2) per channel and a per-channel
 // table fetch (a gather per lane) each cost more than the fetch of the image itself.
@@ -10,7 +11,6 @@ uniform highp sampler2DArray u_images;
 uniform vec3 u_w[4];
 uniform int u_layer[4];
 uniform float u_exposure;
-uniform bool u_linear;
 layout(location = 0) out vec4 o_color;
 
 void main()
@@ -29,11 +29,10 @@ void main()
 #if LR_BLEND_N >= 4
     c += u_w[3] * texelFetch(u_images, ivec3(p, u_layer[3]), 0).rgb;
 #endif
-    if (u_linear) {
-        // Alpha of layer 0: coverage (compose_object.frag), whichever lights are lit.
-        o_color = vec4(c, texelFetch(u_images, ivec3(p, 0), 0).a);
-        return;
-    }
+#if LR_BLEND_OP == 3
+    // Alpha of layer 0: coverage (compose_object.frag), whichever lights are lit.
+    o_color = vec4(c, texelFetch(u_images, ivec3(p, 0), 0).a);
+#else
     // lr_tonemap_apply (render/image/image.c): exposure, curve, clip to [0, 1].
     vec3 v = max(c * u_exposure, vec3(0.0));
 #if LR_BLEND_OP == 1
@@ -47,4 +46,5 @@ void main()
     vec3 s1 = sqrt(v), s2 = sqrt(s1), s3 = sqrt(s2);
     vec3 fit = 0.662002687 * s1 + 0.684122060 * s2 - 0.323583601 * s3 - 0.0225411470 * v;
     o_color = vec4(mix(fit, 12.92 * v, lessThanEqual(v, vec3(0.0031308))), 1.0);
+#endif
 }
