@@ -7,9 +7,11 @@
  *     that the maps have converged after them), median total; DIMMER_FRAMES dimmer-only frames
  *     (light.intensity alternately halved and restored: the blend pass alone), median total;
  *     CAMERA_FRAMES camera-only frames (compose + blend); the floor (issue 11): a fullscreen
- *     pass reading one RGBA16F texture into the output (lr_renderer_debug_floor_ms). Ratios:
- *     full update / dimmer, compose / dimmer (the dimmer against a composition), dimmer /
- *     floor, compose / camera.
+ *     pass reading one RGBA16F texture into the output (lr_renderer_debug_floor_ms), timed as
+ *     a frame's pass is (inside a renderer timer section; wall time glFinish to glFinish
+ *     around the whole, as for the dimmer frames). Ratios: full update / dimmer, compose /
+ *     dimmer (the dimmer against a composition), dimmer / floor by the timers and by wall
+ *     time, compose / camera.
  * (2) Error against accumulated frames, at ERR_W x ERR_H with reduced settings (ERR_K maps of
  *     ERR_MAP^2, ERR_N samples): relative RMSE of the GPU image after 1, 4, 16 and 64 frames,
  *     sqrt(sum (g - r)^2 / sum r^2) over the bands of the masked pixels, in linear light,
