@@ -96,10 +96,14 @@ int lr_renderer_debug_uncovered(lr_renderer *r, int *count, lr_err *e);
 /* ---- the bench's floor (issue 11) ---------------------------------------------------------- */
 
 /* Times `reps` (1..64) runs of the cheapest fullscreen pass that reads one RGBA16F texture of
- * the output size and writes the tone-mapped output target (render/shaders/floor.frag): wall
- * time from glFinish to glFinish around the draw, the way a caller waits for a frame; *ms the
- * median. The blend pass is measured against it. The
- * output target is overwritten: render a frame before reading the image again. */
-int lr_renderer_debug_floor_ms(lr_renderer *r, int reps, double *ms, lr_err *e);
+ * the output size and writes the tone-mapped output target (render/shaders/floor.frag),
+ * measured exactly as lr_renderer_frame measures a dimmer frame's blend pass, so that the two
+ * compare like with like: the draw inside one section of the renderer's timer (reset, begin,
+ * end, collect: *timer_ms, the median of that section, GPU timer queries or CPU+glFinish as
+ * the renderer's timer is), and the whole from glFinish to glFinish (*wall_ms, the median wall
+ * time a caller waits, timer overhead included as in a frame). The output target is
+ * overwritten: render a frame before reading the image again. */
+int lr_renderer_debug_floor_ms(lr_renderer *r, int reps, double *wall_ms, double *timer_ms,
+                               lr_err *e);
 
 #endif

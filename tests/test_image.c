@@ -213,6 +213,33 @@ static void tonemap_and_srgb_values(void **state)
     }
 }
 
+/* The blend pass's fast sRGB encode (lr_srgb_encode_fast, Taylor's three-square-root fit)
+ * against IEC 61966-2-1 over [0, 1], on a uniform grid of 2^22 steps and a logarithmic one
+ * from 2^-30: within 0.25 of an 8-bit step (the fit's own error peaks at 0.247 steps, at the
+ * branch point), so its 8-bit code is the exact one or one step off; the ends are exact. */
+static void fast_srgb_encode_within_a_quarter_step(void **state)
+{
+    (void)state;
+    double worst = 0.0;
+    long off = 0, n = 0;
+    for (int k = 0; k <= (1 << 22); k++) {
+        for (int m = 0; m < 2; m++) {
+            float l = m ? (float)k / (float)(1 << 22) : exp2f(-30.0f + 30.0f * (float)k / (1 << 22));
+            float a = lr_srgb_encode_fast(l), b = lr_srgb_encode(l);
+            worst = fmax(worst, fabs((double)a - b));
+            off += rintf(a * 255.0f) != rintf(b * 255.0f);
+            n++;
+        }
+    }
+    print_message("fast sRGB encode: worst %.4f of a step, %ld of %ld codes one step off\n",
+                  worst * 255.0, off, n);
+    assert_true(worst <= 0.25 / 255.0);
+    assert_true(lr_srgb_encode_fast(0.0f) == 0.0f && lr_srgb_encode_fast(-1.0f) == 0.0f);
+    assert_true(lr_srgb_encode_fast(NAN) == 0.0f);
+    assert_true(lr_srgb_encode_fast(1.0f) <= 1.0f && lr_srgb_encode_fast(5.0f) <= 1.0f);
+    assert_true(rintf(lr_srgb_encode_fast(1.0f) * 255.0f) == 255.0f);
+}
+
 /* ---- PNG ---------------------------------------------------------------------------------- */
 
 static void png_round_trip_is_exact_at_8_bits(void **state)
@@ -382,6 +409,7 @@ int main(void)
         T(pfm_reads_big_endian_and_grey),
         T(pfm_bad_files_are_rejected_by_name),
         T(tonemap_and_srgb_values),
+        T(fast_srgb_encode_within_a_quarter_step),
         T(png_round_trip_is_exact_at_8_bits),
         T(png_rows_are_top_down),
         T(png_bad_files_are_rejected_by_name),

@@ -6,11 +6,14 @@
  * images (the per-texel seeds do not depend on the intensity or on the light's index) and the
  * same weighted sum, so they agree to float rounding: asserted to 1e-5 relative per value
  * (plus 1e-7 of the image's largest value for values near 0), and the tone-mapped bytes
- * to one step. Each dimmer/flicker frame must run the blend pass alone.
+ * to one step; the bytes are also the exact output curve of the linear sum to one step (the
+ * pass encodes sRGB with lr_srgb_encode_fast). Each dimmer/flicker frame must run the blend pass
+ * alone.
  *
  *  - one light: dimmed after convergence, and dimmed in the middle of accumulation (the next
  *    accumulation frames update the per-light images, the blend reads the new intensity);
  *  - two lights (point flame and spot): one dimmed, the other's colour changed;
+ *  - a light switched off (weight 0: its image is not read) equals the re-render without it;
  *  - flicker: a clock time with a flickering flame against a steady flame whose intensity is
  *    the flickering one's at that time.
  */
@@ -121,7 +124,25 @@ static void assert_same(const char *what, lr_renderer *r, const float *want,
     for (int i = 0; i < W * H * 4; i++)
         if (abs((int)got_bytes[i] - (int)want_bytes[i]) > 1)
             fail_msg("%s: byte %d: %d, the re-render %d", what, i, got_bytes[i], want_bytes[i]);
-    print_message("%s: worst relative difference %.3g\n", what, worst);
+    /* The pass encodes with lr_srgb_encode_fast (within a quarter step of the exact encode,
+     * test_image): the bytes are the exact curve's of the linear sum, or one step off. rgba8
+     * rows are top-down, the HDR rows bottom-up (GL order). */
+    lr_tonemap tm;
+    lr_renderer_tonemap(r, &tm);
+    int off = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            for (int c = 0; c < 3; c++) {
+                float v = got[3 * ((H - 1 - y) * W + x) + c];
+                int a = (int)lrintf(lr_srgb_encode(lr_tonemap_apply(&tm, v)) * 255.0f);
+                int b = got_bytes[4 * (y * W + x) + c];
+                if (abs(a - b) > 1)
+                    fail_msg("%s: pixel %d,%d band %d: byte %d, the exact curve %d", what, x,
+                             y, c, b, a);
+                off += a != b;
+            }
+    print_message("%s: worst relative difference %.3g; %d of %d bytes one step from the "
+                  "exact curve\n", what, worst, off, W * H * 3);
     free(got);
     free(got_bytes);
 }
@@ -189,6 +210,30 @@ static void test_two_lights_dimmer_and_colour(void **state)
     lr_scene_destroy(sb);
 }
 
+/* A light switched off (weight 0) is not read by the blend pass; the image is the one of the
+ * scene without its light's contribution: the re-render with intensity 0. */
+static void test_light_switched_off(void **state)
+{
+    (void)state;
+    lr_scene *sb = scene("0.005", "1.0, 0.55, 0.2", "0", "0");
+    float *want;
+    unsigned char *want_bytes;
+    rerender(sb, &want, &want_bytes);
+
+    lr_scene *s = scene("0.005", "1.0, 0.55, 0.2", "0", "0.02");
+    lr_renderer *r = lr_test_renderer(gl, s, W, H, false, SEED);
+    lr_test_converge(r, 20);
+    lr_test_set(s, r, "lights[side].intensity", "0");
+    lr_frame_stats st = lr_test_frame(r);
+    assert_int_equal(st.passes, LR_PASS_BLEND);
+    assert_same("two lights: side switched off", r, want, want_bytes);
+    lr_renderer_destroy(r);
+    free(want);
+    free(want_bytes);
+    lr_scene_destroy(s);
+    lr_scene_destroy(sb);
+}
+
 static void test_flicker_equals_steady_rerender(void **state)
 {
     (void)state;
@@ -224,6 +269,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_one_light_dimmer),
         cmocka_unit_test(test_two_lights_dimmer_and_colour),
+        cmocka_unit_test(test_light_switched_off),
         cmocka_unit_test(test_flicker_equals_steady_rerender),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

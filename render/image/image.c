@@ -75,6 +75,19 @@ float lr_srgb_encode(float l)
     return l <= 0.0031308f ? 12.92f * l : 1.055f * powf(l, 1.0f / 2.4f) - 0.055f;
 }
 
+float lr_srgb_encode_fast(float l)
+{
+    if (!(l > 0.0f))
+        return 0.0f;
+    if (l > 1.0f)
+        l = 1.0f;
+    if (l <= 0.0031308f)
+        return 12.92f * l;
+    float s1 = sqrtf(l), s2 = sqrtf(s1), s3 = sqrtf(s2);
+    float v = 0.662002687f * s1 + 0.684122060f * s2 - 0.323583601f * s3 - 0.0225411470f * l;
+    return v < 1.0f ? v : 1.0f;
+}
+
 float lr_srgb_decode(float s)
 {
     if (!(s > 0.0f))

@@ -48,6 +48,12 @@ float lr_tonemap_apply(const lr_tonemap *tm, float linear);
 /* The sRGB transfer function (IEC 61966-2-1) and its inverse, on [0, 1]. */
 float lr_srgb_encode(float linear);
 float lr_srgb_decode(float encoded);
+/* The blend pass's encode (render/shaders/blend.frag), its CPU twin: the linear segment below
+ * 0.0031308, else I. Taylor's fit 0.662002687 l^(1/2) + 0.684122060 l^(1/4)
+ * - 0.323583601 l^(1/8) - 0.0225411470 l ("sRGB approximations for HLSL", 2012): three
+ * square roots instead of pow, within 0.25 / 255 of lr_srgb_encode on [0, 1] (bounded in
+ * tests/test_image.c), so an 8-bit code is the exact one or one step off. */
+float lr_srgb_encode_fast(float linear);
 
 /* ---- files ---------------------------------------------------------------------------- */
 

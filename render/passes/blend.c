@@ -10,7 +10,12 @@
 
 struct lr_blend {
     lr_gl *gl;
-    lr_program *prog;
+    /* prog[op][n]: the pass for tone curve op (LR_BLEND_OPS: the linear sum) and n images of
+     * non-zero weight (LR_BLEND_OP, LR_BLEND_N), built on first use: a candle's frame reads
+     * one image and runs no per-pixel loop or branch. */
+    lr_program *prog[LR_BLEND_OPS + 1][LR_BLEND_MAX_IMAGES + 1];
+    const char *shader_dir;
+    const char *const *defines;
     lr_tex *ldr, *hdr;
     lr_fb *fb_ldr, *fb_hdr;
     lr_blend_input in; /* of the last run */
@@ -26,15 +31,14 @@ int lr_blend_create(const lr_blend_desc *d, lr_blend **out, lr_err *e)
     if (!b)
         return lr_err_set(e, LR_ENOMEM, "blend pass: out of memory");
     b->gl = d->gl;
-    lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "blend.frag",
-                          .dir = d->shader_dir, .defines = d->defines};
+    b->shader_dir = d->shader_dir;
+    b->defines = d->defines;
     lr_tex_desc hdr = {.format = LR_TEX_RGBA32F, .width = d->width, .height = d->height,
                        .label = "HDR output"};
     lr_tex_desc ldr = {.format = LR_TEX_RGBA8, .width = d->width, .height = d->height,
                        .linear = true, .label = "tone-mapped output"};
     int rc;
-    if ((rc = lr_program_create(&pd, &b->prog, e)) ||
-        (rc = lr_tex_create(d->gl, &hdr, &b->hdr, e)) ||
+    if ((rc = lr_tex_create(d->gl, &hdr, &b->hdr, e)) ||
         (rc = lr_tex_create(d->gl, &ldr, &b->ldr, e)) ||
         (rc = lr_fb_create(d->gl, &(lr_fb_desc){.color = {{b->hdr, 0}}, .label = "HDR output"},
                            &b->fb_hdr, e)) ||
@@ -56,7 +60,9 @@ void lr_blend_destroy(lr_blend *b)
     lr_fb_destroy(b->fb_hdr);
     lr_tex_destroy(b->ldr);
     lr_tex_destroy(b->hdr);
-    lr_program_destroy(b->prog);
+    for (int op = 0; op <= LR_BLEND_OPS; op++)
+        for (int n = 0; n <= LR_BLEND_MAX_IMAGES; n++)
+            lr_program_destroy(b->prog[op][n]);
     free(b);
 }
 
@@ -67,14 +73,58 @@ static void uniform_i(const lr_program *p, const char *name, int v)
         glUniform1i(loc, v);
 }
 
+static void uniform_f(const lr_program *p, const char *name, float v)
+{
+    GLint loc = lr_program_uniform(p, name);
+    if (loc >= 0)
+        glUniform1f(loc, v);
+}
+
+/* The program for tone curve op (LR_BLEND_OPS: the linear sum) and n images of non-zero weight: the caller's defines plus
+ * LR_BLEND_OP and LR_BLEND_N. */
+static int program(lr_blend *b, int op, int n, lr_program **out, lr_err *e)
+{
+    if (!b->prog[op][n]) {
+        static const char *const ops[] = {"LR_BLEND_OP 0", "LR_BLEND_OP 1", "LR_BLEND_OP 2",
+                                          "LR_BLEND_OP 3"};
+        static const char *const ns[] = {"LR_BLEND_N 0", "LR_BLEND_N 1", "LR_BLEND_N 2",
+                                         "LR_BLEND_N 3", "LR_BLEND_N 4"};
+        const char *defs[16];
+        int k = 0;
+        for (; k < 13 && b->defines && b->defines[k]; k++)
+            defs[k] = b->defines[k];
+        defs[k++] = ops[op];
+        defs[k++] = ns[n];
+        defs[k] = NULL;
+        lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "blend.frag",
+                              .dir = b->shader_dir, .defines = defs};
+        int rc = lr_program_create(&pd, &b->prog[op][n], e);
+        if (rc)
+            return rc;
+    }
+    *out = b->prog[op][n];
+    return LR_OK;
+}
+
 static int draw(lr_blend *b, lr_fb *fb, bool linear, lr_err *e)
 {
     const lr_blend_input *in = &b->in;
-    const lr_program *p = b->prog;
+    /* Only the images whose weight is not zero are read (a light switched off costs nothing). */
     float w[3 * LR_BLEND_MAX_IMAGES] = {0};
-    for (int l = 0; l < in->n; l++)
+    int layer[LR_BLEND_MAX_IMAGES] = {0}, n = 0;
+    for (int l = 0; l < in->n; l++) {
+        if (in->w[l][0] == 0.0 && in->w[l][1] == 0.0 && in->w[l][2] == 0.0)
+            continue;
         for (int c = 0; c < 3; c++)
-            w[3 * l + c] = (float)in->w[l][c];
+            w[3 * n + c] = (float)in->w[l][c];
+        layer[n++] = l;
+    }
+    int op = linear ? LR_BLEND_OPS
+                    : in->tonemap_op >= 0 && in->tonemap_op < LR_BLEND_OPS ? in->tonemap_op : 0;
+    lr_program *p = NULL;
+    int rc = program(b, op, n, &p, e);
+    if (rc)
+        return rc;
     lr_fb_bind(fb);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
@@ -87,11 +137,11 @@ static int draw(lr_blend *b, lr_fb *fb, bool linear, lr_err *e)
         loc = lr_program_uniform(p, "u_w[0]");
     if (loc >= 0)
         glUniform3fv(loc, LR_BLEND_MAX_IMAGES, w);
-    uniform_i(p, "u_n", in->n);
-    uniform_i(p, "u_linear", linear);
-    uniform_i(p, "u_op", in->tonemap_op);
-    if ((loc = lr_program_uniform(p, "u_exposure")) >= 0)
-        glUniform1f(loc, in->exposure);
+    if ((loc = lr_program_uniform(p, "u_layer")) >= 0 ||
+        (loc = lr_program_uniform(p, "u_layer[0]")) >= 0)
+        glUniform1iv(loc, LR_BLEND_MAX_IMAGES, layer);
+    /* lr_tonemap_apply's rule: exposure 0 means 1. */
+    uniform_f(p, "u_exposure", in->exposure != 0.0f ? in->exposure : 1.0f);
     lr_gl_draw_fullscreen(b->gl);
     return lr_gl_check(linear ? "blend pass (HDR sum)" : "blend pass", e);
 }

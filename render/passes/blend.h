@@ -1,6 +1,7 @@
 /* lamprig — the blend pass (issue 11): the output is the weighted sum of the per-light
  * unit-intensity linear images, sum_l w_l image_l with w_l = intensity x colour x flicker per
- * band, then exposure, tone curve and sRGB. Light transport is linear in each light's
+ * band, then exposure, tone curve and sRGB (lr_srgb_encode_fast: within a quarter of an
+ * 8-bit step of the exact encode). Images of weight 0 are not read. Light transport is linear in each light's
  * intensity (render/passes/PIPELINE.md "Linearity"), so a dimmer, colour, flicker or exposure
  * change is this one fullscreen pass and nothing else.
  *
@@ -18,6 +19,7 @@
 #include "render/gl/tex.h"
 
 #define LR_BLEND_MAX_IMAGES 4
+#define LR_BLEND_OPS 3 /* lr_tonemap_op values: clamp, Reinhard, ACES */
 
 typedef struct lr_blend lr_blend;
 

@@ -1,23 +1,50 @@
-// The blend pass (render/passes/blend.h): sum_l u_w[l] image_l over the per-light
-// unit-intensity linear images, then tone mapping (or, with u_linear, the linear sum for
-// readback). One fetch per light and pixel; the images are in the same pixel grid.
-#include "lib/tonemap.glsl"
-
+// The blend pass (render/passes/blend.h): sum_k u_w[k] image_{u_layer[k]} over the per-light
+// unit-intensity linear images whose weight is not zero (LR_BLEND_N of them, a compile-time
+// count: no loop, no branch per pixel), then exposure, the tone curve (LR_BLEND_OP, an
+// lr_tonemap_op, compile-time) and the sRGB encode, or, with LR_BLEND_OP 3, the linear sum
+// for readback (a define, not a uniform: llvmpipe runs both sides of a uniform branch under a
+// mask, and the other side's fetch would cost as much as the image's). The encode is lr_srgb_encode_fast (render/image/image.h): three square roots
+// instead of pow, within a quarter of an 8-bit step of IEC 61966-2-1. This pass is the whole
+// of a dimmer or flicker frame; on llvmpipe pow (log2 + exp2) per channel and a per-channel
+// table fetch (a gather per lane) each cost more than the fetch of the image itself.
 uniform highp sampler2DArray u_images;
-uniform vec3 u_w[LR_MAX_LIGHTS];
-uniform int u_n;
-uniform bool u_linear;
+uniform vec3 u_w[4];
+uniform int u_layer[4];
+uniform float u_exposure;
 layout(location = 0) out vec4 o_color;
 
 void main()
 {
     ivec2 p = ivec2(gl_FragCoord.xy);
-    vec4 c0 = texelFetch(u_images, ivec3(p, 0), 0);
-    vec3 c = u_w[0] * c0.rgb;
-    for (int l = 1; l < LR_MAX_LIGHTS; l++) {
-        if (l >= u_n)
-            break;
-        c += u_w[l] * texelFetch(u_images, ivec3(p, l), 0).rgb;
-    }
-    o_color = u_linear ? vec4(c, c0.a) : lr_tonemap_srgb(c);
+    vec3 c = vec3(0.0);
+#if LR_BLEND_N >= 1
+    c += u_w[0] * texelFetch(u_images, ivec3(p, u_layer[0]), 0).rgb;
+#endif
+#if LR_BLEND_N >= 2
+    c += u_w[1] * texelFetch(u_images, ivec3(p, u_layer[1]), 0).rgb;
+#endif
+#if LR_BLEND_N >= 3
+    c += u_w[2] * texelFetch(u_images, ivec3(p, u_layer[2]), 0).rgb;
+#endif
+#if LR_BLEND_N >= 4
+    c += u_w[3] * texelFetch(u_images, ivec3(p, u_layer[3]), 0).rgb;
+#endif
+#if LR_BLEND_OP == 3
+    // Alpha of layer 0: coverage (compose_object.frag), whichever lights are lit.
+    o_color = vec4(c, texelFetch(u_images, ivec3(p, 0), 0).a);
+#else
+    // lr_tonemap_apply (render/image/image.c): exposure, curve, clip to [0, 1].
+    vec3 v = max(c * u_exposure, vec3(0.0));
+#if LR_BLEND_OP == 1
+    v = v / (1.0 + v);
+#elif LR_BLEND_OP == 2
+    v = (v * (2.51 * v + 0.03)) / (v * (2.43 * v + 0.59) + 0.14); // Narkowicz 2015
+#endif
+    v = min(v, vec3(1.0));
+    // lr_srgb_encode_fast: the linear segment below 0.0031308, else Taylor's fit in
+    // l^(1/2), l^(1/4), l^(1/8).
+    vec3 s1 = sqrt(v), s2 = sqrt(s1), s3 = sqrt(s2);
+    vec3 fit = 0.662002687 * s1 + 0.684122060 * s2 - 0.323583601 * s3 - 0.0225411470 * v;
+    o_color = vec4(mix(fit, 12.92 * v, lessThanEqual(v, vec3(0.0031308))), 1.0);
+#endif
 }
