@@ -5,7 +5,7 @@
 #   make test    build with -Werror + ASan + UBSan and run every test binary
 #   make run     render the default candle scene headless
 #   make bench   speed and error figures
-#   make install  PREFIX=/usr/local DESTDIR= (see "Install on a Raspberry Pi" in README.md)
+#   make install  PREFIX=/usr/local DESTDIR= (see tools/install/README.md)
 #   make deb      build/lamprig_VERSION_ARCH.deb from a staged install (tools/debian/)
 #   make test-install  the package, its lintian, unit, udev rules and installed binary
 #   make clean
@@ -181,7 +181,7 @@ test-install: deb
 # 8 progressive frames (the scene converges at 64): about a minute on llvmpipe; leave out
 # --frames to render until render.frames are accumulated. --no-plan: the demo shows the scene
 # file's own settings; the candle's 0.05 budget is below the model's measured bias, and the
-# plan's closest setting (32^2 maps, N 4) looks blotchy (README, "Planner").
+# plan's closest setting (32^2 maps, N 4) looks blotchy (render/plan/README.md).
 run: build/bin/lamprig
 	@mkdir -p build/out
 	./build/bin/lamprig plan --scene configs/scenes/candle.json

@@ -66,7 +66,7 @@ typedef struct lr_camcal_desc {
     /* Chessboard corner refinement half-window (px): 0 -> 11, OpenCV's calibration sample
      * (and the setting behind OpenCV's own result for its sample photos); LR_SUBPIX_AUTO ->
      * 0.4 x the corner spacing in each image, at most 11, better when the board is small in
-     * some views (see README). */
+     * some views (see calib/README.md, "calib camera"). */
     int subpix_window;
     const lr_progress *progress;
 } lr_camcal_desc;

@@ -196,7 +196,8 @@ static void test_fit_recovers_sigma(void **state)
      * image's relative sensitivity to log sigma along the constant-albedo ridge is ~0.25, so
      * one fit resolves about 0.085 / 0.25 = 0.34 in log (one sigma); the bound is two. This is
      * the CPU reference's noise at a test-sized budget (128 samples, 16 x 16), not the
-     * optimiser: more samples shrink it as 1 / sqrt(samples) (README, Calibration). The
+     * optimiser: more samples shrink it as 1 / sqrt(samples) (calib/README.md, "Material
+     * fitting"). The
      * reported Gauss-Newton standard errors ignore that the noise field changes with sigma
      * and come out 3-10x smaller; they are checked to be finite and positive only. */
     for (int b = 0; b < 3; b++) {

@@ -212,7 +212,8 @@ static void test_error_falls_with_frames(void **state)
                      checks[c], checks[c + 1], predicted);
     }
     /* Against the physical reference the model's bias stays (on the candle's object pixels it
-     * is larger than the noise: README "Speed against error"), and the cross term between
+     * is larger than the noise: tools/bench/README.md, "Speed against error"), and the cross term
+     * between
      * bias and noise fluctuates, so 1 -> 4 need not fall; what must fall from 1 to 16 frames
      * is the objects' sigma^2 (1 - 1/16), asked for at half its predicted size. */
     double drop = e2[0] - e2[2], predicted = o2 * (1.0 - 1.0 / 16.0);

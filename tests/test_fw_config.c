@@ -209,7 +209,8 @@ static void test_truncated_and_garbage(void **state)
     lr_test_rmtree(dir);
 }
 
-/* The shipped rigs and control map load, and say what the README says they do. */
+/* The shipped rigs and control map load, and say what firmware/README.md ("Shipped rigs") says
+ * they do. */
 static void test_shipped_rigs(void **state)
 {
     (void)state;

@@ -62,7 +62,8 @@ static lr_ref_scene *shell(const lr_ref_medium_desc *md, lr_vec3 light, bool mes
  * not missed light is what the balance checks: a lost solution would make the camera paths
  * come up short. (Longer runs than this test's do measure a small shortfall on faceted
  * cavities, -0.13 % +- 0.05 % for 320 and for 1280 facets, none on the analytic sphere:
- * connections that land within rounding of a gap's border. README lists it.) The first run has a faceted outer sphere too (1280 facets) and checks exact
+ * connections that land within rounding of a gap's border. render/reference/README.md lists it.)
+ * The first run has a faceted outer sphere too (1280 facets) and checks exact
  * conservation; the balance runs use an analytic outside, so that the (ASan-slowed) BVH work
  * goes to the refracted connections. 64 000 photons, 40 000 camera paths: SE about 0.3 % and
  * 0.6 %. */

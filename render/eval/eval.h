@@ -1,5 +1,5 @@
 /* lamprig — the error of a rendering against a reference, and the speed-against-error front
- * (issue 6: `lamprig-bench sweep`, README "Speed against error").
+ * (issue 6: `lamprig-bench sweep`, tools/bench/README.md, "Speed against error").
  *
  * Images here are linear RGB floats, rows top to bottom (lr_image / lr_ref_image layout).
  * Errors are relative RMSEs in linear light over a pixel mask, all three bands pooled:

@@ -26,7 +26,8 @@
  * shape behind the geometry interface (analytic or mesh). Radiance over n^2 conservation is
  * implied: E is a flux density, valid in any medium.
  *
- * Limits (documented in README): the connection keeps the interface sequence of the straight
+ * Limits (documented in render/reference/README.md): the connection keeps the interface sequence
+ * of the straight
  * segment, and one solution is found. Where refraction produces several (beyond a caustic of
  * a strongly curved, high-index boundary) or a different sequence, those paths are lost;
  * failures are counted in lr_ref_stats.nee_unsolved. In the dense media this rig renders the

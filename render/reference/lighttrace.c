@@ -13,7 +13,8 @@
  * whose light end NEE covers stop at their first vertex: each path is counted once, by one
  * strategy. A path with a reflection at both ends (seen in the wax as a mirror image AND lit
  * by a mirrored light) is counted by neither; it carries a product of two Fresnel
- * reflectances (~0.2 % at normal incidence) and is listed in README as a known omission.
+ * reflectances (~0.2 % at normal incidence) and is listed in render/reference/README.md as a known
+ * omission.
  *
  * The pinhole measurement: the camera averages radiance over the pixel's area on an image
  * plane at distance 1; a point source of flux density E across the beam, seen at angle theta

@@ -16,7 +16,7 @@
  *              lights;
  *   camera     pinhole, box-filtered pixels.
  *
- * Estimators (README "Physical reference"; each light path is counted by exactly one):
+ * Estimators (render/reference/README.md; each light path is counted by exactly one):
  *   - camera paths (lr_ref_radiance, lr_ref_render): unidirectional random walk from the
  *     camera with next-event estimation (NEE) at every non-specular vertex: diffuse receivers
  *     and scattering events inside media. NEE toward a light behind smooth refractive
@@ -392,7 +392,8 @@ int lr_ref_render_cached(const lr_ref_scene *s, const lr_ref_camera *cam,
 
 /* ---- scene files ------------------------------------------------------------------------ */
 
-/* Loads a reference scene file (format in README "Physical reference") into a finished scene
+/* Loads a reference scene file (format in render/reference/README.md, "Scene files") into a
+ * finished scene
  * and its camera and render settings (fields absent from the file keep the values *cam and
  * *d had on entry). */
 int lr_ref_scene_load(const char *path, lr_ref_scene **out, lr_ref_camera *cam,

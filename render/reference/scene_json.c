@@ -1,5 +1,6 @@
 /* Reference scene files: analytic shapes, media, receivers, lights, camera and render settings
- * in one JSON document (format in README "Physical reference"). Errors name file:line:field. */
+ * in one JSON document (format in render/reference/README.md, "Scene files"). Errors name
+ * file:line:field. */
 #include "render/reference/ref_priv.h"
 
 #include <stdio.h>

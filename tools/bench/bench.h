@@ -1,6 +1,6 @@
 /* lamprig-bench — speed (and, as sections are added, error against a reference) of each part of
  * the renderer, one section per module. Each section prints a markdown block that can be pasted
- * into the README as it is. */
+ * into tools/bench/README.md as it is. */
 #ifndef LRB_BENCH_H
 #define LRB_BENCH_H
 

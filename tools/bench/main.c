@@ -1,6 +1,6 @@
 /* lamprig-bench: `lamprig-bench` runs every section; `lamprig-bench NAME...` runs those;
  * `lamprig-bench --list` lists them; `--update-front` makes the sweep also write
- * configs/bench/front.csv. Output is markdown, ready for the README. */
+ * configs/bench/front.csv. Output is markdown, ready for tools/bench/README.md. */
 #include "tools/bench/bench.h"
 
 #include <string.h>

@@ -4,7 +4,8 @@
  * Per scene: the physical reference at LRB_SWEEP_W x LRB_SWEEP_H, LRB_SWEEP_SPP samples per
  * pixel, through lr_ref_render_cached in configs/bench/references/ (keyed by the scene hash;
  * committed, because rendering the four references takes longer than the bench may on two
- * cores: README "Speed against error"); object and receiver masks by ray casting; then every
+ * cores: tools/bench/README.md, "Speed against error"); object and receiver masks by ray casting;
+ * then every
  * setting of sweep_settings.c as a GPU frame series (render/eval/series.c) with its errors
  * after 1, 4, 16 (and 64) frames, its bias (the converged series vs the reference) and noise
  * (F frames vs the converged series).
@@ -122,7 +123,7 @@ static int run_opts(FILE *out, const lrb_options *opt)
         }
         ns++;
     }
-    /* The README table: candle and lamp shade at 640x480. */
+    /* The table in tools/bench/README.md: candle and lamp shade at 640x480. */
     lrb_timing_640 t640[2];
     int nt = 0;
     const char *table_scenes[] = {"candle", "lampshade"};

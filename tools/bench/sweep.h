@@ -1,5 +1,6 @@
 /* Section "sweep": speed against error for every scene in configs/scenes/ (issue 6 items 2
- * and 4; README "Speed against error"). Internal to the bench; the metrics, masks, Pareto
+ * and 4; tools/bench/README.md, "Speed against error"). Internal to the bench; the metrics, masks,
+ * Pareto
  * front, CSV and GPU frame series are in render/eval/eval.h (unit-tested there). */
 #ifndef LRB_SWEEP_H_INCLUDED
 #define LRB_SWEEP_H_INCLUDED
