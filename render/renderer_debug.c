@@ -6,6 +6,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "render/base/median.h"
 #include "render/optics/optics.h"
 #include "render/passes/passes.h"
 
@@ -212,25 +213,6 @@ int lr_renderer_debug_uncovered(lr_renderer *r, int *count, lr_err *e)
     return LR_OK;
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* Median of the finite values of v[0..n) (n <= 64); NaN if none. */
-static double median(const double *v, int n)
-{
-    double s[64];
-    int m = 0;
-    for (int i = 0; i < n && i < 64; i++)
-        if (isfinite(v[i]))
-            s[m++] = v[i];
-    if (!m)
-        return NAN;
-    qsort(s, (size_t)m, sizeof s[0], cmp_double);
-    return m % 2 ? s[m / 2] : 0.5 * (s[m / 2 - 1] + s[m / 2]);
-}
 
 int lr_renderer_debug_floor_ms(lr_renderer *r, int reps, double *wall_ms, double *timer_ms,
                                lr_err *e)
@@ -277,8 +259,8 @@ int lr_renderer_debug_floor_ms(lr_renderer *r, int reps, double *wall_ms, double
     lr_timer_reset(r->timer);
     if ((rc = lr_gl_check("floor pass", e)))
         goto done;
-    *wall_ms = median(t, n);
-    *timer_ms = median(g, n);
+    *wall_ms = lr_median_finite(t, n);
+    *timer_ms = lr_median_finite(g, n);
 done:
     lr_tex_destroy(src);
     lr_program_destroy(p);

@@ -6,6 +6,7 @@
 #include <cmocka.h>
 
 #include <dirent.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,6 +17,7 @@
 #include "firmware/cli.h"
 #include "render/base/atomic_file.h"
 #include "render/base/err.h"
+#include "render/base/median.h"
 #include "render/base/paths.h"
 #include "tests/support/fs.h"
 
@@ -139,12 +141,27 @@ static void test_data_paths(void **state)
     lr_test_rmtree(dir);
 }
 
+/* The median skips failed measurements (NaN, Inf) and leaves its input as it was. */
+static void test_median_finite(void **state)
+{
+    (void)state;
+    double odd[] = {5, NAN, 1, INFINITY, 3};
+    assert_true(lr_median_finite(odd, 5) == 3.0);
+    assert_true(isnan(odd[1]) && odd[0] == 5 && odd[2] == 1); /* unchanged */
+    double even[] = {4, 1, -INFINITY, 2, 3};
+    assert_true(lr_median_finite(even, 5) == 2.5);
+    double none[] = {NAN, INFINITY};
+    assert_true(isnan(lr_median_finite(none, 2)));
+    assert_true(isnan(lr_median_finite(NULL, 0)));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_err_prefix),
         cmocka_unit_test(test_atomic_replace_and_failure_keeps_old),
         cmocka_unit_test(test_data_paths),
+        cmocka_unit_test(test_median_finite),
     };
     return cmocka_run_group_tests_name("base", tests, NULL, NULL);
 }

@@ -37,6 +37,7 @@
 #include <sys/stat.h>
 
 #include "render/base/atomic_file.h"
+#include "render/base/median.h"
 #include "render/base/paths.h"
 #include "render/cpu/frame.h"
 #include "render/gl/gl.h"
@@ -54,24 +55,6 @@ static const char *const scene_names[] = {"candle", "lampshade"};
 static const int sizes[][2] = {{640, 480}, {1280, 720}};
 static const int err_frames[] = {1, 4, 16, 64};
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(const double *v, int n)
-{
-    double s[64];
-    int m = 0;
-    for (int i = 0; i < n && m < 64; i++)
-        if (isfinite(v[i]))
-            s[m++] = v[i];
-    if (!m)
-        return NAN;
-    qsort(s, (size_t)m, sizeof s[0], cmp_double);
-    return m % 2 ? s[m / 2] : 0.5 * (s[m / 2 - 1] + s[m / 2]);
-}
 
 static lr_scene *load(const char *name)
 {
@@ -203,13 +186,13 @@ static int time_one(lr_gl *gl, const char *name, int w, int h, timing_row *row)
         fprintf(stderr, "bench render: floor pass: %s\n", e.msg);
         goto done;
     }
-    row->camera_ms = median(cam, CAMERA_FRAMES);
-    row->dimmer_wall_ms = median(dimw, DIMMER_FRAMES);
+    row->camera_ms = lr_median_finite(cam, CAMERA_FRAMES);
+    row->dimmer_wall_ms = lr_median_finite(dimw, DIMMER_FRAMES);
     for (int p = 0; p < LR_PASS_COUNT; p++)
-        row->pass_ms[p] = median(full[p], FULL_FRAMES);
-    row->total_ms = median(total, FULL_FRAMES);
-    row->accum_ms = median(acc, ACCUM_FRAMES);
-    row->dimmer_ms = median(dim, DIMMER_FRAMES);
+        row->pass_ms[p] = lr_median_finite(full[p], FULL_FRAMES);
+    row->total_ms = lr_median_finite(total, FULL_FRAMES);
+    row->accum_ms = lr_median_finite(acc, ACCUM_FRAMES);
+    row->dimmer_ms = lr_median_finite(dim, DIMMER_FRAMES);
     fprintf(stderr, "bench render: %s %dx%d timed\n", name, w, h);
     rc = 0;
 done:
