@@ -75,8 +75,8 @@ int lrb_sweep_time_640(lr_gl *gl, const char *name, lrb_timing_640 *out)
         lr_renderer_invalidate(r, dirty);
         if ((rc = lr_renderer_frame(r, &st, &e)))
             break;
-        if (st.passes != LR_PASS_COMPOSE)
-            fprintf(stderr, "bench sweep: dimmer frame ran passes 0x%x, not compose alone\n",
+        if (st.passes != LR_PASS_BLEND) /* linear in intensity: the blend pass alone */
+            fprintf(stderr, "bench sweep: dimmer frame ran passes 0x%x, not the blend alone\n",
                     st.passes);
         dim[i] = st.total_ms;
     }
