@@ -10,8 +10,7 @@
 #include "render/base/mat4.h"
 #include "render/passes/passes.h"
 
-/* Images for n lights (a 2D array, one colour attachment per layer, one depth buffer). */
-static int images_alloc(lr_renderer *r, int n, lr_err *e)
+static void images_free(lr_renderer *r)
 {
     lr_fb_destroy(r->img.fb);
     lr_tex_destroy(r->img.images);
@@ -19,6 +18,12 @@ static int images_alloc(lr_renderer *r, int n, lr_err *e)
     r->img.images = NULL;
     r->img.n = 0;
     r->img.valid = false;
+}
+
+/* Images for n lights (a 2D array, one colour attachment per layer, one depth buffer). */
+static int images_alloc(lr_renderer *r, int n, lr_err *e)
+{
+    images_free(r);
     if (n < 1 || n > LR_MAX_LIGHTS || n > r->caps->max_draw_buffers)
         return lr_err_set(e, LR_EUNSUPPORTED,
                           "compose: %d lights; takes 1..%d (and the driver %d draw buffers)", n,
@@ -49,12 +54,7 @@ int lr_compose_alloc(lr_renderer *r, lr_err *e)
 
 void lr_compose_free(lr_renderer *r)
 {
-    lr_fb_destroy(r->img.fb);
-    lr_tex_destroy(r->img.images);
-    r->img.fb = NULL;
-    r->img.images = NULL;
-    r->img.n = 0;
-    r->img.valid = false;
+    images_free(r);
     lr_blend_destroy(r->blend);
     r->blend = NULL;
 }
