@@ -92,6 +92,87 @@ static void context_can_be_recreated(void **state)
     }
 }
 
+/* Draws into a framebuffer object and reads it back: the context is a working one. */
+static void clear_and_read_back(float r, float g, float b)
+{
+    GLuint tex = 0, fb = 0;
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, 4, 4);
+    glGenFramebuffers(1, &fb);
+    glBindFramebuffer(GL_FRAMEBUFFER, fb);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex, 0);
+    assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+    glClearColor(r, g, b, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    unsigned char px[4] = {0};
+    glReadPixels(1, 2, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, px);
+    /* Unorm8 stores round(255 x): within one code. */
+    assert_true(abs(px[0] - (int)(255.0f * r + 0.5f)) <= 1);
+    assert_true(abs(px[1] - (int)(255.0f * g + 0.5f)) <= 1);
+    assert_true(abs(px[2] - (int)(255.0f * b + 0.5f)) <= 1);
+    assert_int_equal(px[3], 255);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDeleteFramebuffers(1, &fb);
+    glDeleteTextures(1, &tex);
+}
+
+/* The EGL-device back end (NVIDIA's headless path) on Mesa's software device, which Mesa lists
+ * through the same EGL_EXT_device_enumeration: a GLES 3.1 context that renders. */
+static void device_backend_renders(void **state)
+{
+    lr_gl *gl = NULL;
+    lr_err e = {0};
+    if (lr_gl_create(&(lr_gl_desc){.backend = LR_GL_DEVICE}, &gl, &e))
+        fail_msg("lr_gl_create(device): %s", e.msg);
+    assert_string_equal(lr_gl_backend_name(gl), "device");
+    assert_int_equal(lr_gl_backend_of(gl), LR_GL_DEVICE);
+    const lr_gl_caps *c = lr_gl_caps_get(gl);
+    assert_true(c->major > 3 || (c->major == 3 && c->minor >= 1));
+    int w = -1, h = -1;
+    lr_gl_size(gl, &w, &h);
+    assert_int_equal(w, 0);
+    assert_int_equal(lr_gl_event_fd(gl), -1);
+    clear_and_read_back(0.25f, 0.5f, 0.75f);
+    assert_int_equal(lr_gl_present(gl, &e), LR_OK);
+    lr_gl_destroy(gl);
+
+    /* The default back end can be sent to the device by the environment. */
+    setenv("LAMPRIG_EGL_PLATFORM", "device", 1);
+    int rc = lr_gl_create(NULL, &gl, &e);
+    unsetenv("LAMPRIG_EGL_PLATFORM");
+    if (rc)
+        fail_msg("lr_gl_create(LAMPRIG_EGL_PLATFORM=device): %s", e.msg);
+    assert_string_equal(lr_gl_backend_name(gl), "device");
+    clear_and_read_back(1.0f, 0.0f, 0.5f);
+    lr_gl_destroy(gl);
+}
+
+static void device_and_platform_choices_are_checked(void **state)
+{
+    lr_gl *gl = (lr_gl *)1;
+    lr_err e = {0};
+    setenv("LAMPRIG_EGL_DEVICE", "99", 1);
+    assert_int_equal(lr_gl_create(&(lr_gl_desc){.backend = LR_GL_DEVICE}, &gl, &e), LR_EINVAL);
+    unsetenv("LAMPRIG_EGL_DEVICE");
+    assert_null(gl);
+    assert_non_null(strstr(e.msg, "LAMPRIG_EGL_DEVICE='99': expected 0.."));
+    setenv("LAMPRIG_EGL_DEVICE", "x", 1);
+    assert_int_equal(lr_gl_create(&(lr_gl_desc){.backend = LR_GL_DEVICE}, &gl, &e), LR_EINVAL);
+    unsetenv("LAMPRIG_EGL_DEVICE");
+    setenv("LAMPRIG_EGL_PLATFORM", "x11", 1);
+    assert_int_equal(lr_gl_create(NULL, &gl, &e), LR_EINVAL);
+    unsetenv("LAMPRIG_EGL_PLATFORM");
+    assert_string_equal(e.msg, "EGL: LAMPRIG_EGL_PLATFORM='x11': expected surfaceless or device");
+    /* Device 0 named explicitly works (Mesa's software device here). */
+    setenv("LAMPRIG_EGL_DEVICE", "0", 1);
+    int rc = lr_gl_create(&(lr_gl_desc){.backend = LR_GL_DEVICE}, &gl, &e);
+    unsetenv("LAMPRIG_EGL_DEVICE");
+    if (rc)
+        fail_msg("LAMPRIG_EGL_DEVICE=0: %s", e.msg);
+    lr_gl_destroy(gl);
+}
+
 static void gl_errors_are_reported_by_name(void **state)
 {
     lr_gl *gl = NULL;
@@ -194,6 +275,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(surfaceless_context_is_gles31_with_caps),
         cmocka_unit_test(context_can_be_recreated),
+        cmocka_unit_test(device_backend_renders),
+        cmocka_unit_test(device_and_platform_choices_are_checked),
         cmocka_unit_test(gl_errors_are_reported_by_name),
         cmocka_unit_test(bad_descriptor_is_rejected),
         cmocka_unit_test(caps_gles31_without_extensions),

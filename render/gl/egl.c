@@ -84,3 +84,24 @@ int lr_gl__egl_context(lr_gl *gl, lr_err *e)
                           lr_gl__egl_error_str(eglGetError()));
     return LR_OK;
 }
+
+int lr_gl__headless_context(lr_gl *gl, lr_err *e)
+{
+    const char *exts = eglQueryString(gl->dpy, EGL_EXTENSIONS);
+    /* Making a context current without a surface is the whole point of a headless back end. */
+    if (!lr_gl__has_ext(exts, "EGL_KHR_surfaceless_context"))
+        return lr_err_set(e, LR_EUNSUPPORTED, "EGL: missing EGL_KHR_surfaceless_context");
+    if (!lr_gl__has_ext(exts, "EGL_KHR_no_config_context")) {
+        /* No surfaces will ever be made, so any GLES 3 config will do. */
+        static const EGLint attribs[] = {
+            EGL_RENDERABLE_TYPE, EGL_OPENGL_ES3_BIT,
+            EGL_SURFACE_TYPE, 0,
+            EGL_NONE,
+        };
+        EGLint n = 0;
+        if (!eglChooseConfig(gl->dpy, attribs, &gl->config, 1, &n) || n < 1)
+            return lr_err_set(e, LR_EUNSUPPORTED, "EGL: no config with EGL_OPENGL_ES3_BIT: %s",
+                              lr_gl__egl_error_str(eglGetError()));
+    }
+    return lr_gl__egl_context(gl, e);
+}

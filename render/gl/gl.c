@@ -9,6 +9,7 @@
 static int (*const backend_init[])(lr_gl *, const lr_gl_desc *, lr_err *) = {
     [LR_GL_SURFACELESS] = lr_gl__surfaceless_init,
     [LR_GL_KMS] = lr_gl__kms_init,
+    [LR_GL_DEVICE] = lr_gl__device_init,
 };
 
 static void copy_gl_string(char *dst, size_t cap, GLenum name)

@@ -2,6 +2,9 @@
  *
  *   LR_GL_SURFACELESS  headless (EGL_PLATFORM_SURFACELESS_MESA): no window, no pbuffer; every
  *                      pass renders into its own framebuffer objects. Tests, `lamprig render`.
+ *   LR_GL_DEVICE       headless on an EGL device (EGL_EXT_platform_device): the first GPU, or
+ *                      LAMPRIG_EGL_DEVICE=N. LR_GL_SURFACELESS falls back to it when the EGL
+ *                      vendor lacks the Mesa platform (NVIDIA's EGL on a GPU server).
  *   LR_GL_KMS          the projector: DRM/KMS + GBM + an EGL window surface, scanned out by
  *                      page flips on vblank (kmscube's legacy path).
  *
@@ -37,6 +40,7 @@ typedef struct lr_gl lr_gl;
 typedef enum lr_gl_backend {
     LR_GL_SURFACELESS = 0, /* default */
     LR_GL_KMS,
+    LR_GL_DEVICE,
 } lr_gl_backend;
 
 typedef struct lr_gl_desc {

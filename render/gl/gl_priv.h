@@ -38,12 +38,16 @@ struct lr_gl {
  * context with lr_gl__egl_context. On failure they leave what they made for lr_gl_destroy. */
 int lr_gl__surfaceless_init(lr_gl *gl, const lr_gl_desc *desc, lr_err *e);
 int lr_gl__kms_init(lr_gl *gl, const lr_gl_desc *desc, lr_err *e);
+int lr_gl__device_init(lr_gl *gl, const lr_gl_desc *desc, lr_err *e);
 
 /* egl.c */
 /* Checks the client extensions for EGL_EXT_platform_base and `platform_ext`, gets the platform
  * display for `native`, initialises it and binds GLES; sets gl->dpy. */
 int lr_gl__egl_display(lr_gl *gl, EGLenum platform, void *native, const char *platform_ext,
                        lr_err *e);
+/* Headless back ends: checks EGL_KHR_surfaceless_context, picks a GLES 3 config when the
+ * driver lacks EGL_KHR_no_config_context, and creates the context. */
+int lr_gl__headless_context(lr_gl *gl, lr_err *e);
 /* Creates a GLES 3.1 context on gl->dpy with gl->config into gl->ctx. */
 int lr_gl__egl_context(lr_gl *gl, lr_err *e);
 /* True when the space-separated extension list `list` holds exactly `name`. */
