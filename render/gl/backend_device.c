@@ -57,7 +57,9 @@ int lr_gl__device_init(lr_gl *gl, const lr_gl_desc *desc, lr_err *e)
     (void)desc;
     gl->ops = &device_ops;
     const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
-    if (!client || !lr_gl__has_ext(client, "EGL_EXT_device_enumeration"))
+    /* EGL_EXT_device_base is enumeration + query in one name (NVIDIA lists only it). */
+    if (!client || (!lr_gl__has_ext(client, "EGL_EXT_device_enumeration") &&
+                    !lr_gl__has_ext(client, "EGL_EXT_device_base")))
         return lr_err_set(e, LR_EUNSUPPORTED,
                           "EGL: missing client extension EGL_EXT_device_enumeration");
     PFNEGLQUERYDEVICESEXTPROC query_devices =
