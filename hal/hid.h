@@ -23,6 +23,7 @@
 #include <stdint.h>
 
 #include "hal/dev.h"
+#include "hal/opt.h"
 #include "hal/hid_report.h"
 #include "render/base/err.h"
 
@@ -34,6 +35,17 @@ typedef struct lr_hid_desc {
     int poll_ms;                /* report queue polling period; default 8 (125 Hz, the PowerMate's
                                  * interrupt interval) */
 } lr_hid_desc;
+
+/* The options above as the rig config reads them (hal/opt.h). */
+enum {
+    LR_HID_OPT_VID = 0,
+    LR_HID_OPT_PID,
+    LR_HID_OPT_SERIAL,
+    LR_HID_OPT_POLL_MS,
+    LR_HID_OPT_PROTO,
+    LR_HID_OPT_REPORT_ID,
+};
+extern const lr_opt lr_hid_opts[];
 
 typedef struct lr_hid lr_hid;
 
