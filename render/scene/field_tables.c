@@ -23,7 +23,7 @@ static const char *const light_objects[] = {"flicker", NULL};
 static const lr_field light_fields[] = {
     {"type", LR_FT_TYPE, .names = light_types, .flags = LR_FF_REQUIRED | LR_FF_NO_SET,
      .help = "point, spot or directional"},
-    {"name", LR_FT_NAME, .dflt_text = "light<i>", .flags = LR_FF_NO_SET,
+    {"name", LR_FT_NAME, .dflt_text = "light0, light1, ...", .flags = LR_FF_NO_SET,
      .help = "unique; letters, digits, _ and - (not only digits)"},
     {"intensity", LR_FT_NUM, P | S, L(intensity), 0, 1e12, LR_FF_REQUIRED | LR_FF_HI_OPEN |
      LR_FF_HI_QUIET, .unit = "(W/sr)", .dirty = LR_DIRTY_INTENSITY,
@@ -121,7 +121,7 @@ static const char *const receiver_what[] = {"a plane receiver", "a box receiver"
 static const lr_field receiver_fields[] = {
     {"type", LR_FT_TYPE, .names = receiver_types, .flags = LR_FF_REQUIRED | LR_FF_NO_SET,
      .help = "plane or box"},
-    {"name", LR_FT_NAME, .dflt_text = "receiver<i>", .flags = LR_FF_NO_SET,
+    {"name", LR_FT_NAME, .dflt_text = "receiver0, ...", .flags = LR_FF_NO_SET,
      .help = "unique; letters, digits, _ and -"},
     {"albedo", LR_FT_RGB, 0, R(albedo), 0, 1, LR_FF_REQUIRED,
      .unit = "(a diffuse surface reflects at most what it receives)",
@@ -156,7 +156,7 @@ const lr_record_desc lr_scene_receiver_desc = {"receivers[i]", "a receiver", rec
 static const char *const sss_models[] = {"directional_dipole", "standard_dipole", NULL};
 
 static const lr_field object_fields[] = {
-    {"name", LR_FT_NAME, .dflt_text = "object<i>", .flags = LR_FF_NO_SET,
+    {"name", LR_FT_NAME, .dflt_text = "object0, ...", .flags = LR_FF_NO_SET,
      .help = "unique; letters, digits, _ and -"},
     {"material", LR_FT_OBJECT, .flags = LR_FF_REQUIRED, .dirty = LR_DIRTY_MATERIAL,
      .help = "a preset name (configs/materials) or a material object (render/material)"},
@@ -198,7 +198,8 @@ static const lr_field mesh_fields[] = {
     {"pool_depth", LR_FT_NUM, CANDLE, M(candle.pool_depth), .flags = LR_FF_ZERO_FLAG,
      .aux = M(candle.flat_top), .unit = "mm", .dirty = G,
      .help = "melt pool depth, < height; 0: a flat top"},
-    {"pool_radius", LR_FT_NUM, CANDLE, M(candle.pool_radius), .unit = "mm", .dirty = G,
+    {"pool_radius", LR_FT_NUM, CANDLE, M(candle.pool_radius), .dflt_text = "radius - 3",
+     .unit = "mm", .dirty = G,
      .help = "melt pool radius, <= radius"},
     {"segments", LR_FT_INT, CANDLE, M(candle.segments), .dirty = G, .help = "around the axis"},
     {"pool_rings", LR_FT_INT, CANDLE, M(candle.pool_rings), .dirty = G,

@@ -280,6 +280,10 @@ int lr_fields_read(const lr_json *j, lr_jnode obj, const char *where, const lr_r
 /* "in (0, 90)", ">= 0", "between 1 and 256". */
 static void range_text(const lr_field *f, bool show_hi, char *buf, size_t cap)
 {
+    if (f->lo == 0.0 && f->hi == 0.0) {
+        buf[0] = '\0';
+        return;
+    }
     bool lo = !isnan(f->lo), hi = !isnan(f->hi) && show_hi;
     bool lo_open = f->flags & LR_FF_LO_OPEN, hi_open = f->flags & LR_FF_HI_OPEN;
     bool ints = f->type == LR_FT_INT || f->type == LR_FT_UINT;
@@ -294,6 +298,11 @@ static void range_text(const lr_field *f, bool show_hi, char *buf, size_t cap)
         snprintf(buf, cap, "%s %g", hi_open ? "<" : "<=", f->hi);
     else
         buf[0] = '\0';
+}
+
+void lr_field_range_text(const lr_field *f, char *buf, size_t cap)
+{
+    range_text(f, true, buf, cap);
 }
 
 /* 0: in range; 1: below lo; 2: above hi (NaN is below). */

@@ -131,7 +131,7 @@ int lr_field_apply(lr_field_op *o, const lr_field *f, void *rec);
  * (settable fields of the kind; "flicker.{amplitude, ...}" groups one prefix). */
 int lr_fields_unknown(lr_field_op *o, const lr_record_desc *d, int kind, const char *field);
 
-/* Writes the field reference (markdown: a table per record) to f. */
-void lr_scene_fields_markdown(FILE *f);
+/* The range as text: "in (0, 90)", ">= 0", "between 1 and 256"; "" when none. */
+void lr_field_range_text(const lr_field *f, char *buf, size_t cap);
 
 #endif

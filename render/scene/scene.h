@@ -73,6 +73,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdio.h>
 
 #include "render/base/err.h"
 #include "render/base/vec3.h"
@@ -272,5 +273,13 @@ int lr_scene_set_assignment(lr_scene *s, const char *assignment, unsigned *dirty
 /* The current value of a parameter as lr_scene_set accepts it (for `lamprig scene get`, logs
  * and event-script round trips). */
 int lr_scene_get(const lr_scene *s, const char *key, char *buf, size_t cap, lr_err *e);
+
+/* ---- Reference ----------------------------------------------------------------------------- */
+
+/* Writes the reference of every scene field (markdown, a table per record: key, kinds, value,
+ * range, default, what a change invalidates, description) from the tables that load, set and
+ * check use (render/scene/field_tables.c). configs/scenes/README.md quotes it between
+ * "<!-- BEGIN scene-fields -->" and "<!-- END scene-fields -->" (tests/test_scene.c compares). */
+void lr_scene_fields_markdown(FILE *f);
 
 #endif
