@@ -13,8 +13,8 @@ int64_t lr_now_ns(void)
 }
 
 const lr_opt lr_dev_opts[] = {
-    [LR_DEV_OPT_NAME] = {"name", LR_OPT_STRING, .dflt_text = "the type",
-                         .help = "source name in events and logs"},
+    [LR_DEV_OPT_NAME] = {"name", LR_OPT_STRING,
+                         .help = "source name in events and logs; default: the type"},
     [LR_DEV_OPT_REQUIRED] = {"required", LR_OPT_BOOL, .dflt = 0,
                              .help = "absent at start: an error instead of retrying"},
     [LR_DEV_OPT_RETRY_MIN_MS] = {"retry_min_ms", LR_OPT_INT, 1, 3600000, 250,

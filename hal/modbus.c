@@ -29,7 +29,7 @@ const lr_opt lr_modbus_opts[] = {
     [LR_MODBUS_OPT_MAX_TIMEOUTS] = {"max_timeouts", LR_OPT_INT, 1, 1000, 3,
                                     .help = "consecutive timeouts that drop the link"},
     [LR_MODBUS_OPT_INPUTS] = {"inputs", LR_OPT_LIST, .help = "panel registers (below)"},
-    [LR_MODBUS_OPT_LAMP] = {"lamp", LR_OPT_LIST, .help = "the lamp driver's register (below)"},
+    [LR_MODBUS_OPT_LAMP] = {"lamp", LR_OPT_OBJECT, .help = "the lamp driver's register (below)"},
     LR_OPT_END,
 };
 

@@ -18,6 +18,7 @@ typedef enum lr_opt_type {
     LR_OPT_ENUM,   /* one of names[], stored as its index */
     LR_OPT_HEX16,  /* a USB id as a hex string, "077d" */
     LR_OPT_LIST,   /* an array of objects with options of their own (documentation only) */
+    LR_OPT_OBJECT, /* an object with options of its own (documentation only) */
 } lr_opt_type;
 
 typedef struct lr_opt {

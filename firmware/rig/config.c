@@ -255,9 +255,7 @@ static int modbus_reg(ctx *x, lr_jnode o, const char *where, bool lamp, lr_rig_m
     if (rc)
         return rc;
     snprintf(r->control, sizeof r->control, "%s", in[LR_MODBUS_IN_CONTROL].dflt_text);
-    /* The rig's own convention (configs/rig): the panel answers as unit 1, the lamp driver
-     * as unit 2; the hal's default for both is 1. */
-    r->unit = lamp ? 2 : (int)in[LR_MODBUS_IN_UNIT].dflt;
+    r->unit = lamp ? LR_RIG_LAMP_UNIT : (int)in[LR_MODBUS_IN_UNIT].dflt;
     r->raw_min = (int)(lamp ? out[LR_MODBUS_OUT_RAW_MIN] : in[LR_MODBUS_IN_RAW_MIN]).dflt;
     r->raw_max = (int)(lamp ? out[LR_MODBUS_OUT_RAW_MAX] : in[LR_MODBUS_IN_RAW_MAX]).dflt;
     if (!lamp) {
