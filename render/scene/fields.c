@@ -288,7 +288,7 @@ static void range_text(const lr_field *f, bool show_hi, char *buf, size_t cap)
     bool lo_open = f->flags & LR_FF_LO_OPEN, hi_open = f->flags & LR_FF_HI_OPEN;
     bool ints = f->type == LR_FT_INT || f->type == LR_FT_UINT;
     if (lo && hi && ints)
-        snprintf(buf, cap, "between %g and %g", f->lo, f->hi);
+        snprintf(buf, cap, "between %.0f and %.0f", f->lo, f->hi);
     else if (lo && hi)
         snprintf(buf, cap, "in %c%g, %g%c", lo_open ? '(' : '[', f->lo, f->hi,
                  hi_open ? ')' : ']');
