@@ -88,6 +88,15 @@ extern const lr_record_desc lr_scene_light_desc, lr_scene_camera_desc, lr_scene_
     lr_scene_object_desc, lr_scene_mesh_desc, lr_scene_transform_desc, lr_scene_render_desc,
     lr_scene_quality_desc;
 
+/* The value at offset off of a record. */
+static inline void *lr_field_ptr(void *rec, size_t off)
+{
+    return (char *)rec + off;
+}
+
+/* "a, b or c" (last: " or ") of a NULL-terminated list. */
+void lr_field_names_text(const char *const *names, const char *last, char *buf, size_t cap);
+
 /* Whether f belongs to records of this kind. */
 bool lr_field_has(const lr_field *f, int kind);
 /* The field with this key for this kind, NULL when none. */

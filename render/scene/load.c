@@ -58,19 +58,6 @@ static int check_keys(ctx *c, lr_jnode obj, const char *where, const lr_record_d
     return lr_json_check_keys(c->j, obj, where, keys, c->e);
 }
 
-/* Reads a record's table fields, then checks it (ranges and relations, check.c) and reports a
- * failure at the field it names. */
-#define READ_AND_CHECK(c, obj, where, desc, kind, rec, check)                                   \
-    do {                                                                                         \
-        int rc_ = lr_fields_read((c)->j, obj, where, desc, kind, rec, (c)->e);                  \
-        if (rc_)                                                                                 \
-            return rc_;                                                                          \
-        const char *field_ = NULL;                                                               \
-        lr_err inner_ = {0};                                                                     \
-        if ((rc_ = check(rec, &field_, &inner_)))                                                \
-            return fail_check(c, obj, where, field_, rc_, &inner_);                             \
-    } while (0)
-
 /* Names are how lr_scene_set finds things: plain, not all digits (those are indices). */
 static bool name_ok(const char *s)
 {
@@ -147,7 +134,12 @@ static int parse_light(ctx *c, lr_jnode obj, int i, lr_light *l)
     lr_scene_light_defaults(l, (enum lr_light_type)type);
     if ((rc = get_name(c, obj, where, "light", i, l->name)))
         return rc;
-    READ_AND_CHECK(c, obj, where, &lr_scene_light_desc, type, l, lr_scene_check_light);
+    if ((rc = lr_fields_read(c->j, obj, where, &lr_scene_light_desc, type, l, c->e)))
+        return rc;
+    const char *field = NULL;
+    lr_err inner = {0};
+    if ((rc = lr_scene_check_light(l, &field, &inner)))
+        return fail_check(c, obj, where, field, rc, &inner);
     return LR_OK;
 }
 
@@ -160,7 +152,12 @@ static int parse_camera(ctx *c, lr_jnode obj, lr_camera *cam)
     if ((rc = check_keys(c, obj, where, &lr_scene_camera_desc, 0)))
         return rc;
     lr_scene_camera_defaults(cam);
-    READ_AND_CHECK(c, obj, where, &lr_scene_camera_desc, 0, cam, lr_scene_check_camera);
+    if ((rc = lr_fields_read(c->j, obj, where, &lr_scene_camera_desc, 0, cam, c->e)))
+        return rc;
+    const char *field = NULL;
+    lr_err inner = {0};
+    if ((rc = lr_scene_check_camera(cam, &field, &inner)))
+        return fail_check(c, obj, where, field, rc, &inner);
     return LR_OK;
 }
 
@@ -181,7 +178,12 @@ static int parse_receiver(ctx *c, lr_jnode obj, int i, lr_receiver *r)
     lr_fields_defaults(&lr_scene_receiver_desc, r);
     if ((rc = get_name(c, obj, where, "receiver", i, r->name)))
         return rc;
-    READ_AND_CHECK(c, obj, where, &lr_scene_receiver_desc, type, r, lr_scene_check_receiver);
+    if ((rc = lr_fields_read(c->j, obj, where, &lr_scene_receiver_desc, type, r, c->e)))
+        return rc;
+    const char *field = NULL;
+    lr_err inner = {0};
+    if ((rc = lr_scene_check_receiver(r, &field, &inner)))
+        return fail_check(c, obj, where, field, rc, &inner);
     return LR_OK;
 }
 
@@ -201,7 +203,12 @@ static int parse_mesh(ctx *c, lr_jnode obj, const char *owhere, mesh_spec *m)
     memset(m, 0, sizeof *m);
     m->kind = (enum lr_mesh_kind)type;
     lr_fields_defaults(&lr_scene_mesh_desc, m);
-    READ_AND_CHECK(c, obj, where, &lr_scene_mesh_desc, type, m, lr_scene_check_mesh);
+    if ((rc = lr_fields_read(c->j, obj, where, &lr_scene_mesh_desc, type, m, c->e)))
+        return rc;
+    const char *field = NULL;
+    lr_err inner = {0};
+    if ((rc = lr_scene_check_mesh(m, &field, &inner)))
+        return fail_check(c, obj, where, field, rc, &inner);
     return LR_OK;
 }
 
@@ -268,7 +275,12 @@ static int parse_transform(ctx *c, lr_jnode n, const char *owhere, xform_spec *x
     int rc;
     if ((rc = check_keys(c, n, where, &lr_scene_transform_desc, 0)))
         return rc;
-    READ_AND_CHECK(c, n, where, &lr_scene_transform_desc, 0, x, lr_scene_check_transform);
+    if ((rc = lr_fields_read(c->j, n, where, &lr_scene_transform_desc, 0, x, c->e)))
+        return rc;
+    const char *field = NULL;
+    lr_err inner = {0};
+    if ((rc = lr_scene_check_transform(x, &field, &inner)))
+        return fail_check(c, n, where, field, rc, &inner);
     return LR_OK;
 }
 
@@ -324,13 +336,13 @@ static int parse_render(ctx *c, lr_jnode n, lr_render_settings *r)
     int rc;
     if ((rc = check_keys(c, n, "render", &lr_scene_render_desc, 0)))
         return rc;
-    READ_AND_CHECK(c, n, "render", &lr_scene_render_desc, 0, r, lr_scene_check_render);
+    if ((rc = lr_fields_read(c->j, n, "render", &lr_scene_render_desc, 0, r, c->e)))
+        return rc;
+    const char *field = NULL;
+    lr_err inner = {0};
+    if ((rc = lr_scene_check_render(r, &field, &inner)))
+        return fail_check(c, n, "render", field, rc, &inner);
     return LR_OK;
-}
-
-static int check_quality(lr_quality *q, const char **field, lr_err *e)
-{
-    return lr_scene_check_quality(q, field, e);
 }
 
 static int parse_quality(ctx *c, lr_jnode n, lr_quality *q)
@@ -341,7 +353,12 @@ static int parse_quality(ctx *c, lr_jnode n, lr_quality *q)
     int rc;
     if ((rc = check_keys(c, n, "quality", &lr_scene_quality_desc, 0)))
         return rc;
-    READ_AND_CHECK(c, n, "quality", &lr_scene_quality_desc, 0, q, check_quality);
+    if ((rc = lr_fields_read(c->j, n, "quality", &lr_scene_quality_desc, 0, q, c->e)))
+        return rc;
+    const char *field = NULL;
+    lr_err inner = {0};
+    if ((rc = lr_scene_check_quality(q, &field, &inner)))
+        return fail_check(c, n, "quality", field, rc, &inner);
     return LR_OK;
 }
 
