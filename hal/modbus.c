@@ -35,31 +35,34 @@ const lr_opt lr_modbus_opts[] = {
 
 static const char *const REG_TYPES[] = {"holding", "input", NULL}; /* lr_modbus_reg_type */
 
-/* Unit ids: 1..247 on a serial line, TCP also 248..255 (checked per transport below). */
+/* The fields an input and the output share. Unit ids: 1..247 on a serial line, TCP also
+ * 248..255 (checked per transport below); registers 0..65535 counted from base (below). */
+#define CH_UNIT {"unit", LR_OPT_INT, 1, 255, 1, .help = "unit (slave) id"}
+#define CH_BASE(help_) {"base", LR_OPT_INT, 0, 1, 0, .help = help_}
+/* reg's range is that of the address reg - base. */
+#define CH_REG(help_) {"reg", LR_OPT_INT, 0, 65535, 0, .required = true, .help = help_}
+#define CH_RAW_MIN {"raw_min", LR_OPT_INT, 0, 65535, 0, .help = "raw value of 0"}
+#define CH_RAW_MAX(dflt_) {"raw_max", LR_OPT_INT, 0, 65535, dflt_, .help = "raw value of 1 (> raw_min)"}
+
 const lr_opt lr_modbus_input_opts[] = {
     [LR_MODBUS_IN_CONTROL] = {"control", LR_OPT_STRING, .dflt_text = "dimmer",
                               .help = "event control name"},
-    [LR_MODBUS_IN_UNIT] = {"unit", LR_OPT_INT, 1, 255, 1, .help = "unit (slave) id"},
-    [LR_MODBUS_IN_REG] = {"reg", LR_OPT_INT, 0, 65536, 0, .required = true,
-                          .help = "register number, counted from base"},
-    [LR_MODBUS_IN_BASE] = {"base", LR_OPT_INT, 0, 1, 0,
-                           .help = "1: 1-based numbering as panel manuals print it"},
+    [LR_MODBUS_IN_UNIT] = CH_UNIT,
+    [LR_MODBUS_IN_REG] = CH_REG("register number; the range is of reg - base"),
+    [LR_MODBUS_IN_BASE] = CH_BASE("1: 1-based numbering as panel manuals print it"),
     [LR_MODBUS_IN_TYPE] = {"type", LR_OPT_ENUM, .dflt = LR_MODBUS_HOLDING, .names = REG_TYPES,
                            .help = "FC 3 or FC 4"},
-    [LR_MODBUS_IN_RAW_MIN] = {"raw_min", LR_OPT_INT, 0, 65535, 0, .help = "raw value of 0"},
-    [LR_MODBUS_IN_RAW_MAX] = {"raw_max", LR_OPT_INT, 0, 65535, 1000,
-                              .help = "raw value of 1 (> raw_min)"},
+    [LR_MODBUS_IN_RAW_MIN] = CH_RAW_MIN,
+    [LR_MODBUS_IN_RAW_MAX] = CH_RAW_MAX(1000),
     LR_OPT_END,
 };
 
 const lr_opt lr_modbus_output_opts[] = {
-    [LR_MODBUS_OUT_UNIT] = {"unit", LR_OPT_INT, 1, 255, 1, .help = "unit (slave) id"},
-    [LR_MODBUS_OUT_REG] = {"reg", LR_OPT_INT, 0, 65536, 0, .required = true,
-                           .help = "holding register, counted from base"},
-    [LR_MODBUS_OUT_BASE] = {"base", LR_OPT_INT, 0, 1, 0, .help = "as for inputs"},
-    [LR_MODBUS_OUT_RAW_MIN] = {"raw_min", LR_OPT_INT, 0, 65535, 0, .help = "raw value of 0"},
-    [LR_MODBUS_OUT_RAW_MAX] = {"raw_max", LR_OPT_INT, 0, 65535, 255,
-                               .help = "raw value of 1 (> raw_min)"},
+    [LR_MODBUS_OUT_UNIT] = CH_UNIT,
+    [LR_MODBUS_OUT_REG] = CH_REG("holding register; the range is of reg - base"),
+    [LR_MODBUS_OUT_BASE] = CH_BASE("as for inputs"),
+    [LR_MODBUS_OUT_RAW_MIN] = CH_RAW_MIN,
+    [LR_MODBUS_OUT_RAW_MAX] = CH_RAW_MAX(255),
     [LR_MODBUS_OUT_MULTIPLE] = {"multiple", LR_OPT_BOOL, .dflt = 0,
                                 .help = "write with FC 16 instead of FC 6"},
     LR_OPT_END,
@@ -511,6 +514,7 @@ static int check_channel(lr_modbus *m, const char *field, int unit, int reg, int
     const lr_opt *uo = &lr_modbus_input_opts[LR_MODBUS_IN_UNIT];
     const lr_opt *bo = &lr_modbus_input_opts[LR_MODBUS_IN_BASE];
     const lr_opt *ro = &lr_modbus_input_opts[LR_MODBUS_IN_RAW_MIN];
+    const lr_opt *rg = &lr_modbus_input_opts[LR_MODBUS_IN_REG];
     int u = (int)lr_opt_or_default(uo, unit);
     int umax = m->url.transport == LR_MODBUS_TCP ? (int)uo->hi : 247;
     if (u < 1 || u > umax)
@@ -518,9 +522,9 @@ static int check_channel(lr_modbus *m, const char *field, int unit, int reg, int
     if (!lr_opt_in_range(bo, base))
         return lr_err_set(e, LR_EINVAL, "%s: %s.base %d is not 0 or 1", pf, field, base);
     int addr = reg - base;
-    if (addr < 0 || addr > 65535)
-        return lr_err_set(e, LR_EINVAL, "%s: %s.reg %d is not %d..%d (base %d)", pf, field, reg,
-                          base, 65535 + base, base);
+    if (!lr_opt_in_range(rg, addr))
+        return lr_err_set(e, LR_EINVAL, "%s: %s.reg %d is not %ld..%ld (base %d)", pf, field, reg,
+                          rg->lo + base, rg->hi + base, base);
     if (raw_min < ro->lo || raw_max > ro->hi || raw_min >= raw_max)
         return lr_err_set(e, LR_EINVAL, "%s: %s: raw range %d..%d is not within 0..65535 and "
                           "increasing", pf, field, raw_min, raw_max);

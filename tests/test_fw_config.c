@@ -77,6 +77,10 @@ static void test_bad_fields_named(void **state)
         {"{\"scene\": \"candle.json\",\n \"devices\": [\n  {\"type\": \"modbus\", \"url\": "
          "\"tcp://127.0.0.1:1502\",\n   \"lamp\": {\"unit\": 300, \"reg\": 0}}]}",
          "rig.json:4: field 'devices[0].lamp.unit': must be in 1..255, got 300"},
+        /* The back end's range (hal/modbus.c lr_modbus_opts), not a copy that disagreed. */
+        {"{\"scene\": \"candle.json\",\n \"devices\": [\n  {\"type\": \"modbus\", \"url\": "
+         "\"tcp://127.0.0.1:1502\",\n   \"poll_ms\": 600000, \"lamp\": {\"reg\": 0}}]}",
+         "rig.json:4: field 'devices[0].poll_ms': must be in 1..60000, got 600000"},
         {"{\"scene\": \"candle.json\",\n \"devices\": [\n  {\"type\": \"gpio\", \"encoders\": "
          "[\n   {\"name\": \"knob1\", \"line_a\": \"17\", \"line_b\": \"27\",\n    "
          "\"steps_per_detent\": 3}]}]}",

@@ -256,8 +256,6 @@ static int modbus_reg(ctx *x, lr_jnode o, const char *where, bool lamp, lr_rig_m
         return rc;
     snprintf(r->control, sizeof r->control, "%s", in[LR_MODBUS_IN_CONTROL].dflt_text);
     r->unit = lamp ? LR_RIG_LAMP_UNIT : (int)in[LR_MODBUS_IN_UNIT].dflt;
-    r->raw_min = (int)(lamp ? out[LR_MODBUS_OUT_RAW_MIN] : in[LR_MODBUS_IN_RAW_MIN]).dflt;
-    r->raw_max = (int)(lamp ? out[LR_MODBUS_OUT_RAW_MAX] : in[LR_MODBUS_IN_RAW_MAX]).dflt;
     if (!lamp) {
         if ((rc = get_str(x, o, where, "control", false, r->control, sizeof r->control)))
             return rc;
@@ -272,13 +270,20 @@ static int modbus_reg(ctx *x, lr_jnode o, const char *where, bool lamp, lr_rig_m
     } else if ((rc = opt_bool(x, o, where, &out[LR_MODBUS_OUT_MULTIPLE], &r->multiple))) {
         return rc;
     }
-    /* unit, base, raw_min and raw_max have the same ranges in both tables. */
-    if ((rc = opt_int(x, o, where, &in[LR_MODBUS_IN_UNIT], &r->unit)) ||
-        (rc = opt_int(x, o, where, &in[LR_MODBUS_IN_BASE], &r->base)) ||
-        /* The register range depends on base: the address reg - base is 0..65535. */
-        (rc = get_int_in(x, o, where, "reg", true, r->base, 65535 + r->base, &r->reg)) ||
-        (rc = opt_int(x, o, where, &in[LR_MODBUS_IN_RAW_MIN], &r->raw_min)) ||
-        (rc = opt_int(x, o, where, &in[LR_MODBUS_IN_RAW_MAX], &r->raw_max)))
+    const lr_opt *unit = lamp ? &out[LR_MODBUS_OUT_UNIT] : &in[LR_MODBUS_IN_UNIT];
+    const lr_opt *base = lamp ? &out[LR_MODBUS_OUT_BASE] : &in[LR_MODBUS_IN_BASE];
+    const lr_opt *raw_min = lamp ? &out[LR_MODBUS_OUT_RAW_MIN] : &in[LR_MODBUS_IN_RAW_MIN];
+    const lr_opt *raw_max = lamp ? &out[LR_MODBUS_OUT_RAW_MAX] : &in[LR_MODBUS_IN_RAW_MAX];
+    const lr_opt *reg = lamp ? &out[LR_MODBUS_OUT_REG] : &in[LR_MODBUS_IN_REG];
+    r->raw_min = (int)raw_min->dflt;
+    r->raw_max = (int)raw_max->dflt;
+    if ((rc = opt_int(x, o, where, unit, &r->unit)) ||
+        (rc = opt_int(x, o, where, base, &r->base)) ||
+        /* The descriptor's range is the address reg - base's. */
+        (rc = get_int_in(x, o, where, "reg", true, reg->lo + r->base, reg->hi + r->base,
+                         &r->reg)) ||
+        (rc = opt_int(x, o, where, raw_min, &r->raw_min)) ||
+        (rc = opt_int(x, o, where, raw_max, &r->raw_max)))
         return rc;
     if (r->raw_max <= r->raw_min) {
         char f[192];
