@@ -39,7 +39,7 @@ typedef struct lr_gpio_button {
     const char *name;      /* control name, e.g. "button1" */
     const char *line;      /* line name or offset */
     bool active_high;      /* default false: pressed pulls the line low (pull-up wiring) */
-    int debounce_ms;       /* default 5; at most 1000 */
+    int debounce_ms;       /* default and range: lr_gpio_button_opts */
 } lr_gpio_button;
 
 typedef enum lr_gpio_bias {

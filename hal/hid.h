@@ -32,8 +32,8 @@ typedef struct lr_hid_desc {
     uint16_t vid, pid;          /* required */
     const char *serial;         /* optional: match this serial number (ASCII) */
     lr_hid_parser_desc parser;  /* parser.proto LR_HID_AUTO: by VID:PID */
-    int poll_ms;                /* report queue polling period; default 8 (125 Hz, the PowerMate's
-                                 * interrupt interval) */
+    int poll_ms;                /* report queue polling period (lr_hid_opts: default 8 ms, 125 Hz,
+                                 * the PowerMate's interrupt interval) */
 } lr_hid_desc;
 
 /* The options above as the rig config reads them (hal/opt.h). */

@@ -100,10 +100,11 @@ typedef struct lr_modbus_desc {
     const lr_modbus_input *inputs;
     int n_inputs;            /* at most 16 */
     lr_modbus_output output;
-    int poll_ms;             /* input polling period; default 50 */
-    int timeout_ms;          /* response (and TCP connect) timeout; default 100 */
-    int byte_timeout_ms;     /* gap allowed inside a frame once it started; default 50 */
-    int max_timeouts;        /* consecutive timeouts that drop the link; default 3 */
+    /* Defaults and ranges of these: lr_modbus_opts below (0: the default). */
+    int poll_ms;             /* input polling period */
+    int timeout_ms;          /* response (and TCP connect) timeout */
+    int byte_timeout_ms;     /* gap allowed inside a frame once it started */
+    int max_timeouts;        /* consecutive timeouts that drop the link */
 } lr_modbus_desc;
 
 /* The options above as the rig config reads them (hal/opt.h); configure() checks with them. */

@@ -44,7 +44,7 @@ typedef struct lr_usb_desc {
                                   * be present at create */
     const lr_usb_watch *watch;
     int n_watch;                 /* 1..LR_USB_MAX_WATCH */
-    int rescan_ms;               /* re-enumeration period without hotplug; default 1000 */
+    int rescan_ms;               /* re-enumeration period without hotplug (lr_usb_opts) */
     bool no_hotplug;             /* re-enumerate even when libusb offers hotplug */
 } lr_usb_desc;
 
