@@ -51,6 +51,8 @@ const char lr_render_usage[] =
     "                    makes a light steady)\n"
     "  --no-plan         keep the scene's render settings even when it has a quality budget\n"
     "  --table CSV       the planner's measured table (default: see `lamprig help plan`)\n"
+    "  --help-scene      print every scene field (type, range, default, what a change\n"
+    "                    re-renders) as markdown, and exit\n"
     "\n"
     "A scene with a \"quality\" block (max_error, frame_ms) is planned first (`lamprig plan`):\n"
     "the chosen settings replace its render settings and one line per object says the choice,\n"
@@ -262,12 +264,18 @@ int lr_cmd_render(int argc, char **argv)
     static const lr_argspec specs[] = {
         {"--scene", 1}, {"--frames", 1}, {"--width", 1}, {"--height", 1}, {"--out", 1},
         {"--hdr", 1},   {"--stats", 1},  {"--no-vpl", 0}, {"--events", 1},
-        {"--vpl-visibility", 0}, {"--fps", 1}, {"--no-plan", 0}, {"--table", 1}, {NULL, 0}};
+        {"--vpl-visibility", 0}, {"--fps", 1}, {"--no-plan", 0}, {"--table", 1},
+        {"--help-scene", 0}, {NULL, 0}};
     lr_args a;
     lr_err e = {0};
     if (lr_args_parse(nrest, rest, specs, 0, &a, &e)) {
         free(rest);
         return usage_error("%s", e.msg);
+    }
+    if (lr_args_has(&a, "--help-scene")) { /* the scene field reference, from its tables */
+        lr_scene_fields_markdown(stdout);
+        free(rest);
+        return LR_EXIT_OK;
     }
     int status = LR_EXIT_OK;
     int frames = 0, width = 640, height = 480;

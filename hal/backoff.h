@@ -15,7 +15,7 @@ typedef struct lr_backoff {
     unsigned failures;     /* consecutive failures since the last reset */
 } lr_backoff;
 
-/* min_ms 0 means 250 ms, max_ms 0 means 10 s; max is raised to min when smaller. */
+/* min_ms 0 means 250 ms, max_ms 0 means 10 s (lr_dev_opts' defaults); max is raised to min when smaller. */
 void lr_backoff_init(lr_backoff *b, int min_ms, int max_ms);
 /* Records a failure at now_ns; returns the time of the next attempt. */
 int64_t lr_backoff_fail(lr_backoff *b, int64_t now_ns);

@@ -12,6 +12,18 @@ int64_t lr_now_ns(void)
     return (int64_t)ts.tv_sec * 1000000000LL + ts.tv_nsec;
 }
 
+const lr_opt lr_dev_opts[] = {
+    [LR_DEV_OPT_NAME] = {"name", LR_OPT_STRING,
+                         .help = "source name in events and logs; default: the type"},
+    [LR_DEV_OPT_REQUIRED] = {"required", LR_OPT_BOOL, .dflt = 0,
+                             .help = "absent at start: an error instead of retrying"},
+    [LR_DEV_OPT_RETRY_MIN_MS] = {"retry_min_ms", LR_OPT_INT, 1, 3600000, 250,
+                                 .help = "first reopen delay after a failure"},
+    [LR_DEV_OPT_RETRY_MAX_MS] = {"retry_max_ms", LR_OPT_INT, 1, 3600000, 10000,
+                                 .help = "backoff cap"},
+    LR_OPT_END,
+};
+
 int lr_dev_init(lr_dev *d, const lr_dev_ops *ops, const lr_dev_desc *desc, lr_err *e)
 {
     memset(d, 0, sizeof *d);
@@ -27,6 +39,11 @@ int lr_dev_init(lr_dev *d, const lr_dev_ops *ops, const lr_dev_desc *desc, lr_er
         snprintf(d->prefix, sizeof d->prefix, "%s %s", ops->kind, name);
     if (!desc->sink.fn)
         return lr_err_set(e, LR_EINVAL, "%s: no event sink (dev.sink.fn is NULL)", d->prefix);
+    const lr_opt *rmin = &lr_dev_opts[LR_DEV_OPT_RETRY_MIN_MS];
+    const lr_opt *rmax = &lr_dev_opts[LR_DEV_OPT_RETRY_MAX_MS];
+    if (!lr_opt_hal_ok(rmin, desc->retry_min_ms) || !lr_opt_hal_ok(rmax, desc->retry_max_ms))
+        return lr_err_set(e, LR_EINVAL, "%s: retry_min_ms %d / retry_max_ms %d is not %ld..%ld",
+                          d->prefix, desc->retry_min_ms, desc->retry_max_ms, rmin->lo, rmin->hi);
     d->sink = desc->sink;
     d->log = desc->log;
     lr_backoff_init(&d->backoff, desc->retry_min_ms, desc->retry_max_ms);

@@ -32,6 +32,7 @@
 
 #include "hal/event.h"
 #include "hal/log.h"
+#include "hal/opt.h"
 
 #define LR_NO_DEADLINE INT64_MAX
 
@@ -52,6 +53,15 @@ typedef struct lr_dev_desc {
     bool required;       /* create fails with LR_ENODEV (and the message) when the device cannot
                           * be opened at start; default false: log, keep retrying, keep running */
 } lr_dev_desc;
+
+/* The lr_dev_desc fields a configuration sets, for every back end (hal/opt.h). */
+enum {
+    LR_DEV_OPT_NAME = 0,
+    LR_DEV_OPT_REQUIRED,
+    LR_DEV_OPT_RETRY_MIN_MS,
+    LR_DEV_OPT_RETRY_MAX_MS,
+};
+extern const lr_opt lr_dev_opts[];
 
 typedef struct lr_dev lr_dev;
 

@@ -50,6 +50,41 @@ struct lr_gpio {
 
 #define NS_PER_S 1000000000LL
 
+static const char *const BIASES[] = {"pull-up", "as-is", "disable", "pull-down", NULL};
+
+const lr_opt lr_gpio_opts[] = {
+    [LR_GPIO_OPT_CHIP] = {"chip", LR_OPT_STRING, .dflt_text = "gpiochip0",
+                          .help = "gpiochip name or path"},
+    [LR_GPIO_OPT_BIAS] = {"bias", LR_OPT_ENUM, .dflt = LR_GPIO_BIAS_PULL_UP, .names = BIASES,
+                          .help = "line bias (lr_gpio_bias order)"},
+    [LR_GPIO_OPT_ENCODERS] = {"encoders", LR_OPT_LIST, .help = "rotary encoders (below)"},
+    [LR_GPIO_OPT_BUTTONS] = {"buttons", LR_OPT_LIST, .help = "push buttons (below)"},
+    LR_OPT_END,
+};
+
+/* steps_per_detent is 1, 2 or 4 (checked below): quadrature has no 3-step detent. */
+const lr_opt lr_gpio_encoder_opts[] = {
+    [LR_GPIO_ENC_NAME] = {"name", LR_OPT_STRING, .required = true, .help = "control name"},
+    [LR_GPIO_ENC_LINE_A] = {"line_a", LR_OPT_STRING, .required = true,
+                            .help = "line name or offset"},
+    [LR_GPIO_ENC_LINE_B] = {"line_b", LR_OPT_STRING, .required = true,
+                            .help = "line name or offset"},
+    [LR_GPIO_ENC_STEPS_PER_DETENT] = {"steps_per_detent", LR_OPT_INT, 1, 4, 4,
+                                      .help = "quadrature transitions per detent: 1, 2 or 4"},
+    [LR_GPIO_ENC_REVERSE] = {"reverse", LR_OPT_BOOL, .dflt = 0, .help = "swap the direction"},
+    LR_OPT_END,
+};
+
+const lr_opt lr_gpio_button_opts[] = {
+    [LR_GPIO_BTN_NAME] = {"name", LR_OPT_STRING, .required = true, .help = "control name"},
+    [LR_GPIO_BTN_LINE] = {"line", LR_OPT_STRING, .required = true, .help = "line name or offset"},
+    [LR_GPIO_BTN_ACTIVE_HIGH] = {"active_high", LR_OPT_BOOL, .dflt = 0,
+                                 .help = "pressed drives the line high"},
+    [LR_GPIO_BTN_DEBOUNCE_MS] = {"debounce_ms", LR_OPT_INT, 0, 1000, 5,
+                                 .help = "debounce window (0: the default)"},
+    LR_OPT_END,
+};
+
 static int64_t event_time(const struct gpiod_line_event *ev, int64_t now_ns)
 {
     int64_t t = (int64_t)ev->ts.tv_sec * NS_PER_S + ev->ts.tv_nsec;
@@ -367,7 +402,8 @@ static int configure(lr_gpio *g, const lr_gpio_desc *desc, lr_err *e)
         return lr_err_set(e, LR_EINVAL, "%s: no encoders or buttons configured", pf);
     if ((desc->n_encoders && !desc->encoders) || (desc->n_buttons && !desc->buttons))
         return lr_err_set(e, LR_EINVAL, "%s: encoder/button array is NULL", pf);
-    const char *chip = desc->chip && desc->chip[0] ? desc->chip : "gpiochip0";
+    const char *chip =
+        desc->chip && desc->chip[0] ? desc->chip : lr_gpio_opts[LR_GPIO_OPT_CHIP].dflt_text;
     if (strlen(chip) >= sizeof g->chip_name)
         return lr_err_set(e, LR_EINVAL, "%s: chip name too long", pf);
     strcpy(g->chip_name, chip);
@@ -401,7 +437,8 @@ static int configure(lr_gpio *g, const lr_gpio_desc *desc, lr_err *e)
         if (strcmp(en->l[0].spec, en->l[1].spec) == 0)
             return lr_err_set(e, LR_EINVAL, "%s: %s.line_a and line_b are both '%s'", pf, field,
                               en->l[0].spec);
-        int s = c->steps_per_detent ? c->steps_per_detent : 4;
+        int s = (int)lr_opt_or_default(&lr_gpio_encoder_opts[LR_GPIO_ENC_STEPS_PER_DETENT],
+                                       c->steps_per_detent);
         if (s != 1 && s != 2 && s != 4)
             return lr_err_set(e, LR_EINVAL, "%s: %s.steps_per_detent %d is not 1, 2 or 4", pf,
                               field, c->steps_per_detent);
@@ -418,10 +455,11 @@ static int configure(lr_gpio *g, const lr_gpio_desc *desc, lr_err *e)
             rc = set_line(g, &bt->l, c->line, bt->name, "", field, e);
         if (rc != LR_OK)
             return rc;
-        if (c->debounce_ms < 0 || c->debounce_ms > 1000)
-            return lr_err_set(e, LR_EINVAL, "%s: %s.debounce_ms %d is not 0..1000", pf, field,
-                              c->debounce_ms);
-        bt->window_ns = (int64_t)(c->debounce_ms ? c->debounce_ms : 5) * 1000000;
+        const lr_opt *db = &lr_gpio_button_opts[LR_GPIO_BTN_DEBOUNCE_MS];
+        if (!lr_opt_in_range(db, c->debounce_ms))
+            return lr_err_set(e, LR_EINVAL, "%s: %s.debounce_ms %d is not %ld..%ld", pf, field,
+                              c->debounce_ms, db->lo, db->hi);
+        bt->window_ns = (int64_t)lr_opt_or_default(db, c->debounce_ms) * 1000000;
         bt->active_high = c->active_high;
     }
     /* One line serves one control. */

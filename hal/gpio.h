@@ -24,6 +24,7 @@
 #include <stdbool.h>
 
 #include "hal/dev.h"
+#include "hal/opt.h"
 #include "render/base/err.h"
 
 typedef struct lr_gpio_encoder {
@@ -38,7 +39,7 @@ typedef struct lr_gpio_button {
     const char *name;      /* control name, e.g. "button1" */
     const char *line;      /* line name or offset */
     bool active_high;      /* default false: pressed pulls the line low (pull-up wiring) */
-    int debounce_ms;       /* default 5; at most 1000 */
+    int debounce_ms;       /* default and range: lr_gpio_button_opts */
 } lr_gpio_button;
 
 typedef enum lr_gpio_bias {
@@ -60,6 +61,20 @@ typedef struct lr_gpio_desc {
     const lr_gpio_button *buttons;
     int n_buttons;            /* 2 * n_encoders + n_buttons <= LR_GPIO_MAX_LINES */
 } lr_gpio_desc;
+
+/* The options above as the rig config reads them (hal/opt.h). */
+enum { LR_GPIO_OPT_CHIP = 0, LR_GPIO_OPT_BIAS, LR_GPIO_OPT_ENCODERS, LR_GPIO_OPT_BUTTONS };
+extern const lr_opt lr_gpio_opts[];
+enum {
+    LR_GPIO_ENC_NAME = 0,
+    LR_GPIO_ENC_LINE_A,
+    LR_GPIO_ENC_LINE_B,
+    LR_GPIO_ENC_STEPS_PER_DETENT,
+    LR_GPIO_ENC_REVERSE,
+};
+extern const lr_opt lr_gpio_encoder_opts[];
+enum { LR_GPIO_BTN_NAME = 0, LR_GPIO_BTN_LINE, LR_GPIO_BTN_ACTIVE_HIGH, LR_GPIO_BTN_DEBOUNCE_MS };
+extern const lr_opt lr_gpio_button_opts[];
 
 typedef struct lr_gpio lr_gpio;
 

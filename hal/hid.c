@@ -8,6 +8,19 @@
 
 #include "hal/dev_impl.h"
 
+const lr_opt lr_hid_opts[] = {
+    [LR_HID_OPT_VID] = {"vid", LR_OPT_HEX16, .required = true, .help = "USB vendor id"},
+    [LR_HID_OPT_PID] = {"pid", LR_OPT_HEX16, .required = true, .help = "USB product id"},
+    [LR_HID_OPT_SERIAL] = {"serial", LR_OPT_STRING, .help = "match this serial number"},
+    [LR_HID_OPT_POLL_MS] = {"poll_ms", LR_OPT_INT, 1, 1000, 8,
+                            .help = "report queue polling period (the PowerMate's 125 Hz)"},
+    [LR_HID_OPT_PROTO] = {"proto", LR_OPT_ENUM, .dflt = LR_HID_AUTO, .names = lr_hid_proto_names,
+                          .help = "report parser; auto: by VID:PID"},
+    [LR_HID_OPT_REPORT_ID] = {"report_id", LR_OPT_INT, 0, 255, 0,
+                              .help = "0: reports carry no ID byte"},
+    LR_OPT_END,
+};
+
 struct lr_hid {
     lr_dev base;
     uint16_t vid, pid;
@@ -146,8 +159,9 @@ int lr_hid_create(const lr_hid_desc *desc, lr_hid **out, lr_err *e)
         rc = lr_err_set(e, LR_EINVAL, "%s: vid and pid are required (e.g. 077d:0410)", pf);
     if (rc == LR_OK && desc->serial && strlen(desc->serial) >= sizeof h->serial)
         rc = lr_err_set(e, LR_EINVAL, "%s: serial too long", pf);
-    if (rc == LR_OK && (desc->poll_ms < 0 || desc->poll_ms > 1000))
-        rc = lr_err_set(e, LR_EINVAL, "%s: poll_ms %d is not 0..1000", pf, desc->poll_ms);
+    const lr_opt *po = &lr_hid_opts[LR_HID_OPT_POLL_MS];
+    if (rc == LR_OK && !lr_opt_hal_ok(po, desc->poll_ms))
+        rc = lr_err_set(e, LR_EINVAL, "%s: poll_ms %d is not 0..%ld", pf, desc->poll_ms, po->hi);
     if (rc == LR_OK) {
         h->vid = desc->vid;
         h->pid = desc->pid;
@@ -168,7 +182,7 @@ int lr_hid_create(const lr_hid_desc *desc, lr_hid **out, lr_err *e)
         snprintf(h->ident, sizeof h->ident, "%04x:%04x (%s%s%s)", h->vid, h->pid,
                  lr_hid_proto_name(h->pdesc.proto), h->serial[0] ? ", serial " : "", h->serial);
         snprintf(h->base.ident, sizeof h->base.ident, "%s", h->ident);
-        h->poll_ns = (int64_t)(desc->poll_ms ? desc->poll_ms : 8) * 1000000;
+        h->poll_ns = (int64_t)lr_opt_or_default(po, desc->poll_ms) * 1000000;
         rc = lr_dev_start(&h->base, desc->dev.required, lr_now_ns(), e);
     }
     if (rc != LR_OK) {

@@ -23,6 +23,7 @@
 #include <stdint.h>
 
 #include "hal/dev.h"
+#include "hal/opt.h"
 #include "hal/hid_report.h"
 #include "render/base/err.h"
 
@@ -31,9 +32,20 @@ typedef struct lr_hid_desc {
     uint16_t vid, pid;          /* required */
     const char *serial;         /* optional: match this serial number (ASCII) */
     lr_hid_parser_desc parser;  /* parser.proto LR_HID_AUTO: by VID:PID */
-    int poll_ms;                /* report queue polling period; default 8 (125 Hz, the PowerMate's
-                                 * interrupt interval) */
+    int poll_ms;                /* report queue polling period (lr_hid_opts: default 8 ms, 125 Hz,
+                                 * the PowerMate's interrupt interval) */
 } lr_hid_desc;
+
+/* The options above as the rig config reads them (hal/opt.h). */
+enum {
+    LR_HID_OPT_VID = 0,
+    LR_HID_OPT_PID,
+    LR_HID_OPT_SERIAL,
+    LR_HID_OPT_POLL_MS,
+    LR_HID_OPT_PROTO,
+    LR_HID_OPT_REPORT_ID,
+};
+extern const lr_opt lr_hid_opts[];
 
 typedef struct lr_hid lr_hid;
 

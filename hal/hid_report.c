@@ -19,16 +19,18 @@ lr_hid_proto lr_hid_proto_for(uint16_t vid, uint16_t pid)
     return LR_HID_CONSUMER;
 }
 
+const char *const lr_hid_proto_names[] = {
+    [LR_HID_AUTO] = "auto",
+    [LR_HID_POWERMATE] = "powermate",
+    [LR_HID_SHUTTLEXPRESS] = "shuttlexpress",
+    [LR_HID_SHUTTLEPRO] = "shuttlepro",
+    [LR_HID_CONSUMER] = "consumer",
+    NULL,
+};
+
 const char *lr_hid_proto_name(lr_hid_proto proto)
 {
-    switch (proto) {
-    case LR_HID_AUTO: return "auto";
-    case LR_HID_POWERMATE: return "powermate";
-    case LR_HID_SHUTTLEXPRESS: return "shuttlexpress";
-    case LR_HID_SHUTTLEPRO: return "shuttlepro";
-    case LR_HID_CONSUMER: return "consumer";
-    }
-    return "?";
+    return (unsigned)proto <= LR_HID_CONSUMER ? lr_hid_proto_names[proto] : "?";
 }
 
 int lr_hid_parser_init(lr_hid_parser *p, const lr_hid_parser_desc *desc, lr_err *e)

@@ -82,6 +82,8 @@ typedef struct lr_hid_parser {
 
 /* Known devices: PowerMate, ShuttleXpress, ShuttlePRO; LR_HID_CONSUMER otherwise. */
 lr_hid_proto lr_hid_proto_for(uint16_t vid, uint16_t pid);
+/* "auto", "powermate", ... in lr_hid_proto order, NULL-terminated (an LR_OPT_ENUM's names). */
+extern const char *const lr_hid_proto_names[];
 const char *lr_hid_proto_name(lr_hid_proto proto);
 
 /* desc->proto must not be LR_HID_AUTO (resolve it with lr_hid_proto_for first). LR_EINVAL when

@@ -17,6 +17,57 @@
 #define MAX_INPUTS 16
 #define MS 1000000LL
 
+const lr_opt lr_modbus_opts[] = {
+    [LR_MODBUS_OPT_URL] = {"url", LR_OPT_STRING, .required = true,
+                           .help = "tcp://HOST:PORT or rtu:DEVICE?baud=..."},
+    [LR_MODBUS_OPT_POLL_MS] = {"poll_ms", LR_OPT_INT, 1, 60000, 50,
+                               .help = "input polling period"},
+    [LR_MODBUS_OPT_TIMEOUT_MS] = {"timeout_ms", LR_OPT_INT, 1, 10000, 100,
+                                  .help = "response (and TCP connect) timeout"},
+    [LR_MODBUS_OPT_BYTE_TIMEOUT_MS] = {"byte_timeout_ms", LR_OPT_INT, 1, 10000, 50,
+                                       .help = "gap allowed inside a frame"},
+    [LR_MODBUS_OPT_MAX_TIMEOUTS] = {"max_timeouts", LR_OPT_INT, 1, 1000, 3,
+                                    .help = "consecutive timeouts that drop the link"},
+    [LR_MODBUS_OPT_INPUTS] = {"inputs", LR_OPT_LIST, .help = "panel registers (below)"},
+    [LR_MODBUS_OPT_LAMP] = {"lamp", LR_OPT_OBJECT, .help = "the lamp driver's register (below)"},
+    LR_OPT_END,
+};
+
+static const char *const REG_TYPES[] = {"holding", "input", NULL}; /* lr_modbus_reg_type */
+
+/* The fields an input and the output share. Unit ids: 1..247 on a serial line, TCP also
+ * 248..255 (checked per transport below); registers 0..65535 counted from base (below). */
+#define CH_UNIT {"unit", LR_OPT_INT, 1, 255, 1, .help = "unit (slave) id"}
+#define CH_BASE(help_) {"base", LR_OPT_INT, 0, 1, 0, .help = help_}
+/* reg's range is that of the address reg - base. */
+#define CH_REG(help_) {"reg", LR_OPT_INT, 0, 65535, 0, .required = true, .help = help_}
+#define CH_RAW_MIN {"raw_min", LR_OPT_INT, 0, 65535, 0, .help = "raw value of 0"}
+#define CH_RAW_MAX(dflt_) {"raw_max", LR_OPT_INT, 0, 65535, dflt_, .help = "raw value of 1 (> raw_min)"}
+
+const lr_opt lr_modbus_input_opts[] = {
+    [LR_MODBUS_IN_CONTROL] = {"control", LR_OPT_STRING, .dflt_text = "dimmer",
+                              .help = "event control name"},
+    [LR_MODBUS_IN_UNIT] = CH_UNIT,
+    [LR_MODBUS_IN_REG] = CH_REG("register number; the range is of reg - base"),
+    [LR_MODBUS_IN_BASE] = CH_BASE("1: 1-based numbering as panel manuals print it"),
+    [LR_MODBUS_IN_TYPE] = {"type", LR_OPT_ENUM, .dflt = LR_MODBUS_HOLDING, .names = REG_TYPES,
+                           .help = "FC 3 or FC 4"},
+    [LR_MODBUS_IN_RAW_MIN] = CH_RAW_MIN,
+    [LR_MODBUS_IN_RAW_MAX] = CH_RAW_MAX(1000),
+    LR_OPT_END,
+};
+
+const lr_opt lr_modbus_output_opts[] = {
+    [LR_MODBUS_OUT_UNIT] = CH_UNIT,
+    [LR_MODBUS_OUT_REG] = CH_REG("holding register; the range is of reg - base"),
+    [LR_MODBUS_OUT_BASE] = CH_BASE("as for inputs"),
+    [LR_MODBUS_OUT_RAW_MIN] = CH_RAW_MIN,
+    [LR_MODBUS_OUT_RAW_MAX] = CH_RAW_MAX(255),
+    [LR_MODBUS_OUT_MULTIPLE] = {"multiple", LR_OPT_BOOL, .dflt = 0,
+                                .help = "write with FC 16 instead of FC 6"},
+    LR_OPT_END,
+};
+
 typedef struct channel {
     char what[96];   /* "input 'dimmer' (unit 1, holding register 0)" */
     bool failing;    /* an error was logged; the next success logs the recovery */
@@ -460,17 +511,21 @@ static int check_channel(lr_modbus *m, const char *field, int unit, int reg, int
                          int raw_min, int raw_max, int *unit_out, int *addr_out, lr_err *e)
 {
     const char *pf = m->base.prefix;
-    int u = unit ? unit : 1;
-    int umax = m->url.transport == LR_MODBUS_TCP ? 255 : 247;
+    const lr_opt *uo = &lr_modbus_input_opts[LR_MODBUS_IN_UNIT];
+    const lr_opt *bo = &lr_modbus_input_opts[LR_MODBUS_IN_BASE];
+    const lr_opt *ro = &lr_modbus_input_opts[LR_MODBUS_IN_RAW_MIN];
+    const lr_opt *rg = &lr_modbus_input_opts[LR_MODBUS_IN_REG];
+    int u = (int)lr_opt_or_default(uo, unit);
+    int umax = m->url.transport == LR_MODBUS_TCP ? (int)uo->hi : 247;
     if (u < 1 || u > umax)
         return lr_err_set(e, LR_EINVAL, "%s: %s.unit %d is not 1..%d", pf, field, unit, umax);
-    if (base != 0 && base != 1)
+    if (!lr_opt_in_range(bo, base))
         return lr_err_set(e, LR_EINVAL, "%s: %s.base %d is not 0 or 1", pf, field, base);
     int addr = reg - base;
-    if (addr < 0 || addr > 65535)
-        return lr_err_set(e, LR_EINVAL, "%s: %s.reg %d is not %d..%d (base %d)", pf, field, reg,
-                          base, 65535 + base, base);
-    if (raw_min < 0 || raw_max > 65535 || raw_min >= raw_max)
+    if (!lr_opt_in_range(rg, addr))
+        return lr_err_set(e, LR_EINVAL, "%s: %s.reg %d is not %ld..%ld (base %d)", pf, field, reg,
+                          rg->lo + base, rg->hi + base, base);
+    if (raw_min < ro->lo || raw_max > ro->hi || raw_min >= raw_max)
         return lr_err_set(e, LR_EINVAL, "%s: %s: raw range %d..%d is not within 0..65535 and "
                           "increasing", pf, field, raw_min, raw_max);
     *unit_out = u;
@@ -505,7 +560,8 @@ static int configure(lr_modbus *m, const lr_modbus_desc *desc, lr_err *e)
         if (c->type != LR_MODBUS_HOLDING && c->type != LR_MODBUS_INPUT)
             return lr_err_set(e, LR_EINVAL, "%s: %s.type %d unknown", pf, field, (int)c->type);
         in->raw_min = c->raw_min;
-        in->raw_max = c->raw_max ? c->raw_max : 1000;
+        in->raw_max = (int)lr_opt_or_default(&lr_modbus_input_opts[LR_MODBUS_IN_RAW_MAX],
+                                             c->raw_max);
         rc = check_channel(m, field, c->unit, c->reg, c->base, in->raw_min, in->raw_max,
                            &in->unit, &in->addr, e);
         if (rc != LR_OK)
@@ -522,7 +578,8 @@ static int configure(lr_modbus *m, const lr_modbus_desc *desc, lr_err *e)
         const lr_modbus_output *c = &desc->output;
         o->enabled = true;
         o->raw_min = c->raw_min;
-        o->raw_max = c->raw_max ? c->raw_max : 255;
+        o->raw_max = (int)lr_opt_or_default(&lr_modbus_output_opts[LR_MODBUS_OUT_RAW_MAX],
+                                            c->raw_max);
         o->multiple = c->multiple;
         rc = check_channel(m, "output", c->unit, c->reg, c->base, o->raw_min, o->raw_max,
                            &o->unit, &o->addr, e);
@@ -531,18 +588,22 @@ static int configure(lr_modbus *m, const lr_modbus_desc *desc, lr_err *e)
         snprintf(o->ch.what, sizeof o->ch.what, "lamp driver (unit %d, holding register %d)",
                  o->unit, o->addr);
     }
-    if (desc->poll_ms < 0 || desc->poll_ms > 60000 || desc->timeout_ms < 0 ||
-        desc->timeout_ms > 10000 || desc->byte_timeout_ms < 0 || desc->byte_timeout_ms > 10000 ||
-        desc->max_timeouts < 0 || desc->max_timeouts > 1000)
+    const lr_opt *op = lr_modbus_opts;
+    if (!lr_opt_hal_ok(&op[LR_MODBUS_OPT_POLL_MS], desc->poll_ms) ||
+        !lr_opt_hal_ok(&op[LR_MODBUS_OPT_TIMEOUT_MS], desc->timeout_ms) ||
+        !lr_opt_hal_ok(&op[LR_MODBUS_OPT_BYTE_TIMEOUT_MS], desc->byte_timeout_ms) ||
+        !lr_opt_hal_ok(&op[LR_MODBUS_OPT_MAX_TIMEOUTS], desc->max_timeouts))
         return lr_err_set(e, LR_EINVAL,
                           "%s: poll_ms %d / timeout_ms %d / byte_timeout_ms %d / max_timeouts %d "
                           "out of range",
                           pf, desc->poll_ms, desc->timeout_ms, desc->byte_timeout_ms,
                           desc->max_timeouts);
-    m->poll_ns = (desc->poll_ms ? desc->poll_ms : 50) * MS;
-    m->timeout_ns = (desc->timeout_ms ? desc->timeout_ms : 100) * MS;
-    m->byte_timeout_ms = desc->byte_timeout_ms ? desc->byte_timeout_ms : 50;
-    m->max_timeouts = desc->max_timeouts ? desc->max_timeouts : 3;
+    m->poll_ns = lr_opt_or_default(&op[LR_MODBUS_OPT_POLL_MS], desc->poll_ms) * MS;
+    m->timeout_ns = lr_opt_or_default(&op[LR_MODBUS_OPT_TIMEOUT_MS], desc->timeout_ms) * MS;
+    m->byte_timeout_ms = (int)lr_opt_or_default(&op[LR_MODBUS_OPT_BYTE_TIMEOUT_MS],
+                                                desc->byte_timeout_ms);
+    m->max_timeouts = (int)lr_opt_or_default(&op[LR_MODBUS_OPT_MAX_TIMEOUTS],
+                                             desc->max_timeouts);
     if (m->url.transport == LR_MODBUS_RTU) {
         /* Modbus over serial line v1.02, 2.5.1.1: 3.5 character times of silence between
          * frames, fixed at 1.75 ms above 19200 baud. A character is 11 bits on the wire. */

@@ -38,6 +38,7 @@
 #include <stdint.h>
 
 #include "hal/dev.h"
+#include "hal/opt.h"
 #include "render/base/err.h"
 
 /* ---- endpoint URL ---- */
@@ -99,11 +100,44 @@ typedef struct lr_modbus_desc {
     const lr_modbus_input *inputs;
     int n_inputs;            /* at most 16 */
     lr_modbus_output output;
-    int poll_ms;             /* input polling period; default 50 */
-    int timeout_ms;          /* response (and TCP connect) timeout; default 100 */
-    int byte_timeout_ms;     /* gap allowed inside a frame once it started; default 50 */
-    int max_timeouts;        /* consecutive timeouts that drop the link; default 3 */
+    /* Defaults and ranges of these: lr_modbus_opts below (0: the default). */
+    int poll_ms;             /* input polling period */
+    int timeout_ms;          /* response (and TCP connect) timeout */
+    int byte_timeout_ms;     /* gap allowed inside a frame once it started */
+    int max_timeouts;        /* consecutive timeouts that drop the link */
 } lr_modbus_desc;
+
+/* The options above as the rig config reads them (hal/opt.h); configure() checks with them. */
+enum {
+    LR_MODBUS_OPT_URL = 0,
+    LR_MODBUS_OPT_POLL_MS,
+    LR_MODBUS_OPT_TIMEOUT_MS,
+    LR_MODBUS_OPT_BYTE_TIMEOUT_MS,
+    LR_MODBUS_OPT_MAX_TIMEOUTS,
+    LR_MODBUS_OPT_INPUTS,
+    LR_MODBUS_OPT_LAMP,
+};
+extern const lr_opt lr_modbus_opts[];
+/* One input (inputs[i]) and the output (the rig config's "lamp"). */
+enum {
+    LR_MODBUS_IN_CONTROL = 0,
+    LR_MODBUS_IN_UNIT,
+    LR_MODBUS_IN_REG,
+    LR_MODBUS_IN_BASE,
+    LR_MODBUS_IN_TYPE,
+    LR_MODBUS_IN_RAW_MIN,
+    LR_MODBUS_IN_RAW_MAX,
+};
+extern const lr_opt lr_modbus_input_opts[];
+enum {
+    LR_MODBUS_OUT_UNIT = 0,
+    LR_MODBUS_OUT_REG,
+    LR_MODBUS_OUT_BASE,
+    LR_MODBUS_OUT_RAW_MIN,
+    LR_MODBUS_OUT_RAW_MAX,
+    LR_MODBUS_OUT_MULTIPLE,
+};
+extern const lr_opt lr_modbus_output_opts[];
 
 typedef struct lr_modbus_counters {
     uint64_t requests;       /* sent */

@@ -9,6 +9,13 @@
 
 #include "hal/dev_impl.h"
 
+const lr_opt lr_sim_opts[] = {
+    [LR_SIM_OPT_SCRIPT] = {"script", LR_OPT_STRING, .help = "script file (hal/README.md)"},
+    [LR_SIM_OPT_TEXT] = {"text", LR_OPT_STRING, .help = "the script itself"},
+    [LR_SIM_OPT_LOOP] = {"loop", LR_OPT_BOOL, .dflt = 0, .help = "start over after the end"},
+    LR_OPT_END,
+};
+
 struct lr_sim_script {
     lr_event *ev;
     int n, cap;

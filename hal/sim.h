@@ -28,6 +28,7 @@
 
 #include "hal/dev.h"
 #include "hal/event.h"
+#include "hal/opt.h"
 #include "render/base/err.h"
 
 /* ---- the script, pure ---- */
@@ -55,6 +56,10 @@ typedef struct lr_sim_desc {
     int64_t start_ns;    /* CLOCK_MONOTONIC time of script time 0; 0 means the time of create */
     bool loop;           /* start over after the end */
 } lr_sim_desc;
+
+/* The options above as the rig config reads them (hal/opt.h); script and text: exactly one. */
+enum { LR_SIM_OPT_SCRIPT = 0, LR_SIM_OPT_TEXT, LR_SIM_OPT_LOOP };
+extern const lr_opt lr_sim_opts[];
 
 typedef struct lr_sim lr_sim;
 

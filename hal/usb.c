@@ -11,6 +11,29 @@
 #define QMAX 64
 #define MS 1000000LL
 
+const lr_opt lr_usb_opts[] = {
+    [LR_USB_OPT_WATCH] = {"watch", LR_OPT_LIST, .required = true,
+                          .help = "devices to watch (below), 1..16"},
+    [LR_USB_OPT_RESCAN_MS] = {"rescan_ms", LR_OPT_INT, 1, 600000, 1000,
+                              .help = "re-enumeration period without hotplug"},
+    [LR_USB_OPT_NO_HOTPLUG] = {"no_hotplug", LR_OPT_BOOL, .dflt = 0,
+                               .help = "re-enumerate even when libusb offers hotplug"},
+    LR_OPT_END,
+};
+
+const lr_opt lr_usb_watch_opts[] = {
+    [LR_USB_W_NAME] = {"name", LR_OPT_STRING, .required = true, .help = "event source name"},
+    [LR_USB_W_VID] = {"vid", LR_OPT_HEX16, .required = true, .help = "USB vendor id"},
+    [LR_USB_W_PID] = {"pid", LR_OPT_HEX16, .required = true, .help = "USB product id"},
+    [LR_USB_W_READ_REPORTS] = {"read_reports", LR_OPT_BOOL, .dflt = 0,
+                               .help = "open it and parse its interrupt IN reports"},
+    [LR_USB_W_INTERFACE] = {"interface", LR_OPT_INT, 0, 255, 0,
+                            .help = "interface to claim for read_reports"},
+    [LR_USB_W_PROTO] = {"proto", LR_OPT_ENUM, .dflt = LR_HID_AUTO, .names = lr_hid_proto_names,
+                        .help = "report parser; auto: by VID:PID"},
+    LR_OPT_END,
+};
+
 struct lr_usb;
 
 typedef struct watch {
@@ -482,7 +505,7 @@ static int configure(lr_usb *u, const lr_usb_desc *desc, lr_err *e)
     if (desc->n_watch < 1 || desc->n_watch > LR_USB_MAX_WATCH || !desc->watch)
         return lr_err_set(e, LR_EINVAL, "%s: n_watch %d is not 1..%d", pf, desc->n_watch,
                           LR_USB_MAX_WATCH);
-    if (desc->rescan_ms < 0 || desc->rescan_ms > 600000)
+    if (!lr_opt_hal_ok(&lr_usb_opts[LR_USB_OPT_RESCAN_MS], desc->rescan_ms))
         return lr_err_set(e, LR_EINVAL, "%s: rescan_ms %d out of range", pf, desc->rescan_ms);
     for (int k = 0; k < desc->n_watch; k++) {
         const lr_usb_watch *c = &desc->watch[k];
@@ -498,7 +521,7 @@ static int configure(lr_usb *u, const lr_usb_desc *desc, lr_err *e)
         if (!c->vid || !c->pid)
             return lr_err_set(e, LR_EINVAL, "%s: watch[%d] (%s): vid and pid are required", pf, k,
                               c->name);
-        if (c->interface < 0 || c->interface > 255)
+        if (!lr_opt_in_range(&lr_usb_watch_opts[LR_USB_W_INTERFACE], c->interface))
             return lr_err_set(e, LR_EINVAL, "%s: watch[%d].interface %d is not 0..255", pf, k,
                               c->interface);
         strcpy(w->name, c->name);
@@ -516,7 +539,7 @@ static int configure(lr_usb *u, const lr_usb_desc *desc, lr_err *e)
         w->retry_at = LR_NO_DEADLINE;
         u->n = k + 1;
     }
-    u->rescan_ns = (desc->rescan_ms ? desc->rescan_ms : 1000) * MS;
+    u->rescan_ns = lr_opt_or_default(&lr_usb_opts[LR_USB_OPT_RESCAN_MS], desc->rescan_ms) * MS;
     u->want_hotplug = !desc->no_hotplug;
     return LR_OK;
 }

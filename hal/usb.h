@@ -25,6 +25,7 @@
 #include <stdint.h>
 
 #include "hal/dev.h"
+#include "hal/opt.h"
 #include "hal/hid_report.h"
 #include "render/base/err.h"
 
@@ -43,9 +44,22 @@ typedef struct lr_usb_desc {
                                   * be present at create */
     const lr_usb_watch *watch;
     int n_watch;                 /* 1..LR_USB_MAX_WATCH */
-    int rescan_ms;               /* re-enumeration period without hotplug; default 1000 */
+    int rescan_ms;               /* re-enumeration period without hotplug (lr_usb_opts) */
     bool no_hotplug;             /* re-enumerate even when libusb offers hotplug */
 } lr_usb_desc;
+
+/* The options above as the rig config reads them (hal/opt.h). */
+enum { LR_USB_OPT_WATCH = 0, LR_USB_OPT_RESCAN_MS, LR_USB_OPT_NO_HOTPLUG };
+extern const lr_opt lr_usb_opts[];
+enum {
+    LR_USB_W_NAME = 0,
+    LR_USB_W_VID,
+    LR_USB_W_PID,
+    LR_USB_W_READ_REPORTS,
+    LR_USB_W_INTERFACE,
+    LR_USB_W_PROTO,
+};
+extern const lr_opt lr_usb_watch_opts[];
 
 typedef struct lr_usb lr_usb;
 

@@ -15,6 +15,7 @@
 #include "render/base/mat4.h"
 #include "render/mesh/shapes.h"
 #include "render/scene/scene.h"
+#include "tests/support/doc_block.h"
 
 typedef struct warnings {
     int n;
@@ -754,6 +755,15 @@ static void test_model_switch_and_light_cap(void **state)
     }
 }
 
+/* configs/scenes/README.md quotes the field reference written from the tables that load, set
+ * and check scenes (render/scene/field_tables.c): a field, range or default changed in one
+ * place shows up in the other, or this fails. */
+static void test_readme_field_reference(void **state)
+{
+    (void)state;
+    lr_test_doc_block("configs/scenes/README.md", "scene-fields", lr_scene_fields_markdown);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -768,6 +778,7 @@ int main(void)
         cmocka_unit_test(test_set_rejects_bad_values),
         cmocka_unit_test(test_set_shade_and_file_mesh),
         cmocka_unit_test(test_model_switch_and_light_cap),
+        cmocka_unit_test(test_readme_field_reference),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

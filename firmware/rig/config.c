@@ -11,8 +11,12 @@
 
 #include "firmware/control/curve.h"
 #include "hal/gpio.h"
+#include "hal/hid.h"
 #include "hal/hid_report.h"
 #include "hal/modbus.h"
+#include "hal/opt.h"
+#include "hal/sim.h"
+#include "hal/usb.h"
 #include "render/base/json.h"
 #include "render/scene/scene.h"
 
@@ -152,6 +156,56 @@ static int check_name(ctx *x, lr_jnode n, const char *field, const char *s)
     return LR_OK;
 }
 
+/* ---- hal options (hal/opt.h): key, range and default are the back end's own ---- */
+
+/* An integer option: absent keeps *out (the caller's default, normally o->dflt). */
+static int opt_int(ctx *x, lr_jnode obj, const char *prefix, const lr_opt *o, int *out)
+{
+    return get_int_in(x, obj, prefix, o->key, o->required, o->lo, o->hi, out);
+}
+
+static int opt_bool(ctx *x, lr_jnode obj, const char *prefix, const lr_opt *o, bool *out)
+{
+    *out = o->dflt != 0;
+    return get_bool(x, obj, prefix, o->key, out);
+}
+
+/* An enum option: *out receives the index of the name (the hal enum's value). */
+static int opt_enum(ctx *x, lr_jnode obj, const char *prefix, const lr_opt *o, int *out)
+{
+    char s[32];
+    snprintf(s, sizeof s, "%s", o->names[o->dflt]);
+    int rc = get_str(x, obj, prefix, o->key, o->required, s, sizeof s);
+    if (rc)
+        return rc;
+    int i = lr_opt_enum_index(o, s);
+    if (i >= 0) {
+        *out = i;
+        return LR_OK;
+    }
+    char list[160] = "", f[192];
+    for (int k = 0; o->names[k]; k++)
+        snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s",
+                 k == 0 ? "" : o->names[k + 1] ? ", " : " or ", o->names[k]);
+    field_name(f, sizeof f, prefix, o->key);
+    return lr_json_fail(x->j, lr_json_get(x->j, obj, o->key), f, x->e, LR_EPARSE,
+                        "'%s' is not %s", s, list);
+}
+
+/* The keys an object may have: those of the option tables (NULL-terminated list of tables)
+ * and the extra ones; out holds up to cap - 1 keys and a NULL. */
+static void opt_keys(const lr_opt *const *tables, const char *const *extra, const char **out,
+                     int cap)
+{
+    int n = 0;
+    for (; extra && *extra && n < cap - 1; extra++)
+        out[n++] = *extra;
+    for (; *tables; tables++)
+        for (const lr_opt *o = *tables; o->key && n < cap - 1; o++)
+            out[n++] = o->key;
+    out[n] = NULL;
+}
+
 /* Resolves a path against the config's directory and checks that the file exists. */
 static int resolve(ctx *x, lr_jnode n, const char *field, const char *rel, char *out, size_t cap)
 {
@@ -189,41 +243,19 @@ static int get_hex16(ctx *x, lr_jnode obj, const char *prefix, const char *key, 
     return LR_OK;
 }
 
-static int get_proto(ctx *x, lr_jnode obj, const char *prefix, int *out)
-{
-    static const char *const names[] = {"auto", "powermate", "shuttlexpress", "shuttlepro",
-                                        "consumer"};
-    char s[32] = "auto";
-    int rc = get_str(x, obj, prefix, "proto", false, s, sizeof s);
-    if (rc)
-        return rc;
-    for (int i = 0; i < 5; i++)
-        if (strcmp(s, names[i]) == 0) {
-            *out = i; /* the lr_hid_proto order */
-            return LR_OK;
-        }
-    char f[192];
-    field_name(f, sizeof f, prefix, "proto");
-    return lr_json_fail(x->j, lr_json_get(x->j, obj, "proto"), f, x->e, LR_EPARSE,
-                        "unknown protocol '%s' (auto, powermate, shuttlexpress, shuttlepro, "
-                        "consumer)", s);
-}
-
 /* ---- devices ---- */
 
 static int modbus_reg(ctx *x, lr_jnode o, const char *where, bool lamp, lr_rig_modbus_reg *r)
 {
-    static const char *const in_keys[] = {"control", "unit", "reg", "base", "type", "raw_min",
-                                          "raw_max", NULL};
-    static const char *const out_keys[] = {"unit", "reg", "base", "raw_min", "raw_max",
-                                           "multiple", NULL};
-    int rc = keys(x, o, where, lamp ? out_keys : in_keys);
+    const lr_opt *in = lr_modbus_input_opts, *out = lr_modbus_output_opts;
+    const lr_opt *const tables[] = {lamp ? out : in, NULL};
+    const char *allowed[16];
+    opt_keys(tables, NULL, allowed, 16);
+    int rc = keys(x, o, where, allowed);
     if (rc)
         return rc;
-    snprintf(r->control, sizeof r->control, "dimmer");
-    r->unit = lamp ? 2 : 1;
-    r->raw_min = 0;
-    r->raw_max = lamp ? 255 : 1000;
+    snprintf(r->control, sizeof r->control, "%s", in[LR_MODBUS_IN_CONTROL].dflt_text);
+    r->unit = lamp ? LR_RIG_LAMP_UNIT : (int)in[LR_MODBUS_IN_UNIT].dflt;
     if (!lamp) {
         if ((rc = get_str(x, o, where, "control", false, r->control, sizeof r->control)))
             return rc;
@@ -231,23 +263,27 @@ static int modbus_reg(ctx *x, lr_jnode o, const char *where, bool lamp, lr_rig_m
         field_name(f, sizeof f, where, "control");
         if ((rc = check_name(x, o, f, r->control)))
             return rc;
-        char type[16] = "holding";
-        if ((rc = get_str(x, o, where, "type", false, type, sizeof type)))
+        int type = LR_MODBUS_HOLDING;
+        if ((rc = opt_enum(x, o, where, &in[LR_MODBUS_IN_TYPE], &type)))
             return rc;
-        if (strcmp(type, "holding") && strcmp(type, "input")) {
-            field_name(f, sizeof f, where, "type");
-            return lr_json_fail(x->j, lr_json_get(x->j, o, "type"), f, x->e, LR_EPARSE,
-                                "'%s' is not holding or input", type);
-        }
-        r->input_regs = strcmp(type, "input") == 0;
-    } else if ((rc = get_bool(x, o, where, "multiple", &r->multiple))) {
+        r->input_regs = type == LR_MODBUS_INPUT;
+    } else if ((rc = opt_bool(x, o, where, &out[LR_MODBUS_OUT_MULTIPLE], &r->multiple))) {
         return rc;
     }
-    if ((rc = get_int_in(x, o, where, "unit", false, 1, 255, &r->unit)) ||
-        (rc = get_int_in(x, o, where, "base", false, 0, 1, &r->base)) ||
-        (rc = get_int_in(x, o, where, "reg", true, r->base, 65535 + r->base, &r->reg)) ||
-        (rc = get_int_in(x, o, where, "raw_min", false, 0, 65535, &r->raw_min)) ||
-        (rc = get_int_in(x, o, where, "raw_max", false, 0, 65535, &r->raw_max)))
+    const lr_opt *unit = lamp ? &out[LR_MODBUS_OUT_UNIT] : &in[LR_MODBUS_IN_UNIT];
+    const lr_opt *base = lamp ? &out[LR_MODBUS_OUT_BASE] : &in[LR_MODBUS_IN_BASE];
+    const lr_opt *raw_min = lamp ? &out[LR_MODBUS_OUT_RAW_MIN] : &in[LR_MODBUS_IN_RAW_MIN];
+    const lr_opt *raw_max = lamp ? &out[LR_MODBUS_OUT_RAW_MAX] : &in[LR_MODBUS_IN_RAW_MAX];
+    const lr_opt *reg = lamp ? &out[LR_MODBUS_OUT_REG] : &in[LR_MODBUS_IN_REG];
+    r->raw_min = (int)raw_min->dflt;
+    r->raw_max = (int)raw_max->dflt;
+    if ((rc = opt_int(x, o, where, unit, &r->unit)) ||
+        (rc = opt_int(x, o, where, base, &r->base)) ||
+        /* The descriptor's range is the address reg - base's. */
+        (rc = get_int_in(x, o, where, "reg", true, reg->lo + r->base, reg->hi + r->base,
+                         &r->reg)) ||
+        (rc = opt_int(x, o, where, raw_min, &r->raw_min)) ||
+        (rc = opt_int(x, o, where, raw_max, &r->raw_max)))
         return rc;
     if (r->raw_max <= r->raw_min) {
         char f[192];
@@ -280,19 +316,14 @@ static int device(ctx *x, lr_jnode o, int index, lr_rig_device *d)
         return lr_json_fail(x->j, lr_json_get(x->j, o, "type"), f, x->e, LR_EPARSE,
                             "unknown device type '%s' (sim, modbus, gpio, hid, usb)", type);
     d->type = (lr_rig_dev_type)t;
-#define COMMON "type", "name", "required", "retry_min_ms", "retry_max_ms"
-    static const char *const sim_keys[] = {COMMON, "script", "text", "loop", NULL};
-    static const char *const modbus_keys[] = {COMMON, "url", "poll_ms", "timeout_ms",
-                                              "byte_timeout_ms", "max_timeouts", "inputs",
-                                              "lamp", NULL};
-    static const char *const gpio_keys[] = {COMMON, "chip", "bias", "encoders", "buttons", NULL};
-    static const char *const hid_keys[] = {COMMON, "vid", "pid", "serial", "poll_ms", "proto",
-                                           "report_id", NULL};
-    static const char *const usb_keys[] = {COMMON, "watch", "rescan_ms", "no_hotplug", NULL};
-#undef COMMON
-    static const char *const *const all_keys[] = {sim_keys, modbus_keys, gpio_keys, hid_keys,
-                                                  usb_keys};
-    if ((rc = keys(x, o, where, all_keys[t])))
+    /* The options of every device and of its back end (hal/opt.h), in lr_rig_dev_type order. */
+    static const lr_opt *const backend[] = {lr_sim_opts, lr_modbus_opts, lr_gpio_opts,
+                                            lr_hid_opts, lr_usb_opts};
+    static const char *const type_key[] = {"type", NULL};
+    const lr_opt *const tables[] = {lr_dev_opts, backend[t], NULL};
+    const char *allowed[32];
+    opt_keys(tables, type_key, allowed, 32);
+    if ((rc = keys(x, o, where, allowed)))
         return rc;
     snprintf(d->name, sizeof d->name, "%s", type);
     if ((rc = get_str(x, o, where, "name", false, d->name, sizeof d->name)))
@@ -300,11 +331,12 @@ static int device(ctx *x, lr_jnode o, int index, lr_rig_device *d)
     field_name(f, sizeof f, where, "name");
     if ((rc = check_name(x, o, f, d->name)))
         return rc;
-    d->retry_min_ms = 250;
-    d->retry_max_ms = 10000;
-    if ((rc = get_bool(x, o, where, "required", &d->required)) ||
-        (rc = get_int_in(x, o, where, "retry_min_ms", false, 1, 3600000, &d->retry_min_ms)) ||
-        (rc = get_int_in(x, o, where, "retry_max_ms", false, 1, 3600000, &d->retry_max_ms)))
+    const lr_opt *dv = lr_dev_opts;
+    d->retry_min_ms = (int)dv[LR_DEV_OPT_RETRY_MIN_MS].dflt;
+    d->retry_max_ms = (int)dv[LR_DEV_OPT_RETRY_MAX_MS].dflt;
+    if ((rc = opt_bool(x, o, where, &dv[LR_DEV_OPT_REQUIRED], &d->required)) ||
+        (rc = opt_int(x, o, where, &dv[LR_DEV_OPT_RETRY_MIN_MS], &d->retry_min_ms)) ||
+        (rc = opt_int(x, o, where, &dv[LR_DEV_OPT_RETRY_MAX_MS], &d->retry_max_ms)))
         return rc;
     switch (d->type) {
     case LR_RIG_DEV_SIM: {
@@ -328,19 +360,19 @@ static int device(ctx *x, lr_jnode o, int index, lr_rig_device *d)
             if ((rc = lr_json_string(x->j, tx, f, d->text, TEXT_MAX, x->e)))
                 return rc;
         }
-        return get_bool(x, o, where, "loop", &d->loop);
+        return opt_bool(x, o, where, &lr_sim_opts[LR_SIM_OPT_LOOP], &d->loop);
     }
     case LR_RIG_DEV_MODBUS: {
-        d->poll_ms = 50;
-        d->timeout_ms = 100;
-        d->byte_timeout_ms = 50;
-        d->max_timeouts = 3;
+        const lr_opt *mo = lr_modbus_opts;
+        d->poll_ms = (int)mo[LR_MODBUS_OPT_POLL_MS].dflt;
+        d->timeout_ms = (int)mo[LR_MODBUS_OPT_TIMEOUT_MS].dflt;
+        d->byte_timeout_ms = (int)mo[LR_MODBUS_OPT_BYTE_TIMEOUT_MS].dflt;
+        d->max_timeouts = (int)mo[LR_MODBUS_OPT_MAX_TIMEOUTS].dflt;
         if ((rc = get_str(x, o, where, "url", true, d->url, sizeof d->url)) ||
-            (rc = get_int_in(x, o, where, "poll_ms", false, 1, 600000, &d->poll_ms)) ||
-            (rc = get_int_in(x, o, where, "timeout_ms", false, 1, 60000, &d->timeout_ms)) ||
-            (rc = get_int_in(x, o, where, "byte_timeout_ms", false, 1, 60000,
-                             &d->byte_timeout_ms)) ||
-            (rc = get_int_in(x, o, where, "max_timeouts", false, 1, 1000, &d->max_timeouts)))
+            (rc = opt_int(x, o, where, &mo[LR_MODBUS_OPT_POLL_MS], &d->poll_ms)) ||
+            (rc = opt_int(x, o, where, &mo[LR_MODBUS_OPT_TIMEOUT_MS], &d->timeout_ms)) ||
+            (rc = opt_int(x, o, where, &mo[LR_MODBUS_OPT_BYTE_TIMEOUT_MS], &d->byte_timeout_ms)) ||
+            (rc = opt_int(x, o, where, &mo[LR_MODBUS_OPT_MAX_TIMEOUTS], &d->max_timeouts)))
             return rc;
         lr_modbus_url u;
         lr_err ue = {0};
@@ -383,22 +415,10 @@ static int device(ctx *x, lr_jnode o, int index, lr_rig_device *d)
         return LR_OK;
     }
     case LR_RIG_DEV_GPIO: {
-        snprintf(d->chip, sizeof d->chip, "gpiochip0");
-        if ((rc = get_str(x, o, where, "chip", false, d->chip, sizeof d->chip)))
+        snprintf(d->chip, sizeof d->chip, "%s", lr_gpio_opts[LR_GPIO_OPT_CHIP].dflt_text);
+        if ((rc = get_str(x, o, where, "chip", false, d->chip, sizeof d->chip)) ||
+            (rc = opt_enum(x, o, where, &lr_gpio_opts[LR_GPIO_OPT_BIAS], &d->bias)))
             return rc;
-        char bias[16] = "pull-up";
-        if ((rc = get_str(x, o, where, "bias", false, bias, sizeof bias)))
-            return rc;
-        static const char *const biases[] = {"pull-up", "as-is", "disable", "pull-down"};
-        d->bias = -1;
-        for (int i = 0; i < 4; i++)
-            if (strcmp(bias, biases[i]) == 0)
-                d->bias = i; /* the lr_gpio_bias order */
-        if (d->bias < 0) {
-            field_name(f, sizeof f, where, "bias");
-            return lr_json_fail(x->j, lr_json_get(x->j, o, "bias"), f, x->e, LR_EPARSE,
-                                "'%s' is not pull-up, as-is, disable or pull-down", bias);
-        }
         for (int pass = 0; pass < 2; pass++) {
             const char *key = pass ? "buttons" : "encoders";
             lr_jnode arr = lr_json_get(x->j, o, key);
@@ -414,15 +434,15 @@ static int device(ctx *x, lr_jnode o, int index, lr_rig_device *d)
                 lr_jnode it = lr_json_at(x->j, arr, i);
                 char w[96], wf[128];
                 snprintf(w, sizeof w, "%s.%s[%d]", where, key, i);
-                static const char *const enc_keys[] = {"name", "line_a", "line_b",
-                                                       "steps_per_detent", "reverse", NULL};
-                static const char *const btn_keys[] = {"name", "line", "active_high",
-                                                       "debounce_ms", NULL};
-                if ((rc = keys(x, it, w, pass ? btn_keys : enc_keys)))
+                const lr_opt *eo = lr_gpio_encoder_opts, *bo = lr_gpio_button_opts;
+                const lr_opt *const itables[] = {pass ? bo : eo, NULL};
+                const char *iallowed[16];
+                opt_keys(itables, NULL, iallowed, 16);
+                if ((rc = keys(x, it, w, iallowed)))
                     return rc;
                 lr_rig_gpio_line *l = pass ? &d->buttons[i] : &d->encoders[i];
-                l->steps_per_detent = 4;
-                l->debounce_ms = 5;
+                l->steps_per_detent = (int)eo[LR_GPIO_ENC_STEPS_PER_DETENT].dflt;
+                l->debounce_ms = (int)bo[LR_GPIO_BTN_DEBOUNCE_MS].dflt;
                 if ((rc = get_str(x, it, w, "name", true, l->name, sizeof l->name)))
                     return rc;
                 field_name(wf, sizeof wf, w, "name");
@@ -430,17 +450,16 @@ static int device(ctx *x, lr_jnode o, int index, lr_rig_device *d)
                     return rc;
                 if (pass) {
                     if ((rc = get_str(x, it, w, "line", true, l->line_a, sizeof l->line_a)) ||
-                        (rc = get_bool(x, it, w, "active_high", &l->active_high)) ||
-                        (rc = get_int_in(x, it, w, "debounce_ms", false, 0, 1000,
-                                         &l->debounce_ms)))
+                        (rc = opt_bool(x, it, w, &bo[LR_GPIO_BTN_ACTIVE_HIGH], &l->active_high)) ||
+                        (rc = opt_int(x, it, w, &bo[LR_GPIO_BTN_DEBOUNCE_MS], &l->debounce_ms)))
                         return rc;
                     d->n_buttons = i + 1;
                 } else {
                     if ((rc = get_str(x, it, w, "line_a", true, l->line_a, sizeof l->line_a)) ||
                         (rc = get_str(x, it, w, "line_b", true, l->line_b, sizeof l->line_b)) ||
-                        (rc = get_bool(x, it, w, "reverse", &l->reverse)) ||
-                        (rc = get_int_in(x, it, w, "steps_per_detent", false, 1, 4,
-                                         &l->steps_per_detent)))
+                        (rc = opt_bool(x, it, w, &eo[LR_GPIO_ENC_REVERSE], &l->reverse)) ||
+                        (rc = opt_int(x, it, w, &eo[LR_GPIO_ENC_STEPS_PER_DETENT],
+                                      &l->steps_per_detent)))
                         return rc;
                     if (l->steps_per_detent == 3) {
                         field_name(wf, sizeof wf, w, "steps_per_detent");
@@ -457,19 +476,22 @@ static int device(ctx *x, lr_jnode o, int index, lr_rig_device *d)
         return LR_OK;
     }
     case LR_RIG_DEV_HID: {
-        d->poll_ms = 8;
+        const lr_opt *ho = lr_hid_opts;
+        d->poll_ms = (int)ho[LR_HID_OPT_POLL_MS].dflt;
+        d->report_id = (int)ho[LR_HID_OPT_REPORT_ID].dflt;
         if ((rc = get_hex16(x, o, where, "vid", &d->vid)) ||
             (rc = get_hex16(x, o, where, "pid", &d->pid)) ||
-            (rc = get_int_in(x, o, where, "poll_ms", false, 1, 10000, &d->poll_ms)) ||
-            (rc = get_int_in(x, o, where, "report_id", false, 0, 255, &d->report_id)) ||
-            (rc = get_proto(x, o, where, &d->proto)))
+            (rc = opt_int(x, o, where, &ho[LR_HID_OPT_POLL_MS], &d->poll_ms)) ||
+            (rc = opt_int(x, o, where, &ho[LR_HID_OPT_REPORT_ID], &d->report_id)) ||
+            (rc = opt_enum(x, o, where, &ho[LR_HID_OPT_PROTO], &d->proto)))
             return rc;
         return get_str(x, o, where, "serial", false, d->serial, sizeof d->serial);
     }
     case LR_RIG_DEV_USB: {
-        d->rescan_ms = 1000;
-        if ((rc = get_int_in(x, o, where, "rescan_ms", false, 10, 600000, &d->rescan_ms)) ||
-            (rc = get_bool(x, o, where, "no_hotplug", &d->no_hotplug)))
+        const lr_opt *uo = lr_usb_opts, *wo = lr_usb_watch_opts;
+        d->rescan_ms = (int)uo[LR_USB_OPT_RESCAN_MS].dflt;
+        if ((rc = opt_int(x, o, where, &uo[LR_USB_OPT_RESCAN_MS], &d->rescan_ms)) ||
+            (rc = opt_bool(x, o, where, &uo[LR_USB_OPT_NO_HOTPLUG], &d->no_hotplug)))
             return rc;
         lr_jnode arr = lr_json_get(x->j, o, "watch");
         field_name(f, sizeof f, where, "watch");
@@ -483,19 +505,21 @@ static int device(ctx *x, lr_jnode o, int index, lr_rig_device *d)
             lr_jnode it = lr_json_at(x->j, arr, i);
             char w[96], wf[128];
             snprintf(w, sizeof w, "%s.watch[%d]", where, i);
-            static const char *const w_keys[] = {"name", "vid", "pid", "read_reports",
-                                                 "interface", "proto", NULL};
+            const lr_opt *const itables[] = {wo, NULL};
+            const char *iallowed[16];
+            opt_keys(itables, NULL, iallowed, 16);
             lr_rig_usb_watch *u = &d->watch[i];
-            if ((rc = keys(x, it, w, w_keys)) ||
+            u->interface = (int)wo[LR_USB_W_INTERFACE].dflt;
+            if ((rc = keys(x, it, w, iallowed)) ||
                 (rc = get_str(x, it, w, "name", true, u->name, sizeof u->name)))
                 return rc;
             field_name(wf, sizeof wf, w, "name");
             if ((rc = check_name(x, it, wf, u->name)) ||
                 (rc = get_hex16(x, it, w, "vid", &u->vid)) ||
                 (rc = get_hex16(x, it, w, "pid", &u->pid)) ||
-                (rc = get_bool(x, it, w, "read_reports", &u->read_reports)) ||
-                (rc = get_int_in(x, it, w, "interface", false, 0, 255, &u->interface)) ||
-                (rc = get_proto(x, it, w, &u->proto)))
+                (rc = opt_bool(x, it, w, &wo[LR_USB_W_READ_REPORTS], &u->read_reports)) ||
+                (rc = opt_int(x, it, w, &wo[LR_USB_W_INTERFACE], &u->interface)) ||
+                (rc = opt_enum(x, it, w, &wo[LR_USB_W_PROTO], &u->proto)))
                 return rc;
             d->n_watch = i + 1;
         }

@@ -31,23 +31,12 @@
  *   "ar_samples": 16                   CPU reference samples per band and pixel for it
  * }
  *
- * DEVICE (every kind): "type", "name" (default the type), "required": false,
- * "retry_min_ms": 250, "retry_max_ms": 10000, and
- *   sim:    "script": "PATH" | "text": "...", "loop": false
- *   modbus: "url": "tcp://HOST:PORT" | "rtu:DEV?baud=...", "poll_ms": 50, "timeout_ms": 100,
- *           "byte_timeout_ms": 50, "max_timeouts": 3,
- *           "inputs": [{"control": "dimmer", "unit": 1, "reg": 0, "base": 0,
- *                       "type": "holding" | "input", "raw_min": 0, "raw_max": 1000}],
- *           "lamp": {"unit": 2, "reg": 0, "base": 0, "raw_min": 0, "raw_max": 255,
- *                    "multiple": false}                (optional: the lamp driver)
- *   gpio:   "chip": "gpiochip0", "bias": "pull-up" | "as-is" | "disable" | "pull-down",
- *           "encoders": [{"name", "line_a", "line_b", "steps_per_detent": 4, "reverse"}],
- *           "buttons": [{"name", "line", "active_high": false, "debounce_ms": 5}]
- *   hid:    "vid": "077d", "pid": "0410" (hex strings), "serial", "poll_ms": 8,
- *           "proto": "auto" | "powermate" | "shuttlexpress" | "shuttlepro" | "consumer",
- *           "report_id": 0
- *   usb:    "watch": [{"name", "vid", "pid", "read_reports": false, "interface": 0,
- *                      "proto": "auto"}], "rescan_ms": 1000, "no_hotplug": false
+ * DEVICE: "type" (sim, modbus, gpio, hid, usb) and the options of that hal back end, read
+ * through its descriptors (hal/opt.h: key, type, range, default, one number in one place);
+ * the reference is firmware/README.md's table, written from them by
+ * lr_rig_config_fields_markdown. sim needs "script" (a file) or "text"; modbus "inputs",
+ * "lamp" (the lamp driver, default unit LR_RIG_LAMP_UNIT) or both; gpio "encoders",
+ * "buttons" or both; usb one or more "watch" entries.
  *
  * BINDING (one control → one scene parameter; firmware/rig/control_map.h):
  *   "control": "SOURCE/CONTROL" | "CONTROL" (any source)      required
@@ -68,6 +57,7 @@
 
 #include <stdbool.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "render/base/err.h"
 
@@ -78,6 +68,9 @@
 #define LR_RIG_MAX_VALUES 32
 #define LR_RIG_MAX_ITEMS 16 /* inputs, encoders, buttons, watches per device */
 #define LR_RIG_MAX_SETS 32
+/* The lamp driver's default Modbus unit: the rig's convention (the panel answers as unit 1, the
+ * lamp driver as unit 2); hal/modbus.c's own default is 1 for both. */
+#define LR_RIG_LAMP_UNIT 2
 
 typedef enum lr_rig_dev_type {
     LR_RIG_DEV_SIM = 0,
@@ -226,6 +219,12 @@ int lr_rig_config_apply_sets(const lr_rig_config *c, struct lr_scene *scene, lr_
 
 /* The modbus device the lamp driver is on, -1 when none. */
 int lr_rig_config_lamp_device(const lr_rig_config *c);
+
+/* Writes the reference of the device fields (markdown: device, field, value, range, default,
+ * what) from the hal back ends' option descriptors (hal/opt.h) the loader reads them through;
+ * firmware/README.md quotes it between "<!-- BEGIN rig-devices -->" and
+ * "<!-- END rig-devices -->" (tests/test_fw_config.c compares). */
+void lr_rig_config_fields_markdown(FILE *f);
 
 /* "sim", "modbus", "gpio", "hid", "usb". */
 const char *lr_rig_dev_type_name(lr_rig_dev_type t);

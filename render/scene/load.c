@@ -1,10 +1,12 @@
-/* Scene files: JSON to validated records, then meshes and materials (schema in scene.h). */
+/* Scene files: JSON to validated records through the field tables (fields.h), then meshes and
+ * materials (schema in scene.h). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "render/base/json.h"
+#include "render/scene/fields.h"
 #include "render/scene/scene_internal.h"
 
 typedef struct ctx {
@@ -48,83 +50,12 @@ static int fail_check(ctx *c, lr_jnode obj, const char *where, const char *field
                         field ? field : "?"), c->e, rc, "%s", inner->msg);
 }
 
-static int get_num(ctx *c, lr_jnode obj, const char *where, const char *key, double *out)
+/* The table's keys for this kind (fields.h) as the allowed keys of obj. */
+static int check_keys(ctx *c, lr_jnode obj, const char *where, const lr_record_desc *d, int kind)
 {
-    lr_jnode n = lr_json_get(c->j, obj, key);
-    char f[256];
-    return n == LR_JNONE ? LR_OK : lr_json_number(c->j, n, cat(f, sizeof f, where, key), out, c->e);
-}
-
-static int get_int(ctx *c, lr_jnode obj, const char *where, const char *key, int *out)
-{
-    lr_jnode n = lr_json_get(c->j, obj, key);
-    if (n == LR_JNONE)
-        return LR_OK;
-    char f[256];
-    long v;
-    int rc = lr_json_int(c->j, n, cat(f, sizeof f, where, key), &v, c->e);
-    if (rc)
-        return rc;
-    if (v < -1000000000L || v > 1000000000L)
-        return lr_json_fail(c->j, n, f, c->e, LR_EINVAL, "out of range, got %ld", v);
-    *out = (int)v;
-    return LR_OK;
-}
-
-static int get_bool(ctx *c, lr_jnode obj, const char *where, const char *key, bool *out)
-{
-    lr_jnode n = lr_json_get(c->j, obj, key);
-    char f[256];
-    return n == LR_JNONE ? LR_OK : lr_json_bool(c->j, n, cat(f, sizeof f, where, key), out, c->e);
-}
-
-static int get_vec(ctx *c, lr_jnode obj, const char *where, const char *key, bool required,
-                   lr_vec3 *out)
-{
-    lr_jnode n = lr_json_get(c->j, obj, key);
-    char f[256];
-    cat(f, sizeof f, where, key);
-    if (n == LR_JNONE)
-        return required ? lr_json_fail(c->j, obj, f, c->e, LR_EPARSE, "missing (required)")
-                        : LR_OK;
-    double v[3];
-    int rc = lr_json_numbers(c->j, n, f, v, 3, c->e);
-    if (!rc)
-        *out = lr_v3(v[0], v[1], v[2]);
-    return rc;
-}
-
-static int get_rgb(ctx *c, lr_jnode obj, const char *where, const char *key, bool required,
-                   double out[3])
-{
-    lr_vec3 v = lr_v3(out[0], out[1], out[2]);
-    int rc = get_vec(c, obj, where, key, required, &v);
-    out[0] = v.x;
-    out[1] = v.y;
-    out[2] = v.z;
-    return rc;
-}
-
-/* A number or [x, y, z] (a scale). */
-static int get_scale3(ctx *c, lr_jnode obj, const char *where, const char *key, lr_vec3 *out)
-{
-    lr_jnode n = lr_json_get(c->j, obj, key);
-    if (n == LR_JNONE)
-        return LR_OK;
-    char f[256];
-    cat(f, sizeof f, where, key);
-    if (lr_json_type(c->j, n) == LR_JSON_NUMBER) {
-        double s;
-        int rc = lr_json_number(c->j, n, f, &s, c->e);
-        if (!rc)
-            *out = lr_v3(s, s, s);
-        return rc;
-    }
-    if (lr_json_type(c->j, n) != LR_JSON_ARRAY)
-        return lr_json_fail(c->j, n, f, c->e, LR_EPARSE,
-                            "expected a number or an array of 3 numbers, got %s",
-                            lr_json_type_name(lr_json_type(c->j, n)));
-    return get_vec(c, obj, where, key, true, out);
+    const char *keys[40];
+    lr_fields_keys(d, kind, "", keys, 40);
+    return lr_json_check_keys(c->j, obj, where, keys, c->e);
 }
 
 /* Names are how lr_scene_set finds things: plain, not all digits (those are indices). */
@@ -194,63 +125,17 @@ static int parse_light(ctx *c, lr_jnode obj, int i, lr_light *l)
 {
     char where[64];
     snprintf(where, sizeof where, "lights[%d]", i);
-    static const char *const types[] = {"point", "spot", "directional", NULL};
     int type = 0, rc;
     if (lr_json_type(c->j, obj) != LR_JSON_OBJECT)
         return lr_json_fail(c->j, obj, where, c->e, LR_EPARSE, "expected an object");
-    if ((rc = type_of(c, obj, where, types, NULL, &type)))
-        return rc;
-    static const char *const k_point[] = {"type", "name", "position", "intensity", "color",
-                                          "flicker", NULL};
-    static const char *const k_spot[] = {"type", "name", "position", "direction", "inner_deg",
-                                         "outer_deg", "intensity", "color", "flicker", NULL};
-    static const char *const k_dir[] = {"type", "name", "direction", "radiance", "color", NULL};
-    const char *const *allowed = type == 0 ? k_point : type == 1 ? k_spot : k_dir;
-    if ((rc = lr_json_check_keys(c->j, obj, where, allowed, c->e)))
+    if ((rc = type_of(c, obj, where, lr_scene_light_desc.kind_names, NULL, &type)) ||
+        (rc = check_keys(c, obj, where, &lr_scene_light_desc, type)))
         return rc;
     lr_scene_light_defaults(l, (enum lr_light_type)type);
     if ((rc = get_name(c, obj, where, "light", i, l->name)))
         return rc;
-    char f[256];
-    if (type != LR_LIGHT_DIRECTIONAL) {
-        if ((rc = get_vec(c, obj, where, "position", true, &l->position)))
-            return rc;
-        if (lr_json_get(c->j, obj, "intensity") == LR_JNONE)
-            return lr_json_fail(c->j, obj, cat(f, sizeof f, where, "intensity"), c->e,
-                                LR_EPARSE, "missing (required, W/sr)");
-        if ((rc = get_num(c, obj, where, "intensity", &l->intensity)))
-            return rc;
-    } else {
-        if (lr_json_get(c->j, obj, "radiance") == LR_JNONE)
-            return lr_json_fail(c->j, obj, cat(f, sizeof f, where, "radiance"), c->e, LR_EPARSE,
-                                "missing (required, W/mm^2)");
-        if ((rc = get_num(c, obj, where, "radiance", &l->intensity)))
-            return rc;
-    }
-    if (type != LR_LIGHT_POINT && (rc = get_vec(c, obj, where, "direction", true, &l->direction)))
+    if ((rc = lr_fields_read(c->j, obj, where, &lr_scene_light_desc, type, l, c->e)))
         return rc;
-    if ((rc = get_num(c, obj, where, "inner_deg", &l->inner_deg)) ||
-        (rc = get_num(c, obj, where, "outer_deg", &l->outer_deg)) ||
-        (rc = get_rgb(c, obj, where, "color", false, l->color)))
-        return rc;
-    lr_jnode fl = lr_json_get(c->j, obj, "flicker");
-    if (fl != LR_JNONE) {
-        static const char *const k_fl[] = {"amplitude", "frequency_hz", "jitter_mm", "seed",
-                                           NULL};
-        char fw[96];
-        cat(fw, sizeof fw, where, "flicker");
-        int seed = (int)l->flicker.seed;
-        if ((rc = lr_json_check_keys(c->j, fl, fw, k_fl, c->e)) ||
-            (rc = get_num(c, fl, fw, "amplitude", &l->flicker.amplitude)) ||
-            (rc = get_num(c, fl, fw, "frequency_hz", &l->flicker.frequency_hz)) ||
-            (rc = get_num(c, fl, fw, "jitter_mm", &l->flicker.jitter_mm)) ||
-            (rc = get_int(c, fl, fw, "seed", &seed)))
-            return rc;
-        if (seed < 0)
-            return lr_json_fail(c->j, lr_json_get(c->j, fl, "seed"), cat(f, sizeof f, fw, "seed"),
-                                c->e, LR_EINVAL, "must be >= 0, got %d", seed);
-        l->flicker.seed = (unsigned)seed;
-    }
     const char *field = NULL;
     lr_err inner = {0};
     if ((rc = lr_scene_check_light(l, &field, &inner)))
@@ -263,22 +148,11 @@ static int parse_light(ctx *c, lr_jnode obj, int i, lr_light *l)
 static int parse_camera(ctx *c, lr_jnode obj, lr_camera *cam)
 {
     const char *where = "camera";
-    static const char *const keys[] = {"type", "position", "target", "up", "fov_deg",
-                                       "height_mm", "near", "far", NULL};
-    static const char *const types[] = {"perspective", "orthographic", NULL};
-    int rc, type = 0;
-    if ((rc = lr_json_check_keys(c->j, obj, where, keys, c->e)) ||
-        (rc = type_of(c, obj, where, types, "perspective", &type)))
+    int rc;
+    if ((rc = check_keys(c, obj, where, &lr_scene_camera_desc, 0)))
         return rc;
     lr_scene_camera_defaults(cam);
-    cam->orthographic = type == 1;
-    if ((rc = get_vec(c, obj, where, "position", true, &cam->position)) ||
-        (rc = get_vec(c, obj, where, "target", true, &cam->target)) ||
-        (rc = get_vec(c, obj, where, "up", false, &cam->up)) ||
-        (rc = get_num(c, obj, where, "fov_deg", &cam->fov_deg)) ||
-        (rc = get_num(c, obj, where, "height_mm", &cam->height_mm)) ||
-        (rc = get_num(c, obj, where, "near", &cam->near_mm)) ||
-        (rc = get_num(c, obj, where, "far", &cam->far_mm)))
+    if ((rc = lr_fields_read(c->j, obj, where, &lr_scene_camera_desc, 0, cam, c->e)))
         return rc;
     const char *field = NULL;
     lr_err inner = {0};
@@ -293,34 +167,18 @@ static int parse_receiver(ctx *c, lr_jnode obj, int i, lr_receiver *r)
 {
     char where[64];
     snprintf(where, sizeof where, "receivers[%d]", i);
-    static const char *const types[] = {"plane", "box", NULL};
     int type = 0, rc;
     if (lr_json_type(c->j, obj) != LR_JSON_OBJECT)
         return lr_json_fail(c->j, obj, where, c->e, LR_EPARSE, "expected an object");
-    if ((rc = type_of(c, obj, where, types, NULL, &type)))
-        return rc;
-    static const char *const k_plane[] = {"name", "type", "center", "normal", "size", "u_dir",
-                                          "albedo", "subdivisions", NULL};
-    static const char *const k_box[] = {"name", "type", "center", "size", "albedo", NULL};
-    if ((rc = lr_json_check_keys(c->j, obj, where, type == 0 ? k_plane : k_box, c->e)))
+    if ((rc = type_of(c, obj, where, lr_scene_receiver_desc.kind_names, NULL, &type)) ||
+        (rc = check_keys(c, obj, where, &lr_scene_receiver_desc, type)))
         return rc;
     memset(r, 0, sizeof *r);
     r->type = (enum lr_receiver_type)type;
-    if ((rc = get_name(c, obj, where, "receiver", i, r->name)) ||
-        (rc = get_vec(c, obj, where, "center", true, &r->center)) ||
-        (rc = get_rgb(c, obj, where, "albedo", true, r->albedo)))
+    lr_fields_defaults(&lr_scene_receiver_desc, r);
+    if ((rc = get_name(c, obj, where, "receiver", i, r->name)))
         return rc;
-    char f[256];
-    lr_jnode sz = lr_json_get(c->j, obj, "size");
-    if (sz == LR_JNONE)
-        return lr_json_fail(c->j, obj, cat(f, sizeof f, where, "size"), c->e, LR_EPARSE,
-                            "missing (required)");
-    if ((rc = lr_json_numbers(c->j, sz, cat(f, sizeof f, where, "size"), r->size,
-                              type == 0 ? 2 : 3, c->e)))
-        return rc;
-    if (type == 0 && ((rc = get_vec(c, obj, where, "normal", true, &r->normal)) ||
-                      (rc = get_vec(c, obj, where, "u_dir", false, &r->u_dir)) ||
-                      (rc = get_int(c, obj, where, "subdivisions", &r->subdivisions))))
+    if ((rc = lr_fields_read(c->j, obj, where, &lr_scene_receiver_desc, type, r, c->e)))
         return rc;
     const char *field = NULL;
     lr_err inner = {0};
@@ -335,83 +193,18 @@ static int parse_mesh(ctx *c, lr_jnode obj, const char *owhere, mesh_spec *m)
 {
     char where[96];
     cat(where, sizeof where, owhere, "mesh");
-    static const char *const types[] = {"candle", "shade", "sphere", "box", "file", NULL};
     int type = 0, rc;
     if (lr_json_type(c->j, obj) != LR_JSON_OBJECT)
         return lr_json_fail(c->j, obj, where, c->e, LR_EPARSE, "expected an object, got %s",
                             lr_json_type_name(lr_json_type(c->j, obj)));
-    if ((rc = type_of(c, obj, where, types, NULL, &type)))
-        return rc;
-    static const char *const keys[5][10] = {
-        {"type", "radius", "height", "pool_depth", "pool_radius", "segments", "pool_rings",
-         "side_rings", NULL},
-        {"type", "radius_bottom", "radius_top", "height", "thickness", "rims", "segments",
-         "rings", NULL},
-        {"type", "radius", "subdivisions", NULL},
-        {"type", "size", NULL},
-        {"type", "path", "scale", NULL}};
-    if ((rc = lr_json_check_keys(c->j, obj, where, keys[type], c->e)))
+    if ((rc = type_of(c, obj, where, lr_scene_mesh_desc.kind_names, NULL, &type)) ||
+        (rc = check_keys(c, obj, where, &lr_scene_mesh_desc, type)))
         return rc;
     memset(m, 0, sizeof *m);
     m->kind = (enum lr_mesh_kind)type;
-    m->file_scale = 1.0;
-    switch (m->kind) {
-    case LR_MESH_CANDLE: {
-        lr_candle_desc *d = &m->candle;
-        if ((rc = get_num(c, obj, where, "radius", &d->radius)) ||
-            (rc = get_num(c, obj, where, "height", &d->height)) ||
-            (rc = get_num(c, obj, where, "pool_radius", &d->pool_radius)) ||
-            (rc = get_int(c, obj, where, "segments", &d->segments)) ||
-            (rc = get_int(c, obj, where, "pool_rings", &d->pool_rings)) ||
-            (rc = get_int(c, obj, where, "side_rings", &d->side_rings)))
-            return rc;
-        lr_jnode pd = lr_json_get(c->j, obj, "pool_depth");
-        if (pd != LR_JNONE) {
-            if ((rc = get_num(c, obj, where, "pool_depth", &d->pool_depth)))
-                return rc;
-            d->flat_top = d->pool_depth == 0.0; /* written 0: a new, flat-topped candle */
-        }
-        break;
-    }
-    case LR_MESH_SHADE: {
-        lr_shade_desc *d = &m->shade;
-        bool rims = true;
-        if ((rc = get_num(c, obj, where, "radius_bottom", &d->radius_bottom)) ||
-            (rc = get_num(c, obj, where, "radius_top", &d->radius_top)) ||
-            (rc = get_num(c, obj, where, "height", &d->height)) ||
-            (rc = get_bool(c, obj, where, "rims", &rims)) ||
-            (rc = get_int(c, obj, where, "segments", &d->segments)) ||
-            (rc = get_int(c, obj, where, "rings", &d->rings)))
-            return rc;
-        d->no_rims = !rims;
-        if (lr_json_get(c->j, obj, "thickness") != LR_JNONE) {
-            if ((rc = get_num(c, obj, where, "thickness", &d->thickness)))
-                return rc;
-            d->single_surface = d->thickness == 0.0; /* written 0: a zero-thickness shade */
-        }
-        break;
-    }
-    case LR_MESH_SPHERE:
-        if ((rc = get_num(c, obj, where, "radius", &m->sphere.radius)) ||
-            (rc = get_int(c, obj, where, "subdivisions", &m->sphere.subdivisions)))
-            return rc;
-        break;
-    case LR_MESH_BOX:
-        if ((rc = get_vec(c, obj, where, "size", false, &m->box.size)))
-            return rc;
-        break;
-    case LR_MESH_FILE: {
-        char f[256];
-        if ((rc = lr_json_get_string(c->j, obj, "path", true, m->path, sizeof m->path, c->e)))
-            return lr_json_get(c->j, obj, "path") == LR_JNONE
-                       ? lr_json_fail(c->j, obj, cat(f, sizeof f, where, "path"), c->e, rc,
-                                      "missing (required)")
-                       : rc;
-        if ((rc = get_num(c, obj, where, "scale", &m->file_scale)))
-            return rc;
-        break;
-    }
-    }
+    lr_fields_defaults(&lr_scene_mesh_desc, m);
+    if ((rc = lr_fields_read(c->j, obj, where, &lr_scene_mesh_desc, type, m, c->e)))
+        return rc;
     const char *field = NULL;
     lr_err inner = {0};
     if ((rc = lr_scene_check_mesh(m, &field, &inner)))
@@ -474,28 +267,20 @@ static int parse_material(ctx *c, lr_jnode n, const char *owhere, mat_spec *ms, 
 
 static int parse_transform(ctx *c, lr_jnode n, const char *owhere, xform_spec *x)
 {
-    x->translate = lr_v3(0, 0, 0);
-    x->rotate_deg = lr_v3(0, 0, 0);
-    x->scale = lr_v3(1, 1, 1);
+    lr_fields_defaults(&lr_scene_transform_desc, x);
     if (n == LR_JNONE)
         return LR_OK;
     char where[96];
     cat(where, sizeof where, owhere, "transform");
-    static const char *const keys[] = {"translate", "rotate_deg", "scale", NULL};
     int rc;
-    if ((rc = lr_json_check_keys(c->j, n, where, keys, c->e)) ||
-        (rc = get_vec(c, n, where, "translate", false, &x->translate)) ||
-        (rc = get_vec(c, n, where, "rotate_deg", false, &x->rotate_deg)) ||
-        (rc = get_scale3(c, n, where, "scale", &x->scale)))
+    if ((rc = check_keys(c, n, where, &lr_scene_transform_desc, 0)))
+        return rc;
+    if ((rc = lr_fields_read(c->j, n, where, &lr_scene_transform_desc, 0, x, c->e)))
         return rc;
     const char *field = NULL;
     lr_err inner = {0};
-    if ((rc = lr_scene_check_transform(x, &field, &inner))) {
-        /* field is "transform.X": locate from the object holding "transform". */
-        char f[256];
-        return lr_json_fail(c->j, locate(c->j, n, field + strlen("transform.")),
-                            cat(f, sizeof f, owhere, field), c->e, rc, "%s", inner.msg);
-    }
+    if ((rc = lr_scene_check_transform(x, &field, &inner)))
+        return fail_check(c, n, where, field, rc, &inner);
     return LR_OK;
 }
 
@@ -505,31 +290,14 @@ static int parse_object(ctx *c, lr_jnode obj, int i, obj_rec *o)
     snprintf(where, sizeof where, "objects[%d]", i);
     if (lr_json_type(c->j, obj) != LR_JSON_OBJECT)
         return lr_json_fail(c->j, obj, where, c->e, LR_EPARSE, "expected an object");
-    static const char *const keys[] = {"name", "material", "mesh", "transform", "model",
-                                       "normalize", NULL};
     int rc;
-    bool normalize = true; /* PIPELINE.md "Energy": S_d energy-normalised unless false */
-    if ((rc = lr_json_check_keys(c->j, obj, where, keys, c->e)) ||
-        (rc = get_name(c, obj, where, "object", i, o->pub.name)))
+    /* normalize: PIPELINE.md "Energy": S_d energy-normalised unless false. */
+    lr_fields_defaults(&lr_scene_object_desc, o);
+    if ((rc = check_keys(c, obj, where, &lr_scene_object_desc, 0)) ||
+        (rc = get_name(c, obj, where, "object", i, o->pub.name)) ||
+        (rc = lr_fields_read(c->j, obj, where, &lr_scene_object_desc, 0, o, c->e)))
         return rc;
-    lr_jnode nz = lr_json_get(c->j, obj, "normalize");
-    char nf[96];
-    if (nz != LR_JNONE &&
-        (rc = lr_json_bool(c->j, nz, cat(nf, sizeof nf, where, "normalize"), &normalize, c->e)))
-        return rc;
-    o->pub.sd_raw = !normalize;
     char f[256];
-    o->pub.sss_model = LR_SSS_DIRECTIONAL_DIPOLE;
-    lr_jnode model = lr_json_get(c->j, obj, "model");
-    if (model != LR_JNONE) {
-        char name[32];
-        if ((rc = lr_json_string(c->j, model, cat(f, sizeof f, where, "model"), name,
-                                 sizeof name, c->e)))
-            return rc;
-        if (!lr_sss_model_parse(name, &o->pub.sss_model))
-            return lr_json_fail(c->j, model, f, c->e, LR_EINVAL,
-                                "'%s': expected directional_dipole or standard_dipole", name);
-    }
     lr_jnode mat = lr_json_get(c->j, obj, "material"), mesh = lr_json_get(c->j, obj, "mesh");
     if (mat == LR_JNONE)
         return lr_json_fail(c->j, obj, cat(f, sizeof f, where, "material"), c->e, LR_EPARSE,
@@ -562,36 +330,18 @@ static int parse_object(ctx *c, lr_jnode obj, int i, obj_rec *o)
 
 static int parse_render(ctx *c, lr_jnode n, lr_render_settings *r)
 {
-    lr_scene_render_defaults(r);
+    lr_scene_render_defaults(r); /* zero or absent: the default */
     if (n == LR_JNONE)
         return LR_OK;
-    static const char *const keys[] = {"K", "N", "N_vpl", "map_size", "gbuffer_size",
-                                       "vpl_map_size", "frames", "exposure", NULL};
-    const char *where = "render";
     int rc;
-    lr_render_settings w = {0};
-    if ((rc = lr_json_check_keys(c->j, n, where, keys, c->e)) ||
-        (rc = get_int(c, n, where, "K", &w.K)) || (rc = get_int(c, n, where, "N", &w.N)) ||
-        (rc = get_int(c, n, where, "N_vpl", &w.N_vpl)) ||
-        (rc = get_int(c, n, where, "map_size", &w.map_size)) ||
-        (rc = get_int(c, n, where, "gbuffer_size", &w.gbuffer_size)) ||
-        (rc = get_int(c, n, where, "vpl_map_size", &w.vpl_map_size)) ||
-        (rc = get_int(c, n, where, "frames", &w.frames)) ||
-        (rc = get_num(c, n, where, "exposure", &w.exposure)))
+    if ((rc = check_keys(c, n, "render", &lr_scene_render_desc, 0)))
         return rc;
-    /* Zero or absent: the default. */
-    if (w.K) r->K = w.K;
-    if (w.N) r->N = w.N;
-    if (w.N_vpl) r->N_vpl = w.N_vpl;
-    if (w.map_size) r->map_size = w.map_size;
-    if (w.gbuffer_size) r->gbuffer_size = w.gbuffer_size;
-    if (w.vpl_map_size) r->vpl_map_size = w.vpl_map_size;
-    if (w.frames) r->frames = w.frames;
-    if (w.exposure != 0.0) r->exposure = w.exposure;
+    if ((rc = lr_fields_read(c->j, n, "render", &lr_scene_render_desc, 0, r, c->e)))
+        return rc;
     const char *field = NULL;
     lr_err inner = {0};
     if ((rc = lr_scene_check_render(r, &field, &inner)))
-        return fail_check(c, n, where, field, rc, &inner);
+        return fail_check(c, n, "render", field, rc, &inner);
     return LR_OK;
 }
 
@@ -600,11 +350,10 @@ static int parse_quality(ctx *c, lr_jnode n, lr_quality *q)
     memset(q, 0, sizeof *q);
     if (n == LR_JNONE)
         return LR_OK;
-    static const char *const keys[] = {"max_error", "frame_ms", NULL};
     int rc;
-    if ((rc = lr_json_check_keys(c->j, n, "quality", keys, c->e)) ||
-        (rc = get_num(c, n, "quality", "max_error", &q->max_error)) ||
-        (rc = get_num(c, n, "quality", "frame_ms", &q->frame_ms)))
+    if ((rc = check_keys(c, n, "quality", &lr_scene_quality_desc, 0)))
+        return rc;
+    if ((rc = lr_fields_read(c->j, n, "quality", &lr_scene_quality_desc, 0, q, c->e)))
         return rc;
     const char *field = NULL;
     lr_err inner = {0};

@@ -5,60 +5,20 @@
  * Units: millimetres, degrees where a name says _deg, radiometry linear. z is up.
  *
  * ---- Scene file (configs/scenes/NAME.json) -------------------------------------------------
- * Every object below rejects unknown and duplicate fields; absent optional fields (and, for
- * counts and sizes, 0) take the default shown. Errors read "FILE:LINE: field 'F': what".
- *
- * {
- *   "name":      string (default: the file name)
- *   "objects": [                                   one or more translucent objects
- *     { "name":      string, unique (default "objects[i]")
- *       "material":  "PRESET"  (configs/materials/PRESET.json)
- *                  | { material object, render/material/material.h: name, source,
- *                      sigma_a, sigma_s_prime, eta, g | base, scale (number or RGB) }
- *       "mesh": one of
- *         {"type": "candle", "radius": 35, "height": 120, "pool_depth": 8 (0: flat top),
- *          "pool_radius": radius - 3, "segments": 64, "pool_rings": 12, "side_rings": auto}
- *         {"type": "shade", "radius_bottom": 100, "radius_top": 60, "height": 150,
- *          "thickness": 1.5 (0: a single surface), "rims": true, "segments": 96,
- *          "rings": auto}
- *         {"type": "sphere", "radius": 50, "subdivisions": 4}
- *         {"type": "box", "size": [100, 100, 100]}
- *         {"type": "file", "path": "x.ply" | "x.obj" (relative to the scene file's
- *          directory), "scale": 1 (e.g. 1000 for a file in metres)}
- *       "transform": {"translate": [0,0,0], "rotate_deg": [0,0,0] (about x, then y, then z),
- *                     "scale": 1 | [sx, sy, sz] (> 0)}                      (optional)
- *       "model":     "directional_dipole" (default; seed 003) | "standard_dipole" (Jensen
- *                    2001: S_d = R_d(r) / pi): the diffusion term of the radiosity maps
- *       "normalize": true (false: the published directional dipole, without the energy
- *                    normalisation of PIPELINE.md "Energy"; no effect on the standard
- *                    dipole, whose total is the reference of that normalisation) (optional)
- *     } ]
- *   "lights": [                                    one to LR_SCENE_MAX_LIGHTS (4)
- *     {"type": "point", "name": string, "position": [x,y,z], "intensity": W/sr (>= 0),
- *      "color": [1,1,1] (relative, per band: I_band = intensity * color[band]),
- *      "flicker": {"amplitude": 0..1 (relative intensity), "frequency_hz": 8,
- *                  "jitter_mm": 0 (position sway), "seed": 1}             (optional)}
- *     {"type": "spot", "name", "position", "direction", "inner_deg": 20, "outer_deg": 30
- *      (half-angles, 0 < inner <= outer < 90), "intensity": on-axis W/sr, "color"}
- *     {"type": "directional", "name", "direction" (the way the light travels),
- *      "radiance": L of seed 003 Eq. 6 = irradiance on a surface facing it, W/mm^2,
- *      "color"} ]
- *   "camera":  {"type": "perspective" | "orthographic", "position", "target",
- *               "up": [0,0,1], "fov_deg": 40 (vertical, perspective),
- *               "height_mm": 300 (view height, orthographic), "near": 10, "far": 10000}
- *   "receivers": [                                 diffuse surfaces (optional)
- *     {"name", "type": "plane", "center", "normal", "size": [w, h],
- *      "u_dir": direction of w (default x, or y for a normal along x),
- *      "albedo": [r,g,b] in [0, 1], "subdivisions": 1}
- *     {"name", "type": "box", "center", "size": [x,y,z], "albedo"} ]
- *   "render":  {"K": 16 maps, "N": 16 samples per texel, band and frame, "N_vpl": 64,
- *               "map_size": 256, "gbuffer_size": 256 (cube face or 2D map),
- *               "vpl_map_size": 64 (cube map of the outer surface for stable VPLs),
- *               "frames": 64 (progressive accumulation), "exposure": 1 (multiplies
- *               radiance in W/(mm^2 sr) before tone mapping)}            (optional)
- *   "quality": {"max_error": 0 (relative RMS against the converged reference; 0: no
- *               budget), "frame_ms": 0 (0: no budget)}                    (optional)
- * }
+ * {"name": string (default: the file name),
+ *  "objects":   [ OBJECT, ... ]       one or more translucent objects: "name", "material"
+ *                                     (a preset name or a material object), "mesh" (a "type"
+ *                                     and its parameters), "transform", "model", "normalize"
+ *  "lights":    [ LIGHT, ... ]        one to LR_SCENE_MAX_LIGHTS: point, spot, directional
+ *  "camera":    CAMERA
+ *  "receivers": [ RECEIVER, ... ]     diffuse planes and boxes (optional)
+ *  "render":    SETTINGS              (optional)
+ *  "quality":   BUDGET                (optional)}
+ * Every field of every record -- type, range, default, what a change invalidates -- is in the
+ * field tables (render/scene/field_tables.c), which the loader, lr_scene_set/get and the
+ * checks use; configs/scenes/README.md quotes the reference written from them
+ * (lr_scene_fields_markdown). Every object rejects unknown and duplicate fields; absent
+ * optional fields take their default. Errors read "FILE:LINE: field 'F': what".
  *
  * ---- Parameters -----------------------------------------------------------------------------
  * lr_scene_set() takes the same names: "lights[1].intensity", "light.intensity" (= lights[0]),
@@ -73,6 +33,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdio.h>
 
 #include "render/base/err.h"
 #include "render/base/vec3.h"
@@ -272,5 +233,13 @@ int lr_scene_set_assignment(lr_scene *s, const char *assignment, unsigned *dirty
 /* The current value of a parameter as lr_scene_set accepts it (for `lamprig scene get`, logs
  * and event-script round trips). */
 int lr_scene_get(const lr_scene *s, const char *key, char *buf, size_t cap, lr_err *e);
+
+/* ---- Reference ----------------------------------------------------------------------------- */
+
+/* Writes the reference of every scene field (markdown, a table per record: key, kinds, value,
+ * range, default, what a change invalidates, description) from the tables that load, set and
+ * check use (render/scene/field_tables.c). configs/scenes/README.md quotes it between
+ * "<!-- BEGIN scene-fields -->" and "<!-- END scene-fields -->" (tests/test_scene.c compares). */
+void lr_scene_fields_markdown(FILE *f);
 
 #endif

@@ -1,0 +1,301 @@
+/* The scene file's fields (fields.h): one table per record, in the order the file reference
+ * lists them and run-time errors name them. A range here is the only statement of it; the
+ * relations between fields are in check.c. */
+#include <stddef.h>
+
+#include "render/scene/fields.h"
+#include "render/scene/scene_internal.h"
+
+#define NB LR_FNONE
+#define COUNT(a) ((int)(sizeof(a) / sizeof((a)[0])))
+
+/* ---- lights ---------------------------------------------------------------------------------- */
+
+#define P (1u << LR_LIGHT_POINT)
+#define S (1u << LR_LIGHT_SPOT)
+#define D (1u << LR_LIGHT_DIRECTIONAL)
+#define L(m) offsetof(lr_light, m)
+
+static const char *const light_types[] = {"point", "spot", "directional", NULL};
+static const char *const light_what[] = {"a point light", "a spot light", "a directional light"};
+static const char *const light_objects[] = {"flicker", NULL};
+
+static const lr_field light_fields[] = {
+    {"type", LR_FT_TYPE, .names = light_types, .flags = LR_FF_REQUIRED | LR_FF_NO_SET,
+     .help = "point, spot or directional"},
+    {"name", LR_FT_NAME, .dflt_text = "light0, light1, ...", .flags = LR_FF_NO_SET,
+     .help = "unique; letters, digits, _ and - (not only digits)"},
+    {"intensity", LR_FT_NUM, P | S, L(intensity), 0, 1e12, LR_FF_REQUIRED | LR_FF_HI_OPEN |
+     LR_FF_HI_QUIET, .unit = "(W/sr)", .dirty = LR_DIRTY_INTENSITY,
+     .help = "radiant intensity (on axis for a spot): the dimmer"},
+    {"radiance", LR_FT_NUM, D, L(intensity), 0, 1e12, LR_FF_REQUIRED | LR_FF_HI_OPEN |
+     LR_FF_HI_QUIET, .unit = "(W/mm^2)", .dirty = LR_DIRTY_INTENSITY,
+     .help = "irradiance on a surface facing the light (seed 003 Eq. 6)"},
+    {"color", LR_FT_RGB, 0, L(color), 0, 1e6, LR_FF_HI_OPEN | LR_FF_HI_QUIET, .dflt = {1, 1, 1},
+     .dirty = LR_DIRTY_INTENSITY, .help = "per-band factor: band b gets intensity * color[b]"},
+    {"position", LR_FT_VEC3, P | S, L(position), NB, NB, LR_FF_REQUIRED | LR_FF_COORD,
+     .unit = "mm", .dirty = LR_DIRTY_LIGHT_GEOMETRY, .help = "where the light is"},
+    {"direction", LR_FT_VEC3, S | D, L(direction), NB, NB, LR_FF_REQUIRED | LR_FF_UNIT,
+     .dflt = {0, 0, -1}, .dirty = LR_DIRTY_LIGHT_GEOMETRY,
+     .help = "the way the light travels (normalised)"},
+    /* inner_deg's upper bound is outer_deg: check.c. */
+    {"inner_deg", LR_FT_NUM, S, L(inner_deg), NB, NB, 0, .dflt = {20}, .unit = "degrees",
+     .dirty = LR_DIRTY_LIGHT_GEOMETRY, .help = "half-angle of full intensity, (0, outer_deg]"},
+    {"outer_deg", LR_FT_NUM, S, L(outer_deg), 0, 90, LR_FF_LO_OPEN | LR_FF_HI_OPEN,
+     .dflt = {30}, .unit = "degrees", .dirty = LR_DIRTY_LIGHT_GEOMETRY,
+     .help = "half-angle of zero intensity"},
+    /* Flicker is applied by the renderer at composition on its clock (render/renderer.h
+     * lr_renderer_set_time), the sway included: the transport stays at the light's mean
+     * position (jitter << 1/sigma_tr), so every flicker field is composition-only. */
+    {"flicker.amplitude", LR_FT_NUM, P | S, L(flicker.amplitude), 0, 1, 0,
+     .dirty = LR_DIRTY_INTENSITY, .help = "relative intensity swing; 0: steady"},
+    {"flicker.frequency_hz", LR_FT_NUM, P | S, L(flicker.frequency_hz), 0, 1000,
+     LR_FF_LO_OPEN, .dflt = {8}, .unit = "Hz", .dirty = LR_DIRTY_INTENSITY,
+     .help = "dominant frequency (candle flames: a few Hz to ~10 Hz)"},
+    {"flicker.jitter_mm", LR_FT_NUM, P | S, L(flicker.jitter_mm), 0, 1000, 0, .unit = "mm",
+     .dirty = LR_DIRTY_INTENSITY, .help = "position sway amplitude; 0: the flame stays put"},
+    {"flicker.seed", LR_FT_UINT, P | S, L(flicker.seed), 0, NB, 0, .dflt = {1},
+     .dirty = LR_DIRTY_INTENSITY, .help = "phases (replays see the same flame)"},
+};
+
+static int light_kind(const void *rec)
+{
+    return (int)((const lr_light *)rec)->type;
+}
+
+const lr_record_desc lr_scene_light_desc = {"lights[i]", "a light", light_types, light_what,
+                                            light_kind, light_objects, light_fields,
+                                            COUNT(light_fields)};
+#undef P
+#undef S
+#undef D
+
+/* ---- camera ---------------------------------------------------------------------------------- */
+
+#define PERSP (1u << 0)
+#define ORTHO (1u << 1)
+#define C(m) offsetof(lr_camera, m)
+
+static const char *const camera_types[] = {"perspective", "orthographic", NULL};
+
+static const lr_field camera_fields[] = {
+    {"type", LR_FT_ENUMB, 0, C(orthographic), .names = camera_types, .dirty = LR_DIRTY_CAMERA,
+     .help = "perspective or orthographic"},
+    {"position", LR_FT_VEC3, 0, C(position), NB, NB, LR_FF_REQUIRED | LR_FF_COORD,
+     .dflt = {0, -600, 300}, .unit = "mm", .dirty = LR_DIRTY_CAMERA, .help = "eye"},
+    {"target", LR_FT_VEC3, 0, C(target), NB, NB, LR_FF_REQUIRED | LR_FF_COORD,
+     .dflt = {0, 0, 60}, .unit = "mm", .dirty = LR_DIRTY_CAMERA,
+     .help = "the point looked at (not the position)"},
+    {"up", LR_FT_VEC3, 0, C(up), NB, NB, LR_FF_UNIT, .dflt = {0, 0, 1}, .dirty = LR_DIRTY_CAMERA,
+     .help = "not along the view"},
+    {"fov_deg", LR_FT_NUM, 0, C(fov_deg), 0, 180, LR_FF_LO_OPEN | LR_FF_HI_OPEN, PERSP,
+     .dflt = {40}, .unit = "degrees", .dirty = LR_DIRTY_CAMERA,
+     .help = "vertical field of view (perspective)"},
+    {"height_mm", LR_FT_NUM, 0, C(height_mm), 0, 2e6, LR_FF_LO_OPEN | LR_FF_HI_QUIET, ORTHO,
+     .dflt = {300}, .unit = "mm", .dirty = LR_DIRTY_CAMERA,
+     .help = "view height (orthographic)"},
+    {"near", LR_FT_NUM, 0, C(near_mm), 0, 1e7, LR_FF_LO_OPEN | LR_FF_HI_OPEN | LR_FF_HI_QUIET,
+     .dflt = {10}, .unit = "mm", .dirty = LR_DIRTY_CAMERA, .help = "near clipping distance"},
+    /* far's lower bound is near: check.c. */
+    {"far", LR_FT_NUM, 0, C(far_mm), NB, NB, 0, .dflt = {10000}, .unit = "mm",
+     .dirty = LR_DIRTY_CAMERA, .help = "far clipping distance, (near, 1e7]"},
+};
+
+static int camera_kind(const void *rec)
+{
+    return ((const lr_camera *)rec)->orthographic ? 1 : 0;
+}
+
+const lr_record_desc lr_scene_camera_desc = {"camera", "camera", NULL, NULL, camera_kind, NULL,
+                                             camera_fields, COUNT(camera_fields)};
+
+/* ---- receivers ------------------------------------------------------------------------------- */
+
+#define PLANE (1u << LR_RECEIVER_PLANE)
+#define BOX (1u << LR_RECEIVER_BOX)
+#define R(m) offsetof(lr_receiver, m)
+
+static const char *const receiver_types[] = {"plane", "box", NULL};
+static const char *const receiver_what[] = {"a plane receiver", "a box receiver"};
+
+static const lr_field receiver_fields[] = {
+    {"type", LR_FT_TYPE, .names = receiver_types, .flags = LR_FF_REQUIRED | LR_FF_NO_SET,
+     .help = "plane or box"},
+    {"name", LR_FT_NAME, .dflt_text = "receiver0, ...", .flags = LR_FF_NO_SET,
+     .help = "unique; letters, digits, _ and -"},
+    {"albedo", LR_FT_RGB, 0, R(albedo), 0, 1, LR_FF_REQUIRED,
+     .unit = "(a diffuse surface reflects at most what it receives)",
+     .dirty = LR_DIRTY_RECEIVERS, .help = "diffuse reflectance per band"},
+    {"center", LR_FT_VEC3, 0, R(center), NB, NB, LR_FF_REQUIRED, .unit = "mm",
+     .dirty = LR_DIRTY_RECEIVERS, .help = "centre of the plane or box"},
+    {"normal", LR_FT_VEC3, PLANE, R(normal), NB, NB, LR_FF_REQUIRED | LR_FF_UNIT,
+     .dirty = LR_DIRTY_RECEIVERS, .help = "front normal, toward the scene"},
+    {"u_dir", LR_FT_VEC3, PLANE, R(u_dir), NB, NB, 0, .dflt_text = "x, or y for a normal along x",
+     .dirty = LR_DIRTY_RECEIVERS, .help = "direction of size[0], projected into the plane"},
+    {"size", LR_FT_PAIR, PLANE, R(size), 0, NB, LR_FF_REQUIRED | LR_FF_LO_OPEN, .unit = "mm",
+     .dirty = LR_DIRTY_RECEIVERS, .help = "w, h"},
+    {"size", LR_FT_SIZE3, BOX, R(size), 0, NB, LR_FF_REQUIRED | LR_FF_LO_OPEN, .unit = "mm",
+     .dirty = LR_DIRTY_RECEIVERS, .help = "x, y, z"},
+    {"subdivisions", LR_FT_INT, PLANE, R(subdivisions), NB, NB, 0, .dflt_text = "1",
+     .dirty = LR_DIRTY_RECEIVERS, .help = "grid cells per side (render/mesh/shapes.h)"},
+};
+
+static int receiver_kind(const void *rec)
+{
+    return (int)((const lr_receiver *)rec)->type;
+}
+
+const lr_record_desc lr_scene_receiver_desc = {"receivers[i]", "a receiver", receiver_types,
+                                               receiver_what, receiver_kind, NULL,
+                                               receiver_fields, COUNT(receiver_fields)};
+
+/* ---- objects --------------------------------------------------------------------------------- */
+
+#define O(m) offsetof(obj_rec, m)
+
+static const char *const sss_models[] = {"directional_dipole", "standard_dipole", NULL};
+
+static const lr_field object_fields[] = {
+    {"name", LR_FT_NAME, .dflt_text = "object0, ...", .flags = LR_FF_NO_SET,
+     .help = "unique; letters, digits, _ and -"},
+    {"material", LR_FT_OBJECT, .flags = LR_FF_REQUIRED, .dirty = LR_DIRTY_MATERIAL,
+     .help = "a preset name (configs/materials) or a material object (render/material)"},
+    {"mesh", LR_FT_OBJECT, .flags = LR_FF_REQUIRED, .dirty = LR_DIRTY_GEOMETRY,
+     .help = "the shape: objects[i].mesh below"},
+    {"transform", LR_FT_OBJECT, .dirty = LR_DIRTY_GEOMETRY,
+     .help = "placement: objects[i].transform below"},
+    /* The lr_sss_model order. */
+    {"model", LR_FT_ENUM, 0, O(pub.sss_model), .names = sss_models, .dirty = LR_DIRTY_MATERIAL,
+     .help = "the S_d of the radiosity maps (seed 003; standard: Jensen 2001)"},
+    {"normalize", LR_FT_BOOL, 0, O(pub.sd_raw), .flags = LR_FF_INVERT, .dflt = {1},
+     .dirty = LR_DIRTY_MATERIAL,
+     .help = "false: the published directional dipole, without the energy normalisation"},
+};
+
+const lr_record_desc lr_scene_object_desc = {"objects[i]", "an object", NULL, NULL, NULL, NULL,
+                                             object_fields, COUNT(object_fields)};
+
+/* ---- meshes: the generators' descriptors (render/mesh/shapes.h), whose own checks hold the
+ * ranges; 0 is "the generator's default" -------------------------------------------------- */
+
+#define CANDLE (1u << LR_MESH_CANDLE)
+#define SHADE (1u << LR_MESH_SHADE)
+#define SPHERE (1u << LR_MESH_SPHERE)
+#define MBOX (1u << LR_MESH_BOX)
+#define MFILE (1u << LR_MESH_FILE)
+#define M(m) offsetof(mesh_spec, m)
+#define G LR_DIRTY_GEOMETRY
+
+static const char *const mesh_types[] = {"candle", "shade", "sphere", "box", "file", NULL};
+static const char *const mesh_what[] = {"a candle mesh", "a shade mesh", "a sphere mesh",
+                                        "a box mesh", "a file mesh"};
+
+static const lr_field mesh_fields[] = {
+    {"type", LR_FT_TYPE, .names = mesh_types, .flags = LR_FF_REQUIRED | LR_FF_NO_SET,
+     .help = "candle, shade, sphere, box or file (fixed at run time)"},
+    {"radius", LR_FT_NUM, CANDLE, M(candle.radius), .unit = "mm", .dirty = G, .help = "pillar radius"},
+    {"height", LR_FT_NUM, CANDLE, M(candle.height), .unit = "mm", .dirty = G, .help = "pillar height"},
+    {"pool_depth", LR_FT_NUM, CANDLE, M(candle.pool_depth), .flags = LR_FF_ZERO_FLAG,
+     .aux = M(candle.flat_top), .unit = "mm", .dirty = G,
+     .help = "melt pool depth, < height; 0: a flat top"},
+    {"pool_radius", LR_FT_NUM, CANDLE, M(candle.pool_radius), .dflt_text = "radius - 3",
+     .unit = "mm", .dirty = G,
+     .help = "melt pool radius, <= radius"},
+    {"segments", LR_FT_INT, CANDLE, M(candle.segments), .dirty = G, .help = "around the axis"},
+    {"pool_rings", LR_FT_INT, CANDLE, M(candle.pool_rings), .dirty = G,
+     .help = "rings from the pool's centre to its edge"},
+    {"side_rings", LR_FT_INT, CANDLE, M(candle.side_rings), .dflt_text = "auto", .dirty = G,
+     .help = "along the height (auto: square-ish quads)"},
+    {"radius_bottom", LR_FT_NUM, SHADE, M(shade.radius_bottom), .unit = "mm", .dirty = G,
+     .help = "outer radius at z = 0"},
+    {"radius_top", LR_FT_NUM, SHADE, M(shade.radius_top), .unit = "mm", .dirty = G,
+     .help = "outer radius at the top"},
+    {"height", LR_FT_NUM, SHADE, M(shade.height), .unit = "mm", .dirty = G, .help = "shade height"},
+    {"thickness", LR_FT_NUM, SHADE, M(shade.thickness), .flags = LR_FF_ZERO_FLAG,
+     .aux = M(shade.single_surface), .unit = "mm", .dirty = G,
+     .help = "wall thickness; 0: a single surface"},
+    {"rims", LR_FT_BOOL, SHADE, M(shade.no_rims), .flags = LR_FF_INVERT, .dflt = {1}, .dirty = G,
+     .help = "close the shell at top and bottom"},
+    {"segments", LR_FT_INT, SHADE, M(shade.segments), .dirty = G, .help = "around the axis"},
+    {"rings", LR_FT_INT, SHADE, M(shade.rings), .dflt_text = "auto", .dirty = G,
+     .help = "along the wall (auto: square-ish quads)"},
+    {"radius", LR_FT_NUM, SPHERE, M(sphere.radius), .unit = "mm", .dirty = G, .help = "radius"},
+    {"subdivisions", LR_FT_INT, SPHERE, M(sphere.subdivisions), .dirty = G,
+     .help = "0..7: 20 * 4^n triangles"},
+    {"size", LR_FT_VEC3, MBOX, M(box.size), .unit = "mm", .dirty = G, .help = "x, y, z"},
+    {"path", LR_FT_PATH, MFILE, M(path), .flags = LR_FF_REQUIRED, .dirty = G,
+     .help = ".ply or .obj, relative to the scene file"},
+    {"scale", LR_FT_NUM, MFILE, M(file_scale), 0, 1e6, LR_FF_LO_OPEN | LR_FF_HI_OPEN |
+     LR_FF_HI_QUIET, .dflt = {1}, .dirty = G, .help = "e.g. 1000 for a file in metres"},
+};
+
+static int mesh_kind(const void *rec)
+{
+    return (int)((const mesh_spec *)rec)->kind;
+}
+
+const lr_record_desc lr_scene_mesh_desc = {"objects[i].mesh", "a mesh", mesh_types, mesh_what,
+                                           mesh_kind, NULL, mesh_fields, COUNT(mesh_fields)};
+
+/* ---- transform ------------------------------------------------------------------------------- */
+
+#define X(m) offsetof(xform_spec, m)
+
+static const lr_field transform_fields[] = {
+    {"translate", LR_FT_VEC3, 0, X(translate), NB, NB, LR_FF_COORD, .unit = "mm", .dirty = G,
+     .help = "applied last"},
+    {"rotate_deg", LR_FT_VEC3, 0, X(rotate_deg), NB, NB, LR_FF_ANGLES, .unit = "degrees",
+     .dirty = G, .help = "about x, then y, then z"},
+    {"scale", LR_FT_SCALE, 0, X(scale), 0, 1e6, LR_FF_LO_OPEN | LR_FF_HI_OPEN | LR_FF_HI_QUIET,
+     .dflt = {1, 1, 1}, .unit = "(no mirroring)", .dirty = G,
+     .help = "a number or per axis, applied first"},
+};
+
+const lr_record_desc lr_scene_transform_desc = {"objects[i].transform", "a transform", NULL,
+                                                NULL, NULL, NULL, transform_fields,
+                                                COUNT(transform_fields)};
+
+/* ---- render settings and quality budget ------------------------------------------------------ */
+
+#define RS(m) offsetof(lr_render_settings, m)
+#define SET LR_DIRTY_SETTINGS
+#define Z LR_FF_ZERO_DEFAULT
+
+/* Seed 003 renders with 31 maps of 512^2 on a desktop GPU; a Raspberry-Pi-class GPU gets half
+ * the maps at a quarter of the texels by default. 256 layers: GL_MAX_ARRAY_TEXTURE_LAYERS is at
+ * least 256 on GLES 3.x; 8192: the largest texture an SBC GPU offers. */
+static const lr_field render_fields[] = {
+    {"K", LR_FT_INT, 0, RS(K), 1, 256, Z, .dflt = {16}, .dirty = SET,
+     .help = "scattered-radiosity maps"},
+    {"N", LR_FT_INT, 0, RS(N), 1, 65536, Z, .dflt = {16}, .dirty = SET,
+     .help = "samples per texel, band and frame"},
+    {"N_vpl", LR_FT_INT, 0, RS(N_vpl), 1, 65536, Z, .dflt = {64}, .dirty = SET,
+     .help = "virtual point lights"},
+    {"map_size", LR_FT_INT, 0, RS(map_size), 8, 8192, Z, .dflt = {256}, .dirty = SET,
+     .help = "radiosity map side, texels"},
+    {"gbuffer_size", LR_FT_INT, 0, RS(gbuffer_size), 8, 8192, Z, .dflt = {256}, .dirty = SET,
+     .help = "light G-buffer side (each cube face when enclosed)"},
+    {"vpl_map_size", LR_FT_INT, 0, RS(vpl_map_size), 4, 4096, Z, .dflt = {64}, .dirty = SET,
+     .help = "cube map of the outer surface that places the VPLs"},
+    {"frames", LR_FT_INT, 0, RS(frames), 1, 10000000, Z, .dflt = {64}, .dirty = SET,
+     .help = "progressive frames until converged"},
+    {"exposure", LR_FT_NUM, 0, RS(exposure), 0, 1e30, Z | LR_FF_LO_OPEN | LR_FF_HI_OPEN |
+     LR_FF_HI_QUIET, .dflt = {1}, .dirty = LR_DIRTY_DISPLAY,
+     .help = "multiplies radiance in W/(mm^2 sr) before tone mapping"},
+};
+
+const lr_record_desc lr_scene_render_desc = {"render", "render", NULL, NULL, NULL, NULL,
+                                             render_fields, COUNT(render_fields)};
+
+#define Q(m) offsetof(lr_quality, m)
+
+static const lr_field quality_fields[] = {
+    {"max_error", LR_FT_NUM, 0, Q(max_error), 0, 1e6, LR_FF_HI_OPEN | LR_FF_HI_QUIET,
+     .unit = "(0: no budget)", .dirty = SET,
+     .help = "relative RMS error against the converged reference"},
+    {"frame_ms", LR_FT_NUM, 0, Q(frame_ms), 0, 1e9, LR_FF_HI_OPEN | LR_FF_HI_QUIET,
+     .unit = "ms (0: no budget)", .dirty = SET, .help = "time budget per frame"},
+};
+
+const lr_record_desc lr_scene_quality_desc = {"quality", "quality", NULL, NULL, NULL, NULL,
+                                              quality_fields, COUNT(quality_fields)};
