@@ -9,7 +9,10 @@
 
 #include "firmware/args.h"
 
-static const lr_argspec specs[] = {{"--r", 1}, {"--plot", 1}, {"--verbose", 0}, {NULL, 0}};
+static const lr_argspec specs[] = {{.name = "--r", .type = LR_ARG_NUMBERS},
+                                   {.name = "--plot", .type = LR_ARG_PATH},
+                                   {.name = "--verbose"},
+                                   {0}};
 
 static void test_parse_forms(void **state)
 {
