@@ -162,7 +162,7 @@ static void print_help(FILE *f)
     if (lr_shaders_dir(shaders, sizeof shaders) != 0)
         snprintf(shaders, sizeof shaders, "(path too long)");
     fprintf(f, "\n`lamprig help COMMAND` (or `lamprig COMMAND --help`) shows a command's "
-               "arguments; `lamprig --version`\n(or `lamprig version`) prints the version.\n"
+               "arguments;\n`lamprig --version` (or `lamprig version`) prints the version.\n"
                "\nData (presets, scenes, example rigs; GLSL shaders), found in this order:\n"
                "--configs/--shaders, $LAMPRIG_CONFIGS/$LAMPRIG_SHADERS, ./configs, the installed\n"
                "PREFIX/share/lamprig beside the binary, the source tree it was built in.\n"

@@ -65,9 +65,9 @@ static const lr_argspec opts[] = {
      .help = "the capture folder written"},
     {.name = "--display", .type = LR_ARG_STRING, .metavar = "file:PATH|prompt:PATTERN_DIR",
      .flags = LR_ARG_REQUIRED,
-     .help = "how a frame is shown (the firmware's projector output is not wired in\n"
-             "yet): written to PATH, which an external viewer shows, or you show\n"
-             "PATTERN_DIR's frame and press Enter"},
+     .help = "how a frame is shown (the firmware's projector output is not\n"
+             "wired in yet): written to PATH, which an external viewer shows,\n"
+             "or you show PATTERN_DIR's frame and press Enter"},
     {.name = "--camera-size", .type = LR_ARG_SIZE,
      .help = "the camera mode (default: the driver's)"},
     {.name = "--settle-ms", .type = LR_ARG_INT, .min = 1, .max = 60000,

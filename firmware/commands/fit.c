@@ -30,8 +30,8 @@ static const lr_argspec opts[] = {
     {.name = "--gamma", .type = LR_ARG_NUMBER, .metavar = "G", .min = 0.1, .max = 10,
      .help = "the camera's response when DIR has no camera_response.json (or\n"
              "there is no --calib): value v is exposure (v/128)^G; default 2.2\n"
-             "(an sRGB camera), the rule lamprig compare and lamprig-capsim use;\n"
-             "refused beside camera_response.json"},
+             "(an sRGB camera), the rule lamprig compare and lamprig-capsim\n"
+             "use; refused beside camera_response.json"},
     {.name = "--times", .type = LR_ARG_NUMBERS, .metavar = "T1,T2,...",
      .help = "their exposure times, s (default 1)"},
     {.name = "--object", .type = LR_ARG_STRING, .metavar = "NAME",
