@@ -29,7 +29,7 @@ typedef struct lr_cli {
 typedef struct lr_command {
     const char *name;
     const char *summary;    /* one line in the parent's list ('\n' continues it) */
-    const char *about;      /* prose after the usage line, or NULL */
+    const char *about;      /* prose after the usage line; NULL: the summary */
     const lr_argspec *opts; /* leaf: its options, terminated by {0} */
     const char *operands;   /* leaf: the positional arguments in the synopsis ("FILE..."), or NULL */
     int max_operands;

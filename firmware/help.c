@@ -1,7 +1,7 @@
 /* The --help text of a command, generated from its table (firmware/cli.h): the synopsis from
  * the options (required ones bare, optional ones in brackets, groups as one word), the option
  * list from their metavars and help lines, a group's subcommands with their synopses; the
- * prose (about, notes) as written. */
+ * prose (about, else the summary; notes) as written. */
 #include <string.h>
 
 #include "firmware/cli.h"
@@ -130,8 +130,10 @@ void lr_help_print(FILE *f, const lr_command *c, const char *path)
         synopsis(&w, c);
     }
     fputc('\n', f);
-    if (c->about)
-        fprintf(f, "\n%s\n", c->about);
+    /* A subcommand's summary is its description when it has no longer one. */
+    const char *about = c->about ? c->about : c->summary;
+    if (about)
+        fprintf(f, "\n%s\n", about);
     if (c->subs) {
         fprintf(f, "\nSubcommands (`lamprig help %s SUBCOMMAND` shows one in full):\n", path);
         list_subs(f, c, "");

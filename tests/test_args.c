@@ -13,6 +13,8 @@
 
 #include "firmware/args.h"
 #include "firmware/cli.h"
+#include "firmware/commands/calib_cli.h"
+#include "tests/support/fs.h"
 
 static const lr_argspec specs[] = {{.name = "--r", .type = LR_ARG_NUMBERS},
                                    {.name = "--plot", .type = LR_ARG_PATH},
@@ -323,6 +325,8 @@ static void test_dispatch_and_help(void **state)
     fclose(f);
     assert_string_equal(text, "usage: lamprig grp leaf --scene FILE [--set key=value ...] [--fail]\n"
                               "\n"
+                              "a leaf\n"
+                              "\n"
                               "  --scene FILE     the scene\n"
                               "  --set key=value  a change\n"
                               "                   over two lines\n"
@@ -336,10 +340,32 @@ static void test_dispatch_and_help(void **state)
     fclose(f);
     assert_string_equal(text, "usage: lamprig grp SUBCOMMAND [OPTIONS]\n"
                               "\n"
+                              "a group\n"
+                              "\n"
                               "Subcommands (`lamprig help grp SUBCOMMAND` shows one in full):\n"
                               "  leaf --scene FILE [--set key=value ...] [--fail]\n"
                               "      a leaf\n");
     free(text);
+}
+
+/* firmware/README.md quotes one generated help: it must be what the program prints. */
+static void test_readme_quotes_the_help(void **state)
+{
+    (void)state;
+    size_t n;
+    char *readme = (char *)lr_test_read("firmware/README.md", &n);
+    assert_non_null(readme);
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    assert_non_null(f);
+    lr_help_print(f, &lr_calib_projector_response, "calib projector-response");
+    fclose(f);
+    if (!strstr(readme, text))
+        fail_msg("firmware/README.md lacks the help of `lamprig calib projector-response`:\n%s",
+                 text);
+    free(text);
+    free(readme);
 }
 
 int main(void)
@@ -351,6 +377,7 @@ int main(void)
         cmocka_unit_test(test_typed_values),
         cmocka_unit_test(test_repeats_lists_required),
         cmocka_unit_test(test_dispatch_and_help),
+        cmocka_unit_test(test_readme_quotes_the_help),
     };
     return cmocka_run_group_tests_name("args", tests, NULL, NULL);
 }

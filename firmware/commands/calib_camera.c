@@ -25,7 +25,6 @@ static const lr_argspec opts[] = {
 const lr_command lr_calib_camera = {
     .name = "camera",
     .summary = "camera intrinsics from photos of a board; outlier views are named",
-    .about = "Camera intrinsics from photos of a board; outlier views are named.",
     .opts = opts,
     .notes = LR_CALIB_EXIT_NOTE,
     .run = run,
