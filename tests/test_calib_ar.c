@@ -25,7 +25,7 @@
 #include "calib/procam.h"
 #include "calib/spatial_ar.h"
 #include "firmware/cli.h"
-#include "firmware/cmd_calib.h"
+#include "firmware/commands/commands.h"
 #include "firmware/rig/rig.h"
 #include "render/base/json.h"
 #include "render/base/mat4.h"

@@ -24,7 +24,7 @@
 #include "calib/compare.h"
 #include "calib/pose.h"
 #include "calib/view_render.h"
-#include "firmware/cmd_compare.h"
+#include "firmware/commands/commands.h"
 #include "render/base/file.h"
 #include "render/base/json.h"
 #include "render/scene/scene.h"

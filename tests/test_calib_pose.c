@@ -19,7 +19,7 @@
 #include "calib/camview.h"
 #include "calib/pose.h"
 #include "calib/rig.h"
-#include "firmware/cmd_calib.h"
+#include "firmware/commands/commands.h"
 #include "render/base/atomic_file.h"
 #include "tests/support/calib_sim.h"
 #include "tests/support/near.h"

@@ -103,10 +103,19 @@ static bool is_project_scene(const char *path)
 static int cmd_render(int argc, char **argv)
 {
     static const lr_argspec specs[] = {
-        {"--scene", 1},   {"--out", 1},   {"--variance", 1}, {"--cache", 0},
-        {"--cache-dir", 1}, {"--width", 1}, {"--height", 1}, {"--spp", 1},
-        {"--pass", 1},    {"--threads", 1}, {"--seed", 1},  {"--progress", 0},
-        {NULL, 0},
+        {.name = "--scene", .type = LR_ARG_STRING},
+        {.name = "--out", .type = LR_ARG_STRING},
+        {.name = "--variance", .type = LR_ARG_STRING},
+        {.name = "--cache"},
+        {.name = "--cache-dir", .type = LR_ARG_STRING},
+        {.name = "--width", .type = LR_ARG_STRING},
+        {.name = "--height", .type = LR_ARG_STRING},
+        {.name = "--spp", .type = LR_ARG_STRING},
+        {.name = "--pass", .type = LR_ARG_STRING},
+        {.name = "--threads", .type = LR_ARG_STRING},
+        {.name = "--seed", .type = LR_ARG_STRING},
+        {.name = "--progress"},
+        {0},
     };
     lr_args a;
     lr_err e = {0};
@@ -219,8 +228,10 @@ static void row(const char *name, lr_ref_estimate x, double published)
 
 static int cmd_validate(int argc, char **argv)
 {
-    static const lr_argspec specs[] = {{"--photons", 1}, {"--threads", 1}, {"--seed", 1},
-                                       {NULL, 0}};
+    static const lr_argspec specs[] = {{.name = "--photons", .type = LR_ARG_STRING},
+                                       {.name = "--threads", .type = LR_ARG_STRING},
+                                       {.name = "--seed", .type = LR_ARG_STRING},
+                                       {0}};
     lr_args a;
     lr_err e = {0};
     if (lr_args_parse(argc, argv, specs, 0, &a, &e)) {

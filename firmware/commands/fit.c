@@ -1,7 +1,5 @@
 /* lamprig fit — arguments, captures, the fit (calib/fit.h), a GPU confirmation render, the
  * material preset written atomically after the material loader accepted it. */
-#include "firmware/cmd_fit.h"
-
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -10,69 +8,77 @@
 #include "calib/fit.h"
 #include "calib/fit_captures.h"
 #include "calib/rig.h"
-#include "firmware/args.h"
-#include "firmware/cli.h"
+#include "firmware/commands/commands.h"
 #include "render/base/atomic_file.h"
 #include "render/base/json.h"
 #include "render/gl/gl.h"
 #include "render/material/material.h"
 #include "render/renderer.h"
 
-const char lr_fit_summary[] = "fit a material (sigma_a, sigma_s' per band, or two scales on a "
-                              "preset) to captures of the lit object";
+static int run_fit(const lr_cli *c);
 
-const char lr_fit_usage[] =
-    "usage: lamprig fit --scene FILE --captures IMG[,IMG...] --out MATERIAL.json\n"
-    "                   [--calib DIR] [--gamma G] [--times T1,T2,...] [--object NAME]\n"
-    "                   [--scale-preset NAME] [--start-sigma-a R,G,B --start-sigma-s R,G,B]\n"
-    "                   [--size WxH] [--samples N] [--capture-scale S] [--huber H]\n"
-    "                   [--max-evals N] [--seed N] [--threads N] [--name NAME] [--no-gpu-check]\n"
-    "\n"
-    "Fits the object's material so that the CPU reference render of the scene's camera view\n"
-    "matches the captures (linearised with the calibration folder's camera response and colour\n"
-    "matrix; several exposures are merged to HDR with --times). The scene's camera must be the\n"
-    "rig's camera. Nelder-Mead in log sigma per band (or on two scales of the preset NAME with\n"
-    "--scale-preset), Huber loss over the object's pixels; the result is confirmed with one GPU\n"
-    "render. Prints parameters, residual (relative RMSE), iterations and time; writes the\n"
-    "material preset (configs/materials format) atomically.\n"
-    "\n"
-    "  --captures IMG,...  8-bit photos of the lit object (one, or an exposure stack)\n"
-    "  --gamma G           the camera's response when DIR has no camera_response.json (or\n"
-    "                      there is no --calib): value v is exposure (v/128)^G; default 2.2\n"
-    "                      (an sRGB camera), the rule lamprig compare and lamprig-capsim use;\n"
-    "                      refused beside camera_response.json\n"
-    "  --times T,...       their exposure times, s (default 1)\n"
-    "  --object NAME       the object fitted (default the first)\n"
-    "  --size WxH          model resolution (default 64x48; the captures' aspect)\n"
-    "  --samples N         reference samples per band per pixel (default 128)\n"
-    "  --capture-scale S   camera exposure units per W/(mm^2 sr) (default render.exposure)\n"
-    "  --huber H           Huber threshold, fraction of the mean capture (default 0.1)\n"
-    "  --max-evals N       model evaluations per band (default 200)\n"
-    "\n"
-    "Exit status: 0 success, 1 failure (the output is left as it was), 2 bad arguments.";
+static const lr_argspec opts[] = {
+    {.name = "--scene", .type = LR_ARG_PATH, .flags = LR_ARG_REQUIRED,
+     .help = "the scene; its camera must be the rig's camera"},
+    {.name = "--captures", .type = LR_ARG_STRING, .metavar = "IMG[,IMG...]",
+     .flags = LR_ARG_REQUIRED,
+     .help = "8-bit photos of the lit object (one, or an exposure stack)"},
+    {.name = "--out", .type = LR_ARG_PATH, .metavar = "MATERIAL.json", .flags = LR_ARG_REQUIRED,
+     .help = "the material preset written (configs/materials format)"},
+    {.name = "--calib", .type = LR_ARG_PATH, .metavar = "DIR",
+     .help = "the calibration folder: camera response and colour matrix"},
+    {.name = "--gamma", .type = LR_ARG_NUMBER, .metavar = "G", .min = 0.1, .max = 10,
+     .help = "the camera's response when DIR has no camera_response.json (or\n"
+             "there is no --calib): value v is exposure (v/128)^G; default 2.2\n"
+             "(an sRGB camera), the rule lamprig compare and lamprig-capsim\n"
+             "use; refused beside camera_response.json"},
+    {.name = "--times", .type = LR_ARG_NUMBERS, .metavar = "T1,T2,...",
+     .help = "their exposure times, s (default 1)"},
+    {.name = "--object", .type = LR_ARG_STRING, .metavar = "NAME",
+     .help = "the object fitted (default the first)"},
+    {.name = "--scale-preset", .type = LR_ARG_STRING, .metavar = "NAME",
+     .help = "fit two scales (sigma_a, sigma_s') on the preset NAME instead of\n"
+             "sigma per band"},
+    {.name = "--start-sigma-a", .type = LR_ARG_TRIPLE, .metavar = "R,G,B",
+     .flags = LR_ARG_ABOVE_MIN, .help = "start of the search, mm^-1 (with --start-sigma-s)"},
+    {.name = "--start-sigma-s", .type = LR_ARG_TRIPLE, .metavar = "R,G,B",
+     .flags = LR_ARG_ABOVE_MIN, .help = "start of the search, mm^-1 (with --start-sigma-a)"},
+    {.name = "--size", .type = LR_ARG_SIZE, .min = 2, .max = 4096,
+     .help = "model resolution (default 64x48; the captures' aspect)"},
+    {.name = "--samples", .type = LR_ARG_INT, .min = 2, .max = 1 << 20,
+     .help = "reference samples per band per pixel (default 128)"},
+    {.name = "--capture-scale", .type = LR_ARG_NUMBER, .metavar = "S", .flags = LR_ARG_ABOVE_MIN,
+     .help = "camera exposure units per W/(mm^2 sr) (default render.exposure)"},
+    {.name = "--huber", .type = LR_ARG_NUMBER, .metavar = "H", .flags = LR_ARG_ABOVE_MIN,
+     .help = "Huber threshold, fraction of the mean capture (default 0.1)"},
+    {.name = "--max-evals", .type = LR_ARG_INT, .min = 3, .max = 100000,
+     .help = "model evaluations per band (default 200)"},
+    {.name = "--seed", .type = LR_ARG_INT, .min = 1, .max = 1 << 30,
+     .help = "the reference renderer's random seed (default 1)"},
+    {.name = "--threads", .type = LR_ARG_INT, .min = 1, .max = 1024,
+     .help = "worker threads (default: all CPUs)"},
+    {.name = "--name", .type = LR_ARG_STRING, .metavar = "NAME",
+     .help = "the preset's name (default: the --out file's base name)"},
+    {.name = "--no-gpu-check", .help = "skip the confirmation render on the GPU"},
+    {0},
+};
 
-static int usage_error(const char *msg)
-{
-    fprintf(stderr, "lamprig fit: %s (see `lamprig help fit`)\n", msg);
-    return LR_EXIT_USAGE;
-}
-
-static int fail(const lr_err *e)
-{
-    fprintf(stderr, "lamprig fit: %s\n", e->msg);
-    return LR_EXIT_FAIL;
-}
-
-static int int_arg(const char *flag, const char *v, int lo, int hi, int *out, lr_err *e)
-{
-    double d;
-    if (lr_args_number(flag, v, &d, e))
-        return LR_EINVAL;
-    if (d != floor(d) || d < lo || d > hi)
-        return lr_err_set(e, LR_EINVAL, "%s %s: a whole number in %d..%d", flag, v, lo, hi);
-    *out = (int)d;
-    return LR_OK;
-}
+const lr_command lr_fit_command = {
+    .name = "fit",
+    .summary = "fit a material (sigma_a, sigma_s' per band, or two scales on a preset) to "
+               "captures of the lit object",
+    .about =
+        "Fits the object's material so that the CPU reference render of the scene's camera view\n"
+        "matches the captures (linearised with the calibration folder's camera response and colour\n"
+        "matrix; several exposures are merged to HDR with --times). The scene's camera must be the\n"
+        "rig's camera. Nelder-Mead in log sigma per band (or on two scales of the preset NAME with\n"
+        "--scale-preset), Huber loss over the object's pixels; the result is confirmed with one GPU\n"
+        "render. Prints parameters, residual (relative RMSE), iterations and time; writes the\n"
+        "material preset (configs/materials format) atomically.",
+    .opts = opts,
+    .notes = "Exit status: 0 success, 1 failure (the output is left as it was), 2 bad arguments.",
+    .run = run_fit,
+};
 
 /* JSON string body with quotes and backslashes escaped (names and paths only). */
 static void json_escape(const char *s, char *buf, size_t cap)
@@ -160,74 +166,48 @@ done:
     return rc;
 }
 
-int lr_cmd_fit(int argc, char **argv)
+static int run_fit(const lr_cli *c)
 {
-    static const lr_argspec specs[] = {
-        {"--scene", 1},   {"--captures", 1},      {"--out", 1},     {"--calib", 1},
-        {"--times", 1},   {"--object", 1},        {"--scale-preset", 1},
-        {"--start-sigma-a", 1}, {"--start-sigma-s", 1}, {"--size", 1}, {"--samples", 1},
-        {"--capture-scale", 1}, {"--huber", 1},   {"--max-evals", 1}, {"--seed", 1},
-        {"--threads", 1}, {"--name", 1},          {"--no-gpu-check", 0}, {"--gamma", 1},
-        {NULL, 0},
-    };
-    lr_args a;
+    const lr_args *a = &c->args;
     lr_err e = {0};
-    if (lr_args_parse(argc - 1, argv + 1, specs, 0, &a, &e))
-        return usage_error(e.msg);
-    const char *scene_path = lr_args_get(&a, "--scene"), *caps = lr_args_get(&a, "--captures"),
-               *out = lr_args_get(&a, "--out");
-    if (!scene_path || !caps || !out)
-        return usage_error("--scene, --captures and --out are required");
+    const char *scene_path = lr_args_get(a, "--scene"), *caps = lr_args_get(a, "--captures"),
+               *out = lr_args_get(a, "--out");
     lr_fit_desc d = {.samples = 128};
-    int w = 64, h = 48;
+    int w = 64, h = 48, seed = 0, n3 = 0;
     double times[16], scale = 0, gamma = 0;
     int ntimes = 0;
-    const char *v;
-    if ((v = lr_args_get(&a, "--size")) && (sscanf(v, "%dx%d", &w, &h) != 2 || w < 2 ||
-                                            h < 2 || w > 4096 || h > 4096))
-        return usage_error("--size: expected WxH, 2..4096 each");
-    if (((v = lr_args_get(&a, "--samples")) && int_arg("--samples", v, 2, 1 << 20, &d.samples, &e)) ||
-        ((v = lr_args_get(&a, "--max-evals")) &&
-         int_arg("--max-evals", v, 3, 100000, &d.max_evals, &e)) ||
-        ((v = lr_args_get(&a, "--threads")) && int_arg("--threads", v, 1, 1024, &d.threads, &e)) ||
-        ((v = lr_args_get(&a, "--times")) && lr_args_numbers("--times", v, times, 1, 16, &ntimes, &e)) ||
-        ((v = lr_args_get(&a, "--capture-scale")) && lr_args_number("--capture-scale", v, &scale, &e)) ||
-        ((v = lr_args_get(&a, "--huber")) && lr_args_number("--huber", v, &d.huber, &e)) ||
-        ((v = lr_args_get(&a, "--gamma")) && lr_args_number("--gamma", v, &gamma, &e)) ||
-        ((v = lr_args_get(&a, "--start-sigma-a")) && lr_args_triple("--start-sigma-a", v, d.sigma_a_start, &e)) ||
-        ((v = lr_args_get(&a, "--start-sigma-s")) && lr_args_triple("--start-sigma-s", v, d.sigma_s_start, &e)))
-        return usage_error(e.msg);
-    if ((v = lr_args_get(&a, "--seed"))) {
-        int s;
-        if (int_arg("--seed", v, 1, 1 << 30, &s, &e))
-            return usage_error(e.msg);
-        d.seed = (unsigned)s;
-    }
-    if (lr_args_has(&a, "--capture-scale") && !(scale > 0))
-        return usage_error("--capture-scale must be > 0");
-    if (lr_args_has(&a, "--huber") && !(d.huber > 0))
-        return usage_error("--huber must be > 0");
-    if (lr_args_has(&a, "--gamma") && !(gamma >= 0.1 && gamma <= 10))
-        return usage_error("--gamma: expected 0.1..10");
-    if (lr_args_has(&a, "--start-sigma-a") != lr_args_has(&a, "--start-sigma-s"))
-        return usage_error("--start-sigma-a and --start-sigma-s go together");
-    for (int b = 0; b < 3; b++)
-        if (lr_args_has(&a, "--start-sigma-a") &&
-            !(d.sigma_a_start[b] > 0 && d.sigma_s_start[b] > 0))
-            return usage_error("start sigmas must be > 0");
+    int st = lr_cli_check(
+        c, lr_args_size(a, "--size", &w, &h, &e) || lr_args_int(a, "--samples", &d.samples, &e) ||
+               lr_args_int(a, "--max-evals", &d.max_evals, &e) ||
+               lr_args_int(a, "--threads", &d.threads, &e) ||
+               lr_args_list(a, "--times", times, 16, &ntimes, &e) ||
+               lr_args_double(a, "--capture-scale", &scale, &e) ||
+               lr_args_double(a, "--huber", &d.huber, &e) ||
+               lr_args_double(a, "--gamma", &gamma, &e) ||
+               lr_args_list(a, "--start-sigma-a", d.sigma_a_start, 3, &n3, &e) ||
+               lr_args_list(a, "--start-sigma-s", d.sigma_s_start, 3, &n3, &e) ||
+               lr_args_int(a, "--seed", &seed, &e),
+        &e);
+    if (st)
+        return st;
+    d.seed = (unsigned)seed;
+    if (lr_args_has(a, "--start-sigma-a") != lr_args_has(a, "--start-sigma-s"))
+        return lr_cli_usage(c->path, "--start-sigma-a and --start-sigma-s go together");
     /* captures: a comma-separated list */
     char *list = strdup(caps);
+    if (!list)
+        return lr_cli_fail(c->path, "out of memory");
     const char *paths[16];
     int n = 0;
     for (char *t = strtok(list, ","); t && n < 16; t = strtok(NULL, ","))
         paths[n++] = t;
     if (ntimes && ntimes != n) {
         free(list);
-        return usage_error("--times needs one time per capture");
+        return lr_cli_usage(c->path, "--times needs one time per capture");
     }
     if (n > 1 && !ntimes) {
         free(list);
-        return usage_error("several captures are an exposure stack: give --times");
+        return lr_cli_usage(c->path, "several captures are an exposure stack: give --times");
     }
 
     int status = LR_EXIT_FAIL;
@@ -239,34 +219,33 @@ int lr_cmd_fit(int argc, char **argv)
         return LR_EXIT_FAIL;
     }
     if (lr_scene_load(scene_path, NULL, &scene, &e)) {
-        status = e.code == LR_EIO ? fail(&e) : usage_error(e.msg);
+        status = e.code == LR_EIO ? lr_cli_fail(c->path, "%s", e.msg)
+                                  : lr_cli_usage(c->path, "%s", e.msg);
         goto done;
     }
-    const char *oname = lr_args_get(&a, "--object");
+    const char *oname = lr_args_get(a, "--object");
     d.object = oname ? lr_scene_find_object(scene, oname) : 0;
     if (d.object < 0) {
-        char msg[256];
-        snprintf(msg, sizeof msg, "--object %s: no such object in %s", oname, scene_path);
-        status = usage_error(msg);
+        status = lr_cli_usage(c->path, "--object %s: no such object in %s", oname, scene_path);
         goto done;
     }
-    const char *preset = lr_args_get(&a, "--scale-preset");
+    const char *preset = lr_args_get(a, "--scale-preset");
     if (preset) {
         char key[64];
         snprintf(key, sizeof key, "objects[%d].material", d.object);
         if (lr_scene_set(scene, key, preset, NULL, &e)) {
-            status = usage_error(e.msg);
+            status = lr_cli_usage(c->path, "%s", e.msg);
             goto done;
         }
         d.mode = LR_FIT_SCALE;
     }
-    const char *cdir = lr_args_get(&a, "--calib");
+    const char *cdir = lr_args_get(a, "--calib");
     if (cdir && lr_rig_calib_load(cdir, cal, &e)) {
-        status = fail(&e);
+        status = lr_cli_fail(c->path, "%s", e.msg);
         goto done;
     }
     if (gamma > 0 && lr_rig_set_gamma(cal, gamma, &e)) {
-        status = usage_error(e.msg);
+        status = lr_cli_usage(c->path, "%s", e.msg);
         goto done;
     }
     /* Said before the work: an assumed response is the first suspect of a bad fit. */
@@ -275,13 +254,13 @@ int lr_cmd_fit(int argc, char **argv)
     if (!scale)
         scale = lr_scene_render(scene)->exposure;
     if (lr_fit_load_captures(paths, ntimes ? times : NULL, n, cal, w, h, scale, &target, &e)) {
-        status = fail(&e);
+        status = lr_cli_fail(c->path, "%s", e.msg);
         goto done;
     }
     unsigned char *om = malloc((size_t)w * h);
     if (!om) {
         lr_err_set(&e, LR_ENOMEM, "out of memory");
-        status = fail(&e);
+        status = lr_cli_fail(c->path, "%s", e.msg);
         goto done;
     }
     long inside = lr_fit_object_mask(scene, d.object, w, h, om), clipped = 0;
@@ -296,7 +275,7 @@ int lr_cmd_fit(int argc, char **argv)
     d.target = &target;
     lr_fit_result r;
     if (lr_fit_run(&d, &r, &e)) {
-        status = fail(&e);
+        status = lr_cli_fail(c->path, "%s", e.msg);
         goto done;
     }
     const lr_scene_object *o = lr_scene_object_at(scene, d.object);
@@ -320,7 +299,7 @@ int lr_cmd_fit(int argc, char **argv)
     }
     printf("  residual: relative RMSE %.4f (start %.4f), %d renders, %.2f s\n", r.rel_rmse_all,
            r.start_rel_rmse, r.renders, r.seconds);
-    if (!lr_args_has(&a, "--no-gpu-check")) {
+    if (!lr_args_has(a, "--no-gpu-check")) {
         double rel = 0, ms = 0;
         lr_err ge = {0};
         if (gpu_check(scene, d.object, &target, &rel, &ms, &ge))
@@ -331,7 +310,7 @@ int lr_cmd_fit(int argc, char **argv)
                    rel, r.rel_rmse_all, ms);
     }
     char name[LR_MATERIAL_NAME_MAX];
-    const char *nm = lr_args_get(&a, "--name");
+    const char *nm = lr_args_get(a, "--name");
     if (!nm) {
         const char *base = strrchr(out, '/');
         base = base ? base + 1 : out;
@@ -348,7 +327,7 @@ int lr_cmd_fit(int argc, char **argv)
              d.mode == LR_FIT_SCALE ? "two scales on a preset" : "sigma per band",
              r.rel_rmse_all, r.mask_pixels, w, h);
     if (write_material(out, nm, source, &o->material.medium, &e)) {
-        status = fail(&e);
+        status = lr_cli_fail(c->path, "%s", e.msg);
         goto done;
     }
     printf("  wrote %s\n", out);

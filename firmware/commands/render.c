@@ -1,15 +1,11 @@
 /* lamprig render — renders a scene headless (EGL surfaceless) through the renderer of
  * render/renderer.h, writes the image, the linear HDR image and per-frame statistics. */
-#include "firmware/cmd_render.h"
-
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "firmware/args.h"
-#include "firmware/cli.h"
+#include "firmware/commands/commands.h"
 #include "firmware/plan_scene.h"
 #include "firmware/render_events.h"
 #include "render/base/atomic_file.h"
@@ -20,85 +16,72 @@
 #include "render/renderer_debug.h"
 #include "render/scene/scene.h"
 
-const char lr_render_summary[] = "render a scene headless: PNG, linear PFM, per-pass statistics";
-
-const char lr_render_usage[] =
-    "usage: lamprig render --scene FILE [--frames N] [--width W --height H] [--out F.png]\n"
-    "                      [--hdr F.pfm] [--stats F.json] [--no-vpl] [--set key=value ...]\n"
-    "                      [--events FILE] [--vpl-visibility] [--fps F] [--no-plan]\n"
-    "                      [--table CSV]\n"
-    "\n"
-    "Renders FILE (configs/scenes/*.json) with seed 003's passes (light G-buffer, scattered-\n"
-    "radiosity maps, virtual point lights, composition) on a headless EGL context.\n"
-    "\n"
-    "  --frames N        frames to render (default: until the maps have accumulated\n"
-    "                    render.frames frames and every event has been applied)\n"
-    "  --width, --height output size (default 640 x 480)\n"
-    "  --out F.png       tone-mapped 8-bit sRGB image (exposure render.exposure)\n"
-    "  --hdr F.pfm       linear RGB radiance, W/(mm^2 sr), PFM\n"
-    "  --stats F.json    {\"scene\",\"width\",\"height\",\"uncovered_pixels\",\"renderer\",\n"
-    "                    \"settings\",\"frames\":[{\"index\",\n"
-    "                    \"passes\":[...],\"ms\":{pass:ms},\"total_ms\",\"samples\",\n"
-    "                    \"converged\",\"time_s\"},...]}\n"
-    "  --no-vpl          no emergent light on the receivers (direct light only)\n"
-    "  --vpl-visibility  shadow the VPLs' light by the objects (beyond seed 003; slower)\n"
-    "  --set key=value   change a scene parameter before rendering (repeatable), names as\n"
-    "                    in the scene file: light.intensity=0.01, render.K=8, camera.position=0,-400,200\n"
-    "  --events FILE     one change per line, FRAME PARAMETER VALUE (e.g. '4 light.intensity\n"
-    "                    0.5'), applied before that frame; '#' starts a comment line\n"
-    "  --fps F           the renderer's clock: frame i is composed at i / F seconds, which\n"
-    "                    drives the lights' flicker (default 30; lights[0].flicker.amplitude=0\n"
-    "                    makes a light steady)\n"
-    "  --no-plan         keep the scene's render settings even when it has a quality budget\n"
-    "  --table CSV       the planner's measured table (default: see `lamprig help plan`)\n"
-    "  --help-scene      print every scene field (type, range, default, what a change\n"
-    "                    re-renders) as markdown, and exit\n"
-    "\n"
-    "A scene with a \"quality\" block (max_error, frame_ms) is planned first (`lamprig plan`):\n"
-    "the chosen settings replace its render settings and one line per object says the choice,\n"
-    "predicted error and time; --set render.* is applied after the plan and wins.\n"
-    "\n"
-    "Files are written atomically. Output paths (--out, --hdr, --stats) are checked before\n"
-    "anything renders: a directory or a missing folder is a bad argument.\n"
-    "Exit status: 0 done; 1 rendering or I/O failed; 2 bad arguments (one line on stderr).\n"
-    "\n"
-    "Example:\n"
-    "  lamprig render --scene configs/scenes/candle.json --out candle.png --stats s.json";
-
 #define MAX_SETS 64
 
-static int usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static int usage_error(const char *fmt, ...)
-{
-    char msg[LR_ERR_MSG_MAX];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    for (char *c = msg; *c; c++)
-        if ((unsigned char)*c < 0x20 || *c == 0x7f)
-            *c = '?';
-    fprintf(stderr, "lamprig render: %s (see `lamprig help render`)\n", msg);
-    return LR_EXIT_USAGE;
-}
+static int run_render(const lr_cli *c);
 
-static int fail(const lr_err *e)
-{
-    fprintf(stderr, "lamprig render: %s\n", e->msg);
-    return LR_EXIT_FAIL;
-}
+static const lr_argspec opts[] = {
+    {.name = "--scene", .type = LR_ARG_PATH, .flags = LR_ARG_REQUIRED,
+     .help = "the scene (configs/scenes/*.json)"},
+    {.name = "--frames", .type = LR_ARG_INT, .min = 1, .max = 1000000,
+     .help = "frames to render (default: until the maps have accumulated\n"
+             "render.frames frames and every event has been applied)"},
+    {.name = "--width", .type = LR_ARG_INT, .metavar = "W", .min = 1, .max = 16384,
+     .help = "output width (default 640)"},
+    {.name = "--height", .type = LR_ARG_INT, .metavar = "H", .min = 1, .max = 16384,
+     .help = "output height (default 480)"},
+    {.name = "--out", .type = LR_ARG_PATH, .metavar = "F.png", .flags = LR_ARG_OUTPUT,
+     .help = "tone-mapped 8-bit sRGB image (exposure render.exposure)"},
+    {.name = "--hdr", .type = LR_ARG_PATH, .metavar = "F.pfm", .flags = LR_ARG_OUTPUT,
+     .help = "linear RGB radiance, W/(mm^2 sr), PFM"},
+    {.name = "--stats", .type = LR_ARG_PATH, .metavar = "F.json", .flags = LR_ARG_OUTPUT,
+     .help = "{\"scene\",\"width\",\"height\",\"uncovered_pixels\",\"renderer\",\n"
+             "\"settings\",\"frames\":[{\"index\",\n"
+             "\"passes\":[...],\"ms\":{pass:ms},\"total_ms\",\"samples\",\n"
+             "\"converged\",\"time_s\"},...]}"},
+    {.name = "--no-vpl", .help = "no emergent light on the receivers (direct light only)"},
+    {.name = "--vpl-visibility",
+     .help = "shadow the VPLs' light by the objects (beyond seed 003; slower)"},
+    {.name = "--set", .type = LR_ARG_STRING, .metavar = "key=value", .repeat = MAX_SETS,
+     .help = "change a scene parameter before rendering (repeatable), names as\n"
+             "in the scene file: light.intensity=0.01, render.K=8,\n"
+             "camera.position=0,-400,200"},
+    {.name = "--events", .type = LR_ARG_PATH,
+     .help = "one change per line, FRAME PARAMETER VALUE (e.g. '4 light.intensity\n"
+             "0.5'), applied before that frame; '#' starts a comment line"},
+    {.name = "--fps", .type = LR_ARG_NUMBER, .metavar = "F", .flags = LR_ARG_ABOVE_MIN,
+     .min = 0, .max = 1e6,
+     .help = "the renderer's clock: frame i is composed at i / F seconds, which\n"
+             "drives the lights' flicker (default 30; lights[0].flicker.amplitude=0\n"
+             "makes a light steady)"},
+    {.name = "--no-plan", .help = "keep the scene's render settings even when it has a quality budget"},
+    {.name = "--help-scene", .flags = LR_ARG_ALONE,
+     .help = "print every scene field (type, range, default, what a change\n"
+             "re-renders) as markdown, and exit"},
+    {.name = "--table", .type = LR_ARG_PATH, .metavar = "CSV",
+     .help = "the planner's measured table (default: see `lamprig help plan`)"},
+    {0},
+};
 
-static int positive_int(const char *flag, const char *text, int max, int *out)
-{
-    lr_err e = {0};
-    double v;
-    if (lr_args_number(flag, text, &v, &e))
-        return usage_error("%s", e.msg);
-    if (v != floor(v) || v < 1 || v > max)
-        return usage_error("%s %s: must be a whole number in 1..%d", flag, text, max);
-    *out = (int)v;
-    return LR_EXIT_OK;
-}
+const lr_command lr_render_command = {
+    .name = "render",
+    .summary = "render a scene headless: PNG, linear PFM, per-pass statistics",
+    .about = "Renders FILE (configs/scenes/*.json) with seed 003's passes (light G-buffer, scattered-\n"
+             "radiosity maps, virtual point lights, composition) on a headless EGL context.",
+    .opts = opts,
+    .notes =
+        "A scene with a \"quality\" block (max_error, frame_ms) is planned first (`lamprig plan`):\n"
+        "the chosen settings replace its render settings and one line per object says the choice,\n"
+        "predicted error and time; --set render.* is applied after the plan and wins.\n"
+        "\n"
+        "Files are written atomically. Output paths (--out, --hdr, --stats) are checked before\n"
+        "anything renders: a directory or a missing folder is a bad argument.\n"
+        "Exit status: 0 done; 1 rendering or I/O failed; 2 bad arguments (one line on stderr).\n"
+        "\n"
+        "Example:\n"
+        "  lamprig render --scene configs/scenes/candle.json --out candle.png --stats s.json",
+    .run = run_render,
+};
 
 typedef struct stats_log {
     lr_frame_stats *v;
@@ -232,88 +215,34 @@ static int read_image(lr_renderer *r, lr_image *img, lr_err *e)
     return LR_OK;
 }
 
-int lr_cmd_render(int argc, char **argv)
+static int run_render(const lr_cli *c)
 {
-    /* --set may repeat: take those out before the table parser, which rejects repeats. */
-    const char *sets[MAX_SETS];
-    int nsets = 0;
-    char **rest = calloc((size_t)argc + 1, sizeof *rest);
-    if (!rest)
-        return LR_EXIT_FAIL;
-    int nrest = 0;
-    for (int i = 1; i < argc; i++) {
-        const char *v = NULL;
-        if (!strcmp(argv[i], "--set")) {
-            if (i + 1 >= argc) {
-                free(rest);
-                return usage_error("--set: missing key=value");
-            }
-            v = argv[++i];
-        } else if (!strncmp(argv[i], "--set=", 6)) {
-            v = argv[i] + 6;
-        } else {
-            rest[nrest++] = argv[i];
-            continue;
-        }
-        if (nsets == MAX_SETS) {
-            free(rest);
-            return usage_error("--set: at most %d", MAX_SETS);
-        }
-        sets[nsets++] = v;
-    }
-    static const lr_argspec specs[] = {
-        {"--scene", 1}, {"--frames", 1}, {"--width", 1}, {"--height", 1}, {"--out", 1},
-        {"--hdr", 1},   {"--stats", 1},  {"--no-vpl", 0}, {"--events", 1},
-        {"--vpl-visibility", 0}, {"--fps", 1}, {"--no-plan", 0}, {"--table", 1},
-        {"--help-scene", 0}, {NULL, 0}};
-    lr_args a;
-    lr_err e = {0};
-    if (lr_args_parse(nrest, rest, specs, 0, &a, &e)) {
-        free(rest);
-        return usage_error("%s", e.msg);
-    }
-    if (lr_args_has(&a, "--help-scene")) { /* the scene field reference, from its tables */
+    const lr_args *a = &c->args;
+    if (lr_args_has(a, "--help-scene")) { /* the scene field reference, from its tables */
         lr_scene_fields_markdown(stdout);
-        free(rest);
         return LR_EXIT_OK;
     }
-    int status = LR_EXIT_OK;
-    int frames = 0, width = 640, height = 480;
-    const char *scene_path = lr_args_get(&a, "--scene");
-    if (!scene_path)
-        status = usage_error("--scene FILE is required");
-    if (!status && lr_args_has(&a, "--frames"))
-        status = positive_int("--frames", lr_args_get(&a, "--frames"), 1000000, &frames);
-    if (!status && lr_args_has(&a, "--width"))
-        status = positive_int("--width", lr_args_get(&a, "--width"), 16384, &width);
-    if (!status && lr_args_has(&a, "--height"))
-        status = positive_int("--height", lr_args_get(&a, "--height"), 16384, &height);
+    const char *sets[MAX_SETS];
+    int nsets = lr_args_values(a, "--set", sets, MAX_SETS);
+    int status, frames = 0, width = 640, height = 480;
     double fps = 30.0;
-    if (!status && lr_args_has(&a, "--fps")) {
-        lr_err fe = {0};
-        if (lr_args_number("--fps", lr_args_get(&a, "--fps"), &fps, &fe))
-            status = usage_error("%s", fe.msg);
-        else if (!(fps > 0.0 && fps <= 1e6))
-            status = usage_error("--fps %s: must be > 0 and <= 1e6", lr_args_get(&a, "--fps"));
-    }
-    const char *out = lr_args_get(&a, "--out"), *hdr = lr_args_get(&a, "--hdr");
-    const char *stats_path = lr_args_get(&a, "--stats"), *events_path = lr_args_get(&a, "--events");
-    bool no_vpl = lr_args_has(&a, "--no-vpl");
-    bool vpl_vis = lr_args_has(&a, "--vpl-visibility");
-    bool no_plan = lr_args_has(&a, "--no-plan");
-    const char *table = lr_args_get(&a, "--table");
-    free(rest);
-    if (status)
+    lr_err e = {0};
+    if ((status = lr_cli_check(c, lr_args_int(a, "--frames", &frames, &e) ||
+                                      lr_args_int(a, "--width", &width, &e) ||
+                                      lr_args_int(a, "--height", &height, &e) ||
+                                      lr_args_double(a, "--fps", &fps, &e),
+                               &e)))
         return status;
+    const char *scene_path = lr_args_get(a, "--scene");
+    const char *out = lr_args_get(a, "--out"), *hdr = lr_args_get(a, "--hdr");
+    const char *stats_path = lr_args_get(a, "--stats"), *events_path = lr_args_get(a, "--events");
+    bool no_vpl = lr_args_has(a, "--no-vpl");
+    bool vpl_vis = lr_args_has(a, "--vpl-visibility");
+    bool no_plan = lr_args_has(a, "--no-plan");
+    const char *table = lr_args_get(a, "--table");
     for (int i = 0; i < nsets; i++)
         if (!strchr(sets[i], '='))
-            return usage_error("--set %s: expected key=value", sets[i]);
-    /* Output paths are checked before the scene loads and the frames render: a directory or a
-     * folder that does not exist is a bad argument now, not an I/O failure after the work. */
-    const char *const outputs[][2] = {{"--out", out}, {"--hdr", hdr}, {"--stats", stats_path}};
-    for (size_t k = 0; k < sizeof outputs / sizeof outputs[0]; k++)
-        if (outputs[k][1] && lr_atomic_file_check(outputs[k][1], &e))
-            return usage_error("%s %s", outputs[k][0], e.msg);
+            return lr_cli_usage(c->path, "--set %s: expected key=value", sets[i]);
 
     lr_scene *scene = NULL;
     lr_gl *gl = NULL;
@@ -323,18 +252,20 @@ int lr_cmd_render(int argc, char **argv)
     lr_image img = {0};
     if (lr_scene_load(scene_path, NULL, &scene, &e)) {
         /* A scene that cannot be read or is invalid is bad input. */
-        status = e.code == LR_EIO ? fail(&e) : usage_error("%s", e.msg);
+        status = e.code == LR_EIO ? lr_cli_fail(c->path, "%s", e.msg)
+                                  : lr_cli_usage(c->path, "%s", e.msg);
         goto done;
     }
     /* --set is checked before the plan (a bad one is a one-line usage error) and applied again
      * after it, so that an explicit render.* setting wins over the plan. */
     for (int i = 0; i < nsets; i++)
         if (lr_scene_set_assignment(scene, sets[i], NULL, &e)) {
-            status = usage_error("--set %s: %s", sets[i], e.msg);
+            status = lr_cli_usage(c->path, "--set %s: %s", sets[i], e.msg);
             goto done;
         }
     if (events_path && lr_render_events_load(events_path, &ev, &e)) {
-        status = e.code == LR_EIO ? fail(&e) : usage_error("%s", e.msg);
+        status = e.code == LR_EIO ? lr_cli_fail(c->path, "%s", e.msg)
+                                  : lr_cli_usage(c->path, "%s", e.msg);
         goto done;
     }
     bool planned = false;
@@ -342,7 +273,7 @@ int lr_cmd_render(int argc, char **argv)
         goto done;
     for (int i = 0; planned && i < nsets; i++) {
         if (lr_scene_set_assignment(scene, sets[i], NULL, &e)) {
-            status = usage_error("--set %s: %s", sets[i], e.msg);
+            status = lr_cli_usage(c->path, "--set %s: %s", sets[i], e.msg);
             goto done;
         }
         if (!strncmp(sets[i], "render.", 7))
@@ -353,7 +284,7 @@ int lr_cmd_render(int argc, char **argv)
                                                .height = height, .no_vpl = no_vpl,
                                                .vpl_visibility = vpl_vis},
                            &r, &e)) {
-        status = fail(&e);
+        status = lr_cli_fail(c->path, "%s", e.msg);
         goto done;
     }
     int next_ev = 0;
@@ -366,7 +297,7 @@ int lr_cmd_render(int argc, char **argv)
             const lr_render_event *x = &ev.ev[next_ev++];
             unsigned dirty = 0;
             if (lr_scene_set(scene, x->key, x->value, &dirty, &e)) {
-                status = usage_error("%s:%d: %s", ev.path, x->line, e.msg);
+                status = lr_cli_usage(c->path, "%s:%d: %s", ev.path, x->line, e.msg);
                 goto done;
             }
             lr_renderer_invalidate(r, dirty);
@@ -376,7 +307,7 @@ int lr_cmd_render(int argc, char **argv)
         lr_renderer_set_time(r, i / fps);
         lr_frame_stats st;
         if (lr_renderer_frame(r, &st, &e)) {
-            status = fail(&e);
+            status = lr_cli_fail(c->path, "%s", e.msg);
             goto done;
         }
         if (log_push(&log, &st)) {
@@ -389,22 +320,22 @@ int lr_cmd_render(int argc, char **argv)
                 ev.path, ev.ev[next_ev].line, ev.ev[next_ev].frame, frames);
     if (out || hdr) {
         if (read_image(r, &img, &e)) {
-            status = fail(&e);
+            status = lr_cli_fail(c->path, "%s", e.msg);
             goto done;
         }
         lr_tonemap tm;
         lr_renderer_tonemap(r, &tm);
         if (out && lr_image_write_png(out, &img, &tm, &e)) {
-            status = fail(&e);
+            status = lr_cli_fail(c->path, "%s", e.msg);
             goto done;
         }
         if (hdr && lr_image_write_pfm(hdr, &img, &e)) {
-            status = fail(&e);
+            status = lr_cli_fail(c->path, "%s", e.msg);
             goto done;
         }
     }
     if (stats_path && write_stats(stats_path, scene, r, &log, &e)) {
-        status = fail(&e);
+        status = lr_cli_fail(c->path, "%s", e.msg);
         goto done;
     }
     {

@@ -1,8 +1,6 @@
 /* `lamprig compare`: argument parsing, the run and its report around calib/compare.h and
  * calib/view_render.h. Nothing is written unless the whole comparison succeeded; the report
  * and the heatmap are written atomically. */
-#include "firmware/cmd_compare.h"
-
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,60 +12,78 @@
 #include "calib/calfile.h" /* the JSON writer (lr_jw), wherever it lives */
 #include "calib/rig.h"
 #include "calib/view_render.h"
-#include "firmware/args.h"
-#include "firmware/cli.h"
+#include "firmware/commands/commands.h"
 #include "render/base/atomic_file.h"
 #include "render/scene/scene.h"
 
 #define MAX_CAPTURES 16
 #define MAX_SETS 64
 
-const char lr_compare_summary[] = "compare a render of the calibrated camera's view with captures";
-const char lr_compare_usage[] =
-    "usage: lamprig compare --scene FILE --calib DIR --capture IMG [IMG...] --report OUT.json\n"
-    "                       [--heatmap OUT.png] [--times T1,T2,...] [--gain G] [--gamma G]\n"
-    "                       [--cpu] [--frames N] [--heatmap-max DE] [--render-out R.pfm]\n"
-    "                       [--vignette none|cos4|poly:V1,V2,V3] [--set key=value ...]\n"
-    "\n"
-    "Renders the camera's view of the scene with the calibrated intrinsics and pose (DIR:\n"
-    "camera.json and pose.json required; camera_response.json and color.json used when\n"
-    "present; without camera_response.json captures are read as gamma --gamma, default 2.2,\n"
-    "the rule lamprig fit and lamprig-capsim use), linearises the captures (several\n"
-    "captures are an exposure stack with --times in seconds, merged to HDR; one capture has\n"
-    "time 1 s unless --times says otherwise), divides by --gain (default: the scene's\n"
-    "render.exposure, as lamprig-capsim assumes) and reports per region (object, receivers,\n"
-    "all; boundary, saturated and shadow pixels excluded): relative RMSE in linear light,\n"
-    "SSIM on luminance, mean and 95th-percentile CIEDE2000, and the render time.\n"
-    "--heatmap writes the per-pixel CIEDE2000 (scale 0..--heatmap-max, default 10).\n"
-    "--cpu renders with the CPU twin instead of the GPU renderer. --vignette divides the\n"
-    "capture by a vignetting model (as lamprig-capsim applies it; cos4 uses the calibrated\n"
-    "focal length and principal point).\n"
-    "\n"
-    "Exit status: 0 success, 1 failure (nothing written), 2 bad arguments.";
+static int run_compare(const lr_cli *c);
 
-static int usage_error(const char *fmt, const char *arg)
-{
-    fprintf(stderr, "lamprig compare: ");
-    fprintf(stderr, fmt, arg);
-    fprintf(stderr, " (see `lamprig help compare`)\n");
-    return LR_EXIT_USAGE;
-}
+static const lr_argspec opts[] = {
+    {.name = "--scene", .type = LR_ARG_PATH, .flags = LR_ARG_REQUIRED, .help = "the scene"},
+    {.name = "--calib", .type = LR_ARG_PATH, .metavar = "DIR", .flags = LR_ARG_REQUIRED,
+     .help = "the calibration folder (camera.json and pose.json required;\n"
+             "camera_response.json and color.json used when present)"},
+    {.name = "--capture", .type = LR_ARG_PATH, .metavar = "IMG",
+     .flags = LR_ARG_REQUIRED | LR_ARG_LIST, .repeat = MAX_CAPTURES,
+     .help = "the captures (several: an exposure stack, merged to HDR)"},
+    {.name = "--report", .type = LR_ARG_PATH, .metavar = "OUT.json", .flags = LR_ARG_REQUIRED,
+     .help = "the report, JSON"},
+    {.name = "--heatmap", .type = LR_ARG_PATH, .metavar = "OUT.png",
+     .help = "the per-pixel CIEDE2000 (scale 0..--heatmap-max)"},
+    {.name = "--times", .type = LR_ARG_STRING, .metavar = "T1,T2,...",
+     .help = "exposure times of the captures, s (1/30 allowed; default 1 s for one)"},
+    {.name = "--gain", .type = LR_ARG_NUMBER, .metavar = "G", .flags = LR_ARG_ABOVE_MIN,
+     .max = 1e12,
+     .help = "capture units per render unit (default: the scene's render.exposure,\n"
+             "as lamprig-capsim assumes)"},
+    {.name = "--gamma", .type = LR_ARG_NUMBER, .metavar = "G", .min = 0.1, .max = 10,
+     .help = "the camera's response without camera_response.json (default 2.2)"},
+    {.name = "--cpu", .help = "render with the CPU twin instead of the GPU renderer"},
+    {.name = "--frames", .type = LR_ARG_INT, .min = 1, .max = 1000000,
+     .help = "frames to render (default: until converged)"},
+    {.name = "--heatmap-max", .type = LR_ARG_NUMBER, .metavar = "DE",
+     .flags = LR_ARG_ABOVE_MIN, .max = 1e6,
+     .help = "the heatmap's full scale, CIEDE2000 (default 10)"},
+    {.name = "--render-out", .type = LR_ARG_PATH, .metavar = "R.pfm",
+     .help = "the render, linear PFM"},
+    {.name = "--vignette", .type = LR_ARG_STRING, .metavar = "none|cos4|poly:V1,V2,V3",
+     .help = "divide the capture by a vignetting model (as lamprig-capsim applies\n"
+             "it; cos4 uses the calibrated focal length and principal point)"},
+    {.name = "--set", .type = LR_ARG_STRING, .metavar = "key=value", .repeat = MAX_SETS,
+     .help = "change a scene parameter first (repeatable), as in lamprig render"},
+    {0},
+};
+
+const lr_command lr_compare_command = {
+    .name = "compare",
+    .summary = "compare a render of the calibrated camera's view with captures",
+    .about =
+        "Renders the camera's view of the scene with the calibrated intrinsics and pose (DIR:\n"
+        "camera.json and pose.json required; camera_response.json and color.json used when\n"
+        "present; without camera_response.json captures are read as gamma --gamma, default 2.2,\n"
+        "the rule lamprig fit and lamprig-capsim use), linearises the captures (several\n"
+        "captures are an exposure stack with --times in seconds, merged to HDR; one capture has\n"
+        "time 1 s unless --times says otherwise), divides by --gain (default: the scene's\n"
+        "render.exposure, as lamprig-capsim assumes) and reports per region (object, receivers,\n"
+        "all; boundary, saturated and shadow pixels excluded): relative RMSE in linear light,\n"
+        "SSIM on luminance, mean and 95th-percentile CIEDE2000, and the render time.\n"
+        "--heatmap writes the per-pixel CIEDE2000 (scale 0..--heatmap-max, default 10).\n"
+        "--cpu renders with the CPU twin instead of the GPU renderer. --vignette divides the\n"
+        "capture by a vignetting model (as lamprig-capsim applies it; cos4 uses the calibrated\n"
+        "focal length and principal point).",
+    .opts = opts,
+    .notes = "Exit status: 0 success, 1 failure (nothing written), 2 bad arguments.",
+    .run = run_compare,
+};
 
 static double now_s(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
-static int parse_number(const char *s, double lo, double hi, double *out)
-{
-    char *end;
-    double v = s ? strtod(s, &end) : 0;
-    if (!s || !*s || *end || !(v >= lo && v <= hi))
-        return -1;
-    *out = v;
-    return 0;
 }
 
 typedef struct report {
@@ -139,82 +155,35 @@ static int write_report(const char *path, const report *r, lr_err *e)
     return lr_atomic_file_commit(f, e);
 }
 
-int lr_cmd_compare(int argc, char **argv)
+static int run_compare(const lr_cli *c)
 {
-    const char *scene_path = NULL, *calib = NULL, *report_path = NULL, *heatmap = NULL;
-    const char *times_s = NULL, *render_out = NULL, *vignette = NULL;
+    const lr_args *a = &c->args;
+    const char *scene_path = lr_args_get(a, "--scene"), *calib = lr_args_get(a, "--calib");
+    const char *report_path = lr_args_get(a, "--report"), *heatmap = lr_args_get(a, "--heatmap");
+    const char *times_s = lr_args_get(a, "--times"), *render_out = lr_args_get(a, "--render-out");
+    const char *vignette = lr_args_get(a, "--vignette");
     const char *captures[MAX_CAPTURES], *sets[MAX_SETS];
-    int ncap = 0, nsets = 0;
-    double gain = 0, gamma = 0, frames = 0, hmax = 10;
-    bool cpu = false;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (!strcmp(a, "--cpu")) {
-            cpu = true;
-            continue;
-        }
-        if (!strcmp(a, "--capture")) {
-            while (i + 1 < argc && strncmp(argv[i + 1], "--", 2) != 0) {
-                if (ncap >= MAX_CAPTURES)
-                    return usage_error("%s", "too many captures (at most 16)");
-                captures[ncap++] = argv[++i];
-            }
-            continue;
-        }
-        if (strncmp(a, "--", 2) != 0)
-            return usage_error("unexpected argument '%s'", a);
-        if (i + 1 >= argc)
-            return usage_error("option '%s' needs a value (or is unknown)", a);
-        const char *v = argv[++i];
-        if (!strcmp(a, "--scene"))
-            scene_path = v;
-        else if (!strcmp(a, "--calib"))
-            calib = v;
-        else if (!strcmp(a, "--report"))
-            report_path = v;
-        else if (!strcmp(a, "--heatmap"))
-            heatmap = v;
-        else if (!strcmp(a, "--times"))
-            times_s = v;
-        else if (!strcmp(a, "--render-out"))
-            render_out = v;
-        else if (!strcmp(a, "--vignette"))
-            vignette = v;
-        else if (!strcmp(a, "--set")) {
-            if (nsets >= MAX_SETS)
-                return usage_error("%s", "too many --set (at most 64)");
-            sets[nsets++] = v;
-        } else if (!strcmp(a, "--gain")) {
-            if (parse_number(v, 1e-12, 1e12, &gain))
-                return usage_error("--gain '%s': expected a number > 0", v);
-        } else if (!strcmp(a, "--gamma")) {
-            if (parse_number(v, 0.1, 10, &gamma))
-                return usage_error("--gamma '%s': expected 0.1..10", v);
-        } else if (!strcmp(a, "--frames")) {
-            if (parse_number(v, 1, 1e6, &frames) || frames != floor(frames))
-                return usage_error("--frames '%s': expected a count >= 1", v);
-        } else if (!strcmp(a, "--heatmap-max")) {
-            if (parse_number(v, 1e-6, 1e6, &hmax))
-                return usage_error("--heatmap-max '%s': expected a number > 0", v);
-        } else {
-            return usage_error("unknown option '%s'", a);
-        }
-    }
-    if (!scene_path)
-        return usage_error("%s", "missing --scene");
-    if (!calib)
-        return usage_error("%s", "missing --calib");
-    if (!report_path)
-        return usage_error("%s", "missing --report");
-    if (ncap == 0)
-        return usage_error("%s", "missing --capture IMG [IMG...]");
+    int ncap = lr_args_values(a, "--capture", captures, MAX_CAPTURES);
+    int nsets = lr_args_values(a, "--set", sets, MAX_SETS);
+    double gain = 0, gamma = 0, hmax = 10;
+    int frames = 0;
+    bool cpu = lr_args_has(a, "--cpu");
+    lr_err pe = {0};
+    int st = lr_cli_check(c, lr_args_double(a, "--gain", &gain, &pe) ||
+                                 lr_args_double(a, "--gamma", &gamma, &pe) ||
+                                 lr_args_int(a, "--frames", &frames, &pe) ||
+                                 lr_args_double(a, "--heatmap-max", &hmax, &pe),
+                          &pe);
+    if (st)
+        return st;
     double times[MAX_CAPTURES];
     if (times_s) {
         int nt = lr_args_times(times_s, times, MAX_CAPTURES);
         if (nt != ncap)
-            return usage_error("--times '%s': expected one exposure time (s) per capture", times_s);
+            return lr_cli_usage(c->path, "--times '%s': expected one exposure time (s) per capture",
+                                times_s);
     } else if (ncap > 1) {
-        return usage_error("%s", "an exposure stack of several captures needs --times");
+        return lr_cli_usage(c->path, "%s", "an exposure stack of several captures needs --times");
     } else {
         times[0] = 1.0;
     }
@@ -223,7 +192,7 @@ int lr_cmd_compare(int argc, char **argv)
     if (vignette) {
         lr_err ve = {0};
         if (lr_sensor_parse_vignette(vignette, &vig, &ve))
-            return usage_error("--vignette %s", ve.msg);
+            return lr_cli_usage(c->path, "--vignette %s", ve.msg);
     }
 
     double t0 = now_s();
@@ -244,7 +213,7 @@ int lr_cmd_compare(int argc, char **argv)
     if (lr_rig_calib_load(calib, rig, &e))
         goto fail;
     if (gamma > 0 && lr_rig_set_gamma(rig, gamma, &e)) {
-        status = usage_error("--gamma: %s", e.msg);
+        status = lr_cli_usage(c->path, "--gamma: %s", e.msg);
         goto done;
     }
     if (!rig->has_camera || !rig->has_pose) {
@@ -259,7 +228,7 @@ int lr_cmd_compare(int argc, char **argv)
         goto fail;
     for (int i = 0; i < nsets; i++)
         if (lr_scene_set_assignment(scene, sets[i], NULL, &e)) {
-            status = usage_error("--set: %s", e.msg);
+            status = lr_cli_usage(c->path, "--set: %s", e.msg);
             goto done;
         }
     for (; nimg < ncap; nimg++)
@@ -292,8 +261,8 @@ int lr_cmd_compare(int argc, char **argv)
         for (int y = 0; y < k->height; y++)
             for (int x = 0; x < k->width; x++) {
                 double V = lr_sensor_vignette(&vig, k->width, k->height, x, y);
-                for (int c = 0; c < 3; c++) { /* V = 0 (a polynomial's far corner): excluded */
-                    float *p = cap.rgb + 3 * ((size_t)y * k->width + x) + c;
+                for (int ch = 0; ch < 3; ch++) { /* V = 0 (a polynomial's far corner): excluded */
+                    float *p = cap.rgb + 3 * ((size_t)y * k->width + x) + ch;
                     *p = V > 1e-6 ? (float)(*p / V) : NAN;
                 }
             }
@@ -302,7 +271,7 @@ int lr_cmd_compare(int argc, char **argv)
         lr_camview_labels(view, scene, labels, &e))
         goto fail;
     double render_s = 0;
-    lr_view_render_desc vd = {.scene = scene, .view = view, .cpu = cpu, .frames = (int)frames};
+    lr_view_render_desc vd = {.scene = scene, .view = view, .cpu = cpu, .frames = frames};
     if (lr_view_render(&vd, &ren, &render_s, &e))
         goto fail;
     lr_compare_result res;
@@ -334,8 +303,7 @@ int lr_cmd_compare(int argc, char **argv)
     status = LR_EXIT_OK;
     goto done;
 fail:
-    fprintf(stderr, "lamprig compare: %s\n", e.msg);
-    status = LR_EXIT_FAIL;
+    status = lr_cli_fail(c->path, "%s", e.msg);
 done:
     for (int i = 0; i < nimg; i++)
         lr_img_free(&imgs[i]);

@@ -1,0 +1,137 @@
+/* lamprig plan — prints the planner's choice for a scene and nothing else: per object the
+ * measured model and settings, predicted error and time, and why (render/plan/plan.h). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "firmware/commands/commands.h"
+#include "render/plan/plan.h"
+#include "render/scene/scene.h"
+
+static int run_plan(const lr_cli *c);
+
+static const lr_argspec opts[] = {
+    {.name = "--scene", .type = LR_ARG_PATH, .flags = LR_ARG_REQUIRED,
+     .help = "the scene (configs/scenes/*.json); its \"quality\" block is the budget"},
+    {.name = "--max-error", .type = LR_ARG_NUMBER, .metavar = "E", .flags = LR_ARG_ABOVE_MIN,
+     .help = "relative RMSE budget (replaces the scene's quality block with --frame-ms)"},
+    {.name = "--frame-ms", .type = LR_ARG_NUMBER, .metavar = "T", .flags = LR_ARG_ABOVE_MIN,
+     .help = "milliseconds per accumulation frame"},
+    {.name = "--table", .type = LR_ARG_PATH, .metavar = "CSV",
+     .help = "the measured table (default: build/bench/results.csv when at least as\n"
+             "new as configs/bench/front.csv, else that one)"},
+    {.name = "--json", .help = "one JSON object instead of text"},
+    {.name = "--models", .type = LR_ARG_STRING,
+     .metavar = "directional_dipole|standard_dipole|all",
+     .help = "models to choose from, comma-separated (default all; the renderer\n"
+             "runs both, per object)"},
+    {0},
+};
+
+const lr_command lr_plan_command = {
+    .name = "plan",
+    .summary = "choose per object the cheapest measured settings that meet the scene's quality "
+               "budget",
+    .about =
+        "Prints, per object of the scene, the cheapest measured model and settings (K, N, N_vpl,\n"
+        "map and G-buffer sizes, frames, VPLs on or off) that meet the budget, the predicted error\n"
+        "(relative RMSE against the physical reference) and time, and the reasons: the measured\n"
+        "scene the rows come from, whether any receiver sees the object (else no VPL pass), how\n"
+        "many maps cover its surface (convex objects need fewer), infeasible budgets.",
+    .opts = opts,
+    .notes =
+        "Exit status: 0 planned (an infeasible budget is planned to the closest setting and said\n"
+        "so); 1 the table cannot be read or has no usable row; 2 bad arguments, scene or budget.\n"
+        "\n"
+        "Example:\n"
+        "  lamprig plan --scene configs/scenes/candle.json --max-error 0.05",
+    .run = run_plan,
+};
+
+static int models_arg(const lr_cli *c, const char *v, unsigned *out)
+{
+    *out = 0;
+    if (!v)
+        return LR_EXIT_OK;
+    char buf[128];
+    snprintf(buf, sizeof buf, "%s", v);
+    for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+        if (!strcmp(tok, "all"))
+            *out |= LR_PLAN_MODEL_DIRECTIONAL | LR_PLAN_MODEL_STANDARD;
+        else if (!strcmp(tok, "directional_dipole"))
+            *out |= LR_PLAN_MODEL_DIRECTIONAL;
+        else if (!strcmp(tok, "standard_dipole"))
+            *out |= LR_PLAN_MODEL_STANDARD;
+        else
+            return lr_cli_usage(c->path, "--models %.100s: expected directional_dipole, "
+                                         "standard_dipole or all", tok);
+    }
+    if (!*out)
+        return lr_cli_usage(c->path, "--models: empty");
+    return LR_EXIT_OK;
+}
+
+static int run_plan(const lr_cli *c)
+{
+    const lr_args *a = &c->args;
+    lr_err e = {0};
+    const char *scene_path = lr_args_get(a, "--scene");
+    lr_plan_budget b = {0};
+    unsigned models;
+    int st;
+    if ((st = lr_cli_check(c, lr_args_double(a, "--max-error", &b.max_error, &e) ||
+                                  lr_args_double(a, "--frame-ms", &b.frame_ms, &e),
+                           &e)) ||
+        (st = models_arg(c, lr_args_get(a, "--models"), &models)))
+        return st;
+
+    lr_scene *scene = NULL;
+    if (lr_scene_load(scene_path, NULL, &scene, &e)) {
+        if (e.code == LR_EIO)
+            return lr_cli_fail(c->path, "%s", e.msg);
+        return lr_cli_usage(c->path, "%s", e.msg);
+    }
+    if (!(b.max_error > 0) && !(b.frame_ms > 0) && !lr_plan_budget_from_scene(scene, &b)) {
+        lr_scene_destroy(scene);
+        return lr_cli_usage(c->path, "the scene has no quality budget (quality.max_error or "
+                           "quality.frame_ms): give --max-error or --frame-ms");
+    }
+    char table[1024];
+    const char *why = "given";
+    const char *tp = lr_args_get(a, "--table");
+    lr_plan_table *t = NULL;
+    lr_plan *plan = calloc(1, sizeof *plan);
+    char *text = NULL;
+    st = LR_EXIT_FAIL;
+    if (!plan)
+        goto done;
+    if (tp)
+        snprintf(table, sizeof table, "%s", tp);
+    else if (lr_plan_default_table(table, sizeof table, &why, &e))
+        goto fail;
+    if (lr_plan_table_load(table, &t, &e))
+        goto fail;
+    if (lr_plan_create(scene, t, &b, &(lr_plan_options){.models = models}, plan, &e))
+        goto fail;
+    bool json = lr_args_has(a, "--json");
+    size_t need = json ? lr_plan_format_json(plan, NULL, 0) : lr_plan_format(plan, NULL, 0);
+    if (!(text = malloc(need + 1)))
+        goto done;
+    if (json)
+        lr_plan_format_json(plan, text, need + 1);
+    else
+        lr_plan_format(plan, text, need + 1);
+    if (!json)
+        printf("plan: table %s (%s)\n", table, why);
+    fputs(text, stdout);
+    st = LR_EXIT_OK;
+    goto done;
+fail:
+    lr_cli_fail(c->path, "%s", e.msg);
+done:
+    free(text);
+    free(plan);
+    lr_plan_table_destroy(t);
+    lr_scene_destroy(scene);
+    return st;
+}
