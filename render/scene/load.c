@@ -499,6 +499,27 @@ static int parse_transform(ctx *c, lr_jnode n, const char *owhere, xform_spec *x
     return LR_OK;
 }
 
+/* "thickness_mm": the wall the multipole models (render/optics/optics.h); required with
+ * "model": "multipole", optional (kept for a later model change) otherwise. */
+static int get_thickness(ctx *c, lr_jnode obj, const char *where,
+                                     lr_scene_object *o)
+{
+    char f[96];
+    lr_jnode t = lr_json_get(c->j, obj, "thickness_mm");
+    o->thickness_mm = 0.0;
+    if (t == LR_JNONE)
+        return o->sss_model == LR_SSS_MULTIPOLE
+                   ? lr_json_fail(c->j, obj, cat(f, sizeof f, where, "thickness_mm"), c->e,
+                                  LR_EPARSE, "missing (required with model multipole)")
+                   : LR_OK;
+    int rc = get_num(c, obj, where, "thickness_mm", &o->thickness_mm);
+    lr_err inner = {0};
+    if (!rc && (rc = lr_multipole_thickness_validate(o->thickness_mm, &inner)))
+        return lr_json_fail(c->j, t, cat(f, sizeof f, where, "thickness_mm"), c->e, rc, "%s",
+                            inner.msg);
+    return rc;
+}
+
 static int parse_object(ctx *c, lr_jnode obj, int i, obj_rec *o)
 {
     char where[64];
@@ -506,7 +527,7 @@ static int parse_object(ctx *c, lr_jnode obj, int i, obj_rec *o)
     if (lr_json_type(c->j, obj) != LR_JSON_OBJECT)
         return lr_json_fail(c->j, obj, where, c->e, LR_EPARSE, "expected an object");
     static const char *const keys[] = {"name", "material", "mesh", "transform", "model",
-                                       "normalize", NULL};
+                                       "normalize", "thickness_mm", NULL};
     int rc;
     bool normalize = true; /* PIPELINE.md "Energy": S_d energy-normalised unless false */
     if ((rc = lr_json_check_keys(c->j, obj, where, keys, c->e)) ||
@@ -528,8 +549,11 @@ static int parse_object(ctx *c, lr_jnode obj, int i, obj_rec *o)
             return rc;
         if (!lr_sss_model_parse(name, &o->pub.sss_model))
             return lr_json_fail(c->j, model, f, c->e, LR_EINVAL,
-                                "'%s': expected directional_dipole or standard_dipole", name);
+                                "'%s': expected directional_dipole, standard_dipole or multipole",
+                                name);
     }
+    if ((rc = get_thickness(c, obj, where, &o->pub)))
+        return rc;
     lr_jnode mat = lr_json_get(c->j, obj, "material"), mesh = lr_json_get(c->j, obj, "mesh");
     if (mat == LR_JNONE)
         return lr_json_fail(c->j, obj, cat(f, sizeof f, where, "material"), c->e, LR_EPARSE,

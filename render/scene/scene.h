@@ -107,6 +107,7 @@ typedef struct lr_scene_object {
     double area;          /* world surface area, mm^2 */
     bool closed;          /* watertight (a shade with rims is; one without is not) */
     enum lr_sss_model sss_model; /* "model": the S_d the radiosity estimator evaluates */
+    double thickness_mm;  /* "thickness_mm": the wall the multipole models; 0: not given */
     bool sd_raw;          /* scene "normalize": false: [14]'s S_d as published, without
                            * coeffs.sd_norm (PIPELINE.md "Energy"); default: normalised */
 } lr_scene_object;

@@ -636,10 +636,23 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
     if (strcmp(f, "model") == 0) {
         enum lr_sss_model m;
         if (!lr_sss_model_parse(o->value, &m))
-            return fail(o, LR_EINVAL, "expected directional_dipole or standard_dipole, got '%s'",
+            return fail(o, LR_EINVAL,
+                        "expected directional_dipole, standard_dipole or multipole, got '%s'",
                         o->value);
+        if (m == LR_SSS_MULTIPOLE && !(rec->pub.thickness_mm > 0.0))
+            return fail(o, LR_EINVAL, "multipole needs the object's thickness_mm set first");
         rec->pub.sss_model = m;
         *d = LR_DIRTY_MATERIAL; /* another S_d: maps, VPLs, composition */
+        return LR_OK;
+    }
+    if (strcmp(f, "thickness_mm") == 0) {
+        double t = rec->pub.thickness_mm;
+        if ((rc = num_field(o, &t)))
+            return rc;
+        if ((rc = lr_multipole_thickness_validate(t, &inner)))
+            return lr_err_set(o->e, rc, "%s: %s", o->key, inner.msg);
+        rec->pub.thickness_mm = t;
+        *d = LR_DIRTY_MATERIAL; /* the multipole's S_d: maps, VPLs, composition */
         return LR_OK;
     }
     mesh_spec ms = rec->mesh;
@@ -657,7 +670,8 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
             return check_failed(o, f, bad, rc, &inner);
     } else {
         return unknown(o, "an object", f,
-                       "material, material.*, mesh.*, transform.*, model, normalize");
+                       "material, material.*, mesh.*, transform.*, model, normalize, "
+                   "thickness_mm");
     }
     lr_mesh *world;
     lr_bvh *bvh;
@@ -699,12 +713,15 @@ static int object_get(op *o, const lr_scene *s, int i, const char *f)
         return transform_field(o, &rec.xf, f + 10);
     if (strcmp(f, "model") == 0)
         return out(o, "%s", lr_sss_model_name(rec.pub.sss_model));
+    if (strcmp(f, "thickness_mm") == 0)
+        return num_field(o, &rec.pub.thickness_mm);
     if (strcmp(f, "normalize") == 0) {
         bool normalize = !rec.pub.sd_raw;
         return bool_field(o, &normalize);
     }
     return unknown(o, "an object", f,
-                   "material, material.*, mesh.*, transform.*, model, normalize");
+                   "material, material.*, mesh.*, transform.*, model, normalize, "
+                   "thickness_mm");
 }
 
 /* ---- keys ------------------------------------------------------------------------------------- */
