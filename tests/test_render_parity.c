@@ -302,6 +302,38 @@ static void test_maps_standard_dipole(void **state)
     lr_scene_destroy(s);
 }
 
+/* The multipole (issue 12) on the lamp shade's 1.5 mm porcelain wall: GPU maps against the twin
+ * evaluating lr_multipole_sd (T across the wall, R on the same face); same assertions as the
+ * directional dipole's lampshade test. The switch must reach the GPU: the multipole's map sum
+ * differs from the directional dipole's (test_maps_lampshade's) by far more than sigma. */
+static void test_maps_lampshade_multipole(void **state)
+{
+    (void)state;
+    static const char *const mp[] = {"objects[shade].thickness_mm=1.5",
+                                     "objects[shade].model=multipole", NULL};
+    lr_scene *s = lr_test_scene("lampshade", parity_settings, mp);
+    lr_renderer *r = lr_test_renderer(gl, s, 16, 12, true, 3);
+    lr_test_converge(r, 20);
+    parity p;
+    compare_maps(r, s, 256, true, &p);
+    report("lampshade maps, multipole (G-buffer emulated)", &p);
+    check_parity(&p);
+    unsigned dirty = 0;
+    lr_err e = {0};
+    if (lr_scene_set(s, "objects[shade].model", "directional_dipole", &dirty, &e))
+        fail_msg("%s", e.msg);
+    assert_int_equal(dirty, LR_DIRTY_MATERIAL);
+    lr_renderer_invalidate(r, dirty);
+    lr_test_converge(r, 20);
+    parity q;
+    compare_maps(r, s, 256, true, &q);
+    print_message("multipole / directional dipole lampshade map sum: %.4f\n",
+                  p.sum_gpu / q.sum_gpu);
+    assert_true(fabs(p.sum_gpu - q.sum_gpu) > 10.0 * (sqrt(p.var_sum) + sqrt(q.var_sum)));
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+}
+
 /* VPLs: the GPU places them from a cube map of the outer surface (vpl_map_size^2 faces), the
  * CPU by exact rays along the same directions u_v = lr_halton_sphere(v + 1) from the same
  * centre. Same validity; positions within 1.5 cube texels (|x_v - c| * 2 / size * 1.5 /
@@ -488,6 +520,7 @@ int main(void)
         cmocka_unit_test(test_maps_lampshade),
         cmocka_unit_test(test_maps_sphere_outside_light),
         cmocka_unit_test(test_maps_standard_dipole),
+        cmocka_unit_test(test_maps_lampshade_multipole),
         cmocka_unit_test(test_vpls),
         cmocka_unit_test(test_final_image),
         cmocka_unit_test(test_two_lights),
