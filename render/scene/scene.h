@@ -28,7 +28,11 @@
  *       "transform": {"translate": [0,0,0], "rotate_deg": [0,0,0] (about x, then y, then z),
  *                     "scale": 1 | [sx, sy, sz] (> 0)}                      (optional)
  *       "model":     "directional_dipole" (default; seed 003) | "standard_dipole" (Jensen
- *                    2001: S_d = R_d(r) / pi): the diffusion term of the radiosity maps
+ *                    2001: S_d = R_d(r) / pi) | "multipole" (Donner & Jensen 2005 slab of
+ *                    thickness_mm: T across the wall, R on the same face; issue 12): the
+ *                    diffusion term of the radiosity maps
+ *       "thickness_mm": the wall the multipole models, in [1e-3, 1e4] (required with
+ *                    "multipole", otherwise kept for a later model change)
  *       "normalize": true (false: the published directional dipole, without the energy
  *                    normalisation of PIPELINE.md "Energy"; no effect on the standard
  *                    dipole, whose total is the reference of that normalisation) (optional)
