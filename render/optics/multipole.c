@@ -77,22 +77,27 @@ int lr_multipole_pairs(const lr_coeffs *c, double d)
     return n;
 }
 
+/* alpha'/(4 pi) times the pole sum through one face (far: the bottom, T; else the top, R),
+ * band j, clamped >= 0. */
+static double face(const lr_coeffs *c, double d, int n, double r, int j, bool far)
+{
+    double s = c->sigma_tr[j], l = source_depth(c, j, d), zb = 0.5 * (c->z_v[j] - c->z_r[j]);
+    double L = d + 2.0 * zb, sum = 0.0;
+    for (int i = -n; i <= n; i++) {
+        double zr = 2.0 * i * L + l, zv = 2.0 * i * L - l - 2.0 * zb;
+        sum += far ? pole(s, d - zr, r) - pole(s, d - zv, r) : pole(s, zr, r) - pole(s, zv, r);
+    }
+    /* The truncated series can dip below 0 far out (its pairs' dipole tails); the profile is a
+     * flux out of the slab, so it is clamped as the directional dipole is [14]. */
+    return fmax(0.0, c->albedo_prime[j] / (4.0 * M_PI) * sum);
+}
+
 void lr_multipole_profile_n(const lr_coeffs *c, double d, int n, double r, double R[3],
                             double T[3])
 {
     for (int j = 0; j < 3; j++) {
-        double s = c->sigma_tr[j], l = source_depth(c, j, d), zb = 0.5 * (c->z_v[j] - c->z_r[j]);
-        double L = d + 2.0 * zb, sr = 0.0, st = 0.0;
-        for (int i = -n; i <= n; i++) {
-            double zr = 2.0 * i * L + l, zv = 2.0 * i * L - l - 2.0 * zb;
-            sr += pole(s, zr, r) - pole(s, zv, r);
-            st += pole(s, d - zr, r) - pole(s, d - zv, r);
-        }
-        /* The truncated series can dip below 0 far out (its pairs' dipole tails); the profile
-         * is a flux out of the slab, so it is clamped as the directional dipole is [14]. */
-        double k = c->albedo_prime[j] / (4.0 * M_PI);
-        R[j] = fmax(0.0, k * sr);
-        T[j] = fmax(0.0, k * st);
+        R[j] = face(c, d, n, r, j, false);
+        T[j] = face(c, d, n, r, j, true);
     }
 }
 
@@ -176,19 +181,14 @@ void lr_multipole_sd(const lr_coeffs *c, double d, lr_vec3 xi, lr_vec3 ni, lr_ve
                      lr_vec3 no, double out[3])
 {
     lr_vec3 x = lr_v3_sub(xo, xi);
-    double R[3], T[3];
-    if (lr_v3_dot(ni, no) < 0.0) {
-        /* Opposite faces: light crossed the wall. The slab's lateral offset is x_o's
-         * tangent-plane distance (the plane the estimator samples in). */
-        double h = lr_v3_dot(x, no), r2 = lr_v3_dot(x, x) - h * h;
-        lr_multipole_profile(c, d, sqrt(fmax(r2, 0.0)), R, T);
-        for (int j = 0; j < 3; j++)
-            out[j] = T[j] / M_PI;
-    } else {
-        lr_multipole_profile(c, d, lr_v3_len(x), R, T);
-        for (int j = 0; j < 3; j++)
-            out[j] = R[j] / M_PI;
-    }
+    /* Opposite faces: light crossed the wall, and the slab's lateral offset is x_o's
+     * tangent-plane distance (the plane the estimator samples in). Same face: the distance. */
+    bool far = lr_v3_dot(ni, no) < 0.0;
+    double h = lr_v3_dot(x, no), x2 = lr_v3_dot(x, x);
+    double r = far ? sqrt(fmax(x2 - h * h, 0.0)) : sqrt(x2);
+    int n = lr_multipole_pairs(c, d);
+    for (int j = 0; j < 3; j++)
+        out[j] = face(c, d, n, r, j, far) / M_PI;
 }
 
 void lr_multipole_sd_fresnel(const lr_coeffs *c, double d, lr_vec3 xi, lr_vec3 ni, lr_vec3 wi,
