@@ -501,8 +501,7 @@ static int parse_transform(ctx *c, lr_jnode n, const char *owhere, xform_spec *x
 
 /* "thickness_mm": the wall the multipole models (render/optics/optics.h); required with
  * "model": "multipole", optional (kept for a later model change) otherwise. */
-static int get_thickness(ctx *c, lr_jnode obj, const char *where,
-                                     lr_scene_object *o)
+static int get_thickness(ctx *c, lr_jnode obj, const char *where, lr_scene_object *o)
 {
     char f[96];
     lr_jnode t = lr_json_get(c->j, obj, "thickness_mm");

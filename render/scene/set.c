@@ -671,7 +671,7 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
     } else {
         return unknown(o, "an object", f,
                        "material, material.*, mesh.*, transform.*, model, normalize, "
-                   "thickness_mm");
+                       "thickness_mm");
     }
     lr_mesh *world;
     lr_bvh *bvh;
