@@ -257,11 +257,13 @@ static void test_shell_energy_bookkeeping(void **state)
  * per solid angle is uniform), with the twin's pass sampler and with the untruncated
  * reference sampler. The reference's Monte Carlo error (4 standard errors, times the gain) is
  * required to be below 2.5 % so that the test discriminates. */
-static void check_closed_shell(double ri, double eta)
+static void check_closed_shell_model(double ri, double eta, enum lr_sss_model model)
 {
     lr_medium m = white(eta);
     lrt_object o;
     lrt_object_make(lrt_shell_mesh(40, ri, 4), &m, &o);
+    o.obj.sss_model = model;
+    o.obj.thickness_mm = 40 - ri;
     lr_light l = lrt_point_light(lr_v3(0, 0, 0));
     lr_cpu_cavity cav;
     lr_err e = {0};
@@ -302,6 +304,11 @@ static void check_closed_shell(double ri, double eta)
     lrt_object_free(&o);
 }
 
+static void check_closed_shell(double ri, double eta)
+{
+    check_closed_shell_model(ri, eta, LR_SSS_DIRECTIONAL_DIPOLE);
+}
+
 static void test_closed_shell_emits_light_power(void **state)
 {
     (void)state;
@@ -309,6 +316,18 @@ static void test_closed_shell_emits_light_power(void **state)
     check_closed_shell(37, 1.5);
     check_closed_shell(20, 1.5);
     check_closed_shell(38, 1.0);
+}
+
+/* The same closed shell with the slab multipole (issue 12, "model": "multipole" with the wall's
+ * thickness): the closure's A is the multipole's exact R + T total (lr_sss_total, 1 at
+ * sigma_a = 0), so the outer surface emits 4 pi I within 5 % here too, for the 2 mm and 3 mm
+ * walls at eta 1.5 and the 2 mm wall at eta 1. */
+static void test_closed_shell_multipole(void **state)
+{
+    (void)state;
+    check_closed_shell_model(38, 1.5, LR_SSS_MULTIPOLE);
+    check_closed_shell_model(37, 1.5, LR_SSS_MULTIPOLE);
+    check_closed_shell_model(38, 1.0, LR_SSS_MULTIPOLE);
 }
 
 /* The raw model ("normalize": false) has no closure: gain 1, and the pass gives the published
@@ -349,6 +368,7 @@ int main(void)
         cmocka_unit_test(test_sphere_scene_light_in_medium),
         cmocka_unit_test(test_shell_energy_bookkeeping),
         cmocka_unit_test(test_closed_shell_emits_light_power),
+        cmocka_unit_test(test_closed_shell_multipole),
         cmocka_unit_test(test_closure_only_where_it_applies),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -391,11 +391,11 @@ static void test_standard_dipole_sd_and_switch(void **state)
     lr_dipole_sd_fresnel(&c, xi, ni, lr_v3_scale(wi, -1.0), xo, sdf);
     for (int j = 0; j < 3; j++)
         assert_true(sdf[j] == 0.0);
-    lr_sss_sd_fresnel(LR_SSS_STANDARD_DIPOLE, &c, xi, ni, wi, xo, no, sw);
+    lr_sss_sd_fresnel(LR_SSS_STANDARD_DIPOLE, &c, 0.0, xi, ni, wi, xo, no, sw);
     lr_dipole_sd_fresnel(&c, xi, ni, wi, xo, sdf);
     for (int j = 0; j < 3; j++)
         assert_true(sw[j] == sdf[j]);
-    lr_sss_sd_fresnel(LR_SSS_DIRECTIONAL_DIPOLE, &c, xi, ni, wi, xo, no, sw);
+    lr_sss_sd_fresnel(LR_SSS_DIRECTIONAL_DIPOLE, &c, 0.0, xi, ni, wi, xo, no, sw);
     lr_dirpole_sd_fresnel(&c, xi, ni, wi, xo, no, dp);
     for (int j = 0; j < 3; j++)
         assert_true(sw[j] == dp[j] && sw[j] != sdf[j]);

@@ -111,12 +111,39 @@ static void test_sphere_shell_emits_light_power(void **state)
     lr_scene_destroy(s);
 }
 
+/* The same shell with the slab multipole (issue 12): "thickness_mm": 2 (the wall) and "model":
+ * "multipole". The closure's A is the slab's exact R + T total (1 here, sigma_a = 0), so the
+ * outer surface still emits 4 pi I within 5 %. */
+static void test_sphere_shell_multipole(void **state)
+{
+    (void)state;
+    static const char *const sets[] = {"render.K=16", "render.N=16", "render.map_size=48",
+                                       "render.gbuffer_size=128", "render.frames=8",
+                                       "render.N_vpl=16", "render.vpl_map_size=16",
+                                       "objects[globe].thickness_mm=2",
+                                       "objects[globe].model=multipole", NULL};
+    lr_scene *s = lr_test_scene("sphere_shell", sets, NULL);
+    lr_renderer *r = lr_test_renderer(gl, s, 64, 48, true, 1);
+    lr_test_converge(r, 8);
+    double P[3], gain[3];
+    outer_power(r, s, P, gain);
+    for (int c = 0; c < 3; c++) {
+        print_message("sphere_shell multipole band %d: cavity gain %.3f, Phi_out %.4f x 4 pi I "
+                      "(GPU maps)\n", c, gain[c], P[c]);
+        assert_true(gain[c] > 1.0);
+        assert_near(P[c], 1.0, 0.05);
+    }
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+}
+
 int main(void)
 {
     if (getenv("LR_TEST_FILTER"))
         cmocka_set_test_filter(getenv("LR_TEST_FILTER"));
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sphere_shell_emits_light_power),
+        cmocka_unit_test(test_sphere_shell_multipole),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

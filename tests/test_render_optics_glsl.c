@@ -205,7 +205,7 @@ static void test_optics_glsl_matches_c(void **state)
         }
         assert_near(g[8], lr_fresnel_reflectance(c->cos_i, c->eta), 1e-5);
         double sw[3], st[3];
-        lr_sss_sd_fresnel(model_of(c->mat), cf, c->xi, c->ni, c->wi, c->xo, c->no, sw);
+        lr_sss_sd_fresnel(model_of(c->mat), cf, 0.0, c->xi, c->ni, c->wi, c->xo, c->no, sw);
         lr_dipole_sd(cf, c->xi, c->xo, st);
         double mw = fmax(sw[0], fmax(sw[1], sw[2])), mt = fmax(st[0], fmax(st[1], st[2]));
         for (int j = 0; j < 3; j++) {
@@ -235,10 +235,120 @@ static void test_optics_glsl_matches_c(void **state)
     free(cs);
 }
 
+/* The multipole (model 2) through the same shader's model switch (texel 3) against
+ * lr_sss_sd_fresnel: slabs of porcelain 1.5 mm, candle_wax 7 and 14 mm, marble 3 mm and a
+ * 0.1 mm sheet (source at d/2); entry on the top face, exit on the same face (R) and on the
+ * far face (T), at radii 0.02-4 (d + 2 z_b). Float: every pole term is one exp (<= 1.1e-5)
+ * and ~12 roundings; the pairs' sum cancels at most where the profile has fallen far below
+ * its peak, so the assertion is 1e-3 relative plus 1e-5 of the profile's value at r = 0
+ * (the absolute floor where T(r) has decayed by orders of magnitude). */
+static void test_multipole_glsl_matches_c(void **state)
+{
+    static const struct {
+        const char *name;
+        double d;
+    } slabs[] = {{"porcelain", 1.5}, {"candle_wax", 7.0}, {"candle_wax", 14.0}, {"marble", 3.0},
+                 {"porcelain", 0.1}};
+    enum { NS = 5, NR = 8, NW = 2 };
+    static const double rfrac[NR] = {0.0, 0.02, 0.1, 0.3, 0.7, 1.2, 2.0, 4.0};
+    lr_coeffs co[NS];
+    lr_err e = {0};
+    float coef[5 * 4 * LR_MAX_OBJECTS] = {0};
+    float sss[3 * 4 * LR_MAX_OBJECTS] = {0};
+    for (int m = 0; m < NS; m++) {
+        lr_material mt;
+        if (lr_material_find(slabs[m].name, &mt, &e) || lr_coeffs_derive(&mt.medium, &co[m], &e))
+            fail_msg("%s", e.msg);
+        lr_passes_pack_coeffs(&co[m], coef + 20 * m);
+        lr_passes_pack_sss(&co[m], LR_SSS_MULTIPOLE, sss + 12 * m);
+        lr_passes_pack_multipole(&co[m], LR_SSS_MULTIPOLE, slabs[m].d, sss + 12 * m);
+        assert_true(sss[12 * m + 11] == (float)lr_multipole_pairs(&co[m], slabs[m].d));
+    }
+    int n = NS * NR * NW;
+    tcase *cs = calloc((size_t)n, sizeof *cs);
+    float *in = calloc((size_t)n * 6 * 4, sizeof *in);
+    for (int m = 0, k = 0; m < NS; m++)
+        for (int a = 0; a < NR; a++)
+            for (int w = 0; w < NW; w++, k++) {
+                tcase *c = &cs[k];
+                double zb = 0.5 * (co[m].z_v[1] - co[m].z_r[1]), d = slabs[m].d;
+                double r = rfrac[a] * (d + 2.0 * zb), phi = 0.4 * a;
+                c->mat = m;
+                c->xi = f3(lr_v3(2.0, 1.0, 0.5));
+                c->ni = f3(lr_v3(0, 0, 1));
+                c->wi = f3(unit(0.3, 0.1, 1.0));
+                c->xo = f3(lr_v3_add(c->xi, lr_v3(r * cos(phi), r * sin(phi), w ? -d : 0.0)));
+                c->no = f3(lr_v3(0, 0, w ? -1 : 1));
+                lr_vec3 v[5] = {c->xi, c->ni, c->wi, c->xo, c->no};
+                for (int j = 0; j < 5; j++) {
+                    in[(k * 6 + j) * 4 + 0] = (float)v[j].x;
+                    in[(k * 6 + j) * 4 + 1] = (float)v[j].y;
+                    in[(k * 6 + j) * 4 + 2] = (float)v[j].z;
+                }
+                in[(k * 6) * 4 + 3] = (float)m;
+                in[(k * 6 + 5) * 4 + 3] = 1.0f; /* r_max of the sampling texel */
+            }
+    lr_tex *tin = NULL, *tout = NULL;
+    lr_fb *fb = NULL;
+    lr_program *p = NULL;
+    if (lr_tex_create(gl, &(lr_tex_desc){.width = 6, .height = n}, &tin, &e) ||
+        lr_tex_upload(tin, 0, in, &e) ||
+        lr_tex_create(gl, &(lr_tex_desc){.width = 5, .height = n}, &tout, &e) ||
+        lr_fb_create(gl, &(lr_fb_desc){.color = {{tout, 0}}}, &fb, &e) ||
+        lr_program_create(&(lr_program_desc){.vertex = "render/shaders/fullscreen.vert",
+                                             .fragment = "tests/shaders/optics_eval.frag"},
+                          &p, &e))
+        fail_msg("%s", e.msg);
+    lr_fb_bind(fb);
+    glUseProgram(lr_program_id(p));
+    glUniform4fv(lr_program_uniform(p, "u_coef"), 5 * LR_MAX_OBJECTS, coef);
+    glUniform4fv(lr_program_uniform(p, "u_sss"), 3 * LR_MAX_OBJECTS, sss);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, lr_tex_id(tin));
+    glUniform1i(lr_program_uniform(p, "u_cases"), 0);
+    lr_gl_draw_fullscreen(gl);
+    float *out = calloc((size_t)n * 5 * 4, sizeof *out);
+    if (lr_fb_read(fb, 0, 0, 0, 5, n, out, &e))
+        fail_msg("%s", e.msg);
+    double worst = 0.0;
+    int nonzero = 0;
+    for (int k = 0; k < n; k++) {
+        const tcase *c = &cs[k];
+        const lr_coeffs *cf = &co[c->mat];
+        double d = slabs[c->mat].d, sw[3], R0[3], T0[3];
+        lr_sss_sd_fresnel(LR_SSS_MULTIPOLE, cf, d, c->xi, c->ni, c->wi, c->xo, c->no, sw);
+        lr_multipole_profile(cf, d, 0.0, R0, T0);
+        bool across = c->no.z < 0.0;
+        double ft = lr_fresnel_transmittance(lr_v3_dot(c->wi, c->ni), cf->eta);
+        const float *g = out + (size_t)k * 5 * 4;
+        for (int j = 0; j < 3; j++) {
+            double floor_ = 1e-5 * ft * (across ? T0[j] : R0[j]) / M_PI;
+            if (!(fabs(g[12 + j] - sw[j]) <= 1e-3 * sw[j] + floor_))
+                fail_msg("case %d (%s %.1f mm, %s) band %d: GLSL %.9g, C %.9g", k,
+                         slabs[c->mat].name, d, across ? "across" : "same face", j, g[12 + j],
+                         sw[j]);
+            if (sw[j] > 100.0 * floor_) { /* above 1e-3 of the peak */
+                nonzero++;
+                worst = fmax(worst, fabs(g[12 + j] - sw[j]) / sw[j]);
+            }
+        }
+    }
+    assert_true(nonzero > n);
+    printf("GLSL vs C multipole: %d cases, worst relative S_d difference %.3g\n", n, worst);
+    lr_program_destroy(p);
+    lr_fb_destroy(fb);
+    lr_tex_destroy(tin);
+    lr_tex_destroy(tout);
+    free(out);
+    free(in);
+    free(cs);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_optics_glsl_matches_c),
+        cmocka_unit_test(test_multipole_glsl_matches_c),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -722,8 +722,32 @@ static void test_model_switch_and_light_cap(void **state)
     set_ok(s, "objects[c].model", "standard_dipole", LR_DIRTY_MATERIAL);
     assert_int_equal(lr_scene_object_at(s, 0)->sss_model, LR_SSS_STANDARD_DIPOLE);
     get(s, "objects[0].model", "standard_dipole");
-    set_bad(s, "objects[0].model", "jensen", "expected directional_dipole or standard_dipole");
+    set_bad(s, "objects[0].model", "jensen",
+            "expected directional_dipole, standard_dipole or multipole");
+    /* The multipole needs the wall's thickness first (issue 12). */
+    set_bad(s, "objects[0].model", "multipole", "needs the object's thickness_mm set first");
+    set_bad(s, "objects[0].thickness_mm", "-2", "objects[0].thickness_mm");
+    /* 0 is "not given", which only the multipole refuses. */
+    set_ok(s, "objects[0].thickness_mm", "0", LR_DIRTY_MATERIAL);
+    set_ok(s, "objects[0].thickness_mm", "1.5", LR_DIRTY_MATERIAL);
+    get(s, "objects[0].thickness_mm", "1.5");
+    set_ok(s, "objects[0].model", "multipole", LR_DIRTY_MATERIAL);
+    assert_int_equal(lr_scene_object_at(s, 0)->sss_model, LR_SSS_MULTIPOLE);
+    assert_true(lr_scene_object_at(s, 0)->thickness_mm == 1.5);
+    set_bad(s, "objects[0].thickness_mm", "0", "the multipole needs a thickness > 0 mm");
+    assert_true(lr_scene_object_at(s, 0)->thickness_mm == 1.5);
+    assert_true(lr_scene_object_sd_norm(lr_scene_object_at(s, 0), 0) == 1.0);
     lr_scene_destroy(s);
+    scene_text(t, sizeof t, ",\n     \"model\": \"multipole\", \"thickness_mm\": 7", "", NULL);
+    assert_int_equal(parse(t, &s, &e), LR_OK);
+    assert_int_equal(lr_scene_object_at(s, 0)->sss_model, LR_SSS_MULTIPOLE);
+    assert_true(lr_scene_object_at(s, 0)->thickness_mm == 7.0);
+    lr_scene_destroy(s);
+    scene_text(t, sizeof t, ",\n     \"model\": \"multipole\"", "", NULL);
+    expect_scene_error(t, LR_EPARSE, "field 'objects[0].thickness_mm': missing (required with "
+                                     "model multipole)");
+    scene_text(t, sizeof t, ",\n     \"model\": \"multipole\", \"thickness_mm\": -1", "", NULL);
+    expect_scene_error(t, LR_EINVAL, "t.json:6: field 'objects[0].thickness_mm'");
 
     scene_text(t, sizeof t, ",\n     \"model\": \"standard_dipole\"", "", NULL);
     assert_int_equal(parse(t, &s, &e), LR_OK);
@@ -731,7 +755,7 @@ static void test_model_switch_and_light_cap(void **state)
     lr_scene_destroy(s);
     scene_text(t, sizeof t, ",\n     \"model\": \"dipole\"", "", NULL);
     expect_scene_error(t, LR_EINVAL, "t.json:6: field 'objects[0].model': 'dipole': expected "
-                                     "directional_dipole or standard_dipole");
+                                     "directional_dipole, standard_dipole or multipole");
     scene_text(t, sizeof t, ",\n     \"model\": 1", "", NULL);
     expect_scene_error(t, LR_EPARSE, "t.json:6: field 'objects[0].model'");
 

@@ -149,7 +149,9 @@ int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
     point_ctx pc = {obj, l, cdf, nt, npts, N, seed, P};
     lr_cpu_parallel_for(npts, d ? d->threads : 0, point_item, &pc);
     double T = lr_hemi_transmittance(eta), A[3];
-    lr_dipole_rd_total(&obj->coeffs, A); /* the normalised model's half-space total */
+    /* The normalised model's half-space total; for the multipole the slab's R + T total
+     * (what entered and was not absorbed: a thin wall absorbs less than a half-space). */
+    lr_sss_total(obj->sss_model, &obj->coeffs, obj->thickness_mm, A);
     for (int c = 0; c < 3; c++) {
         double sum = 0.0;
         for (int i = 0; i < npts; i++)

@@ -18,7 +18,8 @@
  *
  * with a = (power leaving the surface the light does not see) / (power that entered), from the
  * model (area-sampled surface points, B with the untruncated sampler), and A the normalised
- * model's half-space total (lr_dipole_rd_total; 1 at albedo' 1). For a closed non-absorbing
+ * model's half-space total (lr_dipole_rd_total; 1 at albedo' 1; for "model": "multipole" the
+ * slab's R + T total, lr_sss_total). For a closed non-absorbing
  * object (F = 1, A = 1) the unlit surface then emits exactly the light's power whatever a is;
  * the half-space model's own cavity-side B (which double counts in a thin wall) is not used
  * for b. Only for point and spot lights inside the object's hull (LR_ENCLOSURE_HULL); the raw

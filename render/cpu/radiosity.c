@@ -116,8 +116,8 @@ static double lit_point(const ctx *k, lr_vec3 vh, int c)
         return 0.0;
     double sd[3];
     /* w_i = -look points from x_i to the light; n_i . w_i <= 0 contributes 0 (PIPELINE.md). */
-    lr_sss_sd_fresnel(k->obj->sss_model, &k->obj->coeffs, xi, ni, lr_v3_scale(look, -1.0), k->xo,
-                      k->no, sd);
+    lr_sss_sd_fresnel(k->obj->sss_model, &k->obj->coeffs, k->obj->thickness_mm, xi, ni,
+                      lr_v3_scale(look, -1.0), k->xo, k->no, sd);
     return M_PI * sd[c] * shape;
 }
 
@@ -133,8 +133,8 @@ static double lit_plane(const ctx *k, lr_vec3 xj, int c)
     if (!gbuffer_texel(k, org, k->wl, 0.0, &xi, &ni))
         return 0.0;
     double sd[3];
-    lr_sss_sd_fresnel(o->sss_model, &o->coeffs, xi, ni, lr_v3_scale(k->wl, -1.0), k->xo, k->no,
-                      sd);
+    lr_sss_sd_fresnel(o->sss_model, &o->coeffs, o->thickness_mm, xi, ni, lr_v3_scale(k->wl, -1.0),
+                      k->xo, k->no, sd);
     return M_PI * sd[c];
 }
 

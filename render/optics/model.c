@@ -1,12 +1,14 @@
 /* The diffusion-model switch: which S_d an object's scattered-radiosity estimator evaluates
  * (directional dipole [14], seed 003's choice, or the standard dipole of Jensen et al. 2001,
- * for comparison as in seed 003 Fig. 6). The sampling is the same for both (seed 003 Eq. 11-12:
- * both decay as exp(-sigma_tr d)). */
+ * for comparison as in seed 003 Fig. 6), or the slab multipole of Donner & Jensen 2005 for thin
+ * walls (issue 12). The sampling is the same for all (seed 003 Eq. 11-12: all decay as
+ * exp(-sigma_tr d)). */
 #include "render/optics/optics.h"
 
 #include <string.h>
 
-static const char *const names[LR_SSS_MODEL_COUNT] = {"directional_dipole", "standard_dipole"};
+static const char *const names[LR_SSS_MODEL_COUNT] = {"directional_dipole", "standard_dipole",
+                                                       "multipole"};
 
 const char *lr_sss_model_name(enum lr_sss_model m)
 {
@@ -23,11 +25,25 @@ bool lr_sss_model_parse(const char *name, enum lr_sss_model *out)
     return false;
 }
 
-void lr_sss_sd_fresnel(enum lr_sss_model m, const lr_coeffs *c, lr_vec3 xi, lr_vec3 ni,
-                       lr_vec3 wi, lr_vec3 xo, lr_vec3 no, double out[3])
+void lr_sss_sd_fresnel(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm, lr_vec3 xi,
+                       lr_vec3 ni, lr_vec3 wi, lr_vec3 xo, lr_vec3 no, double out[3])
 {
     if (m == LR_SSS_STANDARD_DIPOLE)
         lr_dipole_sd_fresnel(c, xi, ni, wi, xo, out);
+    else if (m == LR_SSS_MULTIPOLE)
+        lr_multipole_sd_fresnel(c, thickness_mm, xi, ni, wi, xo, no, out);
     else
         lr_dirpole_sd_fresnel(c, xi, ni, wi, xo, no, out);
+}
+
+void lr_sss_total(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm, double out[3])
+{
+    if (m != LR_SSS_MULTIPOLE) {
+        lr_dipole_rd_total(c, out);
+        return;
+    }
+    double R[3], T[3];
+    lr_multipole_total(c, thickness_mm, R, T);
+    for (int j = 0; j < 3; j++)
+        out[j] = R[j] + T[j];
 }

@@ -134,6 +134,7 @@ void lr_passes_update_coeffs(lr_renderer *r)
         const lr_scene_object *o = lr_scene_object_at(r->scene, i);
         lr_passes_pack_coeffs(&o->coeffs, r->coef + 20 * i);
         lr_passes_pack_sss(&o->coeffs, o->sss_model, r->sss + 12 * i);
+        lr_passes_pack_multipole(&o->coeffs, o->sss_model, o->thickness_mm, r->sss + 12 * i);
     }
     for (int i = 0; i < LR_MAX_OBJECTS; i++)
         for (int c = 0; c < 3; c++)

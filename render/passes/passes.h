@@ -170,6 +170,10 @@ void lr_passes_pack_coeffs(const lr_coeffs *c, float out[20]);
 /* One object's block of render/shaders/lib/material.glsl's u_sss (12 floats): the model
  * switch and the standard dipole's albedo', z_r, z_v. */
 void lr_passes_pack_sss(const lr_coeffs *c, enum lr_sss_model model, float out[12]);
+/* The multipole's slab into that block (multipole.c): out[7] = thickness_mm, out[11] =
+ * lr_multipole_pairs; both 0 unless model is LR_SSS_MULTIPOLE. */
+void lr_passes_pack_multipole(const lr_coeffs *c, enum lr_sss_model model, double thickness_mm,
+                              float out[12]);
 /* Coefficient blocks (u_coef, u_sss) of every object (render/shaders/lib/material.glsl). */
 void lr_passes_update_coeffs(lr_renderer *r);
 void lr_passes_set_coeffs(lr_renderer *r, const lr_program *p);

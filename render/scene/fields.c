@@ -344,6 +344,8 @@ static int check_one(const lr_field *f, void *rec, const char **field, lr_err *e
     case LR_FT_NUM:
         if ((f->flags & LR_FF_ZERO_FLAG) && *(bool *)at(rec, f->aux))
             return LR_OK;
+        if ((f->flags & LR_FF_ZERO_ABSENT) && *(double *)p == 0.0)
+            return LR_OK;
         v[n++] = *(double *)p;
         break;
     case LR_FT_INT: v[n++] = *(int *)p; break;

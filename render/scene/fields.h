@@ -51,6 +51,7 @@ enum {
     LR_FF_INVERT = 1u << 8,     /* a bool stored negated (normalize -> sd_raw) */
     LR_FF_ZERO_FLAG = 1u << 9,  /* 0 is a shape, not the default: sets the bool at aux */
     LR_FF_NO_SET = 1u << 10,    /* not a run-time parameter (names, types, mesh type) */
+    LR_FF_ZERO_ABSENT = 1u << 11, /* 0 means "not given": outside the range's check */
 };
 
 /* No bound. */

@@ -298,6 +298,13 @@ static int parse_object(ctx *c, lr_jnode obj, int i, obj_rec *o)
         (rc = lr_fields_read(c->j, obj, where, &lr_scene_object_desc, 0, o, c->e)))
         return rc;
     char f[256];
+    const char *field = NULL;
+    lr_err inner = {0};
+    if ((rc = lr_fields_check(&lr_scene_object_desc, o, &field, &inner)))
+        return fail_check(c, obj, where, field, rc, &inner);
+    if (o->pub.sss_model == LR_SSS_MULTIPOLE && !(o->pub.thickness_mm > 0.0))
+        return lr_json_fail(c->j, obj, cat(f, sizeof f, where, "thickness_mm"), c->e, LR_EPARSE,
+                            "missing (required with model multipole)");
     lr_jnode mat = lr_json_get(c->j, obj, "material"), mesh = lr_json_get(c->j, obj, "mesh");
     if (mat == LR_JNONE)
         return lr_json_fail(c->j, obj, cat(f, sizeof f, where, "material"), c->e, LR_EPARSE,
@@ -309,7 +316,6 @@ static int parse_object(ctx *c, lr_jnode obj, int i, obj_rec *o)
         (rc = parse_mesh(c, mesh, where, &o->mesh)) ||
         (rc = parse_transform(c, lr_json_get(c->j, obj, "transform"), where, &o->xf)))
         return rc;
-    lr_err inner = {0};
     if ((rc = lr_coeffs_derive(&o->pub.material.medium, &o->pub.coeffs, &inner)))
         return lr_json_fail(c->j, mat, cat(f, sizeof f, where, "material"), c->e, rc, "%s",
                             inner.msg);

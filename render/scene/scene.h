@@ -8,7 +8,8 @@
  * {"name": string (default: the file name),
  *  "objects":   [ OBJECT, ... ]       one or more translucent objects: "name", "material"
  *                                     (a preset name or a material object), "mesh" (a "type"
- *                                     and its parameters), "transform", "model", "normalize"
+ *                                     and its parameters), "transform", "model", "thickness_mm",
+ *                                     "normalize"
  *  "lights":    [ LIGHT, ... ]        one to LR_SCENE_MAX_LIGHTS: point, spot, directional
  *  "camera":    CAMERA
  *  "receivers": [ RECEIVER, ... ]     diffuse planes and boxes (optional)
@@ -68,6 +69,7 @@ typedef struct lr_scene_object {
     double area;          /* world surface area, mm^2 */
     bool closed;          /* watertight (a shade with rims is; one without is not) */
     enum lr_sss_model sss_model; /* "model": the S_d the radiosity estimator evaluates */
+    double thickness_mm;  /* "thickness_mm": the wall the multipole models; 0: not given */
     bool sd_raw;          /* scene "normalize": false: [14]'s S_d as published, without
                            * coeffs.sd_norm (PIPELINE.md "Energy"); default: normalised */
 } lr_scene_object;

@@ -226,7 +226,8 @@ static int material_failed(op *o, int rc, const lr_err *inner)
     return lr_err_set(o->e, rc, "%s: %s", o->key, inner->msg);
 }
 
-#define OBJECT_KNOWN "known: material, material.*, mesh.*, transform.*, model, normalize"
+#define OBJECT_KNOWN                                                                      \
+    "known: material, material.*, mesh.*, transform.*, model, thickness_mm, normalize"
 
 static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
 {
@@ -253,8 +254,23 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
         *d = LR_DIRTY_MATERIAL;
         return LR_OK;
     }
-    if (strcmp(f, "normalize") == 0 || strcmp(f, "model") == 0) /* another S_d */
+    if (strcmp(f, "normalize") == 0) /* another S_d */
         return table_field(o, &lr_scene_object_desc, rec, f, d);
+    if (strcmp(f, "model") == 0 || strcmp(f, "thickness_mm") == 0) {
+        /* The multipole models a wall: it needs the wall's thickness (issue 12). */
+        obj_rec next = *rec;
+        const char *bad = NULL;
+        if ((rc = table_field(o, &lr_scene_object_desc, &next, f, d)))
+            return rc;
+        if ((rc = lr_fields_check(&lr_scene_object_desc, &next, &bad, &inner)))
+            return check_failed(o, f, bad, rc, &inner);
+        if (next.pub.sss_model == LR_SSS_MULTIPOLE && !(next.pub.thickness_mm > 0.0))
+            return fail(o, LR_EINVAL, strcmp(f, "model") == 0
+                                          ? "multipole needs the object's thickness_mm set first"
+                                          : "the multipole needs a thickness > 0 mm");
+        *rec = next;
+        return LR_OK;
+    }
     mesh_spec ms = rec->mesh;
     xform_spec xf = rec->xf;
     const char *bad = NULL;
@@ -310,7 +326,7 @@ static int object_get(op *o, const lr_scene *s, int i, const char *f)
         return mesh_field(o, &rec.mesh, f + 5, &d);
     if (strncmp(f, "transform.", 10) == 0)
         return table_field(o, &lr_scene_transform_desc, &rec.xf, f + 10, &d);
-    if (strcmp(f, "model") == 0 || strcmp(f, "normalize") == 0)
+    if (strcmp(f, "model") == 0 || strcmp(f, "normalize") == 0 || strcmp(f, "thickness_mm") == 0)
         return table_field(o, &lr_scene_object_desc, &rec, f, &d);
     return fail(o, LR_EINVAL, "an object has no parameter '%s' (%s)", f, OBJECT_KNOWN);
 }

@@ -10,7 +10,8 @@
 
 uniform vec4 u_coef[5 * LR_MAX_OBJECTS];
 // The diffusion model and standard-dipole coefficients, three vec4 per object (common.c
-// lr_passes_pack_sss): [0] albedo'.rgb, model   [1] z_r.rgb   [2] z_v.rgb
+// lr_passes_pack_sss): [0] albedo'.rgb, model   [1] z_r.rgb, multipole thickness (mm)
+// [2] z_v.rgb, multipole pole pairs (lr_passes_pack_multipole; 0 for the other models)
 uniform vec4 u_sss[3 * LR_MAX_OBJECTS];
 
 lr_coeffs_gl lr_material(int id)
@@ -38,5 +39,7 @@ lr_sss_gl lr_material_sss(int id)
     s.albedo_prime = u_sss[b].xyz;
     s.z_r = u_sss[b + 1].xyz;
     s.z_v = u_sss[b + 2].xyz;
+    s.thickness = u_sss[b + 1].w;
+    s.pairs = clamp(int(u_sss[b + 2].w + 0.5), 0, 16); // LR_MULTIPOLE_MAX_PAIRS
     return s;
 }

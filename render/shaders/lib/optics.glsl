@@ -1,6 +1,6 @@
-// GLSL port of render/optics/{fresnel,dirpole,dipole,model,sampling}.c (the C versions are the reference;
-// tests/test_render_optics_glsl.c compares the two on a grid). Float instead of double: the
-// guards that the C code needs for the double range are kept with float thresholds.
+// GLSL port of render/optics/{fresnel,dirpole,dipole,multipole,model,sampling}.c (the C versions
+// are the reference; tests/test_render_optics_glsl.c compares the two on a grid). Float instead
+// of double: the guards that the C code needs for the double range are kept with float thresholds.
 
 const float LR_PI = 3.14159265358979;
 
@@ -162,12 +162,15 @@ vec3 lr_dirpole_sd_fresnel(lr_coeffs_gl c, vec3 xi, vec3 ni, vec3 wi, vec3 xo, v
 }
 
 // Standard dipole (render/optics/dipole.c): the coefficients lr_coeffs_gl lacks, per object,
-// and the model switch (render/optics/model.c; 0 directional dipole, 1 standard dipole).
+// and the model switch (render/optics/model.c; 0 directional dipole, 1 standard dipole,
+// 2 multipole with the slab's thickness and pole-pair count).
 struct lr_sss_gl {
     int model;
     vec3 albedo_prime;
     vec3 z_r;
     vec3 z_v;
+    float thickness;
+    int pairs;
 };
 
 // dipole.c source_term: z (sigma_tr d + 1) e^{-sigma_tr d} / d^3, d = sqrt(r^2 + z^2).
@@ -190,11 +193,49 @@ float lr_dipole_sd_band(lr_coeffs_gl c, lr_sss_gl s, int j, vec3 xi, vec3 xo)
     return rd / LR_PI;
 }
 
+// multipole.c pole(): the signed source term P(z) = z (sigma_tr s + 1) e^{-sigma_tr s} / s^3,
+// s = sqrt(r^2 + z^2).
+float lr_multipole_pole(float sigma_tr, float z, float r)
+{
+    float d = sqrt(r * r + z * z);
+    float s = sigma_tr * d;
+    if (!(s < 87.0) || !(d > 0.0))
+        return 0.0;
+    return z * (s + 1.0) * exp(-s) / (d * d * d);
+}
+
+// lr_multipole_sd for band j (render/optics/multipole.c, Donner & Jensen 2005): T(r_perp) / pi
+// across the wall (n_i . n_o < 0), R(|x_o - x_i|) / pi on the same face; s.pairs pole pairs
+// (lr_multipole_pairs, packed by lr_passes_pack_multipole).
+float lr_multipole_sd_band(lr_coeffs_gl c, lr_sss_gl s, int j, vec3 xi, vec3 ni, vec3 xo,
+                           vec3 no)
+{
+    vec3 x = xo - xi;
+    float d = s.thickness, st = c.sigma_tr[j];
+    float zb = 0.5 * (s.z_v[j] - s.z_r[j]);
+    float l = min(s.z_r[j], 0.5 * d);
+    float L = d + 2.0 * zb;
+    bool across = dot(ni, no) < 0.0;
+    float h = dot(x, no);
+    float r = across ? sqrt(max(dot(x, x) - h * h, 0.0)) : length(x);
+    float sum = 0.0;
+    for (int i = -s.pairs; i <= s.pairs; i++) {
+        float zr = 2.0 * float(i) * L + l, zv = 2.0 * float(i) * L - l - 2.0 * zb;
+        if (across)
+            sum += lr_multipole_pole(st, d - zr, r) - lr_multipole_pole(st, d - zv, r);
+        else
+            sum += lr_multipole_pole(st, zr, r) - lr_multipole_pole(st, zv, r);
+    }
+    return max(s.albedo_prime[j] / (4.0 * LR_PI) * sum, 0.0) / LR_PI;
+}
+
 // The model switch (lr_sss_sd_fresnel without the F_t(w_i) factor), band j.
 float lr_sss_sd_band(lr_coeffs_gl c, lr_sss_gl s, int j, vec3 xi, vec3 ni, vec3 wi, vec3 xo,
                      vec3 no)
 {
     if (s.model == 1)
         return lr_dipole_sd_band(c, s, j, xi, xo);
+    if (s.model == 2)
+        return lr_multipole_sd_band(c, s, j, xi, ni, xo, no);
     return lr_dirpole_sd_band(c, j, xi, ni, wi, xo, no);
 }
