@@ -34,6 +34,7 @@ struct lr_renderer {
     lr_tex_format map_format; /* RGBA32F, or RGBA16F when float targets/blending are missing */
     char info[256];           /* renderer string for the stats */
     char shader_dir[512];
+    lr_shader_defines defines; /* lr_passes_defines: every program is built with them */
     lr_timer *timer;
     lr_pass_programs prog;
 
@@ -77,6 +78,19 @@ static lr_pass_ctx pass_ctx(const lr_renderer *r)
             c.I[l][b] *= f;
     }
     return c;
+}
+
+/* A uniform a pass set that its program's shaders do not declare (lr_program_check). */
+static int check_programs(lr_renderer *r, lr_err *e)
+{
+    lr_program *ps[] = {r->prog.surface, r->prog.depth, r->prog.radiosity, r->prog.vpl,
+                        r->prog.obj,     r->prog.recv,  r->prog.blit,      r->prog.irr};
+    for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++) {
+        int rc = ps[i] ? lr_program_check(ps[i], e) : LR_OK;
+        if (rc)
+            return rc;
+    }
+    return LR_OK;
 }
 
 /* ---- the pass table: each row's hooks hand its pass the inputs it reads ------------------- */
@@ -152,7 +166,7 @@ static int compose_run(lr_renderer *r, unsigned dirty, lr_err *e)
 static int blend_alloc(lr_renderer *r, lr_err *e)
 {
     lr_blend_desc bd = {.gl = r->gl, .width = r->width, .height = r->height,
-                        .shader_dir = r->shader_dir, .defines = lr_passes_defines()};
+                        .shader_dir = r->shader_dir, .defines = r->defines.list};
     return lr_blend_create(&bd, &r->blend, e);
 }
 static void blend_free(lr_renderer *r)
@@ -204,7 +218,7 @@ const lr_pass_desc *lr_pass_table(void)
 static int program(lr_renderer *r, const char *vert, const char *frag, lr_program **out, lr_err *e)
 {
     lr_program_desc d = {.vertex = vert, .fragment = frag, .dir = r->shader_dir,
-                         .defines = lr_passes_defines()};
+                         .defines = r->defines.list};
     return lr_program_create(&d, out, e);
 }
 
@@ -301,6 +315,7 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
         maps = "RGBA16F maps (EXT_float_blend missing; accumulation capped at " STR(
             LR_HALF_MAX_FRAMES) " frames)";
     }
+    lr_passes_defines(&r->defines);
     if ((rc = find_shaders(r, e)))
         goto fail;
     if ((rc = lr_timer_create(r->gl, NULL, &r->timer, e)))
@@ -447,6 +462,8 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
         if ((rc = lr_timer_begin(r->timer, p->name, e)))
             return rc;
         rc = p->run(r, dirty, e);
+        if (!rc)
+            rc = check_programs(r, e);
         int rc2 = lr_timer_end(r->timer, e);
         if (rc || (rc = rc2))
             return rc;
@@ -524,6 +541,9 @@ int lr_renderer_present(lr_renderer *r, lr_err *e)
         glDisable(GL_BLEND);
         glUseProgram(lr_program_id(r->prog.blit));
         lr_passes_bind_tex(r->prog.blit, "u_src", 0, lr_blend_ldr(r->blend));
+        int rc = lr_program_check(r->prog.blit, e);
+        if (rc)
+            return rc;
         lr_gl_draw_fullscreen(r->gl);
     }
     return lr_gl_present(r->gl, e);
@@ -551,6 +571,7 @@ void lr_renderer_tonemap(const lr_renderer *r, lr_tonemap *tm)
 void lr_renderer_parts_get(const lr_renderer *r, lr_renderer_parts *out)
 {
     *out = (lr_renderer_parts){.gl = r->gl, .timer = r->timer, .shader_dir = r->shader_dir,
+                               .defines = r->defines.list,
                                .width = r->width, .height = r->height, .seed = r->seed,
                                .rs = &r->rs, .objs = &r->objs, .gbuffer = &r->gbuffer,
                                .radiosity = &r->rad, .vpl = &r->vpl, .blend = r->blend};

@@ -243,7 +243,7 @@ int lr_renderer_debug_floor_ms(lr_renderer *r, int reps, double *wall_ms, double
     lr_program *p = NULL;
     lr_tex *src = NULL;
     lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "floor.frag",
-                          .dir = pt.shader_dir, .defines = lr_passes_defines()};
+                          .dir = pt.shader_dir, .defines = pt.defines};
     lr_tex_desc td = {.format = LR_TEX_RGBA16F, .width = pt.width, .height = pt.height,
                       .label = "floor pass source"};
     int rc;
@@ -265,6 +265,8 @@ int lr_renderer_debug_floor_ms(lr_renderer *r, int reps, double *wall_ms, double
         glDisable(GL_BLEND);
         glUseProgram(lr_program_id(p));
         lr_passes_bind_tex(p, "u_src", 0, src);
+        if ((rc = lr_program_check(p, e)))
+            goto done;
         lr_gl_draw_fullscreen(pt.gl);
         if ((rc = lr_timer_end(pt.timer, e)))
             goto done;

@@ -15,6 +15,7 @@ typedef struct lr_renderer_parts {
     lr_gl *gl;
     lr_timer *timer;
     const char *shader_dir;
+    const char *const *defines; /* the renderer's lr_passes_defines */
     int width, height;
     unsigned seed;
     const lr_render_settings *rs; /* the settings the resources were made for */

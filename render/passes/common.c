@@ -8,17 +8,6 @@
 #include "render/cpu/cavity.h"
 #include "render/passes/passes.h"
 
-#define STR_(x) #x
-#define STR(x) STR_(x)
-
-const char *const *lr_passes_defines(void)
-{
-    static const char *const defines[] = {"LR_MAX_OBJECTS " STR(LR_MAX_OBJECTS),
-                                          "LR_MAX_K " STR(LR_MAX_K),
-                                          "LR_MAX_LIGHTS " STR(LR_MAX_LIGHTS), NULL};
-    return defines;
-}
-
 static int upload(lr_gpu_mesh *g, const lr_mesh *m, lr_err *e)
 {
     size_t nv = lr_mesh_vertex_count(m), nt = lr_mesh_triangle_count(m);
@@ -164,7 +153,7 @@ int lr_pass_objects_update_cavity(lr_pass_objects *objs, const lr_scene *s, lr_e
     return LR_OK;
 }
 
-void lr_passes_set_coeffs(const lr_pass_objects *o, const lr_program *p)
+void lr_passes_set_coeffs(const lr_pass_objects *o, lr_program *p)
 {
     GLint loc = lr_program_uniform(p, "u_coef");
     if (loc < 0)
@@ -176,19 +165,21 @@ void lr_passes_set_coeffs(const lr_pass_objects *o, const lr_program *p)
         loc = lr_program_uniform(p, "u_sss[0]");
     if (loc >= 0)
         glUniform4fv(loc, 3 * LR_MAX_OBJECTS, o->sss);
-    loc = lr_program_uniform(p, "u_sd_norm");
-    if (loc < 0)
-        loc = lr_program_uniform(p, "u_sd_norm[0]");
-    if (loc >= 0)
-        glUniform3fv(loc, LR_MAX_OBJECTS, o->sd_norm);
-    loc = lr_program_uniform(p, "u_cavity_gain");
-    if (loc < 0)
-        loc = lr_program_uniform(p, "u_cavity_gain[0]");
-    if (loc >= 0)
-        glUniform3fv(loc, LR_MAX_LIGHTS * LR_MAX_OBJECTS, o->cavity_gain);
 }
 
-void lr_passes_uniform_mat4(const lr_program *p, const char *name, const double m[16])
+void lr_passes_uniform_v3_array(lr_program *p, const char *name, const float *v, int count)
+{
+    /* Drivers name an array "u_x" or "u_x[0]". */
+    char first[64];
+    snprintf(first, sizeof first, "%s[0]", name);
+    GLint loc = lr_program_uniform(p, name);
+    if (loc < 0)
+        loc = lr_program_uniform(p, first);
+    if (loc >= 0)
+        glUniform3fv(loc, count, v);
+}
+
+void lr_passes_uniform_mat4(lr_program *p, const char *name, const double m[16])
 {
     float f[16];
     lr_mat4_to_float(m, f);
@@ -197,28 +188,28 @@ void lr_passes_uniform_mat4(const lr_program *p, const char *name, const double 
         glUniformMatrix4fv(loc, 1, GL_FALSE, f);
 }
 
-void lr_passes_uniform_v3(const lr_program *p, const char *name, lr_vec3 v)
+void lr_passes_uniform_v3(lr_program *p, const char *name, lr_vec3 v)
 {
     GLint loc = lr_program_uniform(p, name);
     if (loc >= 0)
         glUniform3f(loc, (float)v.x, (float)v.y, (float)v.z);
 }
 
-void lr_passes_uniform_i(const lr_program *p, const char *name, int v)
+void lr_passes_uniform_i(lr_program *p, const char *name, int v)
 {
     GLint loc = lr_program_uniform(p, name);
     if (loc >= 0)
         glUniform1i(loc, v);
 }
 
-void lr_passes_uniform_f(const lr_program *p, const char *name, float v)
+void lr_passes_uniform_f(lr_program *p, const char *name, float v)
 {
     GLint loc = lr_program_uniform(p, name);
     if (loc >= 0)
         glUniform1f(loc, v);
 }
 
-void lr_passes_bind_tex(const lr_program *p, const char *name, int unit, const lr_tex *t)
+void lr_passes_bind_tex(lr_program *p, const char *name, int unit, const lr_tex *t)
 {
     glActiveTexture(GL_TEXTURE0 + (GLenum)unit);
     if (t)

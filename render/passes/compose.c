@@ -77,7 +77,7 @@ int lr_compose_run(lr_compose *img, const lr_pass_ctx *c, const lr_compose_input
 
     /* Unit intensity: the images hold each light's transport alone; the blend pass weights
      * them with intensity x colour x flicker (PIPELINE.md "Linearity"). */
-    const lr_program *p = c->prog->obj;
+    lr_program *p = c->prog->obj;
     glUseProgram(lr_program_id(p));
     lr_passes_set_coeffs(o, p);
     double unit[LR_MAX_LIGHTS][3];
@@ -107,7 +107,7 @@ int lr_compose_run(lr_compose *img, const lr_pass_ctx *c, const lr_compose_input
     lr_passes_set_coeffs(o, p);
     lr_gbuffer_bind_lights(in->gbuffer, c, p);
     lr_passes_uniform_mat4(p, "u_vp", vp);
-    lr_vpl_bind(in->vpl, c, in->radiosity, p);
+    lr_passes_uniform_i(p, "u_use_vpl", lr_vpl_bind(in->vpl, c, in->radiosity, p));
     for (int i = 0; i < o->n_receivers; i++) {
         lr_irradiance_bind(in->irradiance, c, p, i);
         const lr_receiver *rcv = lr_scene_receiver_at(c->scene, i);

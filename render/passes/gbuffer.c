@@ -71,7 +71,7 @@ static lr_vec3 up_for(lr_vec3 dir)
 /* Draws every object into the bound framebuffer with world -> clip `vp`. */
 static void draw_objects(const lr_pass_ctx *c, const double vp[16])
 {
-    const lr_program *p = c->prog->surface;
+    lr_program *p = c->prog->surface;
     lr_passes_uniform_mat4(p, "u_vp", vp);
     for (int i = 0; i < c->objs->n_objects; i++) {
         lr_passes_uniform_i(p, "u_object", i);
@@ -160,7 +160,7 @@ int lr_gbuffer_run(lr_gbuffer *g, const lr_pass_ctx *c, lr_err *e)
     return lr_gl_check("gbuffer pass", e);
 }
 
-void lr_gbuffer_bind(const lr_gbuffer *gb, const lr_program *p, int l)
+void lr_gbuffer_bind(const lr_gbuffer *gb, lr_program *p, int l)
 {
     const lr_light_gbuffer *g = &gb->light[l];
     if (g->mode == LR_GB_CUBE) {
@@ -188,14 +188,14 @@ void lr_gbuffer_bind(const lr_gbuffer *gb, const lr_program *p, int l)
 }
 
 /* Element i of uniform array `name` ("u_x[2]"). */
-static GLint array_loc(const lr_program *p, const char *name, int i)
+static GLint array_loc(lr_program *p, const char *name, int i)
 {
     char n[64];
     snprintf(n, sizeof n, "%s[%d]", name, i);
     return lr_program_uniform(p, n);
 }
 
-void lr_gbuffer_bind_lights(const lr_gbuffer *gb, const lr_pass_ctx *c, const lr_program *p)
+void lr_gbuffer_bind_lights(const lr_gbuffer *gb, const lr_pass_ctx *c, lr_program *p)
 {
     /* Every array element gets its own unit, used or not: a cube and a 2D sampler must never
      * share one (units 4..10 belong to the gather and the VPLs). */

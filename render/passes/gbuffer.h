@@ -35,9 +35,9 @@ void lr_gbuffer_free(lr_gbuffer *g);
 int lr_gbuffer_run(lr_gbuffer *g, const lr_pass_ctx *c, lr_err *e);
 
 /* Light l's G-buffer samplers and uniforms on units 0..3 (render/shaders/lib/gbuffer.glsl). */
-void lr_gbuffer_bind(const lr_gbuffer *g, const lr_program *p, int l);
+void lr_gbuffer_bind(const lr_gbuffer *g, lr_program *p, int l);
 /* Every light's G-buffer positions and light uniforms (render/shaders/lib/lights.glsl): cube
  * maps on units 0..3, 2D maps on units 11..14; intensities from c->I. */
-void lr_gbuffer_bind_lights(const lr_gbuffer *g, const lr_pass_ctx *c, const lr_program *p);
+void lr_gbuffer_bind_lights(const lr_gbuffer *g, const lr_pass_ctx *c, lr_program *p);
 
 #endif

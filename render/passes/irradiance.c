@@ -64,7 +64,7 @@ int lr_irradiance_run(lr_irradiance *irr, const lr_pass_ctx *c, const lr_vpl *v,
     irr->valid = !irr->grid || c->no_vpl || !v->fb;
     if (irr->valid)
         return LR_OK;
-    const lr_program *p = c->prog->irr;
+    lr_program *p = c->prog->irr;
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
     glUseProgram(lr_program_id(p));
@@ -89,7 +89,7 @@ int lr_irradiance_run(lr_irradiance *irr, const lr_pass_ctx *c, const lr_vpl *v,
     return LR_OK;
 }
 
-void lr_irradiance_bind(const lr_irradiance *irr, const lr_pass_ctx *c, const lr_program *p,
+void lr_irradiance_bind(const lr_irradiance *irr, const lr_pass_ctx *c, lr_program *p,
                         int receiver)
 {
     lr_recv_grid_frame f;

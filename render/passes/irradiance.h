@@ -24,7 +24,7 @@ void lr_irradiance_free(lr_irradiance *irr);
 int lr_irradiance_run(lr_irradiance *irr, const lr_pass_ctx *c, const lr_vpl *v,
                       const lr_radiosity *rad, lr_err *e);
 /* Receiver i's grid for compose_receiver.frag (unit 15), or u_cached = false. */
-void lr_irradiance_bind(const lr_irradiance *irr, const lr_pass_ctx *c, const lr_program *p,
+void lr_irradiance_bind(const lr_irradiance *irr, const lr_pass_ctx *c, lr_program *p,
                         int receiver);
 
 #endif

@@ -14,8 +14,5 @@ void lr_passes_pack_coeffs(const lr_coeffs *c, float out[20]);
 /* One object's block of material.glsl's u_sss (12 floats): the model switch and the standard
  * dipole's albedo', z_r, z_v. */
 void lr_passes_pack_sss(const lr_coeffs *c, enum lr_sss_model model, float out[12]);
-/* The renderer's shader defines (limits and the named enum values of render/passes/
- * PIPELINE.md), NULL-terminated: a program that includes lib/material.glsl needs them. */
-const char *const *lr_passes_defines(void);
 
 #endif

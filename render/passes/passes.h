@@ -17,6 +17,7 @@
 #include "render/gl/shader.h"
 #include "render/gl/tex.h"
 #include "render/image/image.h"
+#include "render/passes/defines.h"
 #include "render/passes/material_pack.h"
 #include "render/scene/scene.h"
 
@@ -62,7 +63,9 @@ typedef struct lr_pass_objects {
     float cavity_gain[3 * LR_MAX_LIGHTS * LR_MAX_OBJECTS];
 } lr_pass_objects;
 
-/* The programs (made once per renderer; several passes draw with the same). */
+/* The programs (made once per renderer; several passes draw with the same). A pass sets only
+ * the uniforms its program declares: another name is an error at the end of the pass
+ * (lr_program_check). */
 typedef struct lr_pass_programs {
     lr_program *surface, *depth, *radiosity, *vpl, *obj, *recv, *blit, *irr;
 } lr_pass_programs;
@@ -94,14 +97,16 @@ void lr_pass_objects_free(lr_pass_objects *o);
 void lr_pass_objects_update_coeffs(lr_pass_objects *o, const lr_scene *s);
 /* Measures o->cavity_gain for every light of s (PIPELINE.md "Energy"). */
 int lr_pass_objects_update_cavity(lr_pass_objects *o, const lr_scene *s, lr_err *e);
-/* Sets u_coef, u_sss, u_sd_norm and u_cavity_gain where p declares them. */
-void lr_passes_set_coeffs(const lr_pass_objects *o, const lr_program *p);
+/* Sets u_coef and u_sss (programs that include lib/material.glsl). */
+void lr_passes_set_coeffs(const lr_pass_objects *o, lr_program *p);
+/* glUniform3fv of `count` vec3 to uniform array `name`. */
+void lr_passes_uniform_v3_array(lr_program *p, const char *name, const float *v, int count);
 void lr_passes_draw(const lr_gpu_mesh *m);
-void lr_passes_uniform_mat4(const lr_program *p, const char *name, const double m[16]);
-void lr_passes_uniform_v3(const lr_program *p, const char *name, lr_vec3 v);
-void lr_passes_uniform_i(const lr_program *p, const char *name, int v);
-void lr_passes_uniform_f(const lr_program *p, const char *name, float v);
-void lr_passes_bind_tex(const lr_program *p, const char *name, int unit, const lr_tex *t);
+void lr_passes_uniform_mat4(lr_program *p, const char *name, const double m[16]);
+void lr_passes_uniform_v3(lr_program *p, const char *name, lr_vec3 v);
+void lr_passes_uniform_i(lr_program *p, const char *name, int v);
+void lr_passes_uniform_f(lr_program *p, const char *name, float v);
+void lr_passes_bind_tex(lr_program *p, const char *name, int unit, const lr_tex *t);
 /* View-projection of cube face f (0..5 = +X..-Z) around `at`. */
 void lr_passes_cube_face_vp(lr_vec3 at, int f, double znear, double zfar, double out[16]);
 

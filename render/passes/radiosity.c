@@ -166,9 +166,10 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
             }
             glDepthMask(GL_FALSE);
             glDepthFunc(GL_LEQUAL);
-            const lr_program *p = c->prog->radiosity;
+            lr_program *p = c->prog->radiosity;
             glUseProgram(lr_program_id(p));
             lr_passes_set_coeffs(c->objs, p);
+            lr_passes_uniform_v3_array(p, "u_sd_norm", c->objs->sd_norm, LR_MAX_OBJECTS);
             lr_gbuffer_bind(gb, p, l);
             lr_passes_uniform_mat4(p, "u_vp", rad->vp[k]);
             lr_passes_uniform_i(p, "u_N", c->rs->N);
@@ -194,7 +195,7 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
     return lr_gl_check("radiosity pass", e);
 }
 
-void lr_radiosity_bind_gather(const lr_radiosity *rad, const lr_program *p, const double w[][3])
+void lr_radiosity_bind_gather(const lr_radiosity *rad, lr_program *p, const double w[][3])
 {
     lr_passes_bind_tex(p, "u_map_B", 4, rad->B);
     lr_passes_bind_tex(p, "u_map_nrm", 5, rad->nrm);
@@ -215,7 +216,7 @@ void lr_radiosity_bind_gather(const lr_radiosity *rad, const lr_program *p, cons
     lr_radiosity_set_light_w(rad, p, w);
 }
 
-void lr_radiosity_set_light_w(const lr_radiosity *rad, const lr_program *p, const double w[][3])
+void lr_radiosity_set_light_w(const lr_radiosity *rad, lr_program *p, const double w[][3])
 {
     /* The maps store B * scale[l]: the weight divides it out. */
     GLint loc;

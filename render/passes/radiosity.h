@@ -34,8 +34,8 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
 
 /* Algorithm 1 uniforms and samplers (units 4..6, render/shaders/lib/gather.glsl); the gather
  * returns sum_l w[l] B_l (u_light_w), w per light and band. */
-void lr_radiosity_bind_gather(const lr_radiosity *rad, const lr_program *p, const double w[][3]);
+void lr_radiosity_bind_gather(const lr_radiosity *rad, lr_program *p, const double w[][3]);
 /* Only the gather's weights u_light_w (w[l] / scale[l]), for a per-object change. */
-void lr_radiosity_set_light_w(const lr_radiosity *rad, const lr_program *p, const double w[][3]);
+void lr_radiosity_set_light_w(const lr_radiosity *rad, lr_program *p, const double w[][3]);
 
 #endif

@@ -83,7 +83,7 @@ static void draw_outer(lr_vpl *v, const lr_pass_ctx *ctx)
     lr_scene_bounds(ctx->scene, &c, &R);
     R = fmax(R, 1e-3);
     v->center = c;
-    const lr_program *p = ctx->prog->surface;
+    lr_program *p = ctx->prog->surface;
     glUseProgram(lr_program_id(p));
     glEnable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);
@@ -116,7 +116,7 @@ int lr_vpl_run(lr_vpl *v, const lr_pass_ctx *c, const lr_radiosity *rad, bool ge
 {
     if (geometry_changed || !v->outer_valid)
         draw_outer(v, c);
-    const lr_program *p = c->prog->vpl;
+    lr_program *p = c->prog->vpl;
     lr_fb_bind(v->fb);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
@@ -138,11 +138,12 @@ int lr_vpl_run(lr_vpl *v, const lr_pass_ctx *c, const lr_radiosity *rad, bool ge
     return lr_gl_check("vpl pass", e);
 }
 
-void lr_vpl_bind(const lr_vpl *v, const lr_pass_ctx *c, const lr_radiosity *rad,
-                 const lr_program *p)
+bool lr_vpl_bind(const lr_vpl *v, const lr_pass_ctx *c, const lr_radiosity *rad,
+                 lr_program *p)
 {
     bool use_vpl = !c->no_vpl && v->fb;
-    lr_passes_uniform_i(p, "u_use_vpl", use_vpl);
+    lr_passes_uniform_v3_array(p, "u_cavity_gain", c->objs->cavity_gain,
+                               LR_MAX_LIGHTS * LR_MAX_OBJECTS);
     lr_passes_uniform_i(p, "u_n_vpl", v->n);
     lr_passes_bind_tex(p, "u_vpl_pos", 7, use_vpl ? v->pos : NULL);
     lr_passes_bind_tex(p, "u_vpl_nrm", 8, use_vpl ? v->nrm : NULL);
@@ -151,4 +152,5 @@ void lr_vpl_bind(const lr_vpl *v, const lr_pass_ctx *c, const lr_radiosity *rad,
     lr_passes_bind_tex(p, "u_outer_pos", 10, use_vpl ? v->outer_pos : NULL);
     lr_passes_uniform_v3(p, "u_center", v->center);
     lr_passes_uniform_f(p, "u_vis_eps", (float)(2.0 * rad->radius / (v->size > 0 ? v->size : 1)));
+    return use_vpl;
 }

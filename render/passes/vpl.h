@@ -24,9 +24,10 @@ void lr_vpl_free(lr_vpl *v);
  * the outer-surface cube is redrawn first when the geometry changed. */
 int lr_vpl_run(lr_vpl *v, const lr_pass_ctx *c, const lr_radiosity *rad, bool geometry_changed,
                lr_err *e);
-/* The VPL inputs of lib/vpl_irradiance.glsl (units 7..10); v may be unallocated (u_use_vpl
- * false). rad gives the visibility test's scale. */
-void lr_vpl_bind(const lr_vpl *v, const lr_pass_ctx *c, const lr_radiosity *rad,
-                 const lr_program *p);
+/* The VPL inputs of lib/vpl_irradiance.glsl (units 7..10) and the cavity gains it applies;
+ * v may be unallocated. rad gives the visibility test's scale. Returns whether there are
+ * VPLs to sum (compose_receiver.frag's u_use_vpl). */
+bool lr_vpl_bind(const lr_vpl *v, const lr_pass_ctx *c, const lr_radiosity *rad,
+                 lr_program *p);
 
 #endif
