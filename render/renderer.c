@@ -1,5 +1,7 @@
-/* The renderer: resources, scheduling by dirty flags (render/renderer.h), per-pass timing,
- * readback and presentation. The passes are in render/passes/. */
+/* The renderer: the pass table, resources, scheduling by dirty flags (render/renderer.h,
+ * render/schedule.h), per-pass timing, readback and presentation. The passes are in
+ * render/passes/, each with its own state; this file holds them and hands each the inputs it
+ * reads. */
 #include "render/renderer.h"
 
 #include <math.h>
@@ -8,25 +10,215 @@
 #include <string.h>
 
 #include "render/base/paths.h"
+#include "render/gl/timer.h"
+#include "render/passes/blend.h"
+#include "render/passes/compose.h"
+#include "render/passes/gbuffer.h"
+#include "render/passes/irradiance.h"
 #include "render/passes/passes.h"
+#include "render/passes/radiosity.h"
+#include "render/passes/vpl.h"
+#include "render/renderer_parts.h"
 
 #define STR_(x) #x
 #define STR(x) STR_(x)
 
-static const char *const pass_names[LR_PASS_COUNT] = {"gbuffer", "radiosity", "vpl", "compose",
-                                                      "blend",   "irradiance"};
-/* The order the passes run in (bit indices). */
-static const int pass_order[LR_PASS_COUNT] = {0, 1, 2, 5, 3, 4};
+struct lr_renderer {
+    lr_gl *gl;
+    lr_scene *scene;
+    int width, height;
+    bool no_vpl;
+    bool vpl_visibility;
+    unsigned seed;
+    const lr_gl_caps *caps;
+    lr_tex_format map_format; /* RGBA32F, or RGBA16F when float targets/blending are missing */
+    char info[256];           /* renderer string for the stats */
+    char shader_dir[512];
+    lr_shader_defines defines; /* lr_passes_defines: every program is built with them */
+    lr_timer *timer;
+    lr_pass_programs prog;
 
-const char *lr_pass_name(int index)
+    /* Settings the resources were made for, and the scene's lights then. */
+    lr_render_settings rs;
+    int n_lights;
+    bool allocated;
+
+    /* Meshes and per-object uniforms (re-uploaded when geometry, receivers or settings
+     * change). */
+    lr_pass_objects objs;
+
+    /* The passes' own state, one per row of pass_table. */
+    lr_gbuffer gbuffer;
+    lr_radiosity rad;
+    lr_vpl vpl;
+    lr_irradiance irr;
+    lr_compose img;
+    lr_blend *blend; /* tone-mapped output and HDR sum (render/passes/blend.h) */
+
+    unsigned dirty;
+    int frame_index;
+
+    /* The clock of lr_renderer_set_time (flicker at composition). */
+    bool clock_set;
+    double time_s;
+};
+
+/* The read-only inputs every pass gets (render/passes/passes.h). */
+static lr_pass_ctx pass_ctx(const lr_renderer *r)
 {
-    return index >= 0 && index < LR_PASS_COUNT ? pass_names[index] : "?";
+    lr_pass_ctx c = {.gl = r->gl, .caps = r->caps, .scene = r->scene, .rs = &r->rs,
+                     .objs = &r->objs, .prog = &r->prog, .shader_dir = r->shader_dir,
+                     .width = r->width, .height = r->height, .n_lights = r->n_lights,
+                     .map_format = r->map_format, .seed = r->seed, .no_vpl = r->no_vpl,
+                     .vpl_visibility = r->vpl_visibility};
+    for (int l = 0; l < r->n_lights && l < LR_MAX_LIGHTS; l++) {
+        lr_light_rgb(lr_scene_light_at(r->scene, l), c.I[l]);
+        double f = lr_renderer_flicker(r, l);
+        for (int b = 0; b < 3; b++)
+            c.I[l][b] *= f;
+    }
+    return c;
+}
+
+/* A uniform a pass set that its program's shaders do not declare (lr_program_check). */
+static int check_programs(lr_renderer *r, lr_err *e)
+{
+    lr_program *ps[] = {r->prog.surface, r->prog.depth, r->prog.radiosity, r->prog.vpl,
+                        r->prog.obj,     r->prog.recv,  r->prog.blit,      r->prog.irr};
+    for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++) {
+        int rc = ps[i] ? lr_program_check(ps[i], e) : LR_OK;
+        if (rc)
+            return rc;
+    }
+    return LR_OK;
+}
+
+/* ---- the pass table: each row's hooks hand its pass the inputs it reads ------------------- */
+
+static int gbuffer_alloc(lr_renderer *r, lr_err *e)
+{
+    lr_pass_ctx c = pass_ctx(r);
+    return lr_gbuffer_alloc(&r->gbuffer, &c, e);
+}
+static void gbuffer_free(lr_renderer *r) { lr_gbuffer_free(&r->gbuffer); }
+static int gbuffer_run(lr_renderer *r, unsigned dirty, lr_err *e)
+{
+    (void)dirty;
+    lr_pass_ctx c = pass_ctx(r);
+    return lr_gbuffer_run(&r->gbuffer, &c, e);
+}
+
+static int radiosity_alloc(lr_renderer *r, lr_err *e)
+{
+    lr_pass_ctx c = pass_ctx(r);
+    return lr_radiosity_alloc(&r->rad, &c, e);
+}
+static void radiosity_free(lr_renderer *r) { lr_radiosity_free(&r->rad); }
+/* Accumulating: render.frames not reached (capped for half-float maps). */
+static bool radiosity_due(const lr_renderer *r) { return r->rad.F < r->rs.frames; }
+static int radiosity_run(lr_renderer *r, unsigned dirty, lr_err *e)
+{
+    /* A change that makes the maps due restarts their running mean. */
+    bool restart = (lr_dirty_passes(dirty) & LR_PASS_RADIOSITY) != 0;
+    lr_pass_ctx c = pass_ctx(r);
+    return lr_radiosity_run(&r->rad, &c, &r->gbuffer, restart, e);
+}
+
+static int vpl_alloc(lr_renderer *r, lr_err *e)
+{
+    lr_pass_ctx c = pass_ctx(r);
+    return r->no_vpl ? LR_OK : lr_vpl_alloc(&r->vpl, &c, e);
+}
+static void vpl_free(lr_renderer *r) { lr_vpl_free(&r->vpl); }
+static int vpl_run(lr_renderer *r, unsigned dirty, lr_err *e)
+{
+    bool geometry = (dirty & (LR_DIRTY_GEOMETRY | LR_DIRTY_SETTINGS)) != 0;
+    lr_pass_ctx c = pass_ctx(r);
+    return lr_vpl_run(&r->vpl, &c, &r->rad, geometry, e);
+}
+
+static void irradiance_free(lr_renderer *r) { lr_irradiance_free(&r->irr); }
+static bool irradiance_due(const lr_renderer *r) { return !r->irr.valid && !r->no_vpl; }
+static int irradiance_run(lr_renderer *r, unsigned dirty, lr_err *e)
+{
+    (void)dirty;
+    lr_pass_ctx c = pass_ctx(r);
+    return lr_irradiance_run(&r->irr, &c, &r->vpl, &r->rad, e);
+}
+
+static int compose_alloc(lr_renderer *r, lr_err *e)
+{
+    lr_pass_ctx c = pass_ctx(r);
+    return lr_compose_alloc(&r->img, &c, e);
+}
+static void compose_free(lr_renderer *r) { lr_compose_free(&r->img); }
+/* The images are composed for as many lights as the scene has now. */
+static bool compose_due(const lr_renderer *r) { return !r->img.valid; }
+static int compose_run(lr_renderer *r, unsigned dirty, lr_err *e)
+{
+    (void)dirty;
+    lr_pass_ctx c = pass_ctx(r);
+    lr_compose_inputs in = {.gbuffer = &r->gbuffer, .radiosity = &r->rad, .vpl = &r->vpl,
+                            .irradiance = &r->irr};
+    return lr_compose_run(&r->img, &c, &in, e);
+}
+
+static int blend_alloc(lr_renderer *r, lr_err *e)
+{
+    lr_blend_desc bd = {.gl = r->gl, .width = r->width, .height = r->height,
+                        .shader_dir = r->shader_dir, .defines = r->defines.list};
+    return lr_blend_create(&bd, &r->blend, e);
+}
+static void blend_free(lr_renderer *r)
+{
+    lr_blend_destroy(r->blend);
+    r->blend = NULL;
+}
+/* The per-light images weighted by intensity x colour x flicker (PIPELINE.md "Blend"). */
+static int blend_run(lr_renderer *r, unsigned dirty, lr_err *e)
+{
+    (void)dirty;
+    lr_pass_ctx c = pass_ctx(r);
+    lr_blend_input in = {.images = r->img.images, .n = r->img.n,
+                         .exposure = (float)r->rs.exposure, .tonemap_op = LR_RENDER_TONEMAP};
+    for (int l = 0; l < r->img.n && l < LR_BLEND_MAX_IMAGES && l < LR_MAX_LIGHTS; l++)
+        for (int b = 0; b < 3; b++)
+            in.w[l][b] = c.I[l][b];
+    return lr_blend_run(r->blend, &in, e);
+}
+
+/* What each scene change makes due (DESIGN.md "Data flow"; render/schedule.c says why). */
+enum {
+    D_TRANSPORT = LR_DIRTY_LIGHT_GEOMETRY | LR_DIRTY_GEOMETRY | LR_DIRTY_SETTINGS,
+    D_MAPS = D_TRANSPORT | LR_DIRTY_MATERIAL,
+    D_GRIDS = D_MAPS | LR_DIRTY_RECEIVERS,
+    D_VIEW = D_GRIDS | LR_DIRTY_CAMERA,
+    D_OUTPUT = D_VIEW | LR_DIRTY_INTENSITY | LR_DIRTY_DISPLAY,
+};
+
+/* The passes in the order they run. */
+static const lr_pass_desc pass_table[LR_PASS_COUNT] = {
+    {"gbuffer", LR_PASS_GBUFFER, D_TRANSPORT, 0, false, gbuffer_alloc, gbuffer_free, NULL,
+     gbuffer_run},
+    {"radiosity", LR_PASS_RADIOSITY, D_MAPS, LR_PASS_VPL | LR_PASS_COMPOSE, false,
+     radiosity_alloc, radiosity_free, radiosity_due, radiosity_run},
+    {"vpl", LR_PASS_VPL, D_MAPS, LR_PASS_IRRADIANCE, true, vpl_alloc, vpl_free, NULL, vpl_run},
+    {"irradiance", LR_PASS_IRRADIANCE, D_GRIDS, LR_PASS_COMPOSE, true, NULL, irradiance_free,
+     irradiance_due, irradiance_run},
+    {"compose", LR_PASS_COMPOSE, D_VIEW, LR_PASS_BLEND, false, compose_alloc, compose_free,
+     compose_due, compose_run},
+    {"blend", LR_PASS_BLEND, D_OUTPUT, 0, false, blend_alloc, blend_free, NULL, blend_run},
+};
+
+const lr_pass_desc *lr_pass_table(void)
+{
+    return pass_table;
 }
 
 static int program(lr_renderer *r, const char *vert, const char *frag, lr_program **out, lr_err *e)
 {
     lr_program_desc d = {.vertex = vert, .fragment = frag, .dir = r->shader_dir,
-                         .defines = lr_passes_defines()};
+                         .defines = r->defines.list};
     return lr_program_create(&d, out, e);
 }
 
@@ -42,11 +234,9 @@ static int find_shaders(lr_renderer *r, lr_err *e)
 
 static void free_resources(lr_renderer *r)
 {
-    lr_gbuffer_free(r);
-    lr_radiosity_free(r);
-    lr_vpl_free(r);
-    lr_compose_free(r);
-    lr_irradiance_free(r);
+    for (int i = 0; i < LR_PASS_COUNT; i++)
+        if (pass_table[i].free)
+            pass_table[i].free(r);
     r->allocated = false;
 }
 
@@ -71,8 +261,15 @@ static int alloc_resources(lr_renderer *r, lr_err *e)
     free_resources(r);
     r->rs = *lr_scene_render(r->scene);
     int rc = settings_check(r, &r->rs, e);
-    if (rc || (rc = lr_gbuffer_alloc(r, e)) || (rc = lr_radiosity_alloc(r, e)) ||
-        (!r->no_vpl && (rc = lr_vpl_alloc(r, e))) || (rc = lr_compose_alloc(r, e))) {
+    int nl = lr_scene_light_count(r->scene);
+    if (!rc && nl > LR_MAX_LIGHTS)
+        rc = lr_err_set(e, LR_EUNSUPPORTED, "renderer: %d lights; at most %d", nl, LR_MAX_LIGHTS);
+    if (!rc)
+        r->n_lights = nl;
+    for (int i = 0; i < LR_PASS_COUNT && !rc; i++)
+        if (pass_table[i].alloc)
+            rc = pass_table[i].alloc(r, e);
+    if (rc) {
         free_resources(r);
         return rc;
     }
@@ -118,22 +315,24 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
         maps = "RGBA16F maps (EXT_float_blend missing; accumulation capped at " STR(
             LR_HALF_MAX_FRAMES) " frames)";
     }
+    lr_passes_defines(&r->defines);
     if ((rc = find_shaders(r, e)))
         goto fail;
     if ((rc = lr_timer_create(r->gl, NULL, &r->timer, e)))
         goto fail;
     snprintf(r->info, sizeof r->info, "%s; %s; %s timers", caps->renderer, maps,
              lr_timer_is_gpu(r->timer) ? "GPU" : "CPU+glFinish");
-    if ((rc = program(r, "mesh.vert", "surface.frag", &r->p_surface, e)) ||
-        (rc = program(r, "mesh.vert", "depth.frag", &r->p_depth, e)) ||
-        (rc = program(r, "mesh.vert", "radiosity.frag", &r->p_radiosity, e)) ||
-        (rc = program(r, "fullscreen.vert", "vpl.frag", &r->p_vpl, e)) ||
-        (rc = program(r, "mesh.vert", "compose_object.frag", &r->p_obj, e)) ||
-        (rc = program(r, "mesh.vert", "compose_receiver.frag", &r->p_recv, e)) ||
-        (rc = program(r, "fullscreen.vert", "blit.frag", &r->p_blit, e)) ||
-        (rc = program(r, "fullscreen.vert", "irradiance.frag", &r->p_irr, e)))
+    lr_pass_programs *pr = &r->prog;
+    if ((rc = program(r, "mesh.vert", "surface.frag", &pr->surface, e)) ||
+        (rc = program(r, "mesh.vert", "depth.frag", &pr->depth, e)) ||
+        (rc = program(r, "mesh.vert", "radiosity.frag", &pr->radiosity, e)) ||
+        (rc = program(r, "fullscreen.vert", "vpl.frag", &pr->vpl, e)) ||
+        (rc = program(r, "mesh.vert", "compose_object.frag", &pr->obj, e)) ||
+        (rc = program(r, "mesh.vert", "compose_receiver.frag", &pr->recv, e)) ||
+        (rc = program(r, "fullscreen.vert", "blit.frag", &pr->blit, e)) ||
+        (rc = program(r, "fullscreen.vert", "irradiance.frag", &pr->irr, e)))
         goto fail;
-    if ((rc = alloc_resources(r, e)) || (rc = lr_passes_upload_meshes(r, e)))
+    if ((rc = alloc_resources(r, e)) || (rc = lr_pass_objects_upload(&r->objs, r->scene, e)))
         goto fail;
     /* Warm-up section: llvmpipe's first time-elapsed query reports time since the context
      * was made (seconds), not the section; one throw-away query absorbs that. */
@@ -157,9 +356,10 @@ void lr_renderer_destroy(lr_renderer *r)
     if (!r)
         return;
     free_resources(r);
-    lr_passes_free_meshes(r);
-    lr_program *ps[] = {r->p_surface, r->p_depth, r->p_radiosity, r->p_vpl,
-                        r->p_obj,     r->p_recv,  r->p_blit,      r->p_irr};
+    lr_pass_objects_free(&r->objs);
+    const lr_pass_programs *pr = &r->prog;
+    lr_program *ps[] = {pr->surface, pr->depth, pr->radiosity, pr->vpl,
+                        pr->obj,     pr->recv,  pr->blit,      pr->irr};
     for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
         lr_program_destroy(ps[i]);
     lr_timer_destroy(r->timer);
@@ -226,7 +426,6 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
     unsigned dirty = r->dirty;
     unsigned passes = lr_dirty_passes(dirty);
     bool restart = (passes & LR_PASS_RADIOSITY) != 0;
-    bool geometry = (dirty & (LR_DIRTY_GEOMETRY | LR_DIRTY_SETTINGS)) != 0;
     if (dirty & LR_DIRTY_SETTINGS) {
         if (resources_stale(r)) {
             if ((rc = alloc_resources(r, e)))
@@ -241,51 +440,30 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
     r->rs.frames = frames_target(r);
     r->rs.N = lr_scene_render(r->scene)->N;
     if (dirty & (LR_DIRTY_GEOMETRY | LR_DIRTY_SETTINGS | LR_DIRTY_RECEIVERS | LR_DIRTY_MATERIAL)) {
-        if ((rc = lr_passes_upload_meshes(r, e)))
+        if ((rc = lr_pass_objects_upload(&r->objs, r->scene, e)))
             return rc;
-        lr_irradiance_free(r); /* receivers may have changed kind: grids laid out again */
+        lr_irradiance_free(&r->irr); /* receivers may have changed kind: grids laid out again */
     }
-    lr_passes_update_coeffs(r);
+    lr_pass_objects_update_coeffs(&r->objs, r->scene);
     /* The cavity gain depends on the light, the geometry and the material: measured (a few
      * ms on the CPU) whenever the maps restart. */
-    if (restart && (rc = lr_passes_update_cavity(r, e)))
+    if (restart && (rc = lr_pass_objects_update_cavity(&r->objs, r->scene, e)))
         return rc;
-    /* Accumulation frames update the per-light images with the new maps (then the blend). */
-    if (!restart && r->rad.F < r->rs.frames)
-        passes |= LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_COMPOSE;
-    if (passes & LR_PASS_RADIOSITY)
-        passes |= LR_PASS_VPL | LR_PASS_COMPOSE;
-    /* New VPL radiosity: the receivers' grids again. */
-    if (passes & LR_PASS_VPL)
-        passes |= LR_PASS_IRRADIANCE;
-    if (!r->irr.valid && !r->no_vpl)
-        passes |= LR_PASS_IRRADIANCE;
-    if (passes & LR_PASS_IRRADIANCE)
-        passes |= LR_PASS_COMPOSE;
-    /* The images are composed for as many lights as the scene has now. */
-    if (!r->img.valid)
-        passes |= LR_PASS_COMPOSE;
-    if (passes & LR_PASS_COMPOSE)
-        passes |= LR_PASS_BLEND;
-    if (r->no_vpl)
-        passes &= ~(unsigned)(LR_PASS_VPL | LR_PASS_IRRADIANCE);
+    /* Accumulation frames update the maps, then what reads them (the table's due and
+     * feeds). */
+    passes = lr_schedule_close(r, passes, r->no_vpl);
 
     lr_frame_stats st = {0};
     lr_timer_reset(r->timer);
-    for (int oi = 0; oi < LR_PASS_COUNT; oi++) {
-        int i = pass_order[oi];
-        if (!(passes & (1u << i)))
+    for (int i = 0; i < LR_PASS_COUNT; i++) {
+        const lr_pass_desc *p = &pass_table[i];
+        if (!(passes & p->bit))
             continue;
-        if ((rc = lr_timer_begin(r->timer, pass_names[i], e)))
+        if ((rc = lr_timer_begin(r->timer, p->name, e)))
             return rc;
-        switch (1u << i) {
-        case LR_PASS_GBUFFER: rc = lr_pass_gbuffer(r, e); break;
-        case LR_PASS_RADIOSITY: rc = lr_pass_radiosity(r, restart, e); break;
-        case LR_PASS_VPL: rc = lr_pass_vpl(r, geometry, e); break;
-        case LR_PASS_IRRADIANCE: rc = lr_pass_irradiance(r, e); break;
-        case LR_PASS_COMPOSE: rc = lr_pass_compose(r, e); break;
-        default: rc = lr_pass_blend(r, e); break;
-        }
+        rc = p->run(r, dirty, e);
+        if (!rc)
+            rc = check_programs(r, e);
         int rc2 = lr_timer_end(r->timer, e);
         if (rc || (rc = rc2))
             return rc;
@@ -294,7 +472,7 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
     int trc = lr_timer_collect(r->timer, NULL);
     for (int s = 0; s < lr_timer_count(r->timer); s++)
         for (int i = 0; i < LR_PASS_COUNT; i++)
-            if (!strcmp(lr_timer_name(r->timer, s), pass_names[i])) {
+            if (!strcmp(lr_timer_name(r->timer, s), lr_pass_name(i))) {
                 st.ms[i] = trc ? NAN : lr_timer_ms(r->timer, s);
                 st.total_ms += st.ms[i];
             }
@@ -361,8 +539,11 @@ int lr_renderer_present(lr_renderer *r, lr_err *e)
         lr_gl_bind_default(r->gl);
         glDisable(GL_DEPTH_TEST);
         glDisable(GL_BLEND);
-        glUseProgram(lr_program_id(r->p_blit));
-        lr_passes_bind_tex(r->p_blit, "u_src", 0, lr_blend_ldr(r->blend));
+        glUseProgram(lr_program_id(r->prog.blit));
+        lr_passes_bind_tex(r->prog.blit, "u_src", 0, lr_blend_ldr(r->blend));
+        int rc = lr_program_check(r->prog.blit, e);
+        if (rc)
+            return rc;
         lr_gl_draw_fullscreen(r->gl);
     }
     return lr_gl_present(r->gl, e);
@@ -385,4 +566,13 @@ void lr_renderer_tonemap(const lr_renderer *r, lr_tonemap *tm)
 {
     tm->op = LR_RENDER_TONEMAP;
     tm->exposure = (float)lr_scene_render(r->scene)->exposure;
+}
+
+void lr_renderer_parts_get(const lr_renderer *r, lr_renderer_parts *out)
+{
+    *out = (lr_renderer_parts){.gl = r->gl, .timer = r->timer, .shader_dir = r->shader_dir,
+                               .defines = r->defines.list,
+                               .width = r->width, .height = r->height, .seed = r->seed,
+                               .rs = &r->rs, .objs = &r->objs, .gbuffer = &r->gbuffer,
+                               .radiosity = &r->rad, .vpl = &r->vpl, .blend = r->blend};
 }

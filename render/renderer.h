@@ -6,8 +6,8 @@
  *
  * Scheduling (DESIGN.md's table): the caller changes the scene with lr_scene_set(), which
  * returns LR_DIRTY_* flags, and hands them to lr_renderer_invalidate(). The next
- * lr_renderer_frame() runs only the passes lr_dirty_passes() names. Composition renders one
- * linear image per light at unit intensity for the current view (objects and receivers); the
+ * lr_renderer_frame() runs only the passes lr_dirty_passes() (render/schedule.h) names.
+ * Composition renders one linear image per light at unit intensity for the current view (objects and receivers); the
  * blend pass sums them with the lights' intensity x colour x flicker, tone-maps and writes the
  * output. So a dimmer, colour, flicker or exposure change runs the blend alone (one fullscreen
  * pass; transport is linear in intensity); a camera change composition and the blend (the
@@ -25,7 +25,7 @@
 #include "render/base/err.h"
 #include "render/gl/gl.h"
 #include "render/image/image.h"
-#include "render/scene/dirty.h"
+#include "render/schedule.h"
 #include "render/scene/scene.h"
 
 typedef struct lr_renderer lr_renderer;
@@ -42,9 +42,6 @@ typedef struct lr_renderer_desc {
                             * fallback for drivers without EXT_float_blend; for its tests) */
 } lr_renderer_desc;
 
-/* gbuffer, radiosity, vpl, compose, blend, irradiance (render/scene/dirty.h; bit index order,
- * not the order they run in: irradiance runs before compose). */
-enum { LR_PASS_COUNT = 6 };
 
 typedef struct lr_frame_stats {
     int index;                   /* frames rendered since create */
@@ -100,7 +97,5 @@ void lr_renderer_size(const lr_renderer *r, int *width, int *height);
  * from lr_renderer_read_hdr matches lr_renderer_read_rgba8. */
 void lr_renderer_tonemap(const lr_renderer *r, lr_tonemap *tm);
 
-/* "gbuffer", "radiosity", "vpl", "compose", "blend", "irradiance" for bit index 0..5. */
-const char *lr_pass_name(int index);
 
 #endif

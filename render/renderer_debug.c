@@ -8,19 +8,28 @@
 
 #include "render/base/median.h"
 #include "render/optics/optics.h"
-#include "render/passes/passes.h"
+#include "render/renderer_parts.h"
+
+static lr_renderer_parts parts(const lr_renderer *r)
+{
+    lr_renderer_parts p;
+    lr_renderer_parts_get(r, &p);
+    return p;
+}
 
 void lr_renderer_debug_map_info(const lr_renderer *r, lr_debug_map_info *out)
 {
+    lr_renderer_parts p = parts(r);
+    const lr_radiosity *rad = p.radiosity;
     memset(out, 0, sizeof *out);
-    out->K = r->rad.K;
-    out->size = r->rad.size;
-    out->frames = r->rad.F;
-    out->N = r->rs.N;
-    out->center = r->rad.center;
-    out->radius = r->rad.radius;
-    out->r_max = r->rad.r_max;
-    out->seed = r->seed;
+    out->K = rad->K;
+    out->size = rad->size;
+    out->frames = rad->F;
+    out->N = p.rs->N;
+    out->center = rad->center;
+    out->radius = rad->radius;
+    out->r_max = rad->r_max;
+    out->seed = p.seed;
 }
 
 void lr_renderer_debug_cavity_gain(const lr_renderer *r, int object, double out[3])
@@ -32,17 +41,19 @@ void lr_renderer_debug_light_cavity_gain(const lr_renderer *r, int l, int object
 {
     bool ok = l >= 0 && l < LR_MAX_LIGHTS && object >= 0 && object < LR_MAX_OBJECTS;
     for (int c = 0; c < 3; c++)
-        out[c] = ok ? r->cavity_gain[3 * (l * LR_MAX_OBJECTS + object) + c] : 1.0;
+        out[c] = ok ? parts(r).objs->cavity_gain[3 * (l * LR_MAX_OBJECTS + object) + c] : 1.0;
 }
 
 lr_vec3 lr_renderer_debug_map_dir(const lr_renderer *r, int k)
 {
-    return k >= 0 && k < r->rad.K ? r->rad.d[k] : lr_v3(0, 0, 0);
+    const lr_radiosity *rad = parts(r).radiosity;
+    return k >= 0 && k < rad->K ? rad->d[k] : lr_v3(0, 0, 0);
 }
 
 void lr_renderer_debug_map_matrix(const lr_renderer *r, int k, double out[16])
 {
-    memcpy(out, r->rad.P[k >= 0 && k < r->rad.K ? k : 0], 16 * sizeof *out);
+    const lr_radiosity *rad = parts(r).radiosity;
+    memcpy(out, rad->P[k >= 0 && k < rad->K ? k : 0], 16 * sizeof *out);
 }
 
 /* Reads colour attachment `att` of framebuffer fb into 4-float texels. */
@@ -76,13 +87,14 @@ int lr_renderer_debug_read_map(lr_renderer *r, int k, float *B, float *pos, floa
 int lr_renderer_debug_read_light_map(lr_renderer *r, int l, int k, float *B, float *pos,
                                      float *nrm, int *object, lr_err *e)
 {
-    if (k < 0 || k >= r->rad.K)
-        return lr_err_set(e, LR_EINVAL, "debug: map %d of %d", k, r->rad.K);
-    if (l < 0 || l >= r->n_lights)
-        return lr_err_set(e, LR_EINVAL, "debug: light %d of %d", l, r->n_lights);
-    int n = r->rad.size;
+    const lr_radiosity *rad = parts(r).radiosity;
+    if (k < 0 || k >= rad->K)
+        return lr_err_set(e, LR_EINVAL, "debug: map %d of %d", k, rad->K);
+    if (l < 0 || l >= rad->n_lights)
+        return lr_err_set(e, LR_EINVAL, "debug: light %d of %d", l, rad->n_lights);
+    int n = rad->size;
     size_t cnt = (size_t)n * n;
-    lr_fb *fb = r->rad.fb[l * r->rad.K + k];
+    lr_fb *fb = rad->fb[l * rad->K + k];
     float *b = read_fb(fb, 0, n, n, e);
     float *p = b ? read_fb(fb, 1, n, n, e) : NULL;
     float *q = p ? read_fb(fb, 2, n, n, e) : NULL;
@@ -94,7 +106,7 @@ int lr_renderer_debug_read_light_map(lr_renderer *r, int l, int k, float *B, flo
     copy3(B, b, cnt);
     if (B)
         for (size_t i = 0; i < 3 * cnt; i++)
-            B[i] /= r->rad.scale[l];
+            B[i] /= rad->scale[l];
     copy3(pos, p, cnt);
     copy3(nrm, q, cnt);
     if (object)
@@ -108,12 +120,13 @@ int lr_renderer_debug_read_light_map(lr_renderer *r, int l, int k, float *B, flo
 
 int lr_renderer_debug_vpl_count(const lr_renderer *r)
 {
-    return r->vpl.fb ? r->vpl.n : 0;
+    const lr_vpl *v = parts(r).vpl;
+    return v->fb ? v->n : 0;
 }
 
 lr_vec3 lr_renderer_debug_vpl_center(const lr_renderer *r)
 {
-    return r->vpl.center;
+    return parts(r).vpl->center;
 }
 
 int lr_renderer_debug_read_vpls(lr_renderer *r, lr_debug_vpl *out, lr_err *e)
@@ -121,9 +134,10 @@ int lr_renderer_debug_read_vpls(lr_renderer *r, lr_debug_vpl *out, lr_err *e)
     int n = lr_renderer_debug_vpl_count(r);
     if (!n)
         return LR_OK;
-    float *p = read_fb(r->vpl.fb, 0, n, 1, e);
-    float *q = p ? read_fb(r->vpl.fb, 1, n, 1, e) : NULL;
-    float *b = q ? read_fb(r->vpl.fb, 2, n, 1, e) : NULL;
+    lr_fb *fb = parts(r).vpl->fb;
+    float *p = read_fb(fb, 0, n, 1, e);
+    float *q = p ? read_fb(fb, 1, n, 1, e) : NULL;
+    float *b = q ? read_fb(fb, 2, n, 1, e) : NULL;
     if (!b) {
         free(p);
         free(q);
@@ -156,9 +170,10 @@ void lr_renderer_debug_gbuffer_info(const lr_renderer *r, lr_debug_gbuffer_info 
 void lr_renderer_debug_light_gbuffer_info(const lr_renderer *r, int l, lr_debug_gbuffer_info *out)
 {
     memset(out, 0, sizeof *out);
-    if (l < 0 || l >= r->n_lights)
+    const lr_gbuffer *gb = parts(r).gbuffer;
+    if (l < 0 || l >= gb->n_lights)
         return;
-    const struct lr_light_gbuffer *g = &r->gb[l];
+    const lr_light_gbuffer *g = &gb->light[l];
     out->cube = g->mode == LR_GB_CUBE;
     out->orthographic = g->mode == LR_GB_ORTHO;
     out->size = g->size;
@@ -173,11 +188,12 @@ void lr_renderer_debug_light_gbuffer_info(const lr_renderer *r, int l, lr_debug_
 int lr_renderer_debug_read_gbuffer(lr_renderer *r, int face, float *pos, float *nrm, int *object,
                                    lr_err *e)
 {
-    bool cube = r->gb[0].mode == LR_GB_CUBE;
+    const lr_light_gbuffer *g = &parts(r).gbuffer->light[0];
+    bool cube = g->mode == LR_GB_CUBE;
     if (face < 0 || face >= (cube ? 6 : 1))
         return lr_err_set(e, LR_EINVAL, "debug: G-buffer face %d", face);
-    lr_fb *fb = cube ? r->gb[0].fb[face] : r->gb[0].fb_2d;
-    int n = r->gb[0].size;
+    lr_fb *fb = cube ? g->fb[face] : g->fb_2d;
+    int n = g->size;
     size_t cnt = (size_t)n * n;
     float *p = read_fb(fb, 0, n, n, e);
     float *q = p ? read_fb(fb, 1, n, n, e) : NULL;
@@ -197,16 +213,17 @@ int lr_renderer_debug_read_gbuffer(lr_renderer *r, int face, float *pos, float *
 
 int lr_renderer_debug_uncovered(lr_renderer *r, int *count, lr_err *e)
 {
+    lr_renderer_parts pt = parts(r);
     lr_fb *hdr;
-    int rc = r->blend ? lr_blend_hdr(r->blend, &hdr, e)
+    int rc = pt.blend ? lr_blend_hdr(pt.blend, &hdr, e)
                       : lr_err_set(e, LR_EINVAL, "renderer: no image (no resources)");
     if (rc)
         return rc;
-    float *p = read_fb(hdr, 0, r->width, r->height, e);
+    float *p = read_fb(hdr, 0, pt.width, pt.height, e);
     if (!p)
         return e ? e->code : LR_EIO;
     int n = 0;
-    for (size_t i = 0; i < (size_t)r->width * r->height; i++)
+    for (size_t i = 0; i < (size_t)pt.width * pt.height; i++)
         n += p[4 * i + 3] < 0.5f;
     free(p);
     *count = n;
@@ -220,16 +237,17 @@ int lr_renderer_debug_floor_ms(lr_renderer *r, int reps, double *wall_ms, double
     *wall_ms = *timer_ms = NAN;
     if (reps < 1 || reps > 64)
         return lr_err_set(e, LR_EINVAL, "floor pass: reps = %d: must be 1..64", reps);
-    if (!r->blend)
+    lr_renderer_parts pt = parts(r);
+    if (!pt.blend)
         return lr_err_set(e, LR_EINVAL, "renderer: no output (resources failed to allocate)");
     lr_program *p = NULL;
     lr_tex *src = NULL;
     lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "floor.frag",
-                          .dir = r->shader_dir, .defines = lr_passes_defines()};
-    lr_tex_desc td = {.format = LR_TEX_RGBA16F, .width = r->width, .height = r->height,
+                          .dir = pt.shader_dir, .defines = pt.defines};
+    lr_tex_desc td = {.format = LR_TEX_RGBA16F, .width = pt.width, .height = pt.height,
                       .label = "floor pass source"};
     int rc;
-    if ((rc = lr_program_create(&pd, &p, e)) || (rc = lr_tex_create(r->gl, &td, &src, e)))
+    if ((rc = lr_program_create(&pd, &p, e)) || (rc = lr_tex_create(pt.gl, &td, &src, e)))
         goto done;
     double t[64], g[64];
     int n = 0;
@@ -239,24 +257,26 @@ int lr_renderer_debug_floor_ms(lr_renderer *r, int reps, double *wall_ms, double
         struct timespec t0, t1;
         glFinish();
         clock_gettime(CLOCK_MONOTONIC, &t0);
-        lr_timer_reset(r->timer);
-        if ((rc = lr_timer_begin(r->timer, "floor", e)))
+        lr_timer_reset(pt.timer);
+        if ((rc = lr_timer_begin(pt.timer, "floor", e)))
             goto done;
-        lr_fb_bind(lr_blend_ldr_fb(r->blend));
+        lr_fb_bind(lr_blend_ldr_fb(pt.blend));
         glDisable(GL_DEPTH_TEST);
         glDisable(GL_BLEND);
         glUseProgram(lr_program_id(p));
         lr_passes_bind_tex(p, "u_src", 0, src);
-        lr_gl_draw_fullscreen(r->gl);
-        if ((rc = lr_timer_end(r->timer, e)))
+        if ((rc = lr_program_check(p, e)))
             goto done;
-        int trc = lr_timer_collect(r->timer, NULL);
+        lr_gl_draw_fullscreen(pt.gl);
+        if ((rc = lr_timer_end(pt.timer, e)))
+            goto done;
+        int trc = lr_timer_collect(pt.timer, NULL);
         glFinish();
         clock_gettime(CLOCK_MONOTONIC, &t1);
-        g[n] = trc || lr_timer_count(r->timer) < 1 ? NAN : lr_timer_ms(r->timer, 0);
+        g[n] = trc || lr_timer_count(pt.timer) < 1 ? NAN : lr_timer_ms(pt.timer, 0);
         t[n++] = (double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) * 1e-6;
     }
-    lr_timer_reset(r->timer);
+    lr_timer_reset(pt.timer);
     if ((rc = lr_gl_check("floor pass", e)))
         goto done;
     *wall_ms = lr_median_finite(t, n);

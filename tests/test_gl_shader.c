@@ -339,6 +339,55 @@ static void project_shaders_compile(void **state)
     free(fs);
 }
 
+/* ---- uniforms the C side sets ------------------------------------------------------------- */
+
+/* A uniform the shaders do not declare (a misspelling in C) is an error naming the program
+ * and the uniform; one the compiler dropped as unused is not (location -1, nothing to set). */
+static void undeclared_uniform_is_an_error(void **state)
+{
+    fixture *f = *state;
+    char *vs = lr_test_write(f->dir, "u.vert",
+                             "uniform mat4 u_vp;\n"
+                             "void main() { gl_Position = u_vp * vec4(0.0, 0.0, 0.0, 1.0); }\n",
+                             (size_t)-1);
+    char *fs = lr_test_write(f->dir, "u.frag",
+                             "uniform highp sampler2D u_src;\n"
+                             "uniform vec3 u_w[4], u_unused;\n" /* u_unused: dropped */
+                             "uniform float u_exposure; // uniform float u_in_comment;\n"
+                             "/* uniform float u_in_block_comment; */\n"
+                             "out vec4 o;\n"
+                             "void main() { o = texture(u_src, vec2(0.5)) * u_exposure"
+                             " + vec4(u_w[2], 0.0); }\n",
+                             (size_t)-1);
+    lr_program *prog = NULL;
+    lr_err e = {0};
+    if (lr_program_create(&(lr_program_desc){.vertex = vs, .fragment = fs}, &prog, &e))
+        fail_msg("%s", e.msg);
+    /* Declared and used: a location, no error. */
+    assert_true(lr_program_uniform(prog, "u_exposure") >= 0);
+    assert_true(lr_program_uniform(prog, "u_vp") >= 0);
+    assert_true(lr_program_uniform(prog, "u_src") >= 0);
+    assert_true(lr_program_uniform(prog, "u_w[2]") >= 0);
+    /* Declared, unused: the driver may drop it; either way not an error. */
+    lr_program_uniform(prog, "u_unused");
+    assert_true(lr_program_declares(prog, "u_unused"));
+    assert_int_equal(lr_program_check(prog, &e), LR_OK);
+    /* Misspelt, or only in a comment: -1 and an error at the check, naming both. */
+    assert_int_equal(lr_program_uniform(prog, "u_exposrue"), -1);
+    assert_int_equal(lr_program_uniform(prog, "u_in_comment"), -1);
+    assert_false(lr_program_declares(prog, "u_in_block_comment"));
+    assert_int_equal(lr_program_check(prog, &e), LR_EINVAL);
+    print_message("%s\n", e.msg);
+    assert_non_null(strstr(e.msg, "u.vert + "));
+    assert_non_null(strstr(e.msg, "u.frag"));
+    assert_non_null(strstr(e.msg, "u_exposrue")); /* the first one asked for */
+    /* Reported once. */
+    assert_int_equal(lr_program_check(prog, &e), LR_OK);
+    lr_program_destroy(prog);
+    free(vs);
+    free(fs);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -352,6 +401,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(link_error_names_both_files, setup, teardown),
         cmocka_unit_test_setup_teardown(compute_shader_and_bad_desc, setup, teardown),
         cmocka_unit_test_setup_teardown(project_shaders_compile, setup, teardown),
+        cmocka_unit_test_setup_teardown(undeclared_uniform_is_an_error, setup, teardown),
     };
     if (getenv("LR_TEST_FILTER")) /* e.g. LR_TEST_FILTER='cube*' to run one test */
         cmocka_set_test_filter(getenv("LR_TEST_FILTER"));

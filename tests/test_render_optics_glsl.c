@@ -35,7 +35,8 @@
 #include "render/gl/tex.h"
 #include "render/material/material.h"
 #include "render/optics/optics.h"
-#include "render/passes/passes.h"
+#include "render/passes/defines.h"
+#include "render/passes/material_pack.h"
 #include "tests/support/gl.h"
 #include "tests/support/near.h"
 
@@ -141,6 +142,7 @@ static void test_optics_glsl_matches_c(void **state)
         s[3] = (float)c->r_max;
     }
     lr_err e = {0};
+    lr_shader_defines defs; /* the renderer's: material.glsl compares against LR_SSS_* */
     lr_tex *tin = NULL, *tout = NULL;
     lr_fb *fb = NULL;
     lr_program *p = NULL;
@@ -149,7 +151,8 @@ static void test_optics_glsl_matches_c(void **state)
         lr_tex_create(gl, &(lr_tex_desc){.width = 5, .height = n}, &tout, &e) ||
         lr_fb_create(gl, &(lr_fb_desc){.color = {{tout, 0}}}, &fb, &e) ||
         lr_program_create(&(lr_program_desc){.vertex = "render/shaders/fullscreen.vert",
-                                             .fragment = "tests/shaders/optics_eval.frag"},
+                                             .fragment = "tests/shaders/optics_eval.frag",
+                                             .defines = lr_passes_defines(&defs)},
                           &p, &e))
         fail_msg("%s", e.msg);
     float coef[5 * 4 * LR_MAX_OBJECTS] = {0};
@@ -291,12 +294,14 @@ static void test_multipole_glsl_matches_c(void **state)
     lr_tex *tin = NULL, *tout = NULL;
     lr_fb *fb = NULL;
     lr_program *p = NULL;
+    lr_shader_defines defs; /* the renderer's: optics.glsl compares against LR_SSS_* */
     if (lr_tex_create(gl, &(lr_tex_desc){.width = 6, .height = n}, &tin, &e) ||
         lr_tex_upload(tin, 0, in, &e) ||
         lr_tex_create(gl, &(lr_tex_desc){.width = 5, .height = n}, &tout, &e) ||
         lr_fb_create(gl, &(lr_fb_desc){.color = {{tout, 0}}}, &fb, &e) ||
         lr_program_create(&(lr_program_desc){.vertex = "render/shaders/fullscreen.vert",
-                                             .fragment = "tests/shaders/optics_eval.frag"},
+                                             .fragment = "tests/shaders/optics_eval.frag",
+                                             .defines = lr_passes_defines(&defs)},
                           &p, &e))
         fail_msg("%s", e.msg);
     lr_fb_bind(fb);

@@ -15,6 +15,7 @@
 #include "render/base/mat4.h"
 #include "render/mesh/shapes.h"
 #include "render/scene/scene.h"
+#include "render/schedule.h"
 #include "tests/support/doc_block.h"
 
 typedef struct warnings {

@@ -11,10 +11,6 @@
 
 #define LOG_MAX 4096
 
-/* The pass names of render/renderer.h's lr_pass_name, kept here so that the stats do not
- * depend on which renderer is linked. */
-static const char *const pass_names[LR_PASS_COUNT] = {"gbuffer", "radiosity", "vpl", "compose",
-                                                      "blend",   "irradiance"};
 #define PENDING_MAX 1024
 
 typedef struct ev_rec {
@@ -236,7 +232,7 @@ int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *conf
         lr_jw_array(w, "passes");
         for (int p = 0; p < LR_PASS_COUNT; p++)
             if (r->f.passes & (1u << p))
-                lr_jw_string(w, NULL, pass_names[p]);
+                lr_jw_string(w, NULL, lr_pass_name(p));
         lr_jw_array_end(w);
         lr_jw_array(w, "ms");
         for (int p = 0; p < LR_PASS_COUNT; p++)

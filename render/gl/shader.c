@@ -370,9 +370,140 @@ int lr_shader_source_map_log(const lr_shader_source *s, const char *log, const c
 
 /* ---- programs ------------------------------------------------------------------------------ */
 
+/* Uniform names a program's sources declare (array names without their index). */
+typedef struct name_list {
+    char **v;
+    int n, cap;
+} name_list;
+
 struct lr_program {
     GLuint id;
+    char label[192];       /* "fullscreen.vert + blend.frag", for messages */
+    name_list uniforms;    /* declared in the sources (scan_uniforms) */
+    char undeclared[64];   /* the first name lr_program_uniform was asked for and the sources
+                            * do not declare, until lr_program_check reports it */
 };
+
+static void names_free(name_list *l)
+{
+    for (int i = 0; i < l->n; i++)
+        free(l->v[i]);
+    free(l->v);
+    memset(l, 0, sizeof *l);
+}
+
+static bool names_has(const name_list *l, const char *name, size_t len)
+{
+    for (int i = 0; i < l->n; i++)
+        if (strlen(l->v[i]) == len && !memcmp(l->v[i], name, len))
+            return true;
+    return false;
+}
+
+static int names_add(name_list *l, const char *name, size_t len)
+{
+    if (names_has(l, name, len))
+        return 0;
+    if (l->n == l->cap) {
+        int cap = l->cap ? 2 * l->cap : 32;
+        char **v = realloc(l->v, (size_t)cap * sizeof *v);
+        if (!v)
+            return -1;
+        l->v = v;
+        l->cap = cap;
+    }
+    char *c = malloc(len + 1);
+    if (!c)
+        return -1;
+    memcpy(c, name, len);
+    c[len] = '\0';
+    l->v[l->n++] = c;
+    return 0;
+}
+
+static bool ident_char(char c)
+{
+    return isalnum((unsigned char)c) || c == '_';
+}
+
+/* Copies text without its comments (each replaced by a space). */
+static char *strip_comments(const char *text)
+{
+    size_t n = strlen(text);
+    char *out = malloc(n + 1), *o = out;
+    if (!out)
+        return NULL;
+    for (const char *t = text; *t;) {
+        if (t[0] == '/' && t[1] == '/') {
+            while (*t && *t != '\n')
+                t++;
+            *o++ = ' ';
+        } else if (t[0] == '/' && t[1] == '*') {
+            const char *end = strstr(t + 2, "*/");
+            t = end ? end + 2 : t + strlen(t);
+            *o++ = ' ';
+        } else {
+            *o++ = *t++;
+        }
+    }
+    *o = '\0';
+    return out;
+}
+
+/* Adds the names of the default-block uniforms that text (assembled GLSL) declares:
+ * `uniform [precision] TYPE name[[N]] [, name2 ...];`. Declarations inside #if blocks count
+ * whether or not the preprocessor keeps them (a name declared under some define is not a
+ * misspelling); uniform blocks are skipped (the shaders have none). Why from the source: the
+ * driver's active uniforms lack those the compiler dropped as unused, which are legitimate
+ * to set (their location is -1). */
+static int scan_uniforms(const char *text, name_list *out)
+{
+    char *src = strip_comments(text);
+    if (!src)
+        return -1;
+    int rc = 0;
+    for (const char *t = src; (t = strstr(t, "uniform")) != NULL && !rc;) {
+        bool word = (t == src || !ident_char(t[-1])) && !ident_char(t[7]);
+        t += 7;
+        if (!word)
+            continue;
+        /* Tokens up to ';' or '{': qualifiers, the type, then the names. */
+        const char *ids[64];
+        size_t lens[64];
+        int n = 0, depth = 0;
+        bool block = false;
+        for (; *t && *t != ';'; t++) {
+            if (*t == '{') {
+                block = true;
+                break;
+            }
+            if (*t == '[')
+                depth++;
+            else if (*t == ']')
+                depth--;
+            else if (depth == 0 && (isalpha((unsigned char)*t) || *t == '_') && n < 64) {
+                ids[n] = t;
+                while (ident_char(t[1]))
+                    t++;
+                lens[n] = (size_t)(t - ids[n]) + 1;
+                n++;
+            }
+        }
+        if (block || n < 2)
+            continue;
+        /* ids: [precision] type name (, name)*: the names are every identifier after the
+         * type (array sizes, inside brackets, are not collected). */
+        int k = 1;
+        static const char *const precision[] = {"highp", "mediump", "lowp"};
+        for (int q = 0; q < 3; q++)
+            if (lens[0] == strlen(precision[q]) && !memcmp(ids[0], precision[q], lens[0]))
+                k = 2;
+        for (int i = k; i < n && !rc; i++)
+            rc = names_add(out, ids[i], lens[i]);
+    }
+    free(src);
+    return rc;
+}
 
 static char *info_log(GLuint obj, bool program)
 {
@@ -392,7 +523,7 @@ static char *info_log(GLuint obj, bool program)
 }
 
 static int compile(const char *dir, const char *name, lr_shader_stage stage,
-                   const char *const *defines, GLuint *out, lr_err *e)
+                   const char *const *defines, name_list *uniforms, GLuint *out, lr_err *e)
 {
     static const GLenum gl_stage[] = {GL_VERTEX_SHADER, GL_FRAGMENT_SHADER, GL_COMPUTE_SHADER};
     char path[PATH_MAX];
@@ -403,8 +534,12 @@ static int compile(const char *dir, const char *name, lr_shader_stage stage,
     int rc = lr_shader_source_load(path, stage, defines, &src, e);
     if (rc)
         return rc;
-    GLuint sh = glCreateShader(gl_stage[stage]);
     const char *text = lr_shader_source_text(src);
+    if (scan_uniforms(text, uniforms) != 0) {
+        lr_shader_source_free(src);
+        return lr_err_set(e, LR_ENOMEM, "%s: uniform names: out of memory", path);
+    }
+    GLuint sh = glCreateShader(gl_stage[stage]);
     glShaderSource(sh, 1, &text, NULL);
     glCompileShader(sh);
     GLint ok = GL_FALSE;
@@ -435,9 +570,10 @@ int lr_program_create(const lr_program_desc *d, lr_program **out, lr_err *e)
     lr_shader_stage stages[2] = {d->compute ? LR_STAGE_COMPUTE : LR_STAGE_VERTEX, LR_STAGE_FRAGMENT};
     int count = d->compute ? 1 : 2;
     GLuint sh[2] = {0, 0};
+    name_list uniforms = {0};
     int rc = LR_OK;
     for (int i = 0; i < count && rc == LR_OK; i++)
-        rc = compile(d->dir, names[i], stages[i], d->defines, &sh[i], e);
+        rc = compile(d->dir, names[i], stages[i], d->defines, &uniforms, &sh[i], e);
 
     GLuint prog = 0;
     if (rc == LR_OK) {
@@ -465,14 +601,19 @@ int lr_program_create(const lr_program_desc *d, lr_program **out, lr_err *e)
     for (int i = 0; i < count; i++)
         if (sh[i])
             glDeleteShader(sh[i]); /* the program keeps what it linked */
-    if (rc)
-        return rc;
-    lr_program *p = malloc(sizeof *p);
-    if (!p) {
+    lr_program *p = rc ? NULL : calloc(1, sizeof *p);
+    if (!rc && !p) {
         glDeleteProgram(prog);
-        return lr_err_set(e, LR_ENOMEM, "program");
+        rc = lr_err_set(e, LR_ENOMEM, "program");
+    }
+    if (rc) {
+        names_free(&uniforms);
+        return rc;
     }
     p->id = prog;
+    p->uniforms = uniforms;
+    snprintf(p->label, sizeof p->label, "%s%s%s", names[0], count > 1 ? " + " : "",
+             count > 1 ? names[1] : "");
     *out = p;
     return LR_OK;
 }
@@ -482,11 +623,43 @@ void lr_program_destroy(lr_program *p)
     if (!p)
         return;
     glDeleteProgram(p->id);
+    names_free(&p->uniforms);
     free(p);
 }
 
 GLuint lr_program_id(const lr_program *p) { return p->id; }
-GLint lr_program_uniform(const lr_program *p, const char *name)
+
+/* The declared name of "u_x" or "u_x[3]" (or "u_x[3].y"): its length up to the index. */
+static size_t base_len(const char *name)
 {
+    size_t n = 0;
+    while (name[n] && name[n] != '[' && name[n] != '.')
+        n++;
+    return n;
+}
+
+bool lr_program_declares(const lr_program *p, const char *name)
+{
+    return names_has(&p->uniforms, name, base_len(name));
+}
+
+GLint lr_program_uniform(lr_program *p, const char *name)
+{
+    if (!lr_program_declares(p, name)) {
+        if (!p->undeclared[0])
+            snprintf(p->undeclared, sizeof p->undeclared, "%s", name);
+        return -1;
+    }
     return glGetUniformLocation(p->id, name);
+}
+
+int lr_program_check(lr_program *p, lr_err *e)
+{
+    if (!p->undeclared[0])
+        return LR_OK;
+    int rc = lr_err_set(e, LR_EINVAL,
+                        "program %s: sets uniform %s, which its shaders do not declare",
+                        p->label, p->undeclared);
+    p->undeclared[0] = '\0';
+    return rc;
 }

@@ -26,6 +26,7 @@
 #define LR_SHADER_H
 
 #include <GLES3/gl31.h>
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "render/base/err.h"
@@ -87,7 +88,17 @@ int lr_program_create(const lr_program_desc *desc, lr_program **out, lr_err *e);
 void lr_program_destroy(lr_program *p);
 
 GLuint lr_program_id(const lr_program *p);
-/* glGetUniformLocation; -1 when the uniform is absent or was optimised out. */
-GLint lr_program_uniform(const lr_program *p, const char *name);
+/* glGetUniformLocation of "u_x" or "u_x[i]"; -1 when the compiler dropped it (declared but
+ * unused: legitimate, nothing to set). A name the program's sources do not declare (found
+ * at creation from the assembled source: compilers drop unused uniforms, so the active ones
+ * cannot tell a misspelling from an unused uniform) also gives -1 and is remembered for
+ * lr_program_check: setting a uniform the shader lacks is an error, not a silent no-op. */
+GLint lr_program_uniform(lr_program *p, const char *name);
+/* Whether the program's sources declare uniform `name` (an array index is ignored). */
+bool lr_program_declares(const lr_program *p, const char *name);
+/* LR_EINVAL "program mesh.vert + radiosity.frag: sets uniform u_foo, which its shaders do not
+ * declare" for the first undeclared name asked of lr_program_uniform since the last check
+ * (then forgotten); LR_OK when there was none. Callers check after each draw's set-up. */
+int lr_program_check(lr_program *p, lr_err *e);
 
 #endif

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "render/gl/shader.h"
+#include "render/passes/defines.h"
 
 struct lr_blend {
     lr_gl *gl;
@@ -66,35 +67,38 @@ void lr_blend_destroy(lr_blend *b)
     free(b);
 }
 
-static void uniform_i(const lr_program *p, const char *name, int v)
+static void uniform_i(lr_program *p, const char *name, int v)
 {
     GLint loc = lr_program_uniform(p, name);
     if (loc >= 0)
         glUniform1i(loc, v);
 }
 
-static void uniform_f(const lr_program *p, const char *name, float v)
+static void uniform_f(lr_program *p, const char *name, float v)
 {
     GLint loc = lr_program_uniform(p, name);
     if (loc >= 0)
         glUniform1f(loc, v);
 }
 
-/* The program for tone curve op (LR_BLEND_OPS: the linear sum) and n images of non-zero weight: the caller's defines plus
- * LR_BLEND_OP and LR_BLEND_N. */
+/* The program for tone curve op (LR_BLEND_OPS: the linear sum, LR_BLEND_LINEAR in GLSL) and
+ * n images of non-zero weight: the caller's defines (render/passes/defines.h: the curves'
+ * names) plus LR_BLEND_OP and LR_BLEND_N. */
 static int program(lr_blend *b, int op, int n, lr_program **out, lr_err *e)
 {
     if (!b->prog[op][n]) {
-        static const char *const ops[] = {"LR_BLEND_OP 0", "LR_BLEND_OP 1", "LR_BLEND_OP 2",
-                                          "LR_BLEND_OP 3"};
-        static const char *const ns[] = {"LR_BLEND_N 0", "LR_BLEND_N 1", "LR_BLEND_N 2",
-                                         "LR_BLEND_N 3", "LR_BLEND_N 4"};
-        const char *defs[16];
+        lr_shader_defines own = {0};
+        const char *defs[2 * LR_DEFINES_MAX + 1];
         int k = 0;
-        for (; k < 13 && b->defines && b->defines[k]; k++)
+        for (; b->defines && b->defines[k] && k < LR_DEFINES_MAX; k++)
             defs[k] = b->defines[k];
-        defs[k++] = ops[op];
-        defs[k++] = ns[n];
+        if (b->defines && b->defines[k])
+            return lr_err_set(e, LR_EINVAL, "blend pass: more than %d shader defines",
+                              LR_DEFINES_MAX);
+        lr_shader_defines_add(&own, "LR_BLEND_OP", op);
+        lr_shader_defines_add(&own, "LR_BLEND_N", n);
+        for (int i = 0; i < own.n; i++)
+            defs[k++] = own.list[i];
         defs[k] = NULL;
         lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "blend.frag",
                               .dir = b->shader_dir, .defines = defs};
@@ -142,6 +146,8 @@ static int draw(lr_blend *b, lr_fb *fb, bool linear, lr_err *e)
         glUniform1iv(loc, LR_BLEND_MAX_IMAGES, layer);
     /* lr_tonemap_apply's rule: exposure 0 means 1. */
     uniform_f(p, "u_exposure", in->exposure != 0.0f ? in->exposure : 1.0f);
+    if ((rc = lr_program_check(p, e)))
+        return rc;
     lr_gl_draw_fullscreen(b->gl);
     return lr_gl_check(linear ? "blend pass (HDR sum)" : "blend pass", e);
 }

@@ -4,53 +4,51 @@
  * face by face (GLES 3.1 has no geometry shaders); a point light outside a perspective 2D
  * map whose frustum holds the bounding sphere; a spot light a perspective map along its axis;
  * a directional light an orthographic map over the bounding sphere. One G-buffer per light
- * (r->gb[l]); the memory per light is 2 x 6 x gbuffer_size^2 RGBA32F texels for the cube
+ * (g->light[l]); the memory per light is 2 x 6 x gbuffer_size^2 RGBA32F texels for the cube
  * plus 2 x gbuffer_size^2 for the 2D map (14.7 MB at 256^2). */
 #include <math.h>
+#include <stdio.h>
 
 #include "render/base/mat4.h"
-#include "render/passes/passes.h"
+#include "render/passes/gbuffer.h"
 
-static int make_fb(lr_renderer *r, lr_tex *pos, lr_tex *nrm, int layer, lr_fb **out, lr_err *e)
+static int make_fb(lr_gl *gl, lr_tex *pos, lr_tex *nrm, int layer, lr_fb **out, lr_err *e)
 {
     lr_fb_desc d = {.color = {{pos, layer}, {nrm, layer}}, .depth_buffer = true,
                     .label = "light G-buffer"};
-    return lr_fb_create(r->gl, &d, out, e);
+    return lr_fb_create(gl, &d, out, e);
 }
 
-int lr_gbuffer_alloc(lr_renderer *r, lr_err *e)
+int lr_gbuffer_alloc(lr_gbuffer *gb, const lr_pass_ctx *c, lr_err *e)
 {
-    int n = r->rs.gbuffer_size, rc;
-    int nl = lr_scene_light_count(r->scene);
-    if (nl > LR_MAX_LIGHTS)
-        return lr_err_set(e, LR_EUNSUPPORTED, "renderer: %d lights; at most %d", nl,
-                          LR_MAX_LIGHTS);
-    r->n_lights = nl;
+    int n = c->rs->gbuffer_size, rc;
+    int nl = c->n_lights;
+    gb->n_lights = nl;
     lr_tex_desc cube = {.type = LR_TEX_CUBE, .format = LR_TEX_RGBA32F, .width = n,
                         .label = "light G-buffer cube"};
     lr_tex_desc flat = {.type = LR_TEX_2D, .format = LR_TEX_RGBA32F, .width = n, .height = n,
                         .label = "light G-buffer 2D"};
     for (int l = 0; l < nl; l++) {
-        struct lr_light_gbuffer *g = &r->gb[l];
+        lr_light_gbuffer *g = &gb->light[l];
         g->size = n;
-        if ((rc = lr_tex_create(r->gl, &cube, &g->pos_cube, e)) ||
-            (rc = lr_tex_create(r->gl, &cube, &g->nrm_cube, e)) ||
-            (rc = lr_tex_create(r->gl, &flat, &g->pos_2d, e)) ||
-            (rc = lr_tex_create(r->gl, &flat, &g->nrm_2d, e)))
+        if ((rc = lr_tex_create(c->gl, &cube, &g->pos_cube, e)) ||
+            (rc = lr_tex_create(c->gl, &cube, &g->nrm_cube, e)) ||
+            (rc = lr_tex_create(c->gl, &flat, &g->pos_2d, e)) ||
+            (rc = lr_tex_create(c->gl, &flat, &g->nrm_2d, e)))
             return rc;
         for (int f = 0; f < 6; f++)
-            if ((rc = make_fb(r, g->pos_cube, g->nrm_cube, f, &g->fb[f], e)))
+            if ((rc = make_fb(c->gl, g->pos_cube, g->nrm_cube, f, &g->fb[f], e)))
                 return rc;
-        if ((rc = make_fb(r, g->pos_2d, g->nrm_2d, 0, &g->fb_2d, e)))
+        if ((rc = make_fb(c->gl, g->pos_2d, g->nrm_2d, 0, &g->fb_2d, e)))
             return rc;
     }
     return LR_OK;
 }
 
-void lr_gbuffer_free(lr_renderer *r)
+void lr_gbuffer_free(lr_gbuffer *gb)
 {
     for (int l = 0; l < LR_MAX_LIGHTS; l++) {
-        struct lr_light_gbuffer *g = &r->gb[l];
+        lr_light_gbuffer *g = &gb->light[l];
         for (int f = 0; f < 6; f++) {
             lr_fb_destroy(g->fb[f]);
             g->fb[f] = NULL;
@@ -71,14 +69,14 @@ static lr_vec3 up_for(lr_vec3 dir)
 }
 
 /* Draws every object into the bound framebuffer with world -> clip `vp`. */
-static void draw_objects(lr_renderer *r, const double vp[16])
+static void draw_objects(const lr_pass_ctx *c, const double vp[16])
 {
-    const lr_program *p = r->p_surface;
+    lr_program *p = c->prog->surface;
     lr_passes_uniform_mat4(p, "u_vp", vp);
-    for (int i = 0; i < r->n_objects; i++) {
+    for (int i = 0; i < c->objs->n_objects; i++) {
         lr_passes_uniform_i(p, "u_object", i);
-        lr_passes_uniform_i(p, "u_two_sided", r->two_sided[i]);
-        lr_passes_draw(&r->obj[i]);
+        lr_passes_uniform_i(p, "u_two_sided", c->objs->two_sided[i]);
+        lr_passes_draw(&c->objs->obj[i]);
     }
 }
 
@@ -92,22 +90,21 @@ static void clear_surface(void)
 }
 
 /* Light l's G-buffer. */
-static void draw_light(lr_renderer *r, int l)
+static void draw_light(lr_light_gbuffer *g, const lr_pass_ctx *ctx, int l)
 {
-    const lr_light *light = lr_passes_light(r, l);
-    struct lr_light_gbuffer *g = &r->gb[l];
+    const lr_light *light = lr_scene_light_at(ctx->scene, l);
     lr_vec3 c;
     double R;
-    lr_scene_bounds(r->scene, &c, &R);
+    lr_scene_bounds(ctx->scene, &c, &R);
     R = fmax(R, 1e-3);
-    g->type = light->type == LR_LIGHT_POINT ? 0 : light->type == LR_LIGHT_SPOT ? 1 : 2;
+    g->type = light->type;
     g->pos = light->position;
     g->dir = lr_v3_normalize(light->direction);
     g->spot_cos[0] = (float)cos(light->outer_deg * M_PI / 180.0);
     g->spot_cos[1] = (float)cos(light->inner_deg * M_PI / 180.0);
 
     double dist = lr_v3_len(lr_v3_sub(c, light->position));
-    enum lr_enclosure enc = lr_scene_light_enclosure(r->scene, l, NULL);
+    enum lr_enclosure enc = lr_scene_light_enclosure(ctx->scene, l, NULL);
     if (light->type == LR_LIGHT_DIRECTIONAL)
         g->mode = LR_GB_ORTHO;
     else if (light->type == LR_LIGHT_POINT && (enc != LR_ENCLOSURE_NONE || dist < 1.05 * R))
@@ -121,7 +118,7 @@ static void draw_light(lr_renderer *r, int l)
             lr_fb_bind(g->fb[f]);
             clear_surface();
             lr_passes_cube_face_vp(light->position, f, znear, zfar, g->face_vp[f]);
-            draw_objects(r, g->face_vp[f]);
+            draw_objects(ctx, g->face_vp[f]);
         }
         lr_mat4_identity(g->vp_d);
     } else {
@@ -145,20 +142,91 @@ static void draw_light(lr_renderer *r, int l)
         lr_mat4_mul(proj, view, g->vp_d);
         lr_fb_bind(g->fb_2d);
         clear_surface();
-        draw_objects(r, g->vp_d);
+        draw_objects(ctx, g->vp_d);
     }
     lr_mat4_to_float(g->vp_d, g->vp);
 }
 
-int lr_pass_gbuffer(lr_renderer *r, lr_err *e)
+int lr_gbuffer_run(lr_gbuffer *g, const lr_pass_ctx *c, lr_err *e)
 {
-    glUseProgram(lr_program_id(r->p_surface));
+    glUseProgram(lr_program_id(c->prog->surface));
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
-    for (int l = 0; l < r->n_lights; l++)
-        draw_light(r, l);
+    for (int l = 0; l < g->n_lights; l++)
+        draw_light(&g->light[l], c, l);
     return lr_gl_check("gbuffer pass", e);
+}
+
+void lr_gbuffer_bind(const lr_gbuffer *gb, lr_program *p, int l)
+{
+    const lr_light_gbuffer *g = &gb->light[l];
+    if (g->mode == LR_GB_CUBE) {
+        lr_passes_bind_tex(p, "u_gb_cube_pos", 0, g->pos_cube);
+        lr_passes_bind_tex(p, "u_gb_cube_nrm", 1, g->nrm_cube);
+        /* Units of the unused sampler type must differ from the used ones. */
+        lr_passes_uniform_i(p, "u_gb_pos", 2);
+        lr_passes_uniform_i(p, "u_gb_nrm", 3);
+    } else {
+        lr_passes_uniform_i(p, "u_gb_cube_pos", 0);
+        lr_passes_uniform_i(p, "u_gb_cube_nrm", 1);
+        lr_passes_bind_tex(p, "u_gb_pos", 2, g->pos_2d);
+        lr_passes_bind_tex(p, "u_gb_nrm", 3, g->nrm_2d);
+    }
+    lr_passes_uniform_i(p, "u_gb_mode", (int)g->mode);
+    GLint loc = lr_program_uniform(p, "u_gb_vp");
+    if (loc >= 0)
+        glUniformMatrix4fv(loc, 1, GL_FALSE, g->vp);
+    lr_passes_uniform_v3(p, "u_light_pos", g->pos);
+    lr_passes_uniform_v3(p, "u_light_dir", g->dir);
+    lr_passes_uniform_i(p, "u_light_type", (int)g->type);
+    loc = lr_program_uniform(p, "u_spot_cos");
+    if (loc >= 0)
+        glUniform2f(loc, g->spot_cos[0], g->spot_cos[1]);
+}
+
+/* Element i of uniform array `name` ("u_x[2]"). */
+static GLint array_loc(lr_program *p, const char *name, int i)
+{
+    char n[64];
+    snprintf(n, sizeof n, "%s[%d]", name, i);
+    return lr_program_uniform(p, n);
+}
+
+void lr_gbuffer_bind_lights(const lr_gbuffer *gb, const lr_pass_ctx *c, lr_program *p)
+{
+    /* Every array element gets its own unit, used or not: a cube and a 2D sampler must never
+     * share one (units 4..10 belong to the gather and the VPLs). */
+    for (int l = 0; l < LR_MAX_LIGHTS; l++) {
+        const lr_light_gbuffer *g = &gb->light[l];
+        bool on = l < gb->n_lights;
+        glActiveTexture(GL_TEXTURE0 + (GLenum)l);
+        glBindTexture(GL_TEXTURE_CUBE_MAP, on && g->mode == LR_GB_CUBE ? lr_tex_id(g->pos_cube) : 0);
+        glActiveTexture(GL_TEXTURE11 + (GLenum)l);
+        glBindTexture(GL_TEXTURE_2D, on && g->mode != LR_GB_CUBE ? lr_tex_id(g->pos_2d) : 0);
+        GLint loc;
+        if ((loc = array_loc(p, "u_lights_cube", l)) >= 0)
+            glUniform1i(loc, l);
+        if ((loc = array_loc(p, "u_lights_2d", l)) >= 0)
+            glUniform1i(loc, 11 + l);
+        if (!on)
+            continue;
+        if ((loc = array_loc(p, "u_lights_mode", l)) >= 0)
+            glUniform1i(loc, (int)g->mode);
+        if ((loc = array_loc(p, "u_lights_type", l)) >= 0)
+            glUniform1i(loc, (int)g->type);
+        if ((loc = array_loc(p, "u_lights_vp", l)) >= 0)
+            glUniformMatrix4fv(loc, 1, GL_FALSE, g->vp);
+        if ((loc = array_loc(p, "u_lights_pos", l)) >= 0)
+            glUniform3f(loc, (float)g->pos.x, (float)g->pos.y, (float)g->pos.z);
+        if ((loc = array_loc(p, "u_lights_dir", l)) >= 0)
+            glUniform3f(loc, (float)g->dir.x, (float)g->dir.y, (float)g->dir.z);
+        if ((loc = array_loc(p, "u_lights_spot_cos", l)) >= 0)
+            glUniform2f(loc, g->spot_cos[0], g->spot_cos[1]);
+        if ((loc = array_loc(p, "u_lights_I", l)) >= 0)
+            glUniform3f(loc, (float)c->I[l][0], (float)c->I[l][1], (float)c->I[l][2]);
+    }
+    lr_passes_uniform_i(p, "u_n_lights", gb->n_lights);
 }

@@ -15,91 +15,92 @@
 
 #include "render/base/mat4.h"
 #include "render/optics/optics.h"
-#include "render/passes/passes.h"
+#include "render/passes/radiosity.h"
 
-int lr_radiosity_alloc(lr_renderer *r, lr_err *e)
+int lr_radiosity_alloc(lr_radiosity *rad, const lr_pass_ctx *c, lr_err *e)
 {
-    int K = r->rs.K, n = r->rs.map_size, rc;
+    int K = c->rs->K, n = c->rs->map_size, rc;
     if (K > LR_MAX_K)
         return lr_err_set(e, LR_EUNSUPPORTED, "render.K = %d: at most %d maps", K, LR_MAX_K);
-    r->rad.K = K;
-    r->rad.size = n;
-    int L = r->n_lights;
-    lr_tex_desc d = {.type = LR_TEX_2D_ARRAY, .format = r->map_format, .width = n, .height = n,
+    rad->K = K;
+    rad->size = n;
+    int L = c->n_lights;
+    rad->n_lights = L;
+    lr_tex_desc d = {.type = LR_TEX_2D_ARRAY, .format = c->map_format, .width = n, .height = n,
                      .layers = K * L, .label = "radiosity maps"};
-    if ((rc = lr_tex_create(r->gl, &d, &r->rad.B, e)))
+    if ((rc = lr_tex_create(c->gl, &d, &rad->B, e)))
         return rc;
     d.format = LR_TEX_RGBA32F;
     d.label = "radiosity map positions";
-    if ((rc = lr_tex_create(r->gl, &d, &r->rad.pos, e)))
+    if ((rc = lr_tex_create(c->gl, &d, &rad->pos, e)))
         return rc;
     d.label = "radiosity map normals";
-    if ((rc = lr_tex_create(r->gl, &d, &r->rad.nrm, e)))
+    if ((rc = lr_tex_create(c->gl, &d, &rad->nrm, e)))
         return rc;
     d.format = LR_TEX_DEPTH32F;
     d.label = "radiosity map depth";
-    if ((rc = lr_tex_create(r->gl, &d, &r->rad.depth, e)))
+    if ((rc = lr_tex_create(c->gl, &d, &rad->depth, e)))
         return rc;
     for (int l = 0; l < L; l++)
         for (int k = 0; k < K; k++) {
-            lr_fb_desc fd = {.color = {{r->rad.B, l * K + k}, {r->rad.pos, k}, {r->rad.nrm, k}},
-                             .depth = {r->rad.depth, k}, .label = "radiosity map"};
-            if ((rc = lr_fb_create(r->gl, &fd, &r->rad.fb[l * K + k], e)))
+            lr_fb_desc fd = {.color = {{rad->B, l * K + k}, {rad->pos, k}, {rad->nrm, k}},
+                             .depth = {rad->depth, k}, .label = "radiosity map"};
+            if ((rc = lr_fb_create(c->gl, &fd, &rad->fb[l * K + k], e)))
                 return rc;
         }
-    r->rad.F = 0;
+    rad->F = 0;
     return LR_OK;
 }
 
-void lr_radiosity_free(lr_renderer *r)
+void lr_radiosity_free(lr_radiosity *rad)
 {
     for (int k = 0; k < LR_MAX_LIGHTS * LR_MAX_K; k++) {
-        lr_fb_destroy(r->rad.fb[k]);
-        r->rad.fb[k] = NULL;
+        lr_fb_destroy(rad->fb[k]);
+        rad->fb[k] = NULL;
     }
-    lr_tex_destroy(r->rad.B);
-    lr_tex_destroy(r->rad.pos);
-    lr_tex_destroy(r->rad.nrm);
-    lr_tex_destroy(r->rad.depth);
-    r->rad.B = r->rad.pos = r->rad.nrm = r->rad.depth = NULL;
-    r->rad.F = 0;
+    lr_tex_destroy(rad->B);
+    lr_tex_destroy(rad->pos);
+    lr_tex_destroy(rad->nrm);
+    lr_tex_destroy(rad->depth);
+    rad->B = rad->pos = rad->nrm = rad->depth = NULL;
+    rad->F = 0;
 }
 
 /* Map cameras from the current geometry: orthographic, looking at the bounding sphere's
  * centre from d_k, frustum around the sphere (depth range [R, 3R] from an eye at 2R). */
-static void place_maps(lr_renderer *r)
+static void place_maps(lr_radiosity *rad, const lr_pass_ctx *ctx, const lr_gbuffer *gb)
 {
     lr_vec3 c;
     double R;
-    lr_scene_bounds(r->scene, &c, &R);
+    lr_scene_bounds(ctx->scene, &c, &R);
     R = fmax(R, 1e-3);
-    r->rad.center = c;
-    r->rad.radius = R;
-    r->rad.r_max = 20.0 * R;
+    rad->center = c;
+    rad->radius = R;
+    rad->r_max = 20.0 * R;
     double S[16] = {0.5, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, 0.5, 0, 0.5, 0.5, 0.5, 1};
-    for (int k = 0; k < r->rad.K; k++) {
+    for (int k = 0; k < rad->K; k++) {
         lr_vec3 d = lr_halton_sphere((unsigned)k + 1);
-        r->rad.d[k] = d;
+        rad->d[k] = d;
         double view[16], proj[16];
         lr_vec3 up = fabs(d.z) > 0.99 ? lr_v3(0.0, 1.0, 0.0) : lr_v3(0.0, 0.0, 1.0);
         lr_mat4_look_at(lr_v3_add(c, lr_v3_scale(d, 2.0 * R)), c, up, view);
         lr_mat4_ortho(-R, R, -R, R, R, 3.0 * R, proj);
-        lr_mat4_mul(proj, view, r->rad.vp[k]);
-        lr_mat4_mul(S, r->rad.vp[k], r->rad.P[k]);
-        lr_mat4_to_float(r->rad.P[k], r->rad.Pf + 16 * k);
-        r->rad.df[3 * k] = (float)d.x;
-        r->rad.df[3 * k + 1] = (float)d.y;
-        r->rad.df[3 * k + 2] = (float)d.z;
+        lr_mat4_mul(proj, view, rad->vp[k]);
+        lr_mat4_mul(S, rad->vp[k], rad->P[k]);
+        lr_mat4_to_float(rad->P[k], rad->Pf + 16 * k);
+        rad->df[3 * k] = (float)d.x;
+        rad->df[3 * k + 1] = (float)d.y;
+        rad->df[3 * k + 2] = (float)d.z;
     }
     /* Maps hold B for a unit light: ~1/d^2 W/mm^2 for a point light at d mm, 1e-4..1e-6 in
      * the shipped scenes, below half floats' normal range (6e-5) and flushed to zero by some
      * drivers. They store B R^2 instead (O(1) at the bounding radius); directional lights
      * (unit radiance, B ~ 1) store B. */
-    for (int l = 0; l < r->n_lights; l++)
-        r->rad.scale[l] = r->gb[l].type == 2 ? 1.0f : (float)(R * R);
-    double texel = 2.0 * R / r->rad.size;
-    r->rad.eps_comb = (float)texel;
-    r->rad.eps_bias = (float)(2.0 * texel / (2.0 * R)); /* two texels, in depth units */
+    for (int l = 0; l < rad->n_lights; l++)
+        rad->scale[l] = gb->light[l].type == LR_LIGHT_DIRECTIONAL ? 1.0f : (float)(R * R);
+    double texel = 2.0 * R / rad->size;
+    rad->eps_comb = (float)texel;
+    rad->eps_bias = (float)(2.0 * texel / (2.0 * R)); /* two texels, in depth units */
 }
 
 /* The running mean's weight for frame F: 1/F. For RGBA16F maps the GPU may evaluate the blend
@@ -117,22 +118,23 @@ static float blend_weight(lr_tex_format format, int F)
     return (float)((k < 1.0 ? 1.0 : k) / 2048.0);
 }
 
-int lr_pass_radiosity(lr_renderer *r, bool restart, lr_err *e)
+int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *gb, bool restart,
+                     lr_err *e)
 {
     static const GLenum all[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
     static const GLenum first[3] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE};
     static const float zero[4] = {0, 0, 0, 0};
-    if (restart || r->rad.F == 0) {
-        place_maps(r);
-        r->rad.F = 0;
+    if (restart || rad->F == 0) {
+        place_maps(rad, c, gb);
+        rad->F = 0;
     }
-    int F = r->rad.F + 1;
-    int K = r->rad.K;
+    int F = rad->F + 1;
+    int K = rad->K;
     glDisable(GL_CULL_FACE);
     glEnable(GL_DEPTH_TEST);
     for (int k = 0; k < K; k++)
-        for (int l = 0; l < r->n_lights; l++) {
-            lr_fb_bind(r->rad.fb[l * K + k]);
+        for (int l = 0; l < rad->n_lights; l++) {
+            lr_fb_bind(rad->fb[l * K + k]);
             if (F == 1 && l == 0) {
                 glDrawBuffers(3, all);
                 glClearBufferfv(GL_COLOR, 0, zero);
@@ -142,12 +144,12 @@ int lr_pass_radiosity(lr_renderer *r, bool restart, lr_err *e)
                 glClearDepthf(1.0f);
                 glClear(GL_DEPTH_BUFFER_BIT);
                 /* Depth-only prepass. */
-                glUseProgram(lr_program_id(r->p_depth));
+                glUseProgram(lr_program_id(c->prog->depth));
                 glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
                 glDepthFunc(GL_LESS);
-                lr_passes_uniform_mat4(r->p_depth, "u_vp", r->rad.vp[k]);
-                for (int i = 0; i < r->n_objects; i++)
-                    lr_passes_draw(&r->obj[i]);
+                lr_passes_uniform_mat4(c->prog->depth, "u_vp", rad->vp[k]);
+                for (int i = 0; i < c->objs->n_objects; i++)
+                    lr_passes_draw(&c->objs->obj[i]);
                 glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
                 glDisable(GL_BLEND);
             } else if (F == 1) {
@@ -159,35 +161,73 @@ int lr_pass_radiosity(lr_renderer *r, bool restart, lr_err *e)
                 glDrawBuffers(3, first);
                 glEnable(GL_BLEND);
                 glBlendEquation(GL_FUNC_ADD);
-                glBlendColor(0.0f, 0.0f, 0.0f, blend_weight(r->map_format, F));
+                glBlendColor(0.0f, 0.0f, 0.0f, blend_weight(c->map_format, F));
                 glBlendFunc(GL_CONSTANT_ALPHA, GL_ONE_MINUS_CONSTANT_ALPHA);
             }
             glDepthMask(GL_FALSE);
             glDepthFunc(GL_LEQUAL);
-            const lr_program *p = r->p_radiosity;
+            lr_program *p = c->prog->radiosity;
             glUseProgram(lr_program_id(p));
-            lr_passes_set_coeffs(r, p);
-            lr_passes_bind_gbuffer(r, p, l);
-            lr_passes_uniform_mat4(p, "u_vp", r->rad.vp[k]);
-            lr_passes_uniform_i(p, "u_N", r->rs.N);
-            lr_passes_uniform_f(p, "u_r_max", (float)r->rad.r_max);
+            lr_passes_set_coeffs(c->objs, p);
+            lr_passes_uniform_v3_array(p, "u_sd_norm", c->objs->sd_norm, LR_MAX_OBJECTS);
+            lr_gbuffer_bind(gb, p, l);
+            lr_passes_uniform_mat4(p, "u_vp", rad->vp[k]);
+            lr_passes_uniform_i(p, "u_N", c->rs->N);
+            lr_passes_uniform_f(p, "u_r_max", (float)rad->r_max);
             lr_passes_uniform_f(p, "u_r_max_dist", 20.0f);
-            lr_passes_uniform_i(p, "u_map_size", r->rad.size);
-            lr_passes_uniform_f(p, "u_map_scale", r->rad.scale[l]);
+            lr_passes_uniform_i(p, "u_map_size", rad->size);
+            lr_passes_uniform_f(p, "u_map_scale", rad->scale[l]);
             /* Half floats: stay below 65504 (a light on the surface has B -> Inf at x_o -> x_l). */
-            lr_passes_uniform_f(p, "u_map_max", r->map_format == LR_TEX_RGBA16F ? 6.0e4f : 3.0e38f);
-            glUniform1ui(lr_program_uniform(p, "u_seed"), r->seed);
+            lr_passes_uniform_f(p, "u_map_max", c->map_format == LR_TEX_RGBA16F ? 6.0e4f : 3.0e38f);
+            glUniform1ui(lr_program_uniform(p, "u_seed"), c->seed);
             glUniform1ui(lr_program_uniform(p, "u_map"), (GLuint)k);
             glUniform1ui(lr_program_uniform(p, "u_frame"), (GLuint)F);
-            for (int i = 0; i < r->n_objects; i++) {
+            for (int i = 0; i < c->objs->n_objects; i++) {
                 lr_passes_uniform_i(p, "u_object", i);
-                lr_passes_uniform_i(p, "u_two_sided", r->two_sided[i]);
-                lr_passes_draw(&r->obj[i]);
+                lr_passes_uniform_i(p, "u_two_sided", c->objs->two_sided[i]);
+                lr_passes_draw(&c->objs->obj[i]);
             }
         }
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);
-    r->rad.F = F;
+    rad->F = F;
     return lr_gl_check("radiosity pass", e);
+}
+
+void lr_radiosity_bind_gather(const lr_radiosity *rad, lr_program *p, const double w[][3])
+{
+    lr_passes_bind_tex(p, "u_map_B", 4, rad->B);
+    lr_passes_bind_tex(p, "u_map_nrm", 5, rad->nrm);
+    lr_passes_bind_tex(p, "u_map_depth", 6, rad->depth);
+    GLint loc = lr_program_uniform(p, "u_map_P");
+    if (loc < 0)
+        loc = lr_program_uniform(p, "u_map_P[0]");
+    if (loc >= 0)
+        glUniformMatrix4fv(loc, rad->K, GL_FALSE, rad->Pf);
+    loc = lr_program_uniform(p, "u_map_d");
+    if (loc < 0)
+        loc = lr_program_uniform(p, "u_map_d[0]");
+    if (loc >= 0)
+        glUniform3fv(loc, rad->K, rad->df);
+    lr_passes_uniform_i(p, "u_K", rad->K);
+    lr_passes_uniform_f(p, "u_eps_bias", rad->eps_bias);
+    lr_passes_uniform_f(p, "u_eps_comb", rad->eps_comb);
+    lr_radiosity_set_light_w(rad, p, w);
+}
+
+void lr_radiosity_set_light_w(const lr_radiosity *rad, lr_program *p, const double w[][3])
+{
+    /* The maps store B * scale[l]: the weight divides it out. */
+    GLint loc;
+    float wf[3 * LR_MAX_LIGHTS] = {0};
+    for (int l = 0; l < rad->n_lights; l++)
+        for (int c = 0; c < 3; c++)
+            wf[3 * l + c] = (float)(w[l][c] / rad->scale[l]);
+    loc = lr_program_uniform(p, "u_light_w");
+    if (loc < 0)
+        loc = lr_program_uniform(p, "u_light_w[0]");
+    if (loc >= 0)
+        glUniform3fv(loc, LR_MAX_LIGHTS, wf);
+    lr_passes_uniform_i(p, "u_n_lights", rad->n_lights);
 }

@@ -1,12 +1,15 @@
 // The blend pass (render/passes/blend.h): sum_k u_w[k] image_{u_layer[k]} over the per-light
 // unit-intensity linear images whose weight is not zero (LR_BLEND_N of them, a compile-time
 // count: no loop, no branch per pixel), then exposure, the tone curve (LR_BLEND_OP, an
-// lr_tonemap_op, compile-time) and the sRGB encode, or, with LR_BLEND_OP 3, the linear sum
+// lr_tonemap_op, compile-time) and the sRGB encode, or, with LR_BLEND_LINEAR, the linear sum
 // for readback (a define, not a uniform: llvmpipe runs both sides of a uniform branch under a
 // mask, and the other side's fetch would cost as much as the image's). The encode is lr_srgb_encode_fast (render/image/image.h): three square roots
 // instead of pow, within a quarter of an 8-bit step of IEC 61966-2-1. This pass is the whole
 // of a dimmer or flicker frame; on llvmpipe pow (log2 + exp2) per channel and a per-channel
 // table fetch (a gather per lane) each cost more than the fetch of the image itself.
+#if !defined(LR_BLEND_OP) || !defined(LR_BLEND_N) || !defined(LR_BLEND_LINEAR)
+#error blend.frag needs the renderer defines (render/passes/defines.h) and LR_BLEND_OP, LR_BLEND_N
+#endif
 uniform highp sampler2DArray u_images;
 uniform vec3 u_w[4];
 uniform int u_layer[4];
@@ -29,15 +32,15 @@ void main()
 #if LR_BLEND_N >= 4
     c += u_w[3] * texelFetch(u_images, ivec3(p, u_layer[3]), 0).rgb;
 #endif
-#if LR_BLEND_OP == 3
+#if LR_BLEND_OP == LR_BLEND_LINEAR
     // Alpha of layer 0: coverage (compose_object.frag), whichever lights are lit.
     o_color = vec4(c, texelFetch(u_images, ivec3(p, 0), 0).a);
 #else
     // lr_tonemap_apply (render/image/image.c): exposure, curve, clip to [0, 1].
     vec3 v = max(c * u_exposure, vec3(0.0));
-#if LR_BLEND_OP == 1
+#if LR_BLEND_OP == LR_TONEMAP_REINHARD
     v = v / (1.0 + v);
-#elif LR_BLEND_OP == 2
+#elif LR_BLEND_OP == LR_TONEMAP_ACES
     v = (v * (2.51 * v + 0.03)) / (v * (2.43 * v + 0.59) + 0.14); // Narkowicz 2015
 #endif
     v = min(v, vec3(1.0));

@@ -10,7 +10,7 @@ in vec3 v_pos;
 in vec3 v_nrm;
 uniform int u_object;
 uniform bool u_two_sided;
-uniform int u_light_type;   // 0 point, 1 spot, 2 directional
+uniform int u_light_type;   // LR_LIGHT_POINT, LR_LIGHT_SPOT, LR_LIGHT_DIRECTIONAL
 uniform vec2 u_spot_cos;    // cos(outer), cos(inner)
 uniform int u_N;
 uniform float u_r_max;      // 20 R; point/spot lights: r_max = max(u_r_max, u_r_max_dist d)
@@ -29,7 +29,7 @@ layout(location = 2) out vec4 o_nrm;
 
 float spot_shape(vec3 dir)
 {
-    if (u_light_type != 1)
+    if (u_light_type != LR_LIGHT_SPOT)
         return 1.0;
     float c = dot(normalize(dir), u_light_dir);
     return smoothstep(u_spot_cos.x, u_spot_cos.y, c);
@@ -47,7 +47,7 @@ void main()
     uint state = lr_seed(uint(tx.y * u_map_size + tx.x), u_map, u_frame, u_seed);
 
     // Tangent frame at x_o (point lights), or the light's view plane (directional).
-    vec3 axis = u_light_type == 2 ? u_light_dir : no;
+    vec3 axis = u_light_type == LR_LIGHT_DIRECTIONAL ? u_light_dir : no;
     vec3 a = abs(axis.z) < 0.9 ? vec3(0.0, 0.0, 1.0) : vec3(1.0, 0.0, 0.0);
     vec3 t1 = normalize(cross(a, axis));
     vec3 t2 = cross(axis, t1);
@@ -56,7 +56,7 @@ void main()
     float d = length(h);
     vec3 A = u_light_pos + h; // antipode of x_o on the sphere of radius d around the light
 
-    float r_max = u_light_type == 2 ? u_r_max : max(u_r_max, u_r_max_dist * d);
+    float r_max = u_light_type == LR_LIGHT_DIRECTIONAL ? u_r_max : max(u_r_max, u_r_max_dist * d);
     vec3 B = vec3(0.0);
     for (int c = 0; c < 3; c++) {
         float sigma_tr = mat.sigma_tr[c];
@@ -87,7 +87,7 @@ void main()
             vec3 wi;
             float J;
             float shape = 1.0;
-            if (u_light_type == 2) {
+            if (u_light_type == LR_LIGHT_DIRECTIONAL) {
                 if (!lr_gbuffer_fetch(xj, xi, ni, id))
                     continue;
                 wi = -u_light_dir;

@@ -9,18 +9,18 @@ uniform highp samplerCube u_gb_cube_pos;
 uniform highp samplerCube u_gb_cube_nrm;
 uniform highp sampler2D u_gb_pos;
 uniform highp sampler2D u_gb_nrm;
-uniform int u_gb_mode;
+uniform int u_gb_mode;     // LR_GB_CUBE, LR_GB_PERSPECTIVE, LR_GB_ORTHO (render/passes/gbuffer.h)
 uniform mat4 u_gb_vp;      // world -> clip of the 2D map
 uniform vec3 u_light_pos;  // point, spot
 uniform vec3 u_light_dir;  // spot axis, directional travel direction (unit)
 
-// Looks up the G-buffer along direction v from the light (modes 0, 1) or at world point v
-// (mode 2). Returns false where there is no surface.
+// Looks up the G-buffer along direction v from the light (LR_GB_CUBE, LR_GB_PERSPECTIVE) or
+// at world point v (LR_GB_ORTHO). Returns false where there is no surface.
 bool lr_gbuffer_fetch(vec3 v, out vec3 xi, out vec3 ni, out int id)
 {
     vec4 p;
     vec4 n;
-    if (u_gb_mode == 0) {
+    if (u_gb_mode == LR_GB_CUBE) {
         p = texture(u_gb_cube_pos, v);
         n = texture(u_gb_cube_nrm, v);
     } else {
@@ -44,7 +44,7 @@ bool lr_gbuffer_lit(vec3 x, float bias)
 {
     vec3 xi, ni;
     int id;
-    if (u_gb_mode == 2) {
+    if (u_gb_mode == LR_GB_ORTHO) {
         if (!lr_gbuffer_fetch(x, xi, ni, id))
             return true;
         return dot(x - xi, u_light_dir) < bias;

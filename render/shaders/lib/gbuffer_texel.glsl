@@ -1,11 +1,11 @@
 // The texel of a 2D light G-buffer (pass 1) that holds lookup v: direction from the light at
-// light_pos (mode 1, perspective) or world point (mode 2, orthographic); vp the map's world ->
+// light_pos (LR_GB_PERSPECTIVE) or world point (LR_GB_ORTHO); vp the map's world ->
 // clip, sz its size. False outside the map. Shared by gbuffer.glsl (one light) and lights.glsl
 // (every light).
 bool lr_gbuffer_texel(int mode, mat4 vp, vec3 light_pos, vec3 v, ivec2 sz, out ivec2 t)
 {
     t = ivec2(0);
-    vec4 clip = vp * vec4(mode == 1 ? light_pos + v : v, 1.0);
+    vec4 clip = vp * vec4(mode == LR_GB_PERSPECTIVE ? light_pos + v : v, 1.0);
     if (!(clip.w > 0.0))
         return false;
     vec3 ndc = clip.xyz / clip.w;

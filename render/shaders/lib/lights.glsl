@@ -15,7 +15,7 @@ uniform highp samplerCube u_lights_cube[LR_MAX_LIGHTS]; // G-buffer positions, c
 uniform highp sampler2D u_lights_2d[LR_MAX_LIGHTS];     // G-buffer positions, 2D modes
 uniform int u_lights_mode[LR_MAX_LIGHTS];               // gbuffer.glsl u_gb_mode
 uniform mat4 u_lights_vp[LR_MAX_LIGHTS];
-uniform int u_lights_type[LR_MAX_LIGHTS];               // 0 point, 1 spot, 2 directional
+uniform int u_lights_type[LR_MAX_LIGHTS];               // LR_LIGHT_*
 uniform vec3 u_lights_pos[LR_MAX_LIGHTS];
 uniform vec3 u_lights_dir[LR_MAX_LIGHTS];
 uniform vec2 u_lights_spot_cos[LR_MAX_LIGHTS];          // cos(outer), cos(inner)
@@ -60,9 +60,9 @@ vec4 lr_lights_2d_pos(int l, ivec2 t)
 bool lr_lights_lit(int l, vec3 x)
 {
     int mode = u_lights_mode[l];
-    vec3 v = mode == 2 ? x : x - u_lights_pos[l];
+    vec3 v = mode == LR_GB_ORTHO ? x : x - u_lights_pos[l];
     vec4 p;
-    if (mode == 0) {
+    if (mode == LR_GB_CUBE) {
         p = lr_lights_cube_pos(l, v);
     } else {
         ivec2 t;
@@ -72,7 +72,7 @@ bool lr_lights_lit(int l, vec3 x)
     }
     if (!(p.w > 0.5))
         return true;
-    if (mode == 2)
+    if (mode == LR_GB_ORTHO)
         return dot(x - p.xyz, u_lights_dir[l]) < 0.0;
     return length(v) < length(p.xyz - u_lights_pos[l]);
 }
@@ -81,7 +81,7 @@ bool lr_lights_lit(int l, vec3 x)
 // pass 4): cos / distance^2 times the spot's profile (directional: cos), 0 in shadow.
 float lr_lights_direct(int l, vec3 x, vec3 nx)
 {
-    if (u_lights_type[l] == 2) {
+    if (u_lights_type[l] == LR_LIGHT_DIRECTIONAL) {
         float c = dot(nx, -u_lights_dir[l]);
         return c > 0.0 && lr_lights_lit(l, x) ? c : 0.0;
     }
@@ -91,7 +91,7 @@ float lr_lights_direct(int l, vec3 x, vec3 nx)
     if (!(c > 0.0) || !lr_lights_lit(l, x))
         return 0.0;
     float shape = 1.0;
-    if (u_lights_type[l] == 1)
+    if (u_lights_type[l] == LR_LIGHT_SPOT)
         shape = smoothstep(u_lights_spot_cos[l].x, u_lights_spot_cos[l].y,
                            dot(-to_l, u_lights_dir[l]) * inversesqrt(d2));
     return shape * c / d2;

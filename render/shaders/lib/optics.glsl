@@ -162,8 +162,8 @@ vec3 lr_dirpole_sd_fresnel(lr_coeffs_gl c, vec3 xi, vec3 ni, vec3 wi, vec3 xo, v
 }
 
 // Standard dipole (render/optics/dipole.c): the coefficients lr_coeffs_gl lacks, per object,
-// and the model switch (render/optics/model.c; 0 directional dipole, 1 standard dipole,
-// 2 multipole with the slab's thickness and pole-pair count).
+// and the model switch (render/optics/model.c; LR_SSS_DIRECTIONAL_DIPOLE, LR_SSS_STANDARD_DIPOLE,
+// LR_SSS_MULTIPOLE with the slab's thickness and pole-pair count).
 struct lr_sss_gl {
     int model;
     vec3 albedo_prime;
@@ -233,9 +233,9 @@ float lr_multipole_sd_band(lr_coeffs_gl c, lr_sss_gl s, int j, vec3 xi, vec3 ni,
 float lr_sss_sd_band(lr_coeffs_gl c, lr_sss_gl s, int j, vec3 xi, vec3 ni, vec3 wi, vec3 xo,
                      vec3 no)
 {
-    if (s.model == 1)
+    if (s.model == LR_SSS_STANDARD_DIPOLE)
         return lr_dipole_sd_band(c, s, j, xi, xo);
-    if (s.model == 2)
+    if (s.model == LR_SSS_MULTIPOLE)
         return lr_multipole_sd_band(c, s, j, xi, ni, xo, no);
     return lr_dirpole_sd_band(c, j, xi, ni, wi, xo, no);
 }

@@ -1,0 +1,37 @@
+/* lamprig — pass 3, composition (render/passes/PIPELINE.md; compose.c): one linear image per
+ * light at unit intensity for the current view, objects through Algorithm 1 over the
+ * radiosity maps, receivers lit directly (shadowed through the G-buffers) and by the VPLs. */
+#ifndef LR_COMPOSE_H
+#define LR_COMPOSE_H
+
+#include "render/passes/gbuffer.h"
+#include "render/passes/irradiance.h"
+#include "render/passes/passes.h"
+#include "render/passes/radiosity.h"
+#include "render/passes/vpl.h"
+
+/* Composition's output: layer l of `images` (colour attachment l of `fb`) is light l's
+ * unit-intensity image, alpha 0 on object pixels no map sees. Valid until the view, the
+ * receivers or the transport change. */
+typedef struct lr_compose {
+    lr_tex *images;
+    lr_fb *fb;
+    int n;      /* layers (the scene's lights when allocated) */
+    bool valid; /* composed since the last (re)allocation */
+} lr_compose;
+
+/* What composition reads: the other passes' results. */
+typedef struct lr_compose_inputs {
+    const lr_gbuffer *gbuffer;      /* direct light and its shadows on the receivers */
+    const lr_radiosity *radiosity;  /* Algorithm 1 for the objects */
+    const lr_vpl *vpl;              /* emergent light on box receivers (unallocated: none) */
+    const lr_irradiance *irradiance; /* emergent light on plane receivers, cached */
+} lr_compose_inputs;
+
+/* Images of the output size for c->n_lights lights. */
+int lr_compose_alloc(lr_compose *img, const lr_pass_ctx *c, lr_err *e);
+void lr_compose_free(lr_compose *img);
+int lr_compose_run(lr_compose *img, const lr_pass_ctx *c, const lr_compose_inputs *in,
+                   lr_err *e);
+
+#endif

@@ -1,0 +1,43 @@
+/* lamprig — pass 1, the light G-buffer (render/passes/PIPELINE.md; gbuffer.c): one per light,
+ * the first surface of the translucent objects seen from it. Owned by the renderer's pass
+ * table; radiosity and composition read it through lr_gbuffer_bind / lr_gbuffer_bind_lights. */
+#ifndef LR_GBUFFER_H
+#define LR_GBUFFER_H
+
+#include "render/passes/passes.h"
+
+/* Light G-buffer layouts (render/shaders/lib/gbuffer.glsl u_gb_mode; reach GLSL as the defines
+ * of the same names). */
+enum lr_gb_mode { LR_GB_CUBE = 0, LR_GB_PERSPECTIVE = 1, LR_GB_ORTHO = 2 };
+
+/* Light l's G-buffer, as the last run drew it. */
+typedef struct lr_light_gbuffer {
+    enum lr_light_type type;
+    lr_vec3 pos, dir;
+    float spot_cos[2]; /* cos(outer), cos(inner) */
+    enum lr_gb_mode mode;
+    int size;
+    lr_tex *pos_cube, *nrm_cube, *pos_2d, *nrm_2d;
+    lr_fb *fb[6], *fb_2d;
+    float vp[16]; /* 2D map: world -> clip */
+    double vp_d[16];
+    double face_vp[6][16];
+} lr_light_gbuffer;
+
+typedef struct lr_gbuffer {
+    int n_lights;
+    lr_light_gbuffer light[LR_MAX_LIGHTS];
+} lr_gbuffer;
+
+/* Targets for c->n_lights lights of c->rs->gbuffer_size. */
+int lr_gbuffer_alloc(lr_gbuffer *g, const lr_pass_ctx *c, lr_err *e);
+void lr_gbuffer_free(lr_gbuffer *g);
+int lr_gbuffer_run(lr_gbuffer *g, const lr_pass_ctx *c, lr_err *e);
+
+/* Light l's G-buffer samplers and uniforms on units 0..3 (render/shaders/lib/gbuffer.glsl). */
+void lr_gbuffer_bind(const lr_gbuffer *g, lr_program *p, int l);
+/* Every light's G-buffer positions and light uniforms (render/shaders/lib/lights.glsl): cube
+ * maps on units 0..3, 2D maps on units 11..14; intensities from c->I. */
+void lr_gbuffer_bind_lights(const lr_gbuffer *g, const lr_pass_ctx *c, lr_program *p);
+
+#endif
