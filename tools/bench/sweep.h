@@ -22,7 +22,7 @@ enum { LRB_SWEEP_W = 64, LRB_SWEEP_H = 48, LRB_SWEEP_SPP = 512 };
 enum { LRB_SWEEP_SS = 4 };
 /* The second, independent reference (the noise floor of median |ln ratio|): seed
  * LRB_SWEEP_SEED2, read from the cache at LRB_SWEEP_SPP or else LRB_SWEEP_SPP2 samples,
- * rendered at LRB_SWEEP_SPP2 when neither is cached. */
+ * rendered at LRB_SWEEP_SPP2 when neither is cached (LRB_SWEEP_REF2=cached: left out instead). */
 enum { LRB_SWEEP_SEED2 = 1, LRB_SWEEP_SPP2 = 128, LRB_SWEEP_SS_MAX = 6 };
 
 /* One setting of the sweep: the base with at most one parameter changed. */

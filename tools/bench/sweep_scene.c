@@ -108,6 +108,12 @@ static int second_reference(const lr_ref_scene *rs, const lr_ref_camera *cam, co
         }
     }
     *spp = rd.spp;
+    const char *mode = getenv("LRB_SWEEP_REF2");
+    char key[17], path[1200];
+    lr_ref_cache_key(rs, cam, &rd, key);
+    snprintf(path, sizeof path, "%s/%s.pfm", dir, key);
+    if (mode && !strcmp(mode, "cached") && access(path, R_OK))
+        return lr_err_set(e, LR_EIO, "not cached (%s) and LRB_SWEEP_REF2=cached", path);
     return lr_ref_render_cached(rs, cam, &rd, dir, NULL, NULL, mean, var, hit, e);
 }
 
