@@ -96,24 +96,22 @@ static int second_reference(const lr_ref_scene *rs, const lr_ref_camera *cam, co
     const int spps[2] = {LRB_SWEEP_SPP, LRB_SWEEP_SPP2};
     lr_ref_render_desc rd = {.width = LRB_SWEEP_W, .height = LRB_SWEEP_H,
                              .seed = LRB_SWEEP_SEED2, .spp = LRB_SWEEP_SPP2};
-    for (int i = 0; i < 2; i++) {
+    bool cached = false;
+    for (int i = 0; i < 2 && !cached; i++) {
         lr_ref_render_desc d = rd;
         d.spp = spps[i];
         char key[17], path[1200];
         lr_ref_cache_key(rs, cam, &d, key);
         snprintf(path, sizeof path, "%s/%s.pfm", dir, key);
-        if (!access(path, R_OK)) {
-            rd = d;
-            break;
-        }
+        if (!access(path, R_OK))
+            rd = d, cached = true;
     }
     *spp = rd.spp;
     const char *mode = getenv("LRB_SWEEP_REF2");
-    char key[17], path[1200];
-    lr_ref_cache_key(rs, cam, &rd, key);
-    snprintf(path, sizeof path, "%s/%s.pfm", dir, key);
-    if (mode && !strcmp(mode, "cached") && access(path, R_OK))
-        return lr_err_set(e, LR_EIO, "not cached (%s) and LRB_SWEEP_REF2=cached", path);
+    if (!cached && mode && !strcmp(mode, "cached"))
+        return lr_err_set(e, LR_EIO, "no seed-%d reference at %d or %d spp in %s "
+                          "(LRB_SWEEP_REF2=cached)", LRB_SWEEP_SEED2, LRB_SWEEP_SPP,
+                          LRB_SWEEP_SPP2, dir);
     return lr_ref_render_cached(rs, cam, &rd, dir, NULL, NULL, mean, var, hit, e);
 }
 
