@@ -15,6 +15,7 @@
 
 #include "render/base/paths.h"
 #include "render/eval/eval.h"
+#include "render/image/image.h"
 #include "render/reference/reference.h"
 #include "tests/support/gl.h"
 #include "tests/support/near.h"
@@ -78,11 +79,11 @@ static void test_csv(void **state)
                          .vpl = true, .frame_ms = 12.5, .rel_rmse = 0.1234, .rel_rmse_object = 0.2,
                          .rel_rmse_receivers = 0.05, .ms = {1, 2, 3, 4}, .bias_object = 0.1,
                          .bias_receivers = 0.02, .noise_object = 0.15, .noise_receivers = 0.01,
-                         .width = 64, .height = 48},
+                         .width = 64, .height = 48, .supersample = 4},
                         {.scene = "lampshade", .model = "standard_dipole", .K = 4, .N = 1,
                          .N_vpl = 16, .map_size = 32, .gbuffer_size = 64, .frames = 1,
                          .vpl = false, .frame_ms = 3, .rel_rmse = NAN, .ms = {NAN, 1, NAN, 2},
-                         .width = 64, .height = 48}};
+                         .width = 64, .height = 48, .supersample = 1}};
     lr_err e = {0};
     assert_int_equal(lr_eval_csv_write(path, r, 2, &e), LR_OK);
     FILE *f = fopen(path, "r");
@@ -94,17 +95,17 @@ static void test_csv(void **state)
                         "scene,model,params,frame_ms,rel_rmse,rel_rmse_object,rel_rmse_receivers,"
                         "K,N,N_vpl,map_size,gbuffer_size,frames,vpl,ms_gbuffer,ms_radiosity,"
                         "ms_vpl,ms_compose,bias_object,bias_receivers,noise_object,"
-                        "noise_receivers,width,height\n");
+                        "noise_receivers,width,height,supersample\n");
     assert_non_null(fgets(line, sizeof line, f));
     assert_string_equal(line, "candle,directional_dipole,K=16 N=16 N_vpl=64 map=256 gbuf=256 "
                               "frames=16 vpl=on,12.500,0.12340,0.20000,0.05000,16,16,64,256,256,"
-                              "16,on,1.000,2.000,3.000,4.000,0.10000,0.02000,0.15000,0.01000,64,48\n");
+                              "16,on,1.000,2.000,3.000,4.000,0.10000,0.02000,0.15000,0.01000,64,48,4\n");
     assert_non_null(fgets(line, sizeof line, f));
-    /* 24 fields, NaN spelt nan. */
+    /* 25 fields, NaN spelt nan. */
     int commas = 0;
     for (char *p = line; *p; p++)
         commas += *p == ',';
-    assert_int_equal(commas, 23);
+    assert_int_equal(commas, 24);
     assert_non_null(strstr(line, "lampshade,standard_dipole,K=4 N=1 N_vpl=16 map=32 gbuf=64 "
                                  "frames=1 vpl=off,3.000,nan,"));
     assert_null(fgets(line, sizeof line, f));
@@ -114,6 +115,253 @@ static void test_csv(void **state)
     /* An unwritable place: an error naming it, no crash. */
     assert_int_not_equal(lr_eval_csv_write("/nonexistent-dir/x.csv", r, 1, &e), LR_OK);
     assert_non_null(strstr(e.msg, "/nonexistent-dir/x.csv"));
+}
+
+/* ---- issue 12: the fair bench's filter, regions and statistics ------------------------------ */
+
+/* The box filter: a known 4x2 image halves to the means of its 2x2 blocks; sides that are not
+ * multiples of the factor are refused. */
+static void test_box_filter_values(void **state)
+{
+    lr_image src, out;
+    assert_int_equal(lr_image_alloc(&src, 4, 2, NULL), LR_OK);
+    for (int y = 0; y < 2; y++)
+        for (int x = 0; x < 4; x++)
+            for (int c = 0; c < 3; c++)
+                src.rgb[3 * (y * 4 + x) + c] = (float)(x + 10 * y + 100 * c);
+    lr_err e = {0};
+    assert_int_equal(lr_image_downsample_box(&src, 2, &out, &e), LR_OK);
+    assert_int_equal(out.width, 2);
+    assert_int_equal(out.height, 1);
+    /* Block 0: x 0..1, y 0..1: mean x 0.5, mean 10 y 5; block 1: mean x 2.5. */
+    for (int c = 0; c < 3; c++) {
+        assert_near(out.rgb[c], 5.5 + 100 * c, 1e-5);
+        assert_near(out.rgb[3 + c], 7.5 + 100 * c, 1e-5);
+    }
+    lr_image_free(&out);
+    assert_int_equal(lr_image_downsample_box(&src, 1, &out, &e), LR_OK);
+    assert_memory_equal(out.rgb, src.rgb, 4 * 2 * 3 * sizeof(float));
+    lr_image_free(&out);
+    assert_int_equal(lr_image_downsample_box(&src, 3, &out, &e), LR_EINVAL);
+    assert_null(out.rgb);
+    assert_non_null(strstr(e.msg, "4x2"));
+    assert_int_equal(lr_image_downsample_box(&src, 0, &out, &e), LR_EINVAL);
+    lr_image_free(&src);
+}
+
+/* The filter's footprint is the reference's pixel. The reference averages g at a uniform
+ * point of pixel x's box in normalised device coordinates, u in [2x/W - 1, 2(x+1)/W - 1]
+ * (render/reference/render.c), so its expected value is g's mean over that box. A pinhole
+ * image at s times the size has subpixel X = s x + i centred at u = 2(X + 1/2)/(sW) - 1 (as
+ * lr_cpu_camera_ray and the GPU); the filter is then the midpoint rule on s cells of width
+ * d = 2/(sW), which for g = u^2 + v falls short of the box mean by exactly d^2 / 12 (the
+ * midpoint rule's error on u^2; exact on the linear v). So the filtered pixel converges to the
+ * reference's as 1/s^2, and a wrong footprint (shifted or scaled cells) would not match. */
+static void test_box_filter_matches_reference_pixel(void **state)
+{
+    enum { W = 5, H = 3 };
+    const int factors[] = {1, 2, 4, 8};
+    for (int k = 0; k < 4; k++) {
+        int s = factors[k];
+        lr_image fine, out;
+        assert_int_equal(lr_image_alloc(&fine, W * s, H * s, NULL), LR_OK);
+        for (int Y = 0; Y < H * s; Y++)
+            for (int X = 0; X < W * s; X++) {
+                double u = 2.0 * (X + 0.5) / (W * s) - 1.0, v = 1.0 - 2.0 * (Y + 0.5) / (H * s);
+                for (int c = 0; c < 3; c++)
+                    fine.rgb[3 * (Y * W * s + X) + c] = (float)(u * u + v + c);
+            }
+        assert_int_equal(lr_image_downsample_box(&fine, s, &out, NULL), LR_OK);
+        double d = 2.0 / (W * s);
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                double u0 = 2.0 * x / W - 1.0, u1 = 2.0 * (x + 1) / W - 1.0;
+                double vmid = 1.0 - 2.0 * (y + 0.5) / H;
+                double box_mean = (u1 * u1 * u1 - u0 * u0 * u0) / (3.0 * (u1 - u0)) + vmid;
+                for (int c = 0; c < 3; c++)
+                    assert_near(out.rgb[3 * (y * W + x) + c], box_mean + c - d * d / 12.0, 2e-6);
+            }
+        lr_image_free(&fine);
+        lr_image_free(&out);
+    }
+}
+
+static lr_scene *scene_of(const char *text)
+{
+    lr_scene *s = NULL;
+    lr_err e = {0};
+    if (lr_scene_parse(text, strlen(text), "regions.json", NULL, &s, &e))
+        fail_msg("regions.json: %s", e.msg);
+    return s;
+}
+
+/* A 40 mm box (axis radius r = 20 sqrt 2, its corners) on a 400 mm table, seen straight down
+ * by an orthographic camera 400 mm high on 40x40 pixels (10 mm each): pixel (x, y) sees
+ * (X, Y) = (10 x - 195, 195 - 10 y). The box's top (a hull face) covers the 16 centres with
+ * |X|, |Y| < 20; on the table a centre at distance D from the axis is pool for D <= 2 r,
+ * near for D <= 4 r and far beyond (no centre lies on a threshold: 25 (a^2 + b^2) for odd a,
+ * b is never 3200 or 12800). */
+static void test_regions_top_view(void **state)
+{
+    lr_scene *s = scene_of(
+        "{\"objects\": [{\"name\": \"box\", \"material\": \"marble\", \"mesh\": {\"type\": \"box\","
+        " \"size\": [40, 40, 40]}, \"transform\": {\"translate\": [0, 0, 20]}}],"
+        " \"lights\": [{\"type\": \"point\", \"position\": [0, 0, 300], \"intensity\": 1}],"
+        " \"camera\": {\"type\": \"orthographic\", \"position\": [0, 0, 500], \"target\": [0, 0, 0],"
+        " \"up\": [0, 1, 0], \"height_mm\": 400},"
+        " \"receivers\": [{\"name\": \"table\", \"type\": \"plane\", \"center\": [0, 0, 0],"
+        " \"normal\": [0, 0, 1], \"size\": [400, 400], \"albedo\": [0.5, 0.5, 0.5]}]}");
+    lr_eval_regions rg;
+    lr_err e = {0};
+    assert_int_equal(lr_eval_regions_create(s, 40, 40, &rg, &e), LR_OK);
+    long want[LR_EVAL_REGION_COUNT] = {0};
+    const double r = 20.0 * sqrt(2.0);
+    for (int y = 0; y < 40; y++)
+        for (int x = 0; x < 40; x++) {
+            double X = 10.0 * x - 195.0, Y = 195.0 - 10.0 * y, D = hypot(X, Y);
+            int region = fabs(X) < 20.0 && fabs(Y) < 20.0 ? LR_EVAL_REGION_OBJ_OUTER
+                         : D <= 2.0 * r               ? LR_EVAL_REGION_POOL
+                         : D <= 4.0 * r               ? LR_EVAL_REGION_TABLE_NEAR
+                                                      : LR_EVAL_REGION_TABLE_FAR;
+            want[region]++;
+            assert_int_equal(rg.label[y * 40 + x], region);
+        }
+    for (int k = 0; k < LR_EVAL_REGION_COUNT; k++)
+        assert_int_equal(rg.count[k], want[k]);
+    assert_int_equal(want[LR_EVAL_REGION_OBJ_OUTER], 16);
+    /* Against the areas: the pool disc less the box, the near ring, in 100 mm^2 pixels. */
+    assert_near(want[LR_EVAL_REGION_POOL], (M_PI * 4.0 * r * r - 1600.0) / 100.0, 6.0);
+    assert_near(want[LR_EVAL_REGION_TABLE_NEAR], M_PI * 12.0 * r * r / 100.0, 10.0);
+    unsigned char mask[1600];
+    assert_int_equal(lr_eval_regions_mask(&rg, LR_EVAL_REGION_POOL, mask), want[LR_EVAL_REGION_POOL]);
+    lr_eval_regions_free(&rg);
+    lr_scene_destroy(s);
+}
+
+/* The same box seen from the side (orthographic, level, 400 mm high, 40x40 pixels) in front of
+ * a wall: the table is edge-on (no pixel), the box's front face covers 4 x 4 pixels and every
+ * other pixel is wall, 7 r away from the box's axis: never pool. */
+static void test_regions_side_view(void **state)
+{
+    lr_scene *s = scene_of(
+        "{\"objects\": [{\"name\": \"box\", \"material\": \"marble\", \"mesh\": {\"type\": \"box\","
+        " \"size\": [40, 40, 40]}, \"transform\": {\"translate\": [0, 0, 20]}}],"
+        " \"lights\": [{\"type\": \"point\", \"position\": [0, 0, 300], \"intensity\": 1}],"
+        " \"camera\": {\"type\": \"orthographic\", \"position\": [0, -500, 100],"
+        " \"target\": [0, 0, 100], \"up\": [0, 0, 1], \"height_mm\": 400},"
+        " \"receivers\": [{\"name\": \"table\", \"type\": \"plane\", \"center\": [0, 0, 0],"
+        " \"normal\": [0, 0, 1], \"size\": [400, 400], \"albedo\": [0.5, 0.5, 0.5]},"
+        " {\"name\": \"wall\", \"type\": \"plane\", \"center\": [0, 200, 100],"
+        " \"normal\": [0, -1, 0], \"size\": [400, 400], \"albedo\": [0.5, 0.5, 0.5]}]}");
+    lr_eval_regions rg;
+    assert_int_equal(lr_eval_regions_create(s, 40, 40, &rg, NULL), LR_OK);
+    assert_int_equal(rg.count[LR_EVAL_REGION_OBJ_OUTER], 16);
+    assert_int_equal(rg.count[LR_EVAL_REGION_WALL], 1600 - 16);
+    lr_eval_regions_free(&rg);
+    lr_scene_destroy(s);
+}
+
+/* A candle (radius 35 mm, melt pool of radius 31) seen from above on 1 mm pixels: the pool's
+ * dish lies below the rim, off the convex hull (inner), the flat rim ring is on it (outer).
+ * Counts against the areas pi 31^2 and pi (35^2 - 31^2), within 2 % of the top's area (the
+ * mesh's facets and the pixels along two circles). */
+static void test_regions_candle_pool(void **state)
+{
+    lr_scene *s = scene_of(
+        "{\"objects\": [{\"name\": \"pillar\", \"material\": \"candle_wax\", \"mesh\": {\"type\":"
+        " \"candle\", \"radius\": 35, \"height\": 120, \"pool_depth\": 8, \"pool_radius\": 31}}],"
+        " \"lights\": [{\"type\": \"point\", \"position\": [0, 0, 117], \"intensity\": 1}],"
+        " \"camera\": {\"type\": \"orthographic\", \"position\": [0, 0, 500], \"target\": [0, 0, 0],"
+        " \"up\": [0, 1, 0], \"height_mm\": 100}}");
+    lr_eval_regions rg;
+    assert_int_equal(lr_eval_regions_create(s, 100, 100, &rg, NULL), LR_OK);
+    const double top = M_PI * 35.0 * 35.0;
+    assert_near(rg.count[LR_EVAL_REGION_OBJ_INNER], M_PI * 31.0 * 31.0, 0.02 * top);
+    assert_near(rg.count[LR_EVAL_REGION_OBJ_OUTER], top - M_PI * 31.0 * 31.0, 0.02 * top);
+    assert_int_equal(rg.count[LR_EVAL_REGION_POOL] + rg.count[LR_EVAL_REGION_WALL], 0);
+    lr_eval_regions_free(&rg);
+    lr_scene_destroy(s);
+}
+
+/* Power ratios and the median |ln| against hand-computed values. */
+static void test_ratios_by_hand(void **state)
+{
+    const float img[9] = {1, 2, 3, 4, 5, 6, 100, 100, 100};
+    const float ref[9] = {2, 2, 2, 4, 4, 4, 1, 1, 1};
+    const float var[9] = {0.01f, 0.02f, 0.03f, 0.04f, 0.05f, 0.06f, 9, 9, 9};
+    const unsigned char mask[3] = {1, 1, 0};
+    /* Band 0: (1 + 4) / (2 + 4); se = R sqrt(0.01 + 0.04) / 6. */
+    lr_eval_ratio r = lr_eval_power_ratio(img, ref, var, mask, 3, 0);
+    assert_near(r.ratio, 5.0 / 6.0, 1e-12);
+    assert_near(r.se, 5.0 / 6.0 * sqrt(0.05) / 6.0, 1e-7);
+    /* All bands: 21 / 18; se = R sqrt(0.21) / 18. */
+    r = lr_eval_power_ratio(img, ref, var, mask, 3, -1);
+    assert_near(r.ratio, 21.0 / 18.0, 1e-12);
+    assert_near(r.se, 21.0 / 18.0 * sqrt(0.21) / 18.0, 1e-7);
+    /* No variance image: se 0. Empty mask: NaN. */
+    assert_near(lr_eval_power_ratio(img, ref, NULL, mask, 3, 2).se, 0.0, 0.0);
+    const unsigned char none[3] = {0};
+    assert_true(isnan(lr_eval_power_ratio(img, ref, var, none, 3, -1).ratio));
+    /* Told from 1 only beyond two standard errors. */
+    assert_true(lr_eval_ratio_differs((lr_eval_ratio){1.1, 0.04}));
+    assert_false(lr_eval_ratio_differs((lr_eval_ratio){1.05, 0.04}));
+    assert_false(lr_eval_ratio_differs((lr_eval_ratio){0.95, 0.04}));
+    assert_true(lr_eval_ratio_differs((lr_eval_ratio){0.33, 0.02}));
+    assert_false(lr_eval_ratio_differs((lr_eval_ratio){NAN, 0.02}));
+
+    /* Median |ln|: band sums a = 2, 4, 8, 1, 0, 0 against b = 2, 2, 2, 4, 0, 1: |ln| = 0,
+     * ln 2, ln 4, ln 4, (both dark: skipped), +Inf. Five values: the median is ln 4; without
+     * the last pixel, (ln 2 + ln 4) / 2 = 1.5 ln 2. */
+    float a[18] = {0}, b[18] = {0};
+    const float as[6] = {2, 4, 8, 1, 0, 0}, bs[6] = {2, 2, 2, 4, 0, 1};
+    for (int i = 0; i < 6; i++) { /* spread over the bands: only the sums count */
+        a[3 * i] = 0.5f * as[i], a[3 * i + 2] = 0.5f * as[i];
+        b[3 * i + 1] = bs[i];
+    }
+    assert_near(lr_eval_median_abs_log(a, b, NULL, 6), log(4.0), 1e-6);
+    const unsigned char first5[6] = {1, 1, 1, 1, 1, 0};
+    assert_near(lr_eval_median_abs_log(a, b, first5, 6), 1.5 * log(2.0), 1e-6);
+    const unsigned char dark[6] = {0, 0, 0, 0, 1, 0};
+    assert_true(isnan(lr_eval_median_abs_log(a, b, dark, 6)));
+}
+
+/* xorshift64*, a fixed sequence for the simulation below. */
+static double uniform01(uint64_t *s)
+{
+    *s ^= *s >> 12, *s ^= *s << 25, *s ^= *s >> 27;
+    return ((*s * 2685821657736338717ull) >> 11) * 0x1.0p-53;
+}
+
+/* The standard error formula against simulation: a reference whose pixels carry independent
+ * Gaussian noise of known variance (as a Monte Carlo mean does), drawn DRAWS times; the
+ * spread of R = sum g / sum r over the draws is what se = R sqrt(sum var) / sum r predicts.
+ * The relative noise of the sum is 1 %, so the delta method's second-order terms are 1e-4
+ * of se; the standard deviation of DRAWS draws is itself uncertain by 1/sqrt(2 DRAWS) = 1.1 %,
+ * so 5 % is over four of its standard errors. */
+static void test_ratio_standard_error(void **state)
+{
+    enum { PX = 50, DRAWS = 4000 };
+    float img[3 * PX], truth[3 * PX], var[3 * PX], ref[3 * PX];
+    for (int i = 0; i < 3 * PX; i++) {
+        truth[i] = 1.0f + 0.02f * (float)(i % 17);
+        img[i] = 0.8f * truth[i];
+        float sd = 0.12f * truth[i]; /* per pixel 12 %; the sum of 150: about 1 % */
+        var[i] = sd * sd;
+    }
+    uint64_t rng = 0x9e3779b97f4a7c15ull;
+    double sum = 0.0, sum2 = 0.0, se_sum = 0.0;
+    for (int d = 0; d < DRAWS; d++) {
+        for (int i = 0; i < 3 * PX; i++) {
+            double u1 = uniform01(&rng), u2 = uniform01(&rng);
+            double g = sqrt(-2.0 * log(u1 > 0.0 ? u1 : 1e-300)) * cos(2.0 * M_PI * u2);
+            ref[i] = truth[i] + (float)(g * sqrt(var[i]));
+        }
+        lr_eval_ratio r = lr_eval_power_ratio(img, ref, var, NULL, PX, -1);
+        sum += r.ratio, sum2 += r.ratio * r.ratio, se_sum += r.se;
+    }
+    double mean = sum / DRAWS, sd = sqrt((sum2 - DRAWS * mean * mean) / (DRAWS - 1));
+    assert_near(mean, 0.8, 4.0 * sd / sqrt(DRAWS) + 1e-4);
+    assert_near_rel(sd, se_sum / DRAWS, 0.05);
 }
 
 /* ---- error falls as frames accumulate ----------------------------------------------------- */
@@ -236,6 +484,13 @@ int main(void)
         cmocka_unit_test(test_rel_rmse_scale),
         cmocka_unit_test(test_pareto),
         cmocka_unit_test(test_csv),
+        cmocka_unit_test(test_box_filter_values),
+        cmocka_unit_test(test_box_filter_matches_reference_pixel),
+        cmocka_unit_test(test_regions_top_view),
+        cmocka_unit_test(test_regions_side_view),
+        cmocka_unit_test(test_regions_candle_pool),
+        cmocka_unit_test(test_ratios_by_hand),
+        cmocka_unit_test(test_ratio_standard_error),
     };
     const struct CMUnitTest gpu[] = {
         cmocka_unit_test(test_error_falls_with_frames),

@@ -138,7 +138,34 @@ static void test_table_header_driven(void **state)
     assert_near(r->frame_ms, 33.5, 0.0);
     assert_true(isnan(r->rel_rmse_object));
     assert_int_equal(r->width, 0);
+    assert_int_equal(r->supersample, 0); /* absent: pixel-centre errors */
     lr_plan_table_destroy(t);
+}
+
+/* Issue 12: the bench's supersample column is read, and the plan says whether the errors it
+ * planned on are box-filtered like the reference's pixels or pixel-centre samples. */
+static void test_pixel_filter_reason(void **state)
+{
+    const char *head = "scene,model,frame_ms,rel_rmse,K,N,N_vpl,map_size,gbuffer_size,frames,vpl";
+    const char *rows[2] = {",supersample\ncandle,directional_dipole,10,0.1,16,4,16,64,64,8,on,4\n",
+                           "\ncandle,directional_dipole,10,0.1,16,4,16,64,64,8,on\n"};
+    const char *want[2] = {"box-filtered", "pixel-centre"};
+    for (int k = 0; k < 2; k++) {
+        char csv[512];
+        snprintf(csv, sizeof csv, "%s%s", head, rows[k]);
+        lr_plan_table *t;
+        lr_err e = {0};
+        assert_int_equal(lr_plan_table_parse(csv, strlen(csv), "filter.csv", &t, &e), LR_OK);
+        assert_int_equal(lr_plan_table_row(t, 0)->supersample, k ? 0 : 4);
+        lr_plan *p = calloc(1, sizeof *p);
+        assert_non_null(p);
+        assert_int_equal(lr_plan_create(candle, t, &(lr_plan_budget){.max_error = 0.5}, NULL, p,
+                                        &e),
+                         LR_OK);
+        assert_non_null(strstr(p->objects[0].reasons[0], want[k]));
+        free(p);
+        lr_plan_table_destroy(t);
+    }
 }
 
 static void expect_table_error(const char *csv, const char *want)
@@ -738,6 +765,7 @@ int main(void)
         cmocka_unit_test(test_table_fixture),
         cmocka_unit_test(test_predicted_error_from_split),
         cmocka_unit_test(test_table_header_driven),
+        cmocka_unit_test(test_pixel_filter_reason),
         cmocka_unit_test(test_table_errors),
         cmocka_unit_test(test_max_error_both_scenes),
         cmocka_unit_test(test_committed_front_both_scenes),

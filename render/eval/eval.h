@@ -51,6 +51,77 @@ int lr_eval_masks_create(const lr_scene *s, int width, int height, lr_eval_masks
                          lr_err *e);
 void lr_eval_masks_free(lr_eval_masks *m);
 
+/* ---- regions (issue 12: where the model loses light) ----------------------------------------
+ *
+ * Each pixel of the camera image, by its centre ray (as the masks), gets one region from the
+ * scene's geometry ("up" is +z, as in every scene and the physical reference; an object's
+ * axis is the line along up through its bounding-sphere centre, its radius r the largest
+ * distance of a vertex from that axis; d is a receiver point's distance from the nearest
+ * object's axis, in units of that object's r):
+ *   object outer  a hit on an object facet whose plane supports the object's vertex set (all
+ *                 vertices on its inner side, within 1e-3 r): the convex hull's surface, seen
+ *                 from outside: a candle's sides and top rim, a shade's outer wall;
+ *   object inner  any other object hit: a melt pool, a shade's or votive's inner wall;
+ *   pool          a receiver point with d <= LR_EVAL_POOL_R: the light pool around the
+ *                 object's footprint;
+ *   table near    a receiver facing up (n.up >= 0.7), LR_EVAL_POOL_R < d <= LR_EVAL_NEAR_R;
+ *   table far     the same with d > LR_EVAL_NEAR_R;
+ *   wall          a vertical receiver (|n.up| < 0.3) outside the pool;
+ *   other         any other receiver point (a ceiling, a slanted board). */
+enum lr_eval_region {
+    LR_EVAL_REGION_NONE = 0, /* background */
+    LR_EVAL_REGION_OBJ_OUTER,
+    LR_EVAL_REGION_OBJ_INNER,
+    LR_EVAL_REGION_POOL,
+    LR_EVAL_REGION_TABLE_NEAR,
+    LR_EVAL_REGION_TABLE_FAR,
+    LR_EVAL_REGION_WALL,
+    LR_EVAL_REGION_OTHER,
+    LR_EVAL_REGION_COUNT
+};
+#define LR_EVAL_POOL_R 2.0 /* the footprint and one more radius around it */
+#define LR_EVAL_NEAR_R 4.0
+
+typedef struct lr_eval_regions {
+    int width, height;
+    unsigned char *label; /* width * height, enum lr_eval_region */
+    long count[LR_EVAL_REGION_COUNT];
+} lr_eval_regions;
+
+/* "object outer", "object inner", "pool", "table near", "table far", "wall", "other",
+ * "background"; "?" out of range. */
+const char *lr_eval_region_name(int region);
+int lr_eval_regions_create(const lr_scene *s, int width, int height, lr_eval_regions *out,
+                           lr_err *e);
+void lr_eval_regions_free(lr_eval_regions *r);
+/* mask[i] = (label[i] == region); returns the count. */
+long lr_eval_regions_mask(const lr_eval_regions *r, int region, unsigned char *mask);
+
+/* ---- power ratios and the median log ratio ------------------------------------------------ */
+
+/* A power ratio model / reference over a mask, with its standard error from the reference's
+ * variance image: R = sum g / sum r, and since the pixels' means are independent,
+ * Var(sum r) = sum var, so (delta method, the model's own noise neglected: it is converged)
+ *
+ *     se = R sqrt(sum var) / sum r.
+ *
+ * A ratio "cannot be told from 1" when |R - 1| <= 2 se. NaN ratio and se when sum r <= 0. */
+typedef struct lr_eval_ratio {
+    double ratio, se;
+} lr_eval_ratio;
+
+/* Band b alone (0..2), or all three bands pooled (b = -1). */
+lr_eval_ratio lr_eval_power_ratio(const float *img, const float *ref, const float *var,
+                                  const unsigned char *mask, size_t n, int band);
+/* |R - 1| > 2 se (finite values only). */
+bool lr_eval_ratio_differs(lr_eval_ratio r);
+
+/* The median over masked pixels of |ln(sum_b a / sum_b b)| (band sums per pixel). Pixels
+ * where both sums are zero are skipped; where one of them is zero |ln| is +Inf and counts
+ * (it ranks last). NaN when no pixel counts. */
+double lr_eval_median_abs_log(const float *a, const float *b, const unsigned char *mask,
+                              size_t n);
+
 /* ---- Pareto front --------------------------------------------------------------------------- */
 
 /* Marks on_front[i] for each point that no other point dominates (another point with
@@ -74,7 +145,11 @@ typedef struct lr_eval_row {
                                * frame_ms) */
     double bias_object, bias_receivers;   /* converged model vs physical reference */
     double noise_object, noise_receivers; /* `frames` frames vs converged model */
-    int width, height;
+    int width, height; /* where the errors are measured (the reference's size) */
+    /* The pixel filter (issue 12): 1 = pixel centres; s >= 2 = rendered at s*width x
+     * s*height and box-filtered, as the reference's pixels are (the times are then those of
+     * the larger image). */
+    int supersample;
 } lr_eval_row;
 
 /* Pass columns of the CSV: ms_gbuffer .. ms_compose. */
@@ -84,7 +159,7 @@ enum { LR_EVAL_CSV_PASSES = 4 };
 #define LR_EVAL_CSV_HEADER                                                                   \
     "scene,model,params,frame_ms,rel_rmse,rel_rmse_object,rel_rmse_receivers,K,N,N_vpl,"     \
     "map_size,gbuffer_size,frames,vpl,ms_gbuffer,ms_radiosity,ms_vpl,ms_compose,bias_object," \
-    "bias_receivers,noise_object,noise_receivers,width,height"
+    "bias_receivers,noise_object,noise_receivers,width,height,supersample"
 
 /* "K=16 N=16 N_vpl=64 map=256 gbuf=256 frames=16 vpl=on". */
 void lr_eval_row_params(const lr_eval_row *r, char *buf, size_t cap);
@@ -108,10 +183,14 @@ typedef struct lr_eval_series_desc {
     int ncheck; /* at most 8 */
     int converge_frames;
     unsigned seed; /* lr_renderer_desc.seed: 0 = the renderer's default */
+    /* 0 or 1: one sample at each pixel centre. s > 1: rendered at s*width x s*height and
+     * box-filtered back (lr_image_downsample_box), so each pixel is the mean over its area as
+     * in the physical reference; the frame times are then those of the larger image. */
+    int supersample;
 } lr_eval_series_desc;
 
 typedef struct lr_eval_series {
-    float *image[8];  /* per checkpoint, rows top to bottom */
+    float *image[8];  /* per checkpoint, width x height, rows top to bottom */
     float *converged; /* after converge_frames */
     double ms[LR_PASS_COUNT]; /* medians: gbuffer over the full updates, the others over the
                                * accumulation frames */

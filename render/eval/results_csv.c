@@ -43,7 +43,7 @@ void lr_eval_csv_print(FILE *f, const lr_eval_row *rows, int n)
         num(f, r->bias_receivers, "%.5f");
         num(f, r->noise_object, "%.5f");
         num(f, r->noise_receivers, "%.5f");
-        fprintf(f, ",%d,%d\n", r->width, r->height);
+        fprintf(f, ",%d,%d,%d\n", r->width, r->height, r->supersample);
     }
 }
 

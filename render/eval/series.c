@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "render/image/image.h"
+
 enum { FULL_UPDATES = 3 };
 
 static int cmp_double(const void *a, const void *b)
@@ -22,18 +24,29 @@ static double median(double *v, int n)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-/* The renderer's HDR (rows bottom up) into a new top-down buffer. */
-static int read_top_down(lr_renderer *r, int w, int h, float *tmp, float **out, lr_err *e)
+/* The renderer's HDR (rows bottom up, w x h) into a new top-down buffer, box-filtered by
+ * factor ss (w and h are multiples of it). */
+static int read_top_down(lr_renderer *r, int w, int h, int ss, float *tmp, float **out,
+                         lr_err *e)
 {
     int rc = lr_renderer_read_hdr(r, tmp, e);
     if (rc)
         return rc;
     size_t row = (size_t)w * 3;
-    if (!(*out = malloc(row * (size_t)h * sizeof **out)))
-        return lr_err_set(e, LR_ENOMEM, "series: out of memory");
+    lr_image full = {0}, small = {0};
+    if ((rc = lr_image_alloc(&full, w, h, e)))
+        return rc;
     for (int y = 0; y < h; y++)
-        memcpy(*out + (size_t)y * row, tmp + (size_t)(h - 1 - y) * row, row * sizeof **out);
-    return LR_OK;
+        memcpy(full.rgb + (size_t)y * row, tmp + (size_t)(h - 1 - y) * row, row * sizeof *tmp);
+    if (ss <= 1) {
+        *out = full.rgb; /* taken over */
+        return LR_OK;
+    }
+    rc = lr_image_downsample_box(&full, ss, &small, e);
+    lr_image_free(&full);
+    if (!rc)
+        *out = small.rgb; /* taken over */
+    return rc;
 }
 
 void lr_eval_series_free(lr_eval_series *s)
@@ -61,7 +74,13 @@ int lr_eval_series_run(const lr_eval_series_desc *d, lr_eval_series *out, lr_err
     int rc = lr_scene_set(d->scene, "render.frames", val, NULL, e);
     if (rc)
         return rc;
-    const int w = d->width, h = d->height;
+    if (d->supersample < 0 || d->supersample > 16 || d->width < 1 || d->height < 1)
+        return lr_err_set(e, LR_EINVAL, "series: %dx%d supersampled %d (1..16)", d->width,
+                          d->height, d->supersample);
+    /* Supersampling renders the composition at ss times the size: the light-space maps do not
+     * depend on the image size, so only the per-pixel passes see more pixels. */
+    const int ss = d->supersample > 1 ? d->supersample : 1;
+    const int w = d->width * ss, h = d->height * ss;
     float *tmp = malloc((size_t)w * h * 3 * sizeof *tmp);
     double *acc[LR_PASS_COUNT + 1] = {0}, full[FULL_UPDATES];
     for (int p = 0; p <= LR_PASS_COUNT; p++)
@@ -91,7 +110,7 @@ int lr_eval_series_run(const lr_eval_series_desc *d, lr_eval_series *out, lr_err
     int next = 0, nacc = 0;
     for (;;) {
         if (next < d->ncheck && st.samples == d->checkpoints[next]) {
-            if ((rc = read_top_down(r, w, h, tmp, &out->image[next], e)))
+            if ((rc = read_top_down(r, w, h, ss, tmp, &out->image[next], e)))
                 goto done;
             next++;
         }
@@ -114,7 +133,7 @@ int lr_eval_series_run(const lr_eval_series_desc *d, lr_eval_series *out, lr_err
                         d->checkpoints[next]);
         goto done;
     }
-    if ((rc = read_top_down(r, w, h, tmp, &out->converged, e)))
+    if ((rc = read_top_down(r, w, h, ss, tmp, &out->converged, e)))
         goto done;
     out->ms[0] = median(full, FULL_UPDATES);
     for (int p = 1; p < LR_PASS_COUNT; p++) {

@@ -29,6 +29,14 @@ void lr_image_free(lr_image *img);
 /* Allocates img from w x h RGBA floats in GL order (rows bottom up), dropping alpha. */
 int lr_image_from_gl_rgba(lr_image *img, const float *rgba, int width, int height, lr_err *e);
 
+/* Box filter by an integer factor: out is (src width / factor) x (src height / factor), each
+ * pixel the mean of the factor x factor source pixels it covers. A pinhole image rendered at
+ * factor times the size has its subpixel centres at (i + 1/2) / factor of each output pixel,
+ * so the mean is the midpoint rule for the pixel's box integral: the footprint of the
+ * physical reference (render/reference: a uniform random point in each pixel). LR_EINVAL
+ * when a side is not a positive multiple of the factor; out is allocated (lr_image_free). */
+int lr_image_downsample_box(const lr_image *src, int factor, lr_image *out, lr_err *e);
+
 /* ---- tone mapping (the CPU twin of the composition pass's last step) --------------------- */
 
 typedef enum lr_tonemap_op {

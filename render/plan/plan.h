@@ -43,6 +43,11 @@ typedef struct lr_plan_row {
     double ms_gbuffer, ms_radiosity, ms_vpl, ms_compose; /* optional */
     double bias_object, bias_receivers, noise_object, noise_receivers; /* optional */
     int width, height; /* optional, 0 when absent */
+    /* Optional: the bench's pixel filter (issue 12). s >= 2: the model was rendered at s x s
+     * the size and box-filtered like the physical reference's pixels, so the error columns
+     * are the fair ones; 0 (absent) or 1: pixel-centre samples (a table from before issue
+     * 12, whose errors are biased high where a light pool is a few pixels tall). */
+    int supersample;
 } lr_plan_row;
 
 typedef struct lr_plan_table lr_plan_table;

@@ -25,7 +25,7 @@ struct lr_plan_table {
 enum col {
     C_SCENE, C_MODEL, C_PARAMS, C_FRAME_MS, C_RMSE, C_RMSE_OBJ, C_RMSE_REC, C_K, C_N, C_NVPL,
     C_MAP, C_GBUF, C_FRAMES, C_VPL, C_MS_G, C_MS_R, C_MS_V, C_MS_C, C_W, C_H, C_BIAS_O, C_BIAS_R,
-    C_NOISE_O, C_NOISE_R, C_COUNT
+    C_NOISE_O, C_NOISE_R, C_SS, C_COUNT
 };
 
 static const struct {
@@ -44,7 +44,7 @@ static const struct {
     [C_MS_C] = {"ms_compose", false},     [C_W] = {"width", false},
     [C_H] = {"height", false},            [C_BIAS_O] = {"bias_object", false},
     [C_BIAS_R] = {"bias_receivers", false}, [C_NOISE_O] = {"noise_object", false},
-    [C_NOISE_R] = {"noise_receivers", false},
+    [C_NOISE_R] = {"noise_receivers", false}, [C_SS] = {"supersample", false},
 };
 
 #define MAX_FIELDS 64
@@ -179,6 +179,7 @@ static int parse_row(const char *name, int line, char **f, const int *at, lr_pla
     NUM(C_BIAS_R, bias_receivers);
     NUM(C_NOISE_O, noise_object);
     NUM(C_NOISE_R, noise_receivers);
+    INT(C_SS, supersample, 0);
 #undef TXT
 #undef NUM
 #undef INT

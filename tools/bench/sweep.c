@@ -72,7 +72,7 @@ static bool skipped(const char *name)
 
 /* Whether `name` is one of the comma-separated names of `list` (whole names: "candle" must
  * not select "candle_spot"). */
-static bool listed(const char *list, const char *name)
+bool lrb_listed(const char *list, const char *name)
 {
     size_t n = strlen(name);
     for (const char *p = list; *p;) {
@@ -113,7 +113,7 @@ static int run_opts(FILE *out, const lrb_options *opt)
     const char *only = getenv("LRB_SWEEP_SCENES");
     int ns = 0;
     for (int k = 0; k < nscenes; k++) {
-        if (only && !listed(only, names[k]))
+        if (only && !lrb_listed(only, names[k]))
             continue;
         if (!only && skipped(names[k]))
             continue;
@@ -128,7 +128,7 @@ static int run_opts(FILE *out, const lrb_options *opt)
     int nt = 0;
     const char *table_scenes[] = {"candle", "lampshade"};
     for (int k = 0; k < 2; k++)
-        if (!only || listed(only, table_scenes[k])) {
+        if (!only || lrb_listed(only, table_scenes[k])) {
             if (lrb_sweep_time_640(gl, table_scenes[k], &t640[nt]))
                 status = 1;
             nt++;
@@ -171,6 +171,7 @@ static int run_opts(FILE *out, const lrb_options *opt)
             nrows, ns, total, LRB_SWEEP_W, LRB_SWEEP_H, load[0][0], load[1][0],
             !status && opt->update_front ? " and configs/bench/front.csv" : "");
     lrb_sweep_table_md(out, rows, nrows, t640, nt);
+    lrb_sweep_fair_md(out, res, ns);
     for (int k = 0; k < ns; k++)
         fprintf(out, "- %s: %s; reference SE %.4f (objects) / %.4f (receivers); units check "
                      "%.4f ± %.4f\n",

@@ -14,6 +14,16 @@
 enum { LRB_SWEEP_W = 64, LRB_SWEEP_H = 48, LRB_SWEEP_SPP = 512 };
 /* Where the references are cached (committed: generating them takes longer than the bench). */
 #define LRB_SWEEP_REF_DIR "configs/bench/references"
+/* The model's pixel filter (issue 12): every setting is rendered at LRB_SWEEP_SS times the
+ * bench's size and box-filtered back, so its pixels are box integrals as the reference's are
+ * (the chosen factor and its convergence check: tools/bench/README.md, "A fair bench").
+ * LRB_SWEEP_SUPERSAMPLE=s overrides it; LRB_SWEEP_SS_CHECK=1,2,4,8 adds, per scene, the base
+ * setting's converged bias at each listed factor. */
+enum { LRB_SWEEP_SS = 4 };
+/* The second, independent reference (the noise floor of median |ln ratio|): seed
+ * LRB_SWEEP_SEED2, read from the cache at LRB_SWEEP_SPP or else LRB_SWEEP_SPP2 samples,
+ * rendered at LRB_SWEEP_SPP2 when neither is cached (LRB_SWEEP_REF2=cached: left out instead). */
+enum { LRB_SWEEP_SEED2 = 1, LRB_SWEEP_SPP2 = 128, LRB_SWEEP_SS_MAX = 6 };
 
 /* One setting of the sweep: the base with at most one parameter changed. */
 typedef struct lrb_setting {
@@ -46,7 +56,35 @@ typedef struct lrb_scene_result {
     long direct_px;
     double sweep_s;
     int row0, nrows; /* the scene's rows in the table */
+    /* Issue 12's fair figures, from the base setting's converged image (C frames). */
+    int supersample;                                  /* the sweep's pixel filter */
+    double centre_bias_object, centre_bias_receivers; /* pixel-centre samples: the old bench */
+    double fair_bias_object, fair_bias_receivers;     /* box-filtered (the base row's bias) */
+    double mal_centre, mal_fair; /* median |ln(model / reference)| over object pixels */
+    /* The same between the two references (seeds 0 and LRB_SWEEP_SEED2): raw, and scaled to
+     * two references of LRB_SWEEP_SPP samples each (x sqrt(2 / (1 + spp / spp2))). NaN when
+     * the second reference failed. */
+    double mal_floor_raw, mal_floor;
+    int ref2_spp;
+    bool ref2_hit;
+    long region_px[LR_EVAL_REGION_COUNT];
+    lr_eval_ratio region_ratio[LR_EVAL_REGION_COUNT][4]; /* bands R, G, B, then all pooled */
+    lr_eval_ratio receiver_ratio, centre_receiver_ratio; /* all receiver pixels, pooled */
+    /* LRB_SWEEP_SS_CHECK: base setting converged at each factor. */
+    int nss, ss[LRB_SWEEP_SS_MAX];
+    double ss_bias_object[LRB_SWEEP_SS_MAX], ss_bias_receivers[LRB_SWEEP_SS_MAX],
+        ss_mal[LRB_SWEEP_SS_MAX];
 } lrb_scene_result;
+
+/* Whether name is one of the comma-separated names of list (whole names: "candle" does not
+ * select "candle_spot"). */
+bool lrb_listed(const char *list, const char *name);
+
+/* The supersampling factor of this run (LRB_SWEEP_SS or LRB_SWEEP_SUPERSAMPLE). */
+int lrb_sweep_supersample(void);
+/* Per scene, the fair figures as markdown: the summary table (one line per scene) and the
+ * region table (sweep_fair.c). */
+void lrb_sweep_fair_md(FILE *f, const lrb_scene_result *scenes, int nscenes);
 
 /* Applies a setting to a scene (render.* and every object's model). */
 int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e);

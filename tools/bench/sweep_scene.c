@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "render/base/paths.h"
 #include "render/reference/reference.h"
@@ -45,11 +46,104 @@ static double debias(double rmse, double se)
     return v > 0.0 ? sqrt(v) : 0.0;
 }
 
+int lrb_sweep_supersample(void)
+{
+    const char *v = getenv("LRB_SWEEP_SUPERSAMPLE");
+    int s = v ? atoi(v) : LRB_SWEEP_SS;
+    return s >= 1 && s <= 16 ? s : LRB_SWEEP_SS;
+}
+
+static int run_series(lr_gl *gl, lr_scene *s, const lrb_setting *st, int ss, lr_eval_series *ser,
+                      lr_err *e)
+{
+    int rc = lrb_sweep_apply(s, st, e);
+    if (!rc)
+        rc = lr_eval_series_run(&(lr_eval_series_desc){.gl = gl, .scene = s, .width = LRB_SWEEP_W,
+                                                       .height = LRB_SWEEP_H, .no_vpl = !st->vpl,
+                                                       .checkpoints = st->checkpoints,
+                                                       .ncheck = st->ncheck,
+                                                       .converge_frames = st->converge_frames,
+                                                       .supersample = ss},
+                                &ser[0], e);
+    if (rc)
+        lr_err_prefix(e, "setting %s (supersampled %d)", st->label, ss);
+    return rc;
+}
+
+/* Bias of a series's converged image C against the physical reference: the reference's noise
+ * (se) and C's own (its last checkpoint's noise about C, sigma^2 / F, scaled to sigma^2 / C)
+ * taken out in quadrature. */
+static void series_bias(const lr_eval_series *ser, const lrb_setting *st, const float *ref,
+                        const lr_eval_masks *m, const lrb_scene_result *res, double *bo,
+                        double *br)
+{
+    const size_t n = (size_t)LRB_SWEEP_W * LRB_SWEEP_H;
+    const float *C = ser->converged, *I = ser->image[st->ncheck - 1];
+    const double Cf = st->converge_frames, Fl = st->checkpoints[st->ncheck - 1];
+    const double k = sqrt(Fl / Cf) / sqrt(1.0 - Fl / Cf);
+    *bo = debias(debias(lr_eval_rel_rmse(C, ref, m->object, n), res->ref_se_object),
+                 lr_eval_rel_rmse(I, C, m->object, n) * k);
+    *br = debias(debias(lr_eval_rel_rmse(C, ref, m->receivers, n), res->ref_se_receivers),
+                 lr_eval_rel_rmse(I, C, m->receivers, n) * k);
+}
+
+/* The second reference (seed LRB_SWEEP_SEED2): from the cache at LRB_SWEEP_SPP samples, else
+ * at LRB_SWEEP_SPP2, else rendered at LRB_SWEEP_SPP2 and cached beside the first. */
+static int second_reference(const lr_ref_scene *rs, const lr_ref_camera *cam, const char *dir,
+                            lr_ref_image *mean, lr_ref_image *var, int *spp, bool *hit,
+                            lr_err *e)
+{
+    const int spps[2] = {LRB_SWEEP_SPP, LRB_SWEEP_SPP2};
+    lr_ref_render_desc rd = {.width = LRB_SWEEP_W, .height = LRB_SWEEP_H,
+                             .seed = LRB_SWEEP_SEED2, .spp = LRB_SWEEP_SPP2};
+    bool cached = false;
+    for (int i = 0; i < 2 && !cached; i++) {
+        lr_ref_render_desc d = rd;
+        d.spp = spps[i];
+        char key[17], path[1200];
+        lr_ref_cache_key(rs, cam, &d, key);
+        snprintf(path, sizeof path, "%s/%s.pfm", dir, key);
+        if (!access(path, R_OK))
+            rd = d, cached = true;
+    }
+    *spp = rd.spp;
+    const char *mode = getenv("LRB_SWEEP_REF2");
+    if (!cached && mode && !strcmp(mode, "cached"))
+        return lr_err_set(e, LR_EIO, "no seed-%d reference at %d or %d spp in %s "
+                          "(LRB_SWEEP_REF2=cached)", LRB_SWEEP_SEED2, LRB_SWEEP_SPP,
+                          LRB_SWEEP_SPP2, dir);
+    return lr_ref_render_cached(rs, cam, &rd, dir, NULL, NULL, mean, var, hit, e);
+}
+
+/* Issue 12's figures on the base setting's converged, box-filtered image C: power ratios per
+ * region and band with the reference's standard error, the receivers' power ratio and the
+ * median |ln ratio| over object pixels. */
+static void fair_figures(const float *C, const lr_ref_image *mean, const lr_ref_image *var,
+                         const lr_eval_regions *rg, const lr_eval_masks *m, unsigned char *mask,
+                         lrb_scene_result *res)
+{
+    const size_t n = (size_t)LRB_SWEEP_W * LRB_SWEEP_H;
+    for (int r = 0; r < LR_EVAL_REGION_COUNT; r++) {
+        res->region_px[r] = lr_eval_regions_mask(rg, r, mask);
+        for (int b = 0; b < 4; b++)
+            res->region_ratio[r][b] =
+                lr_eval_power_ratio(C, mean->rgb, var->rgb, mask, n, b < 3 ? b : -1);
+    }
+    res->receiver_ratio = lr_eval_power_ratio(C, mean->rgb, var->rgb, m->receivers, n, -1);
+    res->mal_fair = lr_eval_median_abs_log(C, mean->rgb, m->object, n);
+}
+
 int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, int cap,
                     lrb_scene_result *res)
 {
     *res = (lrb_scene_result){.units_ratio = NAN, .units_se = NAN, .direct_ratio = NAN,
-                              .direct_se = NAN, .row0 = *nrows};
+                              .direct_se = NAN, .row0 = *nrows,
+                              .supersample = lrb_sweep_supersample(),
+                              .centre_bias_object = NAN, .centre_bias_receivers = NAN,
+                              .fair_bias_object = NAN, .fair_bias_receivers = NAN,
+                              .mal_centre = NAN, .mal_fair = NAN, .mal_floor_raw = NAN,
+                              .mal_floor = NAN,
+                              .receiver_ratio = {NAN, NAN}, .centre_receiver_ratio = {NAN, NAN}};
     snprintf(res->name, sizeof res->name, "%s", name);
     const int w = LRB_SWEEP_W, h = LRB_SWEEP_H;
     const size_t n = (size_t)w * h;
@@ -59,9 +153,11 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
     lr_err e = {0};
     lr_scene *s = NULL;
     lr_ref_scene *rs = NULL;
-    lr_ref_image mean = {0}, var = {0};
+    lr_ref_image mean = {0}, var = {0}, mean2 = {0}, var2 = {0};
     lr_eval_masks m = {0};
-    unsigned char *both = NULL, *direct = NULL;
+    lr_eval_regions rg = {0};
+    unsigned char *both = NULL, *direct = NULL, *mask = NULL;
+    const int ss = res->supersample;
     int rc;
     double t0 = lrb_now();
     if ((rc = lr_scene_load(path, NULL, &s, &e)))
@@ -75,11 +171,28 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
                                    &e)))
         goto done;
     res->ref_s = lrb_now() - t0;
-    if ((rc = lr_eval_masks_create(s, w, h, &m, &e)))
+    if ((rc = second_reference(rs, &cam, refdir, &mean2, &var2, &res->ref2_spp, &res->ref2_hit,
+                               &e))) {
+        /* The floor is optional: the errors stand without it. */
+        fprintf(stderr, "bench sweep: %s: second reference: %s\n", name, e.msg);
+        e = (lr_err){0};
+        rc = LR_OK;
+    }
+    if ((rc = lr_eval_masks_create(s, w, h, &m, &e)) ||
+        (rc = lr_eval_regions_create(s, w, h, &rg, &e)))
         goto done;
+    if (mean2.rgb) {
+        /* Median |ln| of a ratio of two means scales with the standard deviation of the log,
+         * which goes as 1/sqrt(spp): two references of spp and spp2 samples differ like two
+         * of spp samples times sqrt((1/spp + 1/spp2) / (2/spp)). */
+        res->mal_floor_raw = lr_eval_median_abs_log(mean.rgb, mean2.rgb, m.object, n);
+        res->mal_floor = res->mal_floor_raw *
+                         sqrt(2.0 / (1.0 + (double)LRB_SWEEP_SPP / res->ref2_spp));
+    }
     both = malloc(n);
     direct = calloc(n, 1);
-    if (!both || !direct) {
+    mask = malloc(n);
+    if (!both || !direct || !mask) {
         rc = lr_err_set(&e, LR_ENOMEM, "out of memory");
         goto done;
     }
@@ -96,34 +209,25 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
     double t1 = lrb_now();
     for (int k = 0; k < nset; k++) {
         const lrb_setting *st = &set[k];
+        /* LRB_SWEEP_SETTINGS=K=4,N=16 restricts the variants (the base always runs: the fair
+         * figures come from it). */
+        if (k && getenv("LRB_SWEEP_SETTINGS") && !lrb_listed(getenv("LRB_SWEEP_SETTINGS"),
+                                                            st->label))
+            continue;
         lr_eval_series ser = {0};
-        if ((rc = lrb_sweep_apply(s, st, &e)) ||
-            (rc = lr_eval_series_run(&(lr_eval_series_desc){.gl = gl, .scene = s, .width = w,
-                                                            .height = h, .no_vpl = !st->vpl,
-                                                            .checkpoints = st->checkpoints,
-                                                            .ncheck = st->ncheck,
-                                                            .converge_frames =
-                                                                st->converge_frames},
-                                     &ser, &e))) {
-            lr_err_prefix(&e, "setting %s", st->label);
+        if ((rc = run_series(gl, s, st, ss, &ser, &e)))
             goto done;
-        }
         const float *C = ser.converged;
         const double Cf = st->converge_frames;
-        /* Noise of the converged image itself, from the last checkpoint's: sigma^2 / F
-         * scales to sigma^2 / C. */
-        int Fl = st->checkpoints[st->ncheck - 1];
-        double fix_l = 1.0 / sqrt(1.0 - Fl / Cf);
-        double nC_obj = lr_eval_rel_rmse(ser.image[st->ncheck - 1], C, m.object, n) * fix_l *
-                        sqrt(Fl / Cf);
-        double nC_rec = lr_eval_rel_rmse(ser.image[st->ncheck - 1], C, m.receivers, n) * fix_l *
-                        sqrt(Fl / Cf);
         /* Bias: converged model vs physical, without the reference's and the converged
          * image's own noise. */
-        double bias_obj = debias(debias(lr_eval_rel_rmse(C, mean.rgb, m.object, n),
-                                        res->ref_se_object), nC_obj);
-        double bias_rec = debias(debias(lr_eval_rel_rmse(C, mean.rgb, m.receivers, n),
-                                        res->ref_se_receivers), nC_rec);
+        double bias_obj, bias_rec;
+        series_bias(&ser, st, mean.rgb, &m, res, &bias_obj, &bias_rec);
+        if (k == 0) { /* the base setting */
+            res->fair_bias_object = bias_obj;
+            res->fair_bias_receivers = bias_rec;
+            fair_figures(C, &mean, &var, &rg, &m, mask, res);
+        }
         for (int c = 0; c < st->ncheck && *nrows < cap; c++) {
             const float *I = ser.image[c];
             int F = st->checkpoints[c];
@@ -142,7 +246,7 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
                 .bias_object = bias_obj, .bias_receivers = bias_rec,
                 .noise_object = lr_eval_rel_rmse(I, C, m.object, n) * fix,
                 .noise_receivers = lr_eval_rel_rmse(I, C, m.receivers, n) * fix,
-                .width = w, .height = h,
+                .width = w, .height = h, .supersample = ss,
             };
             snprintf(r.scene, sizeof r.scene, "%s", name);
             snprintf(r.model, sizeof r.model, "%s", st->model);
@@ -169,6 +273,46 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
         lr_eval_series_free(&ser);
     }
     res->sweep_s = lrb_now() - t1;
+    /* The old bench's figures for the same setting: pixel-centre samples. */
+    {
+        lr_eval_series ser = {0};
+        if (ss == 1) {
+            res->centre_bias_object = res->fair_bias_object;
+            res->centre_bias_receivers = res->fair_bias_receivers;
+        } else if ((rc = run_series(gl, s, &set[0], 1, &ser, &e)))
+            goto done;
+        const float *C = ss == 1 ? NULL : ser.converged;
+        if (C) {
+            series_bias(&ser, &set[0], mean.rgb, &m, res, &res->centre_bias_object,
+                        &res->centre_bias_receivers);
+            res->mal_centre = lr_eval_median_abs_log(C, mean.rgb, m.object, n);
+            res->centre_receiver_ratio =
+                lr_eval_power_ratio(C, mean.rgb, var.rgb, m.receivers, n, -1);
+        } else {
+            res->mal_centre = res->mal_fair;
+            res->centre_receiver_ratio = res->receiver_ratio;
+        }
+        lr_eval_series_free(&ser);
+    }
+    /* LRB_SWEEP_SS_CHECK=1,2,4,8: how the base setting's bias converges with the factor. */
+    for (const char *p = getenv("LRB_SWEEP_SS_CHECK"); p && *p && res->nss < LRB_SWEEP_SS_MAX;) {
+        int f = atoi(p);
+        p += strcspn(p, ",");
+        p += *p == ',';
+        if (f < 1 || f > 16)
+            continue;
+        lr_eval_series ser = {0};
+        if ((rc = run_series(gl, s, &set[0], f, &ser, &e)))
+            goto done;
+        int j = res->nss++;
+        res->ss[j] = f;
+        series_bias(&ser, &set[0], mean.rgb, &m, res, &res->ss_bias_object[j],
+                    &res->ss_bias_receivers[j]);
+        res->ss_mal[j] = lr_eval_median_abs_log(ser.converged, mean.rgb, m.object, n);
+        fprintf(stderr, "bench sweep: %s supersampled %dx%d: bias %.4f / %.4f, median |ln| %.4f\n",
+                name, f, f, res->ss_bias_object[j], res->ss_bias_receivers[j], res->ss_mal[j]);
+        lr_eval_series_free(&ser);
+    }
     lrb_sweep_units(gl, name, &res->units_ratio, &res->units_se, &res->units_px);
     res->ok = true;
 done:
@@ -177,9 +321,13 @@ done:
     res->nrows = *nrows - res->row0;
     free(both);
     free(direct);
+    free(mask);
     lr_eval_masks_free(&m);
+    lr_eval_regions_free(&rg);
     lr_ref_image_free(&mean);
     lr_ref_image_free(&var);
+    lr_ref_image_free(&mean2);
+    lr_ref_image_free(&var2);
     lr_ref_scene_destroy(rs);
     lr_scene_destroy(s);
     return rc;

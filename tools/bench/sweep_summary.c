@@ -155,6 +155,7 @@ int lrb_sweep_summary(const char *path, const lr_eval_row *rows, int nrows,
             LRB_SWEEP_W, LRB_SWEEP_H);
     if (nt640)
         lrb_sweep_table_md(f, rows, nrows, t640, nt640);
+    lrb_sweep_fair_md(f, scenes, nscenes);
     for (int k = 0; k < nscenes; k++)
         scene_block(f, &scenes[k], rows + scenes[k].row0);
     return lr_atomic_file_commit(af, e);
