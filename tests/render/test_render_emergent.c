@@ -125,7 +125,7 @@ static void check_scene(const char *name, const probe *probes, int np)
             double L = I[c] * rc->albedo[c] / M_PI * E[c];
             assert_near(hl[k + c], L, 1e-4 * L + 1e-30);
             /* ... within 5 % of the sum at the pixel itself (the grid's interpolation error;
-             * tests/test_cpu_recv_grid.c bounds it on the whole plane)... */
+             * tests/cpu/test_cpu_recv_grid.c bounds it on the whole plane)... */
             assert_near(E[c], Ex[c], 0.05 * Ex[c]);
             /* ... and at least 1e-4 of what the bare light would give there,
              * albedo/pi * 1e-4 I / d^2 (d from the light). Derivation for the candle (the
