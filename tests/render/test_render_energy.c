@@ -26,20 +26,7 @@
 #include "tests/support/near.h"
 #include "tests/support/render.h"
 
-static lr_gl *gl;
-
-static int setup(void **state)
-{
-    (void)state;
-    return lr_test_gl_create(&gl) ? -1 : 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    lr_gl_destroy(gl);
-    return 0;
-}
+LR_TEST_GL_FIXTURE(gl) /* tests/support/gl.h: setup(), teardown() */
 
 /* Phi / (4 pi I) per band from the GPU's maps (see the top), and the gain composition uses. */
 static void outer_power(lr_renderer *r, const lr_scene *s, double P[3], double gain[3])
