@@ -12,7 +12,8 @@
 #
 # Sources are found by wildcard: every .c under render/ hal/ calib/ and firmware/ (except
 # firmware/main.c) goes into the library; tools/NAME/*.c builds build/bin/lamprig-NAME;
-# tests/test_NAME.c (plus tests/support/*.c) builds one test binary per area.
+# tests/AREA/test_NAME.c (plus tests/support/*.c) builds one test binary per area,
+# build/test/test_NAME (the binary name has no sub-folder: make build/test/test_scene).
 
 PUBLIC_TARGETS := all build test run bench install deb test-install
 
@@ -57,7 +58,7 @@ LIB_C   := $(sort $(filter-out firmware/main.c, \
                         calib/*.c calib/*/*.c firmware/*.c firmware/*/*.c)))
 LIB_CXX := $(sort $(wildcard calib/*.cpp calib/*/*.cpp))
 TOOLS   := $(sort $(patsubst tools/%/,%,$(dir $(wildcard tools/*/*.c))))
-TESTS   := $(sort $(patsubst tests/%.c,%,$(wildcard tests/test_*.c)))
+TESTS   := $(sort $(notdir $(basename $(wildcard tests/*/test_*.c))))
 SUPPORT := $(sort $(wildcard tests/support/*.c))
 
 # The version, from one place: the VERSION file (one line), compiled into firmware/version.c
@@ -118,7 +119,9 @@ build/bin/lamprig-%: $$(addprefix build/obj/rel/,$$(addsuffix .o,$$(basename $$(
 	@echo "  LD      $@"
 	$(Q)$(CXX) -o $@ $^ $(LDLIBS)
 
-build/test/test_%: build/obj/asan/tests/test_%.o $(SUPPORT:%.c=build/obj/asan/%.o) build/lib/liblamprig-asan.a
+# The test's source is found in whichever tests/AREA/ holds it (names are unique across areas).
+build/test/test_%: $$(addprefix build/obj/asan/,$$(addsuffix .o,$$(basename $$(wildcard tests/*/test_$$*.c)))) \
+                   $(SUPPORT:%.c=build/obj/asan/%.o) build/lib/liblamprig-asan.a
 	@mkdir -p $(@D)
 	@echo "  LD-SAN  $@"
 	$(Q)$(CXX) -fsanitize=address,undefined -o $@ $^ $(LDLIBS) $(CMOCKA_LIBS)

@@ -4,7 +4,7 @@
 set -eu
 
 # opencv-doc ships OpenCV's sample chessboard photos and OpenCV's own calibration of them
-# (examples/data/left*.jpg, left_intrinsics.yml): tests/test_calib_camera.c checks against them.
+# (examples/data/left*.jpg, left_intrinsics.yml): tests/calib/test_calib_camera.c checks against them.
 # libsystemd-dev: sd_notify from the rig loop. lintian and systemd (systemd-analyze verify)
 # check `make deb`'s package and unit in tests/install.sh; dpkg-dev comes with build-essential.
 PKGS="build-essential pkg-config

@@ -223,7 +223,7 @@ int lr_rig_config_lamp_device(const lr_rig_config *c);
 /* Writes the reference of the device fields (markdown: device, field, value, range, default,
  * what) from the hal back ends' option descriptors (hal/opt.h) the loader reads them through;
  * firmware/README.md quotes it between "<!-- BEGIN rig-devices -->" and
- * "<!-- END rig-devices -->" (tests/test_fw_config.c compares). */
+ * "<!-- END rig-devices -->" (tests/fw/test_fw_config.c compares). */
 void lr_rig_config_fields_markdown(FILE *f);
 
 /* "sim", "modbus", "gpio", "hid", "usb". */

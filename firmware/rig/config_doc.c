@@ -1,6 +1,6 @@
 /* The device part of the rig config reference, written from the hal back ends' option
  * descriptors (hal/opt.h) that config.c reads devices through; firmware/README.md quotes it
- * (tests/test_fw_config.c compares). */
+ * (tests/fw/test_fw_config.c compares). */
 #include <string.h>
 
 #include "firmware/rig/config.h"

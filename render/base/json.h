@@ -23,7 +23,7 @@
  * in Debian 12), so a line-tracking layer over them would have to re-scan the text anyway; and
  * jsmn (used before) is a tokenizer that leaves validation to its users, which is how bare
  * words and trailing commas got through. The scanner (json_scan.c) is one non-recursive
- * pass, tested case by case in tests/test_json.c.
+ * pass, tested case by case in tests/base/test_json.c.
  *
  * A document is immutable after parsing; nodes are indices into it, valid until destroy.
  */

@@ -60,7 +60,7 @@ float lr_srgb_decode(float encoded);
  * 0.0031308, else I. Taylor's fit 0.662002687 l^(1/2) + 0.684122060 l^(1/4)
  * - 0.323583601 l^(1/8) - 0.0225411470 l ("sRGB approximations for HLSL", 2012): three
  * square roots instead of pow, within 0.25 / 255 of lr_srgb_encode on [0, 1] (bounded in
- * tests/test_image.c), so an 8-bit code is the exact one or one step off. */
+ * tests/base/test_image.c), so an 8-bit code is the exact one or one step off. */
 float lr_srgb_encode_fast(float linear);
 
 /* ---- files ---------------------------------------------------------------------------- */

@@ -52,7 +52,7 @@ int lr_fresnel_checked(double cos_i, double eta, double *reflectance, double *tr
  * 2*C1 and 3*C2 (branches eta < 1 and eta > 1), as used by the directional dipole [14]; these
  * functions return C1 and C2 themselves. 2*C1 is the internal hemispherical (diffuse) Fresnel
  * reflectance. Fit error against the exact integrals on [LR_ETA_MIN, LR_ETA_MAX] (measured,
- * see tests/test_optics_fresnel.c): |2C1| <= 4.4e-3 (worst just above eta = 1), |3C2| <= 7e-3. */
+ * see tests/optics/test_optics_fresnel.c): |2C1| <= 4.4e-3 (worst just above eta = 1), |3C2| <= 7e-3. */
 double lr_fresnel_moment1(double eta);
 double lr_fresnel_moment2(double eta);
 /* Internal diffuse reflectance F_dr(eta) of Egan & Hilgeman as used by Jensen et al. 2001

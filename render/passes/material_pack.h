@@ -1,6 +1,6 @@
 /* lamprig — the per-object material blocks the shaders read (render/shaders/lib/material.glsl:
  * u_coef, u_sss), packed from the optics coefficients. Public so that tests can drive the
- * GLSL optics with exactly the renderer's packing (tests/test_render_optics_glsl.c). */
+ * GLSL optics with exactly the renderer's packing (tests/render/test_render_optics_glsl.c). */
 #ifndef LR_MATERIAL_PACK_H
 #define LR_MATERIAL_PACK_H
 

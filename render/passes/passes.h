@@ -29,7 +29,7 @@
 #define LR_MAX_LIGHTS LR_SCENE_MAX_LIGHTS
 /* Frames accumulated at most in RGBA16F maps. Drivers may round the blended result toward
  * zero when storing half floats (llvmpipe does): the running mean then loses ~2^-13 of
- * itself per frame, 1.1% after 64 frames, 16% after 1024 (measured, tests/test_render_hard.c).
+ * itself per frame, 1.1% after 64 frames, 16% after 1024 (measured, tests/render/test_render_hard.c).
  * 32 frames keep that below 0.6%. */
 #define LR_HALF_MAX_FRAMES 32
 

@@ -34,7 +34,7 @@
  * connection is a few mean free paths long and the solution is unique. On faceted meshes the
  * refracted fans of adjacent facets leave dark wedges with no solution (counted as unsolved,
  * correctly contributing nothing); connections at a wedge's border are sometimes missed
- * (-0.13 % of the transmitted power measured on faceted cavities, tests/test_reference_mesh). */
+ * (-0.13 % of the transmitted power measured on faceted cavities, tests/reference/test_reference_mesh.c). */
 #include "render/reference/ref_priv.h"
 
 #include "render/optics/optics.h"

@@ -5,7 +5,7 @@
  * lr_dirty bit a change sets and a one-line description. The loader (load.c) reads JSON
  * through it, lr_scene_set/get (set.c) parse and print values through it, the record checks
  * (check.c) test its ranges, and the field reference in configs/scenes/README.md is written
- * from it (lr_scene_fields_markdown; tests/test_scene.c compares the two). What a table cannot
+ * from it (lr_scene_fields_markdown; tests/base/test_scene.c compares the two). What a table cannot
  * say -- relations between fields (inner_deg <= outer_deg, far > near, a camera that can see),
  * the generators' own mesh checks (render/mesh/shapes.h), materials (render/material) -- is
  * explicit code after the table-driven part.

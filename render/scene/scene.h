@@ -241,7 +241,7 @@ int lr_scene_get(const lr_scene *s, const char *key, char *buf, size_t cap, lr_e
 /* Writes the reference of every scene field (markdown, a table per record: key, kinds, value,
  * range, default, what a change invalidates, description) from the tables that load, set and
  * check use (render/scene/field_tables.c). configs/scenes/README.md quotes it between
- * "<!-- BEGIN scene-fields -->" and "<!-- END scene-fields -->" (tests/test_scene.c compares). */
+ * "<!-- BEGIN scene-fields -->" and "<!-- END scene-fields -->" (tests/base/test_scene.c compares). */
 void lr_scene_fields_markdown(FILE *f);
 
 #endif

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-# Regenerates the dp_cases and dp_grid tables of tests/test_optics_dirpole.c: the directional
+# Regenerates the dp_cases and dp_grid tables of tests/optics/test_optics_dirpole.c: the directional
 # dipole of [14] as written in /work/ref/dirpole_ref.py (an independent pure-Python port), evaluated
 # in 50-digit mpmath; where /work/ref/dirpole_ref.py is present each case is also checked against
 # its double-precision evaluation. Usage: python3 tests/support/gen_dirpole_ref.py > tables.inc

@@ -16,4 +16,23 @@ int lr_test_gl_create(lr_gl **out);
  * suppressed, while leaks in our own code are reported as ever. */
 void lr_test_pin_libraries(void);
 
+/* The cmocka group fixture most GL tests share: declares the file's context VAR and defines
+ * static setup() (lr_test_gl_create into VAR; -1 on failure) and teardown() (destroys it), for
+ * cmocka_run_group_tests(tests, setup, teardown). One context per binary: creating one costs
+ * far more than a test under ASan on llvmpipe. */
+#define LR_TEST_GL_FIXTURE(var)                                                                \
+    static lr_gl *var;                                                                         \
+    static int setup(void **state)                                                             \
+    {                                                                                          \
+        (void)state;                                                                           \
+        return lr_test_gl_create(&var) ? -1 : 0;                                               \
+    }                                                                                          \
+    static int teardown(void **state)                                                          \
+    {                                                                                          \
+        (void)state;                                                                           \
+        lr_gl_destroy(var);                                                                    \
+        var = NULL;                                                                            \
+        return 0;                                                                              \
+    }
+
 #endif

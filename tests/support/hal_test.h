@@ -1,4 +1,4 @@
-/* Test support for tests/test_hal_*.c: a log hook that records lines, and a miniature main
+/* Test support for tests/hal/test_hal_*.c: a log hook that records lines, and a miniature main
  * loop (poll over the devices' fds and deadlines) like the firmware's. */
 #ifndef LR_TEST_HAL_TEST_H
 #define LR_TEST_HAL_TEST_H

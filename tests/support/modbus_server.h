@@ -6,7 +6,7 @@
  *    slave (/dev/pts/N, or a symlink to it, as udev's /dev/serial/by-id links are).
  * Can be stopped and started again: TCP closes every connection and refuses the port; RTU closes
  * the pty, so the slave hangs up and the device node disappears, and a restart opens a new pty
- * and points the symlink at it. Used by tests/test_hal_modbus.c and tests/test_fw_modbus.c. */
+ * and points the symlink at it. Used by tests/hal/test_hal_modbus.c and tests/fw/test_fw_modbus.c. */
 #ifndef LR_TEST_MODBUS_SERVER_H
 #define LR_TEST_MODBUS_SERVER_H
 

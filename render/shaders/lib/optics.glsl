@@ -1,5 +1,5 @@
 // GLSL port of render/optics/{fresnel,dirpole,dipole,multipole,model,sampling}.c (the C versions
-// are the reference; tests/test_render_optics_glsl.c compares the two on a grid). Float instead
+// are the reference; tests/render/test_render_optics_glsl.c compares the two on a grid). Float instead
 // of double: the guards that the C code needs for the double range are kept with float thresholds.
 
 const float LR_PI = 3.14159265358979;

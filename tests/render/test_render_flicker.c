@@ -27,20 +27,7 @@
 #include "tests/support/near.h"
 #include "tests/support/render.h"
 
-static lr_gl *gl;
-
-static int setup(void **state)
-{
-    (void)state;
-    return lr_test_gl_create(&gl) ? -1 : 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    lr_gl_destroy(gl);
-    return 0;
-}
+LR_TEST_GL_FIXTURE(gl) /* tests/support/gl.h: setup(), teardown() */
 
 static const double mult[3] = {1.0, 1.6180339887, 2.7182818285}; /* light.c's partials */
 static const double weight[3] = {0.5, 0.3, 0.2};

@@ -21,18 +21,7 @@
 #define MAP 32
 #define K 4
 
-static lr_gl *gl;
-
-static int setup(void **state)
-{
-    return lr_test_gl_create(&gl) ? -1 : 0;
-}
-
-static int teardown(void **state)
-{
-    lr_gl_destroy(gl);
-    return 0;
-}
+LR_TEST_GL_FIXTURE(gl) /* tests/support/gl.h: setup(), teardown() */
 
 static const char *const settings[] = {
     "render.K=4", "render.N=2", "render.map_size=32", "render.gbuffer_size=64",

@@ -17,20 +17,7 @@
 #include "render/gl/tex.h"
 #include "tests/support/gl.h"
 
-static lr_gl *g_gl;
-
-static int setup(void **state)
-{
-    (void)state;
-    return lr_test_gl_create(&g_gl) ? -1 : 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    lr_gl_destroy(g_gl);
-    return 0;
-}
+LR_TEST_GL_FIXTURE(g_gl) /* tests/support/gl.h: setup(), teardown() */
 
 /* Levels with every value distinct enough to catch a flip, a shift or a channel swap, and
  * some outside 0..1 (clipped). */

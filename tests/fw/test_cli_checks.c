@@ -17,6 +17,7 @@
 #include <sys/wait.h>
 
 #include "calib/colormatrix.h"
+#include "tests/support/cli.h"
 #include "tests/support/fs.h"
 
 static char *dir;
@@ -33,19 +34,8 @@ static int teardown(void **state)
     return 0;
 }
 
-/* Runs a shell command, stdout to dir/out and stderr to dir/err; returns the exit status. */
-static int run(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static int run(const char *fmt, ...)
-{
-    char cmd[2048], full[2400];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(cmd, sizeof cmd, fmt, ap);
-    va_end(ap);
-    snprintf(full, sizeof full, "%s >%s/out 2>%s/err </dev/null", cmd, dir, dir);
-    int st = system(full);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
+/* The child runs with this file's scratch folder (tests/support/cli.h). */
+#define run(...) lr_test_run_cli(dir, __VA_ARGS__)
 
 static char *slurp(const char *name)
 {

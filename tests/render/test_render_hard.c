@@ -23,18 +23,7 @@
 #define W 48
 #define H 36
 
-static lr_gl *gl;
-
-static int setup(void **state)
-{
-    return lr_test_gl_create(&gl) ? -1 : 0;
-}
-
-static int teardown(void **state)
-{
-    lr_gl_destroy(gl);
-    return 0;
-}
+LR_TEST_GL_FIXTURE(gl) /* tests/support/gl.h: setup(), teardown() */
 
 /* Renders to convergence and checks every HDR pixel, map texel and VPL; returns the emergent
  * power per band for unit intensity, sum_v B_v A_v, divided by 4 pi (the power of a unit

@@ -32,20 +32,7 @@
 #include "tests/support/near.h"
 #include "tests/support/render.h"
 
-static lr_gl *gl;
-
-static int setup(void **state)
-{
-    (void)state;
-    return lr_test_gl_create(&gl) ? -1 : 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    lr_gl_destroy(gl);
-    return 0;
-}
+LR_TEST_GL_FIXTURE(gl) /* tests/support/gl.h: setup(), teardown() */
 
 enum { W = 48, H = 36 };
 

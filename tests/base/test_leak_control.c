@@ -172,7 +172,7 @@ static void test_our_leak_fails_the_run(void **state)
     int st = run_child(CHILD_LEAK, dir, &out);
     bool failed = !WIFEXITED(st) || WEXITSTATUS(st) != 0;
     if (!failed || !strstr(out, "LeakSanitizer") || !strstr(out, "512 byte(s)") ||
-        !strstr(out, "leak_on_purpose") || !strstr(out, "tests/test_leak_control.c"))
+        !strstr(out, "leak_on_purpose") || !strstr(out, "tests/base/test_leak_control.c"))
         fail_msg("a 512-byte leak from our code was not reported as such (status %#x):\n%s", st,
                  out);
     /* One leak, ours: nothing of the driver's in the summary. */

@@ -8,7 +8,7 @@
  * (a texel of map k covers h^2 / (n . d_k) of surface; weighting map k by (n . d_k) / sum_j
  * max(0, n . d_j) counts every point of the convex outer surface once over the maps that see
  * it), with `gain` the cavity gain composition applies (render/cpu/cavity.h). The CPU side of
- * the same requirement is tests/test_cpu_energy.c. */
+ * the same requirement is tests/cpu/test_cpu_energy.c. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -26,20 +26,7 @@
 #include "tests/support/near.h"
 #include "tests/support/render.h"
 
-static lr_gl *gl;
-
-static int setup(void **state)
-{
-    (void)state;
-    return lr_test_gl_create(&gl) ? -1 : 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    lr_gl_destroy(gl);
-    return 0;
-}
+LR_TEST_GL_FIXTURE(gl) /* tests/support/gl.h: setup(), teardown() */
 
 /* Phi / (4 pi I) per band from the GPU's maps (see the top), and the gain composition uses. */
 static void outer_power(lr_renderer *r, const lr_scene *s, double P[3], double gain[3])

@@ -22,18 +22,7 @@
 #define W 96
 #define H 72
 
-static lr_gl *gl;
-
-static int setup(void **state)
-{
-    return lr_test_gl_create(&gl) ? -1 : 0;
-}
-
-static int teardown(void **state)
-{
-    lr_gl_destroy(gl);
-    return 0;
-}
+LR_TEST_GL_FIXTURE(gl) /* tests/support/gl.h: setup(), teardown() */
 
 typedef struct probe {
     const char *what;
@@ -125,7 +114,7 @@ static void check_scene(const char *name, const probe *probes, int np)
             double L = I[c] * rc->albedo[c] / M_PI * E[c];
             assert_near(hl[k + c], L, 1e-4 * L + 1e-30);
             /* ... within 5 % of the sum at the pixel itself (the grid's interpolation error;
-             * tests/test_cpu_recv_grid.c bounds it on the whole plane)... */
+             * tests/cpu/test_cpu_recv_grid.c bounds it on the whole plane)... */
             assert_near(E[c], Ex[c], 0.05 * Ex[c]);
             /* ... and at least 1e-4 of what the bare light would give there,
              * albedo/pi * 1e-4 I / d^2 (d from the light). Derivation for the candle (the

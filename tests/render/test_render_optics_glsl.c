@@ -48,18 +48,7 @@ typedef struct tcase {
     double cos_i, eta, xi_s, r_max;
 } tcase;
 
-static lr_gl *gl;
-
-static int setup(void **state)
-{
-    return lr_test_gl_create(&gl) ? -1 : 0;
-}
-
-static int teardown(void **state)
-{
-    lr_gl_destroy(gl);
-    return 0;
-}
+LR_TEST_GL_FIXTURE(gl) /* tests/support/gl.h: setup(), teardown() */
 
 static lr_vec3 unit(double x, double y, double z)
 {

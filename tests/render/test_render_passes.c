@@ -21,18 +21,7 @@
 #include "tests/support/near.h"
 #include "tests/support/render.h"
 
-static lr_gl *gl;
-
-static int setup(void **state)
-{
-    return lr_test_gl_create(&gl) ? -1 : 0;
-}
-
-static int teardown(void **state)
-{
-    lr_gl_destroy(gl);
-    return 0;
-}
+LR_TEST_GL_FIXTURE(gl) /* tests/support/gl.h: setup(), teardown() */
 
 /* GL's cube-map face and (s, t) for direction v (OpenGL ES 3.1, "Cube Map Texture Selection"). */
 static void cube_select(lr_vec3 v, int *face, double *s, double *t)

@@ -25,6 +25,7 @@
 #include "render/plan/plan.h"
 #include "render/renderer.h"
 #include "render/scene/scene.h"
+#include "tests/support/cli.h"
 #include "tests/support/fs.h"
 #include "tests/support/gl.h"
 #include "tests/support/near.h"
@@ -566,29 +567,10 @@ static void test_no_pass_after_convergence(void **state)
 
 /* ---- command line ---- */
 
-static int run(const char *fmt, ...)
-{
-    char cmd[2048], full[2400];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(cmd, sizeof cmd, fmt, ap);
-    va_end(ap);
-    snprintf(full, sizeof full, "%s >%s/out 2>%s/err", cmd, dir, dir);
-    int st = system(full);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
+/* The child runs with this file's scratch folder (tests/support/cli.h). */
+#define run(...) lr_test_run_cli(dir, __VA_ARGS__)
 
-static char *slurp(const char *name)
-{
-    char path[512];
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    char *t = NULL;
-    size_t n;
-    lr_err e = {0};
-    if (lr_file_read(path, &t, &n, &e))
-        fail_msg("%s", e.msg);
-    return t;
-}
+#define slurp(name) lr_test_slurp(dir, name)
 
 static void expect_in(const char *file, const char *want)
 {
