@@ -16,9 +16,7 @@ static void *at(void *rec, size_t off)
 
 /* ---- get and set from text --------------------------------------------------------------------- */
 
-static int fail(lr_field_op *o, int code, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-static int fail(lr_field_op *o, int code, const char *fmt, ...)
+int lr_field_fail(lr_field_op *o, int code, const char *fmt, ...)
 {
     char msg[LR_ERR_MSG_MAX];
     va_list ap;
@@ -28,15 +26,14 @@ static int fail(lr_field_op *o, int code, const char *fmt, ...)
     return lr_err_set(o->e, code, "%s: %s", o->key, msg);
 }
 
-static int out(lr_field_op *o, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static int out(lr_field_op *o, const char *fmt, ...)
+int lr_field_out(lr_field_op *o, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
     int n = vsnprintf(o->buf, o->cap, fmt, ap);
     va_end(ap);
     if (n < 0 || (size_t)n >= o->cap)
-        return fail(o, LR_EINVAL, "value does not fit the %zu-byte buffer", o->cap);
+        return lr_field_fail(o, LR_EINVAL, "value does not fit the %zu-byte buffer", o->cap);
     return LR_OK;
 }
 
@@ -90,9 +87,9 @@ static int out_nums(lr_field_op *o, const double *v, int n)
     char b[3][40];
     for (int i = 0; i < n; i++)
         fmt_num(b[i], sizeof b[i], v[i]);
-    return n == 1 ? out(o, "%s", b[0])
-           : n == 2 ? out(o, "%s,%s", b[0], b[1])
-                    : out(o, "%s,%s,%s", b[0], b[1], b[2]);
+    return n == 1 ? lr_field_out(o, "%s", b[0])
+           : n == 2 ? lr_field_out(o, "%s,%s", b[0], b[1])
+                    : lr_field_out(o, "%s,%s,%s", b[0], b[1], b[2]);
 }
 
 static int get_field(lr_field_op *o, const lr_field *f, void *rec)
@@ -104,8 +101,8 @@ static int get_field(lr_field_op *o, const lr_field *f, void *rec)
                                                                            : *(double *)p;
         return out_nums(o, &v, 1);
     }
-    case LR_FT_INT: return out(o, "%d", *(int *)p);
-    case LR_FT_UINT: return out(o, "%d", (int)*(unsigned *)p);
+    case LR_FT_INT: return lr_field_out(o, "%d", *(int *)p);
+    case LR_FT_UINT: return lr_field_out(o, "%d", (int)*(unsigned *)p);
     case LR_FT_VEC3: {
         lr_vec3 x = *(lr_vec3 *)p;
         return out_nums(o, (double[3]){x.x, x.y, x.z}, 3);
@@ -119,11 +116,11 @@ static int get_field(lr_field_op *o, const lr_field *f, void *rec)
     case LR_FT_SIZE3: return out_nums(o, (double *)p, 3);
     case LR_FT_PAIR: return out_nums(o, (double *)p, 2);
     case LR_FT_BOOL:
-        return out(o, "%s", *(bool *)p != !!(f->flags & LR_FF_INVERT) ? "true" : "false");
-    case LR_FT_ENUM: return out(o, "%s", f->names[*(int *)p]);
-    case LR_FT_ENUMB: return out(o, "%s", f->names[*(bool *)p ? 1 : 0]);
-    case LR_FT_PATH: return out(o, "%s", (char *)p);
-    default: return fail(o, LR_EINVAL, "not a parameter");
+        return lr_field_out(o, "%s", *(bool *)p != !!(f->flags & LR_FF_INVERT) ? "true" : "false");
+    case LR_FT_ENUM: return lr_field_out(o, "%s", f->names[*(int *)p]);
+    case LR_FT_ENUMB: return lr_field_out(o, "%s", f->names[*(bool *)p ? 1 : 0]);
+    case LR_FT_PATH: return lr_field_out(o, "%s", (char *)p);
+    default: return lr_field_fail(o, LR_EINVAL, "not a parameter");
     }
 }
 
@@ -134,7 +131,7 @@ static int set_field(lr_field_op *o, const lr_field *f, void *rec)
     switch (f->type) {
     case LR_FT_NUM:
         if (!value_number(o, &v[0]))
-            return fail(o, LR_EPARSE, "expected a number, got '%s'", o->value);
+            return lr_field_fail(o, LR_EPARSE, "expected a number, got '%s'", o->value);
         if (f->flags & LR_FF_ZERO_FLAG)
             *(bool *)at(rec, f->aux) = v[0] == 0.0;
         if (v[0] == 0.0 && (f->flags & LR_FF_ZERO_DEFAULT))
@@ -144,12 +141,12 @@ static int set_field(lr_field_op *o, const lr_field *f, void *rec)
     case LR_FT_INT:
     case LR_FT_UINT:
         if (!value_number(o, &v[0]))
-            return fail(o, LR_EPARSE, "expected a number, got '%s'", o->value);
+            return lr_field_fail(o, LR_EPARSE, "expected a number, got '%s'", o->value);
         if (v[0] != floor(v[0]) || fabs(v[0]) > 1e9)
-            return fail(o, LR_EPARSE, "expected an integer, got '%s'", o->value);
+            return lr_field_fail(o, LR_EPARSE, "expected an integer, got '%s'", o->value);
         if (f->type == LR_FT_UINT) {
             if (v[0] < 0)
-                return fail(o, LR_EINVAL, "must be >= 0, got %d", (int)v[0]);
+                return lr_field_fail(o, LR_EINVAL, "must be >= 0, got %d", (int)v[0]);
             *(unsigned *)p = (unsigned)v[0];
             return LR_OK;
         }
@@ -161,7 +158,7 @@ static int set_field(lr_field_op *o, const lr_field *f, void *rec)
     case LR_FT_RGB:
     case LR_FT_SIZE3:
         if (!value_numbers(o, v, 3))
-            return fail(o, LR_EPARSE, "expected x,y,z (three numbers), got '%s'", o->value);
+            return lr_field_fail(o, LR_EPARSE, "expected x,y,z (three numbers), got '%s'", o->value);
         if (f->type == LR_FT_VEC3)
             *(lr_vec3 *)p = lr_v3(v[0], v[1], v[2]);
         else
@@ -169,14 +166,14 @@ static int set_field(lr_field_op *o, const lr_field *f, void *rec)
         return LR_OK;
     case LR_FT_PAIR:
         if (!value_numbers(o, v, 2))
-            return fail(o, LR_EPARSE, "expected w,h (two numbers), got '%s'", o->value);
+            return lr_field_fail(o, LR_EPARSE, "expected w,h (two numbers), got '%s'", o->value);
         memcpy(p, v, 2 * sizeof(double));
         return LR_OK;
     case LR_FT_SCALE:
         if (value_number(o, &v[0]))
             v[1] = v[2] = v[0];
         else if (!value_numbers(o, v, 3))
-            return fail(o, LR_EPARSE, "expected a number or x,y,z, got '%s'", o->value);
+            return lr_field_fail(o, LR_EPARSE, "expected a number or x,y,z, got '%s'", o->value);
         *(lr_vec3 *)p = lr_v3(v[0], v[1], v[2]);
         return LR_OK;
     case LR_FT_BOOL: {
@@ -186,7 +183,7 @@ static int set_field(lr_field_op *o, const lr_field *f, void *rec)
         else if (strcmp(o->value, "false") == 0)
             b = false;
         else
-            return fail(o, LR_EPARSE, "expected true or false, got '%s'", o->value);
+            return lr_field_fail(o, LR_EPARSE, "expected true or false, got '%s'", o->value);
         *(bool *)p = b != !!(f->flags & LR_FF_INVERT);
         return LR_OK;
     }
@@ -202,14 +199,14 @@ static int set_field(lr_field_op *o, const lr_field *f, void *rec)
             }
         char list[256];
         lr_field_names_text(f->names, " or ", list, sizeof list);
-        return fail(o, LR_EINVAL, "expected %s, got '%s'", list, o->value);
+        return lr_field_fail(o, LR_EINVAL, "expected %s, got '%s'", list, o->value);
     }
     case LR_FT_PATH:
         if (!o->value[0] || strlen(o->value) >= LR_SCENE_PATH_MAX)
-            return fail(o, LR_EINVAL, "expected a file path");
+            return lr_field_fail(o, LR_EINVAL, "expected a file path");
         snprintf((char *)p, LR_SCENE_PATH_MAX, "%s", o->value);
         return LR_OK;
-    default: return fail(o, LR_EINVAL, "not a parameter");
+    default: return lr_field_fail(o, LR_EINVAL, "not a parameter");
     }
 }
 
@@ -253,5 +250,5 @@ int lr_fields_unknown(lr_field_op *o, const lr_record_desc *d, int kind, const c
     if (group && len < sizeof known)
         snprintf(known + len, sizeof known - len, "}");
     const char *what = d->kind_what ? d->kind_what[kind] : d->what;
-    return fail(o, LR_EINVAL, "%s has no parameter '%s' (known: %s)", what, field, known);
+    return lr_field_fail(o, LR_EINVAL, "%s has no parameter '%s' (known: %s)", what, field, known);
 }

@@ -136,6 +136,11 @@ typedef struct lr_field_op {
     lr_err *e;
 } lr_field_op;
 int lr_field_apply(lr_field_op *o, const lr_field *f, void *rec);
+/* A set's error "KEY: message" (returns code); a get's value into o->buf (an error when it
+ * does not fit). Shared by field_value.c and set.c's non-table fields. */
+int lr_field_fail(lr_field_op *o, int code, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+int lr_field_out(lr_field_op *o, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 /* The "a point light has no parameter 'x' (known: ...)" error, the known list from the table
  * (settable fields of the kind; "flicker.{amplitude, ...}" groups one prefix). */

@@ -14,29 +14,6 @@
 
 typedef lr_field_op op;
 
-static int fail(op *o, int code, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
-static int fail(op *o, int code, const char *fmt, ...)
-{
-    char msg[LR_ERR_MSG_MAX];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    return lr_err_set(o->e, code, "%s: %s", o->key, msg);
-}
-
-static int out(op *o, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static int out(op *o, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(o->buf, o->cap, fmt, ap);
-    va_end(ap);
-    if (n < 0 || (size_t)n >= o->cap)
-        return fail(o, LR_EINVAL, "value does not fit the %zu-byte buffer", o->cap);
-    return LR_OK;
-}
-
 /* Gets or sets the table field `key` of a record (no range check: the caller runs the record
  * check); *dirty gets its lr_dirty bits. */
 static int table_field(op *o, const lr_record_desc *d, void *rec, const char *key,
@@ -53,9 +30,9 @@ static int table_field(op *o, const lr_record_desc *d, void *rec, const char *ke
 static int name_field(op *o, char *p, size_t cap)
 {
     if (o->get)
-        return out(o, "%s", p);
+        return lr_field_out(o, "%s", p);
     if (!lr_material_name_ok(o->value) || strlen(o->value) >= cap)
-        return fail(o, LR_EINVAL, "'%s' is not a name (letters, digits, '_', '-', '.')",
+        return lr_field_fail(o, LR_EINVAL, "'%s' is not a name (letters, digits, '_', '-', '.')",
                     o->value);
     snprintf(p, cap, "%s", o->value);
     return LR_OK;
@@ -76,7 +53,7 @@ static int light_field(op *o, lr_light *l, const char *f, unsigned *d)
 {
     bool dir = l->type == LR_LIGHT_DIRECTIONAL;
     if ((dir && strcmp(f, "intensity") == 0) || (!dir && strcmp(f, "radiance") == 0))
-        return fail(o, LR_EINVAL, "a %s light's strength is its '%s'",
+        return lr_field_fail(o, LR_EINVAL, "a %s light's strength is its '%s'",
                     lr_scene_light_desc.kind_names[l->type], dir ? "radiance" : "intensity");
     return table_field(o, &lr_scene_light_desc, l, f, d);
 }
@@ -111,7 +88,7 @@ static int material_field(op *o, mat_spec *m, const char *f)
 {
     if (f[0] == '\0') { /* the preset itself */
         if (o->get)
-            return out(o, "%s", m->is_preset ? m->preset : m->has_base ? m->base : m->name);
+            return lr_field_out(o, "%s", m->is_preset ? m->preset : m->has_base ? m->base : m->name);
         char name[LR_MATERIAL_NAME_MAX];
         int rc = name_field(o, name, sizeof name);
         if (rc)
@@ -125,18 +102,18 @@ static int material_field(op *o, mat_spec *m, const char *f)
         /* Of a bare preset: its base is itself and its scale 1; coefficients come from the
          * resolved material (handled by the caller). */
         if (strcmp(f, "scale") == 0)
-            return out(o, "1");
+            return lr_field_out(o, "1");
         if (strcmp(f, "base") == 0)
-            return out(o, "%s", m->preset);
+            return lr_field_out(o, "%s", m->preset);
     }
     if (!o->get)
         inline_preset(m);
     if (strcmp(f, "scale") == 0) {
         if (!m->has_base)
-            return fail(o, LR_EINVAL, "the material has no 'base' to scale (scale multiplies "
+            return lr_field_fail(o, LR_EINVAL, "the material has no 'base' to scale (scale multiplies "
                         "a preset's coefficients)");
         if (o->get && !m->has_scale)
-            return out(o, "1");
+            return lr_field_out(o, "1");
         if (!o->get && !m->has_scale)
             m->scale[0] = m->scale[1] = m->scale[2] = 1.0;
         m->has_scale = true;
@@ -149,12 +126,12 @@ static int material_field(op *o, mat_spec *m, const char *f)
         m->scale[2] = v.z;
         for (int b = 0; b < 3; b++)
             if (!(m->scale[b] > 0.0))
-                return fail(o, LR_EINVAL, "must be > 0, got %g", m->scale[b]);
+                return lr_field_fail(o, LR_EINVAL, "must be > 0, got %g", m->scale[b]);
         return LR_OK;
     }
     if (strcmp(f, "base") == 0) {
         if (o->get && !m->has_base)
-            return out(o, "%s", "");
+            return lr_field_out(o, "%s", "");
         m->has_base = true;
         return name_field(o, m->base, sizeof m->base);
     }
@@ -166,7 +143,7 @@ static int material_field(op *o, mat_spec *m, const char *f)
         if (!rc && !o->get)
             for (int b = 0; b < 3; b++)
                 if (!((a ? m->sigma_a : m->sigma_s_prime)[b] >= 0.0))
-                    return fail(o, LR_EINVAL, "must be >= 0 (mm^-1), got %g",
+                    return lr_field_fail(o, LR_EINVAL, "must be >= 0 (mm^-1), got %g",
                                 (a ? m->sigma_a : m->sigma_s_prime)[b]);
         return rc;
     }
@@ -180,7 +157,7 @@ static int material_field(op *o, mat_spec *m, const char *f)
             m->has_g = true;
         return lr_field_apply(o, &mat_g, m);
     }
-    return fail(o, LR_EINVAL, "a material has no parameter '%s' (known: (the preset itself), "
+    return lr_field_fail(o, LR_EINVAL, "a material has no parameter '%s' (known: (the preset itself), "
                 "scale, base, sigma_a, sigma_s_prime, eta, g)", f);
 }
 
@@ -188,8 +165,8 @@ static int mesh_field(op *o, mesh_spec *m, const char *f, unsigned *d)
 {
     if (strcmp(f, "type") == 0) {
         if (o->get)
-            return out(o, "%s", lr_scene_mesh_desc.kind_names[m->kind]);
-        return fail(o, LR_EINVAL, "the mesh type cannot change at run time (edit the scene "
+            return lr_field_out(o, "%s", lr_scene_mesh_desc.kind_names[m->kind]);
+        return lr_field_fail(o, LR_EINVAL, "the mesh type cannot change at run time (edit the scene "
                     "file)");
     }
     if (!o->get)
@@ -265,7 +242,7 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
         if ((rc = lr_fields_check(&lr_scene_object_desc, &next, &bad, &inner)))
             return check_failed(o, f, bad, rc, &inner);
         if (next.pub.sss_model == LR_SSS_MULTIPOLE && !(next.pub.thickness_mm > 0.0))
-            return fail(o, LR_EINVAL, strcmp(f, "model") == 0
+            return lr_field_fail(o, LR_EINVAL, strcmp(f, "model") == 0
                                           ? "multipole needs the object's thickness_mm set first"
                                           : "the multipole needs a thickness > 0 mm");
         *rec = next;
@@ -285,7 +262,7 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
         if ((rc = lr_scene_check_transform(&xf, &bad, &inner)))
             return check_failed(o, f + 10, bad, rc, &inner);
     } else {
-        return fail(o, LR_EINVAL, "an object has no parameter '%s' (%s)", f, OBJECT_KNOWN);
+        return lr_field_fail(o, LR_EINVAL, "an object has no parameter '%s' (%s)", f, OBJECT_KNOWN);
     }
     lr_mesh *world;
     lr_bvh *bvh;
@@ -328,7 +305,7 @@ static int object_get(op *o, const lr_scene *s, int i, const char *f)
         return table_field(o, &lr_scene_transform_desc, &rec.xf, f + 10, &d);
     if (strcmp(f, "model") == 0 || strcmp(f, "normalize") == 0 || strcmp(f, "thickness_mm") == 0)
         return table_field(o, &lr_scene_object_desc, &rec, f, &d);
-    return fail(o, LR_EINVAL, "an object has no parameter '%s' (%s)", f, OBJECT_KNOWN);
+    return lr_field_fail(o, LR_EINVAL, "an object has no parameter '%s' (%s)", f, OBJECT_KNOWN);
 }
 
 /* ---- keys ------------------------------------------------------------------------------------- */
@@ -358,14 +335,14 @@ static int parse_key(const lr_scene *s, op *o, keyref *k)
         const char *p = key + n;
         if (*p == '[') {
             if (!S[i].list)
-                return fail(o, LR_EINVAL, "'%s' takes no index", S[i].name);
+                return lr_field_fail(o, LR_EINVAL, "'%s' takes no index", S[i].name);
             const char *close = strchr(p, ']');
             if (!close || close == p + 1 || close[1] != '.')
-                return fail(o, LR_EINVAL, "expected %s[INDEX or NAME].PARAMETER", S[i].name);
+                return lr_field_fail(o, LR_EINVAL, "expected %s[INDEX or NAME].PARAMETER", S[i].name);
             char idx[LR_SCENE_NAME_MAX];
             size_t len = (size_t)(close - p - 1);
             if (len >= sizeof idx)
-                return fail(o, LR_EINVAL, "index too long");
+                return lr_field_fail(o, LR_EINVAL, "index too long");
             memcpy(idx, p + 1, len);
             idx[len] = '\0';
             bool digits = true;
@@ -377,27 +354,27 @@ static int parse_key(const lr_scene *s, op *o, keyref *k)
             if (digits) {
                 k->index = len > 6 ? count : atoi(idx);
                 if (k->index >= count)
-                    return fail(o, LR_EINVAL, "index %s out of range (the scene has %d %s)", idx,
+                    return lr_field_fail(o, LR_EINVAL, "index %s out of range (the scene has %d %s)", idx,
                                 count, S[i].name);
             } else {
                 k->index = k->section == K_OBJECT ? lr_scene_find_object(s, idx)
                            : k->section == K_LIGHT ? lr_scene_find_light(s, idx)
                                                    : lr_scene_find_receiver(s, idx);
                 if (k->index < 0)
-                    return fail(o, LR_EINVAL, "no %s named '%s'", S[i].name, idx);
+                    return lr_field_fail(o, LR_EINVAL, "no %s named '%s'", S[i].name, idx);
             }
             p = close + 1;
         } else if (S[i].list) {
-            return fail(o, LR_EINVAL, "expected %s[INDEX or NAME].PARAMETER", S[i].name);
+            return lr_field_fail(o, LR_EINVAL, "expected %s[INDEX or NAME].PARAMETER", S[i].name);
         } else if (k->section == K_LIGHT && s->nlight == 0) {
-            return fail(o, LR_EINVAL, "the scene has no light");
+            return lr_field_fail(o, LR_EINVAL, "the scene has no light");
         }
         k->field = p + 1;
         if (!k->field[0])
-            return fail(o, LR_EINVAL, "no parameter after the '.'");
+            return lr_field_fail(o, LR_EINVAL, "no parameter after the '.'");
         return LR_OK;
     }
-    return fail(o, LR_EINVAL, "unknown parameter (expected objects[i].*, lights[i].*, "
+    return lr_field_fail(o, LR_EINVAL, "unknown parameter (expected objects[i].*, lights[i].*, "
                 "light.*, receivers[i].*, camera.*, render.* or quality.*)");
 }
 
