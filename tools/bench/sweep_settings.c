@@ -41,6 +41,8 @@ int lrb_sweep_settings(lrb_setting *out, int cap)
     ADD("gbuf=256", gbuffer_size, 256);
     ADD("vpl=off", vpl, false);
     ADD("standard", model, "standard_dipole");
+    /* Scenes whose objects have a wall thickness (thickness_mm) only. */
+    ADD("multipole", model, "multipole");
 #undef ADD
     return n;
 }
