@@ -22,9 +22,10 @@ static const lr_argspec opts[] = {
              "new as configs/bench/front.csv, else that one)"},
     {.name = "--json", .help = "one JSON object instead of text"},
     {.name = "--models", .type = LR_ARG_STRING,
-     .metavar = "directional_dipole|standard_dipole|all",
-     .help = "models to choose from, comma-separated (default all; the renderer\n"
-             "runs both, per object)"},
+     .metavar = "MODEL,...|all",
+     .help = "models to choose from, comma-separated objects[].model names\n"
+             "(default all; an object that cannot take a model, such as the\n"
+             "multipole without thickness_mm, skips its rows)"},
     {0},
 };
 
@@ -56,15 +57,15 @@ static int models_arg(const lr_cli *c, const char *v, unsigned *out)
     char buf[128];
     snprintf(buf, sizeof buf, "%s", v);
     for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+        enum lr_sss_model m;
         if (!strcmp(tok, "all"))
-            *out |= LR_PLAN_MODEL_DIRECTIONAL | LR_PLAN_MODEL_STANDARD;
-        else if (!strcmp(tok, "directional_dipole"))
-            *out |= LR_PLAN_MODEL_DIRECTIONAL;
-        else if (!strcmp(tok, "standard_dipole"))
-            *out |= LR_PLAN_MODEL_STANDARD;
+            *out |= LR_PLAN_MODEL_ALL;
+        else if (lr_sss_model_parse(tok, &m))
+            *out |= LR_PLAN_MODEL_BIT(m);
         else
-            return lr_cli_usage(c->path, "--models %.100s: expected directional_dipole, "
-                                         "standard_dipole or all", tok);
+            return lr_cli_usage(c->path, "--models %.100s: expected a model name "
+                                         "(`lamprig render --help-scene`, objects[].model) or all",
+                                tok);
     }
     if (!*out)
         return lr_cli_usage(c->path, "--models: empty");

@@ -81,6 +81,7 @@ typedef struct ctx {
     lr_vec3 wl;   /* directional: travel direction */
     lr_vec3 cp;   /* directional reference: object centre projected into x_o's light plane */
     double tmin;
+    int pairs; /* the multipole's pole pairs (lr_sss_pairs), once per estimate, not per sample */
     const lr_scene_object *const *others;
     int n_others;
     lr_vec3 (*snap)(void *, lr_vec3);
@@ -116,8 +117,8 @@ static double lit_point(const ctx *k, lr_vec3 vh, int c)
         return 0.0;
     double sd[3];
     /* w_i = -look points from x_i to the light; n_i . w_i <= 0 contributes 0 (PIPELINE.md). */
-    lr_sss_sd_fresnel(k->obj->sss_model, &k->obj->coeffs, k->obj->thickness_mm, xi, ni,
-                      lr_v3_scale(look, -1.0), k->xo, k->no, sd);
+    lr_sss_sd_fresnel_n(k->obj->sss_model, &k->obj->coeffs, k->obj->thickness_mm, k->pairs, xi,
+                        ni, lr_v3_scale(look, -1.0), k->xo, k->no, sd);
     return M_PI * sd[c] * shape;
 }
 
@@ -133,8 +134,8 @@ static double lit_plane(const ctx *k, lr_vec3 xj, int c)
     if (!gbuffer_texel(k, org, k->wl, 0.0, &xi, &ni))
         return 0.0;
     double sd[3];
-    lr_sss_sd_fresnel(o->sss_model, &o->coeffs, o->thickness_mm, xi, ni, lr_v3_scale(k->wl, -1.0),
-                      k->xo, k->no, sd);
+    lr_sss_sd_fresnel_n(o->sss_model, &o->coeffs, o->thickness_mm, k->pairs, xi, ni,
+                        lr_v3_scale(k->wl, -1.0), k->xo, k->no, sd);
     return M_PI * sd[c];
 }
 
@@ -296,6 +297,7 @@ void lr_cpu_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3
         rmax = LR_CPU_RMAX_RADII * fmax(obj->radius, lr_v3_len(lr_v3_sub(light->position, xo)));
 
     ctx k = {.obj = obj, .light = light, .xo = xo, .no = no, .tmin = LR_CPU_TMIN * obj->radius,
+             .pairs = lr_sss_pairs(obj->sss_model, &obj->coeffs, obj->thickness_mm),
              .others = d ? d->others : NULL, .n_others = d ? d->n_others : 0,
              .snap = d ? d->snap : NULL, .snap_ctx = d ? d->snap_ctx : NULL};
     if (light->type == LR_LIGHT_DIRECTIONAL) {

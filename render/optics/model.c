@@ -28,10 +28,22 @@ bool lr_sss_model_parse(const char *name, enum lr_sss_model *out)
 void lr_sss_sd_fresnel(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm, lr_vec3 xi,
                        lr_vec3 ni, lr_vec3 wi, lr_vec3 xo, lr_vec3 no, double out[3])
 {
+    lr_sss_sd_fresnel_n(m, c, thickness_mm, lr_sss_pairs(m, c, thickness_mm), xi, ni, wi, xo, no,
+                        out);
+}
+
+int lr_sss_pairs(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm)
+{
+    return m == LR_SSS_MULTIPOLE ? lr_multipole_pairs(c, thickness_mm) : 0;
+}
+
+void lr_sss_sd_fresnel_n(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm, int pairs,
+                         lr_vec3 xi, lr_vec3 ni, lr_vec3 wi, lr_vec3 xo, lr_vec3 no, double out[3])
+{
     if (m == LR_SSS_STANDARD_DIPOLE)
         lr_dipole_sd_fresnel(c, xi, ni, wi, xo, out);
     else if (m == LR_SSS_MULTIPOLE)
-        lr_multipole_sd_fresnel(c, thickness_mm, xi, ni, wi, xo, no, out);
+        lr_multipole_sd_fresnel_n(c, thickness_mm, pairs, xi, ni, wi, xo, no, out);
     else
         lr_dirpole_sd_fresnel(c, xi, ni, wi, xo, no, out);
 }

@@ -180,13 +180,18 @@ void lr_multipole_total(const lr_coeffs *c, double d, double R[3], double T[3])
 void lr_multipole_sd(const lr_coeffs *c, double d, lr_vec3 xi, lr_vec3 ni, lr_vec3 xo,
                      lr_vec3 no, double out[3])
 {
+    lr_multipole_sd_n(c, d, lr_multipole_pairs(c, d), xi, ni, xo, no, out);
+}
+
+void lr_multipole_sd_n(const lr_coeffs *c, double d, int n, lr_vec3 xi, lr_vec3 ni, lr_vec3 xo,
+                       lr_vec3 no, double out[3])
+{
     lr_vec3 x = lr_v3_sub(xo, xi);
     /* Opposite faces: light crossed the wall, and the slab's lateral offset is x_o's
      * tangent-plane distance (the plane the estimator samples in). Same face: the distance. */
     bool far = lr_v3_dot(ni, no) < 0.0;
     double h = lr_v3_dot(x, no), x2 = lr_v3_dot(x, x);
     double r = far ? sqrt(fmax(x2 - h * h, 0.0)) : sqrt(x2);
-    int n = lr_multipole_pairs(c, d);
     for (int j = 0; j < 3; j++)
         out[j] = face(c, d, n, r, j, far) / M_PI;
 }
@@ -194,13 +199,19 @@ void lr_multipole_sd(const lr_coeffs *c, double d, lr_vec3 xi, lr_vec3 ni, lr_ve
 void lr_multipole_sd_fresnel(const lr_coeffs *c, double d, lr_vec3 xi, lr_vec3 ni, lr_vec3 wi,
                              lr_vec3 xo, lr_vec3 no, double out[3])
 {
+    lr_multipole_sd_fresnel_n(c, d, lr_multipole_pairs(c, d), xi, ni, wi, xo, no, out);
+}
+
+void lr_multipole_sd_fresnel_n(const lr_coeffs *c, double d, int n, lr_vec3 xi, lr_vec3 ni,
+                               lr_vec3 wi, lr_vec3 xo, lr_vec3 no, double out[3])
+{
     double cos_i = lr_v3_dot(wi, ni);
     double t = cos_i > 0.0 ? lr_fresnel_transmittance(cos_i, c->eta) : 0.0;
     if (!(t > 0.0)) {
         out[0] = out[1] = out[2] = 0.0;
         return;
     }
-    lr_multipole_sd(c, d, xi, ni, xo, no, out);
+    lr_multipole_sd_n(c, d, n, xi, ni, xo, no, out);
     for (int j = 0; j < 3; j++)
         out[j] *= t;
 }

@@ -175,6 +175,13 @@ void lr_multipole_sd(const lr_coeffs *c, double d, lr_vec3 xi, lr_vec3 ni, lr_ve
 /* The same times F_t(w_i); 0 when w_i . n_i <= 0. */
 void lr_multipole_sd_fresnel(const lr_coeffs *c, double d, lr_vec3 xi, lr_vec3 ni, lr_vec3 wi,
                              lr_vec3 xo, lr_vec3 no, double out[3]);
+/* The two above with the pole-pair count n given (n = lr_multipole_pairs(c, d), which costs an
+ * exp, a log and a pow per band): for callers that evaluate one wall many times, as the CPU
+ * twin's estimator does per texel. */
+void lr_multipole_sd_n(const lr_coeffs *c, double d, int n, lr_vec3 xi, lr_vec3 ni, lr_vec3 xo,
+                       lr_vec3 no, double out[3]);
+void lr_multipole_sd_fresnel_n(const lr_coeffs *c, double d, int n, lr_vec3 xi, lr_vec3 ni,
+                               lr_vec3 wi, lr_vec3 xo, lr_vec3 no, double out[3]);
 
 /* ---- Model switch (model.c) ------------------------------------------------------------- */
 
@@ -191,6 +198,14 @@ bool lr_sss_model_parse(const char *name, enum lr_sss_model *out);
  * integrand of seed 003 Eq. 4 with that diffusion term. */
 void lr_sss_sd_fresnel(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm, lr_vec3 xi,
                        lr_vec3 ni, lr_vec3 wi, lr_vec3 xo, lr_vec3 no, double out[3]);
+/* The same with the multipole's pole-pair count given (lr_sss_pairs, once per object and
+ * thickness; ignored by the other models). */
+void lr_sss_sd_fresnel_n(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm, int pairs,
+                         lr_vec3 xi, lr_vec3 ni, lr_vec3 wi, lr_vec3 xo, lr_vec3 no,
+                         double out[3]);
+/* The pole-pair count lr_sss_sd_fresnel_n wants: lr_multipole_pairs for the multipole, 0 for
+ * the other models. */
+int lr_sss_pairs(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm);
 /* Power the model lets out per unit power that entered, per band, when nothing comes back:
  * the multipole's R_total + T_total (lr_multipole_total), the standard dipole's
  * lr_dipole_rd_total for the two dipoles (the normalised directional dipole's half-space

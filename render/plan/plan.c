@@ -170,13 +170,20 @@ static double shortfall(const cand *c, const lr_plan_budget *b)
     return r;
 }
 
-static bool model_ok(const char *model, unsigned models)
+/* Whether row model `model` is allowed and object o can render with it; the first time a
+ * model is left out for the object, says why in the reasons. */
+static bool model_ok(const char *model, unsigned models, const lr_scene_object *o,
+                     lr_plan_choice *c, unsigned *said)
 {
-    if (!strcmp(model, "directional_dipole"))
-        return models & LR_PLAN_MODEL_DIRECTIONAL;
-    if (!strcmp(model, "standard_dipole"))
-        return models & LR_PLAN_MODEL_STANDARD;
-    return false;
+    enum lr_sss_model m;
+    if (!lr_sss_model_parse(model, &m) || !(models & LR_PLAN_MODEL_BIT(m)))
+        return false;
+    const char *why = lr_scene_object_model_unmet(o, m);
+    if (why && !(*said & LR_PLAN_MODEL_BIT(m))) {
+        *said |= LR_PLAN_MODEL_BIT(m);
+        reason(c, "%s rows left out: %s", model, why);
+    }
+    return why == NULL;
 }
 
 static int plan_object(const lr_scene *s, int index, const lr_plan_table *t,
@@ -222,13 +229,14 @@ static int plan_object(const lr_scene *s, int index, const lr_plan_table *t,
     /* Candidates: the measured scene's rows with a model the renderer runs and at least
      * K_cover maps (the bench measures one view; coverage must hold for every view). */
     int n = lr_plan_table_count(t), ncand = 0, nscene = 0, kmax = 0;
+    unsigned said = 0;
     cand *cs = malloc((size_t)n * sizeof *cs);
     if (!cs)
         return lr_err_set(e, LR_ENOMEM, "planner: out of memory");
     for (int pass = 0; pass < 2 && !ncand; pass++) {
         for (int i = 0; i < n; i++) {
             const lr_plan_row *r = lr_plan_table_row(t, i);
-            if (strcmp(r->scene, c->table_scene) || !model_ok(r->model, models))
+            if (strcmp(r->scene, c->table_scene) || !model_ok(r->model, models, o, c, &said))
                 continue;
             if (!pass) {
                 nscene++;
@@ -252,9 +260,9 @@ static int plan_object(const lr_scene *s, int index, const lr_plan_table *t,
     }
     if (!ncand) {
         free(cs);
-        return lr_err_set(e, LR_EINVAL, "planner: %s: no row of scene '%s' in %s with model %s",
-                          o->name, c->table_scene, lr_plan_table_name(t),
-                          models == LR_PLAN_MODEL_DIRECTIONAL ? "directional_dipole" : "allowed");
+        return lr_err_set(e, LR_EINVAL, "planner: %s: no row of scene '%s' in %s with a model "
+                          "allowed (--models) that the object can take",
+                          o->name, c->table_scene, lr_plan_table_name(t));
     }
 
     const cand *best = NULL;

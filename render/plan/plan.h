@@ -33,7 +33,7 @@
 typedef struct lr_plan_row {
     int line; /* in the CSV file, for messages */
     char scene[LR_PLAN_TEXT_MAX]; /* scene file base name ("candle") */
-    char model[LR_PLAN_TEXT_MAX]; /* "directional_dipole" | "standard_dipole" */
+    char model[LR_PLAN_TEXT_MAX]; /* an lr_sss_model name (lr_sss_model_name) */
     char params[LR_PLAN_TEXT_MAX];
     double frame_ms;            /* median ms of one accumulation frame */
     double rel_rmse;            /* whole image */
@@ -153,13 +153,14 @@ typedef struct lr_plan {
     bool feasible; /* every object's choice meets the budget */
 } lr_plan;
 
-/* Models the planner may choose; the renderer runs both (objects[i].model), so the default
- * is both. `lamprig plan --models directional_dipole` restricts the choice. */
-enum lr_plan_models {
-    LR_PLAN_MODEL_DIRECTIONAL = 1u << 0, /* "directional_dipole" */
-    LR_PLAN_MODEL_STANDARD = 1u << 1,    /* "standard_dipole" */
-    LR_PLAN_MODEL_ALL = LR_PLAN_MODEL_DIRECTIONAL | LR_PLAN_MODEL_STANDARD,
-};
+/* Models the planner may choose: bit LR_PLAN_MODEL_BIT(m) for each enum lr_sss_model m
+ * (objects[i].model). The default is every model the renderer runs; an object that cannot
+ * take a model (lr_scene_object_model_unmet: the multipole without thickness_mm) skips its
+ * rows. `lamprig plan --models directional_dipole,multipole` restricts the choice. */
+#define LR_PLAN_MODEL_BIT(m) (1u << (unsigned)(m))
+#define LR_PLAN_MODEL_DIRECTIONAL LR_PLAN_MODEL_BIT(LR_SSS_DIRECTIONAL_DIPOLE)
+#define LR_PLAN_MODEL_STANDARD LR_PLAN_MODEL_BIT(LR_SSS_STANDARD_DIPOLE)
+#define LR_PLAN_MODEL_ALL (LR_PLAN_MODEL_BIT(LR_SSS_MODEL_COUNT) - 1u)
 
 typedef struct lr_plan_options {
     /* Where the scenes the table names are found, to match a scene the table lacks by

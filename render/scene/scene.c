@@ -32,6 +32,15 @@ const lr_camera *lr_scene_camera(const lr_scene *s) { return &s->camera; }
 const lr_render_settings *lr_scene_render(const lr_scene *s) { return &s->render; }
 const lr_quality *lr_scene_quality(const lr_scene *s) { return &s->quality; }
 
+const char *lr_scene_object_model_unmet(const lr_scene_object *o, enum lr_sss_model m)
+{
+    if ((unsigned)m >= LR_SSS_MODEL_COUNT)
+        return "unknown model";
+    if (m == LR_SSS_MULTIPOLE && !(o->thickness_mm > 0.0))
+        return "needs thickness_mm (the wall the multipole models)";
+    return NULL;
+}
+
 const lr_scene_object *lr_scene_object_at(const lr_scene *s, int i)
 {
     return i >= 0 && i < s->nobj ? &s->obj[i].pub : NULL;

@@ -78,6 +78,11 @@ typedef struct lr_scene_object {
  * dipole, 1 for the raw model (sd_raw) and for the standard dipole (sd_norm scales the
  * directional dipole's half-space total to the standard dipole's R_d total, so the standard
  * dipole is its own reference: factor 1). The GLSL pass and the CPU twin both use it. */
+/* Why object o cannot render with model m as it stands ("needs thickness_mm": the multipole
+ * models a wall of the object's thickness_mm), or NULL when it can. The planner and the
+ * bench use it to leave such a model out for that object. */
+const char *lr_scene_object_model_unmet(const lr_scene_object *o, enum lr_sss_model m);
+
 static inline double lr_scene_object_sd_norm(const lr_scene_object *o, int c)
 {
     return o->sd_raw || o->sss_model != LR_SSS_DIRECTIONAL_DIPOLE ? 1.0 : o->coeffs.sd_norm[c];

@@ -194,7 +194,7 @@ static void test_table_errors(void **state)
     expect_table_error(HDR "candle,directional_dipole,10,0.1,4,4,16,64,64,8,maybe\n",
                        "bad.csv:2: column 'vpl': expected on or off, got 'maybe'");
     expect_table_error(HDR "candle,photon_beams,10,0.1,4,4,16,64,64,8,on\n",
-                       "bad.csv:2: column 'model': expected directional_dipole or standard_dipole");
+                       "bad.csv:2: column 'model': expected a diffusion model name");
     expect_table_error(HDR "candle,directional_dipole,10,0.1,4,4,16,64,64,8\n",
                        "bad.csv:2: 10 cells, the header has 11");
     expect_table_error(HDR "candle,directional_dipole,0,0.1,4,4,16,64,64,8,on\n",
@@ -391,6 +391,43 @@ static void test_models_and_coverage_filter(void **state)
     assert_string_equal(p->objects[0].row.model, "standard_dipole");
     assert_near(p->objects[0].predicted_converge_ms, 8990, 1e-9);
     free(p);
+}
+
+/* Every model the renderer runs is a candidate, but only for an object that can take it:
+ * the multipole needs the object's thickness_mm, which the shade has (1.5 mm) and the candle
+ * lacks. Both scenes get a multipole row that would win on cost. */
+static void test_multipole_where_the_object_takes_it(void **state)
+{
+    (void)state;
+    const char *csv =
+        HDR "candle,directional_dipole,100,0.08,8,8,32,128,128,16,on\n"
+            "candle,multipole,50,0.06,8,8,32,128,128,16,on\n"
+            "lampshade,directional_dipole,300,0.08,16,8,96,128,128,32,on\n"
+            "lampshade,multipole,150,0.06,16,8,96,128,128,32,on\n";
+    lr_plan_table *t = NULL;
+    lr_err e = {0};
+    assert_int_equal(lr_plan_table_parse(csv, strlen(csv), "mp.csv", &t, &e), LR_OK);
+    lr_plan_budget b = {.max_error = 0.1};
+    lr_plan *p = malloc(sizeof *p);
+    assert_non_null(p);
+    assert_int_equal(lr_plan_create(shade, t, &b, NULL, p, &e), LR_OK);
+    assert_string_equal(p->objects[0].row.model, "multipole");
+    assert_near(p->objects[0].predicted_frame_ms, 150, 1e-9);
+    assert_int_equal(lr_plan_create(candle, t, &b, NULL, p, &e), LR_OK);
+    assert_string_equal(p->objects[0].row.model, "directional_dipole");
+    char text[4096];
+    lr_plan_format(p, text, sizeof text);
+    if (!strstr(text, "multipole rows left out: needs thickness_mm"))
+        fail_msg("no reason for leaving the multipole out:\n%s", text);
+    /* --models restricts it on the shade too; a model no object can take leaves none. */
+    lr_plan_options o = {.models = LR_PLAN_MODEL_DIRECTIONAL};
+    assert_int_equal(lr_plan_create(shade, t, &b, &o, p, &e), LR_OK);
+    assert_string_equal(p->objects[0].row.model, "directional_dipole");
+    o.models = LR_PLAN_MODEL_BIT(LR_SSS_MULTIPOLE);
+    assert_int_equal(lr_plan_create(candle, t, &b, &o, p, &e), LR_EINVAL);
+    assert_non_null(strstr(e.msg, "that the object can take"));
+    free(p);
+    lr_plan_table_destroy(t);
 }
 
 /* ---- scene analysis ---- */
@@ -754,6 +791,7 @@ int main(void)
         cmocka_unit_test(test_frame_ms_budget),
         cmocka_unit_test(test_both_budgets_and_infeasible),
         cmocka_unit_test(test_models_and_coverage_filter),
+        cmocka_unit_test(test_multipole_where_the_object_takes_it),
         cmocka_unit_test(test_convexity),
         cmocka_unit_test(test_coverage),
         cmocka_unit_test(test_receivers_in_sight),

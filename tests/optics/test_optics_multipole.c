@@ -278,6 +278,38 @@ static void test_sd_faces(void **state)
         assert_true(tot[j] == Rt[j]);
 }
 
+/* The pair count given once (the CPU twin's fast path) is the same function: bit-identical
+ * with lr_multipole_pairs' count, and with another count it sums those poles
+ * (lr_multipole_profile_n). */
+static void test_sd_pairs_given(void **state)
+{
+    (void)state;
+    lr_coeffs c = coeffs_of("porcelain");
+    double d = 1.5, a[3], b[3], R[3], T[3];
+    lr_vec3 up = lr_v3(0, 0, 1), down = lr_v3(0, 0, -1);
+    lr_vec3 wi = lr_v3_normalize(lr_v3(0.3, 0, 1));
+    int n = lr_sss_pairs(LR_SSS_MULTIPOLE, &c, d);
+    assert_int_equal(n, lr_multipole_pairs(&c, d));
+    assert_int_equal(lr_sss_pairs(LR_SSS_DIRECTIONAL_DIPOLE, &c, d), 0);
+    lr_sss_sd_fresnel(LR_SSS_MULTIPOLE, &c, d, lr_v3(0, 0, 0), up, wi, lr_v3(0.7, 0, -d), down, a);
+    lr_sss_sd_fresnel_n(LR_SSS_MULTIPOLE, &c, d, n, lr_v3(0, 0, 0), up, wi, lr_v3(0.7, 0, -d), down,
+                        b);
+    for (int j = 0; j < 3; j++)
+        assert_true(a[j] == b[j]);
+    double ft = lr_fresnel_transmittance(lr_v3_dot(wi, up), c.eta);
+    lr_multipole_sd_fresnel_n(&c, d, 1, lr_v3(0, 0, 0), up, wi, lr_v3(0.7, 0, -d), down, b);
+    lr_multipole_profile_n(&c, d, 1, 0.7, R, T);
+    for (int j = 0; j < 3; j++)
+        assert_near_rel(b[j], ft * T[j] / M_PI, 1e-12);
+    /* The other models ignore the count. */
+    lr_sss_sd_fresnel(LR_SSS_DIRECTIONAL_DIPOLE, &c, d, lr_v3(0, 0, 0), up, wi, lr_v3(0.7, 0, -d),
+                      down, a);
+    lr_sss_sd_fresnel_n(LR_SSS_DIRECTIONAL_DIPOLE, &c, d, 7, lr_v3(0, 0, 0), up, wi,
+                        lr_v3(0.7, 0, -d), down, b);
+    for (int j = 0; j < 3; j++)
+        assert_true(a[j] == b[j]);
+}
+
 /* The directional dipole's transmittance through the slab as the renderer uses it: entry at
  * the origin on the top face (normal incidence), exit on the bottom face, sd_norm applied,
  * pi int S_d dA by quadrature in log r. */
@@ -362,6 +394,7 @@ int main(void)
         cmocka_unit_test(test_energy_bound),
         cmocka_unit_test(test_checked),
         cmocka_unit_test(test_sd_faces),
+        cmocka_unit_test(test_sd_pairs_given),
         cmocka_unit_test(test_porcelain_1p5mm_photons),
         cmocka_unit_test(test_wax_7mm_photons),
         cmocka_unit_test(test_wax_14mm_photons),

@@ -30,7 +30,7 @@ typedef struct lrb_setting {
     const char *label; /* "base", "K=4", ... */
     int K, N, N_vpl, map_size, gbuffer_size;
     bool vpl;
-    const char *model; /* "directional_dipole" or "standard_dipole" */
+    const char *model; /* an objects[].model name (lr_sss_model_name) */
     int checkpoints[4], ncheck;
     int converge_frames;
 } lrb_setting;
@@ -88,6 +88,9 @@ void lrb_sweep_fair_md(FILE *f, const lrb_scene_result *scenes, int nscenes);
 
 /* Applies a setting to a scene (render.* and every object's model). */
 int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e);
+/* Whether any object of s can take the setting's model (lr_scene_object_model_unmet); when
+ * none can, *why says why and the sweep skips the setting for that scene. */
+bool lrb_sweep_takes(const lr_scene *s, const lrb_setting *st, const char **why);
 
 /* Frame times of the base setting at 640x480 (sweep_table.c). */
 typedef struct lrb_timing_640 {

@@ -25,14 +25,33 @@ int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e)
         (rc = set_int(s, "render.map_size", st->map_size, e)) ||
         (rc = set_int(s, "render.gbuffer_size", st->gbuffer_size, e)))
         return rc;
-    /* The model is per object; the sweep switches every object at once. */
+    /* The model is per object; the sweep switches every object that can take it (the
+     * multipole needs thickness_mm); lrb_sweep_takes says whether any can. */
+    enum lr_sss_model m;
+    if (!lr_sss_model_parse(st->model, &m))
+        return lr_err_set(e, LR_EINVAL, "sweep setting %s: unknown model '%s'", st->label,
+                          st->model);
     for (int k = 0; k < lr_scene_object_count(s); k++) {
+        if (lr_scene_object_model_unmet(lr_scene_object_at(s, k), m))
+            continue;
         char key[64];
         snprintf(key, sizeof key, "objects[%d].model", k);
         if ((rc = lr_scene_set(s, key, st->model, NULL, e)))
             return rc;
     }
     return LR_OK;
+}
+
+bool lrb_sweep_takes(const lr_scene *s, const lrb_setting *st, const char **why)
+{
+    enum lr_sss_model m;
+    *why = "unknown model";
+    if (!lr_sss_model_parse(st->model, &m))
+        return false;
+    for (int k = 0; k < lr_scene_object_count(s); k++)
+        if (!(*why = lr_scene_object_model_unmet(lr_scene_object_at(s, k), m)))
+            return true;
+    return false;
 }
 
 /* The error against an unbiased Monte Carlo reference, with the reference's own noise taken
@@ -214,6 +233,12 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
         if (k && getenv("LRB_SWEEP_SETTINGS") && !lrb_listed(getenv("LRB_SWEEP_SETTINGS"),
                                                             st->label))
             continue;
+        const char *why;
+        if (!lrb_sweep_takes(s, st, &why)) {
+            fprintf(stderr, "lamprig-bench: sweep: %s: setting %s skipped: no object %s\n",
+                    lr_scene_name(s), st->label, why);
+            continue;
+        }
         lr_eval_series ser = {0};
         if ((rc = run_series(gl, s, st, ss, &ser, &e)))
             goto done;

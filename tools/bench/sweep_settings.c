@@ -2,6 +2,8 @@
  * changes around it (issue 6: K, N, N_vpl, map sizes, frames, VPLs on/off, model). */
 #include "tools/bench/sweep.h"
 
+#include <string.h>
+
 /* Base: K 8 maps of 64^2, N 4, 64 VPLs, G-buffer 128. Its radiosity is 1/128 of the scenes'
  * own (K 16, 256^2, N 16), so a frame is tens of ms on llvmpipe. */
 static const lrb_setting base = {
@@ -41,6 +43,12 @@ int lrb_sweep_settings(lrb_setting *out, int cap)
     ADD("gbuf=256", gbuffer_size, 256);
     ADD("vpl=off", vpl, false);
     ADD("standard", model, "standard_dipole");
+    /* Scenes whose objects have a wall thickness (thickness_mm) only; with K 16 as well, since
+     * the lamp shade needs 15 maps to cover its inside (the planner's K_cover). */
+    ADD("multipole", model, "multipole");
+    ADD("multipole+K=16", model, "multipole");
+    if (n > 0 && !strcmp(out[n - 1].label, "multipole+K=16"))
+        out[n - 1].K = 16;
 #undef ADD
     return n;
 }
