@@ -114,6 +114,10 @@ int lr_ar_present_draw(lr_ar_present *p, int width, int height, lr_err *e)
     GLint loc = lr_program_uniform(p->blit, "u_src");
     if (loc >= 0)
         glUniform1i(loc, 0);
+    /* As every render pass does: a uniform blit.frag does not declare is an error. */
+    int rc = lr_program_check(p->blit, e);
+    if (rc)
+        return lr_err_prefix(e, "spatial AR output");
     lr_gl_draw_fullscreen(p->gl);
     return lr_gl_check("spatial AR output: draw", e);
 }

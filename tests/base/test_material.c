@@ -6,6 +6,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "tests/support/fs.h"
+
 #include <dirent.h>
 #include <limits.h>
 #include <math.h>
@@ -25,12 +27,7 @@ static char tmpdir[64];
 
 static void write_file(const char *dir, const char *name, const char *text)
 {
-    char path[PATH_MAX];
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
+    free(lr_test_write(dir, name, text, (size_t)-1));
 }
 
 static void remove_tree(const char *dir)

@@ -7,6 +7,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "tests/support/fs.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -71,14 +73,6 @@ static const char *tmp_path(const char *leaf, char *buf, size_t cap)
     return buf;
 }
 
-static void write_file(const char *path, const void *data, size_t len)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    assert_int_equal(fwrite(data, 1, len, f), len);
-    fclose(f);
-}
-
 /* dst = src with the first `from` replaced by `to`. */
 static void replace_once(char *dst, size_t cap, const char *src, const char *from, const char *to)
 {
@@ -87,7 +81,6 @@ static void replace_once(char *dst, size_t cap, const char *src, const char *fro
     snprintf(dst, cap, "%.*s%s%s", (int)(p - src), src, to, p + strlen(from));
 }
 
-static void write_text(const char *path, const char *text) { write_file(path, text, strlen(text)); }
 
 /* Deterministic random numbers for the ray tests (a local 64-bit LCG, Knuth's MMIX constants). */
 typedef struct rng {
@@ -663,7 +656,7 @@ static void test_ply_ascii(void **state)
     (void)state;
     char path[128];
     tmp_path("cube.ply", path, sizeof path);
-    write_text(path, cube_ply_ascii);
+    lr_test_put(path, cube_ply_ascii, (size_t)-1);
     lr_mesh_report rep;
     lr_mesh_checks ck = {.report = &rep};
     lr_mesh *m;
@@ -679,31 +672,31 @@ static void test_ply_ascii(void **state)
     char bad[sizeof cube_ply_ascii + 16];
     snprintf(bad, sizeof bad, "%s", cube_ply_ascii);
     replace_once(bad, sizeof bad, cube_ply_ascii, "10 10 0 255", "nan 10 0 255");
-    write_text(path, bad);
+    lr_test_put(path, bad, (size_t)-1);
     assert_int_equal(lr_mesh_load(path, &ck, &m, &e), LR_EINVAL);
     assert_null(m);
     expect_msg(&e, "cube.ply:14: vertex 2: coordinate x is nan");
 
     /* Index 8 of 8 vertices on line 23 (face 3). */
     replace_once(bad, sizeof bad, cube_ply_ascii, "4 1 2 6 5", "4 1 2 8 5");
-    write_text(path, bad);
+    lr_test_put(path, bad, (size_t)-1);
     assert_int_equal(lr_mesh_load(path, &ck, &m, &e), LR_EINVAL);
     expect_msg(&e, "cube.ply:23: vertex index 8 out of range (8 vertices)");
 
     /* Not a number. */
     replace_once(bad, sizeof bad, cube_ply_ascii, "4 2 3 7 6", "4 x 3 7 6");
-    write_text(path, bad);
+    lr_test_put(path, bad, (size_t)-1);
     assert_int_equal(lr_mesh_load(path, &ck, &m, &e), LR_EPARSE);
     expect_msg(&e, "cube.ply:24: face 4: 'x' is not a valid integer");
 
     /* Header errors name their line. */
-    write_text(path, "ply\nformat ascii 1.0\nelement vertex 8\nproperty flot x\n");
+    lr_test_put(path, "ply\nformat ascii 1.0\nelement vertex 8\nproperty flot x\n", (size_t)-1);
     assert_int_equal(lr_mesh_load(path, &ck, &m, &e), LR_EPARSE);
     expect_msg(&e, "cube.ply:4: malformed property (type 'flot')");
-    write_text(path, "ply\nformat binary_big_endian 1.0\n");
+    lr_test_put(path, "ply\nformat binary_big_endian 1.0\n", (size_t)-1);
     assert_int_equal(lr_mesh_load(path, &ck, &m, &e), LR_EUNSUPPORTED);
     expect_msg(&e, "cube.ply:2: binary_big_endian");
-    write_text(path, "ply\nformat ascii 1.0\nelement vertex 99999999\nend_header\n");
+    lr_test_put(path, "ply\nformat ascii 1.0\nelement vertex 99999999\nend_header\n", (size_t)-1);
     assert_int_equal(lr_mesh_load(path, &ck, &m, &e), LR_EPARSE);
     expect_msg(&e, "cube.ply:3: element 'vertex' claims 99999999 items");
 }
@@ -799,7 +792,7 @@ static void test_ply_binary_skips_and_bad_values(void **state)
     put32(&p, 1);
     char path[128];
     tmp_path("tet.ply", path, sizeof path);
-    write_file(path, buf, (size_t)(p - buf));
+    lr_test_put(path, buf, (size_t)(p - buf));
     lr_mesh_report rep;
     lr_mesh_checks ck = {.report = &rep};
     lr_mesh *m;
@@ -812,7 +805,7 @@ static void test_ply_binary_skips_and_bad_values(void **state)
     /* Vertex 2's y made NaN: named by element index (a binary file has no lines). */
     unsigned char *y2 = buf + strlen(hdr) + 2 * 20 + 12;
     putf(&y2, NAN);
-    write_file(path, buf, (size_t)(p - buf));
+    lr_test_put(path, buf, (size_t)(p - buf));
     assert_int_equal(lr_mesh_load(path, &ck, &m, &e), LR_EINVAL);
     expect_msg(&e, "tet.ply: vertex 2: coordinate y is nan");
     y2 = buf + strlen(hdr) + 2 * 20 + 12;
@@ -820,7 +813,7 @@ static void test_ply_binary_skips_and_bad_values(void **state)
     /* Face 3's last index made 7. */
     unsigned char *f3 = buf + strlen(hdr) + 4 * 20 + 3 * 22 + 10 + 8;
     put32(&f3, 7);
-    write_file(path, buf, (size_t)(p - buf));
+    lr_test_put(path, buf, (size_t)(p - buf));
     assert_int_equal(lr_mesh_load(path, &ck, &m, &e), LR_EINVAL);
     expect_msg(&e, "tet.ply: face 3: vertex index 7 out of range (4 vertices)");
 }
@@ -830,10 +823,10 @@ static void test_ply_nonmanifold_warns(void **state)
     (void)state;
     char path[128];
     tmp_path("fins.ply", path, sizeof path);
-    write_text(path, "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\n"
+    lr_test_put(path, "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\n"
                      "property float y\nproperty float z\nelement face 3\n"
                      "property list uchar int vertex_indices\nend_header\n"
-                     "0 0 0\n1 0 0\n0 1 0\n0 0 1\n0 -1 0\n3 0 1 2\n3 1 0 3\n3 0 1 4\n");
+                     "0 0 0\n1 0 0\n0 1 0\n0 0 1\n0 -1 0\n3 0 1 2\n3 1 0 3\n3 0 1 4\n", (size_t)-1);
     warnings w = {0};
     lr_mesh_report rep;
     lr_mesh_checks ck = {.warn = {collect, &w}, .report = &rep};
@@ -866,7 +859,7 @@ static void test_obj_negative_indices_quads_normals(void **state)
         "vn -1 0 0\ns off\nusemtl wax\nf 4//6 1//6 5//6 8//6\n"; /* 23-26 */
     char path[128];
     tmp_path("cube.obj", path, sizeof path);
-    write_text(path, obj);
+    lr_test_put(path, obj, (size_t)-1);
     lr_mesh_report rep;
     warnings w = {0};
     lr_mesh_checks ck = {.report = &rep, .warn = {collect, &w}};
@@ -900,30 +893,30 @@ static void test_obj_errors(void **state)
     tmp_path("bad.obj", path, sizeof path);
     lr_mesh *m;
     lr_err e = {0};
-    write_text(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n");
+    lr_test_put(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n", (size_t)-1);
     assert_int_equal(lr_mesh_load(path, NULL, &m, &e), LR_EINVAL);
     expect_msg(&e, "bad.obj:5: vertex index 9 out of range (3 vertices)");
-    write_text(path, "v 0 0 0\nv 1 0 0\nf 1 2 -3\nv 0 1 0\n");
+    lr_test_put(path, "v 0 0 0\nv 1 0 0\nf 1 2 -3\nv 0 1 0\n", (size_t)-1);
     assert_int_equal(lr_mesh_load(path, NULL, &m, &e), LR_EINVAL);
     expect_msg(&e, "bad.obj:3: vertex index -3 out of range (2 vertices so far)");
-    write_text(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
+    lr_test_put(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", (size_t)-1);
     assert_int_equal(lr_mesh_load(path, NULL, &m, &e), LR_EINVAL);
     expect_msg(&e, "bad.obj:4: vertex index 0");
-    write_text(path, "v 0 0 0\nv 1 inf 0\n");
+    lr_test_put(path, "v 0 0 0\nv 1 inf 0\n", (size_t)-1);
     assert_int_equal(lr_mesh_load(path, NULL, &m, &e), LR_EINVAL);
     expect_msg(&e, "bad.obj:2: vertex: coordinate y is inf");
-    write_text(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n");
+    lr_test_put(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", (size_t)-1);
     assert_int_equal(lr_mesh_load(path, NULL, &m, &e), LR_EPARSE);
     expect_msg(&e, "bad.obj:4: face with 2 corners");
-    write_text(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//0\n");
+    lr_test_put(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//0\n", (size_t)-1);
     assert_int_equal(lr_mesh_load(path, NULL, &m, &e), LR_EPARSE);
     expect_msg(&e, "bad.obj:5: malformed face corner '3//0'");
-    write_text(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/ 2 3\n");
+    lr_test_put(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/ 2 3\n", (size_t)-1);
     assert_int_equal(lr_mesh_load(path, NULL, &m, &e), LR_EPARSE);
     expect_msg(&e, "bad.obj:4: malformed face corner '1/'");
     /* Unsupported statements: one warning each, the mesh still loads; a forward reference
      * (face before its last vertex) is legal. */
-    write_text(path, "v 0 0 0\nv 1 0 0\nl 1 2\nf 1 2 3\ncurv 0 1 1 2\nl 2 1\nv 0 1 0\n");
+    lr_test_put(path, "v 0 0 0\nv 1 0 0\nl 1 2\nf 1 2 3\ncurv 0 1 1 2\nl 2 1\nv 0 1 0\n", (size_t)-1);
     warnings w = {0};
     lr_mesh_checks ck = {.warn = {collect, &w}, .flags = LR_MESH_OPEN_OK};
     assert_int_equal(lr_mesh_load(path, &ck, &m, &e), LR_OK);

@@ -7,6 +7,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "tests/support/fs.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -278,14 +280,6 @@ static void test_cache_reuse(void **state)
     assert_int_equal(system(cmd), 0);
 }
 
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-}
-
 /* Scene files: a full file loads into the same scene (same hash) as the equivalent calls, and
  * mistakes are reported with file:line and the field. */
 static void test_scene_file(void **state)
@@ -294,7 +288,7 @@ static void test_scene_file(void **state)
     char dir[64], path[128];
     tmpdir(dir, sizeof dir);
     snprintf(path, sizeof path, "%s/s.json", dir);
-    write_file(path,
+    lr_test_put(path,
                "{\n"
                "  \"media\": [{\"name\": \"wax\", \"sigma_a\": [0.3, 0.1, 0.1],\n"
                "              \"sigma_s\": [3, 3, 3], \"g\": 0.4, \"eta\": 1.4}],\n"
@@ -311,7 +305,7 @@ static void test_scene_file(void **state)
                "     \"radius\": 0.3, \"radiance\": [0.5, 0.5, 0.5]}],\n"
                "  \"camera\": {\"position\": [0, -5, 2], \"look_at\": [0, 0, 1], \"fov_deg\": 40},\n"
                "  \"render\": {\"width\": 20, \"height\": 14, \"spp\": 8, \"seed\": 1}\n"
-               "}\n");
+               "}\n", (size_t)-1);
     lr_ref_scene *s, *ref = lamp_scene(0.3);
     lr_ref_camera cam = {0};
     lr_ref_render_desc d = {0};
@@ -341,7 +335,7 @@ static void test_scene_file(void **state)
         {"{\n \"lights\": [{\"type\": \"laser\"}]\n}\n", "laser"},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-        write_file(path, bad[i].text);
+        lr_test_put(path, bad[i].text, (size_t)-1);
         e = (lr_err){0};
         assert_int_not_equal(lr_ref_scene_load(path, &s, &cam, &d, &e), LR_OK);
         assert_null(s);

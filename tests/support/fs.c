@@ -54,12 +54,17 @@ char *lr_test_write(const char *dir, const char *name, const void *data, size_t 
         mkdir(path, 0755);
         *s = '/';
     }
+    lr_test_put(path, data, len);
+    return path;
+}
+
+void lr_test_put(const char *path, const void *data, size_t len)
+{
     if (len == (size_t)-1)
         len = strlen(data);
     FILE *f = fopen(path, "wb");
     if (!f || fwrite(data, 1, len, f) != len || fclose(f) != 0)
         die("write", path);
-    return path;
 }
 
 unsigned char *lr_test_read(const char *path, size_t *len)

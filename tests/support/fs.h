@@ -14,6 +14,8 @@ char *lr_test_path(const char *dir, const char *name);
 /* Writes len bytes (len (size_t)-1: strlen(data)) to dir/name, creating subdirectories of name
  * as needed; returns the malloc'd full path. Aborts on failure. */
 char *lr_test_write(const char *dir, const char *name, const void *data, size_t len);
+/* Writes len bytes (len (size_t)-1: strlen(data)) to path. Aborts on failure. */
+void lr_test_put(const char *path, const void *data, size_t len);
 /* Reads a whole file; returns malloc'd bytes (NUL-terminated) and sets *len. Aborts on failure. */
 unsigned char *lr_test_read(const char *path, size_t *len);
 
