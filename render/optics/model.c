@@ -8,7 +8,16 @@
 #include <string.h>
 
 static const char *const names[LR_SSS_MODEL_COUNT] = {"directional_dipole", "standard_dipole",
-                                                       "multipole"};
+                                                       "multipole", "translucent_radiosity"};
+
+/* Translucent radiosity (seed 000) evaluates a profile of its own choosing: the slab multipole
+ * where the object gives a wall thickness, the standard dipole otherwise. */
+static enum lr_sss_model profile_of(enum lr_sss_model m, double thickness_mm)
+{
+    if (m != LR_SSS_TRANSLUCENT_RADIOSITY)
+        return m;
+    return thickness_mm > 0 ? LR_SSS_MULTIPOLE : LR_SSS_STANDARD_DIPOLE;
+}
 
 const char *lr_sss_model_name(enum lr_sss_model m)
 {
@@ -28,6 +37,7 @@ bool lr_sss_model_parse(const char *name, enum lr_sss_model *out)
 void lr_sss_sd_fresnel(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm, lr_vec3 xi,
                        lr_vec3 ni, lr_vec3 wi, lr_vec3 xo, lr_vec3 no, double out[3])
 {
+    m = profile_of(m, thickness_mm);
     if (m == LR_SSS_STANDARD_DIPOLE)
         lr_dipole_sd_fresnel(c, xi, ni, wi, xo, out);
     else if (m == LR_SSS_MULTIPOLE)
@@ -38,6 +48,7 @@ void lr_sss_sd_fresnel(enum lr_sss_model m, const lr_coeffs *c, double thickness
 
 void lr_sss_total(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm, double out[3])
 {
+    m = profile_of(m, thickness_mm);
     if (m != LR_SSS_MULTIPOLE) {
         lr_dipole_rd_total(c, out);
         return;

@@ -48,7 +48,8 @@ static void kernel(const lr_tr_surf *sf, lr_vec3 x, lr_vec3 ni, const lr_tr_patc
                    double excess, double out[3])
 {
     lr_vec3 r = lr_v3_sub(pj->c, x);
-    if (sf->d.model == LR_SSS_MULTIPOLE && sf->d.thickness_mm > 0) {
+    if ((sf->d.model == LR_SSS_MULTIPOLE || sf->d.model == LR_SSS_TRANSLUCENT_RADIOSITY) &&
+        sf->d.thickness_mm > 0) {
         double R[3], T[3];
         if (lr_v3_dot(ni, pj->n) < 0) {
             double along = lr_v3_dot(r, pj->n);

@@ -149,3 +149,11 @@ void lr_tr_patch_geometry(const lr_tr *t, size_t p, lr_vec3 *centroid, lr_vec3 *
 }
 
 int lr_tr_patch_surface(const lr_tr *t, size_t p) { return p < t->n ? t->p[p].surface : -1; }
+
+bool lr_tr_plane_grid(const lr_tr *t, int s, int *nu, int *nv)
+{
+    bool ok = t && s >= 0 && s < t->nsurf && t->surf[s].d.kind == LR_TR_PLANE;
+    *nu = ok ? t->surf[s].nu : 0;
+    *nv = ok ? t->surf[s].nv : 0;
+    return ok;
+}

@@ -122,6 +122,9 @@ void lr_tr_surface_patches(const lr_tr *t, int s, size_t *first, size_t *count);
 void lr_tr_patch_geometry(const lr_tr *t, size_t p, lr_vec3 *centroid, lr_vec3 *normal,
                           double *area);
 int lr_tr_patch_surface(const lr_tr *t, size_t p);
+/* A plane surface's grid: patch first + u + nu v is the cell (u, v), u along its size_u.
+ * False (and 0 x 0) for other kinds. */
+bool lr_tr_plane_grid(const lr_tr *t, int s, int *nu, int *nv);
 /* The patch a surface's triangle belongs to (plane: the cell of the point x on it). */
 size_t lr_tr_patch_of(const lr_tr *t, int surface, size_t triangle, lr_vec3 x);
 /* F_pq: fraction of the light leaving p diffusely that reaches q (first hit). */
