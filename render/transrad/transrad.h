@@ -16,8 +16,9 @@
  *   F         by cosine-distributed ray casts from points spread over each patch against every
  *             surface's BVH (visibility included; a ray that leaves the scene is the patch's
  *             escape), stored sparse per row (formfactor.c);
- *   S         per object, from the object's diffusion profile (standard dipole R_d, or the
- *             slab multipole's R and T for "multipole") indexed by the in-object distance:
+ *   S         per object, from a diffusion profile (the slab multipole's R and T where a wall
+ *             thickness is given or, for translucent_radiosity, measured under each patch;
+ *             the standard dipole R_d for a half-space) indexed by the in-object distance:
  *             straight where the segment between the two patches' inner points stays inside
  *             the material, otherwise a Dijkstra shortest path over the inner points of the
  *             object's patches (optdist.c), so the profile leaks neither across a concave gap
