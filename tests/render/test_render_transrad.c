@@ -27,9 +27,12 @@ LR_TEST_GL_FIXTURE(gl)
 static const char *const small[] = {"render.K=4", "render.map_size=48", "render.frames=2",
                                     "render.gbuffer_size=64", "render.N_vpl=16", NULL};
 
+/* The twin's solver, kept across the tests like the renderer keeps its own: a light move
+ * re-solves it without rebuilding F and S (the precomputation is most of the time). */
+static lr_tr_scene *ts;
+
 static void compare(lr_renderer *r, const lr_scene *s)
 {
-    lr_tr_scene *ts = NULL;
     lr_err e = {0};
     if (lr_tr_scene_update(&ts, s, &e))
         fail_msg("%s", e.msg);
@@ -72,7 +75,6 @@ static void compare(lr_renderer *r, const lr_scene *s)
     free(B);
     free(pos);
     free(obj);
-    lr_tr_scene_destroy(ts);
 }
 
 static void test_votive_maps(void **state)
@@ -102,9 +104,8 @@ static void test_votive_receiver_extra(void **state)
     (void)state;
     static const char *const tr[] = {"objects[0].model=translucent_radiosity", NULL};
     lr_scene *s = lr_test_scene("votive", small, tr);
-    lr_tr_scene *ts = NULL;
     lr_err e = {0};
-    if (lr_tr_scene_update(&ts, s, &e))
+    if (lr_tr_scene_update(&ts, s, &e)) /* back at the scene's light: a re-solve */
         fail_msg("%s", e.msg);
     for (int r = 0; r < lr_scene_receiver_count(s); r++) {
         const float *X = lr_tr_scene_recv_E(ts, r, 0);
@@ -118,6 +119,7 @@ static void test_votive_receiver_extra(void **state)
         assert_true(lo >= 0);
     }
     lr_tr_scene_destroy(ts);
+    ts = NULL;
     lr_scene_destroy(s);
 }
 
