@@ -15,6 +15,7 @@
 
 #include "render/base/file.h"
 #include "render/base/paths.h"
+#include "render/optics/optics.h"
 
 struct lr_plan_table {
     char name[256];
@@ -156,11 +157,13 @@ static int parse_row(const char *name, int line, char **f, const int *at, lr_pla
     TXT(C_SCENE, scene, true);
     TXT(C_MODEL, model, true);
     TXT(C_PARAMS, params, false);
-    if (strcmp(r->model, "directional_dipole") && strcmp(r->model, "standard_dipole") &&
-        strcmp(r->model, "translucent_radiosity"))
+    /* Any model the renderer runs (a sweep with LRB_SWEEP_MODEL=multipole writes such rows);
+     * which of them the planner may choose is lr_plan_models'. */
+    enum lr_sss_model parsed;
+    if (!lr_sss_model_parse(r->model, &parsed))
         return cell_err(name, line, "model", e,
-                        "expected directional_dipole, standard_dipole or translucent_radiosity",
-                        r->model);
+                        "expected directional_dipole, standard_dipole, multipole or "
+                        "translucent_radiosity", r->model);
     NUM(C_FRAME_MS, frame_ms);
     NUM(C_RMSE, rel_rmse);
     NUM(C_RMSE_OBJ, rel_rmse_object);
