@@ -325,7 +325,7 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
     lr_pass_programs *pr = &r->prog;
     if ((rc = program(r, "mesh.vert", "surface.frag", &pr->surface, e)) ||
         (rc = program(r, "mesh.vert", "depth.frag", &pr->depth, e)) ||
-        (rc = program(r, "mesh.vert", "radiosity.frag", &pr->radiosity, e)) ||
+        (rc = program(r, "radiosity.vert", "radiosity.frag", &pr->radiosity, e)) ||
         (rc = program(r, "fullscreen.vert", "vpl.frag", &pr->vpl, e)) ||
         (rc = program(r, "mesh.vert", "compose_object.frag", &pr->obj, e)) ||
         (rc = program(r, "mesh.vert", "compose_receiver.frag", &pr->recv, e)) ||

@@ -11,6 +11,7 @@
 #include "render/cpu/maps.h"
 #include "render/cpu/parallel.h"
 #include "render/cpu/recv_grid.h"
+#include "render/transrad/tr_scene.h"
 #include "render/cpu/rng.h"
 #include "render/cpu/vpl.h"
 
@@ -47,6 +48,7 @@ typedef struct rctx {
      * without a grid. */
     double **grid;
     int nrecv;
+    lr_tr_scene *tr;     /* translucent radiosity (PASS): the solver's B and receiver extra */
 } rctx;
 
 static uint64_t seed_of(const rctx *r) { return r->d->seed ? r->d->seed : 1; }
@@ -118,6 +120,13 @@ static void grid_item(void *p, long item)
     for (int o = 0; o < r->nobj; o++)
         lr_cpu_vpl_irradiance(r->vpl + (size_t)o * r->nvpl, r->nvpl,
                               lr_scene_object_at(r->s, o)->coeffs.eta, x, rc->normal, E, E + 3);
+    /* Translucent radiosity: what the VPLs do not carry, per light at unit intensity
+     * (render/passes/irradiance.c adds the same to the GPU's grid). */
+    for (int l = 0; l < r->nlight; l++) {
+        const float *X = lr_tr_scene_recv_E(r->tr, i, l);
+        for (int c = 0; X && c < 3; c++)
+            E[c] += r->I[l][c] * X[3 * (size_t)k + (size_t)c];
+    }
 }
 
 /* Nearest hit of the camera ray among objects (kind 0) and receivers (kind 1). */
@@ -285,6 +294,8 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
             goto fail;
     }
     double samples = 0.0;
+    if (!ref && (rc = lr_tr_scene_update(&r.tr, s, e)))
+        goto fail;
     if (!ref) {
         for (int o = 0; o < r.nobj; o++)
             for (int l = 0; l < r.nlight; l++) {
@@ -297,7 +308,8 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
                                                                     (uint64_t)l, 2),
                                        .threads = d->threads,
                                        .others = r.objs,
-                                       .n_others = r.nobj};
+                                       .n_others = r.nobj,
+                                       .tr = r.tr, .tr_object = o, .tr_light = l};
                 lr_cpu_maps **m = &r.maps[o * r.nlight + l];
                 if ((rc = lr_cpu_maps_create(&md, m, e)))
                     goto fail;
@@ -359,6 +371,7 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
         stats->vpls = nv;
     }
 fail:
+    lr_tr_scene_destroy(r.tr);
     if (r.grid)
         for (int i = 0; i < r.nrecv; i++)
             free(r.grid[i]);

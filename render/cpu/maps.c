@@ -7,6 +7,7 @@
 
 #include "render/cpu/parallel.h"
 #include "render/cpu/rng.h"
+#include "render/transrad/tr_scene.h"
 
 struct lr_cpu_maps {
     const lr_scene_object *obj;
@@ -16,6 +17,8 @@ struct lr_cpu_maps {
     const lr_scene_object *const *others;
     int n_others;
     enum lr_cpu_sampler sampler;
+    const lr_tr_scene *tr;
+    int tr_object, tr_light;
     unsigned seed;
     lr_vec3 *dir, *eye, *right, *up;
     lr_cpu_texel *tex; /* K * S * S, map-major, row j then column i */
@@ -86,6 +89,9 @@ int lr_cpu_maps_create(const lr_cpu_maps_desc *d, lr_cpu_maps **out, lr_err *e)
     m->others = d->others;
     m->n_others = d->n_others;
     m->sampler = d->sampler;
+    m->tr = lr_tr_scene_vertex_B(d->tr, d->tr_object, d->tr_light) ? d->tr : NULL;
+    m->tr_object = d->tr_object;
+    m->tr_light = d->tr_light;
     m->seed = d->seed ? d->seed : 1;
     m->threads = d->threads;
     m->texel = 2.0 * m->obj->radius / m->S;
@@ -135,6 +141,19 @@ static void acc_item(void *p, long item)
     lr_cpu_texel *t = m->tex + item;
     if (!t->valid)
         return;
+    if (m->tr) {
+        /* Translucent radiosity: the solved B, the same every frame (no variance). */
+        lr_closest cl;
+        double B[3] = {0, 0, 0};
+        if (lr_bvh_closest(m->obj->bvh, t->x, INFINITY, &cl))
+            lr_tr_scene_B_at(m->tr, m->tr_object, m->tr_light, cl.triangle, cl.w, B);
+        for (int c = 0; c < 3; c++) {
+            t->mean[c] = B[c];
+            t->var[c] = 0;
+        }
+        t->samples += m->N;
+        return;
+    }
     lr_cpu_radiosity_desc d = {.N = m->N, .sampler = m->sampler, .r_max = m->r_max,
                                .others = m->others, .n_others = m->n_others};
     lr_cpu_estimate est;

@@ -35,6 +35,11 @@ typedef struct lr_cpu_maps_desc {
     int threads;                   /* 0: all CPUs */
     /* Algorithm 1's biases in mm; 0: eps_bias = 2 texels, eps_comb = 1 texel (as the GPU). */
     double eps_bias, eps_comb;
+    /* Translucent radiosity (render/transrad/tr_scene.h): when tr has per-vertex B for object
+     * tr_object and light tr_light, every texel takes it, interpolated over the triangle at
+     * x_o (the GPU's radiosity.vert does the same), instead of the estimator. */
+    const struct lr_tr_scene *tr;
+    int tr_object, tr_light;
 } lr_cpu_maps_desc;
 
 typedef struct lr_cpu_texel {

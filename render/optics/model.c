@@ -8,7 +8,16 @@
 #include <string.h>
 
 static const char *const names[LR_SSS_MODEL_COUNT] = {"directional_dipole", "standard_dipole",
-                                                       "multipole"};
+                                                       "multipole", "translucent_radiosity"};
+
+/* Translucent radiosity (seed 000) evaluates a profile of its own choosing: the slab multipole
+ * where the object gives a wall thickness, the standard dipole otherwise. */
+static enum lr_sss_model profile_of(enum lr_sss_model m, double thickness_mm)
+{
+    if (m != LR_SSS_TRANSLUCENT_RADIOSITY)
+        return m;
+    return thickness_mm > 0 ? LR_SSS_MULTIPOLE : LR_SSS_STANDARD_DIPOLE;
+}
 
 const char *lr_sss_model_name(enum lr_sss_model m)
 {
@@ -34,12 +43,13 @@ void lr_sss_sd_fresnel(enum lr_sss_model m, const lr_coeffs *c, double thickness
 
 int lr_sss_pairs(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm)
 {
-    return m == LR_SSS_MULTIPOLE ? lr_multipole_pairs(c, thickness_mm) : 0;
+    return profile_of(m, thickness_mm) == LR_SSS_MULTIPOLE ? lr_multipole_pairs(c, thickness_mm) : 0;
 }
 
 void lr_sss_sd_fresnel_n(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm, int pairs,
                          lr_vec3 xi, lr_vec3 ni, lr_vec3 wi, lr_vec3 xo, lr_vec3 no, double out[3])
 {
+    m = profile_of(m, thickness_mm);
     if (m == LR_SSS_STANDARD_DIPOLE)
         lr_dipole_sd_fresnel(c, xi, ni, wi, xo, out);
     else if (m == LR_SSS_MULTIPOLE)
@@ -50,6 +60,7 @@ void lr_sss_sd_fresnel_n(enum lr_sss_model m, const lr_coeffs *c, double thickne
 
 void lr_sss_total(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm, double out[3])
 {
+    m = profile_of(m, thickness_mm);
     if (m != LR_SSS_MULTIPOLE) {
         lr_dipole_rd_total(c, out);
         return;

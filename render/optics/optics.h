@@ -187,8 +187,11 @@ void lr_multipole_sd_fresnel_n(const lr_coeffs *c, double d, int n, lr_vec3 xi, 
 
 /* The diffusion model an object's radiosity estimator evaluates (scene: objects[i].model). */
 enum lr_sss_model { LR_SSS_DIRECTIONAL_DIPOLE = 0, LR_SSS_STANDARD_DIPOLE = 1,
-                    LR_SSS_MULTIPOLE = 2 };
-#define LR_SSS_MODEL_COUNT 3
+                    LR_SSS_MULTIPOLE = 2,
+                    /* seed 000's patch solve (render/transrad/): its profile is the multipole's
+                     * with a thickness, else the standard dipole's (lr_sss_sd_fresnel) */
+                    LR_SSS_TRANSLUCENT_RADIOSITY = 3 };
+#define LR_SSS_MODEL_COUNT 4
 /* "directional_dipole", "standard_dipole", "multipole". */
 const char *lr_sss_model_name(enum lr_sss_model m);
 /* Inverse of lr_sss_model_name; false for any other text. */

@@ -8,7 +8,44 @@
  * material and cavity uniforms. */
 #include "render/passes/irradiance.h"
 
+#include <stdlib.h>
+
 #include "render/cpu/recv_grid.h"
+#include "render/passes/radiosity.h"
+
+/* Uploads the translucent-radiosity extra of every plane receiver and light (tr_scene.h) into
+ * tr_E, or frees it when no object uses the model. */
+static int tr_upload(lr_irradiance *irr, const lr_pass_ctx *c, const lr_radiosity *rad,
+                     lr_err *e)
+{
+    lr_tex_destroy(irr->tr_E);
+    irr->tr_E = NULL;
+    if (!rad->tr || !irr->grid)
+        return LR_OK;
+    int w, h, layers, rc;
+    lr_tex_size(irr->grid, &w, &h, &layers);
+    lr_tex_desc td = {.type = LR_TEX_2D_ARRAY, .format = LR_TEX_RGBA32F, .width = w, .height = h,
+                      .layers = layers, .label = "translucent radiosity receiver irradiance"};
+    if ((rc = lr_tex_create(c->gl, &td, &irr->tr_E, e)))
+        return rc;
+    size_t n = (size_t)LR_RECV_GRID * LR_RECV_GRID;
+    float *data = malloc(4 * n * sizeof *data);
+    if (!data)
+        return lr_err_set(e, LR_ENOMEM, "irradiance pass: out of memory");
+    for (int i = 0; i < irr->n_receivers && !rc; i++) {
+        if (irr->layer[i] < 0)
+            continue;
+        for (int l = 0; l < irr->n_lights && !rc; l++) {
+            const float *E = lr_tr_scene_recv_E(rad->tr, i, l);
+            for (size_t k = 0; k < n; k++)
+                for (int b = 0; b < 4; b++)
+                    data[4 * k + (size_t)b] = E && b < 3 ? E[3 * k + (size_t)b] : 0.0f;
+            rc = lr_tex_upload(irr->tr_E, irr->layer[i] + l, data, e);
+        }
+    }
+    free(data);
+    return rc;
+}
 
 void lr_irradiance_free(lr_irradiance *irr)
 {
@@ -19,6 +56,8 @@ void lr_irradiance_free(lr_irradiance *irr)
     }
     lr_tex_destroy(irr->grid);
     irr->grid = NULL;
+    lr_tex_destroy(irr->tr_E);
+    irr->tr_E = NULL;
     irr->n_receivers = irr->n_lights = 0;
     irr->valid = false;
 }
@@ -64,6 +103,8 @@ int lr_irradiance_run(lr_irradiance *irr, const lr_pass_ctx *c, const lr_vpl *v,
     irr->valid = !irr->grid || c->no_vpl || !v->fb;
     if (irr->valid)
         return LR_OK;
+    if ((rc = tr_upload(irr, c, rad, e)))
+        return rc;
     lr_program *p = c->prog->irr;
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
@@ -72,6 +113,8 @@ int lr_irradiance_run(lr_irradiance *irr, const lr_pass_ctx *c, const lr_vpl *v,
     lr_passes_uniform_i(p, "u_n_lights", c->n_lights);
     lr_vpl_bind(v, c, rad, p);
     lr_passes_uniform_i(p, "u_grid_size", LR_RECV_GRID);
+    lr_passes_uniform_i(p, "u_tr_on", irr->tr_E != NULL);
+    lr_passes_bind_tex(p, "u_tr_E", 13, irr->tr_E);
     for (int i = 0; i < c->objs->n_receivers; i++) {
         lr_recv_grid_frame f;
         if (irr->layer[i] < 0 || !lr_recv_grid_frame_of(lr_scene_receiver_at(c->scene, i), &f))
@@ -81,6 +124,7 @@ int lr_irradiance_run(lr_irradiance *irr, const lr_pass_ctx *c, const lr_vpl *v,
         lr_passes_uniform_v3(p, "u_grid_wa", lr_v3_scale(f.a, f.w));
         lr_passes_uniform_v3(p, "u_grid_hb", lr_v3_scale(f.b, f.h));
         lr_passes_uniform_v3(p, "u_grid_n", lr_scene_receiver_at(c->scene, i)->normal);
+        lr_passes_uniform_i(p, "u_tr_layer", irr->layer[i]);
         lr_gl_draw_fullscreen(c->gl);
     }
     if ((rc = lr_gl_check("receiver irradiance pass", e)))

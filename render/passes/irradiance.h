@@ -16,6 +16,10 @@ typedef struct lr_irradiance {
     int layer[LR_MAX_RECEIVERS];
     int n_receivers, n_lights; /* what the grids were allocated for */
     bool valid;                /* drawn from the current VPLs */
+    /* Translucent radiosity (seed 000): the irradiance the VPLs do not carry (receiver
+     * inter-reflection, objects' inner faces), laid out like grid; NULL when no object uses
+     * the model. */
+    lr_tex *tr_E;
 } lr_irradiance;
 
 /* Frees the grids (they are laid out again at the next run). */

@@ -12,6 +12,7 @@
  * depend on the light's index: light l's maps are the same whether or not the other lights
  * exist, so a two-light render is the sum of the two one-light renders. */
 #include <math.h>
+#include <stdlib.h>
 
 #include "render/base/mat4.h"
 #include "render/optics/optics.h"
@@ -58,6 +59,12 @@ void lr_radiosity_free(lr_radiosity *rad)
         lr_fb_destroy(rad->fb[k]);
         rad->fb[k] = NULL;
     }
+    for (int i = 0; i < LR_MAX_OBJECTS; i++) {
+        lr_tex_destroy(rad->trB[i]);
+        rad->trB[i] = NULL;
+    }
+    lr_tr_scene_destroy(rad->tr);
+    rad->tr = NULL;
     lr_tex_destroy(rad->B);
     lr_tex_destroy(rad->pos);
     lr_tex_destroy(rad->nrm);
@@ -118,6 +125,46 @@ static float blend_weight(lr_tex_format format, int F)
     return (float)((k < 1.0 ? 1.0 : k) / 2048.0);
 }
 
+/* Translucent radiosity: solve (the solver is rebuilt only when geometry or materials
+ * changed) and upload each such object's per-vertex B, light l's block at rows l tr_rows. */
+static int tr_refresh(lr_radiosity *rad, const lr_pass_ctx *c, lr_err *e)
+{
+    int rc = lr_tr_scene_update(&rad->tr, c->scene, e);
+    for (int i = 0; i < LR_MAX_OBJECTS; i++) {
+        lr_tex_destroy(rad->trB[i]);
+        rad->trB[i] = NULL;
+    }
+    if (rc || !rad->tr)
+        return rc;
+    for (int i = 0; i < c->objs->n_objects && i < LR_MAX_OBJECTS; i++) {
+        if (!lr_tr_scene_vertex_B(rad->tr, i, 0))
+            continue;
+        const lr_mesh *m = lr_scene_object_at(c->scene, i)->mesh;
+        int nv = (int)lr_mesh_vertex_count(m), rows = (nv + LR_TR_TEX_WIDTH - 1) / LR_TR_TEX_WIDTH;
+        int L = rad->n_lights;
+        float *data = calloc((size_t)LR_TR_TEX_WIDTH * (size_t)rows * (size_t)L * 4, sizeof *data);
+        if (!data)
+            return lr_err_set(e, LR_ENOMEM, "radiosity pass: out of memory (vertex B)");
+        for (int l = 0; l < L; l++) {
+            const float *vB = lr_tr_scene_vertex_B(rad->tr, i, l);
+            for (int v = 0; vB && v < nv; v++)
+                for (int b = 0; b < 3; b++)
+                    data[4 * ((size_t)l * rows * LR_TR_TEX_WIDTH + (size_t)v) + (size_t)b] =
+                        vB[3 * (size_t)v + (size_t)b];
+        }
+        lr_tex_desc d = {.type = LR_TEX_2D, .format = LR_TEX_RGBA32F, .width = LR_TR_TEX_WIDTH,
+                         .height = rows * L, .label = "translucent radiosity vertex B"};
+        rc = lr_tex_create(c->gl, &d, &rad->trB[i], e);
+        if (!rc)
+            rc = lr_tex_upload(rad->trB[i], 0, data, e);
+        free(data);
+        if (rc)
+            return rc;
+        rad->tr_rows[i] = rows;
+    }
+    return LR_OK;
+}
+
 int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *gb, bool restart,
                      lr_err *e)
 {
@@ -127,6 +174,9 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
     if (restart || rad->F == 0) {
         place_maps(rad, c, gb);
         rad->F = 0;
+        int rc = tr_refresh(rad, c, e);
+        if (rc)
+            return rc;
     }
     int F = rad->F + 1;
     int K = rad->K;
@@ -185,6 +235,10 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
             for (int i = 0; i < c->objs->n_objects; i++) {
                 lr_passes_uniform_i(p, "u_object", i);
                 lr_passes_uniform_i(p, "u_two_sided", c->objs->two_sided[i]);
+                bool tr = i < LR_MAX_OBJECTS && rad->trB[i];
+                lr_passes_uniform_i(p, "u_tr_on", tr);
+                lr_passes_bind_tex(p, "u_tr_B", 10, tr ? rad->trB[i] : NULL);
+                lr_passes_uniform_i(p, "u_tr_row0", tr ? l * rad->tr_rows[i] : 0);
                 lr_passes_draw(&c->objs->obj[i]);
             }
         }

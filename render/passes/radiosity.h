@@ -5,6 +5,10 @@
 
 #include "render/passes/gbuffer.h"
 #include "render/passes/passes.h"
+#include "render/transrad/tr_scene.h"
+
+/* Texels per row of the per-vertex B textures (radiosity.vert's u_tr_width). */
+#define LR_TR_TEX_WIDTH 1024
 
 typedef struct lr_radiosity {
     int K, size, n_lights;
@@ -22,6 +26,12 @@ typedef struct lr_radiosity {
     lr_fb *fb[LR_MAX_LIGHTS * LR_MAX_K]; /* [l K + k] */
     float scale[LR_MAX_LIGHTS]; /* light l's maps store B * scale[l] */
     int F; /* frames accumulated */
+    /* Translucent radiosity (seed 000): the solver, rebuilt when geometry or materials
+     * change, re-solved per light at each restart; per object a texture of its vertices' B,
+     * rows tr_rows[i] per light (NULL for an object with another model). */
+    lr_tr_scene *tr;
+    lr_tex *trB[LR_MAX_OBJECTS];
+    int tr_rows[LR_MAX_OBJECTS];
 } lr_radiosity;
 
 /* Maps for c->rs (K, map_size) and c->n_lights lights; accumulation restarts. */

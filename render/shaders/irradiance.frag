@@ -9,6 +9,11 @@
 uniform vec3 u_grid_c, u_grid_wa, u_grid_hb; // centre; w a and h b
 uniform vec3 u_grid_n;                       // the plane's front normal
 uniform int u_grid_size;                     // R
+// Translucent radiosity (seed 000, render/transrad/tr_scene.h): per light the irradiance the
+// VPLs do not carry (receiver inter-reflection, the objects' inner faces), on the same grid.
+uniform bool u_tr_on;
+uniform highp sampler2DArray u_tr_E;
+uniform int u_tr_layer;
 layout(location = 0) out vec4 o_light[LR_MAX_LIGHTS];
 
 void main()
@@ -19,6 +24,10 @@ void main()
     for (int l = 0; l < LR_MAX_LIGHTS; l++)
         E[l] = vec3(0.0);
     lr_vpl_irradiance(x, u_grid_n, E);
+    if (u_tr_on)
+        for (int l = 0; l < LR_MAX_LIGHTS; l++)
+            if (l < u_n_lights)
+                E[l] += texelFetch(u_tr_E, ivec3(ivec2(gl_FragCoord.xy), u_tr_layer + l), 0).rgb;
     o_light[0] = vec4(E[0], 1.0);
     o_light[1] = vec4(E[1], 1.0);
     o_light[2] = vec4(E[2], 1.0);

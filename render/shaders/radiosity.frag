@@ -8,6 +8,8 @@
 
 in vec3 v_pos;
 in vec3 v_nrm;
+in vec3 v_trB;              // translucent radiosity: the vertices' solved B (radiosity.vert)
+uniform bool u_tr_on;
 uniform int u_object;
 uniform bool u_two_sided;
 uniform int u_light_type;   // LR_LIGHT_POINT, LR_LIGHT_SPOT, LR_LIGHT_DIRECTIONAL
@@ -41,6 +43,14 @@ void main()
     vec3 no = normalize(v_nrm);
     if (u_two_sided && !gl_FrontFacing)
         no = -no;
+    if (u_tr_on) {
+        // Translucent radiosity (seed 000 Eq. 14, solved over patches on the CPU,
+        // render/transrad/): no estimator, the same B every frame, so the running mean is B.
+        o_B = vec4(min(v_trB * u_map_scale, vec3(u_map_max)), 1.0);
+        o_pos = vec4(xo, 1.0);
+        o_nrm = vec4(no, float(u_object));
+        return;
+    }
     lr_coeffs_gl mat = lr_material(u_object);
     lr_sss_gl sss = lr_material_sss(u_object);
     ivec2 tx = ivec2(gl_FragCoord.xy);

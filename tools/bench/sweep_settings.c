@@ -2,6 +2,7 @@
  * changes around it (issue 6: K, N, N_vpl, map sizes, frames, VPLs on/off, model). */
 #include "tools/bench/sweep.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 /* Base: K 8 maps of 64^2, N 4, 64 VPLs, G-buffer 128. Its radiosity is 1/128 of the scenes'
@@ -29,8 +30,14 @@ int lrb_sweep_settings(lrb_setting *out, int cap)
             out[n++] = s;                                                                    \
         }                                                                                    \
     } while (0)
-    if (n < cap)
-        out[n++] = base;
+    if (n < cap) {
+        out[n] = base;
+        /* LRB_SWEEP_MODEL=NAME: the base setting (and so the fair figures) with that model. */
+        const char *m = getenv("LRB_SWEEP_MODEL");
+        if (m && *m)
+            out[n].model = m;
+        n++;
+    }
     ADD("K=4", K, 4);
     ADD("K=16", K, 16);
     ADD("N=1", N, 1);
@@ -49,6 +56,7 @@ int lrb_sweep_settings(lrb_setting *out, int cap)
     ADD("multipole+K=16", model, "multipole");
     if (n > 0 && !strcmp(out[n - 1].label, "multipole+K=16"))
         out[n - 1].K = 16;
+    ADD("transrad", model, "translucent_radiosity");
 #undef ADD
     return n;
 }

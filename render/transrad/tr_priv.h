@@ -1,0 +1,82 @@
+/* lamprig — translucent radiosity: the solver's private state, shared by its files. */
+#ifndef LR_TR_PRIV_H
+#define LR_TR_PRIV_H
+
+#include "render/transrad/transrad.h"
+
+typedef struct lr_tr_patch {
+    lr_vec3 c, n;       /* area-weighted centroid, unit mean normal */
+    double area;        /* mm^2 */
+    int surface;
+    size_t tri0, ntri;  /* range in lr_tr.tris (mesh kinds); plane: none */
+    int cu, cv;         /* plane: the cell */
+} lr_tr_patch;
+
+typedef struct lr_tr_surf {
+    lr_tr_surface_desc d;
+    size_t first, count;  /* its patches */
+    size_t *tri_patch;    /* mesh kinds: triangle -> patch */
+    double t_hem;         /* translucent: lr_hemi_transmittance(eta) */
+    lr_vec3 a, b;         /* plane: unit axes along size_u, size_v */
+    int nu, nv;
+    lr_mesh *own_mesh;    /* a refined copy when the given triangles exceed patch_mm */
+    lr_bvh *own_bvh;
+} lr_tr_surf;
+
+/* Sparse rows: entries [row[i], row[i+1]) of col/val. */
+typedef struct lr_tr_rows {
+    size_t *row;
+    uint32_t *col;
+    float *val;  /* F: one value; S: three per entry (bands) */
+} lr_tr_rows;
+
+typedef struct lr_tr_slot {
+    double *W, *Wsss, *H, *Hind; /* n x 3 */
+    bool valid;
+} lr_tr_slot;
+
+struct lr_tr {
+    lr_tr_settings set;
+    int nsurf;
+    lr_tr_surf surf[LR_TR_MAX_SURFACES];
+    size_t n;
+    lr_tr_patch *p;
+    size_t *tris;         /* triangles of mesh patches, grouped by patch */
+    lr_tr_rows F;         /* row p: (q, F_pq) */
+    double *escape;
+    lr_tr_rows S;         /* column-major by source: row p lists (q, S_qp[3]) */
+    double *Edir, *Ein;   /* scratch n x 3: direct irradiance, and the part that enters */
+    lr_tr_slot slot[LR_TR_MAX_SLOTS];
+};
+
+/* patches.c */
+int lr_tr_build_patches(lr_tr *t, lr_err *e);
+/* Point k of m spread over patch p (area-weighted, stratified); its normal. */
+void lr_tr_patch_point(const lr_tr *t, size_t p, unsigned k, unsigned m, double jitter_u,
+                       double jitter_v, lr_vec3 *x, lr_vec3 *n);
+/* Nearest hit over every surface; *patch = SIZE_MAX for a back face (absorbed) and false
+ * when nothing is hit. */
+bool lr_tr_trace(const lr_tr *t, lr_vec3 o, lr_vec3 d, double tmax, size_t *patch,
+                 double *dist);
+bool lr_tr_occluded(const lr_tr *t, lr_vec3 o, lr_vec3 d, double tmax);
+/* A ray origin just off the surface along n (scale of the scene). */
+double lr_tr_eps(const lr_tr *t);
+
+/* refine.c: a copy of surface s's mesh cut until no edge exceeds its patch size (at most
+ * LR_TR_MAX_TRIANGLES triangles), so that clusters can be as small as asked. */
+#define LR_TR_MAX_TRIANGLES 60000
+int lr_tr_refine(lr_tr *t, int s, lr_err *e);
+
+/* formfactor.c */
+int lr_tr_build_form_factors(lr_tr *t, lr_err *e);
+/* optdist.c: in-object distances from each patch of surface s to the others, n_s x n_s
+ * (row-major, caller frees); INFINITY where not connected through material. */
+int lr_tr_optical_distances(const lr_tr *t, int s, double **out, lr_err *e);
+/* subsurface.c */
+int lr_tr_build_subsurface(lr_tr *t, lr_err *e);
+/* direct.c */
+void lr_tr_direct(lr_tr *t, const lr_light *light);
+
+void lr_tr_rows_free(lr_tr_rows *r);
+
+#endif

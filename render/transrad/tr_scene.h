@@ -1,0 +1,49 @@
+/* lamprig — translucent radiosity for the renderer and its CPU twin: one solver per scene,
+ * rebuilt only when geometry, materials or receivers change (its F and S are the costly
+ * part) and re-solved per light (warm-started) when the maps restart, turned into what the
+ * passes consume (render/passes/PIPELINE.md, "Translucent radiosity"):
+ *
+ *   per vertex of every object whose model is translucent_radiosity, per light: the map value
+ *     B (lr_tr_map_radiosity) interpolated from the object's patches (Gaussian weights over
+ *     patches within two patch sizes whose normal agrees with the vertex's), which the GPU's
+ *     radiosity pass and the CPU twin's maps interpolate over each triangle (barycentric);
+ *   per plane receiver and light, on the LR_RECV_GRID grid of the receiver irradiance cache:
+ *     the irradiance the VPLs do not carry, bilinear over the receiver's patch grid: light from
+ *     the other receivers (receiver inter-reflection, all orders) and from the inner faces of
+ *     those objects (a shade's inside through its openings; a face is inner when its normal
+ *     points toward the object's centre). The VPLs keep carrying the outer faces' light, now
+ *     with the solved B.
+ * Everything is per unit intensity, so a dimmer change stays blend-only. */
+#ifndef LR_TR_SCENE_H
+#define LR_TR_SCENE_H
+
+#include <stdbool.h>
+
+#include "render/base/err.h"
+#include "render/scene/scene.h"
+#include "render/transrad/transrad.h"
+
+typedef struct lr_tr_scene lr_tr_scene;
+
+/* Whether any object of s uses the model. */
+bool lr_tr_scene_needed(const lr_scene *s);
+/* Creates *ts on first use (NULL when no object needs it: *ts stays NULL), rebuilds the
+ * solver when the scene's geometry, materials or receivers differ from the last call's, and
+ * solves every light. */
+int lr_tr_scene_update(lr_tr_scene **ts, const lr_scene *s, lr_err *e);
+void lr_tr_scene_destroy(lr_tr_scene *ts);
+
+/* Per-vertex B (vertex_count x 3, the object's mesh's vertex order) of object o and light l;
+ * NULL when o does not use the model (or ts is NULL). */
+const float *lr_tr_scene_vertex_B(const lr_tr_scene *ts, int o, int l);
+/* Extra irradiance on plane receiver r for light l at the LR_RECV_GRID^2 texel centres
+ * (s + R t, 3 per texel); NULL when none. */
+const float *lr_tr_scene_recv_E(const lr_tr_scene *ts, int r, int l);
+/* B at point x of object o's triangle tri with barycentric weights w (the CPU twin's maps). */
+void lr_tr_scene_B_at(const lr_tr_scene *ts, int o, int l, size_t tri, const double w[3],
+                      double out[3]);
+const lr_tr *lr_tr_scene_solver(const lr_tr_scene *ts);
+/* Seconds the last update spent: building (0 when reused) and solving. */
+void lr_tr_scene_times(const lr_tr_scene *ts, double *build_s, double *solve_s);
+
+#endif

@@ -1,0 +1,146 @@
+/* lamprig — translucent radiosity (seed 000: Sheng, Shi, Wang, Narasimhan, "Translucent
+ * Radiosity", IEEE TVCG): light transport between translucent objects and diffuse receivers
+ * over patches,
+ *
+ *     B = (I - S F)^-1 S E                                   (seed 000 Eq. 14)
+ *
+ * F the form-factor matrix (light that leaves patch j diffusely and reaches patch i), S the
+ * subsurface-scattering matrix (light that enters patch i and leaves patch j of the same
+ * object, Eq. 8; for a diffuse patch S = P, its albedo, which gives back Eq. 2), E the direct
+ * light from the scene's lights at unit intensity.
+ *
+ * What is built (render/transrad/README.md has the derivations):
+ *   patches   translucent and diffuse meshes: triangles clustered by a cubic cell of edge
+ *             patch_mm and by the dominant axis of their normal (so the inner and outer faces
+ *             of a shell never share a patch); planes: a grid of cells (patches.c);
+ *   F         by cosine-distributed ray casts from points spread over each patch against every
+ *             surface's BVH (visibility included; a ray that leaves the scene is the patch's
+ *             escape), stored sparse per row (formfactor.c);
+ *   S         per object, from a diffusion profile (the slab multipole's R and T where a wall
+ *             thickness is given or, for translucent_radiosity, measured under each patch;
+ *             the standard dipole R_d for a half-space) indexed by the in-object distance:
+ *             straight where the segment between the two patches' inner points stays inside
+ *             the material, otherwise a Dijkstra shortest path over the inner points of the
+ *             object's patches (optdist.c), so the profile leaks neither across a concave gap
+ *             nor through air. Exit at the patch centroid, entry integrated over the source
+ *             patch with more points when near (seed 000 Sec. 4.1); each column scaled so that
+ *             the power that leaves equals the model's plane total (subsurface.c);
+ *   E         per light, unit intensity, shadowed by every surface, averaged over points of each
+ *             patch; on a translucent patch split into the part that enters (F_t(cos)) and the
+ *             Fresnel-reflected rest (direct.c);
+ *   solve     the Jacobi iteration of seed 000 Sec. 5 (L = S E, then L <- S E + S F L),
+ *             warm-started from the last solution of the same light slot (solve.c).
+ *
+ * Radiometry. The solution W is the radiosity that leaves each patch (W/mm^2 per W/sr of the
+ * light). A translucent patch's W = W_sss + W_refl: W_sss left the material after scattering
+ * in it, W_refl is the Fresnel-reflected part of its incident light (taken as diffuse). The
+ * renderer's maps hold B with L_o = F_t(w_o) B / pi, whose exitance is T_hem B: the map value of
+ * a patch is W_sss / T_hem (lr_tr_map_radiosity). Light arriving diffusely at a translucent
+ * patch enters with T_hem and is reflected with 1 - T_hem.
+ *
+ * Opaque struct; create/destroy; errors name the surface and field.
+ */
+#ifndef LR_TRANSRAD_H
+#define LR_TRANSRAD_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "render/base/err.h"
+#include "render/base/vec3.h"
+#include "render/mesh/bvh.h"
+#include "render/mesh/mesh.h"
+#include "render/optics/optics.h"
+#include "render/scene/scene.h"
+
+enum lr_tr_kind {
+    LR_TR_TRANSLUCENT, /* a scattering object: S from its profile */
+    LR_TR_DIFFUSE,     /* an opaque diffuse mesh (a box receiver, a test's sphere) */
+    LR_TR_PLANE,       /* a one-sided rectangle (a plane receiver): a grid of patches */
+};
+
+typedef struct lr_tr_surface_desc {
+    enum lr_tr_kind kind;
+    const lr_mesh *mesh; /* world space, faces outward (toward where their light goes) */
+    const lr_bvh *bvh;   /* over mesh */
+    double albedo[3];    /* diffuse, plane */
+    /* translucent */
+    const lr_coeffs *coeffs;
+    enum lr_sss_model model; /* multipole: R and T of a slab of thickness_mm; others: R_d */
+    double thickness_mm;
+    /* plane: the rectangle (the receiver's) */
+    lr_vec3 center, normal, u_dir;
+    double size_u, size_v;
+    int cells_u, cells_v; /* plane grid; 0: from patch_mm */
+    double patch_mm;      /* cluster cell edge; 0: the settings' */
+} lr_tr_surface_desc;
+
+typedef struct lr_tr_settings {
+    double patch_mm;        /* object cluster cell; 0: 12 mm */
+    double receiver_mm;     /* plane grid cell; 0: 30 mm (at most 64 cells a side) */
+    int rays_per_patch;     /* form-factor rays; 0: 512 */
+    int direct_samples;     /* points per patch for E; 0: 16 */
+    int max_iterations;     /* Jacobi sweeps; 0: 50 */
+    double tolerance;       /* stop when the relative residual is below; 0: 1e-4 */
+    uint64_t seed;
+    int threads;            /* 0: all online CPUs */
+} lr_tr_settings;
+
+#define LR_TR_MAX_SURFACES 32
+#define LR_TR_MAX_SLOTS 4
+
+typedef struct lr_tr lr_tr;
+
+typedef struct lr_tr_stats {
+    int iterations;
+    double residual;        /* ||W_k+1 - W_k||_1 / ||W_k+1||_1, power-weighted, all bands */
+    double residual10;      /* the same after 10 sweeps (or the last, if fewer) */
+    double ms_direct, ms_solve;
+} lr_tr_stats;
+
+/* Builds patches, F and S (the precomputation: after geometry or material changes). */
+int lr_tr_create(const lr_tr_surface_desc *surfaces, int count, const lr_tr_settings *settings,
+                 lr_tr **out, lr_err *e);
+/* From a scene: its objects (translucent, the object's model and thickness) and its
+ * receivers (planes and boxes). */
+int lr_tr_create_scene(const lr_scene *s, const lr_tr_settings *settings, lr_tr **out,
+                       lr_err *e);
+void lr_tr_destroy(lr_tr *t);
+
+/* Direct light of a unit-intensity light (shadowed, per patch) and the solve, warm-started
+ * from slot's last solution. */
+int lr_tr_solve_light(lr_tr *t, const lr_light *light, int slot, lr_tr_stats *st, lr_err *e);
+/* The same with the direct irradiance given (n x 3, W/mm^2; translucent patches take it as
+ * diffuse light). */
+int lr_tr_solve_irradiance(lr_tr *t, const double *E, int slot, lr_tr_stats *st, lr_err *e);
+
+/* ---- Queries ------------------------------------------------------------------------------- */
+size_t lr_tr_patch_count(const lr_tr *t);
+/* First patch and count of surface s (in the order given to create; for a scene: objects,
+ * then receivers). */
+void lr_tr_surface_patches(const lr_tr *t, int s, size_t *first, size_t *count);
+void lr_tr_patch_geometry(const lr_tr *t, size_t p, lr_vec3 *centroid, lr_vec3 *normal,
+                          double *area);
+int lr_tr_patch_surface(const lr_tr *t, size_t p);
+/* A plane surface's grid: patch first + u + nu v is the cell (u, v), u along its size_u.
+ * False (and 0 x 0) for other kinds. */
+bool lr_tr_plane_grid(const lr_tr *t, int s, int *nu, int *nv);
+/* The patch a surface's triangle belongs to (plane: the cell of the point x on it). */
+size_t lr_tr_patch_of(const lr_tr *t, int surface, size_t triangle, lr_vec3 x);
+/* F_pq: fraction of the light leaving p diffusely that reaches q (first hit). */
+double lr_tr_form_factor(const lr_tr *t, size_t p, size_t q);
+/* Fraction of p's rays that left the scene. */
+double lr_tr_escape(const lr_tr *t, size_t p);
+/* S_qp per band: radiosity leaving q per unit irradiance entering p (0 across objects). */
+void lr_tr_subsurface(const lr_tr *t, size_t q, size_t p, double out[3]);
+/* Slot's solution: W leaving p (all of it), the irradiance H arriving at p (direct + bounce),
+ * the indirect part of H, and the renderer's map value W_sss / T_hem. */
+void lr_tr_radiosity(const lr_tr *t, int slot, size_t p, double out[3]);
+void lr_tr_irradiance(const lr_tr *t, int slot, size_t p, double out[3]);
+void lr_tr_indirect(const lr_tr *t, int slot, size_t p, double out[3]);
+void lr_tr_map_radiosity(const lr_tr *t, int slot, size_t p, double out[3]);
+/* Power per band that leaves the scene (escaping rays) in slot's solution, W per W/sr. */
+void lr_tr_escaped_power(const lr_tr *t, int slot, double out[3]);
+
+#endif
