@@ -1,0 +1,84 @@
+/* lamprig — shapes the diffusion grid is built over: sphere and slab (closed forms in the
+ * tests) and closed meshes (through the BVH). */
+#include <math.h>
+
+#include "render/diffusion/dgrid.h"
+
+static bool sphere_inside(const void *ctx, lr_vec3 p)
+{
+    const lr_dsphere *s = ctx;
+    return lr_v3_len(lr_v3_sub(p, s->c)) < s->r;
+}
+
+static bool sphere_closest(const void *ctx, lr_vec3 p, double max_dist, lr_vec3 *b, lr_vec3 *n)
+{
+    const lr_dsphere *s = ctx;
+    lr_vec3 d = lr_v3_sub(p, s->c);
+    double l = lr_v3_len(d);
+    lr_vec3 u = l > 0.0 ? lr_v3_scale(d, 1.0 / l) : lr_v3(0.0, 0.0, 1.0);
+    *b = lr_v3_add(s->c, lr_v3_scale(u, s->r));
+    *n = u;
+    return fabs(l - s->r) <= max_dist;
+}
+
+lr_dshape lr_dshape_sphere(const lr_dsphere *s)
+{
+    lr_vec3 r = lr_v3(s->r, s->r, s->r);
+    return (lr_dshape){sphere_inside, sphere_closest, s, lr_v3_sub(s->c, r), lr_v3_add(s->c, r)};
+}
+
+static bool slab_inside(const void *ctx, lr_vec3 p)
+{
+    const lr_dslab *s = ctx;
+    return p.z > 0.0 && p.z < s->thickness;
+}
+
+static bool slab_closest(const void *ctx, lr_vec3 p, double max_dist, lr_vec3 *b, lr_vec3 *n)
+{
+    const lr_dslab *s = ctx;
+    bool lower = p.z < 0.5 * s->thickness;
+    *b = lr_v3(p.x, p.y, lower ? 0.0 : s->thickness);
+    *n = lr_v3(0.0, 0.0, lower ? -1.0 : 1.0);
+    return fabs(p.z - b->z) <= max_dist;
+}
+
+lr_dshape lr_dshape_slab(const lr_dslab *s)
+{
+    return (lr_dshape){slab_inside, slab_closest, s, lr_v3(0.0, 0.0, 0.0),
+                       lr_v3(0.0, 0.0, s->thickness)};
+}
+
+/* Parity of crossings along a direction tilted off the axes, so that a ray through a grid
+ * column does not run along the mesh's (often axis-aligned) edges. */
+static bool mesh_inside(const void *ctx, lr_vec3 p)
+{
+    const lr_bvh *bvh = ctx;
+    const lr_vec3 d = lr_v3_normalize(lr_v3(0.0123456, 0.0078901, 1.0));
+    double tmin = 0.0;
+    int crossings = 0;
+    lr_hit hit;
+    while (crossings < 100000 && lr_bvh_intersect(bvh, p, d, tmin, INFINITY, &hit)) {
+        crossings++;
+        /* A ray through an edge hits both faces at the same t: step past it once. */
+        tmin = hit.t + 1e-7 * (1.0 + hit.t);
+    }
+    return (crossings & 1) != 0;
+}
+
+static bool mesh_closest(const void *ctx, lr_vec3 p, double max_dist, lr_vec3 *b, lr_vec3 *n)
+{
+    const lr_bvh *bvh = ctx;
+    lr_closest c;
+    if (!lr_bvh_closest(bvh, p, max_dist, &c))
+        return false;
+    *b = c.point;
+    *n = lr_mesh_triangle_normal(lr_bvh_mesh(bvh), c.triangle);
+    return true;
+}
+
+lr_dshape lr_dshape_mesh(const lr_bvh *bvh)
+{
+    lr_dshape s = {mesh_inside, mesh_closest, bvh, lr_v3(0, 0, 0), lr_v3(0, 0, 0)};
+    lr_mesh_bounds(lr_bvh_mesh(bvh), &s.lo, &s.hi);
+    return s;
+}
