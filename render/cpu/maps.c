@@ -17,6 +17,7 @@ struct lr_cpu_maps {
     int n_others;
     enum lr_cpu_sampler sampler;
     unsigned seed;
+    lr_dfield_view dfield; /* the caller's; must outlive the maps */
     lr_vec3 *dir, *eye, *right, *up;
     lr_cpu_texel *tex; /* K * S * S, map-major, row j then column i */
 };
@@ -84,6 +85,7 @@ int lr_cpu_maps_create(const lr_cpu_maps_desc *d, lr_cpu_maps **out, lr_err *e)
     m->N = d->N ? d->N : 16;
     m->r_max = d->r_max;
     m->others = d->others;
+    m->dfield = d->dfield;
     m->n_others = d->n_others;
     m->sampler = d->sampler;
     m->seed = d->seed ? d->seed : 1;
@@ -136,7 +138,8 @@ static void acc_item(void *p, long item)
     if (!t->valid)
         return;
     lr_cpu_radiosity_desc d = {.N = m->N, .sampler = m->sampler, .r_max = m->r_max,
-                               .others = m->others, .n_others = m->n_others};
+                               .others = m->others, .n_others = m->n_others,
+                               .dfield = m->dfield};
     lr_cpu_estimate est;
     lr_cpu_radiosity(m->obj, &m->light, t->x, t->n, &d,
                      lr_cpu_key(m->seed, (uint64_t)k, (uint64_t)texel, (uint64_t)a->frame), &est);

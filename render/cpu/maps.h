@@ -35,6 +35,7 @@ typedef struct lr_cpu_maps_desc {
     int threads;                   /* 0: all CPUs */
     /* Algorithm 1's biases in mm; 0: eps_bias = 2 texels, eps_comb = 1 texel (as the GPU). */
     double eps_bias, eps_comb;
+    lr_dfield_view dfield; /* diffusion_grid objects: the solved field (lr_cpu_radiosity_desc) */
 } lr_cpu_maps_desc;
 
 typedef struct lr_cpu_texel {

@@ -8,7 +8,7 @@
 #include <string.h>
 
 static const char *const names[LR_SSS_MODEL_COUNT] = {"directional_dipole", "standard_dipole",
-                                                       "multipole"};
+                                                       "multipole", "diffusion_grid"};
 
 const char *lr_sss_model_name(enum lr_sss_model m)
 {
@@ -32,6 +32,8 @@ void lr_sss_sd_fresnel(enum lr_sss_model m, const lr_coeffs *c, double thickness
         lr_dipole_sd_fresnel(c, xi, ni, wi, xo, out);
     else if (m == LR_SSS_MULTIPOLE)
         lr_multipole_sd_fresnel(c, thickness_mm, xi, ni, wi, xo, no, out);
+    else if (m == LR_SSS_DIFFUSION_GRID)
+        out[0] = out[1] = out[2] = 0.0; /* no profile: the grid's field (render/diffusion) */
     else
         lr_dirpole_sd_fresnel(c, xi, ni, wi, xo, no, out);
 }

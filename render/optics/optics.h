@@ -180,8 +180,11 @@ void lr_multipole_sd_fresnel(const lr_coeffs *c, double d, lr_vec3 xi, lr_vec3 n
 
 /* The diffusion model an object's radiosity estimator evaluates (scene: objects[i].model). */
 enum lr_sss_model { LR_SSS_DIRECTIONAL_DIPOLE = 0, LR_SSS_STANDARD_DIPOLE = 1,
-                    LR_SSS_MULTIPOLE = 2 };
-#define LR_SSS_MODEL_COUNT 3
+                    LR_SSS_MULTIPOLE = 2,
+                    /* seed 001: the diffusion equation solved on a grid (render/diffusion/);
+                     * not a BSSRDF: lr_sss_sd_fresnel gives 0, the passes read its solved field */
+                    LR_SSS_DIFFUSION_GRID = 3 };
+#define LR_SSS_MODEL_COUNT 4
 /* "directional_dipole", "standard_dipole", "multipole". */
 const char *lr_sss_model_name(enum lr_sss_model m);
 /* Inverse of lr_sss_model_name; false for any other text. */

@@ -22,6 +22,13 @@ typedef struct lr_radiosity {
     lr_fb *fb[LR_MAX_LIGHTS * LR_MAX_K]; /* [l K + k] */
     float scale[LR_MAX_LIGHTS]; /* light l's maps store B * scale[l] */
     int F; /* frames accumulated */
+    /* Seed 001's diffusion_grid objects: their solves (CPU, redone when the maps restart) and
+     * the solved fields on the GPU, one 2D array per object: layer l nz + z holds light l's
+     * slice z (render/shaders/lib/dgrid.glsl). */
+    struct lr_dscene *dscene;
+    lr_tex *dg_tex[LR_MAX_OBJECTS];
+    int dg_dims[LR_MAX_OBJECTS][3];
+    int dg_lights[LR_MAX_OBJECTS];
 } lr_radiosity;
 
 /* Maps for c->rs (K, map_size) and c->n_lights lights; accumulation restarts. */
