@@ -232,10 +232,10 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
         *d = LR_DIRTY_MATERIAL;
         return LR_OK;
     }
-    if (strcmp(f, "normalize") == 0 || strcmp(f, "dgrid_h_mm") == 0 ||
-        strcmp(f, "dgrid_volume") == 0) /* another S_d, or the grid model's parameters */
+    if (strcmp(f, "normalize") == 0 || strcmp(f, "dgrid_volume") == 0) /* another S_d; the
+                                                   grid model's volume (read when it solves) */
         return table_field(o, &lr_scene_object_desc, rec, f, d);
-    if (strcmp(f, "model") == 0 || strcmp(f, "thickness_mm") == 0) {
+    if (strcmp(f, "model") == 0 || strcmp(f, "thickness_mm") == 0 || strcmp(f, "dgrid_h_mm") == 0) {
         /* The multipole models a wall: it needs the wall's thickness (issue 12). */
         obj_rec next = *rec;
         const char *bad = NULL;
