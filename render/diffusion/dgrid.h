@@ -75,6 +75,11 @@ typedef struct lr_dslab {
     double thickness;
 } lr_dslab;
 lr_dshape lr_dshape_slab(const lr_dslab *s);
+/* An axis-aligned box (the inverse problem's block samples, seed 001 Sec. 4.1). */
+typedef struct lr_dbox {
+    lr_vec3 lo, hi;
+} lr_dbox;
+lr_dshape lr_dshape_box(const lr_dbox *b);
 /* A closed mesh through its BVH (which must outlive the shape). Inside: parity of the crossings
  * of a ray from p along a fixed direction just off +z (coincident hits on a shared edge count
  * once). */

@@ -48,6 +48,62 @@ lr_dshape lr_dshape_slab(const lr_dslab *s)
                        lr_v3(0.0, 0.0, s->thickness)};
 }
 
+static bool box_inside(const void *ctx, lr_vec3 p)
+{
+    const lr_dbox *b = ctx;
+    return p.x > b->lo.x && p.x < b->hi.x && p.y > b->lo.y && p.y < b->hi.y && p.z > b->lo.z &&
+           p.z < b->hi.z;
+}
+
+static bool box_closest(const void *ctx, lr_vec3 p, double max_dist, lr_vec3 *out, lr_vec3 *n)
+{
+    const lr_dbox *b = ctx;
+    double pc[3] = {p.x, p.y, p.z}, lo[3] = {b->lo.x, b->lo.y, b->lo.z},
+           hi[3] = {b->hi.x, b->hi.y, b->hi.z}, q[3], nn[3] = {0, 0, 0};
+    if (box_inside(ctx, p)) {
+        /* the nearest face */
+        int best = 0;
+        double bd = INFINITY, side = 1.0;
+        for (int a = 0; a < 3; a++) {
+            if (pc[a] - lo[a] < bd)
+                bd = pc[a] - lo[a], best = a, side = -1.0;
+            if (hi[a] - pc[a] < bd)
+                bd = hi[a] - pc[a], best = a, side = 1.0;
+        }
+        for (int a = 0; a < 3; a++)
+            q[a] = pc[a];
+        q[best] = side > 0 ? hi[best] : lo[best];
+        nn[best] = side;
+    } else {
+        int best = 0;
+        double worst = -1.0;
+        for (int a = 0; a < 3; a++) {
+            q[a] = fmin(hi[a], fmax(lo[a], pc[a]));
+            double v = fabs(pc[a] - q[a]);
+            if (v > worst)
+                worst = v, best = a;
+        }
+        if (!(worst > 0.0)) {
+            /* on the surface: the face it lies on */
+            double bd = INFINITY;
+            for (int a = 0; a < 3; a++) {
+                double d = fmin(pc[a] - lo[a], hi[a] - pc[a]);
+                if (d < bd)
+                    bd = d, best = a;
+            }
+        }
+        nn[best] = pc[best] >= 0.5 * (lo[best] + hi[best]) ? 1.0 : -1.0;
+    }
+    *out = lr_v3(q[0], q[1], q[2]);
+    *n = lr_v3(nn[0], nn[1], nn[2]);
+    return lr_v3_len(lr_v3_sub(p, *out)) <= max_dist;
+}
+
+lr_dshape lr_dshape_box(const lr_dbox *b)
+{
+    return (lr_dshape){box_inside, box_closest, b, b->lo, b->hi};
+}
+
 /* Parity of crossings along a direction tilted off the axes, so that a ray through a grid
  * column does not run along the mesh's (often axis-aligned) edges. */
 static bool mesh_inside(const void *ctx, lr_vec3 p)
