@@ -57,14 +57,16 @@ static int models_arg(const lr_cli *c, const char *v, unsigned *out)
     snprintf(buf, sizeof buf, "%s", v);
     for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
         if (!strcmp(tok, "all"))
-            *out |= LR_PLAN_MODEL_DIRECTIONAL | LR_PLAN_MODEL_STANDARD;
+            *out |= LR_PLAN_MODEL_ALL;
+        else if (!strcmp(tok, "diffusion_grid"))
+            *out |= LR_PLAN_MODEL_DIFFUSION_GRID;
         else if (!strcmp(tok, "directional_dipole"))
             *out |= LR_PLAN_MODEL_DIRECTIONAL;
         else if (!strcmp(tok, "standard_dipole"))
             *out |= LR_PLAN_MODEL_STANDARD;
         else
             return lr_cli_usage(c->path, "--models %.100s: expected directional_dipole, "
-                                         "standard_dipole or all", tok);
+                                         "standard_dipole, diffusion_grid or all", tok);
     }
     if (!*out)
         return lr_cli_usage(c->path, "--models: empty");

@@ -176,6 +176,8 @@ static bool model_ok(const char *model, unsigned models)
         return models & LR_PLAN_MODEL_DIRECTIONAL;
     if (!strcmp(model, "standard_dipole"))
         return models & LR_PLAN_MODEL_STANDARD;
+    if (!strcmp(model, "diffusion_grid"))
+        return models & LR_PLAN_MODEL_DIFFUSION_GRID;
     return false;
 }
 
@@ -228,7 +230,8 @@ static int plan_object(const lr_scene *s, int index, const lr_plan_table *t,
     for (int pass = 0; pass < 2 && !ncand; pass++) {
         for (int i = 0; i < n; i++) {
             const lr_plan_row *r = lr_plan_table_row(t, i);
-            if (strcmp(r->scene, c->table_scene) || !model_ok(r->model, models))
+            if (strcmp(r->scene, c->table_scene) || !model_ok(r->model, models) ||
+                (!o->closed && !strcmp(r->model, "diffusion_grid"))) /* needs a solid body */
                 continue;
             if (!pass) {
                 nscene++;

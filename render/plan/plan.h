@@ -158,7 +158,9 @@ typedef struct lr_plan {
 enum lr_plan_models {
     LR_PLAN_MODEL_DIRECTIONAL = 1u << 0, /* "directional_dipole" */
     LR_PLAN_MODEL_STANDARD = 1u << 1,    /* "standard_dipole" */
-    LR_PLAN_MODEL_ALL = LR_PLAN_MODEL_DIRECTIONAL | LR_PLAN_MODEL_STANDARD,
+    LR_PLAN_MODEL_DIFFUSION_GRID = 1u << 2, /* "diffusion_grid" (seed 001; closed meshes only) */
+    LR_PLAN_MODEL_ALL = LR_PLAN_MODEL_DIRECTIONAL | LR_PLAN_MODEL_STANDARD |
+                        LR_PLAN_MODEL_DIFFUSION_GRID,
 };
 
 typedef struct lr_plan_options {

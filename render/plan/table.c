@@ -156,9 +156,10 @@ static int parse_row(const char *name, int line, char **f, const int *at, lr_pla
     TXT(C_SCENE, scene, true);
     TXT(C_MODEL, model, true);
     TXT(C_PARAMS, params, false);
-    if (strcmp(r->model, "directional_dipole") && strcmp(r->model, "standard_dipole"))
-        return cell_err(name, line, "model", e, "expected directional_dipole or standard_dipole",
-                        r->model);
+    if (strcmp(r->model, "directional_dipole") && strcmp(r->model, "standard_dipole") &&
+        strcmp(r->model, "diffusion_grid"))
+        return cell_err(name, line, "model", e,
+                        "expected directional_dipole, standard_dipole or diffusion_grid", r->model);
     NUM(C_FRAME_MS, frame_ms);
     NUM(C_RMSE, rel_rmse);
     NUM(C_RMSE_OBJ, rel_rmse_object);

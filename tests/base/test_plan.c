@@ -194,7 +194,7 @@ static void test_table_errors(void **state)
     expect_table_error(HDR "candle,directional_dipole,10,0.1,4,4,16,64,64,8,maybe\n",
                        "bad.csv:2: column 'vpl': expected on or off, got 'maybe'");
     expect_table_error(HDR "candle,photon_beams,10,0.1,4,4,16,64,64,8,on\n",
-                       "bad.csv:2: column 'model': expected directional_dipole or standard_dipole");
+                       "bad.csv:2: column 'model': expected directional_dipole, standard_dipole or diffusion_grid");
     expect_table_error(HDR "candle,directional_dipole,10,0.1,4,4,16,64,64,8\n",
                        "bad.csv:2: 10 cells, the header has 11");
     expect_table_error(HDR "candle,directional_dipole,0,0.1,4,4,16,64,64,8,on\n",

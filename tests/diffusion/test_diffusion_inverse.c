@@ -9,6 +9,10 @@
  *     means (geometric) of the recovered mu within 25 % of the truth and in the right order;
  *     on 4 held-out patterns (stripes) the heterogeneous fit's misfit is under half the
  *     homogeneous fit's.
+ *  3. `lamprig fit --diffusion`: a captures file written from the forward model (6 x 6 x 3 mm,
+ *     the same two regions, three bands) gives a volume file the loader accepts whose right
+ *     half absorbs more than its left in every band (truth: 3x); a malformed captures file
+ *     exits 2 naming FILE:LINE.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -23,6 +27,8 @@
 
 #include "render/diffusion/dgrid.h"
 #include "render/diffusion/inverse.h"
+#include "tests/support/cli.h"
+#include "tests/support/fs.h"
 
 typedef struct rect {
     double x0, y0, x1, y1;
@@ -210,11 +216,98 @@ static void test_two_regions(void **state)
     lr_dgrid_destroy(g);
 }
 
+static void test_cli(void **state)
+{
+    (void)state;
+    const double S = 6.0, T = 3.0;
+    lr_dbox box = {lr_v3(0, 0, 0), lr_v3(S, S, T)};
+    lr_dshape shape = lr_dshape_box(&box);
+    lr_dgrid *g;
+    lr_dsystem *sys;
+    lr_err e = {0};
+    assert_int_equal(lr_dgrid_create(&shape, 1.0, &g, &e), LR_OK);
+    assert_int_equal(lr_dsystem_create(g, 1.3, &sys, &e), LR_OK);
+    size_t ng = lr_dgrid_ghost_count(g), np = lr_dgrid_inside_count(g);
+    const rect pr[5] = {{0, 0, 6, 6}, {0, 0, 3, 3}, {3, 0, 6, 3}, {0, 3, 3, 6}, {3, 3, 6, 6}};
+    double *y[5][3], *q = malloc(ng * sizeof *q), *D = malloc(np * sizeof *D),
+                     *mu = malloc(np * sizeof *mu);
+    unsigned char *obs = malloc(ng);
+    for (int c = 0; c < 3; c++) {
+        for (size_t p = 0; p < np; p++) {
+            bool right = lr_dgrid_param_pos(g, p).x > 0.5 * S;
+            D[p] = right ? 0.20 : 0.30;
+            mu[p] = (right ? 0.060 : 0.020) * (1.0 + 0.5 * c);
+        }
+        assert_int_equal(lr_dsystem_set_params(sys, D, mu, &e), LR_OK);
+        for (int m = 0; m < 5; m++) {
+            y[m][c] = malloc(ng * sizeof(double));
+            pattern(g, T, pr[m], q, obs);
+            capture(sys, q, y[m][c]);
+        }
+    }
+    char *dir = lr_test_tmpdir();
+    size_t cap = 1 << 20, w = 0;
+    char *text = malloc(cap);
+    w += (size_t)snprintf(text + w, cap - w,
+                          "lamprig-diffusion-captures 1\n# simulated\nblock 6 6 3\neta 1.3\nh 1\n");
+    for (int m = 0; m < 5; m++) {
+        w += (size_t)snprintf(text + w, cap - w, "pattern %g %g %g %g 1 1 1\n", pr[m].x0, pr[m].y0,
+                              pr[m].x1, pr[m].y1);
+        pattern(g, T, pr[m], q, obs);
+        for (size_t k = 0; k < ng; k++) {
+            if (!obs[k])
+                continue;
+            lr_vec3 b, n;
+            size_t u;
+            lr_dgrid_ghost_at(g, k, &b, &n, &u);
+            w += (size_t)snprintf(text + w, cap - w, "B %.9g %.9g %.9g %.9g %.9g %.9g\n", b.x, b.y,
+                                  b.z, y[m][0][k], y[m][1][k], y[m][2][k]);
+        }
+    }
+    assert_true(w < cap);
+    free(lr_test_write(dir, "caps.txt", text, w));
+    int st = lr_test_run_cli(dir, "build/bin/lamprig fit --diffusion %s/caps.txt --out %s/fit.vol "
+                                  "--max-evals 60", dir, dir);
+    char *out = lr_test_slurp(dir, "out"), *err = lr_test_slurp(dir, "err");
+    printf("%s%s", out, err);
+    assert_int_equal(st, 0);
+    char *vol = lr_test_path(dir, "fit.vol");
+    lr_dvolume *v;
+    assert_int_equal(lr_dvolume_load(vol, &v, &e), LR_OK);
+    double sl[3], sr[3], ss[3];
+    lr_dvolume_at(v, lr_v3(1.0, 3.0, 1.5), sl, ss);
+    lr_dvolume_at(v, lr_v3(5.0, 3.0, 1.5), sr, ss);
+    printf("sigma_a left %.4f %.4f %.4f, right %.4f %.4f %.4f (truth 0.02 0.03 0.04 | 0.06 0.09 0.12)\n",
+           sl[0], sl[1], sl[2], sr[0], sr[1], sr[2]);
+    for (int c = 0; c < 3; c++)
+        assert_true(sr[c] > 1.5 * sl[c]);
+    lr_dvolume_destroy(v);
+    free(vol), free(out), free(err);
+    /* malformed: line 3 */
+    const char *bad = "lamprig-diffusion-captures 1\n\nblock 6 6\n";
+    free(lr_test_write(dir, "bad.txt", bad, strlen(bad)));
+    st = lr_test_run_cli(dir, "build/bin/lamprig fit --diffusion %s/bad.txt --out %s/bad.vol", dir,
+                         dir);
+    err = lr_test_slurp(dir, "err");
+    assert_int_equal(st, 2);
+    assert_non_null(strstr(err, "bad.txt:3: field 'block'"));
+    free(err);
+    free(text);
+    lr_test_rmtree(dir);
+    for (int m = 0; m < 5; m++)
+        for (int c = 0; c < 3; c++)
+            free(y[m][c]);
+    free(q), free(D), free(mu), free(obs);
+    lr_dsystem_destroy(sys);
+    lr_dgrid_destroy(g);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_adjoint_gradient),
         cmocka_unit_test(test_two_regions),
+        cmocka_unit_test(test_cli),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

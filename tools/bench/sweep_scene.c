@@ -214,6 +214,12 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
         if (k && getenv("LRB_SWEEP_SETTINGS") && !lrb_listed(getenv("LRB_SWEEP_SETTINGS"),
                                                             st->label))
             continue;
+        /* The grid diffusion needs solid bodies (a closed mesh): not for an open shade. */
+        bool solid = true;
+        for (int o = 0; o < lr_scene_object_count(s); o++)
+            solid &= lr_scene_object_at(s, o)->closed;
+        if (!solid && strcmp(st->model, "diffusion_grid") == 0)
+            continue;
         lr_eval_series ser = {0};
         if ((rc = run_series(gl, s, st, ss, &ser, &e)))
             goto done;

@@ -41,6 +41,7 @@ int lrb_sweep_settings(lrb_setting *out, int cap)
     ADD("gbuf=256", gbuffer_size, 256);
     ADD("vpl=off", vpl, false);
     ADD("standard", model, "standard_dipole");
+    ADD("diffusion_grid", model, "diffusion_grid"); /* seed 001 (render/diffusion/) */
 #undef ADD
     return n;
 }
