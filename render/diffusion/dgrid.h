@@ -56,11 +56,16 @@
 typedef bool (*lr_dshape_inside_fn)(const void *ctx, lr_vec3 p);
 typedef bool (*lr_dshape_closest_fn)(const void *ctx, lr_vec3 p, double max_dist, lr_vec3 *b,
                                      lr_vec3 *n_face);
+/* Optional: the z of every surface crossing of the vertical line through (x, y), ascending,
+ * at most max; returns the count (the grid builder then classifies a whole column with one
+ * cast instead of one per node). */
+typedef int (*lr_dshape_column_fn)(const void *ctx, double x, double y, double *z, int max);
 typedef struct lr_dshape {
     lr_dshape_inside_fn inside;
     lr_dshape_closest_fn closest;
     const void *ctx;
     lr_vec3 lo, hi; /* bounds of the object */
+    lr_dshape_column_fn column; /* NULL: inside() per node */
 } lr_dshape;
 
 /* A sphere (tests, closed forms). ctx points at the sphere, which must outlive the shape. */
@@ -208,6 +213,9 @@ const lr_dsystem *lr_dsolver_system(const lr_dsolver *s, int band);
 #define LR_DSOLVER_SLOTS 8
 int lr_dsolver_solve(lr_dsolver *s, int slot, lr_dirradiance_fn q, const void *qctx, double tol,
                      lr_err *e);
+/* New coefficients on the same grids (a material edit, seed 001 Sec. 5.4): the slots' last
+ * solutions stay as warm starts. */
+int lr_dsolver_set_material(lr_dsolver *s, const lr_dmaterial *m, lr_err *e);
 /* Forgets the slot's solution (the next solve starts coarse-to-fine). */
 void lr_dsolver_reset(lr_dsolver *s, int slot);
 const double *lr_dsolver_phi(const lr_dsolver *s, int slot, int band);

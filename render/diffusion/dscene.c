@@ -125,11 +125,42 @@ static void resolve_volume(const lr_scene *s, const char *rel, char *out, size_t
     snprintf(out, cap, "%s", rel);
 }
 
-static bool same_build(const dobj *d, const lr_scene_object *o, double h, const char *vol)
+static bool same_grid(const dobj *d, const lr_scene_object *o, double h)
 {
     return d->solver && d->mesh == o->mesh && memcmp(d->model, o->model, sizeof d->model) == 0 &&
-           memcmp(&d->medium, &o->material.medium, sizeof d->medium) == 0 && d->h == h &&
+           d->h == h;
+}
+
+static bool same_material(const dobj *d, const lr_scene_object *o, const char *vol)
+{
+    return memcmp(&d->medium, &o->material.medium, sizeof d->medium) == 0 &&
            strcmp(d->volume_path, vol) == 0;
+}
+
+/* A material edit on the same grid: new coefficients, the solutions kept as warm starts. */
+static int remat(dobj *d, int i, const lr_scene_object *o, const char *vol, lr_err *e)
+{
+    lr_dvolume *nv = NULL;
+    int rc;
+    if (vol[0] && (rc = lr_dvolume_load(vol, &nv, e)))
+        return lr_err_prefix(e, "objects[%d].dgrid_volume", i);
+    lr_dmaterial m = {{0}, {0}, o->material.medium.eta, nv};
+    memcpy(m.sigma_a, o->material.medium.sigma_a, sizeof m.sigma_a);
+    memcpy(m.sigma_s_prime, o->material.medium.sigma_s_prime, sizeof m.sigma_s_prime);
+    if (m.eta != d->medium.eta) { /* A changes the ghost rows: rebuild */
+        lr_dvolume_destroy(nv);
+        return -1;
+    }
+    if ((rc = lr_dsolver_set_material(d->solver, &m, e))) {
+        lr_dvolume_destroy(nv);
+        return rc;
+    }
+    lr_dvolume_destroy(d->volume);
+    d->volume = nv;
+    d->medium = o->material.medium;
+    if (snprintf(d->volume_path, sizeof d->volume_path, "%s", vol) >= (int)sizeof d->volume_path)
+        return lr_err_set(e, LR_EINVAL, "objects[%d].dgrid_volume: path too long", i);
+    return LR_OK;
 }
 
 static int build(dobj *d, const lr_scene *s, int i, const lr_scene_object *o, double h,
@@ -178,7 +209,16 @@ int lr_dscene_update(lr_dscene *d, const lr_scene *s, lr_err *e)
         if (o->dgrid_volume[0])
             resolve_volume(s, o->dgrid_volume, vol, sizeof vol);
         int rc;
-        if (!same_build(D, o, h, vol) && (rc = build(D, s, i, o, h, vol, e))) {
+        rc = LR_OK;
+        if (same_grid(D, o, h)) {
+            if (!same_material(D, o, vol))
+                rc = remat(D, i, o, vol, e);
+        } else {
+            rc = -1;
+        }
+        if (rc == -1)
+            rc = build(D, s, i, o, h, vol, e);
+        if (rc) {
             dobj_clear(D);
             return rc;
         }

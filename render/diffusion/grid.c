@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "render/diffusion/dgrid.h"
 #include "render/diffusion/dgrid_internal.h"
@@ -116,12 +117,61 @@ int lr_dgrid_create_box(const lr_dshape *s, lr_vec3 origin, double h, const int 
         lr_dgrid_destroy(g);
         return lr_err_set(e, LR_ENOMEM, "diffusion grid: out of memory (%zu nodes)", N);
     }
+    /* Inside: one vertical cast per column when the shape offers it (parity of the crossings
+     * below each node), else the shape's own test per node. */
+    if (s->column) {
+        double z[256];
+        for (int j = 0; j < n[1]; j++)
+            for (int i = 0; i < n[0]; i++) {
+                int m = s->column(s->ctx, origin.x + h * i, origin.y + h * j, z, 256);
+                int below = 0;
+                for (int k = 0; k < n[2]; k++) {
+                    double zk = origin.z + h * k;
+                    while (below < m && z[below] < zk)
+                        below++;
+                    g->kind[node_index(g, i, j, k)] = (m < 256 && (below & 1)) ? 1 : 0;
+                }
+            }
+    }
+    else
+        for (size_t node = 0; node < N; node++)
+            g->kind[node] = s->inside(s->ctx, lr_dgrid_node_pos(g, node)) ? 1 : 0;
+    /* Closest points only near the surface: a node within 1.75 h of a (locally flat) surface
+     * has a node of the other side within 3 steps along each axis (3 h (|nx|+|ny|+|nz|) >= 3 h
+     * across it), so nodes whose 7^3 block is all one side are skipped. Max and min filters,
+     * one axis at a time. */
+    uint8_t *mx = malloc(N), *mn = malloc(N), *tmp = malloc(N);
+    if (!mx || !mn || !tmp) {
+        free(mx), free(mn), free(tmp), free(in_band), free(bb), free(bn);
+        lr_dgrid_destroy(g);
+        return lr_err_set(e, LR_ENOMEM, "diffusion grid: out of memory (%zu nodes)", N);
+    }
+    memcpy(mx, g->kind, N);
+    memcpy(mn, g->kind, N);
+    size_t stride[3] = {1, (size_t)n[0], (size_t)n[0] * (size_t)n[1]};
+    for (int a = 0; a < 3; a++)
+        for (int pass = 0; pass < 2; pass++) {
+            uint8_t *f = pass ? mn : mx;
+            memcpy(tmp, f, N);
+            for (size_t node = 0; node < N; node++) {
+                int c = (int)((node / stride[a]) % (size_t)n[a]);
+                uint8_t v = f[node];
+                for (int d = -3; d <= 3; d++) {
+                    if (c + d < 0 || c + d >= n[a])
+                        continue;
+                    uint8_t w = f[(size_t)((long)node + d * (long)stride[a])];
+                    v = pass ? (w < v ? w : v) : (w > v ? w : v);
+                }
+                tmp[node] = v;
+            }
+            memcpy(f, tmp, N);
+        }
     size_t n_in = 0, n_ghost = 0, n_band = 0;
     for (size_t node = 0; node < N; node++) {
         lr_vec3 p = lr_dgrid_node_pos(g, node);
-        bool inside = s->inside(s->ctx, p);
+        bool inside = g->kind[node] == 1;
         lr_vec3 b, nf;
-        if (s->closest(s->ctx, p, LR_DGRID_BAND * h, &b, &nf)) {
+        if (mx[node] != mn[node] && s->closest(s->ctx, p, LR_DGRID_BAND * h, &b, &nf)) {
             lr_vec3 d = lr_v3_sub(p, b);
             double l = lr_v3_len(d);
             in_band[node] = true;
@@ -137,6 +187,7 @@ int lr_dgrid_create_box(const lr_dshape *s, lr_vec3 origin, double h, const int 
         else if (in_band[node])
             n_ghost++;
     }
+    free(mx), free(mn), free(tmp);
     if (n_in == 0) {
         free(in_band), free(bb), free(bn);
         lr_dgrid_destroy(g);

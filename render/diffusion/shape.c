@@ -24,7 +24,8 @@ static bool sphere_closest(const void *ctx, lr_vec3 p, double max_dist, lr_vec3 
 lr_dshape lr_dshape_sphere(const lr_dsphere *s)
 {
     lr_vec3 r = lr_v3(s->r, s->r, s->r);
-    return (lr_dshape){sphere_inside, sphere_closest, s, lr_v3_sub(s->c, r), lr_v3_add(s->c, r)};
+    return (lr_dshape){sphere_inside, sphere_closest, s, lr_v3_sub(s->c, r), lr_v3_add(s->c, r),
+                       NULL};
 }
 
 static bool slab_inside(const void *ctx, lr_vec3 p)
@@ -45,7 +46,7 @@ static bool slab_closest(const void *ctx, lr_vec3 p, double max_dist, lr_vec3 *b
 lr_dshape lr_dshape_slab(const lr_dslab *s)
 {
     return (lr_dshape){slab_inside, slab_closest, s, lr_v3(0.0, 0.0, 0.0),
-                       lr_v3(0.0, 0.0, s->thickness)};
+                       lr_v3(0.0, 0.0, s->thickness), NULL};
 }
 
 static bool box_inside(const void *ctx, lr_vec3 p)
@@ -101,7 +102,7 @@ static bool box_closest(const void *ctx, lr_vec3 p, double max_dist, lr_vec3 *ou
 
 lr_dshape lr_dshape_box(const lr_dbox *b)
 {
-    return (lr_dshape){box_inside, box_closest, b, b->lo, b->hi};
+    return (lr_dshape){box_inside, box_closest, b, b->lo, b->hi, NULL};
 }
 
 /* Parity of crossings along a direction tilted off the axes, so that a ray through a grid
@@ -132,9 +133,29 @@ static bool mesh_closest(const void *ctx, lr_vec3 p, double max_dist, lr_vec3 *b
     return true;
 }
 
+static int mesh_column(const void *ctx, double x, double y, double *z, int max)
+{
+    const lr_bvh *bvh = ctx;
+    lr_vec3 lo, hi;
+    lr_mesh_bounds(lr_bvh_mesh(bvh), &lo, &hi);
+    /* A hair off the node's column, so that a column through a vertex or an edge of a
+     * generated mesh (revolved at regular angles) is not hit twice or grazed. */
+    lr_vec3 o = lr_v3(x + 1.234567e-7 * (1.0 + fabs(x)), y + 7.654321e-8 * (1.0 + fabs(y)),
+                      lo.z - 1.0);
+    const lr_vec3 d = lr_v3(0.0, 0.0, 1.0);
+    double tmin = 0.0;
+    int n = 0;
+    lr_hit hit;
+    while (n < max && lr_bvh_intersect(bvh, o, d, tmin, INFINITY, &hit)) {
+        z[n++] = o.z + hit.t;
+        tmin = hit.t + 1e-9 * (1.0 + hit.t);
+    }
+    return n;
+}
+
 lr_dshape lr_dshape_mesh(const lr_bvh *bvh)
 {
-    lr_dshape s = {mesh_inside, mesh_closest, bvh, lr_v3(0, 0, 0), lr_v3(0, 0, 0)};
+    lr_dshape s = {mesh_inside, mesh_closest, bvh, lr_v3(0, 0, 0), lr_v3(0, 0, 0), mesh_column};
     lr_mesh_bounds(lr_bvh_mesh(bvh), &s.lo, &s.hi);
     return s;
 }

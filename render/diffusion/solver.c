@@ -115,6 +115,17 @@ int lr_dsolver_create(const lr_dshape *shape, double h, int levels, const lr_dma
     return LR_OK;
 }
 
+int lr_dsolver_set_material(lr_dsolver *s, const lr_dmaterial *m, lr_err *e)
+{
+    for (int l = 0; l < s->levels; l++)
+        for (int c = 0; c < 3; c++) {
+            int rc = set_material(s->sys[l][c], s->grid[l], m, c, e);
+            if (rc)
+                return rc;
+        }
+    return LR_OK;
+}
+
 const lr_dgrid *lr_dsolver_grid(const lr_dsolver *s) { return s->grid[0]; }
 const lr_dsystem *lr_dsolver_system(const lr_dsolver *s, int band) { return s->sys[0][band]; }
 const double *lr_dsolver_phi(const lr_dsolver *s, int slot, int band)
