@@ -225,13 +225,19 @@ int lr_dfit_run(const lr_dfit_desc *d, lr_dfit_result *res, lr_err *e)
         lr_vec3 p = lr_v3(c.o[i].x, c.o[i].y, c.o[i].z);
         size_t best = 0;
         double bd = INFINITY;
+        int m = c.o[i].pattern;
         for (size_t k = 0; k < ng; k++) {
             lr_vec3 b, n;
             size_t u;
             lr_dgrid_ghost_at(g, k, &b, &n, &u);
             double dd = lr_v3_len(lr_v3_sub(b, p));
-            if (dd < bd)
-                bd = dd, best = k;
+            /* Ghosts sharing a surface point (a face's depths 0 and h, box edges): the last one
+             * this pattern leaves unlit, as a measurement of multiple scattering is (seed 001
+             * Sec. 4.1). */
+            bool unlit = q[((size_t)m * 3) * ng + k] == 0.0 && q[((size_t)m * 3 + 1) * ng + k] == 0.0 &&
+                         q[((size_t)m * 3 + 2) * ng + k] == 0.0;
+            if (dd < bd - 1e-9 * c.h || (dd <= bd + 1e-9 * c.h && unlit))
+                bd = fmin(bd, dd), best = k;
         }
         if (!(bd <= c.h)) {
             rc = lr_err_set(e, LR_EINVAL,
@@ -239,7 +245,6 @@ int lr_dfit_run(const lr_dfit_desc *d, lr_dfit_result *res, lr_err *e)
                             d->captures, p.x, p.y, p.z, c.h);
             goto done;
         }
-        int m = c.o[i].pattern;
         seen[(size_t)m * ng + best] = 1;
         for (int ch = 0; ch < 3; ch++)
             y[((size_t)m * 3 + ch) * ng + best] = c.o[i].B[ch];

@@ -260,6 +260,23 @@ static void test_cli(void **state)
             lr_vec3 b, n;
             size_t u;
             lr_dgrid_ghost_at(g, k, &b, &n, &u);
+            /* A camera sees face points; edges and corners are where several ghosts (with
+             * different normals, some lit) share one surface point. */
+            int at = (b.x <= 0 || b.x >= S) + (b.y <= 0 || b.y >= S) + (b.z <= 0 || b.z >= T);
+            if (at > 1)
+                continue;
+            /* Where two ghosts share a point (depths 0 and h outside a face), the fit reads
+             * the last one (dfit.c): write that one's B only, so that the captures are the
+             * fit's own forward model (the two differ by the discretisation error). */
+            bool later = false;
+            for (size_t k2 = k + 1; k2 < ng && !later; k2++) {
+                lr_vec3 b2, n2;
+                size_t u2;
+                lr_dgrid_ghost_at(g, k2, &b2, &n2, &u2);
+                later = obs[k2] && lr_v3_len(lr_v3_sub(b2, b)) < 1e-9;
+            }
+            if (later)
+                continue;
             w += (size_t)snprintf(text + w, cap - w, "B %.9g %.9g %.9g %.9g %.9g %.9g\n", b.x, b.y,
                                   b.z, y[m][0][k], y[m][1][k], y[m][2][k]);
         }
@@ -293,7 +310,7 @@ static void test_cli(void **state)
     assert_non_null(strstr(err, "bad.txt:3: field 'block'"));
     free(err);
     free(text);
-    lr_test_rmtree(dir);
+    lr_test_rmtree(dir); /* kept on failure (fail_msg returns early) */
     for (int m = 0; m < 5; m++)
         for (int c = 0; c < 3; c++)
             free(y[m][c]);
