@@ -317,7 +317,7 @@ int lr_dinv_fit(lr_dinv *v, double *theta, int max_iter, double f_stop, lr_dinv_
         if ((rc = line_f(v, theta, dir, x1, tmp, &f1, &r.evaluations, e)) ||
             (rc = line_f(v, theta, dir, x2, tmp, &f2, &r.evaluations, e)))
             goto done;
-        for (int k = 0; k < 12; k++) {
+        for (int k = 0; k < 10; k++) {
             if (f1 < f2) {
                 hi = x2;
                 x2 = x1;
