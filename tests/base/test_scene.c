@@ -763,7 +763,7 @@ static void test_model_switch_and_light_cap(void **state)
     lr_scene_destroy(s);
     scene_text(t, sizeof t, ",\n     \"model\": \"dipole\"", "", NULL);
     expect_scene_error(t, LR_EINVAL, "t.json:6: field 'objects[0].model': 'dipole': expected "
-                                     "directional_dipole, standard_dipole or multipole");
+                                     "directional_dipole, standard_dipole, multipole or diffusion_grid");
     scene_text(t, sizeof t, ",\n     \"model\": 1", "", NULL);
     expect_scene_error(t, LR_EPARSE, "t.json:6: field 'objects[0].model'");
 
