@@ -11,6 +11,7 @@
 #include "firmware/commands/commands.h"
 #include "render/base/atomic_file.h"
 #include "render/base/json.h"
+#include "render/diffusion/dfit.h"
 #include "render/gl/gl.h"
 #include "render/material/material.h"
 #include "render/renderer.h"
@@ -18,6 +19,10 @@
 static int run_fit(const lr_cli *c);
 
 static const lr_argspec opts[] = {
+    {.name = "--diffusion", .type = LR_ARG_PATH, .metavar = "CAPTURES", .flags = LR_ARG_ALONE,
+     .help = "inverse diffusion (seed 001): a block sample's captures under projector patterns\n"
+             "(format in render/diffusion/dfit.h) to a per-voxel volume file, --out F.vol;\n"
+             "--max-evals sets the conjugate-gradient iterations (default 150)"},
     {.name = "--scene", .type = LR_ARG_PATH, .flags = LR_ARG_REQUIRED,
      .help = "the scene; its camera must be the rig's camera"},
     {.name = "--captures", .type = LR_ARG_STRING, .metavar = "IMG[,IMG...]",
@@ -166,10 +171,38 @@ done:
     return rc;
 }
 
+/* lamprig fit --diffusion CAPTURES --out F.vol (render/diffusion/dfit.h). */
+static int run_fit_diffusion(const lr_cli *c)
+{
+    const lr_args *a = &c->args;
+    lr_err e = {0};
+    const char *out = lr_args_get(a, "--out");
+    if (!out)
+        return lr_cli_usage(c->path, "--diffusion needs --out F.vol");
+    lr_dfit_desc d = {.captures = lr_args_get(a, "--diffusion"), .out = out};
+    int st = lr_cli_check(c, lr_args_int(a, "--max-evals", &d.max_iter, &e), &e);
+    if (st)
+        return st;
+    lr_dfit_result r;
+    if (lr_dfit_run(&d, &r, &e))
+        return e.code == LR_EPARSE || e.code == LR_EINVAL ? lr_cli_usage(c->path, "%s", e.msg)
+                                                          : lr_cli_fail(c->path, "%s", e.msg);
+    printf("fit --diffusion: %d patterns, %d observations, %d unknowns per band\n", r.patterns,
+           r.observations, r.unknowns_per_band);
+    for (int ch = 0; ch < 3; ch++)
+        printf("  band %d: homogeneous D %.4g mm mu %.4g /mm (misfit %.3e); per voxel misfit %.3e\n",
+               ch, r.homogeneous_D[ch], r.homogeneous_mu[ch], r.misfit_homogeneous[ch],
+               r.misfit[ch]);
+    printf("wrote %s (%d regions)\n", out, r.regions);
+    return LR_EXIT_OK;
+}
+
 static int run_fit(const lr_cli *c)
 {
     const lr_args *a = &c->args;
     lr_err e = {0};
+    if (lr_args_has(a, "--diffusion"))
+        return run_fit_diffusion(c);
     const char *scene_path = lr_args_get(a, "--scene"), *caps = lr_args_get(a, "--captures"),
                *out = lr_args_get(a, "--out");
     lr_fit_desc d = {.samples = 128};

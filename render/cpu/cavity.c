@@ -88,7 +88,9 @@ int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
     out->applies = enclosure == LR_ENCLOSURE_HULL && l->type != LR_LIGHT_DIRECTIONAL &&
                    !(obj->sd_raw && obj->sss_model == LR_SSS_DIRECTIONAL_DIPOLE) &&
                    /* translucent radiosity solves the cavity's inter-reflection itself */
-                   obj->sss_model != LR_SSS_TRANSLUCENT_RADIOSITY;
+                   obj->sss_model != LR_SSS_TRANSLUCENT_RADIOSITY &&
+
+                   obj->sss_model != LR_SSS_DIFFUSION_GRID; /* not a profile: no closure */
     if (!out->applies)
         return LR_OK;
 

@@ -49,6 +49,7 @@ typedef struct rctx {
     double **grid;
     int nrecv;
     lr_tr_scene *tr;     /* translucent radiosity (PASS): the solver's B and receiver extra */
+    lr_dscene *dscene; /* diffusion_grid objects' fields (NULL when the scene has none) */
 } rctx;
 
 static uint64_t seed_of(const rctx *r) { return r->d->seed ? r->d->seed : 1; }
@@ -70,6 +71,8 @@ static void radiosity_at(const rctx *r, int o, int l, lr_vec3 x, lr_vec3 n, uint
     if (r->d->mode == LR_CPU_REFERENCE) {
         lr_cpu_radiosity_desc rd = {.N = r->samples, .sampler = LR_CPU_REFERENCE,
                                     .others = r->objs, .n_others = r->nobj};
+        if (r->dscene)
+            lr_dscene_field(r->dscene, o, l, &rd.dfield);
         lr_cpu_estimate est;
         lr_cpu_radiosity(lr_scene_object_at(r->s, o), lr_scene_light_at(r->s, l), x, n, &rd, key,
                          &est);
@@ -293,6 +296,11 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
         if (rc)
             goto fail;
     }
+    for (int o = 0; o < r.nobj && !r.dscene; o++)
+        if (lr_scene_object_at(s, o)->sss_model == LR_SSS_DIFFUSION_GRID) {
+            if ((rc = lr_dscene_create(&r.dscene, e)) || (rc = lr_dscene_update(r.dscene, s, e)))
+                goto fail;
+        }
     double samples = 0.0;
     if (!ref && (rc = lr_tr_scene_update(&r.tr, s, e)))
         goto fail;
@@ -310,6 +318,8 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
                                        .others = r.objs,
                                        .n_others = r.nobj,
                                        .tr = r.tr, .tr_object = o, .tr_light = l};
+                if (r.dscene)
+                    lr_dscene_field(r.dscene, o, l, &md.dfield);
                 lr_cpu_maps **m = &r.maps[o * r.nlight + l];
                 if ((rc = lr_cpu_maps_create(&md, m, e)))
                     goto fail;
@@ -380,6 +390,7 @@ fail:
         for (int i = 0; i < r.nobj * r.nlight; i++)
             lr_cpu_maps_destroy(r.maps[i]);
     free(r.maps);
+    lr_dscene_destroy(r.dscene); /* after the maps, which point into it */
     free(r.vpl);
     free(r.I);
     free(r.gain);

@@ -20,6 +20,7 @@ struct lr_cpu_maps {
     const lr_tr_scene *tr;
     int tr_object, tr_light;
     unsigned seed;
+    lr_dfield_view dfield; /* the caller's; must outlive the maps */
     lr_vec3 *dir, *eye, *right, *up;
     lr_cpu_texel *tex; /* K * S * S, map-major, row j then column i */
 };
@@ -87,6 +88,7 @@ int lr_cpu_maps_create(const lr_cpu_maps_desc *d, lr_cpu_maps **out, lr_err *e)
     m->N = d->N ? d->N : 16;
     m->r_max = d->r_max;
     m->others = d->others;
+    m->dfield = d->dfield;
     m->n_others = d->n_others;
     m->sampler = d->sampler;
     m->tr = lr_tr_scene_vertex_B(d->tr, d->tr_object, d->tr_light) ? d->tr : NULL;
@@ -155,7 +157,8 @@ static void acc_item(void *p, long item)
         return;
     }
     lr_cpu_radiosity_desc d = {.N = m->N, .sampler = m->sampler, .r_max = m->r_max,
-                               .others = m->others, .n_others = m->n_others};
+                               .others = m->others, .n_others = m->n_others,
+                               .dfield = m->dfield};
     lr_cpu_estimate est;
     lr_cpu_radiosity(m->obj, &m->light, t->x, t->n, &d,
                      lr_cpu_key(m->seed, (uint64_t)k, (uint64_t)texel, (uint64_t)a->frame), &est);

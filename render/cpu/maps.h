@@ -40,6 +40,7 @@ typedef struct lr_cpu_maps_desc {
      * x_o (the GPU's radiosity.vert does the same), instead of the estimator. */
     const struct lr_tr_scene *tr;
     int tr_object, tr_light;
+    lr_dfield_view dfield; /* diffusion_grid objects: the solved field (lr_cpu_radiosity_desc) */
 } lr_cpu_maps_desc;
 
 typedef struct lr_cpu_texel {

@@ -316,6 +316,16 @@ void lr_cpu_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3
     }
 
     out->n = N;
+    if (obj->sss_model == LR_SSS_DIFFUSION_GRID) {
+        double B[3] = {0.0, 0.0, 0.0};
+        if (d && d->dfield.data)
+            lr_dfield_eval(d->dfield.data, d->dfield.n, d->dfield.origin, d->dfield.h, xo, B);
+        for (int c = 0; c < 3; c++) {
+            out->mean[c] = B[c];
+            out->var[c] = 0.0;
+        }
+        return;
+    }
     for (int c = 0; c < 3; c++) {
         /* seed 003 Sec. 3.1: a separate set of samples per colour band. */
         lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(stream, (uint64_t)c, 0x5A3D, 0));

@@ -29,6 +29,7 @@
 #include <stdint.h>
 
 #include "render/base/vec3.h"
+#include "render/diffusion/dscene.h"
 #include "render/scene/scene.h"
 
 /* PIPELINE.md: r_max = 20 max(bounding radius, |x_l - x_o|) (directional: 20 radii). */
@@ -51,6 +52,9 @@ typedef struct lr_cpu_radiosity_desc {
      * surface the G-buffer texel holds (its texel centre). NULL: exact ray casts. */
     lr_vec3 (*snap)(void *snap_ctx, lr_vec3 v);
     void *snap_ctx;
+    /* "model": "diffusion_grid" (seed 001): B is the solved field at x_o (lr_dfield_eval, the
+     * pass's arithmetic; no samples, variance 0); data NULL gives 0. Both samplers. */
+    lr_dfield_view dfield;
 } lr_cpu_radiosity_desc;
 
 typedef struct lr_cpu_estimate {

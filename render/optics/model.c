@@ -8,7 +8,8 @@
 #include <string.h>
 
 static const char *const names[LR_SSS_MODEL_COUNT] = {"directional_dipole", "standard_dipole",
-                                                       "multipole", "translucent_radiosity"};
+                                                       "multipole", "translucent_radiosity",
+                                                       "diffusion_grid"};
 
 /* Translucent radiosity (seed 000) evaluates a profile of its own choosing: the slab multipole
  * where the object gives a wall thickness, the standard dipole otherwise. */
@@ -54,6 +55,8 @@ void lr_sss_sd_fresnel_n(enum lr_sss_model m, const lr_coeffs *c, double thickne
         lr_dipole_sd_fresnel(c, xi, ni, wi, xo, out);
     else if (m == LR_SSS_MULTIPOLE)
         lr_multipole_sd_fresnel_n(c, thickness_mm, pairs, xi, ni, wi, xo, no, out);
+    else if (m == LR_SSS_DIFFUSION_GRID)
+        out[0] = out[1] = out[2] = 0.0; /* no profile: the grid's field (render/diffusion) */
     else
         lr_dirpole_sd_fresnel(c, xi, ni, wi, xo, no, out);
 }

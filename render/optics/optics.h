@@ -190,9 +190,14 @@ enum lr_sss_model { LR_SSS_DIRECTIONAL_DIPOLE = 0, LR_SSS_STANDARD_DIPOLE = 1,
                     LR_SSS_MULTIPOLE = 2,
                     /* seed 000's patch solve (render/transrad/): its profile is the multipole's
                      * with a thickness, else the standard dipole's (lr_sss_sd_fresnel) */
-                    LR_SSS_TRANSLUCENT_RADIOSITY = 3 };
-#define LR_SSS_MODEL_COUNT 4
-/* "directional_dipole", "standard_dipole", "multipole". */
+                    LR_SSS_TRANSLUCENT_RADIOSITY = 3,
+
+                    /* seed 001: the diffusion equation solved on a grid (render/diffusion/);
+                     * not a BSSRDF: lr_sss_sd_fresnel gives 0, the passes read its solved field */
+                    LR_SSS_DIFFUSION_GRID = 4 };
+#define LR_SSS_MODEL_COUNT 5
+/* "directional_dipole", "standard_dipole", "multipole", "translucent_radiosity",
+ * "diffusion_grid". */
 const char *lr_sss_model_name(enum lr_sss_model m);
 /* Inverse of lr_sss_model_name; false for any other text. */
 bool lr_sss_model_parse(const char *name, enum lr_sss_model *out);

@@ -15,8 +15,13 @@
 #include <stdlib.h>
 
 #include "render/base/mat4.h"
+#include "render/diffusion/dscene.h"
 #include "render/optics/optics.h"
 #include "render/passes/radiosity.h"
+
+/* Texture unit of the diffusion grid's field: above the G-buffer's (0-3), the gather's (4-10)
+ * and the lights' arrays (11-14), within the 16 units GLES 3.1 guarantees. */
+#define LR_DGRID_TEX_UNIT 15
 
 int lr_radiosity_alloc(lr_radiosity *rad, const lr_pass_ctx *c, lr_err *e)
 {
@@ -62,9 +67,13 @@ void lr_radiosity_free(lr_radiosity *rad)
     for (int i = 0; i < LR_MAX_OBJECTS; i++) {
         lr_tex_destroy(rad->trB[i]);
         rad->trB[i] = NULL;
+        lr_tex_destroy(rad->dg_tex[i]);
+        rad->dg_tex[i] = NULL;
     }
     lr_tr_scene_destroy(rad->tr);
     rad->tr = NULL;
+    lr_dscene_destroy(rad->dscene);
+    rad->dscene = NULL;
     lr_tex_destroy(rad->B);
     lr_tex_destroy(rad->pos);
     lr_tex_destroy(rad->nrm);
@@ -108,6 +117,54 @@ static void place_maps(lr_radiosity *rad, const lr_pass_ctx *ctx, const lr_gbuff
     double texel = 2.0 * R / rad->size;
     rad->eps_comb = (float)texel;
     rad->eps_bias = (float)(2.0 * texel / (2.0 * R)); /* two texels, in depth units */
+}
+
+/* Seed 001: solve the diffusion_grid objects for every light (warm-started, dscene.h) and
+ * upload their fields. Runs when the maps restart: a light, material or geometry change. */
+static int dgrid_update(lr_radiosity *rad, const lr_pass_ctx *c, lr_err *e)
+{
+    bool any = false;
+    int n = lr_scene_object_count(c->scene), rc;
+    for (int i = 0; i < n && i < LR_MAX_OBJECTS; i++)
+        any |= lr_scene_object_at(c->scene, i)->sss_model == LR_SSS_DIFFUSION_GRID;
+    if (!any && !rad->dscene)
+        return LR_OK;
+    if (!rad->dscene && (rc = lr_dscene_create(&rad->dscene, e)))
+        return rc;
+    if ((rc = lr_dscene_update(rad->dscene, c->scene, e)))
+        return rc;
+    for (int i = 0; i < LR_MAX_OBJECTS; i++) {
+        lr_dfield_view v;
+        if (!lr_dscene_field(rad->dscene, i, 0, &v)) {
+            lr_tex_destroy(rad->dg_tex[i]);
+            rad->dg_tex[i] = NULL;
+            continue;
+        }
+        int L = rad->n_lights;
+        if (!rad->dg_tex[i] || rad->dg_dims[i][0] != v.n[0] || rad->dg_dims[i][1] != v.n[1] ||
+            rad->dg_dims[i][2] != v.n[2] || rad->dg_lights[i] != L) {
+            lr_tex_destroy(rad->dg_tex[i]);
+            rad->dg_tex[i] = NULL;
+            lr_tex_desc d = {.type = LR_TEX_2D_ARRAY, .format = LR_TEX_RGBA32F, .width = v.n[0],
+                             .height = v.n[1], .layers = v.n[2] * L,
+                             .label = "diffusion grid field"};
+            if ((rc = lr_tex_create(c->gl, &d, &rad->dg_tex[i], e)))
+                return lr_err_prefix(e, "objects[%d]: diffusion_grid (%d x %d x %d nodes, %d lights)",
+                                     i, v.n[0], v.n[1], v.n[2], L);
+            for (int a = 0; a < 3; a++)
+                rad->dg_dims[i][a] = v.n[a];
+            rad->dg_lights[i] = L;
+        }
+        for (int l = 0; l < L; l++) {
+            if (!lr_dscene_field(rad->dscene, i, l, &v))
+                continue;
+            for (int z = 0; z < v.n[2]; z++)
+                if ((rc = lr_tex_upload(rad->dg_tex[i], l * v.n[2] + z,
+                                        v.data + (size_t)4 * v.n[0] * v.n[1] * z, e)))
+                    return rc;
+        }
+    }
+    return LR_OK;
 }
 
 /* The running mean's weight for frame F: 1/F. For RGBA16F maps the GPU may evaluate the blend
@@ -175,6 +232,8 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
         place_maps(rad, c, gb);
         rad->F = 0;
         int rc = tr_refresh(rad, c, e);
+        if (!rc)
+            rc = dgrid_update(rad, c, e);
         if (rc)
             return rc;
     }
@@ -225,6 +284,9 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
             lr_passes_uniform_i(p, "u_N", c->rs->N);
             lr_passes_uniform_f(p, "u_r_max", (float)rad->r_max);
             lr_passes_uniform_f(p, "u_r_max_dist", 20.0f);
+            /* Its own unit even without a diffusion_grid object: the default 0 is the
+             * G-buffer's cube, and two sampler types on one unit fail the draw. */
+            lr_passes_uniform_i(p, "u_dg_field", LR_DGRID_TEX_UNIT);
             lr_passes_uniform_i(p, "u_map_size", rad->size);
             lr_passes_uniform_f(p, "u_map_scale", rad->scale[l]);
             /* Half floats: stay below 65504 (a light on the surface has B -> Inf at x_o -> x_l). */
@@ -233,6 +295,15 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
             glUniform1ui(lr_program_uniform(p, "u_map"), (GLuint)k);
             glUniform1ui(lr_program_uniform(p, "u_frame"), (GLuint)F);
             for (int i = 0; i < c->objs->n_objects; i++) {
+                if (rad->dg_tex[i]) {
+                    lr_dfield_view v;
+                    lr_dscene_field(rad->dscene, i, l, &v);
+                    lr_passes_bind_tex(p, "u_dg_field", LR_DGRID_TEX_UNIT, rad->dg_tex[i]);
+                    lr_passes_uniform_v3(p, "u_dg_origin", v.origin);
+                    lr_passes_uniform_f(p, "u_dg_h", (float)v.h);
+                    glUniform3i(lr_program_uniform(p, "u_dg_dims"), v.n[0], v.n[1], v.n[2]);
+                    lr_passes_uniform_i(p, "u_dg_layer0", l * v.n[2]);
+                }
                 lr_passes_uniform_i(p, "u_object", i);
                 lr_passes_uniform_i(p, "u_two_sided", c->objs->two_sided[i]);
                 bool tr = i < LR_MAX_OBJECTS && rad->trB[i];

@@ -32,6 +32,13 @@ typedef struct lr_radiosity {
     lr_tr_scene *tr;
     lr_tex *trB[LR_MAX_OBJECTS];
     int tr_rows[LR_MAX_OBJECTS];
+    /* Seed 001's diffusion_grid objects: their solves (CPU, redone when the maps restart) and
+     * the solved fields on the GPU, one 2D array per object: layer l nz + z holds light l's
+     * slice z (render/shaders/lib/dgrid.glsl). */
+    struct lr_dscene *dscene;
+    lr_tex *dg_tex[LR_MAX_OBJECTS];
+    int dg_dims[LR_MAX_OBJECTS][3];
+    int dg_lights[LR_MAX_OBJECTS];
 } lr_radiosity;
 
 /* Maps for c->rs (K, map_size) and c->n_lights lights; accumulation restarts. */

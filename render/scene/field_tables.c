@@ -154,7 +154,8 @@ const lr_record_desc lr_scene_receiver_desc = {"receivers[i]", "a receiver", rec
 #define O(m) offsetof(obj_rec, m)
 
 static const char *const sss_models[] = {"directional_dipole", "standard_dipole", "multipole",
-                                         "translucent_radiosity", NULL};
+                                         "translucent_radiosity",
+                                         "diffusion_grid", NULL};
 
 static const lr_field object_fields[] = {
     {"name", LR_FT_NAME, .dflt_text = "object0, ...", .flags = LR_FF_NO_SET,
@@ -169,11 +170,18 @@ static const lr_field object_fields[] = {
     {"model", LR_FT_ENUM, 0, O(pub.sss_model), .names = sss_models, .dirty = LR_DIRTY_MATERIAL,
      .help = "the S_d of the radiosity maps (seed 003; standard: Jensen 2001; multipole: "
              "Donner & Jensen 2005 slab, T across the wall, R on the same face; "
-             "translucent_radiosity: seed 000's patch solve with the receivers)"},
+             "translucent_radiosity: seed 000's patch solve with the receivers; "
+             "diffusion_grid: seed 001's grid solve, closed meshes)"},
     /* The range is lr_multipole_thickness_validate's (LR_MULTIPOLE_D_MIN..MAX). */
     {"thickness_mm", LR_FT_NUM, 0, O(pub.thickness_mm), 1e-3, 1e4, .flags = LR_FF_ZERO_ABSENT,
      .unit = "mm", .dirty = LR_DIRTY_MATERIAL, .dflt_text = "none",
      .help = "the wall the multipole models; required with model multipole"},
+    {"dgrid_h_mm", LR_FT_NUM, 0, O(pub.dgrid_h_mm), 0.05, 100.0, .flags = LR_FF_ZERO_ABSENT,
+     .unit = "mm", .dirty = LR_DIRTY_MATERIAL, .dflt_text = "auto",
+     .help = "diffusion_grid: grid spacing (auto: bounding radius / 20)"},
+    {"dgrid_volume", LR_FT_PATH, 0, O(pub.dgrid_volume), .dirty = LR_DIRTY_MATERIAL,
+     .dflt_text = "none",
+     .help = "diffusion_grid: heterogeneous sigma_a, sigma_s' volume file (render/diffusion)"},
     {"normalize", LR_FT_BOOL, 0, O(pub.sd_raw), .flags = LR_FF_INVERT, .dflt = {1},
      .dirty = LR_DIRTY_MATERIAL,
      .help = "false: the published directional dipole, without the energy normalisation"},

@@ -38,6 +38,8 @@ const char *lr_scene_object_model_unmet(const lr_scene_object *o, enum lr_sss_mo
         return "unknown model";
     if (m == LR_SSS_MULTIPOLE && !(o->thickness_mm > 0.0))
         return "needs thickness_mm (the wall the multipole models)";
+    if (m == LR_SSS_DIFFUSION_GRID && !o->closed)
+        return "needs a closed mesh (the grid diffusion solves inside a solid body)";
     return NULL;
 }
 

@@ -70,6 +70,8 @@ typedef struct lr_scene_object {
     bool closed;          /* watertight (a shade with rims is; one without is not) */
     enum lr_sss_model sss_model; /* "model": the S_d the radiosity estimator evaluates */
     double thickness_mm;  /* "thickness_mm": the wall the multipole models; 0: not given */
+    double dgrid_h_mm;    /* "dgrid_h_mm": diffusion_grid spacing; 0: auto */
+    char dgrid_volume[1024]; /* "dgrid_volume": volume file as written; "": homogeneous */
     bool sd_raw;          /* scene "normalize": false: [14]'s S_d as published, without
                            * coeffs.sd_norm (PIPELINE.md "Energy"); default: normalised */
 } lr_scene_object;

@@ -204,7 +204,8 @@ static int material_failed(op *o, int rc, const lr_err *inner)
 }
 
 #define OBJECT_KNOWN                                                                      \
-    "known: material, material.*, mesh.*, transform.*, model, thickness_mm, normalize"
+    "known: material, material.*, mesh.*, transform.*, model, thickness_mm, normalize, "      \
+    "dgrid_h_mm, dgrid_volume"
 
 static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
 {
@@ -231,9 +232,10 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
         *d = LR_DIRTY_MATERIAL;
         return LR_OK;
     }
-    if (strcmp(f, "normalize") == 0) /* another S_d */
+    if (strcmp(f, "normalize") == 0 || strcmp(f, "dgrid_volume") == 0) /* another S_d; the
+                                                   grid model's volume (read when it solves) */
         return table_field(o, &lr_scene_object_desc, rec, f, d);
-    if (strcmp(f, "model") == 0 || strcmp(f, "thickness_mm") == 0) {
+    if (strcmp(f, "model") == 0 || strcmp(f, "thickness_mm") == 0 || strcmp(f, "dgrid_h_mm") == 0) {
         /* The multipole models a wall: it needs the wall's thickness (issue 12). */
         obj_rec next = *rec;
         const char *bad = NULL;
@@ -303,7 +305,8 @@ static int object_get(op *o, const lr_scene *s, int i, const char *f)
         return mesh_field(o, &rec.mesh, f + 5, &d);
     if (strncmp(f, "transform.", 10) == 0)
         return table_field(o, &lr_scene_transform_desc, &rec.xf, f + 10, &d);
-    if (strcmp(f, "model") == 0 || strcmp(f, "normalize") == 0 || strcmp(f, "thickness_mm") == 0)
+    if (strcmp(f, "model") == 0 || strcmp(f, "normalize") == 0 || strcmp(f, "thickness_mm") == 0 ||
+        strcmp(f, "dgrid_h_mm") == 0 || strcmp(f, "dgrid_volume") == 0)
         return table_field(o, &lr_scene_object_desc, &rec, f, &d);
     return lr_field_fail(o, LR_EINVAL, "an object has no parameter '%s' (%s)", f, OBJECT_KNOWN);
 }

@@ -5,6 +5,7 @@
 #include "lib/material.glsl"
 #include "lib/random.glsl"
 #include "lib/gbuffer.glsl"
+#include "lib/dgrid.glsl"
 
 in vec3 v_pos;
 in vec3 v_nrm;
@@ -53,6 +54,13 @@ void main()
     }
     lr_coeffs_gl mat = lr_material(u_object);
     lr_sss_gl sss = lr_material_sss(u_object);
+    if (sss.model == LR_SSS_DIFFUSION_GRID) {
+        // Seed 001: B was solved on the CPU (render/diffusion/dscene.h); look it up.
+        o_B = vec4(min(lr_dgrid_B(xo) * u_map_scale, vec3(u_map_max)), 1.0);
+        o_pos = vec4(xo, 1.0);
+        o_nrm = vec4(no, float(u_object));
+        return;
+    }
     ivec2 tx = ivec2(gl_FragCoord.xy);
     uint state = lr_seed(uint(tx.y * u_map_size + tx.x), u_map, u_frame, u_seed);
 

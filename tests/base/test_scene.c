@@ -724,7 +724,15 @@ static void test_model_switch_and_light_cap(void **state)
     assert_int_equal(lr_scene_object_at(s, 0)->sss_model, LR_SSS_STANDARD_DIPOLE);
     get(s, "objects[0].model", "standard_dipole");
     set_bad(s, "objects[0].model", "jensen",
-            "expected directional_dipole, standard_dipole, multipole or translucent_radiosity");
+            "expected directional_dipole, standard_dipole, multipole, translucent_radiosity or "
+            "diffusion_grid");
+    /* seed 001's grid model and its spacing (issue 14) */
+    set_ok(s, "objects[0].model", "diffusion_grid", LR_DIRTY_MATERIAL);
+    assert_int_equal(lr_scene_object_at(s, 0)->sss_model, LR_SSS_DIFFUSION_GRID);
+    set_ok(s, "objects[0].dgrid_h_mm", "2.5", LR_DIRTY_MATERIAL);
+    assert_true(lr_scene_object_at(s, 0)->dgrid_h_mm == 2.5);
+    set_bad(s, "objects[0].dgrid_h_mm", "0.01", "dgrid_h_mm");
+    set_ok(s, "objects[0].model", "standard_dipole", LR_DIRTY_MATERIAL);
     /* The multipole needs the wall's thickness first (issue 12). */
     set_bad(s, "objects[0].model", "multipole", "needs the object's thickness_mm set first");
     set_bad(s, "objects[0].thickness_mm", "-2", "objects[0].thickness_mm");
@@ -757,7 +765,7 @@ static void test_model_switch_and_light_cap(void **state)
     scene_text(t, sizeof t, ",\n     \"model\": \"dipole\"", "", NULL);
     expect_scene_error(t, LR_EINVAL, "t.json:6: field 'objects[0].model': 'dipole': expected "
                                      "directional_dipole, standard_dipole, multipole or "
-                                     "translucent_radiosity");
+                                     "translucent_radiosity or diffusion_grid");
     scene_text(t, sizeof t, ",\n     \"model\": 1", "", NULL);
     expect_scene_error(t, LR_EPARSE, "t.json:6: field 'objects[0].model'");
 

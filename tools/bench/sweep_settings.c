@@ -57,6 +57,7 @@ int lrb_sweep_settings(lrb_setting *out, int cap)
     if (n > 0 && !strcmp(out[n - 1].label, "multipole+K=16"))
         out[n - 1].K = 16;
     ADD("transrad", model, "translucent_radiosity");
+    ADD("diffusion_grid", model, "diffusion_grid"); /* seed 001 (render/diffusion/) */
 #undef ADD
     return n;
 }

@@ -237,5 +237,7 @@ float lr_sss_sd_band(lr_coeffs_gl c, lr_sss_gl s, int j, vec3 xi, vec3 ni, vec3 
         return lr_dipole_sd_band(c, s, j, xi, xo);
     if (s.model == LR_SSS_MULTIPOLE)
         return lr_multipole_sd_band(c, s, j, xi, ni, xo, no);
+    if (s.model == LR_SSS_DIFFUSION_GRID)
+        return 0.0; // no profile (lr_sss_sd_fresnel): radiosity.frag reads lib/dgrid.glsl
     return lr_dirpole_sd_band(c, j, xi, ni, wi, xo, no);
 }

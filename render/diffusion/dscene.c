@@ -1,0 +1,262 @@
+/* lamprig — the diffusion_grid objects of a scene, solved per light (dscene.h). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "render/base/paths.h"
+#include "render/diffusion/dscene.h"
+#include "render/optics/optics.h"
+
+/* Relative residual of the render solves: B is read to float precision in the maps, and the
+ * fair bench's noise floor is far above 1e-5. */
+#define LR_DSCENE_TOL 1e-5
+
+typedef struct dobj {
+    bool active;
+    /* what the grid was built from */
+    const lr_mesh *mesh;
+    double model[16];
+    lr_medium medium;
+    double h;
+    char volume_path[2048];
+    lr_dvolume *volume;
+    lr_dsolver *solver;
+    float *field[LR_SCENE_MAX_LIGHTS];
+    bool rebuilt;
+} dobj;
+
+struct lr_dscene {
+    dobj obj[LR_DSCENE_MAX_OBJECTS];
+    int iters;
+};
+
+int lr_dscene_create(lr_dscene **out, lr_err *e)
+{
+    *out = calloc(1, sizeof **out);
+    return *out ? LR_OK : lr_err_set(e, LR_ENOMEM, "diffusion grid: out of memory");
+}
+
+static void dobj_clear(dobj *o)
+{
+    lr_dsolver_destroy(o->solver);
+    lr_dvolume_destroy(o->volume);
+    for (int l = 0; l < LR_SCENE_MAX_LIGHTS; l++)
+        free(o->field[l]);
+    memset(o, 0, sizeof *o);
+}
+
+void lr_dscene_destroy(lr_dscene *d)
+{
+    if (!d)
+        return;
+    for (int i = 0; i < LR_DSCENE_MAX_OBJECTS; i++)
+        dobj_clear(&d->obj[i]);
+    free(d);
+}
+
+double lr_dscene_spacing(const lr_scene_object *o)
+{
+    return o->dgrid_h_mm > 0.0 ? o->dgrid_h_mm : fmax(o->radius, 1e-3) / LR_DSCENE_AUTO_CELLS;
+}
+
+typedef struct qctx {
+    const lr_scene_object *obj;
+    const lr_light *light;
+} qctx;
+
+double lr_dscene_irradiance(const lr_scene_object *obj, const lr_light *light, lr_vec3 b,
+                            lr_vec3 n)
+{
+    double eta = obj->material.medium.eta;
+    double eps = 1e-5 * fmax(obj->radius, 1.0);
+    lr_vec3 o = lr_v3_add(b, lr_v3_scale(n, eps));
+    if (light->type == LR_LIGHT_DIRECTIONAL) {
+        lr_vec3 w = lr_v3_scale(light->direction, -1.0);
+        double c = lr_v3_dot(n, w);
+        if (!(c > 0.0) || lr_bvh_occluded(obj->bvh, o, w, 0.0, INFINITY))
+            return 0.0;
+        return lr_fresnel_transmittance(c, eta) * c;
+    }
+    lr_vec3 d = lr_v3_sub(light->position, b);
+    double r2 = lr_v3_dot(d, d), r = sqrt(r2);
+    if (!(r > 0.0))
+        return 0.0;
+    lr_vec3 w = lr_v3_scale(d, 1.0 / r);
+    double c = lr_v3_dot(n, w);
+    if (!(c > 0.0) || lr_bvh_occluded(obj->bvh, o, w, 0.0, fmax(0.0, r - 2.0 * eps)))
+        return 0.0;
+    double shape = 1.0;
+    if (light->type == LR_LIGHT_SPOT) {
+        /* The pass's spot_shape: smoothstep(cos outer, cos inner, v . axis). */
+        double e0 = cos(light->outer_deg * M_PI / 180.0), e1 = cos(light->inner_deg * M_PI / 180.0);
+        double x = -lr_v3_dot(w, light->direction);
+        double t = e1 > e0 ? fmin(1.0, fmax(0.0, (x - e0) / (e1 - e0))) : (x >= e0 ? 1.0 : 0.0);
+        shape = t * t * (3.0 - 2.0 * t);
+    }
+    return lr_fresnel_transmittance(c, eta) * c / r2 * shape;
+}
+
+static double q_fn(const void *ctx, lr_vec3 b, lr_vec3 n)
+{
+    const qctx *q = ctx;
+    return lr_dscene_irradiance(q->obj, q->light, b, n);
+}
+
+/* A volume path as written: relative to the scene file's folder, else to the configs
+ * folder, else to the working directory. */
+static void resolve_volume(const lr_scene *s, const char *rel, char *out, size_t cap)
+{
+    int w;
+    snprintf(out, cap, "%s", rel);
+    if (rel[0] == '/')
+        return;
+    const char *sp = lr_scene_path(s);
+    const char *slash = sp ? strrchr(sp, '/') : NULL;
+    if (slash) {
+        w = snprintf(out, cap, "%.*s/%s", (int)(slash - sp), sp, rel);
+        if (w > 0 && (size_t)w < cap && access(out, R_OK) == 0)
+            return;
+    }
+    w = snprintf(out, cap, "%s/%s", lr_configs_dir(), rel);
+    if (w > 0 && (size_t)w < cap && access(out, R_OK) == 0)
+        return;
+    snprintf(out, cap, "%s", rel);
+}
+
+static bool same_grid(const dobj *d, const lr_scene_object *o, double h)
+{
+    return d->solver && d->mesh == o->mesh && memcmp(d->model, o->model, sizeof d->model) == 0 &&
+           d->h == h;
+}
+
+static bool same_material(const dobj *d, const lr_scene_object *o, const char *vol)
+{
+    return memcmp(&d->medium, &o->material.medium, sizeof d->medium) == 0 &&
+           strcmp(d->volume_path, vol) == 0;
+}
+
+/* A material edit on the same grid: new coefficients, the solutions kept as warm starts. */
+static int remat(dobj *d, int i, const lr_scene_object *o, const char *vol, lr_err *e)
+{
+    lr_dvolume *nv = NULL;
+    int rc;
+    if (vol[0] && (rc = lr_dvolume_load(vol, &nv, e)))
+        return lr_err_prefix(e, "objects[%d].dgrid_volume", i);
+    lr_dmaterial m = {{0}, {0}, o->material.medium.eta, nv};
+    memcpy(m.sigma_a, o->material.medium.sigma_a, sizeof m.sigma_a);
+    memcpy(m.sigma_s_prime, o->material.medium.sigma_s_prime, sizeof m.sigma_s_prime);
+    if (m.eta != d->medium.eta) { /* A changes the ghost rows: rebuild */
+        lr_dvolume_destroy(nv);
+        return -1;
+    }
+    if ((rc = lr_dsolver_set_material(d->solver, &m, e))) {
+        lr_dvolume_destroy(nv);
+        return rc;
+    }
+    lr_dvolume_destroy(d->volume);
+    d->volume = nv;
+    d->medium = o->material.medium;
+    if (snprintf(d->volume_path, sizeof d->volume_path, "%s", vol) >= (int)sizeof d->volume_path)
+        return lr_err_set(e, LR_EINVAL, "objects[%d].dgrid_volume: path too long", i);
+    return LR_OK;
+}
+
+static int build(dobj *d, const lr_scene *s, int i, const lr_scene_object *o, double h,
+                 const char *vol, lr_err *e)
+{
+    dobj_clear(d);
+    int rc;
+    if (!o->closed)
+        return lr_err_set(e, LR_EINVAL,
+                          "objects[%d] (%s): model diffusion_grid needs a closed mesh (a solid "
+                          "body; this one is open)",
+                          i, o->name);
+    if (vol[0] && (rc = lr_dvolume_load(vol, &d->volume, e)))
+        return lr_err_prefix(e, "objects[%d].dgrid_volume", i);
+    lr_dshape shape = lr_dshape_mesh(o->bvh);
+    lr_dmaterial m = {{0}, {0}, o->material.medium.eta, d->volume};
+    memcpy(m.sigma_a, o->material.medium.sigma_a, sizeof m.sigma_a);
+    memcpy(m.sigma_s_prime, o->material.medium.sigma_s_prime, sizeof m.sigma_s_prime);
+    if ((rc = lr_dsolver_create(&shape, h, 3, &m, &d->solver, e)))
+        return lr_err_prefix(e, "objects[%d] (%s), diffusion_grid at h = %g mm", i, o->name, h);
+    d->mesh = o->mesh;
+    memcpy(d->model, o->model, sizeof d->model);
+    d->medium = o->material.medium;
+    d->h = h;
+    if (snprintf(d->volume_path, sizeof d->volume_path, "%s", vol) >= (int)sizeof d->volume_path)
+        return lr_err_set(e, LR_EINVAL, "objects[%d].dgrid_volume: path too long", i);
+    d->rebuilt = true;
+    return LR_OK;
+}
+
+int lr_dscene_update(lr_dscene *d, const lr_scene *s, lr_err *e)
+{
+    d->iters = 0;
+    int n = lr_scene_object_count(s), L = lr_scene_light_count(s);
+    for (int i = 0; i < LR_DSCENE_MAX_OBJECTS; i++) {
+        dobj *D = &d->obj[i];
+        D->rebuilt = false;
+        const lr_scene_object *o = i < n ? lr_scene_object_at(s, i) : NULL;
+        if (!o || o->sss_model != LR_SSS_DIFFUSION_GRID) {
+            if (D->active)
+                dobj_clear(D);
+            continue;
+        }
+        double h = lr_dscene_spacing(o);
+        char vol[2048] = "";
+        if (o->dgrid_volume[0])
+            resolve_volume(s, o->dgrid_volume, vol, sizeof vol);
+        int rc;
+        rc = LR_OK;
+        if (same_grid(D, o, h)) {
+            if (!same_material(D, o, vol))
+                rc = remat(D, i, o, vol, e);
+        } else {
+            rc = -1;
+        }
+        if (rc == -1)
+            rc = build(D, s, i, o, h, vol, e);
+        if (rc) {
+            dobj_clear(D);
+            return rc;
+        }
+        D->active = true;
+        const lr_dgrid *g = lr_dsolver_grid(D->solver);
+        size_t nodes = lr_dgrid_node_count(g);
+        for (int l = 0; l < L; l++) {
+            qctx q = {o, lr_scene_light_at(s, l)};
+            if ((rc = lr_dsolver_solve(D->solver, l, q_fn, &q, LR_DSCENE_TOL, e)))
+                return lr_err_prefix(e, "objects[%d] (%s), light %d", i, o->name, l);
+            d->iters += lr_dsolver_last_iters(D->solver);
+            if (!D->field[l] && !(D->field[l] = malloc(4 * nodes * sizeof(float))))
+                return lr_err_set(e, LR_ENOMEM, "diffusion grid: out of memory");
+            if ((rc = lr_dsolver_field(D->solver, l, q_fn, &q, D->field[l], e)))
+                return rc;
+        }
+    }
+    return LR_OK;
+}
+
+bool lr_dscene_field(const lr_dscene *d, int object, int light, lr_dfield_view *out)
+{
+    if (object < 0 || object >= LR_DSCENE_MAX_OBJECTS || light < 0 || light >= LR_SCENE_MAX_LIGHTS)
+        return false;
+    const dobj *D = &d->obj[object];
+    if (!D->active || !D->field[light])
+        return false;
+    const lr_dgrid *g = lr_dsolver_grid(D->solver);
+    out->data = D->field[light];
+    lr_dgrid_dims(g, out->n);
+    out->origin = lr_dgrid_origin(g);
+    out->h = lr_dgrid_h(g);
+    return true;
+}
+
+bool lr_dscene_rebuilt(const lr_dscene *d, int object)
+{
+    return object >= 0 && object < LR_DSCENE_MAX_OBJECTS && d->obj[object].rebuilt;
+}
+
+int lr_dscene_last_iters(const lr_dscene *d) { return d->iters; }

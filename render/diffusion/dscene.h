@@ -1,0 +1,54 @@
+/* lamprig — the diffusion_grid model of a scene's objects (seed 001): per object a grid solve
+ * per light, turned into the surface radiosity field the radiosity pass (GPU) and the CPU twin
+ * interpolate (render/diffusion/dgrid.h, field.c).
+ *
+ * lr_dscene_update re-solves what changed: an object whose mesh, material, grid spacing or
+ * volume file changed gets a new grid (solved coarse-to-fine); otherwise each light's solve is
+ * warm-started from that light's last solution (seed 001 Sec. 5.3), so a light move costs a
+ * few BiCGSTAB iterations. Objects with another model are skipped.
+ *
+ * The incident light q(b) per unit intensity (PIPELINE.md's units): point and spot lights
+ * F_t(cos) cos / r^2 (spot: times the pass's smoothstep profile), directional lights F_t(cos)
+ * cos; zero where the object itself shadows b (a ray against its BVH; other objects do not
+ * shadow, as in the pass: "no scattering between objects").
+ */
+#ifndef LR_DSCENE_H
+#define LR_DSCENE_H
+
+#include "render/base/err.h"
+#include "render/diffusion/dgrid.h"
+#include "render/scene/scene.h"
+
+/* Default grid spacing: the object's bounding radius over this (objects[i].dgrid_h_mm = 0). */
+#define LR_DSCENE_AUTO_CELLS 20.0
+/* Objects per scene this holds (the passes' LR_MAX_OBJECTS). */
+#define LR_DSCENE_MAX_OBJECTS 8
+
+typedef struct lr_dscene lr_dscene;
+
+/* A solved field: 4 floats per node (B_r, B_g, B_b, valid), x fastest, per unit intensity. */
+typedef struct lr_dfield_view {
+    const float *data;
+    int n[3];
+    lr_vec3 origin;
+    double h;
+} lr_dfield_view;
+
+int lr_dscene_create(lr_dscene **out, lr_err *e);
+void lr_dscene_destroy(lr_dscene *d);
+/* Brings every diffusion_grid object of s up to date for every light. */
+int lr_dscene_update(lr_dscene *d, const lr_scene *s, lr_err *e);
+/* Object i's field for light l; false when the object has none (another model). */
+bool lr_dscene_field(const lr_dscene *d, int object, int light, lr_dfield_view *out);
+/* Whether the last update rebuilt object i's grid (a change of geometry or material). */
+bool lr_dscene_rebuilt(const lr_dscene *d, int object);
+/* Finest-grid BiCGSTAB iterations of the last update, all objects, lights and bands. */
+int lr_dscene_last_iters(const lr_dscene *d);
+/* The grid spacing object o gets (its dgrid_h_mm, or the auto rule). */
+double lr_dscene_spacing(const lr_scene_object *o);
+
+/* q for a unit-intensity light at b (normal n out of the object); shadowed by obj's mesh. */
+double lr_dscene_irradiance(const lr_scene_object *obj, const lr_light *light, lr_vec3 b,
+                            lr_vec3 n);
+
+#endif
