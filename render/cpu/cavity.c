@@ -86,7 +86,8 @@ int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
     /* Not for the raw directional dipole (its total exceeds 1); the standard dipole is the
      * normalisation's reference, so "normalize" does not change it (lr_scene_object_sd_norm). */
     out->applies = enclosure == LR_ENCLOSURE_HULL && l->type != LR_LIGHT_DIRECTIONAL &&
-                   !(obj->sd_raw && obj->sss_model == LR_SSS_DIRECTIONAL_DIPOLE);
+                   !(obj->sd_raw && obj->sss_model == LR_SSS_DIRECTIONAL_DIPOLE) &&
+                   obj->sss_model != LR_SSS_SH_TRANSLUCENCY; /* its energy is fitted, not closed */
     if (!out->applies)
         return LR_OK;
 

@@ -35,6 +35,8 @@ typedef struct lr_cpu_maps_desc {
     int threads;                   /* 0: all CPUs */
     /* Algorithm 1's biases in mm; 0: eps_bias = 2 texels, eps_comb = 1 texel (as the GPU). */
     double eps_bias, eps_comb;
+    /* sh_translucency objects: see lr_cpu_radiosity_desc.sh_env (copied). */
+    const struct lr_sh_env *sh_env;
 } lr_cpu_maps_desc;
 
 typedef struct lr_cpu_texel {

@@ -51,6 +51,10 @@ typedef struct lr_cpu_radiosity_desc {
      * surface the G-buffer texel holds (its texel centre). NULL: exact ray casts. */
     lr_vec3 (*snap)(void *snap_ctx, lr_vec3 v);
     void *snap_ctx;
+    /* Objects with model sh_translucency: the light's projected environment (render/cpu/sh.h,
+     * lr_cpu_sh_env through the scene's G-buffer cameras). NULL: projected per call through a
+     * small cube (slow). Their estimate is deterministic (variance 0, the sampler unused). */
+    const struct lr_sh_env *sh_env;
 } lr_cpu_radiosity_desc;
 
 typedef struct lr_cpu_estimate {

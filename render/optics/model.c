@@ -8,7 +8,7 @@
 #include <string.h>
 
 static const char *const names[LR_SSS_MODEL_COUNT] = {"directional_dipole", "standard_dipole",
-                                                       "multipole"};
+                                                       "multipole", "sh_translucency"};
 
 const char *lr_sss_model_name(enum lr_sss_model m)
 {
@@ -28,6 +28,10 @@ bool lr_sss_model_parse(const char *name, enum lr_sss_model *out)
 void lr_sss_sd_fresnel(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm, lr_vec3 xi,
                        lr_vec3 ni, lr_vec3 wi, lr_vec3 xo, lr_vec3 no, double out[3])
 {
+    if (m == LR_SSS_SH_TRANSLUCENCY) {
+        out[0] = out[1] = out[2] = 0.0; /* no S_d: sh_translucency.h evaluates B directly */
+        return;
+    }
     if (m == LR_SSS_STANDARD_DIPOLE)
         lr_dipole_sd_fresnel(c, xi, ni, wi, xo, out);
     else if (m == LR_SSS_MULTIPOLE)

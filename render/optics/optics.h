@@ -180,9 +180,10 @@ void lr_multipole_sd_fresnel(const lr_coeffs *c, double d, lr_vec3 xi, lr_vec3 n
 
 /* The diffusion model an object's radiosity estimator evaluates (scene: objects[i].model). */
 enum lr_sss_model { LR_SSS_DIRECTIONAL_DIPOLE = 0, LR_SSS_STANDARD_DIPOLE = 1,
-                    LR_SSS_MULTIPOLE = 2 };
-#define LR_SSS_MODEL_COUNT 3
-/* "directional_dipole", "standard_dipole", "multipole". */
+                    LR_SSS_MULTIPOLE = 2, LR_SSS_SH_TRANSLUCENCY = 3 };
+#define LR_SSS_MODEL_COUNT 4
+/* "directional_dipole", "standard_dipole", "multipole", "sh_translucency" (seed 002; not an S_d:
+ * render/optics/sh_translucency.h; lr_sss_sd_fresnel gives 0 for it). */
 const char *lr_sss_model_name(enum lr_sss_model m);
 /* Inverse of lr_sss_model_name; false for any other text. */
 bool lr_sss_model_parse(const char *name, enum lr_sss_model *out);

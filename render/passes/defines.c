@@ -42,6 +42,7 @@ const char *const *lr_passes_defines(lr_shader_defines *d)
         DEF(LR_SSS_DIRECTIONAL_DIPOLE),
         DEF(LR_SSS_STANDARD_DIPOLE),
         DEF(LR_SSS_MULTIPOLE),
+        DEF(LR_SSS_SH_TRANSLUCENCY),
         DEF(LR_TONEMAP_CLAMP),
         DEF(LR_TONEMAP_REINHARD),
         DEF(LR_TONEMAP_ACES),

@@ -127,6 +127,9 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
     if (restart || rad->F == 0) {
         place_maps(rad, c, gb);
         rad->F = 0;
+        int rc = lr_radiosity_sh_project(rad, c, gb, e);
+        if (rc)
+            return rc;
     }
     int F = rad->F + 1;
     int K = rad->K;
@@ -170,6 +173,7 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
             glUseProgram(lr_program_id(p));
             lr_passes_set_coeffs(c->objs, p);
             lr_passes_uniform_v3_array(p, "u_sd_norm", c->objs->sd_norm, LR_MAX_OBJECTS);
+            lr_radiosity_sh_uniforms(rad, p, l);
             lr_gbuffer_bind(gb, p, l);
             lr_passes_uniform_mat4(p, "u_vp", rad->vp[k]);
             lr_passes_uniform_i(p, "u_N", c->rs->N);

@@ -27,6 +27,8 @@ layout(location = 0) out vec4 o_B;
 layout(location = 1) out vec4 o_pos;
 layout(location = 2) out vec4 o_nrm;
 
+#include "lib/sh_translucency.glsl"
+
 float spot_shape(vec3 dir)
 {
     if (u_light_type != LR_LIGHT_SPOT)
@@ -43,6 +45,14 @@ void main()
         no = -no;
     lr_coeffs_gl mat = lr_material(u_object);
     lr_sss_gl sss = lr_material_sss(u_object);
+    if (sss.model == LR_SSS_SH_TRANSLUCENCY) {
+        // Seed 002: no samples, one evaluation per texel (Eq. 10-12).
+        vec3 Bsh = lr_sh_translucency_B(u_object, mat, xo, no);
+        o_B = vec4(min(Bsh * u_map_scale, vec3(u_map_max)), 1.0);
+        o_pos = vec4(xo, 1.0);
+        o_nrm = vec4(no, float(u_object));
+        return;
+    }
     ivec2 tx = ivec2(gl_FragCoord.xy);
     uint state = lr_seed(uint(tx.y * u_map_size + tx.x), u_map, u_frame, u_seed);
 
