@@ -303,7 +303,7 @@ static void sh_radiosity(const lr_scene_object *obj, const lr_light *light, lr_v
         lr_cpu_sh_env(obj, light, &cam, LR_CPU_SH_FALLBACK_SIZE, others, n_others, 1, &env);
         use = &env;
     }
-    lr_cpu_sh_B(obj, light, use, xo, no, others, n_others, out->mean);
+    lr_cpu_sh_B(obj, light, use, xo, no, d, out->mean);
     out->var[0] = out->var[1] = out->var[2] = 0.0;
 }
 

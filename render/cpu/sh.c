@@ -89,37 +89,67 @@ void lr_cpu_sh_env(const lr_scene_object *obj, const lr_light *light, const lr_g
 }
 
 bool lr_cpu_sh_thickness(const lr_scene_object *obj, const lr_light *light, lr_vec3 xo,
-                         const lr_scene_object *const *others, int n_others, double *d)
+                         const lr_cpu_radiosity_desc *d, double *thickness, lr_vec3 *ni_out)
 {
+    const lr_scene_object *const *others = d ? d->others : NULL;
+    int n_others = d ? d->n_others : 0;
+    lr_vec3 (*snap)(void *, lr_vec3) = d ? d->snap : NULL;
     lr_vec3 org, dir, xi, ni;
     bool blocked;
     double reach;
     if (light->type == LR_LIGHT_DIRECTIONAL) {
         dir = lr_v3_normalize(light->direction);
-        double back = lr_v3_dot(lr_v3_sub(xo, obj->center), dir) + 1.01 * obj->radius + 1.0;
-        org = lr_v3_sub(xo, lr_v3_scale(dir, back));
-        reach = back;
+        lr_vec3 at = snap ? snap(d->snap_ctx, xo) : xo; /* the texel's plane point */
+        double back = lr_v3_dot(lr_v3_sub(at, obj->center), dir) + 1.01 * obj->radius + 1.0;
+        org = lr_v3_sub(at, lr_v3_scale(dir, back));
+        /* the depth difference along the light: x_o's depth from the same plane */
+        reach = lr_v3_dot(lr_v3_sub(xo, org), dir);
     } else {
         lr_vec3 h = lr_v3_sub(xo, light->position);
         reach = lr_v3_len(h);
         org = light->position;
         dir = reach > 0.0 ? lr_v3_scale(h, 1.0 / reach) : lr_v3(0, 0, 1);
+        if (snap)
+            dir = lr_v3_normalize(snap(d->snap_ctx, dir));
     }
-    *d = 0.0;
+    *thickness = 0.0;
+    if (ni_out)
+        *ni_out = lr_v3(0, 0, 0);
     if (!first_own(obj, org, dir, others, n_others, &xi, &ni, &blocked))
         return !blocked;
-    *d = fmax(0.0, reach - lr_v3_len(lr_v3_sub(xi, org)));
+    *thickness = fmax(0.0, reach - lr_v3_len(lr_v3_sub(xi, org)));
+    if (ni_out)
+        *ni_out = ni;
     return true;
 }
 
 void lr_cpu_sh_B(const lr_scene_object *obj, const lr_light *light, const lr_sh_env *env,
-                 lr_vec3 xo, lr_vec3 no, const lr_scene_object *const *others, int n_others,
-                 double out[3])
+                 lr_vec3 xo, lr_vec3 no, const lr_cpu_radiosity_desc *rd, double out[3])
 {
     double d, s[3];
+    lr_vec3 ni;
     out[0] = out[1] = out[2] = 0.0;
-    if (!lr_cpu_sh_thickness(obj, light, xo, others, n_others, &d))
+    if (!lr_cpu_sh_thickness(obj, light, xo, rd, &d, &ni))
         return;
     lr_sh_object_scale(&obj->coeffs, obj->material.sh_scale, s);
     lr_sh_translucency_B(&obj->coeffs, s, env, no, d, out);
+    if (!lr_sh_lit(&obj->coeffs, obj->radius, d, lr_v3_dot(ni, no)))
+        return;
+    /* The direct term: irradiance of the unit light at x_o (PIPELINE.md pass 4's receivers). */
+    double E, cos_i, direct[3];
+    if (light->type == LR_LIGHT_DIRECTIONAL) {
+        cos_i = -lr_v3_dot(no, lr_v3_normalize(light->direction));
+        E = 1.0;
+    } else {
+        lr_vec3 h = lr_v3_sub(light->position, xo);
+        double r2 = lr_v3_dot(h, h);
+        if (!(r2 > 0.0))
+            return;
+        lr_vec3 u = lr_v3_scale(h, 1.0 / sqrt(r2));
+        cos_i = lr_v3_dot(no, u);
+        E = lr_light_shape(light, lr_v3_scale(u, -1.0)) / r2;
+    }
+    lr_sh_direct(&obj->coeffs, cos_i, direct);
+    for (int b = 0; b < 3; b++)
+        out[b] += direct[b] * E;
 }

@@ -67,6 +67,21 @@ void lr_sh_translucency_B(const lr_coeffs *c, const double scale[3], const lr_sh
         out[b] = scale[b] * lr_sh_atten(c->sigma_tr[b], c->sigma_t_prime[b], d) * e;
 }
 
+bool lr_sh_lit(const lr_coeffs *c, double radius, double d, double ni_dot_no)
+{
+    double mfp = (c->mfp[0] + c->mfp[1] + c->mfp[2]) / 3.0;
+    return ni_dot_no > 0.0 && d <= LR_SH_LIT_RADII * radius + mfp;
+}
+
+void lr_sh_direct(const lr_coeffs *c, double cos_i, double out[3])
+{
+    double rho[3];
+    lr_dipole_rd_total(c, rho);
+    double f = cos_i > 0.0 ? lr_fresnel_transmittance(cos_i, c->eta) * cos_i : 0.0;
+    for (int b = 0; b < 3; b++)
+        out[b] = rho[b] * f;
+}
+
 void lr_sh_fit_scale(const lr_coeffs *c, double d_fit, double out[3])
 {
     double R[3], T[3];

@@ -26,6 +26,14 @@
  * (tests/optics/test_optics_sh_translucency.c shows both). d is clamped below at one transport
  * mean free path 1/sigma_t' (the dipole's real source depth; Eq. 12's d^-3 then stays finite).
  *
+ * Direct term. The paper's images are its scattering term over the object's ordinary direct
+ * lighting (seed 002 Fig. 10, 11: "direct lighting only" / "subsurface scattering"); the maps
+ * hold all of an object's radiosity, so the model adds the local diffuse reflection
+ * B_direct,c = rho_c F_t(cos_i) E_direct(x_o) where x_o is the light's first surface (the
+ * G-buffer texel's normal on x_o's side and the thickness under LR_SH_LIT_RADII bounding radii
+ * plus one mean free path), rho_c the dipole's total diffuse reflectance (lr_dipole_rd_total,
+ * what the normalised directional dipole gives a lit half-space).
+ *
  * Energy scale. s_c = T_c(d_fit) / (LR_SH_DELTA_GAIN a_c(d_fit)): the slab's total diffuse transmission T per unit
  * power that entered (lr_multipole_total, the closed form the multipole tests check against
  * the photon-counted slab) at d_fit = LR_SH_FIT_MM, so that a slab of that thickness lit
@@ -43,6 +51,10 @@
  * incidence): along that direction sum_l A_l (2l + 1) / (4 pi) = 1/4 + 1/2 + 5/16 = 17/16 of
  * the entering irradiance. The fit divides it out. */
 #define LR_SH_DELTA_GAIN (17.0 / 16.0)
+/* A point is the light's first surface (direct term) when its thickness is under this many
+ * bounding radii plus the band-averaged mean free path (absorbs the G-buffer's quantised
+ * depth) and the G-buffer's normal there faces x_o's side. */
+#define LR_SH_LIT_RADII 0.02
 /* Slab thickness (mm) at which the energy scale is fitted. */
 #define LR_SH_FIT_MM 10.0
 /* Texels whose surface is seen more grazing than this cosine are left out of the projection
@@ -84,6 +96,12 @@ double lr_sh_atten(double sigma_tr, double sigma_t_prime, double d);
 /* B_c = scale_c a_c(d) lr_sh_env_irradiance(env, n_out), per band (finished env). */
 void lr_sh_translucency_B(const lr_coeffs *c, const double scale[3], const lr_sh_env *env,
                           lr_vec3 n_out, double d, double out[3]);
+/* Whether x_o takes the direct term: n_i . n_o > 0 and d <= LR_SH_LIT_RADII radius + mfp
+ * (mfp: the mean of the bands' 1/sigma_t'). */
+bool lr_sh_lit(const lr_coeffs *c, double radius, double d, double ni_dot_no);
+/* rho_c F_t(cos_i, eta) cos_i per band: the direct term for unit irradiance along the normal
+ * (times 1/r^2 and the spot profile for point and spot lights); 0 for cos_i <= 0. */
+void lr_sh_direct(const lr_coeffs *c, double cos_i, double out[3]);
 /* The energy scale s_c = T_c(d_fit) / (LR_SH_DELTA_GAIN a_c(d_fit)) (T: lr_multipole_total). */
 void lr_sh_fit_scale(const lr_coeffs *c, double d_fit, double out[3]);
 /* The scale an object uses: the preset's when it has one (all three > 0), else fitted here. */

@@ -27,6 +27,7 @@ typedef struct lr_radiosity {
     bool has_sh;
     float sh_E[LR_MAX_LIGHTS][27 * LR_MAX_OBJECTS];
     float sh_scale[3 * LR_MAX_OBJECTS];
+    float sh_rho[4 * LR_MAX_OBJECTS]; /* rho.rgb (lr_dipole_rd_total), lit threshold (mm) */
 } lr_radiosity;
 
 /* Maps for c->rs (K, map_size) and c->n_lights lights; accumulation restarts. */

@@ -57,13 +57,20 @@ int lr_radiosity_sh_project(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gb
     rad->has_sh = false;
     for (int o = 0; o < nobj && o < LR_MAX_OBJECTS; o++) {
         const lr_scene_object *ob = lr_scene_object_at(s, o);
-        double sc[3] = {0, 0, 0};
+        double sc[3] = {0, 0, 0}, rho[3] = {0, 0, 0}, lit = -1.0;
         if (ob->sss_model == LR_SSS_SH_TRANSLUCENCY) {
             rad->has_sh = true;
             lr_sh_object_scale(&ob->coeffs, ob->material.sh_scale, sc);
+            lr_dipole_rd_total(&ob->coeffs, rho);
+            /* lr_sh_lit's threshold: LR_SH_LIT_RADII radius + mean free path */
+            lit = LR_SH_LIT_RADII * ob->radius +
+                  (ob->coeffs.mfp[0] + ob->coeffs.mfp[1] + ob->coeffs.mfp[2]) / 3.0;
         }
-        for (int b = 0; b < 3; b++)
+        for (int b = 0; b < 3; b++) {
             rad->sh_scale[3 * o + b] = (float)sc[b];
+            rad->sh_rho[4 * o + b] = (float)rho[b];
+        }
+        rad->sh_rho[4 * o + 3] = (float)lit;
     }
     if (!rad->has_sh)
         return LR_OK;
@@ -107,4 +114,9 @@ void lr_radiosity_sh_uniforms(const lr_radiosity *rad, lr_program *p, int l)
         return; /* the shader's defaults (0) are never read: no object has the model */
     lr_passes_uniform_v3_array(p, "u_sh_E", rad->sh_E[l], 3 * LR_MAX_OBJECTS);
     lr_passes_uniform_v3_array(p, "u_sh_scale", rad->sh_scale, LR_MAX_OBJECTS);
+    GLint loc = lr_program_uniform(p, "u_sh_rho");
+    if (loc < 0)
+        loc = lr_program_uniform(p, "u_sh_rho[0]");
+    if (loc >= 0)
+        glUniform4fv(loc, LR_MAX_OBJECTS, rad->sh_rho);
 }

@@ -27,8 +27,6 @@ layout(location = 0) out vec4 o_B;
 layout(location = 1) out vec4 o_pos;
 layout(location = 2) out vec4 o_nrm;
 
-#include "lib/sh_translucency.glsl"
-
 float spot_shape(vec3 dir)
 {
     if (u_light_type != LR_LIGHT_SPOT)
@@ -36,6 +34,8 @@ float spot_shape(vec3 dir)
     float c = dot(normalize(dir), u_light_dir);
     return smoothstep(u_spot_cos.x, u_spot_cos.y, c);
 }
+
+#include "lib/sh_translucency.glsl"
 
 void main()
 {

@@ -53,13 +53,13 @@ static void test_thickness_chords(void **state)
         assert_true(lr_bvh_intersect(o.bvh, far, lr_v3_scale(u, -1.0), 0.0, INFINITY, &hit));
         lr_vec3 xo = lr_v3_add(far, lr_v3_scale(u, -hit.t));
         double d;
-        assert_true(lr_cpu_sh_thickness(&o.obj, &L, xo, NULL, 0, &d));
+        assert_true(lr_cpu_sh_thickness(&o.obj, &L, xo, NULL, &d, NULL));
         double chord = 2.0 * sqrt(R_MM * R_MM - b * b), cosr = sqrt(1.0 - (b / R_MM) * (b / R_MM));
         assert_near(d, chord, 2.0 * sagitta() / cosr + 1e-9);
     }
     /* On the lit side x_o is the first surface itself: thickness 0. */
     double d;
-    assert_true(lr_cpu_sh_thickness(&o.obj, &L, lr_v3(0, 0, R_MM), NULL, 0, &d));
+    assert_true(lr_cpu_sh_thickness(&o.obj, &L, lr_v3(0, 0, R_MM), NULL, &d, NULL));
     assert_near(d, 0.0, sagitta());
     /* A directional light along -z: the chord along z at (x, 0). */
     lr_light Ld = lrt_directional_light(lr_v3(0, 0, -1));
@@ -68,7 +68,7 @@ static void test_thickness_chords(void **state)
     assert_true(lr_bvh_intersect(o.bvh, lr_v3(0.5 * R_MM, 0, -3 * R_MM), lr_v3(0, 0, 1), 0.0,
                                  INFINITY, &hit));
     xo.z = -3 * R_MM + hit.t;
-    assert_true(lr_cpu_sh_thickness(&o.obj, &Ld, xo, NULL, 0, &d));
+    assert_true(lr_cpu_sh_thickness(&o.obj, &Ld, xo, NULL, &d, NULL));
     assert_near(d, 2.0 * sqrt(0.75) * R_MM, 2.0 * sagitta() / sqrt(0.75) + 1e-9);
     lrt_object_free(&o);
 }
@@ -192,7 +192,7 @@ static void test_estimator_dispatch(void **state)
     lr_cpu_estimate est;
     lr_cpu_radiosity(&o.obj, &L, xo, no, &d, 1, &est);
     double B[3];
-    lr_cpu_sh_B(&o.obj, &L, &env, xo, no, NULL, 0, B);
+    lr_cpu_sh_B(&o.obj, &L, &env, xo, no, NULL, B);
     for (int c = 0; c < 3; c++) {
         assert_true(B[c] > 0.0);
         assert_near(est.mean[c], B[c], 0.0);
@@ -200,6 +200,20 @@ static void test_estimator_dispatch(void **state)
     }
     /* Back-lit transmission decays with the band's sigma_tr: R (17 mm) > G > B (8 mm). */
     assert_true(B[0] > B[1] && B[1] > B[2]);
+    /* The lit pole takes the direct term on top: rho_c F_t(1) / r^2 (lr_dipole_rd_total; the
+     * light on the axis, x_o the mesh's first surface there, n_o the axis), the scattering
+     * term as lr_sh_translucency_B at d = 0 (clamped to one mean free path). */
+    lr_hit hit;
+    assert_true(lr_bvh_intersect(o.bvh, L.position, lr_v3(0, 0, -1), 0.0, INFINITY, &hit));
+    lr_vec3 top = lr_v3(0, 0, 60.0 - hit.t), up = lr_v3(0, 0, 1);
+    double s[3], rho[3], T[3];
+    lr_cpu_sh_B(&o.obj, &L, &env, top, up, NULL, B);
+    lr_sh_object_scale(&o.obj.coeffs, NULL, s);
+    lr_sh_translucency_B(&o.obj.coeffs, s, &env, up, 0.0, T);
+    lr_dipole_rd_total(&o.obj.coeffs, rho);
+    for (int c = 0; c < 3; c++)
+        assert_near_rel(B[c] - T[c], rho[c] * lr_fresnel_transmittance(1.0, wax.eta) /
+                                         (hit.t * hit.t), 1e-9);
     lrt_object_free(&o);
 }
 

@@ -7,6 +7,7 @@
 
 uniform vec3 u_sh_E[3 * LR_MAX_OBJECTS];  // 9 E_lm per object, light of this draw
 uniform vec3 u_sh_scale[LR_MAX_OBJECTS];  // s_c per object
+uniform vec4 u_sh_rho[LR_MAX_OBJECTS];    // rho_c (lr_dipole_rd_total), lit threshold in mm
 
 // max(0, E(n)) of object obj (lr_sh_env_irradiance).
 float lr_sh_irradiance(int obj, vec3 n)
@@ -26,16 +27,20 @@ float lr_sh_irradiance(int obj, vec3 n)
 }
 
 // The thickness the light crossed to reach x_o (lr_cpu_sh_thickness): false where another
-// object holds the G-buffer texel (its shadow), d = 0 where the texel is empty.
-bool lr_sh_thickness(int obj, vec3 xo, out float d)
+// object holds the G-buffer texel (its shadow), d = 0 where the texel is empty; ni the texel's
+// normal (0 when empty).
+bool lr_sh_thickness(int obj, vec3 xo, out float d, out vec3 ni)
 {
-    vec3 xi, ni;
+    vec3 xi;
     int id;
     d = 0.0;
+    ni = vec3(0.0);
     bool directional = u_light_type == LR_LIGHT_DIRECTIONAL;
     vec3 v = directional ? xo : xo - u_light_pos;
-    if (!lr_gbuffer_fetch(v, xi, ni, id))
+    if (!lr_gbuffer_fetch(v, xi, ni, id)) {
+        ni = vec3(0.0);
         return true;
+    }
     if (id != obj)
         return false;
     d = directional ? max(dot(xo - xi, u_light_dir), 0.0)
@@ -47,8 +52,27 @@ bool lr_sh_thickness(int obj, vec3 xo, out float d)
 vec3 lr_sh_translucency_B(int obj, lr_coeffs_gl mat, vec3 xo, vec3 no)
 {
     float d;
-    if (!lr_sh_thickness(obj, xo, d))
+    vec3 ni;
+    int o = clamp(obj, 0, LR_MAX_OBJECTS - 1);
+    if (!lr_sh_thickness(obj, xo, d, ni))
         return vec3(0.0);
     vec3 a = exp(-mat.sigma_tr * max(vec3(d), mat.mfp));
-    return u_sh_scale[clamp(obj, 0, LR_MAX_OBJECTS - 1)] * a * lr_sh_irradiance(obj, no);
+    vec3 B = u_sh_scale[o] * a * lr_sh_irradiance(obj, no);
+    // The direct term where x_o is the light's first surface (lr_sh_lit, lr_sh_direct).
+    if (!(dot(ni, no) > 0.0) || !(d <= u_sh_rho[o].w))
+        return B;
+    float cos_i, E;
+    if (u_light_type == LR_LIGHT_DIRECTIONAL) {
+        cos_i = -dot(no, u_light_dir);
+        E = 1.0;
+    } else {
+        vec3 h = u_light_pos - xo;
+        float r2 = dot(h, h);
+        vec3 u = h * inversesqrt(r2);
+        cos_i = dot(no, u);
+        E = spot_shape(-u) / r2;
+    }
+    if (!(cos_i > 0.0))
+        return B;
+    return B + u_sh_rho[o].rgb * (lr_fresnel_transmittance(cos_i, mat.eta) * cos_i * E);
 }
