@@ -22,9 +22,9 @@ static const lr_argspec opts[] = {
              "new as configs/bench/front.csv, else that one)"},
     {.name = "--json", .help = "one JSON object instead of text"},
     {.name = "--models", .type = LR_ARG_STRING,
-     .metavar = "directional_dipole|standard_dipole|all",
+     .metavar = "directional_dipole|standard_dipole|sh_translucency|all",
      .help = "models to choose from, comma-separated (default all; the renderer\n"
-             "runs both, per object)"},
+             "runs each, per object)"},
     {0},
 };
 
@@ -57,14 +57,16 @@ static int models_arg(const lr_cli *c, const char *v, unsigned *out)
     snprintf(buf, sizeof buf, "%s", v);
     for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
         if (!strcmp(tok, "all"))
-            *out |= LR_PLAN_MODEL_DIRECTIONAL | LR_PLAN_MODEL_STANDARD;
+            *out |= LR_PLAN_MODEL_ALL;
         else if (!strcmp(tok, "directional_dipole"))
             *out |= LR_PLAN_MODEL_DIRECTIONAL;
         else if (!strcmp(tok, "standard_dipole"))
             *out |= LR_PLAN_MODEL_STANDARD;
+        else if (!strcmp(tok, "sh_translucency"))
+            *out |= LR_PLAN_MODEL_SH;
         else
             return lr_cli_usage(c->path, "--models %.100s: expected directional_dipole, "
-                                         "standard_dipole or all", tok);
+                                         "standard_dipole, sh_translucency or all", tok);
     }
     if (!*out)
         return lr_cli_usage(c->path, "--models: empty");

@@ -176,6 +176,8 @@ static bool model_ok(const char *model, unsigned models)
         return models & LR_PLAN_MODEL_DIRECTIONAL;
     if (!strcmp(model, "standard_dipole"))
         return models & LR_PLAN_MODEL_STANDARD;
+    if (!strcmp(model, "sh_translucency"))
+        return models & LR_PLAN_MODEL_SH;
     return false;
 }
 

@@ -33,7 +33,8 @@
 typedef struct lr_plan_row {
     int line; /* in the CSV file, for messages */
     char scene[LR_PLAN_TEXT_MAX]; /* scene file base name ("candle") */
-    char model[LR_PLAN_TEXT_MAX]; /* "directional_dipole" | "standard_dipole" */
+    char model[LR_PLAN_TEXT_MAX]; /* "directional_dipole" | "standard_dipole" |
+                                   * "sh_translucency" */
     char params[LR_PLAN_TEXT_MAX];
     double frame_ms;            /* median ms of one accumulation frame */
     double rel_rmse;            /* whole image */
@@ -158,7 +159,8 @@ typedef struct lr_plan {
 enum lr_plan_models {
     LR_PLAN_MODEL_DIRECTIONAL = 1u << 0, /* "directional_dipole" */
     LR_PLAN_MODEL_STANDARD = 1u << 1,    /* "standard_dipole" */
-    LR_PLAN_MODEL_ALL = LR_PLAN_MODEL_DIRECTIONAL | LR_PLAN_MODEL_STANDARD,
+    LR_PLAN_MODEL_SH = 1u << 2,          /* "sh_translucency" (seed 002) */
+    LR_PLAN_MODEL_ALL = LR_PLAN_MODEL_DIRECTIONAL | LR_PLAN_MODEL_STANDARD | LR_PLAN_MODEL_SH,
 };
 
 typedef struct lr_plan_options {

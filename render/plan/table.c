@@ -156,8 +156,10 @@ static int parse_row(const char *name, int line, char **f, const int *at, lr_pla
     TXT(C_SCENE, scene, true);
     TXT(C_MODEL, model, true);
     TXT(C_PARAMS, params, false);
-    if (strcmp(r->model, "directional_dipole") && strcmp(r->model, "standard_dipole"))
-        return cell_err(name, line, "model", e, "expected directional_dipole or standard_dipole",
+    if (strcmp(r->model, "directional_dipole") && strcmp(r->model, "standard_dipole") &&
+        strcmp(r->model, "sh_translucency"))
+        return cell_err(name, line, "model", e,
+                        "expected directional_dipole, standard_dipole or sh_translucency",
                         r->model);
     NUM(C_FRAME_MS, frame_ms);
     NUM(C_RMSE, rel_rmse);

@@ -1,5 +1,7 @@
 /* The sweep's settings: a base cheap enough for 256 frames per scene, and one-at-a-time
  * changes around it (issue 6: K, N, N_vpl, map sizes, frames, VPLs on/off, model). */
+#include <stdlib.h>
+
 #include "tools/bench/sweep.h"
 
 /* Base: K 8 maps of 64^2, N 4, 64 VPLs, G-buffer 128. Its radiosity is 1/128 of the scenes'
@@ -41,6 +43,12 @@ int lrb_sweep_settings(lrb_setting *out, int cap)
     ADD("gbuf=256", gbuffer_size, 256);
     ADD("vpl=off", vpl, false);
     ADD("standard", model, "standard_dipole");
+    ADD("sh", model, "sh_translucency"); /* seed 002: deterministic, one evaluation per texel */
 #undef ADD
+    /* LRB_SWEEP_BASE_MODEL=NAME: the base (and so the fair figures: regions, median |ln|) with
+     * another model; the variants keep theirs. */
+    const char *bm = getenv("LRB_SWEEP_BASE_MODEL");
+    if (bm && bm[0] && n > 0)
+        out[0].model = bm;
     return n;
 }
