@@ -724,7 +724,11 @@ static void test_model_switch_and_light_cap(void **state)
     assert_int_equal(lr_scene_object_at(s, 0)->sss_model, LR_SSS_STANDARD_DIPOLE);
     get(s, "objects[0].model", "standard_dipole");
     set_bad(s, "objects[0].model", "jensen",
-            "expected directional_dipole, standard_dipole or multipole");
+            "expected directional_dipole, standard_dipole, multipole or sh_translucency");
+    /* Seed 002's model needs nothing else (issue 14). */
+    set_ok(s, "objects[0].model", "sh_translucency", LR_DIRTY_MATERIAL);
+    assert_int_equal(lr_scene_object_at(s, 0)->sss_model, LR_SSS_SH_TRANSLUCENCY);
+    set_ok(s, "objects[0].model", "standard_dipole", LR_DIRTY_MATERIAL);
     /* The multipole needs the wall's thickness first (issue 12). */
     set_bad(s, "objects[0].model", "multipole", "needs the object's thickness_mm set first");
     set_bad(s, "objects[0].thickness_mm", "-2", "objects[0].thickness_mm");
@@ -756,7 +760,8 @@ static void test_model_switch_and_light_cap(void **state)
     lr_scene_destroy(s);
     scene_text(t, sizeof t, ",\n     \"model\": \"dipole\"", "", NULL);
     expect_scene_error(t, LR_EINVAL, "t.json:6: field 'objects[0].model': 'dipole': expected "
-                                     "directional_dipole, standard_dipole or multipole");
+                                     "directional_dipole, standard_dipole, multipole or "
+                                     "sh_translucency");
     scene_text(t, sizeof t, ",\n     \"model\": 1", "", NULL);
     expect_scene_error(t, LR_EPARSE, "t.json:6: field 'objects[0].model'");
 
