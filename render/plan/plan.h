@@ -154,8 +154,8 @@ typedef struct lr_plan {
     bool feasible; /* every object's choice meets the budget */
 } lr_plan;
 
-/* Models the planner may choose; the renderer runs both (objects[i].model), so the default
- * is both. `lamprig plan --models directional_dipole` restricts the choice. */
+/* Models the planner may choose; the renderer runs each (objects[i].model), so the default
+ * is all of them. `lamprig plan --models directional_dipole` restricts the choice. */
 enum lr_plan_models {
     LR_PLAN_MODEL_DIRECTIONAL = 1u << 0, /* "directional_dipole" */
     LR_PLAN_MODEL_STANDARD = 1u << 1,    /* "standard_dipole" */
