@@ -6,9 +6,10 @@
  * and the G-buffer's quantised depth (the thickness: the texel's surface point is not on the
  * ray to x_o; on the lamp shade's 1.5 mm porcelain wall that alone moves 13 % of the texels by
  * more than 2 % of the largest B, so the twin emulates the G-buffer's texels as
- * test_render_parity does, copied from there). Asserted: the map sums within 1 % and the
- * texels within 2 % of the scene's largest B, all but 1 % of them (the silhouette texels of
- * the thickness lookup). Also: a model switch reaches the GPU (a different map sum). */
+ * test_render_parity does, copied from there). Asserted: the map sums within 0.1 % and the
+ * texels within 1 % of the scene's largest B, all but 0.5 % of them (float arithmetic and
+ * silhouettes). Measured: sums within 0.001 %, no texel beyond 2 % of the largest B on the
+ * candle, a lit sphere and the lamp shade. Also: a model switch reaches the GPU. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -138,7 +139,7 @@ static void compare(lr_renderer *r, lr_scene *s, cmp *out)
     }
     out->n = (long)m;
     for (size_t i = 0; i < m; i++)
-        out->off += fabs(gpu[i] - cpu[i]) > 0.02 * out->max_cpu;
+        out->off += fabs(gpu[i] - cpu[i]) > 0.01 * out->max_cpu;
     free(B);
     free(pos);
     free(nrm);
@@ -153,14 +154,14 @@ static void run_scene(const char *scene, const char *const *sets, cmp *out)
     lr_renderer *r = lr_test_renderer(gl, s, 16, 12, true, 3);
     lr_test_converge(r, 4);
     compare(r, s, out);
-    print_message("%s: %ld texel-bands, sum GPU %.5g CPU %.5g (%+.3f %%), beyond 2 %% of max "
+    print_message("%s: %ld texel-bands, sum GPU %.5g CPU %.5g (%+.3f %%), beyond 1 %% of max "
                   "%.3g: %.2f %%\n", scene, out->n, out->sum_gpu, out->sum_cpu,
                   100.0 * (out->sum_gpu / out->sum_cpu - 1.0), out->max_cpu,
                   100.0 * out->off / out->n);
     assert_true(out->n > 300);
     assert_true(out->sum_cpu > 0.0);
-    assert_near_rel(out->sum_gpu, out->sum_cpu, 0.01);
-    assert_true(out->off <= 0.01 * out->n);
+    assert_near_rel(out->sum_gpu, out->sum_cpu, 1e-3);
+    assert_true(out->off <= 0.005 * out->n);
     lr_renderer_destroy(r);
     lr_scene_destroy(s);
 }
