@@ -89,8 +89,8 @@ int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
                    !(obj->sd_raw && obj->sss_model == LR_SSS_DIRECTIONAL_DIPOLE) &&
                    /* translucent radiosity solves the cavity's inter-reflection itself */
                    obj->sss_model != LR_SSS_TRANSLUCENT_RADIOSITY &&
-
-                   obj->sss_model != LR_SSS_DIFFUSION_GRID; /* not a profile: no closure */
+                   obj->sss_model != LR_SSS_DIFFUSION_GRID && /* not a profile: no closure */
+                   obj->sss_model != LR_SSS_SH_TRANSLUCENCY; /* its energy is fitted, not closed */
     if (!out->applies)
         return LR_OK;
 

@@ -13,6 +13,7 @@
 #include "render/cpu/recv_grid.h"
 #include "render/transrad/tr_scene.h"
 #include "render/cpu/rng.h"
+#include "render/cpu/sh.h"
 #include "render/cpu/vpl.h"
 
 void lr_cpu_camera_ray(const lr_scene *s, int width, int height, int px, int py, lr_vec3 *org,
@@ -41,6 +42,7 @@ typedef struct rctx {
     lr_cpu_vpl *vpl;     /* [obj * nvpl + v]; B per band already summed over lights with I */
     double (*I)[3];      /* per light: intensity * color */
     double (*gain)[3];   /* [obj * nlight + light]: cavity gain (render/cpu/cavity.h) */
+    lr_sh_env *sh;       /* [obj * nlight + light]: sh_translucency environments */
     lr_image *rgb, *var;
     long *object_px, *fallback_px; /* per pixel flags, summed at the end */
     /* PASS: per receiver, E_vpl and its variance at the grid's texel centres (6 doubles per
@@ -70,7 +72,8 @@ static void radiosity_at(const rctx *r, int o, int l, lr_vec3 x, lr_vec3 n, uint
 {
     if (r->d->mode == LR_CPU_REFERENCE) {
         lr_cpu_radiosity_desc rd = {.N = r->samples, .sampler = LR_CPU_REFERENCE,
-                                    .others = r->objs, .n_others = r->nobj};
+                                    .others = r->objs, .n_others = r->nobj,
+                                    .sh_env = r->sh + o * r->nlight + l};
         if (r->dscene)
             lr_dscene_field(r->dscene, o, l, &rd.dfield);
         lr_cpu_estimate est;
@@ -274,7 +277,8 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
     r.fallback_px = calloc((size_t)r.W * r.H, sizeof *r.fallback_px);
     r.objs = calloc((size_t)r.nobj, sizeof *r.objs);
     r.gain = calloc((size_t)r.nobj * r.nlight + 1, sizeof *r.gain);
-    if (!r.I || !r.objs || !r.gain || !r.maps || !r.vpl || !r.object_px || !r.fallback_px) {
+    r.sh = calloc((size_t)r.nobj * r.nlight + 1, sizeof *r.sh);
+    if (!r.I || !r.objs || !r.gain || !r.sh || !r.maps || !r.vpl || !r.object_px || !r.fallback_px) {
         rc = lr_err_set(e, LR_ENOMEM, "cpu render: out of memory");
         goto fail;
     }
@@ -282,6 +286,15 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
         lr_light_rgb(lr_scene_light_at(s, l), r.I[l]);
     for (int o = 0; o < r.nobj; o++)
         r.objs[o] = lr_scene_object_at(s, o);
+    /* sh_translucency: each light's environment through the GPU's G-buffer texels. */
+    for (int l = 0; l < r.nlight; l++) {
+        lr_gb_camera cam;
+        lr_gb_camera_scene(s, l, &cam);
+        for (int o = 0; o < r.nobj; o++)
+            if (r.objs[o]->sss_model == LR_SSS_SH_TRANSLUCENCY)
+                lr_cpu_sh_env(r.objs[o], lr_scene_light_at(s, l), &cam, rs->gbuffer_size, r.objs,
+                              r.nobj, d->threads, &r.sh[o * r.nlight + l]);
+    }
     for (int l = 0; l < r.nlight; l++) {
         double(*g)[3] = calloc((size_t)r.nobj + 1, sizeof *g);
         if (!g) {
@@ -317,7 +330,8 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
                                        .threads = d->threads,
                                        .others = r.objs,
                                        .n_others = r.nobj,
-                                       .tr = r.tr, .tr_object = o, .tr_light = l};
+                                       .tr = r.tr, .tr_object = o, .tr_light = l,
+                                       .sh_env = r.sh + o * r.nlight + l};
                 if (r.dscene)
                     lr_dscene_field(r.dscene, o, l, &md.dfield);
                 lr_cpu_maps **m = &r.maps[o * r.nlight + l];
@@ -394,6 +408,7 @@ fail:
     free(r.vpl);
     free(r.I);
     free(r.gain);
+    free(r.sh);
     free(r.object_px);
     free(r.fallback_px);
     free(r.objs);

@@ -8,6 +8,7 @@
 #include "render/cpu/parallel.h"
 #include "render/cpu/rng.h"
 #include "render/transrad/tr_scene.h"
+#include "render/optics/sh_translucency.h"
 
 struct lr_cpu_maps {
     const lr_scene_object *obj;
@@ -21,6 +22,8 @@ struct lr_cpu_maps {
     int tr_object, tr_light;
     unsigned seed;
     lr_dfield_view dfield; /* the caller's; must outlive the maps */
+    bool has_sh;
+    lr_sh_env sh;
     lr_vec3 *dir, *eye, *right, *up;
     lr_cpu_texel *tex; /* K * S * S, map-major, row j then column i */
 };
@@ -95,6 +98,9 @@ int lr_cpu_maps_create(const lr_cpu_maps_desc *d, lr_cpu_maps **out, lr_err *e)
     m->tr_object = d->tr_object;
     m->tr_light = d->tr_light;
     m->seed = d->seed ? d->seed : 1;
+    m->has_sh = d->sh_env != NULL;
+    if (d->sh_env)
+        m->sh = *d->sh_env;
     m->threads = d->threads;
     m->texel = 2.0 * m->obj->radius / m->S;
     m->eps_bias = d->eps_bias > 0.0 ? d->eps_bias : 2.0 * m->texel;
@@ -158,7 +164,8 @@ static void acc_item(void *p, long item)
     }
     lr_cpu_radiosity_desc d = {.N = m->N, .sampler = m->sampler, .r_max = m->r_max,
                                .others = m->others, .n_others = m->n_others,
-                               .dfield = m->dfield};
+                               .dfield = m->dfield,
+                               .sh_env = m->has_sh ? &m->sh : NULL};
     lr_cpu_estimate est;
     lr_cpu_radiosity(m->obj, &m->light, t->x, t->n, &d,
                      lr_cpu_key(m->seed, (uint64_t)k, (uint64_t)texel, (uint64_t)a->frame), &est);

@@ -41,6 +41,8 @@ typedef struct lr_cpu_maps_desc {
     const struct lr_tr_scene *tr;
     int tr_object, tr_light;
     lr_dfield_view dfield; /* diffusion_grid objects: the solved field (lr_cpu_radiosity_desc) */
+    /* sh_translucency objects: see lr_cpu_radiosity_desc.sh_env (copied). */
+    const struct lr_sh_env *sh_env;
 } lr_cpu_maps_desc;
 
 typedef struct lr_cpu_texel {

@@ -6,6 +6,7 @@
 #include <stdint.h>
 
 #include "render/cpu/rng.h"
+#include "render/cpu/sh.h"
 #include "render/optics/optics.h"
 
 /* A light closer to x_o than this many bounding radii is taken to sit on it: the lookup sphere
@@ -286,6 +287,27 @@ static double sample_ref(const ctx *k, int c, lr_cpu_rng *rng)
     return lit_point(k, vh, c) / p;
 }
 
+/* Seed 002's sh_translucency (render/cpu/sh.h): deterministic, so the variance is 0. Without a
+ * precomputed environment one is projected here through a cube of LR_CPU_SH_FALLBACK_SIZE^2
+ * texels per face around the light (the caller's G-buffer cameras are unknown here). */
+#define LR_CPU_SH_FALLBACK_SIZE 32
+static void sh_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3 xo,
+                         lr_vec3 no, const lr_cpu_radiosity_desc *d, lr_cpu_estimate *out)
+{
+    const lr_scene_object *const *others = d ? d->others : NULL;
+    int n_others = d ? d->n_others : 0;
+    lr_sh_env env;
+    const lr_sh_env *use = d ? d->sh_env : NULL;
+    if (!use) {
+        lr_gb_camera cam;
+        lr_gb_camera_make(light, obj->center, obj->radius, false, &cam);
+        lr_cpu_sh_env(obj, light, &cam, LR_CPU_SH_FALLBACK_SIZE, others, n_others, 1, &env);
+        use = &env;
+    }
+    lr_cpu_sh_B(obj, light, use, xo, no, d, out->mean);
+    out->var[0] = out->var[1] = out->var[2] = 0.0;
+}
+
 void lr_cpu_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3 xo, lr_vec3 no,
                       const lr_cpu_radiosity_desc *d, uint64_t stream, lr_cpu_estimate *out)
 {
@@ -324,6 +346,10 @@ void lr_cpu_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3
             out->mean[c] = B[c];
             out->var[c] = 0.0;
         }
+        return;
+    }
+    if (obj->sss_model == LR_SSS_SH_TRANSLUCENCY) {
+        sh_radiosity(obj, light, xo, no, d, out);
         return;
     }
     for (int c = 0; c < 3; c++) {

@@ -170,7 +170,7 @@ static int parse_object(const lr_json *j, lr_jnode obj, const char *where, const
 {
     static const char *const allowed[] = {"name",  "source", "sigma_a", "sigma_s_prime",
                                           "eta",   "g",      "base",    "scale",
-                                          NULL};
+                                          "sh_scale", NULL};
     const char *what = where && where[0] ? where : "material";
     char f[256];
     int rc = lr_json_check_keys(j, obj, what, allowed, e);
@@ -269,6 +269,15 @@ static int parse_object(const lr_json *j, lr_jnode obj, const char *where, const
         if (!(m.medium.g > -1.0 && m.medium.g < 1.0))
             return lr_json_fail(j, n, f, e, LR_EINVAL, "must be in (-1, 1), got %g",
                                 m.medium.g);
+    }
+
+    /* Seed 002's energy scale (render/optics/sh_translucency.h); never taken from a base: a
+     * scaled or overridden medium has its own fit. */
+    n = lr_json_get(j, obj, "sh_scale");
+    if (n != LR_JNONE) {
+        rc = get_scale(j, n, field_name(f, sizeof f, where, "sh_scale"), m.sh_scale, e);
+        if (rc)
+            return rc;
     }
 
     /* The optics' own range checks (sigma_t' > 0, eta range of the Fresnel fits, ...). */

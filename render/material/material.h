@@ -8,6 +8,9 @@
  *   sigma_s_prime  [R, G, B] reduced scattering sigma_s (1 - g), mm^-1, >= 0
  *   eta            relative index of refraction inside / outside, > 0
  *   g              optional Henyey-Greenstein mean cosine in (-1, 1), default 0
+ *   sh_scale       optional number or [R, G, B] > 0: the sh_translucency model's energy scale,
+ *                  lr_sh_fit_scale at 10 mm (render/optics/sh_translucency.h); absent: fitted
+ *                  when the object loads. Not inherited from a base.
  * or, for a scaled preset,
  *   base           name of another preset (resolved as below); its medium is the starting point
  *   scale          optional number or [R, G, B] > 0 (default 1) multiplying both sigma_a and
@@ -37,6 +40,8 @@ typedef struct lr_material {
     char name[LR_MATERIAL_NAME_MAX];
     char source[LR_MATERIAL_SOURCE_MAX]; /* where the numbers come from (citation / derivation) */
     lr_medium medium;                    /* sigma_a, sigma_s_prime (mm^-1, RGB), eta, g */
+    double sh_scale[3];                  /* "sh_scale": seed 002's fitted energy scale per band
+                                          * (render/optics/sh_translucency.h); 0: not given */
 } lr_material;
 
 /* Loads a material file. A `base` in it names a preset in the same directory as `path`. */

@@ -9,7 +9,7 @@
 
 static const char *const names[LR_SSS_MODEL_COUNT] = {"directional_dipole", "standard_dipole",
                                                        "multipole", "translucent_radiosity",
-                                                       "diffusion_grid"};
+                                                       "diffusion_grid", "sh_translucency"};
 
 /* Translucent radiosity (seed 000) evaluates a profile of its own choosing: the slab multipole
  * where the object gives a wall thickness, the standard dipole otherwise. */
@@ -51,6 +51,10 @@ void lr_sss_sd_fresnel_n(enum lr_sss_model m, const lr_coeffs *c, double thickne
                          lr_vec3 xi, lr_vec3 ni, lr_vec3 wi, lr_vec3 xo, lr_vec3 no, double out[3])
 {
     m = profile_of(m, thickness_mm);
+    if (m == LR_SSS_SH_TRANSLUCENCY) {
+        out[0] = out[1] = out[2] = 0.0; /* no S_d: sh_translucency.h evaluates B directly */
+        return;
+    }
     if (m == LR_SSS_STANDARD_DIPOLE)
         lr_dipole_sd_fresnel(c, xi, ni, wi, xo, out);
     else if (m == LR_SSS_MULTIPOLE)

@@ -194,10 +194,13 @@ enum lr_sss_model { LR_SSS_DIRECTIONAL_DIPOLE = 0, LR_SSS_STANDARD_DIPOLE = 1,
 
                     /* seed 001: the diffusion equation solved on a grid (render/diffusion/);
                      * not a BSSRDF: lr_sss_sd_fresnel gives 0, the passes read its solved field */
-                    LR_SSS_DIFFUSION_GRID = 4 };
-#define LR_SSS_MODEL_COUNT 5
+                    LR_SSS_DIFFUSION_GRID = 4,
+                    /* seed 002 (render/optics/sh_translucency.h): not an S_d,
+                     * lr_sss_sd_fresnel gives 0 for it */
+                    LR_SSS_SH_TRANSLUCENCY = 5 };
+#define LR_SSS_MODEL_COUNT 6
 /* "directional_dipole", "standard_dipole", "multipole", "translucent_radiosity",
- * "diffusion_grid". */
+ * "diffusion_grid", "sh_translucency". */
 const char *lr_sss_model_name(enum lr_sss_model m);
 /* Inverse of lr_sss_model_name; false for any other text. */
 bool lr_sss_model_parse(const char *name, enum lr_sss_model *out);

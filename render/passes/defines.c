@@ -44,6 +44,7 @@ const char *const *lr_passes_defines(lr_shader_defines *d)
         DEF(LR_SSS_MULTIPOLE),
         DEF(LR_SSS_TRANSLUCENT_RADIOSITY),
         DEF(LR_SSS_DIFFUSION_GRID),
+        DEF(LR_SSS_SH_TRANSLUCENCY),
         DEF(LR_TONEMAP_CLAMP),
         DEF(LR_TONEMAP_REINHARD),
         DEF(LR_TONEMAP_ACES),

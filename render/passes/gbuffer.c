@@ -8,6 +8,7 @@
  * plus 2 x gbuffer_size^2 for the 2D map (14.7 MB at 256^2). */
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "render/base/mat4.h"
 #include "render/passes/gbuffer.h"
@@ -63,11 +64,6 @@ void lr_gbuffer_free(lr_gbuffer *gb)
     }
 }
 
-static lr_vec3 up_for(lr_vec3 dir)
-{
-    return fabs(dir.z) > 0.99 ? lr_v3(0.0, 1.0, 0.0) : lr_v3(0.0, 0.0, 1.0);
-}
-
 /* Draws every object into the bound framebuffer with world -> clip `vp`. */
 static void draw_objects(const lr_pass_ctx *c, const double vp[16])
 {
@@ -93,53 +89,25 @@ static void clear_surface(void)
 static void draw_light(lr_light_gbuffer *g, const lr_pass_ctx *ctx, int l)
 {
     const lr_light *light = lr_scene_light_at(ctx->scene, l);
-    lr_vec3 c;
-    double R;
-    lr_scene_bounds(ctx->scene, &c, &R);
-    R = fmax(R, 1e-3);
     g->type = light->type;
     g->pos = light->position;
     g->dir = lr_v3_normalize(light->direction);
     g->spot_cos[0] = (float)cos(light->outer_deg * M_PI / 180.0);
     g->spot_cos[1] = (float)cos(light->inner_deg * M_PI / 180.0);
 
-    double dist = lr_v3_len(lr_v3_sub(c, light->position));
-    enum lr_enclosure enc = lr_scene_light_enclosure(ctx->scene, l, NULL);
-    if (light->type == LR_LIGHT_DIRECTIONAL)
-        g->mode = LR_GB_ORTHO;
-    else if (light->type == LR_LIGHT_POINT && (enc != LR_ENCLOSURE_NONE || dist < 1.05 * R))
-        g->mode = LR_GB_CUBE;
-    else
-        g->mode = LR_GB_PERSPECTIVE;
-
+    lr_gb_camera cam;
+    lr_gb_camera_scene(ctx->scene, l, &cam);
+    g->mode = cam.mode;
     if (g->mode == LR_GB_CUBE) {
-        double znear = fmax(1e-4 * R, 1e-3), zfar = dist + 3.0 * R;
         for (int f = 0; f < 6; f++) {
             lr_fb_bind(g->fb[f]);
             clear_surface();
-            lr_passes_cube_face_vp(light->position, f, znear, zfar, g->face_vp[f]);
+            memcpy(g->face_vp[f], cam.vp[f], sizeof cam.vp[f]);
             draw_objects(ctx, g->face_vp[f]);
         }
         lr_mat4_identity(g->vp_d);
     } else {
-        double view[16], proj[16];
-        if (g->mode == LR_GB_ORTHO) {
-            lr_vec3 eye = lr_v3_sub(c, lr_v3_scale(g->dir, 2.0 * R));
-            lr_mat4_look_at(eye, c, up_for(g->dir), view);
-            lr_mat4_ortho(-R, R, -R, R, 0.5 * R, 3.5 * R, proj);
-        } else if (light->type == LR_LIGHT_SPOT) {
-            lr_mat4_look_at(light->position, lr_v3_add(light->position, g->dir), up_for(g->dir),
-                            view);
-            double fov = fmin(2.0 * light->outer_deg * M_PI / 180.0 * 1.02, 170.0 * M_PI / 180.0);
-            lr_mat4_perspective(fov, 1.0, fmax(1e-3 * R, 1e-3), dist + 3.0 * R, proj);
-        } else {
-            lr_vec3 axis = lr_v3_normalize(lr_v3_sub(c, light->position));
-            lr_mat4_look_at(light->position, c, up_for(axis), view);
-            double fov = 2.0 * asin(fmin(R / dist, 1.0)) * 1.05;
-            lr_mat4_perspective(fmin(fov, 170.0 * M_PI / 180.0), 1.0, fmax(0.5 * (dist - R), 1e-3),
-                                dist + 2.0 * R, proj);
-        }
-        lr_mat4_mul(proj, view, g->vp_d);
+        memcpy(g->vp_d, cam.vp[0], sizeof cam.vp[0]);
         lr_fb_bind(g->fb_2d);
         clear_surface();
         draw_objects(ctx, g->vp_d);

@@ -4,11 +4,9 @@
 #ifndef LR_GBUFFER_H
 #define LR_GBUFFER_H
 
+#include "render/passes/gbuffer_camera.h"
 #include "render/passes/passes.h"
 
-/* Light G-buffer layouts (render/shaders/lib/gbuffer.glsl u_gb_mode; reach GLSL as the defines
- * of the same names). */
-enum lr_gb_mode { LR_GB_CUBE = 0, LR_GB_PERSPECTIVE = 1, LR_GB_ORTHO = 2 };
 
 /* Light l's G-buffer, as the last run drew it. */
 typedef struct lr_light_gbuffer {

@@ -234,6 +234,8 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
         int rc = tr_refresh(rad, c, e);
         if (!rc)
             rc = dgrid_update(rad, c, e);
+        if (!rc)
+            rc = lr_radiosity_sh_project(rad, c, gb, e);
         if (rc)
             return rc;
     }
@@ -279,6 +281,7 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
             glUseProgram(lr_program_id(p));
             lr_passes_set_coeffs(c->objs, p);
             lr_passes_uniform_v3_array(p, "u_sd_norm", c->objs->sd_norm, LR_MAX_OBJECTS);
+            lr_radiosity_sh_uniforms(rad, p, l);
             lr_gbuffer_bind(gb, p, l);
             lr_passes_uniform_mat4(p, "u_vp", rad->vp[k]);
             lr_passes_uniform_i(p, "u_N", c->rs->N);

@@ -39,6 +39,12 @@ typedef struct lr_radiosity {
     lr_tex *dg_tex[LR_MAX_OBJECTS];
     int dg_dims[LR_MAX_OBJECTS][3];
     int dg_lights[LR_MAX_OBJECTS];
+    /* sh_translucency objects (seed 002, render/passes/sh.c): per light the finished E_lm of
+     * each object, 3 vec3 per object (u_sh_E), and per object the energy scale (u_sh_scale). */
+    bool has_sh;
+    float sh_E[LR_MAX_LIGHTS][27 * LR_MAX_OBJECTS];
+    float sh_scale[3 * LR_MAX_OBJECTS];
+    float sh_rho[4 * LR_MAX_OBJECTS]; /* rho.rgb (lr_dipole_rd_total), lit threshold (mm) */
 } lr_radiosity;
 
 /* Maps for c->rs (K, map_size) and c->n_lights lights; accumulation restarts. */
@@ -48,6 +54,14 @@ void lr_radiosity_free(lr_radiosity *rad);
  * map cameras from the current geometry, the scale per light from gb's light types. */
 int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *gb, bool restart,
                      lr_err *e);
+
+/* sh.c: when any object has model sh_translucency, reads back every light's G-buffer and
+ * projects the light entering each such object (lr_sh_env_add per texel), fills sh_E and
+ * sh_scale. Run at restart, after the G-buffer pass. */
+int lr_radiosity_sh_project(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *gb,
+                            lr_err *e);
+/* Sets u_sh_E (light l's) and u_sh_scale on the radiosity program. */
+void lr_radiosity_sh_uniforms(const lr_radiosity *rad, lr_program *p, int l);
 
 /* Algorithm 1 uniforms and samplers (units 4..6, render/shaders/lib/gather.glsl); the gather
  * returns sum_l w[l] B_l (u_light_w), w per light and band. */

@@ -155,7 +155,7 @@ const lr_record_desc lr_scene_receiver_desc = {"receivers[i]", "a receiver", rec
 
 static const char *const sss_models[] = {"directional_dipole", "standard_dipole", "multipole",
                                          "translucent_radiosity",
-                                         "diffusion_grid", NULL};
+                                         "diffusion_grid", "sh_translucency", NULL};
 
 static const lr_field object_fields[] = {
     {"name", LR_FT_NAME, .dflt_text = "object0, ...", .flags = LR_FF_NO_SET,
@@ -171,7 +171,8 @@ static const lr_field object_fields[] = {
      .help = "the S_d of the radiosity maps (seed 003; standard: Jensen 2001; multipole: "
              "Donner & Jensen 2005 slab, T across the wall, R on the same face; "
              "translucent_radiosity: seed 000's patch solve with the receivers; "
-             "diffusion_grid: seed 001's grid solve, closed meshes)"},
+             "diffusion_grid: seed 001's grid solve, closed meshes; sh_translucency: seed 002, SH "
+             "of the entering light times a thickness attenuation, the cheapest)"},
     /* The range is lr_multipole_thickness_validate's (LR_MULTIPOLE_D_MIN..MAX). */
     {"thickness_mm", LR_FT_NUM, 0, O(pub.thickness_mm), 1e-3, 1e4, .flags = LR_FF_ZERO_ABSENT,
      .unit = "mm", .dirty = LR_DIRTY_MATERIAL, .dflt_text = "none",

@@ -38,6 +38,8 @@ float spot_shape(vec3 dir)
     return smoothstep(u_spot_cos.x, u_spot_cos.y, c);
 }
 
+#include "lib/sh_translucency.glsl"
+
 void main()
 {
     vec3 xo = v_pos;
@@ -57,6 +59,14 @@ void main()
     if (sss.model == LR_SSS_DIFFUSION_GRID) {
         // Seed 001: B was solved on the CPU (render/diffusion/dscene.h); look it up.
         o_B = vec4(min(lr_dgrid_B(xo) * u_map_scale, vec3(u_map_max)), 1.0);
+        o_pos = vec4(xo, 1.0);
+        o_nrm = vec4(no, float(u_object));
+        return;
+    }
+    if (sss.model == LR_SSS_SH_TRANSLUCENCY) {
+        // Seed 002: no samples, one evaluation per texel (Eq. 10-12).
+        vec3 Bsh = lr_sh_translucency_B(u_object, mat, xo, no);
+        o_B = vec4(min(Bsh * u_map_scale, vec3(u_map_max)), 1.0);
         o_pos = vec4(xo, 1.0);
         o_nrm = vec4(no, float(u_object));
         return;

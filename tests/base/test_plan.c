@@ -427,6 +427,30 @@ static void test_multipole_where_the_object_takes_it(void **state)
     assert_int_equal(lr_plan_create(candle, t, &b, &o, p, &e), LR_EINVAL);
     assert_non_null(strstr(e.msg, "that the object can take"));
     free(p);
+/* Seed 002's sh_translucency is a table model like the dipoles: with a loose budget its cheap
+ * row (hand-made, 4 ms at 0.3) wins; under 0.1 it cannot, and excluded it is never chosen. */
+static void test_sh_translucency_rows(void **state)
+{
+    (void)state;
+    static const char csv[] =
+        HDR "candle,directional_dipole,20,0.09,8,4,64,64,128,16,on\n"
+            "candle,sh_translucency,4,0.30,8,4,64,64,128,1,on\n";
+    lr_plan_table *t = NULL;
+    lr_err e = {0};
+    if (lr_plan_table_parse(csv, strlen(csv), "sh.csv", &t, &e))
+        fail_msg("%s", e.msg);
+    const double budgets[3] = {0.5, 0.1, 0.5};
+    const unsigned models[3] = {0, 0, LR_PLAN_MODEL_DIRECTIONAL | LR_PLAN_MODEL_STANDARD};
+    const char *const want[3] = {"sh_translucency", "directional_dipole", "directional_dipole"};
+    for (int k = 0; k < 3; k++) {
+        lr_plan *p = calloc(1, sizeof *p);
+        assert_non_null(p);
+        lr_plan_budget b = {budgets[k], 0};
+        if (lr_plan_create(candle, t, &b, &(lr_plan_options){.models = models[k]}, p, &e))
+            fail_msg("plan: %s", e.msg);
+        assert_string_equal(p->objects[0].row.model, want[k]);
+        free(p);
+    }
     lr_plan_table_destroy(t);
 }
 
@@ -792,6 +816,7 @@ int main(void)
         cmocka_unit_test(test_both_budgets_and_infeasible),
         cmocka_unit_test(test_models_and_coverage_filter),
         cmocka_unit_test(test_multipole_where_the_object_takes_it),
+        cmocka_unit_test(test_sh_translucency_rows),
         cmocka_unit_test(test_convexity),
         cmocka_unit_test(test_coverage),
         cmocka_unit_test(test_receivers_in_sight),

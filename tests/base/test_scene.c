@@ -731,6 +731,9 @@ static void test_model_switch_and_light_cap(void **state)
     set_ok(s, "objects[0].dgrid_h_mm", "2.5", LR_DIRTY_MATERIAL);
     assert_true(lr_scene_object_at(s, 0)->dgrid_h_mm == 2.5);
     set_bad(s, "objects[0].dgrid_h_mm", "0.01", "dgrid_h_mm");
+    /* Seed 002's model needs nothing else (issue 14). */
+    set_ok(s, "objects[0].model", "sh_translucency", LR_DIRTY_MATERIAL);
+    assert_int_equal(lr_scene_object_at(s, 0)->sss_model, LR_SSS_SH_TRANSLUCENCY);
     set_ok(s, "objects[0].model", "standard_dipole", LR_DIRTY_MATERIAL);
     /* The multipole needs the wall's thickness first (issue 12). */
     set_bad(s, "objects[0].model", "multipole", "needs the object's thickness_mm set first");

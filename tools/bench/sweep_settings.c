@@ -1,5 +1,7 @@
 /* The sweep's settings: a base cheap enough for 256 frames per scene, and one-at-a-time
  * changes around it (issue 6: K, N, N_vpl, map sizes, frames, VPLs on/off, model). */
+#include <stdlib.h>
+
 #include "tools/bench/sweep.h"
 
 #include <stdlib.h>
@@ -58,6 +60,7 @@ int lrb_sweep_settings(lrb_setting *out, int cap)
         out[n - 1].K = 16;
     ADD("transrad", model, "translucent_radiosity");
     ADD("diffusion_grid", model, "diffusion_grid"); /* seed 001 (render/diffusion/) */
+    ADD("sh", model, "sh_translucency"); /* seed 002: deterministic, one evaluation per texel */
 #undef ADD
     return n;
 }

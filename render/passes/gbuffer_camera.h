@@ -1,0 +1,31 @@
+/* lamprig — the light G-buffer's cameras (pass 1, render/passes/PIPELINE.md) as plain math, so
+ * that the CPU twin can cast its rays through the very texels the GPU draws (the sh_translucency
+ * projection, render/optics/sh_translucency.h). No GL here. */
+#ifndef LR_GBUFFER_CAMERA_H
+#define LR_GBUFFER_CAMERA_H
+
+#include <stdbool.h>
+
+#include "render/base/vec3.h"
+#include "render/scene/scene.h"
+
+/* Light G-buffer layouts (render/shaders/lib/gbuffer.glsl u_gb_mode; reach GLSL as the defines
+ * of the same names). */
+enum lr_gb_mode { LR_GB_CUBE = 0, LR_GB_PERSPECTIVE = 1, LR_GB_ORTHO = 2 };
+
+typedef struct lr_gb_camera {
+    enum lr_gb_mode mode;
+    int views;        /* 6 cube faces (lr_passes_cube_face_vp order) or 1 */
+    double vp[6][16]; /* world -> clip of each view */
+} lr_gb_camera;
+
+/* The cameras gbuffer.c draws light `light` with, for objects in the bounding sphere (c, R):
+ * a cube around an enclosed point light (or one within 1.05 R of c), else a perspective map
+ * holding the sphere (point) or the spot cone (spot), or an orthographic map over the sphere
+ * (directional). */
+void lr_gb_camera_make(const lr_light *light, lr_vec3 c, double R, bool enclosed,
+                       lr_gb_camera *out);
+/* The same for light l of scene s (its bounds and the light's enclosure). */
+void lr_gb_camera_scene(const lr_scene *s, int l, lr_gb_camera *out);
+
+#endif
