@@ -427,6 +427,9 @@ static void test_multipole_where_the_object_takes_it(void **state)
     assert_int_equal(lr_plan_create(candle, t, &b, &o, p, &e), LR_EINVAL);
     assert_non_null(strstr(e.msg, "that the object can take"));
     free(p);
+    lr_plan_table_destroy(t);
+}
+
 /* Seed 002's sh_translucency is a table model like the dipoles: with a loose budget its cheap
  * row (hand-made, 4 ms at 0.3) wins; under 0.1 it cannot, and excluded it is never chosen. */
 static void test_sh_translucency_rows(void **state)
