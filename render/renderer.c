@@ -290,6 +290,17 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
     if (lr_scene_light_count(desc->scene) < 1 || lr_scene_object_count(desc->scene) < 1)
         return lr_err_set(e, LR_EINVAL, "renderer: scene %s needs a light and an object",
                           lr_scene_name(desc->scene));
+    /* Area lights (render/area) are rendered by the CPU twin (lamprig-cpuref --twin) and the
+     * physical reference; the GLES passes do not sample them yet (render/area/README.md says
+     * what is missing), so refuse rather than render them as something else. */
+    for (int l = 0; l < lr_scene_light_count(desc->scene); l++)
+        if (lr_light_is_area(lr_scene_light_at(desc->scene, l)))
+            return lr_err_set(e, LR_EUNSUPPORTED, "renderer: scene %s: light '%s' is an area "
+                              "light (%s), which the GLES renderer does not render yet; use "
+                              "lamprig-cpuref --twin or lamprig-reference",
+                              lr_scene_name(desc->scene), lr_scene_light_at(desc->scene, l)->name,
+                              lr_scene_light_at(desc->scene, l)->type == LR_LIGHT_QUAD ? "quad"
+                                                                                       : "disk");
     int rc = lr_gl_caps_require(caps, LR_GL_NEED_FLOAT_RT, e);
     if (rc)
         return lr_err_prefix(e, "renderer (positions, normals and the HDR output are RGBA32F)");

@@ -1,5 +1,6 @@
 /* Area emitters: construction, emission profile and point sets (emitter.h). */
 #include <math.h>
+#include <stdlib.h>
 
 #include "render/area/emitter.h"
 #include "render/cpu/rng.h"
@@ -87,7 +88,50 @@ void lr_area_stratified(const lr_area_emitter *em, int n, uint64_t seed, lr_vec3
 
 double lr_area_poisson_radius(double area, int n)
 {
-    return n > 0 && area > 0.0 ? sqrt(0.7 * 2.0 * area / (sqrt(3.0) * n)) : 0.0;
+    return n > 0 && area > 0.0 ? sqrt(2.0 * area / (M_PI * n)) : 0.0;
+}
+
+/* Toroidal distance^2 in the parameter square with axis scales (sx, sy). */
+static double torus_d2(const double a[2], const double b[2], double sx, double sy)
+{
+    double dx = fabs(a[0] - b[0]), dy = fabs(a[1] - b[1]);
+    dx = fmin(dx, 1.0 - dx) * sx;
+    dy = fmin(dy, 1.0 - dy) * sy;
+    return dx * dx + dy * dy;
+}
+
+void lr_area_poisson_uv(double sx, double sy, double r_min, int cap, int max_fails,
+                        uint64_t seed, double (*uv)[2], int *n)
+{
+    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(seed, 0x9015, 0, 0));
+    double r2 = r_min * r_min;
+    int fails = 0, count = 0;
+    /* Few points on an emitter (tens to a few thousand): a linear scan is simple enough. */
+    while (count < cap && fails < max_fails) {
+        double c[2] = {lr_cpu_rng_next(&rng), lr_cpu_rng_next(&rng)};
+        bool ok = true;
+        for (int i = 0; i < count && ok; i++)
+            ok = torus_d2(c, uv[i], sx, sy) >= r2;
+        if (ok) {
+            uv[count][0] = c[0];
+            uv[count][1] = c[1];
+            count++;
+            fails = 0;
+        } else {
+            fails++;
+        }
+    }
+    *n = count;
+}
+
+void lr_area_param_scales(const lr_area_emitter *em, double *sx, double *sy)
+{
+    if (em->kind == LR_AREA_QUAD) {
+        *sx = 2.0 * lr_v3_len(em->u);
+        *sy = 2.0 * lr_v3_len(em->v);
+    } else {
+        *sx = *sy = 2.0 * em->radius;
+    }
 }
 
 int lr_area_poisson(const lr_area_emitter *em, double r_min, int cap, int max_fails,
@@ -97,24 +141,14 @@ int lr_area_poisson(const lr_area_emitter *em, double r_min, int cap, int max_fa
     if (!(r_min > 0.0) || !isfinite(r_min) || cap < 1 || max_fails < 1)
         return lr_err_set(e, LR_EINVAL, "area light: Poisson-disk radius must be > 0 and the "
                           "capacity and attempts >= 1 (got %g, %d, %d)", r_min, cap, max_fails);
-    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(seed, 0x9015, 0, 0));
-    double r2 = r_min * r_min;
-    int fails = 0, count = 0;
-    /* Few points on an emitter (tens to hundreds): a linear scan is cheaper than a grid. */
-    while (count < cap && fails < max_fails) {
-        lr_vec3 p = lr_area_point(em, lr_cpu_rng_next(&rng), lr_cpu_rng_next(&rng));
-        bool ok = true;
-        for (int i = 0; i < count && ok; i++) {
-            lr_vec3 d = lr_v3_sub(p, out[i]);
-            ok = lr_v3_dot(d, d) >= r2;
-        }
-        if (ok) {
-            out[count++] = p;
-            fails = 0;
-        } else {
-            fails++;
-        }
-    }
-    *n = count;
+    double (*uv)[2] = malloc((size_t)cap * sizeof *uv);
+    if (!uv)
+        return lr_err_set(e, LR_ENOMEM, "area light: out of memory for %d points", cap);
+    double sx, sy;
+    lr_area_param_scales(em, &sx, &sy);
+    lr_area_poisson_uv(sx, sy, r_min, cap, max_fails, seed, uv, n);
+    for (int i = 0; i < *n; i++)
+        out[i] = lr_area_point(em, uv[i][0], uv[i][1]);
+    free(uv);
     return LR_OK;
 }

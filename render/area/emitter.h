@@ -56,15 +56,27 @@ lr_vec3 lr_area_point(const lr_area_emitter *em, double u1, double u2);
 void lr_area_stratified(const lr_area_emitter *em, int n, uint64_t seed, lr_vec3 *out);
 
 /* A Poisson-disk set on the emitter (seed 004 Sec. 3, after Bowers et al. 2010): dart throwing
- * of area-uniform candidates, each accepted when it is at least r_min from every accepted
- * point, until `max_fails` candidates in a row were refused or cap points were placed.
- * *n receives the count. r_min <= 0 or cap < 1: LR_EINVAL. */
+ * of uniform candidates in the parameter square of lr_area_point, each accepted when it is at
+ * least r_min (mm) from every accepted point, until `max_fails` candidates in a row were
+ * refused or cap points were placed; *n receives the count. The distance is measured on the
+ * torus: the parameter square with its axes scaled by the emitter's extent (lr_area_param_
+ * scales; on a rectangle the Euclidean distance away from the wrap, on a disk that of the
+ * concentric map's square). The torus has no boundary, so the set's density is uniform: dart
+ * throwing in a bounded domain packs points more densely along the boundary, which would bias
+ * the estimate A/n sum f(y_j) toward the rim. r_min <= 0 or cap < 1: LR_EINVAL. */
 int lr_area_poisson(const lr_area_emitter *em, double r_min, int cap, int max_fails,
                     uint64_t seed, lr_vec3 *out, int *n, lr_err *e);
+/* The same in the parameter square: axis scales (sx, sy), points uv. */
+void lr_area_poisson_uv(double sx, double sy, double r_min, int cap, int max_fails,
+                        uint64_t seed, double (*uv)[2], int *n);
+/* The axis scales of the parameter square (mm): a quad's full edge lengths, a disk's
+ * diameter. */
+void lr_area_param_scales(const lr_area_emitter *em, double *sx, double *sy);
 
-/* The radius that packs about n Poisson-disk points on an area A: maximal Poisson-disk sets
- * reach a density of about 0.7 of the hexagonal packing, whose disks of radius r_min/2 cover
- * pi/(2 sqrt 3) of the plane; so r_min = sqrt(0.7 * 2 A / (sqrt(3) n)). */
+/* The radius at which dart throwing places about n points on an area A: disks of radius
+ * r_min/2 around the points are disjoint, and random sequential adsorption jams when they
+ * cover 0.547 of the plane (Feder 1980); aiming at a coverage of 1/2, n pi r_min^2 / 4 = A / 2,
+ * gives r_min = sqrt(2 A / (pi n)), which a few thousand refusals in a row reach. */
 double lr_area_poisson_radius(double area, int n);
 
 /* ---- irradiance ----------------------------------------------------------------------------- */

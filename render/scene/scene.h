@@ -124,12 +124,17 @@ typedef struct lr_light {
 void lr_light_rgb(const lr_light *l, double out[3]);
 /* The light's angular shape in travel direction dir (unit): 1 for a point light; for a spot
  * 1 inside inner_deg, 0 outside outer_deg, smoothstep in the cosine between; for a
- * directional light 1. */
+ * directional light 1; for an area light A cos(theta_e) (0 behind a one-sided one): the
+ * intensity per unit radiance of the emitter seen as a point, which a renderer places at one
+ * sample point of the emitter per accumulation frame (render/area/frames.h). */
 double lr_light_shape(const lr_light *l, lr_vec3 dir);
 /* Flicker at time t seconds: the factor on intensity (>= 0, mean 1) and the position offset
  * (mm). Deterministic in (seed, t): a sum of three sines at incommensurate multiples of
  * frequency_hz with seed-derived phases, so that replays and tests see the same flame. */
 void lr_light_flicker_at(const lr_light *l, double t, double *scale, lr_vec3 *offset);
+/* Area lights: the unit normal of the emitting side and the area (mm^2; 0 for others). */
+lr_vec3 lr_light_area_normal(const lr_light *l);
+double lr_light_area(const lr_light *l);
 /* Whether the light is an area light (quad or disk). */
 static inline bool lr_light_is_area(const lr_light *l)
 {
