@@ -195,9 +195,28 @@ static void test_dimming_one_light_runs_compose_only(void **state)
     lr_scene_destroy(s2);
 }
 
+/* Area lights (render/area) are rendered by the CPU twin and the reference; the GLES renderer
+ * refuses them with LR_EUNSUPPORTED, naming the light, rather than render them as points. */
+static void test_area_light_refused(void **state)
+{
+    (void)state;
+    const char *panel = "{\"type\": \"quad\", \"name\": \"panel\", \"position\": [0, 0, 200],"
+                        " \"edge_u\": [20, 0, 0], \"edge_v\": [0, 5, 0], \"radiance\": 1e-4}";
+    lr_scene *s = scene(flame, panel);
+    lr_renderer *r = NULL;
+    lr_err e = {0};
+    lr_renderer_desc d = {.gl = gl, .scene = s, .width = W, .height = H};
+    assert_int_equal(lr_renderer_create(&d, &r, &e), LR_EUNSUPPORTED);
+    assert_null(r);
+    if (!strstr(e.msg, "light 'panel' is an area light (quad)"))
+        fail_msg("message '%s'", e.msg);
+    lr_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_area_light_refused),
         cmocka_unit_test(test_two_lights_are_the_sum_of_one_light_each),
         cmocka_unit_test(test_cavity_gain_per_light),
         cmocka_unit_test(test_dimming_one_light_runs_compose_only),
