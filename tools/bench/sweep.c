@@ -64,12 +64,10 @@ static int list_scenes(char names[MAX_SCENES][64])
 /* Scenes the physical reference cannot resolve at the bench's sample count, left out unless
  * named in LRB_SWEEP_SCENES: "sphere" (a point light at the centre of a non-absorbing marble
  * ball, the energy test) comes out of render/reference with every non-zero pixel a single
- * sample (relative standard error 1.0 at 16 spp), so no error against it would mean anything.
- * "led_shade" has area lights, which the GLES renderer does not render yet (render/area/
- * README.md; its CPU twin's figures are there). */
+ * sample (relative standard error 1.0 at 16 spp), so no error against it would mean anything. */
 static bool skipped(const char *name)
 {
-    return !strcmp(name, "sphere") || !strcmp(name, "led_shade");
+    return !strcmp(name, "sphere");
 }
 
 /* Whether `name` is one of the comma-separated names of `list` (whole names: "candle" must
