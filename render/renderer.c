@@ -11,6 +11,7 @@
 
 #include "render/base/paths.h"
 #include "render/gl/timer.h"
+#include "render/passes/area_direct.h"
 #include "render/passes/blend.h"
 #include "render/passes/compose.h"
 #include "render/passes/gbuffer.h"
@@ -54,6 +55,9 @@ struct lr_renderer {
     lr_irradiance irr;
     lr_compose img;
     lr_blend *blend; /* tone-mapped output and HDR sum (render/passes/blend.h) */
+    /* Area lights' direct light on the plane receivers, accumulated with the maps
+     * (render/passes/area_direct.h); unallocated without area lights. */
+    lr_area_direct area;
 
     unsigned dirty;
     int frame_index;
@@ -84,7 +88,8 @@ static lr_pass_ctx pass_ctx(const lr_renderer *r)
 static int check_programs(lr_renderer *r, lr_err *e)
 {
     lr_program *ps[] = {r->prog.surface, r->prog.depth, r->prog.radiosity, r->prog.vpl,
-                        r->prog.obj,     r->prog.recv,  r->prog.blit,      r->prog.irr};
+                        r->prog.obj,     r->prog.recv,  r->prog.blit,      r->prog.irr,
+                        r->prog.area};
     for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++) {
         int rc = ps[i] ? lr_program_check(ps[i], e) : LR_OK;
         if (rc)
@@ -101,11 +106,19 @@ static int gbuffer_alloc(lr_renderer *r, lr_err *e)
     return lr_gbuffer_alloc(&r->gbuffer, &c, e);
 }
 static void gbuffer_free(lr_renderer *r) { lr_gbuffer_free(&r->gbuffer); }
+/* An area light's G-buffer is redrawn at each accumulation frame's sample p_f
+ * (render/area/frames.h): due while the maps accumulate. */
+static bool gbuffer_due(const lr_renderer *r)
+{
+    return r->rad.F < r->rs.frames && lr_area_direct_needed(r->scene);
+}
 static int gbuffer_run(lr_renderer *r, unsigned dirty, lr_err *e)
 {
-    (void)dirty;
+    /* The frame the maps add next: 0 after a restart (lr_radiosity_run resets them). */
+    bool restart = (lr_dirty_passes(dirty) & LR_PASS_RADIOSITY) != 0;
+    long frame = restart ? 0 : r->rad.F;
     lr_pass_ctx c = pass_ctx(r);
-    return lr_gbuffer_run(&r->gbuffer, &c, e);
+    return lr_gbuffer_run(&r->gbuffer, &c, frame, e);
 }
 
 static int radiosity_alloc(lr_renderer *r, lr_err *e)
@@ -113,7 +126,11 @@ static int radiosity_alloc(lr_renderer *r, lr_err *e)
     lr_pass_ctx c = pass_ctx(r);
     return lr_radiosity_alloc(&r->rad, &c, e);
 }
-static void radiosity_free(lr_renderer *r) { lr_radiosity_free(&r->rad); }
+static void radiosity_free(lr_renderer *r)
+{
+    lr_radiosity_free(&r->rad);
+    lr_area_direct_free(&r->area);
+}
 /* Accumulating: render.frames not reached (capped for half-float maps). */
 static bool radiosity_due(const lr_renderer *r) { return r->rad.F < r->rs.frames; }
 static int radiosity_run(lr_renderer *r, unsigned dirty, lr_err *e)
@@ -121,7 +138,11 @@ static int radiosity_run(lr_renderer *r, unsigned dirty, lr_err *e)
     /* A change that makes the maps due restarts their running mean. */
     bool restart = (lr_dirty_passes(dirty) & LR_PASS_RADIOSITY) != 0;
     lr_pass_ctx c = pass_ctx(r);
-    return lr_radiosity_run(&r->rad, &c, &r->gbuffer, restart, e);
+    int rc = lr_radiosity_run(&r->rad, &c, &r->gbuffer, restart, e);
+    /* The area lights' direct light: the same frame's sample, the same running mean. */
+    if (!rc && lr_area_direct_needed(r->scene))
+        rc = lr_area_direct_run(&r->area, &c, &r->gbuffer, r->rad.F, e);
+    return rc;
 }
 
 static int vpl_alloc(lr_renderer *r, lr_err *e)
@@ -159,7 +180,7 @@ static int compose_run(lr_renderer *r, unsigned dirty, lr_err *e)
     (void)dirty;
     lr_pass_ctx c = pass_ctx(r);
     lr_compose_inputs in = {.gbuffer = &r->gbuffer, .radiosity = &r->rad, .vpl = &r->vpl,
-                            .irradiance = &r->irr};
+                            .irradiance = &r->irr, .area = &r->area};
     return lr_compose_run(&r->img, &c, &in, e);
 }
 
@@ -198,7 +219,7 @@ enum {
 
 /* The passes in the order they run. */
 static const lr_pass_desc pass_table[LR_PASS_COUNT] = {
-    {"gbuffer", LR_PASS_GBUFFER, D_TRANSPORT, 0, false, gbuffer_alloc, gbuffer_free, NULL,
+    {"gbuffer", LR_PASS_GBUFFER, D_TRANSPORT, 0, false, gbuffer_alloc, gbuffer_free, gbuffer_due,
      gbuffer_run},
     {"radiosity", LR_PASS_RADIOSITY, D_MAPS, LR_PASS_VPL | LR_PASS_COMPOSE, false,
      radiosity_alloc, radiosity_free, radiosity_due, radiosity_run},
@@ -265,6 +286,8 @@ static int alloc_resources(lr_renderer *r, lr_err *e)
     if (!rc && nl > LR_MAX_LIGHTS)
         rc = lr_err_set(e, LR_EUNSUPPORTED, "renderer: %d lights; at most %d", nl, LR_MAX_LIGHTS);
     if (!rc)
+        rc = lr_area_direct_check(r->scene, e);
+    if (!rc)
         r->n_lights = nl;
     for (int i = 0; i < LR_PASS_COUNT && !rc; i++)
         if (pass_table[i].alloc)
@@ -290,7 +313,12 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
     if (lr_scene_light_count(desc->scene) < 1 || lr_scene_object_count(desc->scene) < 1)
         return lr_err_set(e, LR_EINVAL, "renderer: scene %s needs a light and an object",
                           lr_scene_name(desc->scene));
-    int rc = lr_gl_caps_require(caps, LR_GL_NEED_FLOAT_RT, e);
+    /* Area lights: the passes sample them frame by frame (render/area/frames.h); their
+     * direct light is accumulated on plane receivers only (render/passes/area_direct.h). */
+    int rc = lr_area_direct_check(desc->scene, e);
+    if (rc)
+        return rc;
+    rc = lr_gl_caps_require(caps, LR_GL_NEED_FLOAT_RT, e);
     if (rc)
         return lr_err_prefix(e, "renderer (positions, normals and the HDR output are RGBA32F)");
     lr_renderer *r = calloc(1, sizeof *r);
@@ -330,7 +358,8 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
         (rc = program(r, "mesh.vert", "compose_object.frag", &pr->obj, e)) ||
         (rc = program(r, "mesh.vert", "compose_receiver.frag", &pr->recv, e)) ||
         (rc = program(r, "fullscreen.vert", "blit.frag", &pr->blit, e)) ||
-        (rc = program(r, "fullscreen.vert", "irradiance.frag", &pr->irr, e)))
+        (rc = program(r, "fullscreen.vert", "irradiance.frag", &pr->irr, e)) ||
+        (rc = program(r, "fullscreen.vert", "area_direct.frag", &pr->area, e)))
         goto fail;
     if ((rc = alloc_resources(r, e)) || (rc = lr_pass_objects_upload(&r->objs, r->scene, e)))
         goto fail;
@@ -359,7 +388,7 @@ void lr_renderer_destroy(lr_renderer *r)
     lr_pass_objects_free(&r->objs);
     const lr_pass_programs *pr = &r->prog;
     lr_program *ps[] = {pr->surface, pr->depth, pr->radiosity, pr->vpl,
-                        pr->obj,     pr->recv,  pr->blit,      pr->irr};
+                        pr->obj,     pr->recv,  pr->blit,      pr->irr, pr->area};
     for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
         lr_program_destroy(ps[i]);
     lr_timer_destroy(r->timer);
@@ -424,6 +453,16 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
 {
     int rc;
     unsigned dirty = r->dirty;
+    if (dirty & (LR_DIRTY_RECEIVERS | LR_DIRTY_LIGHT_GEOMETRY | LR_DIRTY_SETTINGS)) {
+        if ((rc = lr_area_direct_check(r->scene, e)))
+            return rc;
+        /* The area lights' direct grid is a running mean over the map frames: new receivers
+         * accumulate it again from the first frame, with the maps. */
+        if ((dirty & LR_DIRTY_RECEIVERS) && lr_area_direct_needed(r->scene)) {
+            dirty |= LR_DIRTY_LIGHT_GEOMETRY;
+            lr_area_direct_free(&r->area);
+        }
+    }
     unsigned passes = lr_dirty_passes(dirty);
     bool restart = (passes & LR_PASS_RADIOSITY) != 0;
     if (dirty & LR_DIRTY_SETTINGS) {

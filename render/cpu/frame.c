@@ -1,5 +1,6 @@
 /* Whole CPU images, twin and reference; see frame.h. */
 #include "render/cpu/frame.h"
+#include "render/area/frames.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -52,7 +53,25 @@ typedef struct rctx {
     int nrecv;
     lr_tr_scene *tr;     /* translucent radiosity (PASS): the solver's B and receiver extra */
     lr_dscene *dscene; /* diffusion_grid objects' fields (NULL when the scene has none) */
+    /* Per light, the lights the transport sees frame by frame (render/area/frames.h): an area
+     * light's frame samples (PASS: the `frames` accumulated; REFERENCE: LR_REF_AREA_FRAMES),
+     * any other light itself once. */
+    lr_light **fl;
+    int *nfl;
 } rctx;
+
+/* Frame samples standing for an area light in LR_CPU_REFERENCE: 16 cycles of the Poisson set,
+ * each rotated anew (about 1000 area-uniform points). */
+#define LR_REF_AREA_FRAMES (16 * LR_AREA_SEQ_MAX)
+
+/* The mean of the direct irradiance over the light's frame samples. */
+static double direct_at(const rctx *r, int l, lr_vec3 x, lr_vec3 n)
+{
+    double sum = 0.0;
+    for (int f = 0; f < r->nfl[l]; f++)
+        sum += lr_cpu_direct_irradiance(r->s, &r->fl[l][f], x, n);
+    return sum / r->nfl[l];
+}
 
 static uint64_t seed_of(const rctx *r) { return r->d->seed ? r->d->seed : 1; }
 
@@ -71,17 +90,23 @@ static void radiosity_at(const rctx *r, int o, int l, lr_vec3 x, lr_vec3 n, uint
                          double B[3], double var[3], bool *fallback)
 {
     if (r->d->mode == LR_CPU_REFERENCE) {
-        lr_cpu_radiosity_desc rd = {.N = r->samples, .sampler = LR_CPU_REFERENCE,
-                                    .others = r->objs, .n_others = r->nobj,
-                                    .sh_env = r->sh + o * r->nlight + l};
+        /* An area light: the mean over its first m frame samples, samples / m each. */
+        int m = r->nfl[l] > 1 ? LR_AREA_SEQ_MAX : 1;
+        lr_cpu_radiosity_desc rd = {.N = r->samples / m > 0 ? r->samples / m : 1,
+                                    .sampler = LR_CPU_REFERENCE, .others = r->objs,
+                                    .n_others = r->nobj, .sh_env = r->sh + o * r->nlight + l};
         if (r->dscene)
             lr_dscene_field(r->dscene, o, l, &rd.dfield);
-        lr_cpu_estimate est;
-        lr_cpu_radiosity(lr_scene_object_at(r->s, o), lr_scene_light_at(r->s, l), x, n, &rd, key,
-                         &est);
-        for (int c = 0; c < 3; c++) {
-            B[c] = est.mean[c];
-            var[c] = est.var[c] / est.n;
+        for (int c = 0; c < 3; c++)
+            B[c] = var[c] = 0.0;
+        for (int f = 0; f < m; f++) {
+            lr_cpu_estimate est;
+            lr_cpu_radiosity(lr_scene_object_at(r->s, o), &r->fl[l][f], x, n, &rd,
+                             lr_cpu_key(key, (uint64_t)f, 0, 0), &est);
+            for (int c = 0; c < 3; c++) {
+                B[c] += est.mean[c] / m;
+                var[c] += est.var[c] / est.n / ((double)m * m);
+            }
         }
         if (fallback)
             *fallback = false;
@@ -205,7 +230,7 @@ static void pixel_item(void *p, long item)
         const lr_receiver *rc = lr_scene_receiver_at(r->s, idx);
         double E[3] = {0}, EV[3] = {0};
         for (int l = 0; l < r->nlight; l++) {
-            double ed = lr_cpu_direct_irradiance(r->s, lr_scene_light_at(r->s, l), x, n);
+            double ed = direct_at(r, l, x, n);
             for (int c = 0; c < 3; c++)
                 E[c] += r->I[l][c] * ed;
         }
@@ -282,8 +307,29 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
         rc = lr_err_set(e, LR_ENOMEM, "cpu render: out of memory");
         goto fail;
     }
-    for (int l = 0; l < r.nlight; l++)
-        lr_light_rgb(lr_scene_light_at(s, l), r.I[l]);
+    r.fl = calloc((size_t)r.nlight, sizeof *r.fl);
+    r.nfl = calloc((size_t)r.nlight, sizeof *r.nfl);
+    if (!r.fl || !r.nfl) {
+        rc = lr_err_set(e, LR_ENOMEM, "cpu render: out of memory");
+        goto fail;
+    }
+    for (int l = 0; l < r.nlight; l++) {
+        const lr_light *li = lr_scene_light_at(s, l);
+        lr_light_rgb(li, r.I[l]);
+        int nf = !lr_light_is_area(li) ? 1 : ref ? LR_REF_AREA_FRAMES : frames;
+        if (!(r.fl[l] = calloc((size_t)nf, sizeof *r.fl[l]))) {
+            rc = lr_err_set(e, LR_ENOMEM, "cpu render: out of memory");
+            goto fail;
+        }
+        r.nfl[l] = nf;
+        lr_area_sequence seq;
+        bool area = lr_light_is_area(li) && lr_area_sequence_make(li, &seq, NULL) == LR_OK;
+        for (int f = 0; f < nf; f++) {
+            r.fl[l][f] = *li;
+            if (area)
+                r.fl[l][f].position = lr_area_frame_point(&seq, f);
+        }
+    }
     for (int o = 0; o < r.nobj; o++)
         r.objs[o] = lr_scene_object_at(s, o);
     /* sh_translucency: each light's environment through the GPU's G-buffer texels. */
@@ -405,6 +451,11 @@ fail:
             lr_cpu_maps_destroy(r.maps[i]);
     free(r.maps);
     lr_dscene_destroy(r.dscene); /* after the maps, which point into it */
+    if (r.fl)
+        for (int l = 0; l < r.nlight; l++)
+            free(r.fl[l]);
+    free(r.fl);
+    free(r.nfl);
     free(r.vpl);
     free(r.I);
     free(r.gain);

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "render/area/frames.h"
 #include "render/cpu/parallel.h"
 #include "render/cpu/rng.h"
 #include "render/transrad/tr_scene.h"
@@ -137,6 +138,7 @@ void lr_cpu_maps_destroy(lr_cpu_maps *m)
 typedef struct acc_ctx {
     lr_cpu_maps *m;
     int frame;
+    lr_light light; /* the frame's: an area light at its frame sample (render/area/frames.h) */
 } acc_ctx;
 
 static void acc_item(void *p, long item)
@@ -167,7 +169,7 @@ static void acc_item(void *p, long item)
                                .dfield = m->dfield,
                                .sh_env = m->has_sh ? &m->sh : NULL};
     lr_cpu_estimate est;
-    lr_cpu_radiosity(m->obj, &m->light, t->x, t->n, &d,
+    lr_cpu_radiosity(m->obj, &a->light, t->x, t->n, &d,
                      lr_cpu_key(m->seed, (uint64_t)k, (uint64_t)texel, (uint64_t)a->frame), &est);
     /* Running mean and pooled variance (Chan et al.'s pairwise update). */
     long na = t->samples, nb = est.n, n = na + nb;
@@ -185,7 +187,8 @@ static void acc_item(void *p, long item)
 void lr_cpu_maps_accumulate(lr_cpu_maps *m, int frames)
 {
     for (int f = 0; f < frames; f++) {
-        acc_ctx a = {m, m->frames};
+        acc_ctx a = {m, m->frames, m->light};
+        lr_light_at_frame(&m->light, m->frames, &a.light);
         lr_cpu_parallel_for((long)m->K * m->S * m->S, m->threads, acc_item, &a);
         m->frames++;
     }

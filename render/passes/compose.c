@@ -110,6 +110,7 @@ int lr_compose_run(lr_compose *img, const lr_pass_ctx *c, const lr_compose_input
     lr_passes_uniform_i(p, "u_use_vpl", lr_vpl_bind(in->vpl, c, in->radiosity, p));
     for (int i = 0; i < o->n_receivers; i++) {
         lr_irradiance_bind(in->irradiance, c, p, i);
+        lr_area_direct_bind(in->area, c, p, i);
         const lr_receiver *rcv = lr_scene_receiver_at(c->scene, i);
         GLint loc = lr_program_uniform(p, "u_albedo");
         if (loc >= 0)

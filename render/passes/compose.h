@@ -4,6 +4,7 @@
 #ifndef LR_COMPOSE_H
 #define LR_COMPOSE_H
 
+#include "render/passes/area_direct.h"
 #include "render/passes/gbuffer.h"
 #include "render/passes/irradiance.h"
 #include "render/passes/passes.h"
@@ -26,6 +27,7 @@ typedef struct lr_compose_inputs {
     const lr_radiosity *radiosity;  /* Algorithm 1 for the objects */
     const lr_vpl *vpl;              /* emergent light on box receivers (unallocated: none) */
     const lr_irradiance *irradiance; /* emergent light on plane receivers, cached */
+    const lr_area_direct *area;     /* area lights' direct light on plane receivers */
 } lr_compose_inputs;
 
 /* Images of the output size for c->n_lights lights. */

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "render/area/frames.h"
 #include "render/base/mat4.h"
 #include "render/passes/gbuffer.h"
 
@@ -86,9 +87,17 @@ static void clear_surface(void)
 }
 
 /* Light l's G-buffer. */
-static void draw_light(lr_light_gbuffer *g, const lr_pass_ctx *ctx, int l)
+static void draw_light(lr_light_gbuffer *g, const lr_pass_ctx *ctx, int l, long frame)
 {
-    const lr_light *light = lr_scene_light_at(ctx->scene, l);
+    /* An area light is a point light at the frame's sample p_f with the emitter's profile
+     * A cos(theta_e) (render/area/frames.h; the twin's lr_light_at_frame). */
+    lr_light at;
+    lr_light_at_frame(lr_scene_light_at(ctx->scene, l), frame, &at);
+    const lr_light *light = &at;
+    bool area = lr_light_is_area(light);
+    g->area_n = area ? lr_light_area_normal(light) : lr_v3(0.0, 0.0, 1.0);
+    g->area = area ? (float)lr_light_area(light) : 0.0f;
+    g->two_sided = area && light->two_sided;
     g->type = light->type;
     g->pos = light->position;
     g->dir = lr_v3_normalize(light->direction);
@@ -96,7 +105,7 @@ static void draw_light(lr_light_gbuffer *g, const lr_pass_ctx *ctx, int l)
     g->spot_cos[1] = (float)cos(light->inner_deg * M_PI / 180.0);
 
     lr_gb_camera cam;
-    lr_gb_camera_scene(ctx->scene, l, &cam);
+    lr_gb_camera_scene_frame(ctx->scene, l, frame, &cam);
     g->mode = cam.mode;
     if (g->mode == LR_GB_CUBE) {
         for (int f = 0; f < 6; f++) {
@@ -115,7 +124,7 @@ static void draw_light(lr_light_gbuffer *g, const lr_pass_ctx *ctx, int l)
     lr_mat4_to_float(g->vp_d, g->vp);
 }
 
-int lr_gbuffer_run(lr_gbuffer *g, const lr_pass_ctx *c, lr_err *e)
+int lr_gbuffer_run(lr_gbuffer *g, const lr_pass_ctx *c, long frame, lr_err *e)
 {
     glUseProgram(lr_program_id(c->prog->surface));
     glEnable(GL_DEPTH_TEST);
@@ -124,7 +133,7 @@ int lr_gbuffer_run(lr_gbuffer *g, const lr_pass_ctx *c, lr_err *e)
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
     for (int l = 0; l < g->n_lights; l++)
-        draw_light(&g->light[l], c, l);
+        draw_light(&g->light[l], c, l, frame);
     return lr_gl_check("gbuffer pass", e);
 }
 
@@ -153,6 +162,13 @@ void lr_gbuffer_bind(const lr_gbuffer *gb, lr_program *p, int l)
     loc = lr_program_uniform(p, "u_spot_cos");
     if (loc >= 0)
         glUniform2f(loc, g->spot_cos[0], g->spot_cos[1]);
+    /* The area light's profile (radiosity.frag light_shape); set only where declared. */
+    if ((loc = lr_program_uniform(p, "u_area_n")) >= 0)
+        glUniform3f(loc, (float)g->area_n.x, (float)g->area_n.y, (float)g->area_n.z);
+    if ((loc = lr_program_uniform(p, "u_area")) >= 0)
+        glUniform1f(loc, g->area);
+    if ((loc = lr_program_uniform(p, "u_area_two_sided")) >= 0)
+        glUniform1i(loc, g->two_sided);
 }
 
 /* Element i of uniform array `name` ("u_x[2]"). */
@@ -193,6 +209,12 @@ void lr_gbuffer_bind_lights(const lr_gbuffer *gb, const lr_pass_ctx *c, lr_progr
             glUniform3f(loc, (float)g->dir.x, (float)g->dir.y, (float)g->dir.z);
         if ((loc = array_loc(p, "u_lights_spot_cos", l)) >= 0)
             glUniform2f(loc, g->spot_cos[0], g->spot_cos[1]);
+        if ((loc = array_loc(p, "u_lights_area_n", l)) >= 0)
+            glUniform3f(loc, (float)g->area_n.x, (float)g->area_n.y, (float)g->area_n.z);
+        if ((loc = array_loc(p, "u_lights_area", l)) >= 0)
+            glUniform1f(loc, g->area);
+        if ((loc = array_loc(p, "u_lights_two_sided", l)) >= 0)
+            glUniform1i(loc, g->two_sided);
         if ((loc = array_loc(p, "u_lights_I", l)) >= 0)
             glUniform3f(loc, (float)c->I[l][0], (float)c->I[l][1], (float)c->I[l][2]);
     }

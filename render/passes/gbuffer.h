@@ -13,6 +13,11 @@ typedef struct lr_light_gbuffer {
     enum lr_light_type type;
     lr_vec3 pos, dir;
     float spot_cos[2]; /* cos(outer), cos(inner) */
+    /* Area light (quad, disk; render/area/frames.h): pos is the frame's sample p_f, and the
+     * radiosity pass's shape is area * cos(theta_e) about area_n (|cos| when two-sided). */
+    lr_vec3 area_n;
+    float area;
+    bool two_sided;
     enum lr_gb_mode mode;
     int size;
     lr_tex *pos_cube, *nrm_cube, *pos_2d, *nrm_2d;
@@ -30,7 +35,9 @@ typedef struct lr_gbuffer {
 /* Targets for c->n_lights lights of c->rs->gbuffer_size. */
 int lr_gbuffer_alloc(lr_gbuffer *g, const lr_pass_ctx *c, lr_err *e);
 void lr_gbuffer_free(lr_gbuffer *g);
-int lr_gbuffer_run(lr_gbuffer *g, const lr_pass_ctx *c, lr_err *e);
+/* `frame`: the accumulation frame about to be added to the maps (0 at a restart): an area
+ * light is drawn from its sample of that frame (lr_area_frame_point, as the CPU twin's maps). */
+int lr_gbuffer_run(lr_gbuffer *g, const lr_pass_ctx *c, long frame, lr_err *e);
 
 /* Light l's G-buffer samplers and uniforms on units 0..3 (render/shaders/lib/gbuffer.glsl). */
 void lr_gbuffer_bind(const lr_gbuffer *g, lr_program *p, int l);

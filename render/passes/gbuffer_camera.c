@@ -4,6 +4,7 @@
 
 #include <math.h>
 
+#include "render/area/frames.h"
 #include "render/base/mat4.h"
 #include "render/passes/passes.h"
 
@@ -20,7 +21,8 @@ void lr_gb_camera_make(const lr_light *light, lr_vec3 c, double R, bool enclosed
     double dist = lr_v3_len(lr_v3_sub(c, light->position));
     if (light->type == LR_LIGHT_DIRECTIONAL)
         out->mode = LR_GB_ORTHO;
-    else if (light->type == LR_LIGHT_POINT && (enclosed || dist < 1.05 * R))
+    else if ((light->type == LR_LIGHT_POINT || lr_light_is_area(light)) &&
+             (enclosed || dist < 1.05 * R))
         out->mode = LR_GB_CUBE;
     else
         out->mode = LR_GB_PERSPECTIVE;
@@ -54,9 +56,16 @@ void lr_gb_camera_make(const lr_light *light, lr_vec3 c, double R, bool enclosed
 
 void lr_gb_camera_scene(const lr_scene *s, int l, lr_gb_camera *out)
 {
+    lr_gb_camera_scene_frame(s, l, 0, out);
+}
+
+void lr_gb_camera_scene_frame(const lr_scene *s, int l, long frame, lr_gb_camera *out)
+{
     lr_vec3 c;
     double R;
     lr_scene_bounds(s, &c, &R);
     enum lr_enclosure enc = lr_scene_light_enclosure(s, l, NULL);
-    lr_gb_camera_make(lr_scene_light_at(s, l), c, R, enc != LR_ENCLOSURE_NONE, out);
+    lr_light at;
+    lr_light_at_frame(lr_scene_light_at(s, l), frame, &at);
+    lr_gb_camera_make(&at, c, R, enc != LR_ENCLOSURE_NONE, out);
 }

@@ -20,12 +20,15 @@ typedef struct lr_gb_camera {
 } lr_gb_camera;
 
 /* The cameras gbuffer.c draws light `light` with, for objects in the bounding sphere (c, R):
- * a cube around an enclosed point light (or one within 1.05 R of c), else a perspective map
+ * a cube around an enclosed point light or area-light sample (or one within 1.05 R of c), else a perspective map
  * holding the sphere (point) or the spot cone (spot), or an orthographic map over the sphere
  * (directional). */
 void lr_gb_camera_make(const lr_light *light, lr_vec3 c, double R, bool enclosed,
                        lr_gb_camera *out);
-/* The same for light l of scene s (its bounds and the light's enclosure). */
+/* The same for light l of scene s (its bounds and the light's enclosure); an area light at
+ * accumulation frame `frame`'s sample (lr_light_at_frame, render/area/frames.h), frame 0 for
+ * lr_gb_camera_scene (the sh_translucency projection sees an area light from that sample). */
 void lr_gb_camera_scene(const lr_scene *s, int l, lr_gb_camera *out);
+void lr_gb_camera_scene_frame(const lr_scene *s, int l, long frame, lr_gb_camera *out);
 
 #endif

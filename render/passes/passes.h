@@ -68,6 +68,7 @@ typedef struct lr_pass_objects {
  * (lr_program_check). */
 typedef struct lr_pass_programs {
     lr_program *surface, *depth, *radiosity, *vpl, *obj, *recv, *blit, *irr;
+    lr_program *area; /* area lights' direct grid (area_direct.c) */
 } lr_pass_programs;
 
 /* The read-only inputs of a pass: the context, the scene, the settings the resources were

@@ -174,7 +174,7 @@ static int dgrid_update(lr_radiosity *rad, const lr_pass_ctx *c, lr_err *e)
  * multiple of 2^-11, so that both it and 1 - it are exact; the estimate stays a weighted mean
  * whose weights sum to 1 (unbiased), and from F = 2048 on it is an exponential average over
  * ~2048 frames. */
-static float blend_weight(lr_tex_format format, int F)
+float lr_radiosity_blend_weight(lr_tex_format format, int F)
 {
     if (format != LR_TEX_RGBA16F)
         return (float)(1.0 / F);
@@ -272,7 +272,7 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
                 glDrawBuffers(3, first);
                 glEnable(GL_BLEND);
                 glBlendEquation(GL_FUNC_ADD);
-                glBlendColor(0.0f, 0.0f, 0.0f, blend_weight(c->map_format, F));
+                glBlendColor(0.0f, 0.0f, 0.0f, lr_radiosity_blend_weight(c->map_format, F));
                 glBlendFunc(GL_CONSTANT_ALPHA, GL_ONE_MINUS_CONSTANT_ALPHA);
             }
             glDepthMask(GL_FALSE);

@@ -68,5 +68,8 @@ void lr_radiosity_sh_uniforms(const lr_radiosity *rad, lr_program *p, int l);
 void lr_radiosity_bind_gather(const lr_radiosity *rad, lr_program *p, const double w[][3]);
 /* Only the gather's weights u_light_w (w[l] / scale[l]), for a per-object change. */
 void lr_radiosity_set_light_w(const lr_radiosity *rad, lr_program *p, const double w[][3]);
+/* The running mean's blend weight for frame F (1/F; for RGBA16F targets rounded to a multiple
+ * of 2^-11, radiosity.c says why). Shared with the area lights' direct grid (area_direct.c). */
+float lr_radiosity_blend_weight(lr_tex_format format, int F);
 
 #endif

@@ -12,6 +12,48 @@
  * through the microscopic air gap under a real candle. */
 #define RECEIVER_GAP_MM 1e-3
 
+/* The gap (mm) between the two faces of a two-sided area light: the reference's area lights
+ * are one-sided surfaces that absorb what meets them, so a two-sided one is two of them back
+ * to back; the gap keeps their order along a ray unambiguous (as RECEIVER_GAP_MM does). */
+#define TWO_SIDED_GAP_MM 1e-3
+
+static int add_light(lr_ref_scene *s, const lr_light *l, lr_err *e)
+{
+    /* The steady light: flicker is a display effect around intensity (mean factor 1). */
+    lr_ref_light_desc ld = {.kind = l->type == LR_LIGHT_SPOT ? LR_REF_LIGHT_SPOT
+                                                              : LR_REF_LIGHT_POINT,
+                            .position = l->position, .direction = l->direction,
+                            .inner_deg = l->inner_deg, .outer_deg = l->outer_deg};
+    lr_light_rgb(l, ld.emission);
+    if (l->type == LR_LIGHT_QUAD) {
+        /* The reference's quad is a corner and full edges; it emits on edge1 x edge2's side,
+         * which is edge_u x edge_v's. */
+        ld.kind = LR_REF_LIGHT_QUAD;
+        ld.position = lr_v3_sub(lr_v3_sub(l->position, l->edge_u), l->edge_v);
+        ld.edge1 = lr_v3_scale(l->edge_u, 2.0);
+        ld.edge2 = lr_v3_scale(l->edge_v, 2.0);
+    } else if (l->type == LR_LIGHT_DISK) {
+        ld.kind = LR_REF_LIGHT_DISK;
+        ld.radius = l->radius;
+    }
+    int rc = lr_ref_scene_add_light(s, &ld, e);
+    if (rc || !lr_light_is_area(l) || !l->two_sided)
+        return rc;
+    /* The back face: the same emitter turned over, just behind the front one. */
+    lr_vec3 n = l->type == LR_LIGHT_DISK ? l->direction
+                                         : lr_v3_normalize(lr_v3_cross(l->edge_u, l->edge_v));
+    lr_vec3 back = lr_v3_scale(n, -TWO_SIDED_GAP_MM);
+    ld.position = lr_v3_add(ld.position, back);
+    if (l->type == LR_LIGHT_QUAD) {
+        lr_vec3 t = ld.edge1;
+        ld.edge1 = ld.edge2;
+        ld.edge2 = t;
+    } else {
+        ld.direction = lr_v3_scale(l->direction, -1.0);
+    }
+    return lr_ref_scene_add_light(s, &ld, e);
+}
+
 int lr_ref_scene_from_scene(const lr_scene *sc, lr_ref_scene **out, lr_ref_camera *cam,
                             lr_err *e)
 {
@@ -59,16 +101,8 @@ int lr_ref_scene_from_scene(const lr_scene *sc, lr_ref_scene **out, lr_ref_camer
             od.albedo[b] = r->albedo[b];
         rc = lr_ref_scene_add_object(s, &od, e);
     }
-    for (int i = 0; !rc && i < lr_scene_light_count(sc); i++) {
-        const lr_light *l = lr_scene_light_at(sc, i);
-        /* The steady light: flicker is a display effect around intensity (mean factor 1). */
-        lr_ref_light_desc ld = {.kind = l->type == LR_LIGHT_SPOT ? LR_REF_LIGHT_SPOT
-                                                                  : LR_REF_LIGHT_POINT,
-                                .position = l->position, .direction = l->direction,
-                                .inner_deg = l->inner_deg, .outer_deg = l->outer_deg};
-        lr_light_rgb(l, ld.emission);
-        rc = lr_ref_scene_add_light(s, &ld, e);
-    }
+    for (int i = 0; !rc && i < lr_scene_light_count(sc); i++)
+        rc = add_light(s, lr_scene_light_at(sc, i), e);
     if (!rc)
         rc = lr_ref_scene_finish(s, e);
     if (rc) {

@@ -26,6 +26,18 @@ int lr_scene_check_light(lr_light *l, const char **field, lr_err *e)
         return lr_err_set(e, LR_EINVAL, "must be in (0, outer_deg = %g] degrees, got %g",
                           l->outer_deg, l->inner_deg);
     }
+    /* A quad has an area: its half-edges span a plane (the area is 4 |edge_u x edge_v|; a
+     * relative 1e-9 keeps the normal well defined in double). */
+    if (l->type == LR_LIGHT_QUAD) {
+        double a = lr_v3_len(lr_v3_cross(l->edge_u, l->edge_v));
+        if (!(a > 1e-9 * lr_v3_dot(l->edge_u, l->edge_u) && a > 1e-9 * lr_v3_dot(l->edge_v, l->edge_v)
+              && a > 1e-12)) {
+            *field = "edge_v";
+            return lr_err_set(e, LR_EINVAL, "must not be parallel to edge_u (the quad has no "
+                              "area), got edge_u %g,%g,%g and edge_v %g,%g,%g", l->edge_u.x,
+                              l->edge_u.y, l->edge_u.z, l->edge_v.x, l->edge_v.y, l->edge_v.z);
+        }
+    }
     return LR_OK;
 }
 

@@ -14,15 +14,18 @@
 #define P (1u << LR_LIGHT_POINT)
 #define S (1u << LR_LIGHT_SPOT)
 #define D (1u << LR_LIGHT_DIRECTIONAL)
+#define Q (1u << LR_LIGHT_QUAD)
+#define K (1u << LR_LIGHT_DISK)
 #define L(m) offsetof(lr_light, m)
 
-static const char *const light_types[] = {"point", "spot", "directional", NULL};
-static const char *const light_what[] = {"a point light", "a spot light", "a directional light"};
+static const char *const light_types[] = {"point", "spot", "directional", "quad", "disk", NULL};
+static const char *const light_what[] = {"a point light", "a spot light", "a directional light",
+                                         "a quad light", "a disk light"};
 static const char *const light_objects[] = {"flicker", NULL};
 
 static const lr_field light_fields[] = {
     {"type", LR_FT_TYPE, .names = light_types, .flags = LR_FF_REQUIRED | LR_FF_NO_SET,
-     .help = "point, spot or directional"},
+     .help = "point, spot, directional, quad or disk"},
     {"name", LR_FT_NAME, .dflt_text = "light0, light1, ...", .flags = LR_FF_NO_SET,
      .help = "unique; letters, digits, _ and - (not only digits)"},
     {"intensity", LR_FT_NUM, P | S, L(intensity), 0, 1e12, LR_FF_REQUIRED | LR_FF_HI_OPEN |
@@ -31,10 +34,29 @@ static const lr_field light_fields[] = {
     {"radiance", LR_FT_NUM, D, L(intensity), 0, 1e12, LR_FF_REQUIRED | LR_FF_HI_OPEN |
      LR_FF_HI_QUIET, .unit = "(W/mm^2)", .dirty = LR_DIRTY_INTENSITY,
      .help = "irradiance on a surface facing the light (seed 003 Eq. 6)"},
+    {"radiance", LR_FT_NUM, Q | K, L(intensity), 0, 1e12, LR_FF_REQUIRED | LR_FF_HI_OPEN |
+     LR_FF_HI_QUIET, .unit = "(W/(mm^2 sr))", .dirty = LR_DIRTY_INTENSITY,
+     .help = "emitted radiance of the Lambertian area light: the dimmer"},
     {"color", LR_FT_RGB, 0, L(color), 0, 1e6, LR_FF_HI_OPEN | LR_FF_HI_QUIET, .dflt = {1, 1, 1},
      .dirty = LR_DIRTY_INTENSITY, .help = "per-band factor: band b gets intensity * color[b]"},
     {"position", LR_FT_VEC3, P | S, L(position), NB, NB, LR_FF_REQUIRED | LR_FF_COORD,
      .unit = "mm", .dirty = LR_DIRTY_LIGHT_GEOMETRY, .help = "where the light is"},
+    {"position", LR_FT_VEC3, Q | K, L(position), NB, NB, LR_FF_REQUIRED | LR_FF_COORD,
+     .unit = "mm", .dirty = LR_DIRTY_LIGHT_GEOMETRY, .help = "the emitter's centre"},
+    /* Not parallel to each other: check.c. */
+    {"edge_u", LR_FT_VEC3, Q, L(edge_u), -1e6, 1e6, LR_FF_REQUIRED, .unit = "mm",
+     .dirty = LR_DIRTY_LIGHT_GEOMETRY,
+     .help = "half-edge vector from the centre (the quad spans -edge_u..edge_u)"},
+    {"edge_v", LR_FT_VEC3, Q, L(edge_v), -1e6, 1e6, LR_FF_REQUIRED, .unit = "mm",
+     .dirty = LR_DIRTY_LIGHT_GEOMETRY,
+     .help = "second half-edge vector; emits on the side of edge_u x edge_v"},
+    {"normal", LR_FT_VEC3, K, L(direction), NB, NB, LR_FF_REQUIRED | LR_FF_UNIT,
+     .dflt = {0, 0, -1}, .dirty = LR_DIRTY_LIGHT_GEOMETRY,
+     .help = "the emitting side (normalised)"},
+    {"radius", LR_FT_NUM, K, L(radius), 0, 1e6, LR_FF_REQUIRED | LR_FF_LO_OPEN | LR_FF_HI_QUIET,
+     .unit = "mm", .dirty = LR_DIRTY_LIGHT_GEOMETRY, .help = "disk radius"},
+    {"two_sided", LR_FT_BOOL, Q | K, L(two_sided), .dirty = LR_DIRTY_LIGHT_GEOMETRY,
+     .help = "emit on both sides (an LED strip seen from both faces)"},
     {"direction", LR_FT_VEC3, S | D, L(direction), NB, NB, LR_FF_REQUIRED | LR_FF_UNIT,
      .dflt = {0, 0, -1}, .dirty = LR_DIRTY_LIGHT_GEOMETRY,
      .help = "the way the light travels (normalised)"},
@@ -69,6 +91,8 @@ const lr_record_desc lr_scene_light_desc = {"lights[i]", "a light", light_types,
 #undef P
 #undef S
 #undef D
+#undef Q
+#undef K
 
 /* ---- camera ---------------------------------------------------------------------------------- */
 

@@ -9,8 +9,31 @@ void lr_light_rgb(const lr_light *l, double out[3])
         out[b] = l->intensity * l->color[b];
 }
 
+lr_vec3 lr_light_area_normal(const lr_light *l)
+{
+    if (l->type == LR_LIGHT_QUAD)
+        return lr_v3_normalize(lr_v3_cross(l->edge_u, l->edge_v));
+    return lr_v3_normalize(l->direction);
+}
+
+double lr_light_area(const lr_light *l)
+{
+    if (l->type == LR_LIGHT_QUAD)
+        return 4.0 * lr_v3_len(lr_v3_cross(l->edge_u, l->edge_v));
+    if (l->type == LR_LIGHT_DISK)
+        return M_PI * l->radius * l->radius;
+    return 0.0;
+}
+
 double lr_light_shape(const lr_light *l, lr_vec3 dir)
 {
+    if (lr_light_is_area(l)) {
+        /* The whole emitter as a point (render/area/emitter.h): I = L_e A cos(theta_e). */
+        double c = lr_v3_dot(dir, lr_light_area_normal(l));
+        if (l->two_sided)
+            c = fabs(c);
+        return c > 0.0 ? lr_light_area(l) * c : 0.0;
+    }
     if (l->type != LR_LIGHT_SPOT)
         return 1.0;
     double c = lr_v3_dot(dir, l->direction);

@@ -10,7 +10,8 @@
  *                                     (a preset name or a material object), "mesh" (a "type"
  *                                     and its parameters), "transform", "model", "thickness_mm",
  *                                     "normalize"
- *  "lights":    [ LIGHT, ... ]        one to LR_SCENE_MAX_LIGHTS: point, spot, directional
+ *  "lights":    [ LIGHT, ... ]        one to LR_SCENE_MAX_LIGHTS: point, spot, directional,
+ *                                     quad, disk (area lights)
  *  "camera":    CAMERA
  *  "receivers": [ RECEIVER, ... ]     diffuse planes and boxes (optional)
  *  "render":    SETTINGS              (optional)
@@ -92,7 +93,10 @@ static inline double lr_scene_object_sd_norm(const lr_scene_object *o, int c)
 
 /* ---- Lights ------------------------------------------------------------------------------- */
 
-enum lr_light_type { LR_LIGHT_POINT, LR_LIGHT_SPOT, LR_LIGHT_DIRECTIONAL };
+/* QUAD and DISK are Lambertian area lights (LED panels and strips, seed 004): radiance L_e
+ * over a rectangle or a disk, emitted on the normal's side or on both (two_sided). */
+enum lr_light_type { LR_LIGHT_POINT, LR_LIGHT_SPOT, LR_LIGHT_DIRECTIONAL, LR_LIGHT_QUAD,
+                     LR_LIGHT_DISK };
 
 typedef struct lr_flicker {
     double amplitude;    /* relative intensity swing, 0..1; 0: steady */
@@ -104,13 +108,20 @@ typedef struct lr_flicker {
 typedef struct lr_light {
     char name[LR_SCENE_NAME_MAX];
     enum lr_light_type type;
-    lr_vec3 position;  /* point, spot; mm */
-    lr_vec3 direction; /* spot, directional: unit, the way the light travels */
+    lr_vec3 position;  /* point, spot; quad and disk: the centre; mm */
+    lr_vec3 direction; /* spot, directional: unit, the way the light travels; disk: unit
+                        * normal of the emitting side */
+    lr_vec3 edge_u, edge_v; /* quad: half-edge vectors from the centre (mm); the quad is
+                             * position + s edge_u + t edge_v, s, t in [-1, 1]; it emits on
+                             * the side of edge_u x edge_v */
+    double radius;     /* disk: mm */
+    bool two_sided;    /* quad, disk: emits on both sides */
     double inner_deg, outer_deg; /* spot: half-angles of full and zero intensity */
     /* The scale the dimmer turns, kept apart from the light's shape (position, direction,
      * cone, flicker) so that a renderer can rescale its result linearly. Point and spot:
      * radiant intensity in W/sr (on axis for a spot); directional: the file's `radiance`,
-     * W/mm^2 on a surface facing the light. */
+     * W/mm^2 on a surface facing the light; quad, disk: the file's `radiance`, the emitted
+     * radiance L_e in W/(mm^2 sr) (render/area/emitter.h). */
     double intensity;
     double color[3]; /* relative per band (not normalised): band b gets intensity * color[b] */
     lr_flicker flicker;
@@ -120,12 +131,22 @@ typedef struct lr_light {
 void lr_light_rgb(const lr_light *l, double out[3]);
 /* The light's angular shape in travel direction dir (unit): 1 for a point light; for a spot
  * 1 inside inner_deg, 0 outside outer_deg, smoothstep in the cosine between; for a
- * directional light 1. */
+ * directional light 1; for an area light A cos(theta_e) (0 behind a one-sided one): the
+ * intensity per unit radiance of the emitter seen as a point, which a renderer places at one
+ * sample point of the emitter per accumulation frame (render/area/frames.h). */
 double lr_light_shape(const lr_light *l, lr_vec3 dir);
 /* Flicker at time t seconds: the factor on intensity (>= 0, mean 1) and the position offset
  * (mm). Deterministic in (seed, t): a sum of three sines at incommensurate multiples of
  * frequency_hz with seed-derived phases, so that replays and tests see the same flame. */
 void lr_light_flicker_at(const lr_light *l, double t, double *scale, lr_vec3 *offset);
+/* Area lights: the unit normal of the emitting side and the area (mm^2; 0 for others). */
+lr_vec3 lr_light_area_normal(const lr_light *l);
+double lr_light_area(const lr_light *l);
+/* Whether the light is an area light (quad or disk). */
+static inline bool lr_light_is_area(const lr_light *l)
+{
+    return l->type == LR_LIGHT_QUAD || l->type == LR_LIGHT_DISK;
+}
 
 /* Whether a light is surrounded by an object: then the light G-buffer is a cube map and the
  * radiosity sampling uses the stereographic correction (seed 003 Sec. 3.3).

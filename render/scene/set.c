@@ -51,7 +51,8 @@ static int check_failed(op *o, const char *field, const char *bad, int rc, const
 
 static int light_field(op *o, lr_light *l, const char *f, unsigned *d)
 {
-    bool dir = l->type == LR_LIGHT_DIRECTIONAL;
+    /* Directional and area lights: radiance; point and spot: intensity. */
+    bool dir = l->type == LR_LIGHT_DIRECTIONAL || lr_light_is_area(l);
     if ((dir && strcmp(f, "intensity") == 0) || (!dir && strcmp(f, "radiance") == 0))
         return lr_field_fail(o, LR_EINVAL, "a %s light's strength is its '%s'",
                     lr_scene_light_desc.kind_names[l->type], dir ? "radiance" : "intensity");

@@ -13,8 +13,14 @@ in vec3 v_trB;              // translucent radiosity: the vertices' solved B (ra
 uniform bool u_tr_on;
 uniform int u_object;
 uniform bool u_two_sided;
-uniform int u_light_type;   // LR_LIGHT_POINT, LR_LIGHT_SPOT, LR_LIGHT_DIRECTIONAL
+uniform int u_light_type;   // LR_LIGHT_POINT, _SPOT, _DIRECTIONAL, _QUAD, _DISK
 uniform vec2 u_spot_cos;    // cos(outer), cos(inner)
+// Area lights (render/area/frames.h): this frame's sample p_f is u_light_pos, and the whole
+// emitter's Lambertian profile I(w) = A cos(theta_e) about u_area_n (|cos| two-sided) is
+// the intensity, as lr_light_shape in the twin.
+uniform vec3 u_area_n;
+uniform float u_area;
+uniform bool u_area_two_sided;
 uniform int u_N;
 uniform float u_r_max;      // 20 R; point/spot lights: r_max = max(u_r_max, u_r_max_dist d)
 uniform float u_r_max_dist; // 20 (PIPELINE.md: r_max = 20 max(R, |x_l - x_o|))
@@ -30,8 +36,15 @@ layout(location = 0) out vec4 o_B;
 layout(location = 1) out vec4 o_pos;
 layout(location = 2) out vec4 o_nrm;
 
-float spot_shape(vec3 dir)
+// The light's angular profile along `dir` (from the light): lr_light_shape.
+float light_shape(vec3 dir)
 {
+    if (u_light_type == LR_LIGHT_QUAD || u_light_type == LR_LIGHT_DISK) {
+        float c = dot(normalize(dir), u_area_n);
+        if (u_area_two_sided)
+            c = abs(c);
+        return c > 0.0 ? u_area * c : 0.0;
+    }
     if (u_light_type != LR_LIGHT_SPOT)
         return 1.0;
     float c = dot(normalize(dir), u_light_dir);
@@ -136,7 +149,7 @@ void main()
                 if (!lr_gbuffer_fetch(v, xi, ni, id))
                     continue;
                 wi = normalize(u_light_pos - xi);
-                shape = spot_shape(v);
+                shape = light_shape(v);
             }
             if (id != u_object)
                 continue; // light does not scatter from one object into another

@@ -17,6 +17,7 @@
 #include "render/scene/scene.h"
 #include "render/schedule.h"
 #include "tests/support/doc_block.h"
+#include "tests/support/near.h"
 
 typedef struct warnings {
     int n;
@@ -793,6 +794,63 @@ static void test_model_switch_and_light_cap(void **state)
 /* configs/scenes/README.md quotes the field reference written from the tables that load, set
  * and check scenes (render/scene/field_tables.c): a field, range or default changed in one
  * place shows up in the other, or this fails. */
+/* Area lights (issue 14, seed 004): the shipped LED shade's quads, a disk from text, changes by
+ * name with their dirty bits, and the refusals (parallel edges, no radius, a point light's
+ * strength name). */
+static void test_area_lights(void **state)
+{
+    (void)state;
+    lr_scene *s = load("configs/scenes/led_shade.json");
+    assert_int_equal(lr_scene_light_count(s), 4);
+    const lr_light *l = lr_scene_light_at(s, 0);
+    assert_int_equal(l->type, LR_LIGHT_QUAD);
+    assert_true(lr_light_is_area(l));
+    assert_false(l->two_sided);
+    /* 8 x 60 mm facing +x: edge_u x edge_v = (0,4,0) x (0,0,30). */
+    assert_near(lr_light_area(l), 480.0, 1e-9);
+    lr_vec3 n = lr_light_area_normal(l);
+    assert_near(n.x, 1.0, 1e-12);
+    assert_near(lr_light_shape(l, lr_v3(1, 0, 0)), 480.0, 1e-9);
+    assert_near(lr_light_shape(l, lr_v3(-1, 0, 0)), 0.0, 0.0);
+    assert_near(l->intensity, 5e-4, 1e-18);
+    get(s, "lights[led_px].edge_u", "0,4,0");
+    get(s, "lights[0].two_sided", "false");
+    set_ok(s, "lights[0].radiance", "1e-3", LR_DIRTY_INTENSITY);
+    set_ok(s, "lights[0].edge_v", "0,0,20", LR_DIRTY_LIGHT_GEOMETRY);
+    set_ok(s, "lights[0].two_sided", "true", LR_DIRTY_LIGHT_GEOMETRY);
+    assert_near(lr_light_shape(lr_scene_light_at(s, 0), lr_v3(-1, 0, 0)), 320.0, 1e-9);
+    set_bad(s, "lights[0].edge_v", "0,8,0", "must not be parallel to edge_u");
+    set_bad(s, "lights[0].intensity", "1", "a quad light's strength is its 'radiance'");
+    set_bad(s, "lights[0].radius", "3", "a quad light has no parameter 'radius'");
+    set_bad(s, "lights[0].radiance", "-1", "must be >= 0 (W/(mm^2 sr))");
+    lr_scene_destroy(s);
+
+    char t[1024];
+    snprintf(t, sizeof t, "{\"objects\": [{\"material\": \"marble\", \"mesh\": {\"type\": "
+             "\"sphere\"}}],\n \"lights\": [{\"type\": \"disk\", \"position\": [0,0,100],\n"
+             " \"normal\": [0,0,-2], \"radius\": 10, \"radiance\": 0.5, \"two_sided\": true}],\n"
+             " \"camera\": {\"position\": [0,-300,0], \"target\": [0,0,0]}}");
+    lr_err e = {0};
+    assert_int_equal(parse(t, &s, &e), LR_OK);
+    l = lr_scene_light_at(s, 0);
+    assert_int_equal(l->type, LR_LIGHT_DISK);
+    assert_near(l->direction.z, -1.0, 1e-15); /* normalised */
+    assert_near(lr_light_area(l), 100.0 * M_PI, 1e-9);
+    assert_true(l->two_sided);
+    set_bad(s, "lights[0].radius", "0", "must be > 0");
+    set_ok(s, "lights[0].normal", "0,1,0", LR_DIRTY_LIGHT_GEOMETRY);
+    lr_scene_destroy(s);
+    /* Required fields and the edges' relation, at the file's line. */
+    char *r = strstr(t, "\"radius\": 10, ");
+    memset(r, ' ', strlen("\"radius\": 10, "));
+    expect_scene_error(t, LR_EPARSE, "t.json:2: field 'lights[0].radius': missing (required");
+    snprintf(t, sizeof t, "{\"objects\": [{\"material\": \"marble\", \"mesh\": {\"type\": "
+             "\"sphere\"}}],\n \"lights\": [{\"type\": \"quad\", \"position\": [0,0,100],\n"
+             " \"edge_u\": [1,0,0], \"edge_v\": [-2,0,0], \"radiance\": 1}],\n"
+             " \"camera\": {\"position\": [0,-300,0], \"target\": [0,0,0]}}");
+    expect_scene_error(t, LR_EINVAL, "field 'lights[0].edge_v': must not be parallel");
+}
+
 static void test_readme_field_reference(void **state)
 {
     (void)state;
@@ -808,6 +866,7 @@ int main(void)
         cmocka_unit_test(test_object_normalize_field),
         cmocka_unit_test(test_camera_matrices),
         cmocka_unit_test(test_light_shape_and_flicker),
+        cmocka_unit_test(test_area_lights),
         cmocka_unit_test(test_file_errors_name_file_line_field),
         cmocka_unit_test(test_set_dirty_flags),
         cmocka_unit_test(test_set_rejects_bad_values),

@@ -3,8 +3,10 @@
  *
  *   lamprig-cpuref --scene FILE [--width W] [--height H] [--samples N] --out F.pfm
  *                  [--var F.var.pfm] [--twin [--frames F]] [--vpl N] [--no-vpl]
- *                  [--threads T] [--seed S] [--set key=value ...]
+ *                  [--threads T] [--seed S] [--set key=value ...] [--compare REF.pfm]
  *
+ * --compare: also print the errors against a physical reference image of the same size
+ * (`lamprig-reference render`, REF.var.pfm beside it) on the bench's masks (compare.c).
  * --samples: reference samples per band per pixel and per VPL (default 1024). The variance
  * image defaults to the --out name with ".var.pfm" for ".pfm". A summary line (time, samples,
  * samples/s, pixels) goes to stdout. */
@@ -15,12 +17,13 @@
 #include "render/cpu/frame.h"
 #include "render/image/image.h"
 #include "render/scene/scene.h"
+#include "tools/cpuref/compare.h"
 
 static void usage(FILE *f)
 {
     fprintf(f, "usage: lamprig-cpuref --scene FILE --out F.pfm [--width W] [--height H] "
                "[--samples N] [--var F.var.pfm] [--twin] [--frames F] [--vpl N] [--no-vpl] "
-               "[--threads T] [--seed S] [--set key=value ...]\n");
+               "[--threads T] [--seed S] [--set key=value ...] [--compare REF.pfm]\n");
 }
 
 static int int_arg(const char *opt, const char *v, int lo, int hi, int *out)
@@ -37,7 +40,7 @@ static int int_arg(const char *opt, const char *v, int lo, int hi, int *out)
 
 int main(int argc, char **argv)
 {
-    const char *scene_path = NULL, *out = NULL, *var_path = NULL;
+    const char *scene_path = NULL, *out = NULL, *var_path = NULL, *compare = NULL;
     lr_cpu_render_desc d = {.mode = LR_CPU_REFERENCE, .width = 160, .height = 120};
     const char *sets[64];
     int nsets = 0, seed = 1;
@@ -65,6 +68,8 @@ int main(int argc, char **argv)
             scene_path = v;
         else if (!strcmp(a, "--out"))
             out = v;
+        else if (!strcmp(a, "--compare"))
+            compare = v;
         else if (!strcmp(a, "--var"))
             var_path = v;
         else if (!strcmp(a, "--width"))
@@ -132,6 +137,8 @@ int main(int argc, char **argv)
                lr_scene_name(s), d.width, d.height, d.mode == LR_CPU_PASS ? "twin" : "reference",
                st.seconds, st.samples, st.samples_per_s, st.object_pixels, st.fallback_pixels,
                st.vpls, out, var_path);
+    if (!rc && compare && (rc = lr_cpuref_compare(s, &rgb, compare, stdout, &e)))
+        fprintf(stderr, "lamprig-cpuref: --compare: %s\n", e.msg);
     lr_image_free(&rgb);
     lr_image_free(&var);
     lr_scene_destroy(s);

@@ -20,6 +20,11 @@ uniform vec3 u_lights_pos[LR_MAX_LIGHTS];
 uniform vec3 u_lights_dir[LR_MAX_LIGHTS];
 uniform vec2 u_lights_spot_cos[LR_MAX_LIGHTS];          // cos(outer), cos(inner)
 uniform vec3 u_lights_I[LR_MAX_LIGHTS];                 // intensity per band (with flicker)
+// Area lights (render/area/frames.h): u_lights_pos is this frame's sample p_f; the profile is
+// A cos(theta_e) about the emitter's normal (|cos| when two-sided), lr_light_shape.
+uniform vec3 u_lights_area_n[LR_MAX_LIGHTS];
+uniform float u_lights_area[LR_MAX_LIGHTS];
+uniform bool u_lights_two_sided[LR_MAX_LIGHTS];
 uniform int u_n_lights;
 
 vec4 lr_lights_cube_pos(int l, vec3 v)
@@ -77,8 +82,15 @@ bool lr_lights_lit(int l, vec3 x)
     return length(v) < length(p.xyz - u_lights_pos[l]);
 }
 
+bool lr_lights_is_area(int l)
+{
+    return u_lights_type[l] == LR_LIGHT_QUAD || u_lights_type[l] == LR_LIGHT_DISK;
+}
+
 // Irradiance at receiver point x (normal nx) from light l for unit intensity (PIPELINE.md
-// pass 4): cos / distance^2 times the spot's profile (directional: cos), 0 in shadow.
+// pass 4): cos / distance^2 times the spot's or the area light's profile (directional: cos),
+// 0 in shadow. An area light: the point light at this frame's sample (area_direct.frag
+// averages it over frames).
 float lr_lights_direct(int l, vec3 x, vec3 nx)
 {
     if (u_lights_type[l] == LR_LIGHT_DIRECTIONAL) {
@@ -91,7 +103,12 @@ float lr_lights_direct(int l, vec3 x, vec3 nx)
     if (!(c > 0.0) || !lr_lights_lit(l, x))
         return 0.0;
     float shape = 1.0;
-    if (u_lights_type[l] == LR_LIGHT_SPOT)
+    if (lr_lights_is_area(l)) {
+        float ce = dot(-to_l, u_lights_area_n[l]) * inversesqrt(d2);
+        if (u_lights_two_sided[l])
+            ce = abs(ce);
+        shape = ce > 0.0 ? u_lights_area[l] * ce : 0.0;
+    } else if (u_lights_type[l] == LR_LIGHT_SPOT)
         shape = smoothstep(u_lights_spot_cos[l].x, u_lights_spot_cos[l].y,
                            dot(-to_l, u_lights_dir[l]) * inversesqrt(d2));
     return shape * c / d2;
