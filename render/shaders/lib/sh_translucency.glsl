@@ -70,7 +70,7 @@ vec3 lr_sh_translucency_B(int obj, lr_coeffs_gl mat, vec3 xo, vec3 no)
         float r2 = dot(h, h);
         vec3 u = h * inversesqrt(r2);
         cos_i = dot(no, u);
-        E = spot_shape(-u) / r2;
+        E = light_shape(-u) / r2;
     }
     if (!(cos_i > 0.0))
         return B;
