@@ -9,7 +9,8 @@
  *  - a light's pose or cone, an object's geometry, the render settings: everything (settings
  *    also reallocate and restart accumulation);
  *  - material: the scattered-radiosity maps, VPLs, receiver grids, composition, blend;
- *  - view: composition and blend (the radiosity maps and the grids are view-independent);
+ *  - view: composition and blend (the radiosity maps, the grids and the objects' surface
+ *    cache are view-independent);
  *  - receivers: their irradiance grids, composition and blend (receivers are lit at
  *    composition and take no part in the transport through the object). */
 
@@ -43,9 +44,8 @@ unsigned lr_schedule_close(const lr_renderer *r, unsigned passes, bool no_emerge
         if (passes & t[i].bit)
             passes |= t[i].feeds;
     }
-    if (no_emergent)
-        for (int i = 0; i < LR_PASS_COUNT; i++)
-            if (t[i].emergent)
-                passes &= ~t[i].bit;
+    for (int i = 0; i < LR_PASS_COUNT; i++)
+        if ((no_emergent && t[i].emergent) || (t[i].on && !t[i].on(r)))
+            passes &= ~t[i].bit;
     return passes;
 }

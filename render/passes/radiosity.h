@@ -22,6 +22,7 @@ typedef struct lr_radiosity {
     lr_fb *fb[LR_MAX_LIGHTS * LR_MAX_K]; /* [l K + k] */
     float scale[LR_MAX_LIGHTS]; /* light l's maps store B * scale[l] */
     int F; /* frames accumulated */
+    unsigned gen; /* runs so far: a reader's result made from other maps is stale */
 } lr_radiosity;
 
 /* Maps for c->rs (K, map_size) and c->n_lights lights; accumulation restarts. */

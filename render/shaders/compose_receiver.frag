@@ -16,6 +16,8 @@ uniform bool u_cached;               // this receiver has a grid
 uniform highp sampler2DArray u_irr;  // grids, layer u_irr_layer + l for light l
 uniform int u_irr_layer;
 uniform vec3 u_grid_c, u_grid_a, u_grid_b; // centre; axes divided by the plane's w and h
+// Image l holds u_image_scale[l] L_l (half floats in their normal range; compose.h).
+uniform float u_image_scale[LR_MAX_LIGHTS];
 // Output l is light l's image (unrolled writes: GLSL ES indexes outputs by constants only).
 layout(location = 0) out vec4 o_light[LR_MAX_LIGHTS];
 
@@ -47,8 +49,8 @@ void main()
         lr_vpl_irradiance(x, nx, E);
     }
     vec3 alb = u_albedo / LR_PI;
-    o_light[0] = vec4(alb * E[0], 1.0);
-    o_light[1] = vec4(alb * E[1], 1.0);
-    o_light[2] = vec4(alb * E[2], 1.0);
-    o_light[3] = vec4(alb * E[3], 1.0);
+    o_light[0] = vec4(u_image_scale[0] * alb * E[0], 1.0);
+    o_light[1] = vec4(u_image_scale[1] * alb * E[1], 1.0);
+    o_light[2] = vec4(u_image_scale[2] * alb * E[2], 1.0);
+    o_light[3] = vec4(u_image_scale[3] * alb * E[3], 1.0);
 }
