@@ -87,7 +87,8 @@ static int check_programs(lr_renderer *r, lr_err *e)
 {
     lr_program *ps[] = {r->prog.surface, r->prog.depth, r->prog.radiosity, r->prog.vpl,
                         r->prog.obj,     r->prog.recv,  r->prog.blit,      r->prog.irr,
-                        r->prog.cache,   r->prog.obj_cached};
+                        r->prog.cache,   r->prog.obj_cached[0], r->prog.obj_cached[1],
+                        r->prog.obj_cached[2], r->prog.obj_cached[3]};
     for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++) {
         int rc = ps[i] ? lr_program_check(ps[i], e) : LR_OK;
         if (rc)
@@ -353,9 +354,22 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
         (rc = program(r, "mesh.vert", "compose_receiver.frag", &pr->recv, e)) ||
         (rc = program(r, "fullscreen.vert", "blit.frag", &pr->blit, e)) ||
         (rc = program(r, "fullscreen.vert", "irradiance.frag", &pr->irr, e)) ||
-        (rc = program(r, "fullscreen.vert", "surface_cache.frag", &pr->cache, e)) ||
-        (rc = program(r, "compose_cached.vert", "compose_cached.frag", &pr->obj_cached, e)))
+        (rc = program(r, "fullscreen.vert", "surface_cache.frag", &pr->cache, e)))
         goto fail;
+    /* Composition from the surface cache, one program per light count (its varyings). */
+    for (int n = 1; n <= LR_MAX_LIGHTS; n++) {
+        lr_shader_defines d = r->defines;
+        for (int i = 0; i < d.n; i++)
+            d.list[i] = d.text[i]; /* the copy's own text */
+        if (!lr_shader_defines_add(&d, "LR_CACHE_LIGHTS", n)) {
+            rc = lr_err_set(e, LR_EINVAL, "renderer: too many shader defines");
+            goto fail;
+        }
+        lr_program_desc pd = {.vertex = "compose_cached.vert", .fragment = "compose_cached.frag",
+                              .dir = r->shader_dir, .defines = d.list};
+        if ((rc = lr_program_create(&pd, &pr->obj_cached[n - 1], e)))
+            goto fail;
+    }
     if ((rc = alloc_resources(r, e)) || (rc = lr_pass_objects_upload(&r->objs, r->scene, e)))
         goto fail;
     /* Warm-up section: llvmpipe's first time-elapsed query reports time since the context
@@ -382,8 +396,10 @@ void lr_renderer_destroy(lr_renderer *r)
     free_resources(r);
     lr_pass_objects_free(&r->objs);
     const lr_pass_programs *pr = &r->prog;
-    lr_program *ps[] = {pr->surface, pr->depth, pr->radiosity, pr->vpl,  pr->obj,
-                        pr->recv,    pr->blit,  pr->irr,       pr->cache, pr->obj_cached};
+    lr_program *ps[] = {pr->surface,       pr->depth,         pr->radiosity,     pr->vpl,
+                        pr->obj,           pr->recv,          pr->blit,          pr->irr,
+                        pr->cache,         pr->obj_cached[0], pr->obj_cached[1],
+                        pr->obj_cached[2], pr->obj_cached[3]};
     for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
         lr_program_destroy(ps[i]);
     lr_timer_destroy(r->timer);

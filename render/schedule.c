@@ -39,13 +39,19 @@ unsigned lr_schedule_close(const lr_renderer *r, unsigned passes, bool no_emerge
      * before it passes its output on. */
     const lr_pass_desc *t = lr_pass_table();
     for (int i = 0; i < LR_PASS_COUNT; i++) {
+        /* A pass switched off is neither due nor does it make its readers due. */
+        if (t[i].on && !t[i].on(r)) {
+            passes &= ~t[i].bit;
+            continue;
+        }
         if (t[i].due && t[i].due(r))
             passes |= t[i].bit;
         if (passes & t[i].bit)
             passes |= t[i].feeds;
     }
-    for (int i = 0; i < LR_PASS_COUNT; i++)
-        if ((no_emergent && t[i].emergent) || (t[i].on && !t[i].on(r)))
-            passes &= ~t[i].bit;
+    if (no_emergent)
+        for (int i = 0; i < LR_PASS_COUNT; i++)
+            if (t[i].emergent)
+                passes &= ~t[i].bit;
     return passes;
 }

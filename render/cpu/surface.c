@@ -6,16 +6,14 @@
 
 double lr_surface_edge_bound(const lr_scene *s, int object, int map_size)
 {
-    const lr_scene_object *o = lr_scene_object_at(s, object);
+    (void)object;
     lr_vec3 c;
     double R;
     lr_scene_bounds(s, &c, &R);
-    double st = 0.0;
-    for (int b = 0; b < 3; b++)
-        st = fmax(st, o->coeffs.sigma_tr[b]);
+    /* The per-pixel gather it stands in for resolves nothing finer than a map texel (bilinear
+     * taps); B's own scale, the diffusion length, only sets the error of the linear fit
+     * (PIPELINE.md "Surface cache"). */
     double h = LR_SURFACE_EDGE_TEXELS * 2.0 * R / (map_size > 0 ? map_size : 1);
-    if (st > 0.0 && isfinite(st))
-        h = fmin(h, LR_SURFACE_EDGE_DIFFUSION / st);
     return h > 1e-3 ? h : 1e-3;
 }
 

@@ -11,17 +11,17 @@
 #include "render/mesh/refine.h"
 #include "render/scene/scene.h"
 
-/* Edge bound of the refinement, in map texels and in diffusion lengths 1/sigma_tr (the
- * smaller wins; PIPELINE.md "Surface cache" derives the interpolation error). */
+/* Edge bound of the refinement in map texels (PIPELINE.md "Surface cache" derives the
+ * interpolation error from it and the diffusion length 1/sigma_tr). */
 #define LR_SURFACE_EDGE_TEXELS 2.0
-#define LR_SURFACE_EDGE_DIFFUSION 0.5
 /* Vertices of all refined meshes at most (the GPU's cache textures: 2 x 16 bytes per entry
  * plus 16 per light); beyond, the edge bound doubles. */
 #define LR_SURFACE_MAX_VERTICES ((size_t)4 << 20)
 
-/* The edge bound for object i of s (mm): LR_SURFACE_EDGE_TEXELS texels of the radiosity maps
- * (2 R / map_size, R the radius of lr_scene_bounds, the maps' extent) or
- * LR_SURFACE_EDGE_DIFFUSION / max_c sigma_tr,c, the smaller; at least 1e-3. */
+/* The edge bound for the objects of s (mm): LR_SURFACE_EDGE_TEXELS texels of the radiosity
+ * maps, tau = 2 R / map_size (R the radius of lr_scene_bounds, the maps' extent); at least
+ * 1e-3. The object does not change it (the maps are shared); it is an argument so that a
+ * per-object rule needs no new signature. */
 double lr_surface_edge_bound(const lr_scene *s, int object, int map_size);
 
 /* Object i refined to its edge bound, doubled while the result would have more than `budget`

@@ -91,7 +91,6 @@ static void draw_objects_cached(const lr_compose *img, const lr_surface *sc,
 {
     const lr_pass_objects *o = c->objs;
     lr_surface_bind(sc, p);
-    lr_passes_uniform_i(p, "u_n_lights", sc->n_lights);
     for (int i = 0; i < o->n_objects && i < sc->n_objects; i++) {
         double w[LR_MAX_LIGHTS][3];
         float g[3 * LR_MAX_LIGHTS];
@@ -143,7 +142,7 @@ int lr_compose_run(lr_compose *img, const lr_pass_ctx *c, const lr_compose_input
 
     /* Unit intensity: the images hold each light's transport alone; the blend pass weights
      * them with intensity x colour x flicker (PIPELINE.md "Linearity"). */
-    lr_program *p = in->surface ? c->prog->obj_cached : c->prog->obj;
+    lr_program *p = in->surface ? c->prog->obj_cached[in->surface->n_lights - 1] : c->prog->obj;
     glUseProgram(lr_program_id(p));
     lr_passes_set_coeffs(o, p);
     lr_passes_uniform_mat4(p, "u_vp", vp);

@@ -69,7 +69,8 @@ typedef struct lr_pass_objects {
 typedef struct lr_pass_programs {
     lr_program *surface, *depth, *radiosity, *vpl, *obj, *recv, *blit, *irr;
     lr_program *cache;      /* surface_cache.frag: Algorithm 1 at the cache's entries */
-    lr_program *obj_cached; /* compose_cached.{vert,frag}: objects from the cache */
+    /* compose_cached.{vert,frag}: objects from the cache, [n - 1] for n lights */
+    lr_program *obj_cached[LR_MAX_LIGHTS];
 } lr_pass_programs;
 
 /* The read-only inputs of a pass: the context, the scene, the settings the resources were
