@@ -8,10 +8,11 @@
  *  - switching the cache off is a composition-only change and composition then gathers;
  *  - the cached image against the per-pixel gather of the same maps, over object pixels, for
  *    the candle, the lamp shade and the votive: relative RMSE within the bound of PIPELINE.md,
- *    (sigma_tr h)^2 / 6 (a linear fit's error on B's smooth part, h the edge bound) plus the
- *    per-pixel image's own sampling noise (the cache is a low-pass of the same maps: what it
- *    drops below the vertex spacing is at most that noise and detail under two map texels),
- *    the noise measured from a second seed. The figures are printed.
+ *    (sigma_tr h)^2 / 6 (a linear fit's error on B's smooth part, h the edge bound; only where
+ *    sigma_tr h < 1) plus the per-pixel image's own sampling noise (the cache is a low-pass
+ *    of the same maps: what it drops below the vertex spacing is that noise and detail under
+ *    two map texels), the noise measured from a second seed. The figures are printed;
+ *    LR_SURFACE_FRAMES=F accumulates F frames instead of 12.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -40,6 +41,18 @@ enum { W = 160, H = 120 };
 /* The scenes' own map size (the edge bound is tied to its texels), fewer maps, samples and
  * frames than they ship with; no VPLs (they light the receivers, not the objects). */
 static const char *const settings[] = {"render.K=8", "render.N=4", "render.frames=12", NULL};
+/* LR_SURFACE_FRAMES=F (4..4096) accumulates F frames instead of 12 (how the cache's error and
+ * the noise fall with convergence; not part of the default run). */
+static const char *const *test_settings(void)
+{
+    static char frames[32];
+    static const char *s[4] = {"render.K=8", "render.N=4", NULL, NULL};
+    const char *f = getenv("LR_SURFACE_FRAMES");
+    int n = f ? atoi(f) : 12;
+    snprintf(frames, sizeof frames, "render.frames=%d", n >= 4 && n <= 4096 ? n : 12);
+    s[2] = frames;
+    return s;
+}
 
 /* Object pixels (rows bottom up, as the HDR readback): the camera ray meets an object before
  * any receiver. */
@@ -103,7 +116,7 @@ static lr_renderer *converged(lr_scene *s, unsigned seed, bool cache)
     assert_int_equal(lr_scene_set(s, "render.surface_cache", cache ? "true" : "false", &d, &e),
                      LR_OK);
     lr_renderer *r = lr_test_renderer(gl, s, W, H, true, seed);
-    lr_test_converge(r, 100);
+    lr_test_converge(r, 5000);
     assert_false(lr_renderer_needs_frame(r));
     return r;
 }
@@ -182,7 +195,7 @@ static void test_cache_follows_the_maps(void **state)
  * noise from a second seed. */
 static void cache_against_gather(const char *name)
 {
-    lr_scene *s = lr_test_scene(name, settings, NULL);
+    lr_scene *s = lr_test_scene(name, test_settings(), NULL);
     unsigned char *m = object_mask(s);
     lr_renderer *r = converged(s, 3, true);
     float *cached = lr_test_hdr(r);
@@ -196,13 +209,17 @@ static void cache_against_gather(const char *name)
     double worst_c, worst_n;
     double err = rel_rmse(cached, gathered, m, &worst_c);
     double noise = rel_rmse(other, gathered, m, &worst_n) / sqrt(2.0);
-    /* The smooth part's bound with the largest sigma_tr of the scene's objects. */
+    /* The smooth part's bound with the largest sigma_tr of the scene's objects; it holds
+     * where B is smooth over an edge (sigma_tr h < 1). Where it is not (the lamp shade's
+     * porcelain: 1/sigma_tr 0.55 mm against h 2.2 mm) the bound is the noise alone. */
     double fit = 0.0;
     for (int i = 0; i < lr_scene_object_count(s); i++) {
         double st = 0.0;
         for (int c = 0; c < 3; c++)
             st = fmax(st, lr_scene_object_at(s, i)->coeffs.sigma_tr[c]);
-        fit = fmax(fit, st * si.h[i] * st * si.h[i] / 6.0);
+        double sh = st * si.h[i];
+        if (sh < 1.0)
+            fit = fmax(fit, sh * sh / 6.0);
     }
     print_message("%s (%dx%d, K 8, N 4, %d frames, map %d): cache vs per-pixel gather: "
                   "relative RMSE %.4f, max %.3f x RMS; the gather's own noise %.4f (max %.3f x "
@@ -240,8 +257,9 @@ static void test_votive_cache_vs_gather(void **state)
 static void test_default(void **state)
 {
     (void)state;
-    /* On by default (PIPELINE.md "Surface cache": its error is under the sampling noise). */
-    assert_true(cache_on_by_default());
+    /* Off by default (PIPELINE.md "Surface cache": on the lamp shade its error is 0.8 of the
+     * 12-frame noise, and how both fall with convergence is not yet measured). */
+    assert_false(cache_on_by_default());
 }
 
 int main(void)
