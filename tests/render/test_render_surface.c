@@ -254,6 +254,62 @@ static void test_votive_cache_vs_gather(void **state)
     cache_against_gather("votive");
 }
 
+/* The CPU twin follows the cache (render/cpu/frame.c with the scene's render.surface_cache:
+ * B at the same refined vertices, interpolated at the hit): a 32 x 24 image of the candle
+ * against the GPU's, object pixels summed, within 4 sigma of the twin's variance image + 5 %
+ * (test_render_parity's final-image rule), and against the twin's own per-pixel image. */
+static void test_twin_follows_cache(void **state)
+{
+    (void)state;
+    enum { TW = 32, TH = 24 };
+    static const char *const small[] = {"render.K=8",          "render.N=4",
+                                        "render.map_size=64",  "render.gbuffer_size=128",
+                                        "render.frames=4",     "render.surface_cache=true",
+                                        NULL};
+    lr_scene *s = lr_test_scene("candle", small, NULL);
+    lr_renderer *r = lr_test_renderer(gl, s, TW, TH, true, 3);
+    lr_test_converge(r, 20);
+    assert_false(lr_renderer_debug_compose_gathered(r));
+    float *hdr = lr_test_hdr(r);
+    lr_cpu_render_desc d = {.scene = s, .width = TW, .height = TH, .mode = LR_CPU_PASS,
+                            .no_vpl = true};
+    lr_image twin, var, plain;
+    lr_err e = {0};
+    if (lr_cpu_render(&d, &twin, &var, NULL, &e))
+        fail_msg("%s", e.msg);
+    unsigned dirty = 0;
+    assert_int_equal(lr_scene_set(s, "render.surface_cache", "false", &dirty, &e), LR_OK);
+    if (lr_cpu_render(&d, &plain, NULL, NULL, &e))
+        fail_msg("%s", e.msg);
+    double g = 0.0, c = 0.0, p = 0.0, v = 0.0;
+    for (int y = 0; y < TH; y++)
+        for (int x = 0; x < TW; x++) {
+            lr_vec3 org, dir;
+            lr_cpu_camera_ray(s, TW, TH, x, y, &org, &dir);
+            lr_hit h;
+            if (!lr_bvh_intersect(lr_scene_object_at(s, 0)->bvh, org, dir, 0, INFINITY, &h))
+                continue;
+            size_t k = (size_t)y * TW + x;
+            for (int b = 0; b < 3; b++) {
+                g += hdr[3 * ((size_t)(TH - 1 - y) * TW + x) + b];
+                c += twin.rgb[3 * k + b];
+                p += plain.rgb[3 * k + b];
+                v += 2.0 * var.rgb[3 * k + b];
+            }
+        }
+    print_message("candle 32x24, cache on: GPU %.5g, CPU twin %.5g (%+.2f %%, sigma %.2f %%); "
+                  "twin per pixel %.5g (%+.2f %%)\n", g, c, 100 * (g / c - 1),
+                  100 * sqrt(v) / c, p, 100 * (c / p - 1));
+    assert_near(g, c, 4.0 * sqrt(v) + 0.05 * c);
+    assert_true(fabs(c / p - 1.0) < 0.10);
+    free(hdr);
+    lr_image_free(&twin);
+    lr_image_free(&var);
+    lr_image_free(&plain);
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+}
+
 static void test_default(void **state)
 {
     (void)state;
@@ -268,6 +324,7 @@ int main(void)
         cmocka_unit_test(test_default),
         cmocka_unit_test(test_camera_move_runs_no_gather),
         cmocka_unit_test(test_cache_follows_the_maps),
+        cmocka_unit_test(test_twin_follows_cache),
         cmocka_unit_test(test_candle_cache_vs_gather),
         cmocka_unit_test(test_lampshade_cache_vs_gather),
         cmocka_unit_test(test_votive_cache_vs_gather),
