@@ -11,7 +11,7 @@
 #include "render/passes/surface.h"
 #include "render/passes/vpl.h"
 
-/* Composition's output: layer l of `images` (colour attachment l of `fb`, RGBA16F) is light
+/* Composition's output: layer l of `images` (colour attachment l of `fb`, RGBA32F) is light
  * l's unit-intensity image times scale[l], alpha 0 on object pixels no map sees. Valid until
  * the view, the receivers or the transport change. */
 typedef struct lr_compose {
@@ -21,7 +21,7 @@ typedef struct lr_compose {
     bool valid; /* composed since the last (re)allocation */
     bool gathered; /* the last run ran Algorithm 1 per pixel (no surface cache) */
     /* Per light: the images hold scale[l] L_l (the maps' scale, R^2 for point and spot
-     * lights), so that half floats keep their 11 bits; the blend divides it out. */
+     * lights: O(1) values, as half floats would need); the blend divides it out. */
     float scale[LR_MAX_LIGHTS];
 } lr_compose;
 
