@@ -18,6 +18,7 @@
 #include "render/passes/irradiance.h"
 #include "render/passes/passes.h"
 #include "render/passes/radiosity.h"
+#include "render/passes/surface.h"
 #include "render/passes/vpl.h"
 #include "render/renderer_parts.h"
 
@@ -53,6 +54,7 @@ struct lr_renderer {
     lr_radiosity rad;
     lr_vpl vpl;
     lr_irradiance irr;
+    lr_surface surf;
     lr_compose img;
     lr_blend *blend; /* tone-mapped output and HDR sum (render/passes/blend.h) */
     /* Area lights' direct light on the plane receivers, accumulated with the maps
@@ -89,7 +91,9 @@ static int check_programs(lr_renderer *r, lr_err *e)
 {
     lr_program *ps[] = {r->prog.surface, r->prog.depth, r->prog.radiosity, r->prog.vpl,
                         r->prog.obj,     r->prog.recv,  r->prog.blit,      r->prog.irr,
-                        r->prog.area};
+                        r->prog.area,
+                        r->prog.cache,   r->prog.obj_cached[0], r->prog.obj_cached[1],
+                        r->prog.obj_cached[2], r->prog.obj_cached[3]};
     for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++) {
         int rc = ps[i] ? lr_program_check(ps[i], e) : LR_OK;
         if (rc)
@@ -167,6 +171,22 @@ static int irradiance_run(lr_renderer *r, unsigned dirty, lr_err *e)
     return lr_irradiance_run(&r->irr, &c, &r->vpl, &r->rad, e);
 }
 
+static void surface_free(lr_renderer *r) { lr_surface_free(&r->surf); }
+static bool surface_on(const lr_renderer *r) { return r->rs.surface_cache; }
+/* Not drawn yet, or drawn from other maps (accumulation went on while it was off). */
+static bool surface_due(const lr_renderer *r)
+{
+    return !r->surf.valid || r->surf.gen != r->rad.gen;
+}
+static int surface_run(lr_renderer *r, unsigned dirty, lr_err *e)
+{
+    (void)dirty;
+    lr_pass_ctx c = pass_ctx(r);
+    int rc = lr_surface_run(&r->surf, &c, &r->rad, e);
+    r->surf.gen = r->rad.gen;
+    return rc;
+}
+
 static int compose_alloc(lr_renderer *r, lr_err *e)
 {
     lr_pass_ctx c = pass_ctx(r);
@@ -180,7 +200,8 @@ static int compose_run(lr_renderer *r, unsigned dirty, lr_err *e)
     (void)dirty;
     lr_pass_ctx c = pass_ctx(r);
     lr_compose_inputs in = {.gbuffer = &r->gbuffer, .radiosity = &r->rad, .vpl = &r->vpl,
-                            .irradiance = &r->irr, .area = &r->area};
+                            .irradiance = &r->irr, .area = &r->area,
+                            .surface = r->rs.surface_cache && r->surf.valid ? &r->surf : NULL};
     return lr_compose_run(&r->img, &c, &in, e);
 }
 
@@ -204,7 +225,7 @@ static int blend_run(lr_renderer *r, unsigned dirty, lr_err *e)
                          .exposure = (float)r->rs.exposure, .tonemap_op = LR_RENDER_TONEMAP};
     for (int l = 0; l < r->img.n && l < LR_BLEND_MAX_IMAGES && l < LR_MAX_LIGHTS; l++)
         for (int b = 0; b < 3; b++)
-            in.w[l][b] = c.I[l][b];
+            in.w[l][b] = c.I[l][b] / r->img.scale[l]; /* the images hold scale[l] L_l */
     return lr_blend_run(r->blend, &in, e);
 }
 
@@ -220,15 +241,17 @@ enum {
 /* The passes in the order they run. */
 static const lr_pass_desc pass_table[LR_PASS_COUNT] = {
     {"gbuffer", LR_PASS_GBUFFER, D_TRANSPORT, 0, false, gbuffer_alloc, gbuffer_free, gbuffer_due,
-     gbuffer_run},
-    {"radiosity", LR_PASS_RADIOSITY, D_MAPS, LR_PASS_VPL | LR_PASS_COMPOSE, false,
-     radiosity_alloc, radiosity_free, radiosity_due, radiosity_run},
-    {"vpl", LR_PASS_VPL, D_MAPS, LR_PASS_IRRADIANCE, true, vpl_alloc, vpl_free, NULL, vpl_run},
+     gbuffer_run, NULL},
+    {"radiosity", LR_PASS_RADIOSITY, D_MAPS, LR_PASS_VPL | LR_PASS_SURFACE | LR_PASS_COMPOSE,
+     false, radiosity_alloc, radiosity_free, radiosity_due, radiosity_run, NULL},
+    {"vpl", LR_PASS_VPL, D_MAPS, LR_PASS_IRRADIANCE, true, vpl_alloc, vpl_free, NULL, vpl_run, NULL},
     {"irradiance", LR_PASS_IRRADIANCE, D_GRIDS, LR_PASS_COMPOSE, true, NULL, irradiance_free,
-     irradiance_due, irradiance_run},
+     irradiance_due, irradiance_run, NULL},
+    {"surface", LR_PASS_SURFACE, D_MAPS, LR_PASS_COMPOSE, false, NULL, surface_free,
+     surface_due, surface_run, surface_on},
     {"compose", LR_PASS_COMPOSE, D_VIEW, LR_PASS_BLEND, false, compose_alloc, compose_free,
-     compose_due, compose_run},
-    {"blend", LR_PASS_BLEND, D_OUTPUT, 0, false, blend_alloc, blend_free, NULL, blend_run},
+     compose_due, compose_run, NULL},
+    {"blend", LR_PASS_BLEND, D_OUTPUT, 0, false, blend_alloc, blend_free, NULL, blend_run, NULL},
 };
 
 const lr_pass_desc *lr_pass_table(void)
@@ -359,8 +382,23 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
         (rc = program(r, "mesh.vert", "compose_receiver.frag", &pr->recv, e)) ||
         (rc = program(r, "fullscreen.vert", "blit.frag", &pr->blit, e)) ||
         (rc = program(r, "fullscreen.vert", "irradiance.frag", &pr->irr, e)) ||
-        (rc = program(r, "fullscreen.vert", "area_direct.frag", &pr->area, e)))
+        (rc = program(r, "fullscreen.vert", "area_direct.frag", &pr->area, e)) ||
+        (rc = program(r, "fullscreen.vert", "surface_cache.frag", &pr->cache, e)))
         goto fail;
+    /* Composition from the surface cache, one program per light count (its varyings). */
+    for (int n = 1; n <= LR_MAX_LIGHTS; n++) {
+        lr_shader_defines d = r->defines;
+        for (int i = 0; i < d.n; i++)
+            d.list[i] = d.text[i]; /* the copy's own text */
+        if (!lr_shader_defines_add(&d, "LR_CACHE_LIGHTS", n)) {
+            rc = lr_err_set(e, LR_EINVAL, "renderer: too many shader defines");
+            goto fail;
+        }
+        lr_program_desc pd = {.vertex = "compose_cached.vert", .fragment = "compose_cached.frag",
+                              .dir = r->shader_dir, .defines = d.list};
+        if ((rc = lr_program_create(&pd, &pr->obj_cached[n - 1], e)))
+            goto fail;
+    }
     if ((rc = alloc_resources(r, e)) || (rc = lr_pass_objects_upload(&r->objs, r->scene, e)))
         goto fail;
     /* Warm-up section: llvmpipe's first time-elapsed query reports time since the context
@@ -387,8 +425,10 @@ void lr_renderer_destroy(lr_renderer *r)
     free_resources(r);
     lr_pass_objects_free(&r->objs);
     const lr_pass_programs *pr = &r->prog;
-    lr_program *ps[] = {pr->surface, pr->depth, pr->radiosity, pr->vpl,
-                        pr->obj,     pr->recv,  pr->blit,      pr->irr, pr->area};
+    lr_program *ps[] = {pr->surface,       pr->depth,         pr->radiosity,     pr->vpl,
+                        pr->obj,           pr->recv,          pr->blit,          pr->irr,
+                        pr->cache,         pr->obj_cached[0], pr->obj_cached[1],
+                        pr->obj_cached[2], pr->obj_cached[3], pr->area};
     for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
         lr_program_destroy(ps[i]);
     lr_timer_destroy(r->timer);
@@ -478,6 +518,10 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
     r->rs.exposure = lr_scene_render(r->scene)->exposure;
     r->rs.frames = frames_target(r);
     r->rs.N = lr_scene_render(r->scene)->N;
+    r->rs.surface_cache = lr_scene_render(r->scene)->surface_cache;
+    /* The refined meshes depend on the geometry, sigma_tr and the map size (surface.h). */
+    if (dirty & (LR_DIRTY_GEOMETRY | LR_DIRTY_SETTINGS | LR_DIRTY_MATERIAL))
+        lr_surface_invalidate_geometry(&r->surf);
     if (dirty & (LR_DIRTY_GEOMETRY | LR_DIRTY_SETTINGS | LR_DIRTY_RECEIVERS | LR_DIRTY_MATERIAL)) {
         if ((rc = lr_pass_objects_upload(&r->objs, r->scene, e)))
             return rc;
@@ -613,5 +657,6 @@ void lr_renderer_parts_get(const lr_renderer *r, lr_renderer_parts *out)
                                .defines = r->defines.list,
                                .width = r->width, .height = r->height, .seed = r->seed,
                                .rs = &r->rs, .objs = &r->objs, .gbuffer = &r->gbuffer,
-                               .radiosity = &r->rad, .vpl = &r->vpl, .blend = r->blend};
+                               .radiosity = &r->rad, .vpl = &r->vpl, .compose = &r->img,
+                               .surface = &r->surf, .blend = r->blend};
 }

@@ -230,6 +230,24 @@ int lr_renderer_debug_uncovered(lr_renderer *r, int *count, lr_err *e)
     return LR_OK;
 }
 
+bool lr_renderer_debug_compose_gathered(const lr_renderer *r)
+{
+    return parts(r).compose->gathered;
+}
+
+void lr_renderer_debug_surface_info(const lr_renderer *r, lr_debug_surface_info *out)
+{
+    const lr_surface *sc = parts(r).surface;
+    memset(out, 0, sizeof *out);
+    if (!sc->built)
+        return;
+    out->entries = sc->entries;
+    out->n_objects = sc->n_objects;
+    for (int i = 0; i < sc->n_objects && i < LR_MAX_OBJECTS; i++) {
+        out->nv[i] = sc->nv[i];
+        out->h[i] = sc->h[i];
+    }
+}
 
 int lr_renderer_debug_floor_ms(lr_renderer *r, int reps, double *wall_ms, double *timer_ms,
                                lr_err *e)

@@ -92,6 +92,18 @@ int lr_renderer_debug_read_gbuffer(lr_renderer *r, int face, float *pos, float *
 /* Object pixels of the last composed image that no radiosity map sees (Algorithm 1's n = 0:
  * they took the map facing them most, without visibility; PIPELINE.md pass 3). */
 int lr_renderer_debug_uncovered(lr_renderer *r, int *count, lr_err *e);
+/* Whether the last composition ran Algorithm 1 per object pixel (render.surface_cache off)
+ * rather than reading the surface cache (render/passes/surface.h). */
+bool lr_renderer_debug_compose_gathered(const lr_renderer *r);
+
+/* The surface cache: entries (refined vertices, both sides of open objects), and object i's
+ * refined vertex count and edge bound in mm (0 when the cache is not built). */
+typedef struct lr_debug_surface_info {
+    int entries, n_objects;
+    int nv[8]; /* LR_MAX_OBJECTS (render/passes/material_pack.h) */
+    double h[8];
+} lr_debug_surface_info;
+void lr_renderer_debug_surface_info(const lr_renderer *r, lr_debug_surface_info *out);
 
 /* ---- the bench's floor (issue 11) ---------------------------------------------------------- */
 

@@ -6,6 +6,7 @@
 
 #include "render/gl/timer.h"
 #include "render/passes/blend.h"
+#include "render/passes/compose.h"
 #include "render/passes/gbuffer.h"
 #include "render/passes/radiosity.h"
 #include "render/passes/vpl.h"
@@ -23,6 +24,8 @@ typedef struct lr_renderer_parts {
     const lr_gbuffer *gbuffer;
     const lr_radiosity *radiosity;
     const lr_vpl *vpl;
+    const lr_compose *compose;
+    const lr_surface *surface;
     lr_blend *blend; /* NULL when resources failed to allocate */
 } lr_renderer_parts;
 

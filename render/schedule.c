@@ -9,7 +9,8 @@
  *  - a light's pose or cone, an object's geometry, the render settings: everything (settings
  *    also reallocate and restart accumulation);
  *  - material: the scattered-radiosity maps, VPLs, receiver grids, composition, blend;
- *  - view: composition and blend (the radiosity maps and the grids are view-independent);
+ *  - view: composition and blend (the radiosity maps, the grids and the objects' surface
+ *    cache are view-independent);
  *  - receivers: their irradiance grids, composition and blend (receivers are lit at
  *    composition and take no part in the transport through the object). */
 
@@ -38,6 +39,11 @@ unsigned lr_schedule_close(const lr_renderer *r, unsigned passes, bool no_emerge
      * before it passes its output on. */
     const lr_pass_desc *t = lr_pass_table();
     for (int i = 0; i < LR_PASS_COUNT; i++) {
+        /* A pass switched off is neither due nor does it make its readers due. */
+        if (t[i].on && !t[i].on(r)) {
+            passes &= ~t[i].bit;
+            continue;
+        }
         if (t[i].due && t[i].due(r))
             passes |= t[i].bit;
         if (passes & t[i].bit)

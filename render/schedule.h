@@ -21,10 +21,11 @@ enum lr_pass {
     LR_PASS_COMPOSE = 1u << 3,   /* composition: one unit-intensity linear image per light */
     LR_PASS_BLEND = 1u << 4,     /* sum_l I_l image_l, tone mapping, output (passes/blend.h) */
     LR_PASS_IRRADIANCE = 1u << 5, /* receiver irradiance grids from the VPLs (before compose) */
+    LR_PASS_SURFACE = 1u << 6,    /* the objects' B per refined vertex (passes/surface.h) */
 };
 
-/* gbuffer, radiosity, vpl, compose, blend, irradiance (bit index order). */
-enum { LR_PASS_COUNT = 6 };
+/* gbuffer, radiosity, vpl, compose, blend, irradiance, surface (bit index order). */
+enum { LR_PASS_COUNT = 7 };
 
 typedef struct lr_renderer lr_renderer; /* render/renderer.h */
 
@@ -47,6 +48,9 @@ typedef struct lr_pass_desc {
     bool (*due)(const lr_renderer *r);
     /* One run; dirty is the frame's LR_DIRTY_* mask. */
     int (*run)(lr_renderer *r, unsigned dirty, lr_err *e);
+    /* Whether the pass is switched on by the settings (NULL: always); a pass that is off never
+     * runs, whatever makes it due. */
+    bool (*on)(const lr_renderer *r);
 } lr_pass_desc;
 
 /* The renderer's passes, LR_PASS_COUNT of them in the order they run (render/renderer.c). */
@@ -58,11 +62,12 @@ unsigned lr_dirty_passes(unsigned dirty);
 
 /* A frame's passes from those its changes require (lr_dirty_passes): adds the passes that
  * are due by themselves (the table's `due`) and, transitively, those that read the output of
- * a pass that runs (`feeds`); with no_emergent, drops the emergent-light passes. */
+ * a pass that runs (`feeds`); with no_emergent, drops the emergent-light passes; drops the
+ * passes whose `on` says they are off. */
 unsigned lr_schedule_close(const lr_renderer *r, unsigned passes, bool no_emergent);
 
-/* "gbuffer", "radiosity", "vpl", "compose", "blend", "irradiance" for bit index 0..5; "?"
- * otherwise. */
+/* "gbuffer", "radiosity", "vpl", "compose", "blend", "irradiance", "surface" for bit index
+ * 0..6; "?" otherwise. */
 const char *lr_pass_name(int index);
 
 #endif

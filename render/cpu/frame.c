@@ -15,6 +15,7 @@
 #include "render/transrad/tr_scene.h"
 #include "render/cpu/rng.h"
 #include "render/cpu/sh.h"
+#include "render/cpu/surface.h"
 #include "render/cpu/vpl.h"
 
 void lr_cpu_camera_ray(const lr_scene *s, int width, int height, int px, int py, lr_vec3 *org,
@@ -58,6 +59,12 @@ typedef struct rctx {
      * any other light itself once. */
     lr_light **fl;
     int *nfl;
+    /* PASS with render.surface_cache: per object its refined mesh and, per light, side and
+     * refined vertex, B (3 doubles), its variance (3) and whether a map saw it (1): the GPU's
+     * surface cache (render/cpu/surface.h), interpolated per pixel. NULL: per pixel. */
+    lr_refined *ref;
+    double **cache;
+    long *cache_first; /* item -> (object, light, side, vertex): prefix over objects */
 } rctx;
 
 /* Frame samples standing for an area light in LR_CPU_REFERENCE: 16 cycles of the Poisson set,
@@ -72,6 +79,8 @@ static double direct_at(const rctx *r, int l, lr_vec3 x, lr_vec3 n)
         sum += lr_cpu_direct_irradiance(r->s, &r->fl[l][f], x, n);
     return sum / r->nfl[l];
 }
+
+enum { CACHE_DOUBLES = 7 };
 
 static uint64_t seed_of(const rctx *r) { return r->d->seed ? r->d->seed : 1; }
 
@@ -133,6 +142,61 @@ static void vpl_item(void *p, long item)
             v->var[c] += r->I[l][c] * r->I[l][c] * var[c];
         }
     }
+}
+
+/* Sides cached for object o: an open object also for its reversed normal. */
+static int sides(const rctx *r, int o) { return lr_scene_object_at(r->s, o)->closed ? 1 : 2; }
+
+/* The cache entry of object o, light l, side, refined vertex v. */
+static double *cache_at(const rctx *r, int o, int l, int side, size_t v)
+{
+    size_t nv = r->ref[o].nv;
+    return r->cache[o] + CACHE_DOUBLES * (((size_t)l * (size_t)sides(r, o) + (size_t)side) * nv + v);
+}
+
+/* Algorithm 1 at one refined vertex for every light (item over all objects' entries). */
+static void cache_item(void *p, long item)
+{
+    rctx *r = p;
+    int o = 0;
+    while (item >= r->cache_first[o + 1])
+        o++;
+    long k = item - r->cache_first[o];
+    size_t nv = r->ref[o].nv;
+    int side = (int)((size_t)k / nv);
+    size_t v = (size_t)k % nv;
+    const float *x = r->ref[o].pos + 3 * v, *nn = r->ref[o].nrm + 3 * v;
+    lr_vec3 n = lr_v3(nn[0], nn[1], nn[2]);
+    if (!(lr_v3_len(n) > 1e-12))
+        return;
+    n = lr_v3_scale(lr_v3_normalize(n), side ? -1.0 : 1.0);
+    for (int l = 0; l < r->nlight; l++) {
+        double *c = cache_at(r, o, l, side, v);
+        bool fb = false;
+        radiosity_at(r, o, l, lr_v3(x[0], x[1], x[2]), n, 0, c, c + 3, &fb);
+        c[6] = fb ? 0.0 : 1.0;
+    }
+}
+
+/* B of object o for light l at the camera hit (parent triangle t, barycentrics u, v): the
+ * cache interpolated over the refined triangle, as the GPU's rasteriser does. */
+static void cached_at(const rctx *r, int o, int l, int side, size_t t, double u, double v,
+                      double B[3], double var[3], bool *fallback)
+{
+    double w[3];
+    size_t k = lr_refined_locate(&r->ref[o], t, u, v, w);
+    double cover = 0.0;
+    for (int c = 0; c < 3; c++)
+        B[c] = var[c] = 0.0;
+    for (int j = 0; j < 3; j++) {
+        const double *e = cache_at(r, o, l, side, r->ref[o].idx[3 * k + j]);
+        for (int c = 0; c < 3; c++) {
+            B[c] += w[j] * e[c];
+            var[c] += w[j] * w[j] * e[3 + c];
+        }
+        cover += w[j] * e[6];
+    }
+    *fallback = !(cover >= 0.5);
 }
 
 /* E_vpl at texel (item mod R^2) of receiver (item / R^2)'s grid. */
@@ -211,13 +275,22 @@ static void pixel_item(void *p, long item)
         const lr_scene_object *o = lr_scene_object_at(r->s, idx);
         if (!o->closed && lr_v3_dot(n, dir) > 0.0)
             n = lr_v3_scale(n, -1.0); /* two-sided open surface: the side the camera sees */
+        /* The surface cache's entry: the hit's parent triangle and barycentrics, and the side
+         * the GPU takes (gl_FrontFacing: the triangle's winding against the ray). */
+        lr_hit hit;
+        bool cached = r->cache && lr_bvh_intersect(o->bvh, org, dir, 0.0, INFINITY, &hit);
+        int side = cached && !o->closed &&
+                   lr_v3_dot(lr_mesh_triangle_normal(o->mesh, hit.triangle), dir) > 0.0;
         double cos_o = -lr_v3_dot(n, dir);
         double ft = lr_fresnel_transmittance(cos_o > 0.0 ? cos_o : 0.0, o->coeffs.eta);
         for (int l = 0; l < r->nlight; l++) {
             double B[3], var[3];
             bool fb = false;
-            radiosity_at(r, idx, l, x, n, lr_cpu_key(seed_of(r), (uint64_t)item, (uint64_t)l, 1),
-                         B, var, &fb);
+            if (cached)
+                cached_at(r, idx, l, side, hit.triangle, hit.u, hit.v, B, var, &fb);
+            else
+                radiosity_at(r, idx, l, x, n,
+                             lr_cpu_key(seed_of(r), (uint64_t)item, (uint64_t)l, 1), B, var, &fb);
             if (fb)
                 r->fallback_px[item] = 1;
             for (int c = 0; c < 3; c++) {
@@ -392,6 +465,33 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
                                 samples += 3.0 * md.N * frames;
             }
     }
+    /* The GPU's surface cache (render.surface_cache): B at the refined vertices. */
+    if (!ref && rs->surface_cache) {
+        int msize = d->map_size ? d->map_size : rs->map_size;
+        r.ref = calloc((size_t)r.nobj, sizeof *r.ref);
+        r.cache = calloc((size_t)r.nobj, sizeof *r.cache);
+        r.cache_first = calloc((size_t)r.nobj + 1, sizeof *r.cache_first);
+        if (!r.ref || !r.cache || !r.cache_first) {
+            rc = lr_err_set(e, LR_ENOMEM, "cpu render: out of memory");
+            goto fail;
+        }
+        size_t total = 0;
+        for (int o = 0; o < r.nobj; o++) {
+            double h;
+            size_t budget = LR_SURFACE_MAX_VERTICES > total ? LR_SURFACE_MAX_VERTICES - total : 1;
+            if ((rc = lr_surface_refine(s, o, msize, budget, &r.ref[o], &h, e)))
+                goto fail;
+            size_t entries = r.ref[o].nv * (size_t)sides(&r, o);
+            total += entries;
+            r.cache_first[o + 1] = r.cache_first[o] + (long)entries;
+            r.cache[o] = calloc(entries * (size_t)r.nlight * CACHE_DOUBLES, sizeof **r.cache);
+            if (!r.cache[o]) {
+                rc = lr_err_set(e, LR_ENOMEM, "cpu render: surface cache: out of memory");
+                goto fail;
+            }
+        }
+        lr_cpu_parallel_for(r.cache_first[r.nobj], d->threads, cache_item, &r);
+    }
     int nv = 0;
     if (r.nvpl > 0) {
         for (int o = 0; o < r.nobj; o++)
@@ -442,6 +542,13 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
     }
 fail:
     lr_tr_scene_destroy(r.tr);
+    for (int o = 0; o < r.nobj && r.ref; o++)
+        lr_refined_free(&r.ref[o]);
+    for (int o = 0; o < r.nobj && r.cache; o++)
+        free(r.cache[o]);
+    free(r.ref);
+    free(r.cache);
+    free(r.cache_first);
     if (r.grid)
         for (int i = 0; i < r.nrecv; i++)
             free(r.grid[i]);

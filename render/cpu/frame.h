@@ -1,8 +1,9 @@
 /* lamprig — a whole image of a scene's camera view on the CPU, in two modes:
  *
  *   LR_CPU_PASS       the CPU twin of the GPU renderer: per object and light, K radiosity maps
- *                     accumulated over `frames` frames (maps.h), Algorithm 1 per camera pixel,
- *                     L_o = I F_t(w_o) B / pi; receivers lit directly (shadow rays) and by the
+ *                     accumulated over `frames` frames (maps.h), Algorithm 1 per camera pixel
+ *                     (with render.surface_cache: at the refined vertices of surface.h,
+ *                     interpolated at the hit, as the GPU), L_o = I F_t(w_o) B / pi; receivers lit directly (shadow rays) and by the
  *                     scene's N_vpl VPLs with B from Algorithm 1 (vpl.h), on plane receivers
  *                     through the GPU's receiver irradiance grid (recv_grid.h: E_vpl at its
  *                     texel centres, bilinear in between).

@@ -8,34 +8,39 @@
 #include "render/cpu/cavity.h"
 #include "render/passes/passes.h"
 
-static int upload(lr_gpu_mesh *g, const lr_mesh *m, lr_err *e)
+int lr_passes_upload_arrays(lr_gpu_mesh *g, const float *pos, const float *nrm, size_t nv,
+                            const uint32_t *idx, size_t nt, const char *name, lr_err *e)
 {
-    size_t nv = lr_mesh_vertex_count(m), nt = lr_mesh_triangle_count(m);
     if (nt * 3 > 0x7fffffff)
-        return lr_err_set(e, LR_EINVAL, "mesh %s: too many triangles for the GPU", lr_mesh_name(m));
+        return lr_err_set(e, LR_EINVAL, "mesh %s: too many triangles for the GPU", name);
     glGenVertexArrays(1, &g->vao);
     glGenBuffers(2, g->vbo);
     glGenBuffers(1, &g->ebo);
     glBindVertexArray(g->vao);
     glBindBuffer(GL_ARRAY_BUFFER, g->vbo[0]);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * 3 * sizeof(float)), lr_mesh_positions(m),
-                 GL_STATIC_DRAW);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * 3 * sizeof(float)), pos, GL_STATIC_DRAW);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, 0);
     glEnableVertexAttribArray(0);
     glBindBuffer(GL_ARRAY_BUFFER, g->vbo[1]);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * 3 * sizeof(float)), lr_mesh_normals(m),
-                 GL_STATIC_DRAW);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * 3 * sizeof(float)), nrm, GL_STATIC_DRAW);
     glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, 0);
     glEnableVertexAttribArray(1);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g->ebo);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(nt * 3 * sizeof(uint32_t)),
-                 lr_mesh_indices(m), GL_STATIC_DRAW);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(nt * 3 * sizeof(uint32_t)), idx,
+                 GL_STATIC_DRAW);
     glBindVertexArray(0);
     g->count = (GLsizei)(nt * 3);
     return lr_gl_check("mesh upload", e);
 }
 
-static void release(lr_gpu_mesh *g)
+static int upload(lr_gpu_mesh *g, const lr_mesh *m, lr_err *e)
+{
+    return lr_passes_upload_arrays(g, lr_mesh_positions(m), lr_mesh_normals(m),
+                                   lr_mesh_vertex_count(m), lr_mesh_indices(m),
+                                   lr_mesh_triangle_count(m), lr_mesh_name(m), e);
+}
+
+void lr_passes_release_mesh(lr_gpu_mesh *g)
 {
     if (g->vao) {
         glDeleteVertexArrays(1, &g->vao);
@@ -48,9 +53,9 @@ static void release(lr_gpu_mesh *g)
 void lr_pass_objects_free(lr_pass_objects *o)
 {
     for (int i = 0; i < LR_MAX_OBJECTS; i++)
-        release(&o->obj[i]);
+        lr_passes_release_mesh(&o->obj[i]);
     for (int i = 0; i < LR_MAX_RECEIVERS; i++)
-        release(&o->recv[i]);
+        lr_passes_release_mesh(&o->recv[i]);
     o->n_objects = o->n_receivers = 0;
 }
 

@@ -9,16 +9,21 @@
 #include "render/passes/irradiance.h"
 #include "render/passes/passes.h"
 #include "render/passes/radiosity.h"
+#include "render/passes/surface.h"
 #include "render/passes/vpl.h"
 
-/* Composition's output: layer l of `images` (colour attachment l of `fb`) is light l's
- * unit-intensity image, alpha 0 on object pixels no map sees. Valid until the view, the
- * receivers or the transport change. */
+/* Composition's output: layer l of `images` (colour attachment l of `fb`, RGBA32F) is light
+ * l's unit-intensity image times scale[l], alpha 0 on object pixels no map sees. Valid until
+ * the view, the receivers or the transport change. */
 typedef struct lr_compose {
     lr_tex *images;
     lr_fb *fb;
     int n;      /* layers (the scene's lights when allocated) */
     bool valid; /* composed since the last (re)allocation */
+    bool gathered; /* the last run ran Algorithm 1 per pixel (no surface cache) */
+    /* Per light: the images hold scale[l] L_l (the maps' scale, R^2 for point and spot
+     * lights: O(1) values, as half floats would need); the blend divides it out. */
+    float scale[LR_MAX_LIGHTS];
 } lr_compose;
 
 /* What composition reads: the other passes' results. */
@@ -28,6 +33,8 @@ typedef struct lr_compose_inputs {
     const lr_vpl *vpl;              /* emergent light on box receivers (unallocated: none) */
     const lr_irradiance *irradiance; /* emergent light on plane receivers, cached */
     const lr_area_direct *area;     /* area lights' direct light on plane receivers */
+    const lr_surface *surface;      /* the objects' B per refined vertex; NULL: Algorithm 1
+                                     * per pixel (render.surface_cache off) */
 } lr_compose_inputs;
 
 /* Images of the output size for c->n_lights lights. */

@@ -69,6 +69,9 @@ typedef struct lr_pass_objects {
 typedef struct lr_pass_programs {
     lr_program *surface, *depth, *radiosity, *vpl, *obj, *recv, *blit, *irr;
     lr_program *area; /* area lights' direct grid (area_direct.c) */
+    lr_program *cache;      /* surface_cache.frag: Algorithm 1 at the cache's entries */
+    /* compose_cached.{vert,frag}: objects from the cache, [n - 1] for n lights */
+    lr_program *obj_cached[LR_MAX_LIGHTS];
 } lr_pass_programs;
 
 /* The read-only inputs of a pass: the context, the scene, the settings the resources were
@@ -103,6 +106,11 @@ void lr_passes_set_coeffs(const lr_pass_objects *o, lr_program *p);
 /* glUniform3fv of `count` vec3 to uniform array `name`. */
 void lr_passes_uniform_v3_array(lr_program *p, const char *name, const float *v, int count);
 void lr_passes_draw(const lr_gpu_mesh *m);
+/* A mesh from arrays (3 floats per vertex for pos and nrm, 3 indices per triangle); `name`
+ * for messages. lr_passes_release_mesh frees it (idempotent). */
+int lr_passes_upload_arrays(lr_gpu_mesh *g, const float *pos, const float *nrm, size_t nv,
+                            const uint32_t *idx, size_t nt, const char *name, lr_err *e);
+void lr_passes_release_mesh(lr_gpu_mesh *g);
 void lr_passes_uniform_mat4(lr_program *p, const char *name, const double m[16]);
 void lr_passes_uniform_v3(lr_program *p, const char *name, lr_vec3 v);
 void lr_passes_uniform_i(lr_program *p, const char *name, int v);

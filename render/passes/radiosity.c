@@ -320,6 +320,7 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);
     rad->F = F;
+    rad->gen++;
     return lr_gl_check("radiosity pass", e);
 }
 

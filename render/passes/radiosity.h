@@ -45,6 +45,7 @@ typedef struct lr_radiosity {
     float sh_E[LR_MAX_LIGHTS][27 * LR_MAX_OBJECTS];
     float sh_scale[3 * LR_MAX_OBJECTS];
     float sh_rho[4 * LR_MAX_OBJECTS]; /* rho.rgb (lr_dipole_rd_total), lit threshold (mm) */
+    unsigned gen; /* runs so far: a reader's result made from other maps is stale */
 } lr_radiosity;
 
 /* Maps for c->rs (K, map_size) and c->n_lights lights; accumulation restarts. */

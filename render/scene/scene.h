@@ -204,6 +204,9 @@ typedef struct lr_render_settings {
     int vpl_map_size; /* cube map of the outer surface that places the VPLs */
     int frames;       /* progressive frames until converged */
     double exposure;  /* multiplies radiance before tone mapping */
+    /* Composition reads the objects' B from the view-independent surface cache
+     * (render/passes/surface.h) instead of running Algorithm 1 per pixel (issue 11). */
+    bool surface_cache;
 } lr_render_settings;
 
 typedef struct lr_quality {

@@ -23,6 +23,8 @@ uniform bool u_area_cached;
 uniform highp sampler2DArray u_area_grid; // layer u_area_layer + l for light l
 uniform int u_area_layer;
 uniform vec3 u_area_c, u_area_a, u_area_b;
+// Image l holds u_image_scale[l] L_l (half floats in their normal range; compose.h).
+uniform float u_image_scale[LR_MAX_LIGHTS];
 // Output l is light l's image (unrolled writes: GLSL ES indexes outputs by constants only).
 layout(location = 0) out vec4 o_light[LR_MAX_LIGHTS];
 
@@ -78,8 +80,8 @@ void main()
         lr_vpl_irradiance(x, nx, E);
     }
     vec3 alb = u_albedo / LR_PI;
-    o_light[0] = vec4(alb * E[0], 1.0);
-    o_light[1] = vec4(alb * E[1], 1.0);
-    o_light[2] = vec4(alb * E[2], 1.0);
-    o_light[3] = vec4(alb * E[3], 1.0);
+    o_light[0] = vec4(u_image_scale[0] * alb * E[0], 1.0);
+    o_light[1] = vec4(u_image_scale[1] * alb * E[1], 1.0);
+    o_light[2] = vec4(u_image_scale[2] * alb * E[2], 1.0);
+    o_light[3] = vec4(u_image_scale[3] * alb * E[3], 1.0);
 }

@@ -503,7 +503,7 @@ static void test_set_dirty_flags(void **state)
     set_ok(s, "lights[0].flicker.seed", "4", LR_DIRTY_INTENSITY);
     assert_int_equal(lr_dirty_passes(LR_DIRTY_LIGHT_GEOMETRY),
                      LR_PASS_GBUFFER | LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_IRRADIANCE |
-                         LR_PASS_COMPOSE | LR_PASS_BLEND);
+                         LR_PASS_SURFACE | LR_PASS_COMPOSE | LR_PASS_BLEND);
 
     /* Materials: maps, VPLs and composition, not the light's G-buffer. */
     lr_material marble;
@@ -528,8 +528,8 @@ static void test_set_dirty_flags(void **state)
     set_ok(s, "objects[0].material", "candle_wax", LR_DIRTY_MATERIAL);
     get(s, "objects[0].material.scale", "1");
     assert_int_equal(lr_dirty_passes(LR_DIRTY_MATERIAL),
-                     LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_IRRADIANCE | LR_PASS_COMPOSE |
-                         LR_PASS_BLEND);
+                     LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_IRRADIANCE | LR_PASS_SURFACE |
+                         LR_PASS_COMPOSE | LR_PASS_BLEND);
 
     /* View and receivers: composition only. */
     set_ok(s, "camera.position", "0,-500,250", LR_DIRTY_CAMERA);
@@ -559,7 +559,7 @@ static void test_set_dirty_flags(void **state)
     assert_true(fabs(o->center.x - 100) < 1e-4);
     assert_int_equal(lr_dirty_passes(LR_DIRTY_GEOMETRY),
                      LR_PASS_GBUFFER | LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_IRRADIANCE |
-                         LR_PASS_COMPOSE | LR_PASS_BLEND);
+                         LR_PASS_SURFACE | LR_PASS_COMPOSE | LR_PASS_BLEND);
     /* The flame stayed at the origin: now outside the moved candle's hull. */
     assert_int_equal(lr_scene_light_enclosure(s, 0, NULL), LR_ENCLOSURE_NONE);
     set_ok(s, "light.position", "100,0,60", LR_DIRTY_LIGHT_GEOMETRY); /* in the wax */

@@ -379,14 +379,15 @@ static int write_csvs(const timing_row *t, int nt, const error_row *er, int ne)
         goto fail;
     f = lr_atomic_file_stream(af);
     fprintf(f, "scene,resolution,gbuffer_ms,radiosity_ms,vpl_ms,compose_ms,total_ms,accum_ms,"
-               "dimmer_ms,ratio,blend_ms,floor_ms,camera_ms,dimmer_wall_ms,floor_timer_ms\n");
+               "dimmer_ms,ratio,blend_ms,floor_ms,camera_ms,dimmer_wall_ms,floor_timer_ms,"
+               "surface_ms\n");
     for (int i = 0; i < nt; i++)
-        fprintf(f, "%s,%dx%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f\n",
+        fprintf(f, "%s,%dx%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n",
                 t[i].scene,
                 t[i].w, t[i].h, t[i].pass_ms[0], t[i].pass_ms[1], t[i].pass_ms[2],
                 t[i].pass_ms[3], t[i].total_ms, t[i].accum_ms, t[i].dimmer_ms,
                 t[i].total_ms / t[i].dimmer_ms, t[i].pass_ms[4], t[i].floor_ms, t[i].camera_ms,
-                t[i].dimmer_wall_ms, t[i].floor_timer_ms);
+                t[i].dimmer_wall_ms, t[i].floor_timer_ms, t[i].pass_ms[6]);
     if (lr_atomic_file_commit(af, &e))
         goto fail;
 errors:
@@ -467,16 +468,17 @@ static int run(FILE *out)
                      "dimmer / floor ratio compares like with like. Scenes' own settings (K 16, "
                      "N 16, 256² maps).\n\n",
                 FULL_FRAMES, ACCUM_FRAMES, DIMMER_FRAMES, CAMERA_FRAMES, FLOOR_REPS);
-        fprintf(out, "| scene | size | gbuffer | radiosity | vpl | compose | blend | full update | "
+        fprintf(out, "| scene | size | gbuffer | radiosity | vpl | surface | compose | blend | full update | "
                      "accumulation | dimmer | dimmer wall | floor | floor wall | camera | "
                      "full / dimmer | compose / dimmer | dimmer / floor | "
                      "dimmer wall / floor wall | compose / camera |\n");
-        fprintf(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+        fprintf(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
         for (int i = 0; i < nt; i++)
-            fprintf(out, "| %s | %d×%d | %.1f | %.1f | %.1f | %.1f | %.2f | %.1f | %.1f | %.2f | "
+            fprintf(out, "| %s | %d×%d | %.1f | %.1f | %.1f | %.1f | %.1f | %.2f | %.1f | %.1f | %.2f | "
                          "%.2f | %.2f | %.2f | %.1f | %.0f | %.0f | %.2f | %.2f | %.2f |\n",
                     t[i].scene, t[i].w, t[i].h, t[i].pass_ms[0], t[i].pass_ms[1], t[i].pass_ms[2],
-                    t[i].pass_ms[3], t[i].pass_ms[4], t[i].total_ms, t[i].accum_ms, t[i].dimmer_ms,
+                    t[i].pass_ms[6], t[i].pass_ms[3], t[i].pass_ms[4], t[i].total_ms,
+                    t[i].accum_ms, t[i].dimmer_ms,
                     t[i].dimmer_wall_ms, t[i].floor_timer_ms, t[i].floor_ms, t[i].camera_ms,
                     t[i].total_ms / t[i].dimmer_ms, t[i].pass_ms[3] / t[i].dimmer_ms,
                     t[i].dimmer_ms / t[i].floor_timer_ms, t[i].dimmer_wall_ms / t[i].floor_ms,

@@ -1,0 +1,337 @@
+/* The objects' surface cache (issue 11, render/passes/surface.h, PIPELINE.md "Surface cache").
+ *
+ * Composition with render.surface_cache reads B_l per refined vertex instead of running
+ * Algorithm 1 per pixel. Asserted:
+ *  - a camera move after convergence runs compose and blend alone (no radiosity, no surface
+ *    pass) and composition runs no gather; moving back gives the same image bit for bit;
+ *  - accumulation frames redraw the cache (the surface pass runs with every radiosity frame);
+ *  - switching the cache off is a composition-only change and composition then gathers;
+ *  - the cached image against the per-pixel gather of the same maps, over object pixels, for
+ *    the candle, the lamp shade and the votive: relative RMSE within the bound of PIPELINE.md,
+ *    (sigma_tr h)^2 / 6 (a linear fit's error on B's smooth part, h the edge bound; only where
+ *    sigma_tr h < 1, else the measured 0.10 with a margin) plus the per-pixel image's own
+ *    sampling noise (the cache is a low-pass
+ *    of the same maps: what it drops below the vertex spacing is that noise and detail under
+ *    two map texels), the noise measured from a second seed. The figures are printed;
+ *    LR_SURFACE_FRAMES=F accumulates F frames instead of 12.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render/cpu/frame.h"
+#include "render/mesh/bvh.h"
+#include "render/renderer.h"
+#include "render/renderer_debug.h"
+#include "render/schedule.h"
+#include "tests/support/gl.h"
+#include "tests/support/near.h"
+#include "tests/support/render.h"
+
+LR_TEST_GL_FIXTURE(gl) /* tests/support/gl.h: setup(), teardown() */
+
+enum { W = 160, H = 120 };
+
+/* The scenes' own map size (the edge bound is tied to its texels), fewer maps, samples and
+ * frames than they ship with; no VPLs (they light the receivers, not the objects). */
+static const char *const settings[] = {"render.K=8", "render.N=4", "render.frames=12", NULL};
+/* LR_SURFACE_FRAMES=F (4..4096) accumulates F frames instead of 12 (how the cache's error and
+ * the noise fall with convergence; not part of the default run). */
+static const char *const *test_settings(void)
+{
+    static char frames[32];
+    static const char *s[4] = {"render.K=8", "render.N=4", NULL, NULL};
+    const char *f = getenv("LR_SURFACE_FRAMES");
+    int n = f ? atoi(f) : 12;
+    snprintf(frames, sizeof frames, "render.frames=%d", n >= 4 && n <= 4096 ? n : 12);
+    s[2] = frames;
+    return s;
+}
+
+/* Object pixels (rows bottom up, as the HDR readback): the camera ray meets an object before
+ * any receiver. */
+static unsigned char *object_mask(const lr_scene *s)
+{
+    unsigned char *m = calloc((size_t)W * H, 1);
+    assert_non_null(m);
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            lr_vec3 org, dir;
+            lr_cpu_camera_ray(s, W, H, x, y, &org, &dir);
+            double t_obj = INFINITY, t_rcv = INFINITY;
+            lr_hit h;
+            for (int i = 0; i < lr_scene_object_count(s); i++)
+                if (lr_bvh_intersect(lr_scene_object_at(s, i)->bvh, org, dir, 0, t_obj, &h))
+                    t_obj = fmin(t_obj, h.t);
+            for (int i = 0; i < lr_scene_receiver_count(s); i++)
+                if (lr_bvh_intersect(lr_scene_receiver_at(s, i)->bvh, org, dir, 0, t_rcv, &h))
+                    t_rcv = fmin(t_rcv, h.t);
+            m[(size_t)(H - 1 - y) * W + x] = t_obj < t_rcv;
+        }
+    return m;
+}
+
+/* sqrt(sum (a - b)^2 / sum b^2) over the masked pixels' bands; *worst: the largest |a - b|
+ * over the RMS of b there. */
+static double rel_rmse(const float *a, const float *b, const unsigned char *m, double *worst)
+{
+    double num = 0.0, den = 0.0, big = 0.0;
+    long n = 0;
+    for (size_t i = 0; i < (size_t)W * H; i++) {
+        if (!m[i])
+            continue;
+        for (int c = 0; c < 3; c++) {
+            double d = (double)a[3 * i + c] - b[3 * i + c];
+            num += d * d;
+            den += (double)b[3 * i + c] * b[3 * i + c];
+            big = fmax(big, fabs(d));
+            n++;
+        }
+    }
+    assert_true(n > 0 && den > 0.0);
+    if (worst)
+        *worst = big / sqrt(den / n);
+    return sqrt(num / den);
+}
+
+static bool cache_on_by_default(void)
+{
+    lr_scene *s = lr_test_scene("candle", NULL, NULL);
+    bool on = lr_scene_render(s)->surface_cache;
+    lr_scene_destroy(s);
+    return on;
+}
+
+/* A converged renderer of scene `name` with the cache as asked. */
+static lr_renderer *converged(lr_scene *s, unsigned seed, bool cache)
+{
+    lr_err e = {0};
+    unsigned d = 0;
+    assert_int_equal(lr_scene_set(s, "render.surface_cache", cache ? "true" : "false", &d, &e),
+                     LR_OK);
+    lr_renderer *r = lr_test_renderer(gl, s, W, H, true, seed);
+    lr_test_converge(r, 5000);
+    assert_false(lr_renderer_needs_frame(r));
+    return r;
+}
+
+static void test_camera_move_runs_no_gather(void **state)
+{
+    (void)state;
+    lr_scene *s = lr_test_scene("candle", settings, NULL);
+    lr_err e = {0};
+    unsigned d = 0;
+    assert_int_equal(lr_scene_set(s, "render.surface_cache", "true", &d, &e), LR_OK);
+    lr_renderer *r = lr_test_renderer(gl, s, W, H, true, 3);
+    /* Every accumulation frame redraws the cache from the maps it just updated. */
+    for (int f = 0; lr_renderer_needs_frame(r); f++) {
+        lr_frame_stats st = lr_test_frame(r);
+        assert_true(st.passes & LR_PASS_RADIOSITY);
+        assert_true(st.passes & LR_PASS_SURFACE);
+        assert_false(lr_renderer_debug_compose_gathered(r));
+        assert_true(f < 100);
+    }
+    lr_debug_surface_info si;
+    lr_renderer_debug_surface_info(r, &si);
+    print_message("candle: %d cache entries, edge bound %.3f mm\n", si.entries, si.h[0]);
+    assert_true(si.entries > 0 && si.h[0] > 0.0);
+    float *before = lr_test_hdr(r);
+    const lr_camera *cam = lr_scene_camera(s);
+    lr_vec3 c0 = cam->position;
+    char moved[96], back[96];
+    snprintf(moved, sizeof moved, "%.17g,%.17g,%.17g", c0.x + 40.0, c0.y, c0.z + 20.0);
+    snprintf(back, sizeof back, "%.17g,%.17g,%.17g", c0.x, c0.y, c0.z);
+    const char *pos[] = {moved, back};
+    for (int i = 0; i < 2; i++) {
+        lr_test_set(s, r, "camera.position", pos[i]);
+        lr_frame_stats st = lr_test_frame(r);
+        assert_int_equal(st.passes, LR_PASS_COMPOSE | LR_PASS_BLEND);
+        assert_false(lr_renderer_debug_compose_gathered(r));
+    }
+    float *after = lr_test_hdr(r);
+    assert_memory_equal(before, after, (size_t)W * H * 3 * sizeof *before);
+    /* The cache off: composition alone again, now with the per-pixel gather. */
+    lr_test_set(s, r, "render.surface_cache", "false");
+    lr_frame_stats st = lr_test_frame(r);
+    assert_int_equal(st.passes, LR_PASS_COMPOSE | LR_PASS_BLEND);
+    assert_true(lr_renderer_debug_compose_gathered(r));
+    /* ... and on: the cache is still that of the current maps, so no surface pass. */
+    lr_test_set(s, r, "render.surface_cache", "true");
+    st = lr_test_frame(r);
+    assert_int_equal(st.passes, LR_PASS_COMPOSE | LR_PASS_BLEND);
+    assert_false(lr_renderer_debug_compose_gathered(r));
+    free(before);
+    free(after);
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+}
+
+/* The cache was off while the maps accumulated: switching it on draws it first. */
+static void test_cache_follows_the_maps(void **state)
+{
+    (void)state;
+    lr_scene *s = lr_test_scene("candle", lr_test_small_settings, NULL);
+    lr_renderer *r = converged(s, 3, false);
+    lr_test_set(s, r, "render.surface_cache", "true");
+    lr_frame_stats st = lr_test_frame(r);
+    assert_int_equal(st.passes, LR_PASS_SURFACE | LR_PASS_COMPOSE | LR_PASS_BLEND);
+    /* A material change restarts the maps: the cache is redrawn (and its meshes refined again
+     * for the new sigma_tr). */
+    lr_test_set(s, r, "objects[0].material", "marble");
+    st = lr_test_frame(r);
+    assert_true(st.passes & LR_PASS_RADIOSITY);
+    assert_true(st.passes & LR_PASS_SURFACE);
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+}
+
+/* The cached image against the per-pixel gather of the same maps, and the gather's own
+ * noise from a second seed. */
+static void cache_against_gather(const char *name)
+{
+    lr_scene *s = lr_test_scene(name, test_settings(), NULL);
+    unsigned char *m = object_mask(s);
+    lr_renderer *r = converged(s, 3, true);
+    float *cached = lr_test_hdr(r);
+    lr_debug_surface_info si;
+    lr_renderer_debug_surface_info(r, &si);
+    lr_test_set(s, r, "render.surface_cache", "false");
+    lr_test_frame(r);
+    float *gathered = lr_test_hdr(r);
+    lr_renderer *r2 = converged(s, 11, false);
+    float *other = lr_test_hdr(r2);
+    double worst_c, worst_n;
+    double err = rel_rmse(cached, gathered, m, &worst_c);
+    double noise = rel_rmse(other, gathered, m, &worst_n) / sqrt(2.0);
+    /* The smooth part's bound with the largest sigma_tr of the scene's objects; it holds
+     * where B is smooth over an edge (sigma_tr h < 1). Where it is not (the lamp shade's
+     * porcelain: 1/sigma_tr 0.55 mm against h 2.2 mm) nothing is derived: the part of the
+     * error that does not fall with convergence was measured, 0.10 (PIPELINE.md "Surface
+     * cache", 12 and 48 frames), and 0.15 is asserted. */
+    double fit = 0.0;
+    bool smooth = true;
+    for (int i = 0; i < lr_scene_object_count(s); i++) {
+        double st = 0.0;
+        for (int c = 0; c < 3; c++)
+            st = fmax(st, lr_scene_object_at(s, i)->coeffs.sigma_tr[c]);
+        double sh = st * si.h[i];
+        smooth = smooth && sh < 1.0;
+        fit = fmax(fit, sh * sh / 6.0);
+    }
+    print_message("%s (%dx%d, K 8, N 4, %d frames, map %d): cache vs per-pixel gather: "
+                  "relative RMSE %.4f, max %.3f x RMS; the gather's own noise %.4f (max %.3f x "
+                  "RMS); smooth-part bound %.5f; %d entries, h %.3f mm\n",
+                  name, W, H, lr_scene_render(s)->frames, lr_scene_render(s)->map_size, err,
+                  worst_c, noise, worst_n, fit, si.entries, si.h[0]);
+    assert_true(smooth ? err <= fit + noise : err <= 0.15);
+    free(cached);
+    free(gathered);
+    free(other);
+    free(m);
+    lr_renderer_destroy(r);
+    lr_renderer_destroy(r2);
+    lr_scene_destroy(s);
+}
+
+static void test_candle_cache_vs_gather(void **state)
+{
+    (void)state;
+    cache_against_gather("candle");
+}
+
+static void test_lampshade_cache_vs_gather(void **state)
+{
+    (void)state;
+    cache_against_gather("lampshade");
+}
+
+static void test_votive_cache_vs_gather(void **state)
+{
+    (void)state;
+    cache_against_gather("votive");
+}
+
+/* The CPU twin follows the cache (render/cpu/frame.c with the scene's render.surface_cache:
+ * B at the same refined vertices, interpolated at the hit): a 32 x 24 image of the candle
+ * against the GPU's, object pixels summed, within 4 sigma of the twin's variance image + 5 %
+ * (test_render_parity's final-image rule), and against the twin's own per-pixel image. */
+static void test_twin_follows_cache(void **state)
+{
+    (void)state;
+    enum { TW = 32, TH = 24 };
+    static const char *const small[] = {"render.K=8",          "render.N=4",
+                                        "render.map_size=64",  "render.gbuffer_size=128",
+                                        "render.frames=4",     "render.surface_cache=true",
+                                        NULL};
+    lr_scene *s = lr_test_scene("candle", small, NULL);
+    lr_renderer *r = lr_test_renderer(gl, s, TW, TH, true, 3);
+    lr_test_converge(r, 20);
+    assert_false(lr_renderer_debug_compose_gathered(r));
+    float *hdr = lr_test_hdr(r);
+    lr_cpu_render_desc d = {.scene = s, .width = TW, .height = TH, .mode = LR_CPU_PASS,
+                            .no_vpl = true};
+    lr_image twin, var, plain;
+    lr_err e = {0};
+    if (lr_cpu_render(&d, &twin, &var, NULL, &e))
+        fail_msg("%s", e.msg);
+    unsigned dirty = 0;
+    assert_int_equal(lr_scene_set(s, "render.surface_cache", "false", &dirty, &e), LR_OK);
+    if (lr_cpu_render(&d, &plain, NULL, NULL, &e))
+        fail_msg("%s", e.msg);
+    double g = 0.0, c = 0.0, p = 0.0, v = 0.0;
+    for (int y = 0; y < TH; y++)
+        for (int x = 0; x < TW; x++) {
+            lr_vec3 org, dir;
+            lr_cpu_camera_ray(s, TW, TH, x, y, &org, &dir);
+            lr_hit h;
+            if (!lr_bvh_intersect(lr_scene_object_at(s, 0)->bvh, org, dir, 0, INFINITY, &h))
+                continue;
+            size_t k = (size_t)y * TW + x;
+            for (int b = 0; b < 3; b++) {
+                g += hdr[3 * ((size_t)(TH - 1 - y) * TW + x) + b];
+                c += twin.rgb[3 * k + b];
+                p += plain.rgb[3 * k + b];
+                v += 2.0 * var.rgb[3 * k + b];
+            }
+        }
+    print_message("candle 32x24, cache on: GPU %.5g, CPU twin %.5g (%+.2f %%, sigma %.2f %%); "
+                  "twin per pixel %.5g (%+.2f %%)\n", g, c, 100 * (g / c - 1),
+                  100 * sqrt(v) / c, p, 100 * (c / p - 1));
+    assert_near(g, c, 4.0 * sqrt(v) + 0.05 * c);
+    assert_true(fabs(c / p - 1.0) < 0.10);
+    free(hdr);
+    lr_image_free(&twin);
+    lr_image_free(&var);
+    lr_image_free(&plain);
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+}
+
+static void test_default(void **state)
+{
+    (void)state;
+    /* Off by default (PIPELINE.md "Surface cache": its error is 0.7-0.9 of the converged noise
+     * on the candle and the votive, above the 48-frame noise on the lamp shade). */
+    assert_false(cache_on_by_default());
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_default),
+        cmocka_unit_test(test_camera_move_runs_no_gather),
+        cmocka_unit_test(test_cache_follows_the_maps),
+        cmocka_unit_test(test_twin_follows_cache),
+        cmocka_unit_test(test_candle_cache_vs_gather),
+        cmocka_unit_test(test_lampshade_cache_vs_gather),
+        cmocka_unit_test(test_votive_cache_vs_gather),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
