@@ -30,60 +30,12 @@
 #include "render/cpu/vpl.h"
 #include "render/renderer.h"
 #include "render/renderer_debug.h"
+#include "tests/support/gbuffer_snap.h"
 #include "tests/support/gl.h"
 #include "tests/support/near.h"
 #include "tests/support/render.h"
 
 LR_TEST_GL_FIXTURE(gl) /* tests/support/gl.h: setup(), teardown() */
-
-/* The light G-buffer's texel for a lookup (render/shaders/lib/gbuffer.glsl): cube face by the
- * major axis (GL's selection), or the 2D map; the texel floor((ndc * 0.5 + 0.5) * size) its
- * rasterisation put there; returned: the direction (point for a directional light) through
- * that texel's centre, whose first surface the texel holds. */
-typedef struct snap_ctx {
-    lr_debug_gbuffer_info info;
-    double inv[6][16];
-} snap_ctx;
-
-static lr_vec3 snap(void *p, lr_vec3 v)
-{
-    snap_ctx *g = p;
-    int face = 0;
-    if (g->info.cube) {
-        double ax = fabs(v.x), ay = fabs(v.y), az = fabs(v.z);
-        if (ax >= ay && ax >= az)
-            face = v.x > 0 ? 0 : 1;
-        else if (ay >= az)
-            face = v.y > 0 ? 2 : 3;
-        else
-            face = v.z > 0 ? 4 : 5;
-    }
-    lr_vec3 world = g->info.orthographic ? v : lr_v3_add(g->info.light_pos, v);
-    const double *m = g->info.vp[face];
-    double cx = m[0] * world.x + m[4] * world.y + m[8] * world.z + m[12];
-    double cy = m[1] * world.x + m[5] * world.y + m[9] * world.z + m[13];
-    double cz = m[2] * world.x + m[6] * world.y + m[10] * world.z + m[14];
-    double cw = m[3] * world.x + m[7] * world.y + m[11] * world.z + m[15];
-    if (!(cw > 0.0))
-        return v;
-    double nx = cx / cw, ny = cy / cw, nz = cz / cw;
-    if (fabs(nx) > 1.0 || fabs(ny) > 1.0)
-        return v;
-    int S = g->info.size;
-    int tx = (int)floor((nx * 0.5 + 0.5) * S), ty = (int)floor((ny * 0.5 + 0.5) * S);
-    tx = tx < 0 ? 0 : tx >= S ? S - 1 : tx;
-    ty = ty < 0 ? 0 : ty >= S ? S - 1 : ty;
-    lr_vec3 c = lr_mat4_project(g->inv[face], lr_v3((tx + 0.5) / S * 2.0 - 1.0,
-                                                    (ty + 0.5) / S * 2.0 - 1.0, nz));
-    return g->info.orthographic ? c : lr_v3_sub(c, g->info.light_pos);
-}
-
-static void snap_init(lr_renderer *r, int light, snap_ctx *g)
-{
-    lr_renderer_debug_light_gbuffer_info(r, light, &g->info);
-    for (int f = 0; f < (g->info.cube ? 6 : 1); f++)
-        assert_int_equal(lr_mat4_inverse(g->info.vp[f], g->inv[f]), 0);
-}
 
 typedef struct parity {
     long n;          /* texel-bands compared */
@@ -97,8 +49,8 @@ typedef struct parity {
 static void compare_light_maps(lr_renderer *r, lr_scene *s, int light, int n_cpu, bool emulate,
                                parity *out)
 {
-    snap_ctx g;
-    snap_init(r, light, &g);
+    lr_test_snap g;
+    lr_test_snap_init(r, light, &g);
     const lr_light *L = lr_scene_light_at(s, light);
     lr_debug_map_info info;
     lr_renderer_debug_map_info(r, &info);
@@ -123,7 +75,8 @@ static void compare_light_maps(lr_renderer *r, lr_scene *s, int light, int n_cpu
             lr_vec3 xo = lr_v3(pos[3 * t], pos[3 * t + 1], pos[3 * t + 2]);
             lr_vec3 no = lr_v3_normalize(lr_v3(nrm[3 * t], nrm[3 * t + 1], nrm[3 * t + 2]));
             lr_cpu_radiosity_desc d = {.N = n_cpu, .r_max = info.r_max, .others = objs,
-                                       .n_others = nobj, .snap = emulate ? snap : NULL,
+                                       .n_others = nobj,
+                                       .snap = emulate ? lr_test_snap_lookup : NULL,
                                        .snap_ctx = &g};
             lr_cpu_estimate est;
             lr_cpu_radiosity(objs[obj[t]], L, xo, no, &d,
