@@ -272,7 +272,7 @@ int lr_replan_update(lr_replan *r, lr_scene *s, unsigned changed, unsigned *dirt
     if (!(changed & LR_DIRTY_MATERIAL) || r->plan.nobjects != lr_scene_object_count(s))
         return LR_OK;
     text t = {0};
-    int n = 0, rc = LR_OK;
+    int n = 0, said = 0, rc = LR_OK;
     lr_plan_choice *c = malloc(sizeof *c);
     if (!c)
         return lr_err_set(e, LR_ENOMEM, "re-plan: out of memory");
@@ -295,6 +295,10 @@ int lr_replan_update(lr_replan *r, lr_scene *s, unsigned changed, unsigned *dirt
             continue;
         }
         bool changed_model = strcmp(c->row.model, was) != 0;
+        /* Said only when the choice changed: a knob fading through materials re-plans every
+         * frame of the fade, mostly to the same row. */
+        bool changed_row = changed_model || c->row.line != r->plan.objects[i].row.line ||
+                           c->predicted_error != r->plan.objects[i].predicted_error;
         char prev[LR_PLAN_TEXT_MAX];
         snprintf(prev, sizeof prev, "%s", was);
         r->plan.objects[i] = *c;
@@ -307,6 +311,9 @@ int lr_replan_update(lr_replan *r, lr_scene *s, unsigned changed, unsigned *dirt
                 break;
             lr_sss_model_parse(c->row.model, &r->model[i]);
         }
+        if (!changed_row)
+            continue;
+        said++;
         size_t need = lr_plan_format_choice(c, NULL, 0);
         char *buf = malloc(need + 1);
         if (!buf) {
@@ -326,11 +333,13 @@ int lr_replan_update(lr_replan *r, lr_scene *s, unsigned changed, unsigned *dirt
     if (!rc && n) {
         merge(&r->plan, s);
         rc = write_settings(r, s, dirty, e);
+    }
+    if (!rc && said) {
         const lr_render_settings *rs = lr_scene_render(s);
         char line[400];
         int k = snprintf(line, sizeof line, "plan: %s: re-planned %d object%s; budget %s; render "
                          "K=%d N=%d N_vpl=%d map_size=%d gbuffer_size=%d frames=%d\n",
-                         r->plan.scene, n, n == 1 ? "" : "s",
+                         r->plan.scene, said, said == 1 ? "" : "s",
                          r->plan.feasible ? "met" : "NOT MET (closest settings chosen)", rs->K,
                          rs->N, rs->N_vpl, rs->map_size, rs->gbuffer_size, rs->frames);
         if (!rc)

@@ -59,7 +59,8 @@ void lr_replan_destroy(lr_replan *r);
  * this file. Writes the new model and settings into s, ORing their flags into *dirty (may be
  * NULL). *text (may be NULL) receives a malloc'd log text, one line per re-planned object as
  * lr_plan_format_choice writes it, a line saying whether its model changed, and one scene
- * line; NULL when nothing was re-planned or said. *replanned (may be NULL): the objects
+ * line; only for objects whose chosen row changed (a knob fading through materials re-plans
+ * on every frame of the fade, mostly to the same row); NULL when nothing was said. *replanned (may be NULL): the objects
  * re-planned. An object whose re-plan finds no usable row keeps its model, and the text says
  * so (not an error). Errors: LR_ENOMEM; a rejected lr_scene_set (cannot happen for values the
  * table's parser accepted, but reported). */
