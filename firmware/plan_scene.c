@@ -33,6 +33,17 @@ int lr_plan_scene(lr_scene *scene, const char *table, lr_plan_scene_result *res,
     return LR_OK;
 }
 
+int lr_plan_scene_replanner(const lr_scene *scene, const lr_plan_scene_result *res,
+                            lr_replan **out, lr_err *e)
+{
+    *out = NULL;
+    if (!res->planned)
+        return lr_err_set(e, LR_EINVAL, "re-plan: the scene was not planned");
+    lr_plan_table *t;
+    int rc = lr_plan_table_load(res->table, &t, e);
+    return rc ? rc : lr_replan_create(scene, t, &res->plan, NULL, out, e);
+}
+
 char *lr_plan_scene_text(const lr_plan_scene_result *res)
 {
     size_t need = lr_plan_format(&res->plan, NULL, 0);

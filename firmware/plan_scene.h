@@ -9,6 +9,7 @@
 
 #include "render/base/err.h"
 #include "render/plan/plan.h"
+#include "render/plan/replan.h"
 #include "render/scene/scene.h"
 
 typedef struct lr_plan_scene_result {
@@ -24,6 +25,12 @@ typedef struct lr_plan_scene_result {
  * lr_plan_default_table. Errors (no table, bad table, no usable row) leave the scene as it
  * was; the caller decides whether that is fatal. */
 int lr_plan_scene(lr_scene *scene, const char *table, lr_plan_scene_result *res, lr_err *e);
+
+/* A re-planner (render/plan/replan.h) for the scene a successful lr_plan_scene planned, over
+ * the same table (loaded again). Call it once the settings that win over the plan (the rig's
+ * scene_set) are applied: an object whose model they set is then left alone. */
+int lr_plan_scene_replanner(const lr_scene *scene, const lr_plan_scene_result *res,
+                            lr_replan **out, lr_err *e);
 
 /* The plan's lines (lr_plan_format) preceded by "plan: table PATH (WHY)". Returns a malloc'd
  * string, NULL when out of memory. */

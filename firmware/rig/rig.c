@@ -46,6 +46,7 @@ typedef struct rigset {
     int n_devs, n_lamps;
     bool has_hid;
     bool no_vpl; /* the planner found no receiver that sees any object */
+    lr_replan *replan;    /* re-plans on a material change; NULL when not planned */
     lr_rig_calib *calib;  /* spatial AR ("calib" in the config); NULL without */
     lr_albedo albedo;     /* the mockup's response, when the folder has albedo.json */
     bool has_albedo;
@@ -90,6 +91,7 @@ static void set_free(rigset *s)
     for (int i = 0; i < s->n_devs; i++)
         lr_dev_destroy(s->devs[i]);
     lr_control_map_destroy(s->map);
+    lr_replan_destroy(s->replan);
     lr_scene_destroy(s->scene);
     lr_rig_config_destroy(s->cfg);
     lr_rig_calib_free(s->calib);
@@ -212,11 +214,14 @@ static int create_device(lr_rig *r, rigset *s, const lr_rig_device *d, lr_err *e
 /* The planner (firmware/plan_scene.h) for a scene with a quality budget (in the scene file
  * or the config's scene_set), unless --no-plan: its settings are applied, then the config's
  * scene_set once more so that an explicit render.* setting wins. A missing or unusable table
- * is logged and the scene's settings stay. *no_vpl: the plan cuts the VPL pass. */
+ * is logged and the scene's settings stay. *no_vpl: the plan cuts the VPL pass. *replan: the
+ * re-planner for material changes (NULL when not planned, or when it could not be made:
+ * logged, the plan stands without it). */
 static int plan_scene(lr_rig *r, const lr_rig_config *cfg, lr_scene *scene, bool *no_vpl,
-                      lr_err *e)
+                      lr_replan **replan, lr_err *e)
 {
     *no_vpl = false;
+    *replan = NULL;
     if (r->opts.no_plan)
         return LR_OK;
     lr_plan_scene_result *res = calloc(1, sizeof *res);
@@ -246,6 +251,9 @@ static int plan_scene(lr_rig *r, const lr_rig_config *cfg, lr_scene *scene, bool
                          "plan: the config's scene_set overrides it: render K=%d N=%d N_vpl=%d "
                          "map_size=%d gbuffer_size=%d frames=%d",
                          now->K, now->N, now->N_vpl, now->map_size, now->gbuffer_size, now->frames);
+        if (!rc && lr_plan_scene_replanner(scene, res, replan, &pe))
+            lr_log_write(&r->log, LR_LOG_WARN, "plan: %s; no re-plan on material changes",
+                         pe.msg);
     }
     free(res);
     return rc;
@@ -304,7 +312,7 @@ static int set_build(lr_rig *r, rigset *s, bool with_devices, lr_err *e)
     if (!rc)
         rc = lr_rig_config_apply_sets(s->cfg, s->scene, e);
     if (!rc)
-        rc = plan_scene(r, s->cfg, s->scene, &s->no_vpl, e);
+        rc = plan_scene(r, s->cfg, s->scene, &s->no_vpl, &s->replan, e);
     if (!rc)
         rc = lr_control_map_create(s->cfg, s->scene, true, lr_now_ns(), &s->map, e);
     if (!rc && s->cfg->calib[0])
@@ -349,12 +357,32 @@ static void write_lamp(lr_rig *r, double level)
     r->lamp_written = level;
 }
 
+/* A control changed a material: the planner chooses again for the objects whose model it
+ * chose (render/plan/replan.h); a dimmer (LR_DIRTY_INTENSITY) never gets here. */
+static void replan(lr_rig *r, unsigned *dirty)
+{
+    char *text = NULL;
+    lr_err e = {0};
+    if (lr_replan_update(r->set.replan, r->set.scene, *dirty, dirty, &text, NULL, &e))
+        lr_log_write(&r->log, LR_LOG_WARN, "plan: %s", e.msg);
+    for (char *line = text, *nl; line && *line; line = nl + 1) {
+        if ((nl = strchr(line, '\n')))
+            *nl = '\0';
+        lr_log_write(&r->log, LR_LOG_INFO, "%s", line);
+        if (!nl)
+            break;
+    }
+    free(text);
+}
+
 static void apply(lr_rig *r, int64_t now)
 {
     unsigned dirty = 0;
     lr_err e = {0};
     if (lr_control_map_update(r->set.map, r->set.scene, now, &dirty, &e))
         lr_log_write(&r->log, LR_LOG_WARN, "control map: %s", e.msg);
+    if (r->set.replan && (dirty & LR_DIRTY_MATERIAL))
+        replan(r, &dirty);
     if (dirty) {
         lr_rig_view_invalidate(r->view, dirty);
         r->ar_dirty = true;
@@ -371,9 +399,10 @@ static void switch_scene(lr_rig *r, const char *path)
     lr_err e = {0};
     lr_warn_sink warn = {scene_warn, r};
     bool no_vpl = false;
+    lr_replan *rp = NULL;
     if (lr_scene_load(path, &warn, &scene, &e) ||
         lr_rig_config_apply_sets(r->set.cfg, scene, &e) ||
-        plan_scene(r, r->set.cfg, scene, &no_vpl, &e)) {
+        plan_scene(r, r->set.cfg, scene, &no_vpl, &rp, &e)) {
         lr_log_write(&r->log, LR_LOG_ERROR, "scene switch: %s; keeping %s", e.msg,
                      lr_scene_path(r->set.scene));
         lr_scene_destroy(scene);
@@ -382,13 +411,16 @@ static void switch_scene(lr_rig *r, const char *path)
     lr_rig_view *view;
     if (view_build(r, scene, no_vpl, &view, &e)) {
         lr_log_write(&r->log, LR_LOG_ERROR, "scene switch: %s", e.msg);
+        lr_replan_destroy(rp);
         lr_scene_destroy(scene);
         return;
     }
     lr_rig_view_destroy(r->view);
+    lr_replan_destroy(r->set.replan);
     lr_scene_destroy(r->set.scene);
     r->view = view;
     r->set.scene = scene;
+    r->set.replan = rp;
     lr_control_map_scene_replaced(r->set.map);
     r->ar_dirty = true;
     lr_log_write(&r->log, LR_LOG_INFO, "scene: %s", path);

@@ -87,10 +87,9 @@ int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
      * normalisation's reference, so "normalize" does not change it (lr_scene_object_sd_norm). */
     out->applies = enclosure == LR_ENCLOSURE_HULL && l->type != LR_LIGHT_DIRECTIONAL &&
                    !(obj->sd_raw && obj->sss_model == LR_SSS_DIRECTIONAL_DIPOLE) &&
-                   /* translucent radiosity solves the cavity's inter-reflection itself */
-                   obj->sss_model != LR_SSS_TRANSLUCENT_RADIOSITY &&
-                   obj->sss_model != LR_SSS_DIFFUSION_GRID && /* not a profile: no closure */
-                   obj->sss_model != LR_SSS_SH_TRANSLUCENCY; /* its energy is fitted, not closed */
+                   /* the models that close the cavity themselves or are fitted
+                    * (lr_sss_model_props: no_closure says why) */
+                   !lr_sss_model_props_of(obj->sss_model)->no_closure;
     if (!out->applies)
         return LR_OK;
 

@@ -11,6 +11,27 @@ static const char *const names[LR_SSS_MODEL_COUNT] = {"directional_dipole", "sta
                                                        "multipole", "translucent_radiosity",
                                                        "diffusion_grid", "sh_translucency"};
 
+/* Designated rows: a model appended to the enum without a row here is a profile model (the
+ * all-zero row), which is what lr_sss_sd_fresnel_n's default branch evaluates. */
+static const lr_sss_model_props props[LR_SSS_MODEL_COUNT] = {
+    [LR_SSS_MULTIPOLE] = {.needs_thickness = "needs thickness_mm (the wall the multipole models)"},
+    [LR_SSS_TRANSLUCENT_RADIOSITY] = {.no_closure = "translucent radiosity solves the cavity's "
+                                                    "inter-reflection itself"},
+    [LR_SSS_DIFFUSION_GRID] = {.no_profile = true,
+                               .needs_closed = "needs a closed mesh (the grid diffusion solves "
+                                               "inside a solid body)",
+                               .no_closure = "not a profile: the grid's boundary condition "
+                                             "holds the cavity's light"},
+    [LR_SSS_SH_TRANSLUCENCY] = {.no_profile = true,
+                                .no_closure = "its energy is fitted, not closed"},
+};
+
+const lr_sss_model_props *lr_sss_model_props_of(enum lr_sss_model m)
+{
+    static const lr_sss_model_props none;
+    return (unsigned)m < LR_SSS_MODEL_COUNT ? &props[m] : &none;
+}
+
 /* Translucent radiosity (seed 000) evaluates a profile of its own choosing: the slab multipole
  * where the object gives a wall thickness, the standard dipole otherwise. */
 static enum lr_sss_model profile_of(enum lr_sss_model m, double thickness_mm)
@@ -51,16 +72,15 @@ void lr_sss_sd_fresnel_n(enum lr_sss_model m, const lr_coeffs *c, double thickne
                          lr_vec3 xi, lr_vec3 ni, lr_vec3 wi, lr_vec3 xo, lr_vec3 no, double out[3])
 {
     m = profile_of(m, thickness_mm);
-    if (m == LR_SSS_SH_TRANSLUCENCY) {
-        out[0] = out[1] = out[2] = 0.0; /* no S_d: sh_translucency.h evaluates B directly */
+    if (lr_sss_model_props_of(m)->no_profile) {
+        /* no S_d: the grid's field (render/diffusion), SH's B (sh_translucency.h) */
+        out[0] = out[1] = out[2] = 0.0;
         return;
     }
     if (m == LR_SSS_STANDARD_DIPOLE)
         lr_dipole_sd_fresnel(c, xi, ni, wi, xo, out);
     else if (m == LR_SSS_MULTIPOLE)
         lr_multipole_sd_fresnel_n(c, thickness_mm, pairs, xi, ni, wi, xo, no, out);
-    else if (m == LR_SSS_DIFFUSION_GRID)
-        out[0] = out[1] = out[2] = 0.0; /* no profile: the grid's field (render/diffusion) */
     else
         lr_dirpole_sd_fresnel(c, xi, ni, wi, xo, no, out);
 }

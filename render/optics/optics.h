@@ -223,6 +223,24 @@ int lr_sss_pairs(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm);
  * total, PIPELINE.md "Energy"). The cavity closure's A (render/cpu/cavity.h). */
 void lr_sss_total(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm, double out[3]);
 
+/* What sets a model apart, in one table (render/optics/model.c) for the code that treats
+ * models differently, instead of chains of model comparisons there. All-zero is a BSSRDF
+ * profile model like the dipoles: an S_d, any mesh, the cavity closure applies. */
+typedef struct lr_sss_model_props {
+    /* No S_d profile: lr_sss_sd_fresnel gives 0 and the passes read the model's own B (the
+     * grid's solved field, the SH evaluation). */
+    bool no_profile;
+    /* Why the model renders only with the object's thickness_mm, or only on a closed mesh
+     * (lr_scene_object_model_unmet returns these); NULL: it does not need it. */
+    const char *needs_thickness;
+    const char *needs_closed;
+    /* Why the one-gain cavity closure (render/cpu/cavity.h) does not apply to it; NULL: it
+     * applies. */
+    const char *no_closure;
+} lr_sss_model_props;
+/* The model's row; an all-zero row for a value outside the enum. */
+const lr_sss_model_props *lr_sss_model_props_of(enum lr_sss_model m);
+
 /* ---- Directional dipole, Frisvad, Hachisuka, Kjeldsen 2014 (dirpole.c) ----------------- */
 
 /* S_d(x_i, n_i, w_i; x_o, n_o) per band, mm^-2 sr^-1, without boundary Fresnel transmission.

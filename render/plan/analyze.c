@@ -197,8 +197,13 @@ static void features(const lr_scene *s, int index, lr_plan_features *f, double *
     f->shell = !o->closed || 2.0 * vol / area < 0.1 * o->radius;
     double tol = 1e-5 * o->radius + 1e-4; /* float positions */
     f->convex = lr_plan_mesh_convex(o->mesh, o->closed, tol, violation);
+    f->size_tr = lr_plan_size_tr(o);
+}
+
+double lr_plan_size_tr(const lr_scene_object *o)
+{
     double str = (o->coeffs.sigma_tr[0] + o->coeffs.sigma_tr[1] + o->coeffs.sigma_tr[2]) / 3.0;
-    f->size_tr = o->radius * str;
+    return o->radius * str;
 }
 
 void lr_plan_features_of(const lr_scene *s, int index, lr_plan_features *out)

@@ -15,6 +15,8 @@
 #include <string.h>
 
 #include "render/base/paths.h"
+#include "render/plan/choose.h"
+#include "render/plan/limits.h"
 
 #define MAX_SCENES 32
 
@@ -54,7 +56,7 @@ bool lr_plan_budget_from_scene(const lr_scene *s, lr_plan_budget *out)
 }
 
 /* The scene file's base name without extension: what the bench writes in `scene`. */
-static void scene_key(const lr_scene *s, char *buf, size_t cap)
+void lr_plan_scene_key(const lr_scene *s, char *buf, size_t cap)
 {
     const char *p = lr_scene_path(s);
     if (!p || !*p)
@@ -66,7 +68,7 @@ static void scene_key(const lr_scene *s, char *buf, size_t cap)
         *dot = '\0';
 }
 
-static double feature_distance(const lr_plan_features *a, const lr_plan_features *b)
+double lr_plan_feature_distance(const lr_plan_features *a, const lr_plan_features *b)
 {
     /* Light inside or outside and solid or shell change which paths dominate (seed 003's
      * stereographic lookup; transmission through a wall); convexity changes coverage; the
@@ -78,7 +80,7 @@ static double feature_distance(const lr_plan_features *a, const lr_plan_features
     return d;
 }
 
-static const char *features_text(const lr_plan_features *f, char *buf, size_t cap)
+const char *lr_plan_features_text(const lr_plan_features *f, char *buf, size_t cap)
 {
     snprintf(buf, cap, "%s, %s, %s, %.1f diffusion lengths",
              f->enclosed ? "light enclosed" : "light outside", f->shell ? "thin shell" : "solid",
@@ -121,7 +123,7 @@ static int nearest_scene(const lr_scene *s, int index, const lr_plan_table *t,
         lr_plan_features f;
         lr_plan_features_of(ms, 0, &f);
         lr_scene_destroy(ms);
-        double d = feature_distance(&mine, &f);
+        double d = lr_plan_feature_distance(&mine, &f);
         if (d < best) {
             best = d;
             best_f = f;
@@ -133,8 +135,8 @@ static int nearest_scene(const lr_scene *s, int index, const lr_plan_table *t,
                           "planner: scene '%s' is not in %s and none of its measured scenes "
                           "could be loaded from %s/scenes to compare features (%s)",
                           lr_scene_name(s), lr_plan_table_name(t), configs, skipped);
-    features_text(&mine, why, whycap);
-    features_text(&best_f, why_theirs, whycap);
+    lr_plan_features_text(&mine, why, whycap);
+    lr_plan_features_text(&best_f, why_theirs, whycap);
     return LR_OK;
 }
 
@@ -170,15 +172,20 @@ static double shortfall(const cand *c, const lr_plan_budget *b)
     return r;
 }
 
-/* Whether row model `model` is allowed and object o can render with it; the first time a
- * model is left out for the object, says why in the reasons. */
+/* Whether row model `model` is allowed and object o can render with it as it stands: its
+ * geometry (lr_scene_object_model_unmet) and its material's validity limits
+ * (lr_plan_model_limit); the first time a model is left out for the object, says why in the
+ * reasons. */
 static bool model_ok(const char *model, unsigned models, const lr_scene_object *o,
                      lr_plan_choice *c, unsigned *said)
 {
     enum lr_sss_model m;
     if (!lr_sss_model_parse(model, &m) || !(models & LR_PLAN_MODEL_BIT(m)))
         return false;
+    char buf[LR_PLAN_REASON_MAX - LR_PLAN_TEXT_MAX - 16];
     const char *why = lr_scene_object_model_unmet(o, m);
+    if (!why)
+        why = lr_plan_model_limit(o, m, buf, sizeof buf);
     if (why && !(*said & LR_PLAN_MODEL_BIT(m))) {
         *said |= LR_PLAN_MODEL_BIT(m);
         reason(c, "%s rows left out: %s", model, why);
@@ -199,7 +206,7 @@ static int plan_object(const lr_scene *s, int index, const lr_plan_table *t,
     const lr_plan_analysis *a = &c->analysis;
 
     char key[LR_PLAN_TEXT_MAX];
-    scene_key(s, key, sizeof key);
+    lr_plan_scene_key(s, key, sizeof key);
     if (lr_plan_table_has_scene(t, key)) {
         snprintf(c->table_scene, sizeof c->table_scene, "%s", key);
         c->scene_matched = true;
@@ -214,8 +221,7 @@ static int plan_object(const lr_scene *s, int index, const lr_plan_table *t,
     }
 
     /* VPLs carry emergent light to receivers; with none in sight they light nothing. */
-    bool need_vpl = a->receivers_seeing != 0;
-    if (!need_vpl)
+    if (!a->receivers_seeing)
         reason(c, "no receiver sees %s%s: VPL pass off", o->name,
                a->receivers_checked ? "" : " (the scene has none)");
 
@@ -225,18 +231,27 @@ static int plan_object(const lr_scene *s, int index, const lr_plan_table *t,
     else
         reason(c, "not convex (vertices up to %.1f mm outside a face plane): %d maps to cover %.1f %%",
                a->convex_violation_mm, a->K_cover, 100.0 * a->coverage[a->K_cover - 1]);
+    return lr_plan_choose(s, index, t, b, models, -1, c, e);
+}
 
+int lr_plan_choose(const lr_scene *s, int index, const lr_plan_table *t, const lr_plan_budget *b,
+                   unsigned models, int vpl_rows, lr_plan_choice *c, lr_err *e)
+{
+    const lr_scene_object *o = lr_scene_object_at(s, index);
+    const lr_plan_analysis *a = &c->analysis;
+    bool need_vpl = a->receivers_seeing != 0;
     /* Candidates: the measured scene's rows with a model the renderer runs and at least
      * K_cover maps (the bench measures one view; coverage must hold for every view). */
     int n = lr_plan_table_count(t), ncand = 0, nscene = 0, kmax = 0;
     unsigned said = 0;
-    cand *cs = malloc((size_t)n * sizeof *cs);
+    cand *cs = malloc((size_t)(n > 0 ? n : 1) * sizeof *cs);
     if (!cs)
         return lr_err_set(e, LR_ENOMEM, "planner: out of memory");
     for (int pass = 0; pass < 2 && !ncand; pass++) {
         for (int i = 0; i < n; i++) {
             const lr_plan_row *r = lr_plan_table_row(t, i);
-            if (strcmp(r->scene, c->table_scene) || !model_ok(r->model, models, o, c, &said))
+            if (strcmp(r->scene, c->table_scene) || (vpl_rows >= 0 && r->vpl != (vpl_rows > 0)) ||
+                !model_ok(r->model, models, o, c, &said))
                 continue;
             if (!pass) {
                 nscene++;
@@ -401,23 +416,35 @@ static void put_budget(out *o, const lr_plan_budget *b)
         put(o, "<= %g ms/frame", b->frame_ms);
 }
 
+static void put_choice(out *o, const lr_plan_choice *c)
+{
+    const lr_plan_row *r = &c->row;
+    put(o, "plan: %s: %s K=%d N=%d N_vpl=%d map=%d gbuffer=%d frames=%d vpl=%s, error %.3g, "
+           "%.0f ms/frame, converged in %.1f s%s",
+        c->object, r->model, r->K, r->N, c->vpl ? r->N_vpl : 0, r->map_size, r->gbuffer_size,
+        r->frames, c->vpl ? "on" : "off", c->predicted_error, c->predicted_frame_ms,
+        c->predicted_converge_ms / 1000.0, c->feasible ? "" : " [INFEASIBLE]");
+    for (int k = 0; k < c->nreasons; k++)
+        put(o, "%s%s", k ? "; " : " (", c->reasons[k]);
+    put(o, "%s\n", c->nreasons ? ")" : "");
+}
+
+size_t lr_plan_format_choice(const lr_plan_choice *c, char *buf, size_t cap)
+{
+    out o = {buf, cap, 0};
+    if (cap)
+        buf[0] = '\0';
+    put_choice(&o, c);
+    return o.len;
+}
+
 size_t lr_plan_format(const lr_plan *p, char *buf, size_t cap)
 {
     out o = {buf, cap, 0};
     if (cap)
         buf[0] = '\0';
-    for (int i = 0; i < p->nobjects; i++) {
-        const lr_plan_choice *c = &p->objects[i];
-        const lr_plan_row *r = &c->row;
-        put(&o, "plan: %s: %s K=%d N=%d N_vpl=%d map=%d gbuffer=%d frames=%d vpl=%s, error %.3g, "
-                "%.0f ms/frame, converged in %.1f s%s",
-            c->object, r->model, r->K, r->N, c->vpl ? r->N_vpl : 0, r->map_size, r->gbuffer_size,
-            r->frames, c->vpl ? "on" : "off", c->predicted_error, c->predicted_frame_ms,
-            c->predicted_converge_ms / 1000.0, c->feasible ? "" : " [INFEASIBLE]");
-        for (int k = 0; k < c->nreasons; k++)
-            put(&o, "%s%s", k ? "; " : " (", c->reasons[k]);
-        put(&o, "%s\n", c->nreasons ? ")" : "");
-    }
+    for (int i = 0; i < p->nobjects; i++)
+        put_choice(&o, &p->objects[i]);
     const lr_render_settings *s = &p->settings;
     put(&o, "plan: %s: budget ", p->scene);
     put_budget(&o, &p->budget);

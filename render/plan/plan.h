@@ -109,6 +109,8 @@ typedef struct lr_plan_analysis {
 int lr_plan_analyze(const lr_scene *s, int index, lr_plan_analysis *out, lr_err *e);
 /* The features alone (no sampling): for matching scenes. */
 void lr_plan_features_of(const lr_scene *s, int index, lr_plan_features *out);
+/* The one feature that depends on the material: bounding radius x mean sigma_tr. */
+double lr_plan_size_tr(const lr_scene_object *o);
 /* All vertices on the inner side of every face plane, within tol (mm); closed meshes only
  * (an open surface is a shell, never convex). *violation receives the largest distance of a
  * vertex beyond a face plane (within tol of 0 when convex; 0 for an open mesh). */
@@ -121,7 +123,7 @@ typedef struct lr_plan_budget {
     double frame_ms;  /* ms per accumulation frame; 0: none */
 } lr_plan_budget;
 
-#define LR_PLAN_REASONS 6
+#define LR_PLAN_REASONS 10
 #define LR_PLAN_REASON_MAX 320
 
 typedef struct lr_plan_choice {
@@ -198,6 +200,8 @@ int lr_plan_apply(const lr_plan *p, lr_scene *s, unsigned *dirty, lr_err *e);
  * after the planned frames until something changes); written to buf (truncated to cap,
  * which may be 0). Returns the length it needed, without the NUL. */
 size_t lr_plan_format(const lr_plan *p, char *buf, size_t cap);
+/* One object's line of lr_plan_format. */
+size_t lr_plan_format_choice(const lr_plan_choice *c, char *buf, size_t cap);
 /* The same as one JSON object. */
 size_t lr_plan_format_json(const lr_plan *p, char *buf, size_t cap);
 

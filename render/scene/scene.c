@@ -36,10 +36,11 @@ const char *lr_scene_object_model_unmet(const lr_scene_object *o, enum lr_sss_mo
 {
     if ((unsigned)m >= LR_SSS_MODEL_COUNT)
         return "unknown model";
-    if (m == LR_SSS_MULTIPOLE && !(o->thickness_mm > 0.0))
-        return "needs thickness_mm (the wall the multipole models)";
-    if (m == LR_SSS_DIFFUSION_GRID && !o->closed)
-        return "needs a closed mesh (the grid diffusion solves inside a solid body)";
+    const lr_sss_model_props *p = lr_sss_model_props_of(m);
+    if (p->needs_thickness && !(o->thickness_mm > 0.0))
+        return p->needs_thickness;
+    if (p->needs_closed && !o->closed)
+        return p->needs_closed;
     return NULL;
 }
 

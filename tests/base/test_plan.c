@@ -22,6 +22,7 @@
 #include "render/base/json.h"
 #include "render/gl/gl.h"
 #include "render/optics/optics.h"
+#include "render/plan/limits.h"
 #include "render/plan/plan.h"
 #include "render/renderer.h"
 #include "render/scene/scene.h"
@@ -216,13 +217,20 @@ static void test_table_errors(void **state)
  * the scene's rows (either model: the planner's default) with at least K_cover maps and
  * error <= budget, the soonest converged (ms_gbuffer + frames x frame_ms). */
 static const lr_plan_row *brute_force_in(const lr_plan_table *t, const char *scene, int K_cover,
-                                         double max_error)
+                                         double max_error, const lr_scene_object *o)
 {
+    char why[256];
     const lr_plan_row *best = NULL;
     double best_t = INFINITY;
     for (int i = 0; i < lr_plan_table_count(t); i++) {
         const lr_plan_row *r = lr_plan_table_row(t, i);
         if (strcmp(r->scene, scene) || r->K < K_cover || lr_plan_row_error(r) > max_error)
+            continue;
+        enum lr_sss_model m;
+        /* o: leave out the models the object cannot take, or outside their limits for its
+         * material (render/plan/limits.h) */
+        if (o && (!lr_sss_model_parse(r->model, &m) || lr_scene_object_model_unmet(o, m) ||
+                  lr_plan_model_limit(o, m, why, sizeof why)))
             continue;
         double ms = (isnan(r->ms_gbuffer) ? 0.0 : r->ms_gbuffer) + r->frames * r->frame_ms;
         if (ms < best_t) {
@@ -235,7 +243,7 @@ static const lr_plan_row *brute_force_in(const lr_plan_table *t, const char *sce
 
 static const lr_plan_row *brute_force(const char *scene, int K_cover, double max_error)
 {
-    return brute_force_in(table, scene, K_cover, max_error);
+    return brute_force_in(table, scene, K_cover, max_error, NULL);
 }
 
 static void test_max_error_both_scenes(void **state)
@@ -298,8 +306,13 @@ static void test_committed_front_both_scenes(void **state)
         assert_int_equal(lr_plan_analyze(scenes[s], 0, &a, &e), LR_OK);
         for (int i = 0; i < lr_plan_table_count(t); i++) {
             const lr_plan_row *r = lr_plan_table_row(t, i);
-            if (strcmp(r->scene, names[s]) || r->K < a.K_cover)
-                continue;
+            enum lr_sss_model m;
+            char why[256];
+            const lr_scene_object *o = lr_scene_object_at(scenes[s], 0);
+            if (strcmp(r->scene, names[s]) || r->K < a.K_cover ||
+                !lr_sss_model_parse(r->model, &m) || lr_scene_object_model_unmet(o, m) ||
+                lr_plan_model_limit(o, m, why, sizeof why))
+                continue; /* a row the object cannot take is no budget the planner can meet */
             /* The committed front has the bias/noise split: the predicted error is
              * sqrt(bias^2 + noise^2), never below the larger region's bias. */
             double err = lr_plan_row_error(r);
@@ -309,7 +322,8 @@ static void test_committed_front_both_scenes(void **state)
                              LR_OK);
             assert_true(p.feasible);
             assert_true(p.objects[0].predicted_error <= err);
-            const lr_plan_row *want = brute_force_in(t, names[s], a.K_cover, err);
+            const lr_plan_row *want = brute_force_in(t, names[s], a.K_cover, err,
+                                                   lr_scene_object_at(scenes[s], 0));
             double want_ms = (isnan(want->ms_gbuffer) ? 0.0 : want->ms_gbuffer) +
                              want->frames * want->frame_ms;
             assert_near(p.objects[0].predicted_converge_ms, want_ms, 1e-9 * want_ms);

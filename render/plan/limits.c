@@ -1,0 +1,34 @@
+/* lamprig planner — the material-dependent validity limits of the models (see limits.h). */
+#include "render/plan/limits.h"
+
+#include <math.h>
+#include <stdio.h>
+
+#include "render/diffusion/dscene.h"
+
+const char *lr_plan_model_limit(const lr_scene_object *o, enum lr_sss_model m, char *buf,
+                                size_t cap)
+{
+    const lr_coeffs *c = &o->coeffs;
+    if (m == LR_SSS_DIFFUSION_GRID) {
+        double h = lr_dscene_spacing(o);
+        double s = fmax(c->sigma_tr[0], fmax(c->sigma_tr[1], c->sigma_tr[2]));
+        if (!(s * h <= LR_PLAN_GRID_MAX_SIGMA_H)) {
+            snprintf(buf, cap, "the grid spacing %.2g mm is %.2g diffusion lengths of the "
+                     "material (at most %g: the stencil's decay rate is then %.0f %% low)",
+                     h, s * h, LR_PLAN_GRID_MAX_SIGMA_H,
+                     100.0 * (1.0 - acosh(1.0 + 0.5 * s * h * s * h) / (s * h)));
+            return buf;
+        }
+    }
+    if (m == LR_SSS_SH_TRANSLUCENCY && o->thickness_mm > 0.0) {
+        double mfp = fmax(c->mfp[0], fmax(c->mfp[1], c->mfp[2]));
+        if (o->thickness_mm < mfp) {
+            snprintf(buf, cap, "the wall (%.3g mm) is thinner than one transport mean free path "
+                     "of the material (%.3g mm), where the SH attenuation is clamped",
+                     o->thickness_mm, mfp);
+            return buf;
+        }
+    }
+    return NULL;
+}

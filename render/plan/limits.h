@@ -1,0 +1,38 @@
+/* lamprig planner — validity limits of the models that depend on the object's material.
+ *
+ * The measured table holds each scene with its shipped material; a control may give the object
+ * another (a preset button, a translucency knob). Some models then leave the range in which
+ * their measured error means anything, whatever the table says:
+ *
+ *   diffusion_grid   the grid (render/diffusion/dgrid.h, 7-point finite differences of seed 001
+ *                    Eq. 1) must resolve the diffusion length 1/sigma_tr. Along a grid axis the
+ *                    discrete solution of phi'' = sigma_tr^2 phi decays as e^{-lambda x} with
+ *                    2 (cosh(lambda h) - 1) / h^2 = sigma_tr^2, i.e.
+ *                    lambda h = acosh(1 + (sigma_tr h)^2 / 2): at sigma_tr h = 1 the decay rate
+ *                    is 3.8 % low and the error grows as (sigma_tr h)^2 / 24 beyond. The limit
+ *                    is LR_PLAN_GRID_MAX_SIGMA_H for the largest band's sigma_tr and the spacing
+ *                    the object gets (lr_dscene_spacing).
+ *   sh_translucency  seed 002 attenuates by the crossed thickness d through
+ *                    a_c = exp(-sigma_tr max(d, 1/sigma_t')) (render/optics/sh_translucency.h: the
+ *                    clamp at one transport mean free path). A wall (thickness_mm) thinner than
+ *                    that mean free path in some band sits wholly in the clamp: the model cannot
+ *                    tell that wall from a thicker one, so its figures do not carry over.
+ *
+ * The other models have no limit that depends on the material here (the multipole needs a
+ * thickness_mm, the grid a closed mesh: lr_scene_object_model_unmet, geometry).
+ */
+#ifndef LR_PLAN_LIMITS_H
+#define LR_PLAN_LIMITS_H
+
+#include <stddef.h>
+
+#include "render/scene/scene.h"
+
+#define LR_PLAN_GRID_MAX_SIGMA_H 1.0
+
+/* Why model m is outside its validity limits for object o's current material (written to
+ * buf, which is returned), or NULL when it is within them. */
+const char *lr_plan_model_limit(const lr_scene_object *o, enum lr_sss_model m, char *buf,
+                                size_t cap);
+
+#endif
