@@ -11,6 +11,7 @@ static const lrb_section *const sections[] = {
     &lrb_render_section,
     &lrb_rig_section,
     &lrb_sweep_section,
+    &lrb_dimmer_section,
 };
 #define NSECTIONS (sizeof sections / sizeof sections[0])
 
