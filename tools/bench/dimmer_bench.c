@@ -17,8 +17,9 @@
  * The scenes' own settings except render.frames = 1 and render.N = 1: the blend reads the
  * per-light images whatever their values (no per-pixel branch), so a converged image is not
  * needed and the first frame is cheaper. LRB_DIMMER_REPS (default 60, 1..1000) pairs;
- * LRB_DIMMER_SCENES ("candle,lampshade"-style list; default both). Not part of `make bench`'s
- * default set of tables in the README's headline: it is for A/B runs.
+ * LRB_DIMMER_SCENES ("candle,lampshade"-style list; default both). Runs with the other
+ * sections under `make bench` (about a minute); the A/B table in tools/bench/README.md
+ * ("SRGB8_ALPHA8 output") was made by running it from two binaries alternately.
  */
 #include <stdio.h>
 #include <stdlib.h>
