@@ -249,58 +249,101 @@ void lr_renderer_debug_surface_info(const lr_renderer *r, lr_debug_surface_info 
     }
 }
 
+struct lr_debug_floor {
+    lr_renderer_parts pt;
+    lr_program *p;
+    lr_tex *src;
+};
+
+void lr_debug_floor_destroy(lr_debug_floor *f)
+{
+    if (!f)
+        return;
+    lr_tex_destroy(f->src);
+    lr_program_destroy(f->p);
+    free(f);
+}
+
+int lr_debug_floor_create(lr_renderer *r, lr_debug_floor **out, lr_err *e)
+{
+    *out = NULL;
+    lr_debug_floor *f = calloc(1, sizeof *f);
+    if (!f)
+        return lr_err_set(e, LR_ENOMEM, "floor pass: out of memory");
+    f->pt = parts(r);
+    if (!f->pt.blend) {
+        free(f);
+        return lr_err_set(e, LR_EINVAL, "renderer: no output (resources failed to allocate)");
+    }
+    lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "floor.frag",
+                          .dir = f->pt.shader_dir, .defines = f->pt.defines};
+    lr_tex_desc td = {.format = LR_TEX_RGBA16F, .width = f->pt.width, .height = f->pt.height,
+                      .label = "floor pass source"};
+    int rc;
+    if ((rc = lr_program_create(&pd, &f->p, e)) || (rc = lr_tex_create(f->pt.gl, &td, &f->src, e))) {
+        lr_debug_floor_destroy(f);
+        return rc;
+    }
+    *out = f;
+    return LR_OK;
+}
+
+static double ms_between(const struct timespec *a, const struct timespec *b)
+{
+    return (double)(b->tv_sec - a->tv_sec) * 1e3 + (double)(b->tv_nsec - a->tv_nsec) * 1e-6;
+}
+
+int lr_debug_floor_run(lr_debug_floor *f, double *wall_ms, double *timer_ms, double *cpu_ms,
+                       lr_err *e)
+{
+    *wall_ms = *timer_ms = *cpu_ms = NAN;
+    lr_renderer_parts *pt = &f->pt;
+    /* Timed the way a frame is (lr_renderer_frame): the draw inside the renderer's timer
+     * section (reset, begin, end, collect), the whole from glFinish to glFinish. */
+    struct timespec t0, t1, c0, c1;
+    glFinish();
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
+    lr_timer_reset(pt->timer);
+    int rc;
+    if ((rc = lr_timer_begin(pt->timer, "floor", e)))
+        return rc;
+    lr_fb_bind(lr_blend_ldr_fb(pt->blend));
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    glUseProgram(lr_program_id(f->p));
+    lr_passes_bind_tex(f->p, "u_src", 0, f->src);
+    if ((rc = lr_program_check(f->p, e)))
+        return rc;
+    lr_gl_draw_fullscreen(pt->gl);
+    if ((rc = lr_timer_end(pt->timer, e)))
+        return rc;
+    int trc = lr_timer_collect(pt->timer, NULL);
+    glFinish();
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
+    *timer_ms = trc || lr_timer_count(pt->timer) < 1 ? NAN : lr_timer_ms(pt->timer, 0);
+    *wall_ms = ms_between(&t0, &t1);
+    *cpu_ms = ms_between(&c0, &c1);
+    lr_timer_reset(pt->timer);
+    return lr_gl_check("floor pass", e);
+}
+
 int lr_renderer_debug_floor_ms(lr_renderer *r, int reps, double *wall_ms, double *timer_ms,
                                lr_err *e)
 {
     *wall_ms = *timer_ms = NAN;
     if (reps < 1 || reps > 64)
         return lr_err_set(e, LR_EINVAL, "floor pass: reps = %d: must be 1..64", reps);
-    lr_renderer_parts pt = parts(r);
-    if (!pt.blend)
-        return lr_err_set(e, LR_EINVAL, "renderer: no output (resources failed to allocate)");
-    lr_program *p = NULL;
-    lr_tex *src = NULL;
-    lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "floor.frag",
-                          .dir = pt.shader_dir, .defines = pt.defines};
-    lr_tex_desc td = {.format = LR_TEX_RGBA16F, .width = pt.width, .height = pt.height,
-                      .label = "floor pass source"};
-    int rc;
-    if ((rc = lr_program_create(&pd, &p, e)) || (rc = lr_tex_create(pt.gl, &td, &src, e)))
-        goto done;
-    double t[64], g[64];
-    int n = 0;
-    for (int i = 0; i < reps; i++) {
-        /* Timed the way a frame is (lr_renderer_frame): the draw inside the renderer's timer
-         * section (reset, begin, end, collect), the whole from glFinish to glFinish. */
-        struct timespec t0, t1;
-        glFinish();
-        clock_gettime(CLOCK_MONOTONIC, &t0);
-        lr_timer_reset(pt.timer);
-        if ((rc = lr_timer_begin(pt.timer, "floor", e)))
-            goto done;
-        lr_fb_bind(lr_blend_ldr_fb(pt.blend));
-        glDisable(GL_DEPTH_TEST);
-        glDisable(GL_BLEND);
-        glUseProgram(lr_program_id(p));
-        lr_passes_bind_tex(p, "u_src", 0, src);
-        if ((rc = lr_program_check(p, e)))
-            goto done;
-        lr_gl_draw_fullscreen(pt.gl);
-        if ((rc = lr_timer_end(pt.timer, e)))
-            goto done;
-        int trc = lr_timer_collect(pt.timer, NULL);
-        glFinish();
-        clock_gettime(CLOCK_MONOTONIC, &t1);
-        g[n] = trc || lr_timer_count(pt.timer) < 1 ? NAN : lr_timer_ms(pt.timer, 0);
-        t[n++] = (double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) * 1e-6;
+    lr_debug_floor *f = NULL;
+    int rc = lr_debug_floor_create(r, &f, e);
+    double t[64], g[64], c;
+    for (int i = 0; i < reps && !rc; i++)
+        rc = lr_debug_floor_run(f, &t[i], &g[i], &c, e);
+    if (!rc) {
+        *wall_ms = lr_median_finite(t, reps);
+        *timer_ms = lr_median_finite(g, reps);
     }
-    lr_timer_reset(pt.timer);
-    if ((rc = lr_gl_check("floor pass", e)))
-        goto done;
-    *wall_ms = lr_median_finite(t, n);
-    *timer_ms = lr_median_finite(g, n);
-done:
-    lr_tex_destroy(src);
-    lr_program_destroy(p);
+    lr_debug_floor_destroy(f);
     return rc;
 }

@@ -108,7 +108,8 @@ void lr_renderer_debug_surface_info(const lr_renderer *r, lr_debug_surface_info 
 /* ---- the bench's floor (issue 11) ---------------------------------------------------------- */
 
 /* Times `reps` (1..64) runs of the cheapest fullscreen pass that reads one RGBA16F texture of
- * the output size and writes the tone-mapped output target (render/shaders/floor.frag),
+ * the output size and writes the tone-mapped output target (render/shaders/floor.frag; the
+ * blend's own target, SRGB8_ALPHA8 where it is, so the store's sRGB encode is in both),
  * measured exactly as lr_renderer_frame measures a dimmer frame's blend pass, so that the two
  * compare like with like: the draw inside one section of the renderer's timer (reset, begin,
  * end, collect: *timer_ms, the median of that section, GPU timer queries or CPU+glFinish as
@@ -117,5 +118,16 @@ void lr_renderer_debug_surface_info(const lr_renderer *r, lr_debug_surface_info 
  * overwritten: render a frame before reading the image again. */
 int lr_renderer_debug_floor_ms(lr_renderer *r, int reps, double *wall_ms, double *timer_ms,
                                lr_err *e);
+
+/* The same floor one run at a time, for benches that pair it with frames (tools/bench
+ * dimmer_bench.c): its program and source texture are made once, so no run pays a compile or
+ * llvmpipe's first-draw shader variant. Each run gives the wall and timer times as above and
+ * the process CPU time from glFinish to glFinish (CLOCK_PROCESS_CPUTIME_ID: every thread).
+ * The floor must not outlive r. */
+typedef struct lr_debug_floor lr_debug_floor;
+int lr_debug_floor_create(lr_renderer *r, lr_debug_floor **out, lr_err *e);
+int lr_debug_floor_run(lr_debug_floor *f, double *wall_ms, double *timer_ms, double *cpu_ms,
+                       lr_err *e);
+void lr_debug_floor_destroy(lr_debug_floor *f);
 
 #endif

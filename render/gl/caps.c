@@ -37,6 +37,7 @@ int lr_gl_caps_parse(const char *version, const char *const *exts, int n_exts, l
     c->texture_float_linear = has(exts, n_exts, "GL_OES_texture_float_linear");
     c->float_blend = has(exts, n_exts, "GL_EXT_float_blend");
     c->timer_query = has(exts, n_exts, "GL_EXT_disjoint_timer_query");
+    c->srgb_decode = has(exts, n_exts, "GL_EXT_texture_sRGB_decode");
     return LR_OK;
 }
 
@@ -57,6 +58,8 @@ int lr_gl_caps_require(const lr_gl_caps *c, unsigned need, lr_err *e)
          "blending into 32-bit float targets"},
         {LR_GL_NEED_TIMER, offsetof(lr_gl_caps, timer_query), "GL_EXT_disjoint_timer_query",
          "GPU timer queries"},
+        {LR_GL_NEED_SRGB_DECODE, offsetof(lr_gl_caps, srgb_decode), "GL_EXT_texture_sRGB_decode",
+         "sampling an sRGB texture without decoding it"},
     };
     char missing[LR_ERR_MSG_MAX] = "";
     size_t len = 0;

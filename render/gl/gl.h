@@ -71,6 +71,9 @@ typedef struct lr_gl_caps {
     bool float_blend;
     /* GPU timestamps: EXT_disjoint_timer_query. */
     bool timer_query;
+    /* Sampling an sRGB texture without decoding it (EXT_texture_sRGB_decode): the output
+     * target is SRGB8_ALPHA8 (the store encodes) and its readers see the stored bytes. */
+    bool srgb_decode;
     int max_texture_size;
     int max_cube_map_size;
     int max_array_layers;
@@ -85,6 +88,7 @@ enum lr_gl_need {
     LR_GL_NEED_FLOAT_LINEAR = 1u << 2,  /* linear filtering of RGBA32F / R32F textures */
     LR_GL_NEED_FLOAT_BLEND = 1u << 3,   /* additive blending into RGBA32F */
     LR_GL_NEED_TIMER = 1u << 4,         /* GPU timer queries */
+    LR_GL_NEED_SRGB_DECODE = 1u << 5,   /* sampling SRGB8_ALPHA8 as stored (SKIP_DECODE) */
 };
 
 /* Creates the context and makes it current. Errors: LR_ENODEV (no DRM device / display /

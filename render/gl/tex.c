@@ -20,6 +20,10 @@ struct lr_fb {
     char label[48];
 };
 
+/* EXT_texture_sRGB_decode (GLES2/gl2ext.h names them; the values are the registry's). */
+#define LR_GL_TEXTURE_SRGB_DECODE_EXT 0x8A48
+#define LR_GL_SKIP_DECODE_EXT 0x8A4A
+
 static const struct format_info {
     GLenum internal, format, type; /* internal format; upload format/type */
     int channels;
@@ -37,6 +41,8 @@ static const struct format_info {
                          "DEPTH32F"},
     [LR_TEX_DEPTH24] = {GL_DEPTH_COMPONENT24, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, 1, false, true,
                         false, 0, "DEPTH24"},
+    [LR_TEX_SRGB8_ALPHA8] = {GL_SRGB8_ALPHA8, GL_RGBA, GL_UNSIGNED_BYTE, 4, false, false, false,
+                             LR_GL_NEED_SRGB_DECODE, "SRGB8_ALPHA8"},
 };
 
 int lr_tex_create(lr_gl *gl, const lr_tex_desc *d, lr_tex **out, lr_err *e)
@@ -65,6 +71,9 @@ int lr_tex_create(lr_gl *gl, const lr_tex_desc *d, lr_tex **out, lr_err *e)
         if (rc)
             return lr_err_prefix(e, "%s (%s, linear)", label, f->name);
     }
+    /* An sRGB texture is sampled as stored (below): without the extension it would decode. */
+    if (d->format == LR_TEX_SRGB8_ALPHA8 && lr_gl_caps_require(caps, f->need, e))
+        return lr_err_prefix(e, "%s (%s)", label, f->name);
 
     lr_tex *t = calloc(1, sizeof *t);
     if (!t)
@@ -89,6 +98,11 @@ int lr_tex_create(lr_gl *gl, const lr_tex_desc *d, lr_tex **out, lr_err *e)
     glTexParameteri(t->target, GL_TEXTURE_WRAP_S, wrap);
     glTexParameteri(t->target, GL_TEXTURE_WRAP_T, wrap);
     glTexParameteri(t->target, GL_TEXTURE_WRAP_R, wrap);
+    /* Readers of the sRGB output (the present blit, previews) want the encoded bytes, as they
+     * got them from the RGBA8 target that the shader encoded: no decode on sampling. Rendering
+     * into it still encodes (EXT_sRGB_write_control's default; GLES 3.0 always). */
+    if (d->format == LR_TEX_SRGB8_ALPHA8)
+        glTexParameteri(t->target, LR_GL_TEXTURE_SRGB_DECODE_EXT, LR_GL_SKIP_DECODE_EXT);
     glBindTexture(t->target, 0);
     int rc = lr_gl_check(label, e);
     if (rc) {

@@ -27,6 +27,9 @@ typedef enum lr_tex_format {
     LR_TEX_RGBA8,       /* tone-mapped output */
     LR_TEX_DEPTH32F,
     LR_TEX_DEPTH24,
+    LR_TEX_SRGB8_ALPHA8, /* tone-mapped output, sRGB-encoded by the store (GLES 3.0 core);
+                          * sampled and read back as the stored bytes (SKIP_DECODE), like
+                          * RGBA8 holding the encoded values */
 } lr_tex_format;
 
 typedef struct lr_tex lr_tex;

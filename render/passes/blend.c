@@ -21,6 +21,9 @@ struct lr_blend {
     lr_fb *fb_ldr, *fb_hdr;
     lr_blend_input in; /* of the last run */
     bool have_input, hdr_valid;
+    /* The output is SRGB8_ALPHA8 (the store encodes, LR_BLEND_SRGB_STORE 1), or RGBA8 that
+     * the shader encodes where EXT_texture_sRGB_decode is missing. */
+    bool srgb_store;
 };
 
 int lr_blend_create(const lr_blend_desc *d, lr_blend **out, lr_err *e)
@@ -36,8 +39,13 @@ int lr_blend_create(const lr_blend_desc *d, lr_blend **out, lr_err *e)
     b->defines = d->defines;
     lr_tex_desc hdr = {.format = LR_TEX_RGBA32F, .width = d->width, .height = d->height,
                        .label = "HDR output"};
-    lr_tex_desc ldr = {.format = LR_TEX_RGBA8, .width = d->width, .height = d->height,
-                       .linear = true, .label = "tone-mapped output"};
+    /* The hardware sRGB encode on the store replaces the shader's (three square roots per
+     * channel on llvmpipe, where this pass is the whole of a dimmer frame). Its readers see
+     * the stored bytes either way (render/gl/tex.h). */
+    b->srgb_store = lr_gl_caps_get(d->gl)->srgb_decode;
+    lr_tex_desc ldr = {.format = b->srgb_store ? LR_TEX_SRGB8_ALPHA8 : LR_TEX_RGBA8,
+                       .width = d->width, .height = d->height, .linear = true,
+                       .label = "tone-mapped output"};
     int rc;
     if ((rc = lr_tex_create(d->gl, &hdr, &b->hdr, e)) ||
         (rc = lr_tex_create(d->gl, &ldr, &b->ldr, e)) ||
@@ -74,13 +82,6 @@ static void uniform_i(lr_program *p, const char *name, int v)
         glUniform1i(loc, v);
 }
 
-static void uniform_f(lr_program *p, const char *name, float v)
-{
-    GLint loc = lr_program_uniform(p, name);
-    if (loc >= 0)
-        glUniform1f(loc, v);
-}
-
 /* The program for tone curve op (LR_BLEND_OPS: the linear sum, LR_BLEND_LINEAR in GLSL) and
  * n images of non-zero weight: the caller's defines (render/passes/defines.h: the curves'
  * names) plus LR_BLEND_OP and LR_BLEND_N. */
@@ -97,6 +98,7 @@ static int program(lr_blend *b, int op, int n, lr_program **out, lr_err *e)
                               LR_DEFINES_MAX);
         lr_shader_defines_add(&own, "LR_BLEND_OP", op);
         lr_shader_defines_add(&own, "LR_BLEND_N", n);
+        lr_shader_defines_add(&own, "LR_BLEND_SRGB_STORE", b->srgb_store ? 1 : 0);
         for (int i = 0; i < own.n; i++)
             defs[k++] = own.list[i];
         defs[k] = NULL;
@@ -113,6 +115,9 @@ static int program(lr_blend *b, int op, int n, lr_program **out, lr_err *e)
 static int draw(lr_blend *b, lr_fb *fb, bool linear, lr_err *e)
 {
     const lr_blend_input *in = &b->in;
+    /* Exposure multiplies the weights here rather than every pixel (lr_tonemap_apply's rule:
+     * exposure 0 means 1); the linear sum for readback takes the weights alone. */
+    double x = linear ? 1.0 : in->exposure != 0.0f ? (double)in->exposure : 1.0;
     /* Only the images whose weight is not zero are read (a light switched off costs nothing). */
     float w[3 * LR_BLEND_MAX_IMAGES] = {0};
     int layer[LR_BLEND_MAX_IMAGES] = {0}, n = 0;
@@ -120,7 +125,7 @@ static int draw(lr_blend *b, lr_fb *fb, bool linear, lr_err *e)
         if (in->w[l][0] == 0.0 && in->w[l][1] == 0.0 && in->w[l][2] == 0.0)
             continue;
         for (int c = 0; c < 3; c++)
-            w[3 * n + c] = (float)in->w[l][c];
+            w[3 * n + c] = (float)(in->w[l][c] * x);
         layer[n++] = l;
     }
     int op = linear ? LR_BLEND_OPS
@@ -144,8 +149,6 @@ static int draw(lr_blend *b, lr_fb *fb, bool linear, lr_err *e)
     if ((loc = lr_program_uniform(p, "u_layer")) >= 0 ||
         (loc = lr_program_uniform(p, "u_layer[0]")) >= 0)
         glUniform1iv(loc, LR_BLEND_MAX_IMAGES, layer);
-    /* lr_tonemap_apply's rule: exposure 0 means 1. */
-    uniform_f(p, "u_exposure", in->exposure != 0.0f ? in->exposure : 1.0f);
     if ((rc = lr_program_check(p, e)))
         return rc;
     lr_gl_draw_fullscreen(b->gl);

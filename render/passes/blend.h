@@ -1,7 +1,9 @@
 /* lamprig — the blend pass (issue 11): the output is the weighted sum of the per-light
  * unit-intensity linear images, sum_l w_l image_l with w_l = intensity x colour x flicker per
- * band, then exposure, tone curve and sRGB (lr_srgb_encode_fast: within a quarter of an
- * 8-bit step of the exact encode). Images of weight 0 are not read. Light transport is linear in each light's
+ * band, then exposure (folded into the weights), tone curve and sRGB: the output target is
+ * SRGB8_ALPHA8, whose store encodes (render/gl/tex.h; where EXT_texture_sRGB_decode is missing,
+ * RGBA8 and lr_srgb_encode_fast in the shader, within a quarter of an 8-bit step of the
+ * exact encode). Images of weight 0 are not read. Light transport is linear in each light's
  * intensity (render/passes/PIPELINE.md "Linearity"), so a dimmer, colour, flicker or exposure
  * change is this one fullscreen pass and nothing else.
  *

@@ -252,6 +252,22 @@ static void caps_gles32_has_float_targets_in_core(void **state)
     assert_false(c.texture_float_linear); /* never core */
 }
 
+/* The sRGB output target (render/passes/blend.h) needs sampling without decode. */
+static void caps_srgb_decode(void **state)
+{
+    (void)state;
+    const char *exts[] = {"GL_EXT_texture_sRGB_decode"};
+    lr_gl_caps c = {0};
+    lr_err e = {0};
+    assert_int_equal(lr_gl_caps_parse("OpenGL ES 3.1", exts, 1, &c, &e), LR_OK);
+    assert_true(c.srgb_decode);
+    assert_int_equal(lr_gl_caps_require(&c, LR_GL_NEED_SRGB_DECODE, &e), LR_OK);
+    assert_int_equal(lr_gl_caps_parse("OpenGL ES 3.2", NULL, 0, &c, &e), LR_OK);
+    assert_false(c.srgb_decode); /* not core in any GLES */
+    assert_int_equal(lr_gl_caps_require(&c, LR_GL_NEED_SRGB_DECODE, &e), LR_EUNSUPPORTED);
+    assert_non_null(strstr(e.msg, "missing GL_EXT_texture_sRGB_decode "));
+}
+
 static void caps_extension_names_match_whole(void **state)
 {
     const char *exts[] = {"GL_EXT_color_buffer_float_x", "GL_EXT_disjoint_timer_query_webgl"};
@@ -282,6 +298,7 @@ int main(void)
         cmocka_unit_test(caps_gles31_without_extensions),
         cmocka_unit_test(caps_half_float_only),
         cmocka_unit_test(caps_gles32_has_float_targets_in_core),
+        cmocka_unit_test(caps_srgb_decode),
         cmocka_unit_test(caps_extension_names_match_whole),
         cmocka_unit_test(caps_desktop_gl_is_rejected),
     };

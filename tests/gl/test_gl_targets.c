@@ -16,6 +16,7 @@
 #include "render/gl/shader.h"
 #include "render/gl/tex.h"
 #include "render/gl/timer.h"
+#include "render/image/image.h"
 #include "tests/support/fs.h"
 #include "tests/support/gl.h"
 
@@ -348,6 +349,59 @@ static void rgba8_target_reads_as_unit_floats(void **state)
     lr_tex_destroy(t);
 }
 
+/* The tone-mapped output (render/passes/blend.h): the store clamps and sRGB-encodes the
+ * colour (alpha stays linear), glReadPixels returns the stored bytes, and a sampler sees the
+ * stored bytes too (SKIP_DECODE), as the RGBA8 target that the shader encoded gave them. */
+static void srgb8_target_encodes_on_store_and_samples_as_stored(void **state)
+{
+    fixture *f = *state;
+    if (!lr_gl_caps_get(f->gl)->srgb_decode)
+        skip();
+    lr_tex *t = tex(f, (lr_tex_desc){.format = LR_TEX_SRGB8_ALPHA8, .width = 1, .height = 1,
+                                     .linear = true});
+    lr_tex *t8 = tex(f, (lr_tex_desc){.format = LR_TEX_RGBA8, .width = 1, .height = 1});
+    lr_fb *fb = fb1(f, t, 0), *fb8 = fb1(f, t8, 0);
+    lr_program *copy = program(f, "copy.frag", "uniform highp sampler2D u_src;\nout vec4 o;\n"
+                                               "void main() { o = texture(u_src, vec2(0.5)); }\n");
+    /* Both sides of the linear segment's end (0.0031308), mid-tones, the clip at 1, below 0. */
+    static const float lin[] = {0.0f, 1e-3f, 0.0031308f, 0.004f, 0.02f, 0.2140f, 0.5f,
+                                0.9f, 1.0f, 1.5f, -0.25f};
+    int off = 0;
+    for (size_t i = 0; i < sizeof lin / sizeof lin[0]; i++) {
+        fill(f, fb, (const float[4]){lin[i], 0.5f * lin[i], 1.0f - lin[i], 128.0f / 255.0f});
+        float px[4], back[4];
+        CHECK(lr_fb_read(fb, 0, 0, 0, 1, 1, px, e));
+        for (int c = 0; c < 3; c++) {
+            float v = c == 0 ? lin[i] : c == 1 ? 0.5f * lin[i] : 1.0f - lin[i];
+            v = v < 0.0f ? 0.0f : v > 1.0f ? 1.0f : v;
+            long want = lrintf(lr_srgb_encode(v) * 255.0f), got = lrintf(px[c] * 255.0f);
+            /* The driver's encode: the exact curve's byte or, at a rounding boundary, one
+             * step off (what test_render_blend allows the output). */
+            if (labs(got - want) > 1)
+                fail_msg("linear %.7g band %d: byte %ld, the exact curve %ld", (double)v, c, got,
+                         want);
+            off += got != want;
+        }
+        assert_true(lrintf(px[3] * 255.0f) == 128); /* alpha is not encoded */
+        lr_fb_bind(fb8);
+        glUseProgram(lr_program_id(copy));
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, lr_tex_id(t));
+        glUniform1i(lr_program_uniform(copy, "u_src"), 0);
+        lr_gl_draw_fullscreen(f->gl);
+        CHECK(lr_fb_read(fb8, 0, 0, 0, 1, 1, back, e));
+        for (int c = 0; c < 4; c++)
+            assert_int_equal(lrintf(back[c] * 255.0f), lrintf(px[c] * 255.0f));
+    }
+    print_message("sRGB store: %d of %zu bytes one step from the exact curve\n", off,
+                  3 * (sizeof lin / sizeof lin[0]));
+    lr_program_destroy(copy);
+    lr_fb_destroy(fb8);
+    lr_fb_destroy(fb);
+    lr_tex_destroy(t8);
+    lr_tex_destroy(t);
+}
+
 static void timers_report_sections(void **state)
 {
     fixture *f = *state;
@@ -402,6 +456,7 @@ int main(void)
         T(depth_texture_attachment),
         T(bad_targets_are_rejected_with_field_names),
         T(rgba8_target_reads_as_unit_floats),
+        T(srgb8_target_encodes_on_store_and_samples_as_stored),
         T(timers_report_sections),
     };
     if (getenv("LR_TEST_FILTER")) /* e.g. LR_TEST_FILTER='cube*' to run one test */

@@ -12,6 +12,7 @@ static const lrb_section *const sections[] = {
     &lrb_rig_section,
     &lrb_sweep_section,
     &lrb_models_section,
+    &lrb_dimmer_section,
 };
 #define NSECTIONS (sizeof sections / sizeof sections[0])
 
