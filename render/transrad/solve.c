@@ -165,7 +165,9 @@ int lr_tr_solve_light(lr_tr *t, const lr_light *light, int slot, lr_tr_stats *st
         return lr_err_set(e, LR_EINVAL, "transrad: field 'slot': %d outside [0, %d)", slot,
                           LR_TR_MAX_SLOTS);
     double t0 = now_ms();
-    lr_tr_direct(t, light);
+    int rc = lr_tr_direct(t, light, e);
+    if (rc)
+        return rc;
     if (st)
         st->ms_direct = now_ms() - t0;
     return solve(t, slot, st, e);

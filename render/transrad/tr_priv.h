@@ -74,8 +74,11 @@ int lr_tr_build_form_factors(lr_tr *t, lr_err *e);
 int lr_tr_optical_distances(const lr_tr *t, int s, double **out, lr_err *e);
 /* subsurface.c */
 int lr_tr_build_subsurface(lr_tr *t, lr_err *e);
-/* direct.c */
-void lr_tr_direct(lr_tr *t, const lr_light *light);
+/* direct.c: E and Ein of one light at unit intensity (area lights: direct_area.c). */
+int lr_tr_direct(lr_tr *t, const lr_light *light, lr_err *e);
+/* direct_area.c: the same for a quad or disk light at unit radiance; LR_EINVAL for a
+ * degenerate emitter. */
+int lr_tr_direct_area(lr_tr *t, const lr_light *light, lr_err *e);
 
 void lr_tr_rows_free(lr_tr_rows *r);
 

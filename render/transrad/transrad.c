@@ -54,6 +54,9 @@ int lr_tr_create(const lr_tr_surface_desc *surfaces, int count, const lr_tr_sett
         s.rays_per_patch < 0 || s.direct_samples < 0 || s.max_iterations < 0 ||
         !isfinite(s.patch_mm) || !isfinite(s.receiver_mm) || !isfinite(s.tolerance))
         return lr_err_set(e, LR_EINVAL, "transrad: field 'settings': negative or not finite");
+    if (s.area_samples < 0 || s.area_samples > 256)
+        return lr_err_set(e, LR_EINVAL, "transrad: field 'area_samples': %d outside [0, 256]",
+                          s.area_samples);
     if (s.patch_mm == 0)
         s.patch_mm = 12;
     if (s.receiver_mm == 0)
@@ -62,6 +65,8 @@ int lr_tr_create(const lr_tr_surface_desc *surfaces, int count, const lr_tr_sett
         s.rays_per_patch = 512;
     if (s.direct_samples == 0)
         s.direct_samples = 16;
+    if (s.area_samples == 0)
+        s.area_samples = 16;
     if (s.max_iterations == 0)
         s.max_iterations = 50;
     if (s.tolerance == 0)

@@ -27,7 +27,9 @@
  *             the power that leaves equals the model's plane total (subsurface.c);
  *   E         per light, unit intensity, shadowed by every surface, averaged over points of each
  *             patch; on a translucent patch split into the part that enters (F_t(cos)) and the
- *             Fresnel-reflected rest (direct.c);
+ *             Fresnel-reflected rest (direct.c); a quad or disk light at unit radiance: the
+ *             closed-form irradiance of render/area times the visible fraction from shadow
+ *             rays to stratified points on the emitter (direct_area.c);
  *   solve     the Jacobi iteration of seed 000 Sec. 5 (L = S E, then L <- S E + S F L),
  *             warm-started from the last solution of the same light slot (solve.c).
  *
@@ -81,6 +83,8 @@ typedef struct lr_tr_settings {
     double receiver_mm;     /* plane grid cell; 0: 30 mm (at most 64 cells a side) */
     int rays_per_patch;     /* form-factor rays; 0: 512 */
     int direct_samples;     /* points per patch for E; 0: 16 */
+    int area_samples;       /* quad/disk lights: shadow rays per point to the emitter
+                             * (stratified), 0: 16, at most 256 (direct_area.c) */
     int max_iterations;     /* Jacobi sweeps; 0: 50 */
     double tolerance;       /* stop when the relative residual is below; 0: 1e-4 */
     uint64_t seed;
