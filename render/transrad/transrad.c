@@ -97,7 +97,8 @@ int lr_tr_create(const lr_tr_surface_desc *surfaces, int count, const lr_tr_sett
         rc = lr_err_set(e, LR_ENOMEM, "transrad: out of memory");
         goto fail;
     }
-    if ((rc = lr_tr_build_form_factors(t, e)) || (rc = lr_tr_build_subsurface(t, e)))
+    if ((rc = lr_tr_build_form_factors(t, e)) || (rc = lr_tr_build_subsurface(t, e)) ||
+        (rc = lr_tr_transfer_build(t, e)))
         goto fail;
     *out = t;
     return LR_OK;
@@ -121,6 +122,7 @@ void lr_tr_destroy(lr_tr *t)
         free(t->slot[i].H);
         free(t->slot[i].Hind);
     }
+    lr_tr_transfer_free(&t->X);
     lr_tr_rows_free(&t->F);
     lr_tr_rows_free(&t->S);
     free(t->escape);

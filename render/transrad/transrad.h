@@ -31,7 +31,10 @@
  *             closed-form irradiance of render/area times the visible fraction from shadow
  *             rays to stratified points on the emitter (direct_area.c);
  *   solve     the Jacobi iteration of seed 000 Sec. 5 (L = S E, then L <- S E + S F L),
- *             warm-started from the last solution of the same light slot (solve.c).
+ *             warm-started from the last solution of the same light slot (solve.c); or,
+ *             where the budget allows, the precomputed transfer: LU factors of I - S F
+ *             (with the interfaces' reflection), so a light move is E and two triangular
+ *             solves (transfer.c).
  *
  * Radiometry. The solution W is the radiosity that leaves each patch (W/mm^2 per W/sr of the
  * light). A translucent patch's W = W_sss + W_refl: W_sss left the material after scattering
@@ -89,6 +92,11 @@ typedef struct lr_tr_settings {
     double tolerance;       /* stop when the relative residual is below; 0: 1e-4 */
     uint64_t seed;
     int threads;            /* 0: all online CPUs */
+    int transfer_mb;        /* budget of the precomputed transfer (transfer.c: 24 n^2 bytes),
+                             * e.g. 256 (the 4 GB target's share); <= 0 (default): not built.
+                             * Over the budget the warm-started sweeps solve instead. Off by
+                             * default: measured slower than the warm sweeps after a light
+                             * move (render/transrad/README.md) */
 } lr_tr_settings;
 
 #define LR_TR_MAX_SURFACES 32
@@ -101,6 +109,7 @@ typedef struct lr_tr_stats {
     double residual;        /* ||W_k+1 - W_k||_1 / ||W_k+1||_1, power-weighted, all bands */
     double residual10;      /* the same after 10 sweeps (or the last, if fewer) */
     double ms_direct, ms_solve;
+    bool transfer;          /* solved by the precomputed transfer (iterations 0) */
 } lr_tr_stats;
 
 /* Builds patches, F and S (the precomputation: after geometry or material changes). */
@@ -120,6 +129,8 @@ int lr_tr_solve_light(lr_tr *t, const lr_light *light, int slot, lr_tr_stats *st
 int lr_tr_solve_irradiance(lr_tr *t, const double *E, int slot, lr_tr_stats *st, lr_err *e);
 
 /* ---- Queries ------------------------------------------------------------------------------- */
+/* Bytes of the precomputed transfer; 0 when it was not built (over the budget). */
+size_t lr_tr_transfer_bytes(const lr_tr *t);
 size_t lr_tr_patch_count(const lr_tr *t);
 /* First patch and count of surface s (in the order given to create; for a scene: objects,
  * then receivers). */
