@@ -55,6 +55,7 @@ struct lr_tr {
     double *Edir, *Ein;   /* scratch n x 3: direct irradiance, and the part that enters */
     lr_tr_slot slot[LR_TR_MAX_SLOTS];
     lr_tr_transfer X;
+    bool cache_hit;       /* F and S came from the cache (cache.c) */
 };
 
 /* patches.c */
@@ -95,6 +96,13 @@ size_t lr_tr_transfer_need(size_t n);
 int lr_tr_transfer_build(lr_tr *t, lr_err *e);
 void lr_tr_transfer_free(lr_tr_transfer *x);
 int lr_tr_transfer_solve(lr_tr *t, lr_tr_slot *sl, lr_tr_stats *st, lr_err *e);
+
+/* cache.c: the key of t's F and S (patches built), the file of a key, loading it into t (false,
+ * t untouched, when missing or not valid) and storing t's. */
+uint64_t lr_tr_cache_key(const lr_tr *t);
+int lr_tr_cache_path(const char *dir, uint64_t key, char *out, size_t cap);
+bool lr_tr_cache_load(lr_tr *t, uint64_t key, const char *dir);
+int lr_tr_cache_store(const lr_tr *t, uint64_t key, const char *dir, lr_err *e);
 
 void lr_tr_rows_free(lr_tr_rows *r);
 

@@ -97,8 +97,17 @@ int lr_tr_create(const lr_tr_surface_desc *surfaces, int count, const lr_tr_sett
         rc = lr_err_set(e, LR_ENOMEM, "transrad: out of memory");
         goto fail;
     }
-    if ((rc = lr_tr_build_form_factors(t, e)) || (rc = lr_tr_build_subsurface(t, e)) ||
-        (rc = lr_tr_transfer_build(t, e)))
+    uint64_t key = s.cache_dir ? lr_tr_cache_key(t) : 0;
+    t->cache_hit = s.cache_dir && lr_tr_cache_load(t, key, s.cache_dir);
+    if (!t->cache_hit) {
+        if ((rc = lr_tr_build_form_factors(t, e)) || (rc = lr_tr_build_subsurface(t, e)))
+            goto fail;
+        /* Best effort: a folder that cannot be written costs the next start a rebuild. */
+        lr_err ce = {0};
+        if (s.cache_dir)
+            (void)lr_tr_cache_store(t, key, s.cache_dir, &ce);
+    }
+    if ((rc = lr_tr_transfer_build(t, e)))
         goto fail;
     *out = t;
     return LR_OK;
@@ -134,6 +143,8 @@ void lr_tr_destroy(lr_tr *t)
 }
 
 size_t lr_tr_patch_count(const lr_tr *t) { return t ? t->n : 0; }
+
+bool lr_tr_cache_hit(const lr_tr *t) { return t && t->cache_hit; }
 
 void lr_tr_surface_patches(const lr_tr *t, int s, size_t *first, size_t *count)
 {

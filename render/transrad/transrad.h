@@ -97,6 +97,8 @@ typedef struct lr_tr_settings {
                              * Over the budget the warm-started sweeps solve instead. Off by
                              * default: measured slower than the warm sweeps after a light
                              * move (render/transrad/README.md) */
+    const char *cache_dir;  /* F and S cached in this folder (cache.c), keyed by a hash of the
+                             * geometry, materials and the settings above; NULL: no cache */
 } lr_tr_settings;
 
 #define LR_TR_MAX_SURFACES 32
@@ -129,6 +131,11 @@ int lr_tr_solve_light(lr_tr *t, const lr_light *light, int slot, lr_tr_stats *st
 int lr_tr_solve_irradiance(lr_tr *t, const double *E, int slot, lr_tr_stats *st, lr_err *e);
 
 /* ---- Queries ------------------------------------------------------------------------------- */
+/* Whether create took F and S from the cache (settings.cache_dir) instead of building them. */
+bool lr_tr_cache_hit(const lr_tr *t);
+/* The default cache folder: $XDG_CACHE_HOME/lamprig, else $HOME/.cache/lamprig (absolute
+ * paths only); NULL when neither is set. buf receives it. */
+const char *lr_tr_cache_default_dir(char *buf, size_t cap);
 /* Bytes of the precomputed transfer; 0 when it was not built (over the budget). */
 size_t lr_tr_transfer_bytes(const lr_tr *t);
 size_t lr_tr_patch_count(const lr_tr *t);

@@ -6,6 +6,9 @@
  *   lamprig-transrad SCENE.json [--set KEY=VALUE]... [--patch MM] [--receiver MM] [--rays N]
  *                    [--transfer-mb MB]   (build the precomputed transfer within MB; default
  *                                          none: the warm-started sweeps)
+ *                    [--no-cache]         (build F and S even when $XDG_CACHE_HOME/lamprig has
+ *                                          them; by default they are read from and written to
+ *                                          the cache, render/transrad/cache.c)
  */
 #include <math.h>
 #include <stdio.h>
@@ -27,7 +30,7 @@ int main(int argc, char **argv)
 {
     if (argc < 2) {
         fprintf(stderr, "usage: lamprig-transrad SCENE.json [--set K=V]... [--patch MM] "
-                        "[--receiver MM] [--rays N] [--transfer-mb MB]\n");
+                        "[--receiver MM] [--rays N] [--transfer-mb MB] [--no-cache]\n");
         return 2;
     }
     lr_err e = {0};
@@ -36,7 +39,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "lamprig-transrad: %s\n", e.msg);
         return 1;
     }
-    lr_tr_settings set = {0};
+    char cdir[1024];
+    lr_tr_settings set = {.cache_dir = lr_tr_cache_default_dir(cdir, sizeof cdir)};
     for (int i = 2; i < argc; i++) {
         if (!strcmp(argv[i], "--set") && i + 1 < argc) {
             if (lr_scene_set_assignment(s, argv[++i], NULL, &e)) {
@@ -47,6 +51,8 @@ int main(int argc, char **argv)
             set.patch_mm = atof(argv[++i]);
         } else if (!strcmp(argv[i], "--receiver") && i + 1 < argc) {
             set.receiver_mm = atof(argv[++i]);
+        } else if (!strcmp(argv[i], "--no-cache")) {
+            set.cache_dir = NULL;
         } else if (!strcmp(argv[i], "--transfer-mb") && i + 1 < argc) {
             set.transfer_mb = atoi(argv[++i]);
         } else if (!strcmp(argv[i], "--rays") && i + 1 < argc) {
@@ -71,8 +77,9 @@ int main(int argc, char **argv)
         printf("%s%zu", i ? " " : "", c);
     }
     size_t xb = lr_tr_transfer_bytes(t);
-    printf("), precomputation (F, S) %.2f s, transfer %s (%.1f MB)\n", t1 - t0,
-           xb ? "built" : "not built", xb / 1048576.0);
+    printf("), precomputation (F, S%s) %.2f s, transfer %s (%.1f MB)\n",
+           lr_tr_cache_hit(t) ? " from the cache" : "", t1 - t0, xb ? "built" : "not built",
+           xb / 1048576.0);
     for (int l = 0; l < lr_scene_light_count(s) && l < LR_TR_MAX_SLOTS; l++) {
         lr_tr_stats st = {0};
         if (lr_tr_solve_light(t, lr_scene_light_at(s, l), l, &st, &e)) {
