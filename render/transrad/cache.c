@@ -34,6 +34,10 @@ uint64_t lr_tr_cache_key(const lr_tr *t)
     lr_ref_hash h;
     lr_ref_hash_init(&h);
     lr_ref_hash_str(&h, "lamprig transrad F S v1");
+    /* The file holds native size_t, float and byte order: another machine is another key. */
+    const uint32_t order = 0x01020304u;
+    lr_ref_hash_u64(&h, sizeof(size_t));
+    lr_ref_hash_bytes(&h, &order, sizeof order);
     lr_ref_hash_double(&h, t->set.patch_mm);
     lr_ref_hash_double(&h, t->set.receiver_mm);
     lr_ref_hash_u64(&h, (uint64_t)t->set.rays_per_patch);
@@ -94,9 +98,8 @@ typedef struct piece {
     size_t bytes;
 } piece;
 
-static int pieces(lr_tr *t, size_t n, size_t nf, size_t ns, piece out[7])
+static void pieces(size_t n, size_t nf, size_t ns, piece out[7])
 {
-    (void)t;
     out[0] = (piece){NULL, (n + 1) * sizeof(size_t)};
     out[1] = (piece){NULL, nf * sizeof(uint32_t)};
     out[2] = (piece){NULL, nf * sizeof(float)};
@@ -104,7 +107,6 @@ static int pieces(lr_tr *t, size_t n, size_t nf, size_t ns, piece out[7])
     out[4] = (piece){NULL, (n + 1) * sizeof(size_t)};
     out[5] = (piece){NULL, ns * sizeof(uint32_t)};
     out[6] = (piece){NULL, 3 * ns * sizeof(float)};
-    return 7;
 }
 
 static uint64_t payload_hash(const unsigned char *p, size_t len)
@@ -132,7 +134,7 @@ int lr_tr_cache_store(const lr_tr *t, uint64_t key, const char *dir, lr_err *e)
         return lr_err_set(e, LR_EINVAL, "transrad cache: field 'dir': path too long");
     size_t n = t->n, nf = t->F.row[n], ns = t->S.row[n];
     piece pc[7];
-    pieces((lr_tr *)t, n, nf, ns, pc);
+    pieces(n, nf, ns, pc);
     pc[0].p = t->F.row;
     pc[1].p = t->F.col;
     pc[2].p = t->F.val;
@@ -198,7 +200,7 @@ bool lr_tr_cache_load(lr_tr *t, uint64_t key, const char *dir)
     piece pc[7];
     size_t want = head;
     if (ok) {
-        pieces(t, n, (size_t)w[2], (size_t)w[3], pc);
+        pieces(n, (size_t)w[2], (size_t)w[3], pc);
         for (int i = 0; i < 7; i++)
             want += pc[i].bytes;
         ok = len == want && payload_hash((unsigned char *)data + head, len - head) == w[4];

@@ -107,6 +107,7 @@ int lr_tr_create(const lr_tr_surface_desc *surfaces, int count, const lr_tr_sett
         if (s.cache_dir)
             (void)lr_tr_cache_store(t, key, s.cache_dir, &ce);
     }
+    t->set.cache_dir = NULL; /* the caller's string: not kept */
     if ((rc = lr_tr_transfer_build(t, e)))
         goto fail;
     *out = t;

@@ -98,7 +98,8 @@ typedef struct lr_tr_settings {
                              * default: measured slower than the warm sweeps after a light
                              * move (render/transrad/README.md) */
     const char *cache_dir;  /* F and S cached in this folder (cache.c), keyed by a hash of the
-                             * geometry, materials and the settings above; NULL: no cache */
+                             * geometry, materials and the settings above; NULL: no cache.
+                             * Read during create only (the pointer is not kept in use) */
 } lr_tr_settings;
 
 #define LR_TR_MAX_SURFACES 32
