@@ -4,7 +4,7 @@
  * (point, spot) or cos (directional: unit radiance on a surface facing it), each point shadowed
  * by every surface (seed 000 Eq. 14's E). On a translucent patch the part that enters is
  * weighted by the boundary's F_t(cos) (Ein); the rest, Edir - Ein, is reflected by the
- * interface. */
+ * interface. Quad and disk lights: direct_area.c. */
 #include "render/transrad/tr_priv.h"
 
 #include <math.h>
@@ -61,8 +61,11 @@ static void dl_item(void *vctx, long item)
     }
 }
 
-void lr_tr_direct(lr_tr *t, const lr_light *light)
+int lr_tr_direct(lr_tr *t, const lr_light *light, lr_err *e)
 {
+    if (lr_light_is_area(light))
+        return lr_tr_direct_area(t, light, e);
     dl_ctx c = {t, light, lr_tr_eps(t)};
     lr_cpu_parallel_for((long)t->n, t->set.threads, dl_item, &c);
+    return LR_OK;
 }

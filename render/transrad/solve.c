@@ -47,6 +47,19 @@ static int solve(lr_tr *t, int slot, lr_tr_stats *st, lr_err *e)
     if (rc)
         return rc;
     lr_tr_slot *sl = &t->slot[slot];
+    if (t->X.built) {
+        lr_tr_stats s = {0};
+        rc = lr_tr_transfer_solve(t, sl, &s, e);
+        if (rc)
+            return rc;
+        sl->valid = true;
+        s.ms_solve = now_ms() - t0;
+        if (st) {
+            s.ms_direct = st->ms_direct;
+            *st = s;
+        }
+        return LR_OK;
+    }
     size_t n = t->n;
     double *Wn = malloc(3 * (n ? n : 1) * sizeof *Wn);
     double *phi = malloc(3 * (n ? n : 1) * sizeof *phi);
@@ -165,7 +178,9 @@ int lr_tr_solve_light(lr_tr *t, const lr_light *light, int slot, lr_tr_stats *st
         return lr_err_set(e, LR_EINVAL, "transrad: field 'slot': %d outside [0, %d)", slot,
                           LR_TR_MAX_SLOTS);
     double t0 = now_ms();
-    lr_tr_direct(t, light);
+    int rc = lr_tr_direct(t, light, e);
+    if (rc)
+        return rc;
     if (st)
         st->ms_direct = now_ms() - t0;
     return solve(t, slot, st, e);

@@ -35,6 +35,13 @@ typedef struct lr_tr_slot {
     bool valid;
 } lr_tr_slot;
 
+/* The precomputed transfer (transfer.c): LU factors of I - K per band, row-major n x n. */
+typedef struct lr_tr_transfer {
+    double *lu[3];
+    uint32_t *perm[3];
+    bool built;
+} lr_tr_transfer;
+
 struct lr_tr {
     lr_tr_settings set;
     int nsurf;
@@ -47,6 +54,8 @@ struct lr_tr {
     lr_tr_rows S;         /* column-major by source: row p lists (q, S_qp[3]) */
     double *Edir, *Ein;   /* scratch n x 3: direct irradiance, and the part that enters */
     lr_tr_slot slot[LR_TR_MAX_SLOTS];
+    lr_tr_transfer X;
+    bool cache_hit;       /* F and S came from the cache (cache.c) */
 };
 
 /* patches.c */
@@ -74,8 +83,26 @@ int lr_tr_build_form_factors(lr_tr *t, lr_err *e);
 int lr_tr_optical_distances(const lr_tr *t, int s, double **out, lr_err *e);
 /* subsurface.c */
 int lr_tr_build_subsurface(lr_tr *t, lr_err *e);
-/* direct.c */
-void lr_tr_direct(lr_tr *t, const lr_light *light);
+/* direct.c: E and Ein of one light at unit intensity (area lights: direct_area.c). */
+int lr_tr_direct(lr_tr *t, const lr_light *light, lr_err *e);
+/* direct_area.c: the same for a quad or disk light at unit radiance; LR_EINVAL for a
+ * degenerate emitter. */
+int lr_tr_direct_area(lr_tr *t, const lr_light *light, lr_err *e);
+
+/* transfer.c: bytes the transfer of n patches takes; build it when within the settings'
+ * budget (else nothing); the solve of slot sl's W, Wsss, H, Hind by it (stats: 0 sweeps, the
+ * residual of the fixed point). */
+size_t lr_tr_transfer_need(size_t n);
+int lr_tr_transfer_build(lr_tr *t, lr_err *e);
+void lr_tr_transfer_free(lr_tr_transfer *x);
+int lr_tr_transfer_solve(lr_tr *t, lr_tr_slot *sl, lr_tr_stats *st, lr_err *e);
+
+/* cache.c: the key of t's F and S (patches built), the file of a key, loading it into t (false,
+ * t untouched, when missing or not valid) and storing t's. */
+uint64_t lr_tr_cache_key(const lr_tr *t);
+int lr_tr_cache_path(const char *dir, uint64_t key, char *out, size_t cap);
+bool lr_tr_cache_load(lr_tr *t, uint64_t key, const char *dir);
+int lr_tr_cache_store(const lr_tr *t, uint64_t key, const char *dir, lr_err *e);
 
 void lr_tr_rows_free(lr_tr_rows *r);
 

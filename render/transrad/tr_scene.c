@@ -243,7 +243,10 @@ int lr_tr_scene_update(lr_tr_scene **tsp, const lr_scene *s, lr_err *e)
     if (!ts->tr || nk != ts->nkey || memcmp(key, ts->key, (size_t)nk * sizeof *key)) {
         lr_tr_destroy(ts->tr);
         ts->tr = NULL;
-        lr_tr_settings set = {.rays_per_patch = 256};
+        /* F and S from the on-disk cache when this geometry was seen before (cache.c). */
+        char cdir[1024];
+        lr_tr_settings set = {.rays_per_patch = 256,
+                              .cache_dir = lr_tr_cache_default_dir(cdir, sizeof cdir)};
         int rc = lr_tr_create_scene(s, &set, &ts->tr, e);
         if (rc)
             return rc;

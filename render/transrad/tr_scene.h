@@ -13,7 +13,9 @@
  *     those objects (a shade's inside through its openings; a face is inner when its normal
  *     points toward the object's centre). The VPLs keep carrying the outer faces' light, now
  *     with the solved B.
- * Everything is per unit intensity, so a dimmer change stays blend-only. */
+ * Everything is per unit intensity, so a dimmer change stays blend-only. F and S are cached on
+ * disk under lr_tr_cache_default_dir ($XDG_CACHE_HOME/lamprig), so a second start with the
+ * same geometry and materials skips their build (render/transrad/cache.c). */
 #ifndef LR_TR_SCENE_H
 #define LR_TR_SCENE_H
 

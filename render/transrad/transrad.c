@@ -54,6 +54,9 @@ int lr_tr_create(const lr_tr_surface_desc *surfaces, int count, const lr_tr_sett
         s.rays_per_patch < 0 || s.direct_samples < 0 || s.max_iterations < 0 ||
         !isfinite(s.patch_mm) || !isfinite(s.receiver_mm) || !isfinite(s.tolerance))
         return lr_err_set(e, LR_EINVAL, "transrad: field 'settings': negative or not finite");
+    if (s.area_samples < 0 || s.area_samples > 256)
+        return lr_err_set(e, LR_EINVAL, "transrad: field 'area_samples': %d outside [0, 256]",
+                          s.area_samples);
     if (s.patch_mm == 0)
         s.patch_mm = 12;
     if (s.receiver_mm == 0)
@@ -62,6 +65,8 @@ int lr_tr_create(const lr_tr_surface_desc *surfaces, int count, const lr_tr_sett
         s.rays_per_patch = 512;
     if (s.direct_samples == 0)
         s.direct_samples = 16;
+    if (s.area_samples == 0)
+        s.area_samples = 16;
     if (s.max_iterations == 0)
         s.max_iterations = 50;
     if (s.tolerance == 0)
@@ -92,7 +97,18 @@ int lr_tr_create(const lr_tr_surface_desc *surfaces, int count, const lr_tr_sett
         rc = lr_err_set(e, LR_ENOMEM, "transrad: out of memory");
         goto fail;
     }
-    if ((rc = lr_tr_build_form_factors(t, e)) || (rc = lr_tr_build_subsurface(t, e)))
+    uint64_t key = s.cache_dir ? lr_tr_cache_key(t) : 0;
+    t->cache_hit = s.cache_dir && lr_tr_cache_load(t, key, s.cache_dir);
+    if (!t->cache_hit) {
+        if ((rc = lr_tr_build_form_factors(t, e)) || (rc = lr_tr_build_subsurface(t, e)))
+            goto fail;
+        /* Best effort: a folder that cannot be written costs the next start a rebuild. */
+        lr_err ce = {0};
+        if (s.cache_dir)
+            (void)lr_tr_cache_store(t, key, s.cache_dir, &ce);
+    }
+    t->set.cache_dir = NULL; /* the caller's string: not kept */
+    if ((rc = lr_tr_transfer_build(t, e)))
         goto fail;
     *out = t;
     return LR_OK;
@@ -116,6 +132,7 @@ void lr_tr_destroy(lr_tr *t)
         free(t->slot[i].H);
         free(t->slot[i].Hind);
     }
+    lr_tr_transfer_free(&t->X);
     lr_tr_rows_free(&t->F);
     lr_tr_rows_free(&t->S);
     free(t->escape);
@@ -127,6 +144,8 @@ void lr_tr_destroy(lr_tr *t)
 }
 
 size_t lr_tr_patch_count(const lr_tr *t) { return t ? t->n : 0; }
+
+bool lr_tr_cache_hit(const lr_tr *t) { return t && t->cache_hit; }
 
 void lr_tr_surface_patches(const lr_tr *t, int s, size_t *first, size_t *count)
 {

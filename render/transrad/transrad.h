@@ -27,9 +27,14 @@
  *             the power that leaves equals the model's plane total (subsurface.c);
  *   E         per light, unit intensity, shadowed by every surface, averaged over points of each
  *             patch; on a translucent patch split into the part that enters (F_t(cos)) and the
- *             Fresnel-reflected rest (direct.c);
+ *             Fresnel-reflected rest (direct.c); a quad or disk light at unit radiance: the
+ *             closed-form irradiance of render/area times the visible fraction from shadow
+ *             rays to stratified points on the emitter (direct_area.c);
  *   solve     the Jacobi iteration of seed 000 Sec. 5 (L = S E, then L <- S E + S F L),
- *             warm-started from the last solution of the same light slot (solve.c).
+ *             warm-started from the last solution of the same light slot (solve.c); or,
+ *             where the budget allows, the precomputed transfer: LU factors of I - S F
+ *             (with the interfaces' reflection), so a light move is E and two triangular
+ *             solves (transfer.c).
  *
  * Radiometry. The solution W is the radiosity that leaves each patch (W/mm^2 per W/sr of the
  * light). A translucent patch's W = W_sss + W_refl: W_sss left the material after scattering
@@ -81,10 +86,20 @@ typedef struct lr_tr_settings {
     double receiver_mm;     /* plane grid cell; 0: 30 mm (at most 64 cells a side) */
     int rays_per_patch;     /* form-factor rays; 0: 512 */
     int direct_samples;     /* points per patch for E; 0: 16 */
+    int area_samples;       /* quad/disk lights: shadow rays per point to the emitter
+                             * (stratified), 0: 16, at most 256 (direct_area.c) */
     int max_iterations;     /* Jacobi sweeps; 0: 50 */
     double tolerance;       /* stop when the relative residual is below; 0: 1e-4 */
     uint64_t seed;
     int threads;            /* 0: all online CPUs */
+    int transfer_mb;        /* budget of the precomputed transfer (transfer.c: 24 n^2 bytes),
+                             * e.g. 256 (the 4 GB target's share); <= 0 (default): not built.
+                             * Over the budget the warm-started sweeps solve instead. Off by
+                             * default: measured slower than the warm sweeps after a light
+                             * move (render/transrad/README.md) */
+    const char *cache_dir;  /* F and S cached in this folder (cache.c), keyed by a hash of the
+                             * geometry, materials and the settings above; NULL: no cache.
+                             * Read during create only (the pointer is not kept in use) */
 } lr_tr_settings;
 
 #define LR_TR_MAX_SURFACES 32
@@ -97,6 +112,7 @@ typedef struct lr_tr_stats {
     double residual;        /* ||W_k+1 - W_k||_1 / ||W_k+1||_1, power-weighted, all bands */
     double residual10;      /* the same after 10 sweeps (or the last, if fewer) */
     double ms_direct, ms_solve;
+    bool transfer;          /* solved by the precomputed transfer (iterations 0) */
 } lr_tr_stats;
 
 /* Builds patches, F and S (the precomputation: after geometry or material changes). */
@@ -116,6 +132,13 @@ int lr_tr_solve_light(lr_tr *t, const lr_light *light, int slot, lr_tr_stats *st
 int lr_tr_solve_irradiance(lr_tr *t, const double *E, int slot, lr_tr_stats *st, lr_err *e);
 
 /* ---- Queries ------------------------------------------------------------------------------- */
+/* Whether create took F and S from the cache (settings.cache_dir) instead of building them. */
+bool lr_tr_cache_hit(const lr_tr *t);
+/* The default cache folder: $XDG_CACHE_HOME/lamprig, else $HOME/.cache/lamprig (absolute
+ * paths only); NULL when neither is set. buf receives it. */
+const char *lr_tr_cache_default_dir(char *buf, size_t cap);
+/* Bytes of the precomputed transfer; 0 when it was not built (over the budget). */
+size_t lr_tr_transfer_bytes(const lr_tr *t);
 size_t lr_tr_patch_count(const lr_tr *t);
 /* First patch and count of surface s (in the order given to create; for a scene: objects,
  * then receivers). */

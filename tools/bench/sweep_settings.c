@@ -59,6 +59,10 @@ int lrb_sweep_settings(lrb_setting *out, int cap)
     if (n > 0 && !strcmp(out[n - 1].label, "multipole+K=16"))
         out[n - 1].K = 16;
     ADD("transrad", model, "translucent_radiosity");
+    /* The lamp shade's K_cover is 15: the planner can pick the model there only with K 16. */
+    ADD("transrad+K=16", model, "translucent_radiosity");
+    if (n > 0 && !strcmp(out[n - 1].label, "transrad+K=16"))
+        out[n - 1].K = 16;
     ADD("diffusion_grid", model, "diffusion_grid"); /* seed 001 (render/diffusion/) */
     ADD("sh", model, "sh_translucency"); /* seed 002: deterministic, one evaluation per texel */
 #undef ADD

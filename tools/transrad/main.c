@@ -4,6 +4,11 @@
  * indirect from objects and from receivers; the power that leaves the scene).
  *
  *   lamprig-transrad SCENE.json [--set KEY=VALUE]... [--patch MM] [--receiver MM] [--rays N]
+ *                    [--transfer-mb MB]   (build the precomputed transfer within MB; default
+ *                                          none: the warm-started sweeps)
+ *                    [--no-cache]         (build F and S even when $XDG_CACHE_HOME/lamprig has
+ *                                          them; by default they are read from and written to
+ *                                          the cache, render/transrad/cache.c)
  */
 #include <math.h>
 #include <stdio.h>
@@ -25,7 +30,7 @@ int main(int argc, char **argv)
 {
     if (argc < 2) {
         fprintf(stderr, "usage: lamprig-transrad SCENE.json [--set K=V]... [--patch MM] "
-                        "[--receiver MM] [--rays N]\n");
+                        "[--receiver MM] [--rays N] [--transfer-mb MB] [--no-cache]\n");
         return 2;
     }
     lr_err e = {0};
@@ -34,7 +39,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "lamprig-transrad: %s\n", e.msg);
         return 1;
     }
-    lr_tr_settings set = {0};
+    char cdir[1024];
+    lr_tr_settings set = {.cache_dir = lr_tr_cache_default_dir(cdir, sizeof cdir)};
     for (int i = 2; i < argc; i++) {
         if (!strcmp(argv[i], "--set") && i + 1 < argc) {
             if (lr_scene_set_assignment(s, argv[++i], NULL, &e)) {
@@ -45,6 +51,10 @@ int main(int argc, char **argv)
             set.patch_mm = atof(argv[++i]);
         } else if (!strcmp(argv[i], "--receiver") && i + 1 < argc) {
             set.receiver_mm = atof(argv[++i]);
+        } else if (!strcmp(argv[i], "--no-cache")) {
+            set.cache_dir = NULL;
+        } else if (!strcmp(argv[i], "--transfer-mb") && i + 1 < argc) {
+            set.transfer_mb = atoi(argv[++i]);
         } else if (!strcmp(argv[i], "--rays") && i + 1 < argc) {
             set.rays_per_patch = atoi(argv[++i]);
         } else {
@@ -66,7 +76,10 @@ int main(int argc, char **argv)
         lr_tr_surface_patches(t, i, &f, &c);
         printf("%s%zu", i ? " " : "", c);
     }
-    printf("), precomputation (F, S) %.2f s\n", t1 - t0);
+    size_t xb = lr_tr_transfer_bytes(t);
+    printf("), precomputation (F, S%s) %.2f s, transfer %s (%.1f MB)\n",
+           lr_tr_cache_hit(t) ? " from the cache" : "", t1 - t0, xb ? "built" : "not built",
+           xb / 1048576.0);
     for (int l = 0; l < lr_scene_light_count(s) && l < LR_TR_MAX_SLOTS; l++) {
         lr_tr_stats st = {0};
         if (lr_tr_solve_light(t, lr_scene_light_at(s, l), l, &st, &e)) {
@@ -126,8 +139,9 @@ int main(int argc, char **argv)
             fprintf(stderr, "lamprig-transrad: %s\n", e.msg);
             return 1;
         }
-        printf("  after a 1 mm light move (warm start): direct %.1f ms, solve %.1f ms, %d "
-               "sweeps\n", sm.ms_direct, sm.ms_solve, sm.iterations);
+        printf("  after a 1 mm light move (%s): direct %.1f ms, solve %.1f ms, %d sweeps, "
+               "residual %.2e\n", sm.transfer ? "transfer" : "warm start", sm.ms_direct,
+               sm.ms_solve, sm.iterations, sm.residual);
     }
     lr_tr_destroy(t);
     lr_scene_destroy(s);

@@ -1,0 +1,214 @@
+/* The on-disk cache of translucent radiosity's F and S (render/transrad/cache.c):
+ *  - a second create with the same scene and settings takes F and S from the file and solves
+ *    to the same W bit for bit;
+ *  - another setting (rays per patch) or another material is another key: a miss, a new file;
+ *  - a corrupt cache (a flipped payload byte, a flipped key byte, a truncated file, garbage,
+ *    an empty file) is never used: create rebuilds, solves to the same W, and rewrites it, so
+ *    the next create hits again;
+ *  - a folder that cannot be written costs only the cache (create succeeds, no hit). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "render/base/paths.h"
+#include "render/transrad/transrad.h"
+
+static char dir[256];
+
+static lr_scene *load(void)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/scenes/lampshade.json", lr_configs_dir());
+    lr_scene *s;
+    lr_err e = {0};
+    if (lr_scene_load(path, NULL, &s, &e) ||
+        lr_scene_set_assignment(s, "objects[0].model=translucent_radiosity", NULL, &e))
+        fail_msg("%s", e.msg);
+    return s;
+}
+
+static lr_tr *create(const lr_scene *s, const char *cache, int rays)
+{
+    lr_tr_settings set = {.patch_mm = 30, .receiver_mm = 150, .rays_per_patch = rays,
+                          .seed = 9, .cache_dir = cache};
+    lr_tr *t;
+    lr_err e = {0};
+    if (lr_tr_create_scene(s, &set, &t, &e))
+        fail_msg("%s", e.msg);
+    lr_tr_stats st;
+    if (lr_tr_solve_light(t, lr_scene_light_at(s, 0), 0, &st, &e))
+        fail_msg("%s", e.msg);
+    return t;
+}
+
+/* Largest |W_a - W_b| over patches and bands. */
+static double max_diff(const lr_tr *a, const lr_tr *b)
+{
+    double m = 0;
+    for (size_t p = 0; p < lr_tr_patch_count(a); p++) {
+        double wa[3], wb[3];
+        lr_tr_radiosity(a, 0, p, wa);
+        lr_tr_radiosity(b, 0, p, wb);
+        for (int c = 0; c < 3; c++)
+            m = fmax(m, fabs(wa[c] - wb[c]));
+    }
+    return m;
+}
+
+static int count_files(char *first, size_t cap)
+{
+    DIR *d = opendir(dir);
+    int n = 0;
+    struct dirent *ent;
+    while (d && (ent = readdir(d)))
+        if (!strncmp(ent->d_name, "transrad-", 9)) {
+            if (n++ == 0 && first)
+                snprintf(first, cap, "%s/%s", dir, ent->d_name);
+        }
+    if (d)
+        closedir(d);
+    return n;
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    snprintf(dir, sizeof dir, "/tmp/lamprig-test-transrad-cache-XXXXXX");
+    return mkdtemp(dir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    DIR *d = opendir(dir);
+    struct dirent *ent;
+    char path[600];
+    while (d && (ent = readdir(d)))
+        if (ent->d_name[0] != '.') {
+            snprintf(path, sizeof path, "%s/%s", dir, ent->d_name);
+            unlink(path);
+        }
+    if (d)
+        closedir(d);
+    rmdir(dir);
+    return 0;
+}
+
+static void test_hit_and_keys(void **state)
+{
+    (void)state;
+    lr_scene *s = load();
+    lr_tr *ref = create(s, NULL, 64);
+    lr_tr *a = create(s, dir, 64);
+    assert_false(lr_tr_cache_hit(ref));
+    assert_false(lr_tr_cache_hit(a));
+    assert_int_equal(count_files(NULL, 0), 1);
+    lr_tr *b = create(s, dir, 64);
+    assert_true(lr_tr_cache_hit(b));
+    assert_true(max_diff(b, ref) == 0.0);
+    assert_true(lr_tr_form_factor(b, 3, 7) == lr_tr_form_factor(ref, 3, 7));
+    /* Another setting, another material: misses with their own files. */
+    lr_tr *c = create(s, dir, 48);
+    assert_false(lr_tr_cache_hit(c));
+    assert_int_equal(count_files(NULL, 0), 2);
+    lr_err e = {0};
+    if (lr_scene_set_assignment(s, "receivers[0].albedo=0.5,0.5,0.5", NULL, &e))
+        fail_msg("%s", e.msg);
+    lr_tr *d = create(s, dir, 64);
+    assert_false(lr_tr_cache_hit(d));
+    assert_int_equal(count_files(NULL, 0), 3);
+    print_message("%zu patches: hit solves to the same W; 3 keys, 3 files\n",
+                  lr_tr_patch_count(a));
+    lr_tr_destroy(ref);
+    lr_tr_destroy(a);
+    lr_tr_destroy(b);
+    lr_tr_destroy(c);
+    lr_tr_destroy(d);
+    lr_scene_destroy(s);
+}
+
+/* Damages the single cache file, then create must miss, agree with ref, and repair it. */
+static void damaged(const lr_scene *s, const lr_tr *ref, const char *what, long at, int len)
+{
+    char path[600];
+    assert_int_equal(count_files(path, sizeof path), 1);
+    FILE *f = fopen(path, "r+b");
+    assert_non_null(f);
+    fseek(f, 0, SEEK_END);
+    long size = ftell(f);
+    if (len < 0) { /* truncate to at */
+        fclose(f);
+        assert_int_equal(truncate(path, at), 0);
+    } else {
+        long pos = at >= 0 ? at : size + at;
+        fseek(f, pos, SEEK_SET);
+        int ch = fgetc(f);
+        fseek(f, pos, SEEK_SET);
+        fputc(ch ^ 0x5A, f);
+        fclose(f);
+    }
+    lr_tr *t = create(s, dir, 64);
+    print_message("%s: hit %d, W differs by %g\n", what, lr_tr_cache_hit(t), max_diff(t, ref));
+    assert_false(lr_tr_cache_hit(t));
+    assert_true(max_diff(t, ref) == 0.0);
+    lr_tr_destroy(t);
+    t = create(s, dir, 64); /* rewritten */
+    assert_true(lr_tr_cache_hit(t));
+    lr_tr_destroy(t);
+}
+
+static void test_corrupt(void **state)
+{
+    teardown(state);
+    assert_int_equal(setup(state), 0);
+    lr_scene *s = load();
+    lr_tr *ref = create(s, dir, 64);
+    damaged(s, ref, "payload byte", -5, 1);
+    damaged(s, ref, "key byte", 9, 1);
+    damaged(s, ref, "magic", 0, 1);
+    damaged(s, ref, "truncated", 1000, -1);
+    damaged(s, ref, "empty", 0, -1);
+    /* Garbage of the right length: the payload hash refuses it. */
+    char path[600];
+    assert_int_equal(count_files(path, sizeof path), 1);
+    FILE *f = fopen(path, "r+b");
+    fseek(f, 200, SEEK_SET);
+    for (int i = 0; i < 4096; i++)
+        fputc(i * 37 & 255, f);
+    fclose(f);
+    lr_tr *t = create(s, dir, 64);
+    assert_false(lr_tr_cache_hit(t));
+    assert_true(max_diff(t, ref) == 0.0);
+    lr_tr_destroy(t);
+    lr_tr_destroy(ref);
+    lr_scene_destroy(s);
+}
+
+static void test_unwritable_folder(void **state)
+{
+    (void)state;
+    lr_scene *s = load();
+    lr_tr *t = create(s, "/proc/lamprig-no-such-folder", 64);
+    assert_false(lr_tr_cache_hit(t));
+    lr_tr_destroy(t);
+    lr_scene_destroy(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_hit_and_keys),
+        cmocka_unit_test(test_corrupt),
+        cmocka_unit_test(test_unwritable_folder),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
