@@ -13,6 +13,11 @@ export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0}"
 export LSAN_OPTIONS="suppressions=$here/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 export CMOCKA_MESSAGE_OUTPUT=stdout
+# The tests' caches (the transrad F/S cache, render/transrad/cache.c) go to a folder of this run,
+# so that a user's ~/.cache never feeds a test and a test run never fills it.
+XDG_CACHE_HOME=$(mktemp -d "${TMPDIR:-/tmp}/lamprig-test-cache.XXXXXX") || exit 1
+export XDG_CACHE_HOME
+trap 'rm -rf "$XDG_CACHE_HOME"' EXIT
 failed=""
 n=0
 for t in "$@"; do
