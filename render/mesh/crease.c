@@ -12,8 +12,8 @@
  *
  * Corner (t, k) at vertex v gets sum_s A_s n_s over the triangles s around v whose unit normal
  * is within LR_MESH_CREASE_DEG of t's (A_s n_s = half the cross product: area-weighted, as
- * lr_mesh_create's normals), normalised; corners of v with bit-identical sums (the same set of
- * faces, summed in the same order) share one output vertex. */
+ * lr_mesh_create's normals), normalised; corners of v with equal sums (the same set of faces,
+ * summed in the same order) share one output vertex. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -42,7 +42,8 @@ int lr_mesh_crease_normals(const double *pos, size_t nv, uint32_t *idx, size_t n
     size_t *around = malloc((nc ? nc : 1) * sizeof *around);
     lr_vec3 *cn = malloc((nc ? nc : 1) * sizeof *cn);   /* per corner */
     uint32_t *out_of = malloc((nc ? nc : 1) * sizeof *out_of);
-    double *op = malloc(3 * (nc ? nc : 1) * sizeof *op), *on = malloc(3 * (nc ? nc : 1) * sizeof *on);
+    double *op = malloc(3 * (nc ? nc : 1) * sizeof *op);
+    double *on = malloc(3 * (nc ? nc : 1) * sizeof *on);
     int rc = -1;
     if (!fn || !fu || !start || !fill || !around || !cn || !out_of || !op || !on)
         goto done;
@@ -78,7 +79,7 @@ int lr_mesh_crease_normals(const double *pos, size_t nv, uint32_t *idx, size_t n
         for (size_t i = start[v]; i < start[v + 1]; i++) {
             size_t c = around[i], j = first;
             for (; j < no; j++)
-                if (!memcmp(&on[3 * j], (double[3]){cn[c].x, cn[c].y, cn[c].z}, 3 * sizeof(double)))
+                if (on[3 * j] == cn[c].x && on[3 * j + 1] == cn[c].y && on[3 * j + 2] == cn[c].z)
                     break;
             if (j == no) {
                 memcpy(&op[3 * no], &pos[3 * v], 3 * sizeof(double));
