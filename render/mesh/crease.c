@@ -3,8 +3,8 @@
  * Why: averaging every face around a vertex (lr_mesh_create's computed normals) bends the
  * normals of a whole wall when its vertices are shared with a floor or a rim at 90 degrees: on
  * configs/meshes/votive.obj (6 rings, 90-degree edges at the floor, the rim and the bottom) the
- * floor's corners by the wall took nearly horizontal normals (84 degrees from the floor's) and
- * the walls' normals tilted toward the floor and the rim. The physical reference uses the faces'
+ * corner normals were up to 84 degrees from their facet on the rim, 69 on the floor and 22-23
+ * on the walls (tilted toward the floor and the rim). The physical reference uses the faces'
  * geometric normals; the renderer's estimator, the light's G-buffer and the cavity closure use
  * these vertex normals, so a tilt changes which face the diffusion profile treats as "across
  * the wall" (the multipole's R or T) and the Fresnel factors. Modelling tools smooth only
