@@ -35,6 +35,13 @@ int lr_mesh_crease_normals(const double *pos, size_t nv, uint32_t *idx, size_t n
     *pos_out = *nrm_out = NULL;
     *nv_out = 0;
     size_t nc = 3 * nt;
+    /* Input lr_mesh_create would refuse: left to it, so that its message names the problem. */
+    for (size_t c = 0; c < nc; c++)
+        if (idx[c] >= nv)
+            return 1;
+    for (size_t i = 0; i < 3 * nv; i++)
+        if (!isfinite(pos[i]))
+            return 1;
     lr_vec3 *fn = malloc((nt ? nt : 1) * sizeof *fn);   /* area-weighted face normals */
     lr_vec3 *fu = malloc((nt ? nt : 1) * sizeof *fu);   /* unit (0 for zero area) */
     size_t *start = calloc(nv + 1, sizeof *start);       /* CSR: corners around each vertex */

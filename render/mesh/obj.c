@@ -324,17 +324,19 @@ int lr_mesh_load_obj(const char *path, const lr_mesh_checks *checks, lr_mesh **o
     /* No normals in the file: computed here, split along sharp edges (crease.c). */
     if (!all_normals) {
         size_t ncr = 0;
-        if (lr_mesh_crease_normals(pos.v, nv, idx, ntri, cos(LR_MESH_CREASE_DEG * M_PI / 180.0),
-                                   &outpos, &outnrm, &ncr)) {
+        int cr_rc = lr_mesh_crease_normals(pos.v, nv, idx, ntri,
+                                           cos(LR_MESH_CREASE_DEG * M_PI / 180.0), &outpos,
+                                           &outnrm, &ncr);
+        if (cr_rc < 0) {
             rc = lr_err_set(e, LR_ENOMEM, "%s: out of memory", path);
             goto done;
         }
-        nout = ncr;
+        nout = cr_rc ? nv : ncr;
     }
     lr_mesh_desc d = {
         .name = path,
         .vertex_count = nout,
-        .positions = outpos,
+        .positions = outpos ? outpos : pos.v,
         .normals = outnrm,
         .triangle_count = ntri,
         .indices = idx,

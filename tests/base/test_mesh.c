@@ -964,6 +964,23 @@ static void test_obj_crease_normals(void **state)
     }
     lr_mesh_destroy(m);
 
+    /* The same cube as PLY without normals: the same split. */
+    tmp_path("cube_nonormals.ply", path, sizeof path);
+    lr_test_put(path, cube_ply_ascii, (size_t)-1);
+    assert_int_equal(lr_mesh_load(path, &ck, &m, &e), LR_OK);
+    assert_true(rep.closed && rep.oriented && rep.normals_computed);
+    assert_int_equal(lr_mesh_vertex_count(m), 24);
+    n = lr_mesh_normals(m);
+    idx = lr_mesh_indices(m);
+    for (size_t t = 0; t < lr_mesh_triangle_count(m); t++) {
+        lr_vec3 g = lr_mesh_triangle_normal(m, t);
+        for (int k = 0; k < 3; k++) {
+            const float *vn = &n[3 * idx[3 * t + k]];
+            assert_true(lr_v3_dot(g, lr_v3(vn[0], vn[1], vn[2])) > 1.0 - 1e-6);
+        }
+    }
+    lr_mesh_destroy(m);
+
     snprintf(path, sizeof path, "%s/meshes/votive.obj", lr_configs_dir());
     assert_int_equal(lr_mesh_load(path, &ck, &m, &e), LR_OK);
     assert_true(rep.closed && rep.oriented && rep.normals_computed);
