@@ -34,6 +34,17 @@ typedef struct lr_mesh_edge {
 int lr_mesh_topology(const uint32_t *weld, size_t nclasses, const uint32_t *idx, size_t nt,
                      lr_mesh_report *out, lr_mesh_edge **edges_out);
 
+/* Mesh files without normals (OBJ, PLY): vertex normals averaged (area-weighted) only over the
+ * faces within LR_MESH_CREASE_DEG of each corner's face, so that a sharp edge (a votive's floor
+ * and rim) gives each side its own normal (crease.c). Rewrites idx[0..3 nt) to the returned
+ * vertices (*nv_out of them: positions *pos_out, unit normals *nrm_out, 3 doubles each, caller
+ * frees); returns 0, 1 (nothing done) when an index is out of range or a coordinate not
+ * finite (lr_mesh_create then reports it), or -1 on allocation failure. */
+#define LR_MESH_CREASE_DEG 60.0
+int lr_mesh_crease_normals(const double *pos, size_t nv, uint32_t *idx, size_t nt,
+                           double cos_crease, double **pos_out, double **nrm_out,
+                           size_t *nv_out);
+
 /* Growable arrays for the generators. */
 typedef struct lr_mesh_builder {
     double *pos, *nrm;

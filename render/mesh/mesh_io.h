@@ -5,7 +5,9 @@
  * with a `vertex_indices` (or `vertex_index`) list; other elements are skipped. OBJ: v, vn and
  * f with the v, v/vt, v//vn and v/vt/vn forms, negative (relative) indices; vt, o, g, s,
  * usemtl, mtllib are ignored, other statements ignored with one warning each. Polygons are
- * fan-triangulated. Everything then goes through lr_mesh_create's validation and repair, with
+ * fan-triangulated. A file without normals gets them computed by the loader, averaged over
+ * the faces within LR_MESH_CREASE_DEG (60) degrees of each other and split along sharper edges
+ * (a cup's floor and rim), as modelling tools' auto smooth (crease.c). Everything then goes through lr_mesh_create's validation and repair, with
  * messages that name the file and the line (or, in binary PLY, the element index).
  */
 #ifndef LR_MESH_IO_H

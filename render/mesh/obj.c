@@ -321,11 +321,23 @@ int lr_mesh_load_obj(const char *path, const lr_mesh_checks *checks, lr_mesh **o
             origin[t++] = cr.line.v[a];
         }
     }
+    /* No normals in the file: computed here, split along sharp edges (crease.c). */
+    if (!all_normals) {
+        size_t ncr = 0;
+        int cr_rc = lr_mesh_crease_normals(pos.v, nv, idx, ntri,
+                                           cos(LR_MESH_CREASE_DEG * M_PI / 180.0), &outpos,
+                                           &outnrm, &ncr);
+        if (cr_rc < 0) {
+            rc = lr_err_set(e, LR_ENOMEM, "%s: out of memory", path);
+            goto done;
+        }
+        nout = cr_rc ? nv : ncr;
+    }
     lr_mesh_desc d = {
         .name = path,
         .vertex_count = nout,
-        .positions = all_normals ? outpos : pos.v,
-        .normals = all_normals ? outnrm : NULL,
+        .positions = outpos ? outpos : pos.v,
+        .normals = outnrm,
         .triangle_count = ntri,
         .indices = idx,
         .origin = origin,
@@ -334,6 +346,8 @@ int lr_mesh_load_obj(const char *path, const lr_mesh_checks *checks, lr_mesh **o
     if (checks)
         d.checks = *checks;
     rc = lr_mesh_create(&d, out, e);
+    if (!rc && !all_normals && checks && checks->report)
+        checks->report->normals_computed = true; /* by the loader, not read from the file */
 done:
     free(buf);
     free(pos.v);

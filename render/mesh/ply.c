@@ -443,6 +443,24 @@ int lr_mesh_load_ply(const char *path, const lr_mesh_checks *checks, lr_mesh **o
             }
         }
     }
+    /* No normals in the file: computed here, split along sharp edges (crease.c). */
+    double *cpos = NULL, *cnrm = NULL;
+    if (!normals) {
+        size_t ncr = 0;
+        int cr_rc = lr_mesh_crease_normals(g.pos, nv, g.idx, g.nt,
+                                           cos(LR_MESH_CREASE_DEG * M_PI / 180.0), &cpos, &cnrm,
+                                           &ncr);
+        if (cr_rc < 0) {
+            rc = lr_err_set(e, LR_ENOMEM, "%s: out of memory", path);
+            goto done;
+        }
+        if (cr_rc == 0) {
+            free(g.pos);
+            g.pos = cpos;
+            g.nrm = cnrm;
+            nv = ncr;
+        }
+    }
     lr_mesh_desc d = {
         .name = path,
         .vertex_count = nv,
@@ -456,6 +474,8 @@ int lr_mesh_load_ply(const char *path, const lr_mesh_checks *checks, lr_mesh **o
     if (checks)
         d.checks = *checks;
     rc = lr_mesh_create(&d, out, e);
+    if (!rc && !normals && checks && checks->report)
+        checks->report->normals_computed = true; /* by the loader, not read from the file */
 done:
     free(r.buf);
     free(el);

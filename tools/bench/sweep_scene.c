@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "render/base/paths.h"
+#include "render/image/image.h"
 #include "render/reference/reference.h"
 
 static int set_int(lr_scene *s, const char *key, int v, lr_err *e)
@@ -152,6 +153,35 @@ static void fair_figures(const float *C, const lr_ref_image *mean, const lr_ref_
     res->mal_fair = lr_eval_median_abs_log(C, mean->rgb, m->object, n);
 }
 
+
+/* LRB_SWEEP_DUMP=dir (diagnosis, issue 12): writes dir/<scene>_<what>.pfm: the base setting's
+ * converged fair image ("model"), the reference ("ref", "ref_var"), the second reference
+ * ("ref2") and the region labels ("regions": enum lr_eval_region in every band). Best effort:
+ * a failed write is reported on stderr and the sweep goes on. */
+static void dump_pfm(const char *scene, const char *what, const float *rgb, int w, int h)
+{
+    const char *dir = getenv("LRB_SWEEP_DUMP");
+    if (!dir || !*dir || !rgb)
+        return;
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s_%s.pfm", dir, scene, what);
+    lr_image img = {.width = w, .height = h, .rgb = (float *)rgb};
+    lr_err e = {0};
+    if (lr_image_write_pfm(path, &img, &e))
+        fprintf(stderr, "bench sweep: dump: %s\n", e.msg);
+}
+
+static void dump_regions(const char *scene, const lr_eval_regions *rg, int w, int h)
+{
+    if (!getenv("LRB_SWEEP_DUMP"))
+        return;
+    float *lab = malloc((size_t)w * h * 3 * sizeof *lab);
+    for (size_t i = 0; lab && i < (size_t)w * h; i++)
+        lab[3 * i] = lab[3 * i + 1] = lab[3 * i + 2] = rg->label[i];
+    dump_pfm(scene, "regions", lab, w, h);
+    free(lab);
+}
+
 int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, int cap,
                     lrb_scene_result *res)
 {
@@ -252,6 +282,11 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
             res->fair_bias_object = bias_obj;
             res->fair_bias_receivers = bias_rec;
             fair_figures(C, &mean, &var, &rg, &m, mask, res);
+            dump_pfm(name, "model", C, w, h);
+            dump_pfm(name, "ref", mean.rgb, w, h);
+            dump_pfm(name, "ref_var", var.rgb, w, h);
+            dump_pfm(name, "ref2", mean2.rgb, w, h);
+            dump_regions(name, &rg, w, h);
         }
         for (int c = 0; c < st->ncheck && *nrows < cap; c++) {
             const float *I = ser.image[c];
@@ -298,8 +333,10 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
         lr_eval_series_free(&ser);
     }
     res->sweep_s = lrb_now() - t1;
-    /* The old bench's figures for the same setting: pixel-centre samples. */
-    {
+    /* The old bench's figures for the same setting: pixel-centre samples (LRB_SWEEP_CENTRE=0
+     * leaves them out, nan, to halve a diagnosis run). */
+    const char *centre = getenv("LRB_SWEEP_CENTRE");
+    if (!centre || strcmp(centre, "0")) {
         lr_eval_series ser = {0};
         if (ss == 1) {
             res->centre_bias_object = res->fair_bias_object;
