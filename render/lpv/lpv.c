@@ -246,6 +246,8 @@ void lr_lpv_irradiance(const lr_lpv *v, lr_vec3 x, lr_vec3 n, double E[3])
             continue;
         /* Bilinear over the interface plane between the cells' centres across. */
         int b1 = (a + 1) % 3, b2 = (a + 2) % 3, i0[2];
+        if (!(uu[b1] >= 0.0 && uu[b1] <= N && uu[b2] >= 0.0 && uu[b2] <= N))
+            continue; /* beside the box */
         double f[2];
         for (int q = 0; q < 2; q++) {
             double c = fmin(fmax(uu[q ? b2 : b1] - 0.5, 0.0), N - 1.0);

@@ -154,6 +154,29 @@ static int build_box(const lr_scene *s, int n, lr_lpv **out, lr_err *e)
     return rc ? rc : lr_lpv_create(&d, out, e);
 }
 
+/* Adds the volume's irradiance at every plane receiver's grid texels (but group g's own). */
+static void gather_receivers(const lr_scene *s, const lr_lpv *v, int g, double *const *out,
+                             double gathered[3])
+{
+    size_t texels = (size_t)LR_RECV_GRID * LR_RECV_GRID;
+    for (int i = 0; i < lr_scene_receiver_count(s); i++) {
+        lr_recv_grid_frame f;
+        const lr_receiver *r = lr_scene_receiver_at(s, i);
+        if (i == g || !out[i] || !lr_recv_grid_frame_of(r, &f))
+            continue;
+        double ta = f.w * f.h / (double)texels;
+        for (int t = 0; t < LR_RECV_GRID; t++)
+            for (int q = 0; q < LR_RECV_GRID; q++) {
+                double E[3];
+                lr_lpv_irradiance(v, lr_recv_grid_point(&f, q, t), r->normal, E);
+                for (int c = 0; c < 3; c++) {
+                    out[i][((size_t)t * LR_RECV_GRID + q) * 3 + c] += E[c];
+                    gathered[c] += E[c] * ta;
+                }
+            }
+    }
+}
+
 int lr_lpv_scene_indirect(const lr_scene *s, int light, const lr_lpv_scene_desc *d,
                           double *const *out, lr_lpv_scene_stats *stats, lr_err *e)
 {
@@ -204,39 +227,48 @@ int lr_lpv_scene_indirect(const lr_scene *s, int light, const lr_lpv_scene_desc 
     }
     lr_lpv_propagate_fn prop = d && d->propagate ? d->propagate : cpu_propagate;
     void *ctx = d ? d->ctx : NULL;
-    for (int g = 0; g <= nrec && !rc; g++) {
-        lr_lpv_clear_light(v);
-        bool any = false;
-        for (int k = 0; k < ss.n && !rc; k++) {
-            if (ss.s[k].group != g)
-                continue;
-            rc = lr_lpv_inject_lobe(v, ss.s[k].p, ss.s[k].n, &phi[3 * k], e);
-            for (int c = 0; c < 3; c++)
-                st.injected[c] += phi[3 * k + c];
-            any = true;
-        }
-        if (rc || !any)
-            continue;
-        if ((rc = prop(ctx, v, 4 * n, e)))
-            break;
-        for (int i = 0; i < nrec; i++) {
-            lr_recv_grid_frame f;
-            const lr_receiver *r = lr_scene_receiver_at(s, i);
-            if (i == g || !out[i] || !lr_recv_grid_frame_of(r, &f))
-                continue;
-            double ta = f.w * f.h / (double)texels;
-            for (int t = 0; t < LR_RECV_GRID; t++)
-                for (int q = 0; q < LR_RECV_GRID; q++) {
-                    lr_vec3 x = lr_recv_grid_point(&f, q, t);
-                    double E[3];
-                    lr_lpv_irradiance(v, x, r->normal, E);
-                    for (int c = 0; c < 3; c++) {
-                        out[i][((size_t)t * LR_RECV_GRID + q) * 3 + c] += E[c];
-                        st.gathered[c] += E[c] * ta;
-                    }
+    int bounces = d && d->bounces > 0 ? d->bounces : 0;
+    /* What the objects' samples receive from the volume, for their next bounce. */
+    double *next = rc ? NULL : calloc(3 * (size_t)(ss.n ? ss.n : 1), sizeof *next);
+    if (!rc && !next)
+        rc = lr_err_set(e, LR_ENOMEM, "lpv: out of memory");
+    for (int b = 0; b <= bounces && !rc; b++) {
+        for (int g = b == 0 ? 0 : nrec; g <= nrec && !rc; g++) {
+            lr_lpv_clear_light(v);
+            bool any = false;
+            for (int k = 0; k < ss.n && !rc; k++) {
+                if (ss.s[k].group != g)
+                    continue;
+                rc = lr_lpv_inject_lobe(v, ss.s[k].p, ss.s[k].n, &phi[3 * k], e);
+                for (int c = 0; c < 3; c++) {
+                    st.injected[c] += phi[3 * k + c];
+                    any |= phi[3 * k + c] > 0.0;
                 }
+            }
+            if (rc || !any)
+                continue;
+            if ((rc = prop(ctx, v, 4 * n, e)))
+                break;
+            gather_receivers(s, v, g, out, st.gathered);
+            for (int k = 0; k < ss.n && b < bounces; k++) {
+                if (ss.s[k].group != nrec)
+                    continue;
+                double E[3];
+                lr_lpv_irradiance(v, ss.s[k].p, ss.s[k].n, E);
+                for (int c = 0; c < 3; c++)
+                    next[3 * k + c] += E[c];
+            }
         }
+        /* The next bounce: the objects reflect what the volume delivered to them. */
+        for (int k = 0; k < ss.n && next; k++)
+            for (int c = 0; c < 3; c++) {
+                phi[3 * k + c] = ss.s[k].group == nrec
+                                     ? ss.s[k].refl[c] * next[3 * k + c] * ss.s[k].area
+                                     : 0.0;
+                next[3 * k + c] = 0.0;
+            }
     }
+    free(next);
     free(phi);
     free(ss.s);
     lr_lpv_destroy(v);

@@ -22,7 +22,10 @@
  *  - Propagation: 4 n steps per group (lpv.h; on the CPU, or the caller's, e.g. the compute
  *    shader), gather from the absorbed record at the receiver grid's texel centres. A group
  *    is never gathered on itself: a plane cannot light itself, but the volume's diffusion
- *    would return part of its own lobe. One bounce: light blocked by a surface is absorbed.
+ *    would return part of its own lobe. Light blocked by a surface is absorbed; with
+ *    `bounces` > 0 the objects' samples gather what the volumes delivered to them and send
+ *    R of it back in, once per bounce (a shade's cavity, whose inner wall returns R = 0.79
+ *    of paper's light, keeps most of its light for several bounces).
  *
  * Only area lights (quad, disk); other lights get nothing (LR_OK, zero grids). */
 #ifndef LR_LPV_SCENE_H
@@ -37,6 +40,7 @@ typedef int (*lr_lpv_propagate_fn)(void *ctx, lr_lpv *v, int steps, lr_err *e);
 
 typedef struct lr_lpv_scene_desc {
     int n;                         /* cells per axis; 0: 32 */
+    int bounces;                   /* further bounces off the objects (0: one bounce) */
     lr_lpv_propagate_fn propagate; /* NULL: the CPU */
     void *ctx;
 } lr_lpv_scene_desc;
