@@ -150,7 +150,9 @@ static int build_box(const lr_scene *s, int n, lr_lpv **out, lr_err *e)
         return lr_err_set(e, LR_EINVAL, "lpv: the scene has no objects to place the volume");
     lr_vec3 ext = lr_v3_sub(hi, lo);
     lr_lpv_desc d;
-    int rc = lr_lpv_desc_around(lo, hi, fmax(ext.x, fmax(ext.y, ext.z)), n, &d, e);
+    /* 1.25 extents: a wall or table near the lamp lies a few cells inside the box (light that
+     * reaches the border leaves; a receiver on it would gather nothing). */
+    int rc = lr_lpv_desc_around(lo, hi, 1.25 * fmax(ext.x, fmax(ext.y, ext.z)), n, &d, e);
     return rc ? rc : lr_lpv_create(&d, out, e);
 }
 

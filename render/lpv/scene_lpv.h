@@ -3,8 +3,9 @@
  * parts 3-4), per light at unit radiance, on the receivers' irradiance grids
  * (render/cpu/recv_grid.h), for composition to add to the direct light.
  *
- *  - Volume: n^3 cells around the objects' bounds, widened on every side by their largest
- *    extent (the table and wall near a lamp fall inside).
+ *  - Volume: n^3 cells around the objects' bounds, widened on every side by 1.25 times their
+ *    largest extent (the table and wall near a lamp fall a few cells inside; light reaching
+ *    the border leaves, so a receiver on it would gather nothing).
  *  - Blocking: diffuse samples on the plane receivers (a grid of spacing h/2 where the plane
  *    crosses the volume) and Poisson-disk samples on the objects (render/area/poisson_mesh.h,
  *    r_min = h/3), each blocking its interfaces (lpv.h).
