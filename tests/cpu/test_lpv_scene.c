@@ -1,8 +1,8 @@
 /* A scene's light-propagation volume on the plane receivers (render/lpv/scene_lpv.h) on
  * led_shade (4 LED quads in a paper shade, table and wall): the receivers never gather more
  * than was injected, the table under the shade and the wall receive indirect light, nothing
- * lands outside the volume, twice the cells keep the receivers' indirect power within a
- * factor, a point light gets none (area lights only), a bad light index is refused. */
+ * lands outside the volume, further bounces add light within R / (1 - R), a point light gets
+ * none (area lights only), a bad light index and n = 1 are refused. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
