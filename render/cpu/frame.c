@@ -12,6 +12,7 @@
 #include "render/cpu/maps.h"
 #include "render/cpu/parallel.h"
 #include "render/cpu/recv_grid.h"
+#include "render/lpv/scene_lpv.h"
 #include "render/transrad/tr_scene.h"
 #include "render/cpu/rng.h"
 #include "render/cpu/sh.h"
@@ -52,6 +53,11 @@ typedef struct rctx {
      * without a grid. */
     double **grid;
     int nrecv;
+    /* render.lpv (PASS): per receiver and light, the light-propagation volume's indirect
+     * irradiance per unit radiance at the grid's texel centres (3 doubles per texel;
+     * render/lpv/scene_lpv.h), [receiver * nlight + light], NULL where none; the GPU adds
+     * the same to its area lights' direct grid (render/passes/area_direct.c). */
+    double **lpv;
     lr_tr_scene *tr;     /* translucent radiosity (PASS): the solver's B and receiver extra */
     lr_dscene *dscene; /* diffusion_grid objects' fields (NULL when the scene has none) */
     /* Per light, the lights the transport sees frame by frame (render/area/frames.h): an area
@@ -307,6 +313,18 @@ static void pixel_item(void *p, long item)
             for (int c = 0; c < 3; c++)
                 E[c] += r->I[l][c] * ed;
         }
+        for (int l = 0; r->lpv && l < r->nlight; l++) {
+            const double *g = r->lpv[(size_t)idx * r->nlight + l];
+            lr_recv_grid_frame f;
+            if (!g || !lr_recv_grid_frame_of(rc, &f))
+                continue;
+            int ti[4];
+            double tw[4];
+            lr_recv_grid_taps(&f, x, ti, tw);
+            for (int q = 0; q < 4; q++)
+                for (int c = 0; c < 3; c++)
+                    E[c] += r->I[l][c] * tw[q] * g[3 * (size_t)ti[q] + c];
+        }
         if (!r->d->no_vpl && r->grid && r->grid[idx]) {
             /* The GPU's receiver irradiance grid: bilinear over texel centres. */
             lr_recv_grid_frame f;
@@ -334,6 +352,36 @@ static void pixel_item(void *p, long item)
         if (vout)
             vout[c] = (float)V[c];
     }
+}
+
+/* render.lpv: the light-propagation volume's grids on the CPU (the GPU propagates the same
+ * volumes with the compute shader; 2 further bounces off the objects, as there). */
+static int lpv_grids(rctx *r, int n, lr_err *e)
+{
+    const size_t texels = (size_t)LR_RECV_GRID * LR_RECV_GRID;
+    r->lpv = calloc((size_t)r->nrecv * r->nlight, sizeof *r->lpv);
+    if (!r->lpv)
+        return lr_err_set(e, LR_ENOMEM, "cpu render: out of memory");
+    double **out = calloc((size_t)r->nrecv, sizeof *out);
+    if (!out)
+        return lr_err_set(e, LR_ENOMEM, "cpu render: out of memory");
+    lr_lpv_scene_desc d = {.n = n, .bounces = 2};
+    int rc = LR_OK;
+    for (int l = 0; l < r->nlight && !rc; l++) {
+        for (int i = 0; i < r->nrecv && !rc; i++) {
+            out[i] = NULL;
+            lr_recv_grid_frame f;
+            if (!lr_recv_grid_frame_of(lr_scene_receiver_at(r->s, i), &f))
+                continue;
+            if (!(out[i] = r->lpv[(size_t)i * r->nlight + l] =
+                      malloc(sizeof(double) * 3 * texels)))
+                rc = lr_err_set(e, LR_ENOMEM, "cpu render: out of memory");
+        }
+        if (!rc)
+            rc = lr_lpv_scene_indirect(r->s, l, &d, out, NULL, e);
+    }
+    free(out);
+    return rc;
 }
 
 static double now_s(void)
@@ -523,6 +571,9 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
         }
         lr_cpu_parallel_for((long)(r.nrecv * n), d->threads, grid_item, &r);
     }
+    if (!ref && lr_scene_render(s)->lpv > 0 && r.nrecv > 0 &&
+        (rc = lpv_grids(&r, lr_scene_render(s)->lpv, e)))
+        goto fail;
     lr_cpu_parallel_for((long)r.W * r.H, d->threads, pixel_item, &r);
     long objpx = 0, fbpx = 0;
     for (long i = 0; i < (long)r.W * r.H; i++) {
@@ -553,6 +604,10 @@ fail:
         for (int i = 0; i < r.nrecv; i++)
             free(r.grid[i]);
     free(r.grid);
+    if (r.lpv)
+        for (int i = 0; i < r.nrecv * r.nlight; i++)
+            free(r.lpv[i]);
+    free(r.lpv);
     if (r.maps)
         for (int i = 0; i < r.nobj * r.nlight; i++)
             lr_cpu_maps_destroy(r.maps[i]);

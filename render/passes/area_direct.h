@@ -16,6 +16,10 @@ typedef struct lr_area_direct {
     int layer[LR_MAX_RECEIVERS];
     int n_receivers, n_lights;
     int F; /* frames in the running mean */
+    /* render.lpv: the light-propagation volume's indirect irradiance per plane receiver and
+     * light (render/lpv/scene_lpv.h), same layers as grid, added to every frame's direct
+     * light so the running mean carries it; computed when the mean restarts (F = 1). */
+    lr_tex *lpv;
 } lr_area_direct;
 
 /* Whether the scene has an area light (the grid is needed). */

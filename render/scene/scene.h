@@ -207,6 +207,9 @@ typedef struct lr_render_settings {
     /* Composition reads the objects' B from the view-independent surface cache
      * (render/passes/surface.h) instead of running Algorithm 1 per pixel (issue 11). */
     bool surface_cache;
+    /* Light-propagation volume (render/lpv/, seed 004) for the area lights' indirect light on
+     * the plane receivers: cells per axis, 0 off. */
+    int lpv;
 } lr_render_settings;
 
 typedef struct lr_quality {

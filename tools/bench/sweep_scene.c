@@ -26,6 +26,10 @@ int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e)
         (rc = set_int(s, "render.map_size", st->map_size, e)) ||
         (rc = set_int(s, "render.gbuffer_size", st->gbuffer_size, e)))
         return rc;
+    /* LRB_SWEEP_LPV=32: every setting with the light-propagation volume (render.lpv). */
+    const char *lpv = getenv("LRB_SWEEP_LPV");
+    if (lpv && *lpv && (rc = lr_scene_set(s, "render.lpv", lpv, NULL, e)))
+        return rc;
     /* The model is per object; the sweep switches every object that can take it (the
      * multipole needs thickness_mm); lrb_sweep_takes says whether any can. */
     enum lr_sss_model m;

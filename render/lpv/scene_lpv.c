@@ -1,0 +1,280 @@
+/* lamprig — the scene's light-propagation volume on the plane receivers (scene_lpv.h). */
+#include "render/lpv/scene_lpv.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render/area/emitter.h"
+#include "render/area/frames.h"
+#include "render/area/poisson_mesh.h"
+#include "render/cpu/recv_grid.h"
+#include "render/mesh/bvh.h"
+#include "render/optics/optics.h"
+
+#define EMITTER_POINTS 64
+
+typedef struct sample {
+    lr_vec3 p, n;
+    double area, refl[3]; /* the share of E sent back to the lit side */
+    int group;
+} sample;
+
+typedef struct samples {
+    sample *s;
+    int n, cap;
+} samples;
+
+static int push(samples *ss, sample x)
+{
+    if (ss->n == ss->cap) {
+        int cap = ss->cap ? 2 * ss->cap : 1024;
+        sample *t = realloc(ss->s, sizeof *t * (size_t)cap);
+        if (!t)
+            return LR_ENOMEM;
+        ss->s = t;
+        ss->cap = cap;
+    }
+    ss->s[ss->n++] = x;
+    return LR_OK;
+}
+
+static bool in_box(const lr_lpv *v, lr_vec3 p)
+{
+    int ijk[3];
+    return lr_lpv_cell_of(v, p, ijk) == 0;
+}
+
+/* Direct irradiance per unit radiance at x (normal nx) from the emitter points, shadowed by
+ * the scene's objects. */
+static double direct(const lr_scene *s, const lr_area_emitter *em, const lr_vec3 *pts, lr_vec3 x,
+                     lr_vec3 nx)
+{
+    double E = 0.0;
+    lr_vec3 o = lr_v3_add(x, lr_v3_scale(nx, 1e-3));
+    for (int j = 0; j < EMITTER_POINTS; j++) {
+        lr_vec3 d = lr_v3_sub(pts[j], o);
+        double dist = lr_v3_len(d);
+        if (!(dist > 0.0))
+            continue;
+        lr_vec3 w = lr_v3_scale(d, 1.0 / dist);
+        double cx = lr_v3_dot(w, nx);
+        if (cx <= 0.0)
+            continue;
+        double I = lr_area_intensity_factor(em, lr_v3_scale(w, -1.0)) / EMITTER_POINTS;
+        if (I <= 0.0)
+            continue;
+        bool hidden = false;
+        for (int i = 0; i < lr_scene_object_count(s) && !hidden; i++)
+            hidden = lr_bvh_occluded(lr_scene_object_at(s, i)->bvh, o, w, 1e-4, dist - 1e-4);
+        if (!hidden)
+            E += I * cx / (dist * dist);
+    }
+    return E;
+}
+
+static int receiver_samples(const lr_scene *s, const lr_lpv *v, samples *ss, int *count)
+{
+    double sp = lr_lpv_h(v) / 2.0;
+    for (int i = 0; i < lr_scene_receiver_count(s); i++) {
+        const lr_receiver *rc = lr_scene_receiver_at(s, i);
+        lr_recv_grid_frame f;
+        if (!lr_recv_grid_frame_of(rc, &f))
+            continue;
+        int ns = (int)ceil(f.w / sp), nt = (int)ceil(f.h / sp);
+        for (int a = 0; a < ns; a++)
+            for (int b = 0; b < nt; b++) {
+                double u = ((a + 0.5) / ns - 0.5) * f.w, t = ((b + 0.5) / nt - 0.5) * f.h;
+                lr_vec3 p = lr_v3_add(f.c, lr_v3_add(lr_v3_scale(f.a, u), lr_v3_scale(f.b, t)));
+                if (!in_box(v, p))
+                    continue;
+                sample x = {.p = p, .n = rc->normal, .area = (f.w / ns) * (f.h / nt),
+                            .group = i};
+                memcpy(x.refl, rc->albedo, sizeof x.refl);
+                if (push(ss, x))
+                    return LR_ENOMEM;
+                (*count)++;
+            }
+    }
+    return LR_OK;
+}
+
+static int object_samples(const lr_scene *s, const lr_lpv *v, int group, samples *ss,
+                          int *count, lr_err *e)
+{
+    for (int i = 0; i < lr_scene_object_count(s); i++) {
+        const lr_scene_object *o = lr_scene_object_at(s, i);
+        double R[3], T[3];
+        if (o->thickness_mm > 0.0)
+            lr_multipole_total(&o->coeffs, o->thickness_mm, R, T);
+        else
+            lr_dipole_rd_total(&o->coeffs, R);
+        lr_poisson_set set = {0};
+        int rc = lr_poisson_mesh(o->mesh, lr_lpv_h(v) / 3.0, 200000, 2000, 0x1F5u + (unsigned)i,
+                                 &set, e);
+        if (rc)
+            return rc;
+        for (int k = 0; k < set.n; k++) {
+            if (!in_box(v, set.s[k].p))
+                continue;
+            sample x = {.p = set.s[k].p, .n = set.s[k].n, .area = set.s[k].area,
+                        .group = group};
+            memcpy(x.refl, R, sizeof x.refl);
+            if (push(ss, x)) {
+                lr_poisson_set_free(&set);
+                return LR_ENOMEM;
+            }
+            (*count)++;
+        }
+        lr_poisson_set_free(&set);
+    }
+    return LR_OK;
+}
+
+static int cpu_propagate(void *ctx, lr_lpv *v, int steps, lr_err *e)
+{
+    (void)ctx;
+    return lr_lpv_propagate(v, steps, e);
+}
+
+static int build_box(const lr_scene *s, int n, lr_lpv **out, lr_err *e)
+{
+    lr_vec3 lo = lr_v3(INFINITY, INFINITY, INFINITY), hi = lr_v3(-INFINITY, -INFINITY, -INFINITY);
+    for (int i = 0; i < lr_scene_object_count(s); i++) {
+        lr_vec3 a, b;
+        lr_mesh_bounds(lr_scene_object_at(s, i)->mesh, &a, &b);
+        lo = lr_v3(fmin(lo.x, a.x), fmin(lo.y, a.y), fmin(lo.z, a.z));
+        hi = lr_v3(fmax(hi.x, b.x), fmax(hi.y, b.y), fmax(hi.z, b.z));
+    }
+    if (lr_scene_object_count(s) == 0)
+        return lr_err_set(e, LR_EINVAL, "lpv: the scene has no objects to place the volume");
+    lr_vec3 ext = lr_v3_sub(hi, lo);
+    lr_lpv_desc d;
+    /* 1.25 extents: a wall or table near the lamp lies a few cells inside the box (light that
+     * reaches the border leaves; a receiver on it would gather nothing). */
+    int rc = lr_lpv_desc_around(lo, hi, 1.25 * fmax(ext.x, fmax(ext.y, ext.z)), n, &d, e);
+    return rc ? rc : lr_lpv_create(&d, out, e);
+}
+
+/* Adds the volume's irradiance at every plane receiver's grid texels (but group g's own). */
+static void gather_receivers(const lr_scene *s, const lr_lpv *v, int g, double *const *out,
+                             double gathered[3])
+{
+    size_t texels = (size_t)LR_RECV_GRID * LR_RECV_GRID;
+    for (int i = 0; i < lr_scene_receiver_count(s); i++) {
+        lr_recv_grid_frame f;
+        const lr_receiver *r = lr_scene_receiver_at(s, i);
+        if (i == g || !out[i] || !lr_recv_grid_frame_of(r, &f))
+            continue;
+        double ta = f.w * f.h / (double)texels;
+        for (int t = 0; t < LR_RECV_GRID; t++)
+            for (int q = 0; q < LR_RECV_GRID; q++) {
+                double E[3];
+                lr_lpv_irradiance(v, lr_recv_grid_point(&f, q, t), r->normal, E);
+                for (int c = 0; c < 3; c++) {
+                    out[i][((size_t)t * LR_RECV_GRID + q) * 3 + c] += E[c];
+                    gathered[c] += E[c] * ta;
+                }
+            }
+    }
+}
+
+int lr_lpv_scene_indirect(const lr_scene *s, int light, const lr_lpv_scene_desc *d,
+                          double *const *out, lr_lpv_scene_stats *stats, lr_err *e)
+{
+    lr_lpv_scene_stats st;
+    memset(&st, 0, sizeof st);
+    int n = d && d->n ? d->n : 32;
+    if (light < 0 || light >= lr_scene_light_count(s))
+        return lr_err_set(e, LR_EINVAL, "lpv: light %d of %d", light, lr_scene_light_count(s));
+    int nrec = lr_scene_receiver_count(s);
+    size_t texels = (size_t)LR_RECV_GRID * LR_RECV_GRID;
+    for (int i = 0; i < nrec; i++)
+        if (out[i])
+            memset(out[i], 0, texels * 3 * sizeof *out[i]);
+    const lr_light *li = lr_scene_light_at(s, light);
+    if (!lr_light_is_area(li)) {
+        if (stats)
+            *stats = st;
+        return LR_OK;
+    }
+    lr_area_emitter em;
+    int rc = lr_area_from_light(li, &em, e);
+    if (rc)
+        return rc;
+    lr_vec3 pts[EMITTER_POINTS];
+    lr_area_stratified(&em, EMITTER_POINTS, 0x1B0u + (unsigned)light, pts);
+    lr_lpv *v = NULL;
+    if ((rc = build_box(s, n, &v, e)))
+        return rc;
+    st.cell_mm = lr_lpv_h(v);
+    samples ss = {0};
+    rc = receiver_samples(s, v, &ss, &st.samples_receivers);
+    if (rc)
+        lr_err_set(e, rc, "lpv: out of memory for receiver samples");
+    if (!rc)
+        rc = object_samples(s, v, nrec, &ss, &st.samples_objects, e);
+    for (int k = 0; k < ss.n && !rc; k++)
+        rc = lr_lpv_add_blocker(v, ss.s[k].p, ss.s[k].n, ss.s[k].area, e);
+    /* Direct light and reflected flux of every sample (the gathering of Eq. 3b). */
+    double *phi = rc ? NULL : malloc(sizeof *phi * 3 * (size_t)(ss.n ? ss.n : 1));
+    if (!rc && !phi)
+        rc = lr_err_set(e, LR_ENOMEM, "lpv: out of memory");
+    for (int k = 0; k < ss.n && !rc; k++) {
+        double E = direct(s, &em, pts, ss.s[k].p, ss.s[k].n);
+        if (ss.s[k].group < nrec)
+            st.direct_receivers += E * ss.s[k].area;
+        for (int c = 0; c < 3; c++)
+            phi[3 * k + c] = ss.s[k].refl[c] * E * ss.s[k].area;
+    }
+    lr_lpv_propagate_fn prop = d && d->propagate ? d->propagate : cpu_propagate;
+    void *ctx = d ? d->ctx : NULL;
+    int bounces = d && d->bounces > 0 ? d->bounces : 0;
+    /* What the objects' samples receive from the volume, for their next bounce. */
+    double *next = rc ? NULL : calloc(3 * (size_t)(ss.n ? ss.n : 1), sizeof *next);
+    if (!rc && !next)
+        rc = lr_err_set(e, LR_ENOMEM, "lpv: out of memory");
+    for (int b = 0; b <= bounces && !rc; b++) {
+        for (int g = b == 0 ? 0 : nrec; g <= nrec && !rc; g++) {
+            lr_lpv_clear_light(v);
+            bool any = false;
+            for (int k = 0; k < ss.n && !rc; k++) {
+                if (ss.s[k].group != g)
+                    continue;
+                rc = lr_lpv_inject_lobe(v, ss.s[k].p, ss.s[k].n, &phi[3 * k], e);
+                for (int c = 0; c < 3; c++) {
+                    st.injected[c] += phi[3 * k + c];
+                    any |= phi[3 * k + c] > 0.0;
+                }
+            }
+            if (rc || !any)
+                continue;
+            if ((rc = prop(ctx, v, 4 * n, e)))
+                break;
+            gather_receivers(s, v, g, out, st.gathered);
+            for (int k = 0; k < ss.n && b < bounces; k++) {
+                if (ss.s[k].group != nrec)
+                    continue;
+                double E[3];
+                lr_lpv_irradiance(v, ss.s[k].p, ss.s[k].n, E);
+                for (int c = 0; c < 3; c++)
+                    next[3 * k + c] += E[c];
+            }
+        }
+        /* The next bounce: the objects reflect what the volume delivered to them. */
+        for (int k = 0; k < ss.n && next; k++)
+            for (int c = 0; c < 3; c++) {
+                phi[3 * k + c] = ss.s[k].group == nrec
+                                     ? ss.s[k].refl[c] * next[3 * k + c] * ss.s[k].area
+                                     : 0.0;
+                next[3 * k + c] = 0.0;
+            }
+    }
+    free(next);
+    free(phi);
+    free(ss.s);
+    lr_lpv_destroy(v);
+    if (stats)
+        *stats = st;
+    return rc;
+}

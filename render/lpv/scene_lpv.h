@@ -1,0 +1,65 @@
+/* lamprig — the light-propagation volume of a scene (seed 004 Sec. 3.2, 4.1-4.4): the
+ * indirect irradiance on the plane receivers that the maps and VPLs do not carry (issue 12
+ * parts 3-4), per light at unit radiance, on the receivers' irradiance grids
+ * (render/cpu/recv_grid.h), for composition to add to the direct light.
+ *
+ *  - Volume: n^3 cells around the objects' bounds, widened on every side by 1.25 times their
+ *    largest extent (the table and wall near a lamp fall a few cells inside; light reaching
+ *    the border leaves, so a receiver on it would gather nothing).
+ *  - Blocking: diffuse samples on the plane receivers (a grid of spacing h/2 where the plane
+ *    crosses the volume) and Poisson-disk samples on the objects (render/area/poisson_mesh.h,
+ *    r_min = h/3), each blocking its interfaces (lpv.h).
+ *  - Injection, per source group (each plane receiver, and the objects together):
+ *      (a) DPDS on a receiver: its direct irradiance E from the area light (64 stratified
+ *          emitter points, shadow rays through the objects), reflected flux rho E A as the
+ *          lobe of Eq. 3b-4 one cell off the plane;
+ *      (b) TPDS on the objects: the part R of the direct light that the wall sends back to
+ *          the side it came from (the slab's total diffuse reflectance, Donner-Jensen
+ *          multipole for objects with thickness_mm, else the semi-infinite dipole's), as the
+ *          lobe along the lit face's normal: light the inner face of a shade returns into the
+ *          cavity and that leaves through the openings. (The seed's TPLs carry the object's
+ *          emergent radiosity; here the reflected share of the direct light, which the maps
+ *          only show to the camera and the outer-surface VPLs never send to the receivers.)
+ *  - Propagation: 4 n steps per group (lpv.h; on the CPU, or the caller's, e.g. the compute
+ *    shader), gather from the absorbed record at the receiver grid's texel centres. A group
+ *    is never gathered on itself: a plane cannot light itself, but the volume's diffusion
+ *    would return part of its own lobe. Light blocked by a surface is absorbed; with
+ *    `bounces` > 0 the objects' samples gather what the volumes delivered to them and send
+ *    R of it back in, once per bounce (a shade's cavity, whose inner wall returns R = 0.79
+ *    of paper's light, keeps most of its light for several bounces).
+ *
+ * Only area lights (quad, disk); other lights get nothing (LR_OK, zero grids). */
+#ifndef LR_LPV_SCENE_H
+#define LR_LPV_SCENE_H
+
+#include "render/base/err.h"
+#include "render/lpv/lpv.h"
+#include "render/scene/scene.h"
+
+/* Propagates v by `steps` (lr_lpv_propagate, or a GPU round trip). */
+typedef int (*lr_lpv_propagate_fn)(void *ctx, lr_lpv *v, int steps, lr_err *e);
+
+typedef struct lr_lpv_scene_desc {
+    int n;                         /* cells per axis; 0: 32 */
+    int bounces;                   /* further bounces off the objects (0: one bounce) */
+    lr_lpv_propagate_fn propagate; /* NULL: the CPU */
+    void *ctx;
+} lr_lpv_scene_desc;
+
+typedef struct lr_lpv_scene_stats {
+    double injected[3];  /* flux injected over all groups, W per unit radiance */
+    double gathered[3];  /* flux the receivers' grids account for (sum E A over the texels) */
+    double direct_receivers; /* the receivers' direct power from the light inside the volume
+                              * (sum E A over their samples), W per unit radiance */
+    int samples_receivers, samples_objects;
+    double cell_mm;
+} lr_lpv_scene_stats;
+
+/* Fills out[i] (LR_RECV_GRID^2 * 3 doubles, rows t, columns s, RGB) for every plane receiver
+ * i of the scene with light `light`'s indirect irradiance per unit radiance; out[i] NULL for
+ * a receiver to skip (box receivers are always skipped). stats may be NULL. LR_EINVAL for a
+ * bad light index or n; LR_ENOMEM. */
+int lr_lpv_scene_indirect(const lr_scene *s, int light, const lr_lpv_scene_desc *d,
+                          double *const *out, lr_lpv_scene_stats *stats, lr_err *e);
+
+#endif
