@@ -211,6 +211,18 @@ static int create_device(lr_rig *r, rigset *s, const lr_rig_device *d, lr_err *e
     return LR_OK;
 }
 
+/* The planner's text, one log line per line (it ends lines in '\n'; TEXT is cut in place). */
+static void log_lines(lr_rig *r, char *text)
+{
+    for (char *line = text, *nl; line && *line; line = nl + 1) {
+        if ((nl = strchr(line, '\n')))
+            *nl = '\0';
+        lr_log_write(&r->log, LR_LOG_INFO, "%s", line);
+        if (!nl)
+            break;
+    }
+}
+
 /* The planner (firmware/plan_scene.h) for a scene with a quality budget (in the scene file
  * or the config's scene_set), unless --no-plan: its settings are applied, then the config's
  * scene_set once more so that an explicit render.* setting wins. A missing or unusable table
@@ -233,13 +245,7 @@ static int plan_scene(lr_rig *r, const lr_rig_config *cfg, lr_scene *scene, bool
         lr_log_write(&r->log, LR_LOG_WARN, "plan: %s; running with the scene's settings", pe.msg);
     } else if (res->planned) {
         char *text = lr_plan_scene_text(res);
-        for (char *line = text, *nl; line && *line; line = nl + 1) {
-            if ((nl = strchr(line, '\n')))
-                *nl = '\0';
-            lr_log_write(&r->log, LR_LOG_INFO, "%s", line);
-            if (!nl)
-                break;
-        }
+        log_lines(r, text);
         free(text);
         *no_vpl = !res->vpl;
         rc = lr_rig_config_apply_sets(cfg, scene, e);
@@ -365,13 +371,7 @@ static void replan(lr_rig *r, unsigned *dirty)
     lr_err e = {0};
     if (lr_replan_update(r->set.replan, r->set.scene, *dirty, dirty, &text, NULL, &e))
         lr_log_write(&r->log, LR_LOG_WARN, "plan: %s", e.msg);
-    for (char *line = text, *nl; line && *line; line = nl + 1) {
-        if ((nl = strchr(line, '\n')))
-            *nl = '\0';
-        lr_log_write(&r->log, LR_LOG_INFO, "%s", line);
-        if (!nl)
-            break;
-    }
+    log_lines(r, text);
     free(text);
 }
 

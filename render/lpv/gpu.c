@@ -188,3 +188,14 @@ int lr_lpv_gpu_download(lr_lpv_gpu *g, lr_lpv *v, lr_err *e)
     free(ab);
     return rc;
 }
+
+int lr_lpv_gpu_run(void *ctx, lr_lpv *v, int steps, lr_err *e)
+{
+    lr_lpv_gpu *g = ctx;
+    int rc = lr_lpv_gpu_upload(g, v, e);
+    if (!rc)
+        rc = lr_lpv_gpu_propagate(g, steps, e);
+    if (!rc)
+        rc = lr_lpv_gpu_download(g, v, e);
+    return rc;
+}

@@ -25,5 +25,8 @@ int lr_lpv_gpu_upload(lr_lpv_gpu *g, const lr_lpv *v, lr_err *e);
 int lr_lpv_gpu_propagate(lr_lpv_gpu *g, int steps, lr_err *e);
 /* Reads the light in flight and the absorbed record back into v (lr_lpv_set_state). */
 int lr_lpv_gpu_download(lr_lpv_gpu *g, lr_lpv *v, lr_err *e);
+/* Upload, STEPS propagation steps, read back: the `propagate` callback of lr_lpv_scene_desc
+ * (render/lpv/scene_lpv.h) for the compute shader; ctx is the lr_lpv_gpu. */
+int lr_lpv_gpu_run(void *ctx, lr_lpv *v, int steps, lr_err *e);
 
 #endif

@@ -89,18 +89,6 @@ static int alloc(lr_area_direct *a, const lr_pass_ctx *c, lr_err *e)
     return LR_OK;
 }
 
-/* The volume propagated by the compute shader: upload, steps, read back. */
-static int gpu_propagate(void *ctx, lr_lpv *v, int steps, lr_err *e)
-{
-    lr_lpv_gpu *g = ctx;
-    int rc = lr_lpv_gpu_upload(g, v, e);
-    if (!rc)
-        rc = lr_lpv_gpu_propagate(g, steps, e);
-    if (!rc)
-        rc = lr_lpv_gpu_download(g, v, e);
-    return rc;
-}
-
 /* render.lpv: every area light's indirect irradiance on the plane receivers' grids
  * (render/lpv/scene_lpv.h: injection and gathering on the CPU, propagation on the GPU), per
  * unit radiance, into a->lpv (the layers of a->grid). */
@@ -129,7 +117,7 @@ static int lpv_build(lr_area_direct *a, const lr_pass_ctx *c, lr_err *e)
     for (int i = 0; i < nr && !rc; i++)
         if (a->layer[i] >= 0 && !(out[i] = malloc(sizeof *out[i] * texels * 3)))
             rc = lr_err_set(e, LR_ENOMEM, "lpv: out of memory");
-    lr_lpv_scene_desc d = {.n = n, .bounces = LPV_BOUNCES, .propagate = gpu_propagate, .ctx = g};
+    lr_lpv_scene_desc d = {.n = n, .bounces = LPV_BOUNCES, .propagate = lr_lpv_gpu_run, .ctx = g};
     for (int l = 0; l < nl && !rc; l++) {
         if ((rc = lr_lpv_scene_indirect(c->scene, l, &d, out, NULL, e)))
             break;

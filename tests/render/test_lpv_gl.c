@@ -137,17 +137,6 @@ static void test_gpu_matches_twin(void **st)
     lr_lpv_destroy(gpu);
 }
 
-static int gpu_propagate(void *ctx, lr_lpv *v, int steps, lr_err *e)
-{
-    lr_lpv_gpu *g = ctx;
-    int rc = lr_lpv_gpu_upload(g, v, e);
-    if (!rc)
-        rc = lr_lpv_gpu_propagate(g, steps, e);
-    if (!rc)
-        rc = lr_lpv_gpu_download(g, v, e);
-    return rc;
-}
-
 /* The scene's receiver grids (led_shade, light 0, 12^3 cells, one further bounce) with the
  * compute shader's propagation, as the renderer's area-direct pass makes them, against the
  * CPU twin's: within 1e-4 of the largest texel. */
@@ -170,7 +159,7 @@ static void test_scene_grids_match_twin(void **st)
     if (lr_lpv_gpu_create(gl, 12, NULL, &g, &e))
         fail_msg("%s", e.msg);
     lr_lpv_scene_desc dc = {.n = 12, .bounces = 1};
-    lr_lpv_scene_desc dg = {.n = 12, .bounces = 1, .propagate = gpu_propagate, .ctx = g};
+    lr_lpv_scene_desc dg = {.n = 12, .bounces = 1, .propagate = lr_lpv_gpu_run, .ctx = g};
     if (lr_lpv_scene_indirect(s, 0, &dc, cpu, NULL, &e) ||
         lr_lpv_scene_indirect(s, 0, &dg, gpu, NULL, &e))
         fail_msg("%s", e.msg);

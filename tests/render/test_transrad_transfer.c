@@ -18,21 +18,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/base/paths.h"
 #include "render/transrad/transrad.h"
 #include "tests/support/near.h"
+#include "tests/support/render.h"
 
 static lr_scene *load(const char *name)
 {
-    char path[1024];
-    snprintf(path, sizeof path, "%s/scenes/%s.json", lr_configs_dir(), name);
-    lr_scene *s;
-    lr_err e = {0};
-    if (lr_scene_load(path, NULL, &s, &e))
-        fail_msg("%s", e.msg);
-    if (lr_scene_set_assignment(s, "objects[0].model=translucent_radiosity", NULL, &e))
-        fail_msg("%s", e.msg);
-    return s;
+    static const char *const model[] = {"objects[0].model=translucent_radiosity", NULL};
+    return lr_test_scene(name, model, NULL);
 }
 
 static lr_tr *create(const lr_scene *s, int transfer_mb)
