@@ -137,19 +137,20 @@ static void test_gpu_matches_twin(void **st)
     lr_lpv_destroy(gpu);
 }
 
-/* The scene's receiver grids (led_shade, light 0, 12^3 cells, one further bounce) with the
- * compute shader's propagation, as the renderer's area-direct pass makes them, against the
- * CPU twin's: within 1e-4 of the largest texel. */
-static void test_scene_grids_match_twin(void **st)
+/* A scene's receiver grids (light 0, 12^3 cells, one further bounce) with the compute
+ * shader's propagation, as the renderer's area-direct pass makes them, against the CPU
+ * twin's: within 1e-4 of the largest texel. */
+static void grids_match_twin(const char *path)
 {
-    (void)st;
     lr_err e = {0};
     lr_scene *s = NULL;
-    if (lr_scene_load("configs/scenes/led_shade.json", NULL, &s, &e))
+    if (lr_scene_load(path, NULL, &s, &e))
         fail_msg("%s", e.msg);
     const size_t texels = (size_t)LR_RECV_GRID * LR_RECV_GRID;
-    double *cpu[2], *gpu[2];
-    for (int i = 0; i < 2; i++) {
+    int nr = lr_scene_receiver_count(s);
+    assert_true(nr >= 1 && nr <= 4);
+    double *cpu[4] = {NULL}, *gpu[4] = {NULL};
+    for (int i = 0; i < nr; i++) {
         cpu[i] = malloc(texels * 3 * sizeof(double));
         gpu[i] = malloc(texels * 3 * sizeof(double));
         assert_non_null(cpu[i]);
@@ -163,11 +164,11 @@ static void test_scene_grids_match_twin(void **st)
     if (lr_lpv_scene_indirect(s, 0, &dc, cpu, NULL, &e) ||
         lr_lpv_scene_indirect(s, 0, &dg, gpu, NULL, &e))
         fail_msg("%s", e.msg);
-    for (int i = 0; i < 2; i++) {
+    for (int i = 0; i < nr; i++) {
         double m = max_abs(cpu[i], texels * 3), worst = 0.0;
         for (size_t k = 0; k < texels * 3; k++)
             worst = fmax(worst, fabs(cpu[i][k] - gpu[i][k]));
-        printf("receiver %d: max |gpu - cpu| %.3g of max %.3g\n", i, worst, m);
+        printf("%s receiver %d: max |gpu - cpu| %.3g of max %.3g\n", path, i, worst, m);
         assert_true(m > 0.0);
         assert_true(worst <= 1e-4 * m);
         free(cpu[i]);
@@ -175,6 +176,20 @@ static void test_scene_grids_match_twin(void **st)
     }
     lr_lpv_gpu_destroy(g);
     lr_scene_destroy(s);
+}
+
+/* led_shade: an LED quad (area light, per unit radiance). */
+static void test_scene_grids_match_twin(void **st)
+{
+    (void)st;
+    grids_match_twin("configs/scenes/led_shade.json");
+}
+
+/* lampshade: a bulb (point light, per unit intensity) inside a shade. */
+static void test_point_scene_grids_match_twin(void **st)
+{
+    (void)st;
+    grids_match_twin("configs/scenes/lampshade.json");
 }
 
 static void test_gpu_bad_parameters(void **st)
@@ -200,6 +215,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_gpu_matches_twin),
         cmocka_unit_test(test_scene_grids_match_twin),
+        cmocka_unit_test(test_point_scene_grids_match_twin),
         cmocka_unit_test(test_gpu_bad_parameters),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
