@@ -21,6 +21,7 @@
 #include <stdlib.h>
 #include "tests/support/gl.h"
 #include "tests/support/near.h"
+#include "tests/support/render.h"
 
 LR_TEST_GL_FIXTURE(gl)
 
@@ -192,6 +193,65 @@ static void test_point_scene_grids_match_twin(void **st)
     grids_match_twin("configs/scenes/lampshade.json");
 }
 
+/* End to end, a point light (lampshade's bulb) with render.lpv = 8 and no VPLs: at receiver
+ * points in the shade's shadow (direct light 0, test_render_emergent.c) the renderer's HDR
+ * pixel is the volume's light alone, I albedo / pi E_lpv, E_lpv the CPU twin's grid there
+ * (2 further bounces, as the area-direct pass builds it) interpolated as composition does.
+ * Tolerance 2e-3 relative: the GPU propagation (1e-4 above) and the running-mean grid's
+ * half-float storage (2^-11). */
+static void test_renderer_point_light(void **st)
+{
+    (void)st;
+    static const char *const lpv[] = {"render.lpv=8", NULL};
+    lr_scene *s = lr_test_scene("lampshade", lr_test_small_settings, lpv);
+    enum { W = 64, H = 48 };
+    lr_renderer *r = lr_test_renderer(gl, s, W, H, true, 1);
+    lr_test_converge(r, 8);
+    float *hdr = lr_test_hdr(r);
+    const size_t texels = (size_t)LR_RECV_GRID * LR_RECV_GRID;
+    double *g[2] = {malloc(texels * 3 * sizeof(double)), malloc(texels * 3 * sizeof(double))};
+    assert_int_equal(lr_scene_receiver_count(s), 2);
+    assert_non_null(g[0]);
+    assert_non_null(g[1]);
+    lr_err e = {0};
+    lr_lpv_scene_desc d = {.n = 8, .bounces = 2};
+    if (lr_lpv_scene_indirect(s, 0, &d, g, NULL, &e))
+        fail_msg("%s", e.msg);
+    double I[3];
+    lr_light_rgb(lr_scene_light_at(s, 0), I);
+    static const struct { int receiver; lr_vec3 p; } probes[] = {
+        {0, {300.0, -150.0, 0.0}}, /* the table outside the light pool */
+        {1, {200.0, 250.0, 300.0}}, /* the wall beside the shade */
+    };
+    for (int i = 0; i < 2; i++) {
+        const lr_receiver *rc = lr_scene_receiver_at(s, probes[i].receiver);
+        int x, y;
+        assert_true(lr_test_project(s, W, H, probes[i].p, &x, &y));
+        lr_vec3 p = lr_test_pixel_on_plane(s, W, H, x, y, rc->center, rc->normal);
+        lr_recv_grid_frame f;
+        assert_true(lr_recv_grid_frame_of(rc, &f));
+        int idx[4];
+        double w[4];
+        lr_recv_grid_taps(&f, p, idx, w);
+        for (int c = 0; c < 3; c++) {
+            double E = 0.0;
+            for (int k = 0; k < 4; k++)
+                E += w[k] * g[probes[i].receiver][(size_t)idx[k] * 3 + c];
+            double L = I[c] * rc->albedo[c] / M_PI * E, got = hdr[3 * ((size_t)y * W + x) + c];
+            if (c == 0)
+                printf("receiver %d at (%.0f, %.0f, %.0f): pixel %.4g, I albedo / pi E_lpv "
+                       "%.4g\n", probes[i].receiver, p.x, p.y, p.z, got, L);
+            assert_true(L > 0.0);
+            assert_near(got, L, 2e-3 * L);
+        }
+    }
+    free(g[0]);
+    free(g[1]);
+    free(hdr);
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+}
+
 static void test_gpu_bad_parameters(void **st)
 {
     (void)st;
@@ -216,6 +276,7 @@ int main(void)
         cmocka_unit_test(test_gpu_matches_twin),
         cmocka_unit_test(test_scene_grids_match_twin),
         cmocka_unit_test(test_point_scene_grids_match_twin),
+        cmocka_unit_test(test_renderer_point_light),
         cmocka_unit_test(test_gpu_bad_parameters),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
