@@ -3,6 +3,7 @@
  * than was injected, the table under the shade and the wall receive indirect light, nothing
  * lands outside the volume, further bounces add light within R / (1 - R); a point light over
  * a table beside a wall injects the closed-form integral of albedo E over both planes; the
+ * spot with a cone wider than the planes injects the same, a narrow one less; the
  * lampshade's point light lights its receivers; a bad light index and n = 1 are refused. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -185,6 +186,51 @@ static void test_point_light_closed_form(void **st)
     lr_scene_destroy(s);
 }
 
+/* The same scene with the light a spot pointing down: with a cone wider than every sample's
+ * direction (inner 88.5 degrees; the wall's top samples are 88.2 degrees off the axis) the
+ * receivers inject exactly what the point light gives (the same code, shape 1); a 20-degree
+ * cone gives less, but some. */
+static void test_spot_light(void **st)
+{
+    (void)st;
+    lr_scene *s = lr_test_scene_text(POINT_SCENE, NULL);
+    lr_lpv_scene_desc d = {.n = 16};
+    lr_lpv_scene_stats point, wide, narrow;
+    lr_err e = {0};
+    double *g[2] = {malloc(TEXELS * 3 * sizeof(double)), malloc(TEXELS * 3 * sizeof(double))};
+    assert_non_null(g[0]);
+    assert_non_null(g[1]);
+    if (lr_lpv_scene_indirect(s, 0, &d, g, &point, &e))
+        fail_msg("%s", e.msg);
+    lr_scene_destroy(s);
+    const char *at_type = strstr(POINT_SCENE, "\"point\"");
+    assert_non_null(at_type);
+    char text[2048];
+    for (int k = 0; k < 2; k++) {
+        snprintf(text, sizeof text,
+                 "%.*s\"spot\", \"direction\": [0, 0, -1], \"inner_deg\": %s, "
+                 "\"outer_deg\": %s%s",
+                 (int)(at_type - POINT_SCENE), POINT_SCENE, k ? "10" : "88.5", k ? "20" : "89.5",
+                 at_type + strlen("\"point\""));
+        s = lr_test_scene_text(text, NULL);
+        assert_int_equal(lr_scene_light_at(s, 0)->type, LR_LIGHT_SPOT);
+        if (lr_lpv_scene_indirect(s, 0, &d, g, k ? &narrow : &wide, &e))
+            fail_msg("%s", e.msg);
+        lr_scene_destroy(s);
+    }
+    printf("receivers inject (R): point %.6g, spot 88.5-89.5 deg %.6g, spot 10-20 deg %.6g\n",
+           point.injected_receivers[0], wide.injected_receivers[0],
+           narrow.injected_receivers[0]);
+    for (int c = 0; c < 3; c++) {
+        assert_near(wide.injected_receivers[c], point.injected_receivers[c],
+                    1e-12 * point.injected_receivers[c]);
+        assert_true(narrow.injected_receivers[c] > 0.0);
+        assert_true(narrow.injected_receivers[c] < 0.5 * point.injected_receivers[c]);
+    }
+    free(g[0]);
+    free(g[1]);
+}
+
 static void test_point_light_and_bad_index(void **st)
 {
     (void)st;
@@ -235,6 +281,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_led_shade),
         cmocka_unit_test(test_point_light_closed_form),
+        cmocka_unit_test(test_spot_light),
         cmocka_unit_test(test_point_light_and_bad_index),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
