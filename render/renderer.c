@@ -144,7 +144,7 @@ static int radiosity_run(lr_renderer *r, unsigned dirty, lr_err *e)
     lr_pass_ctx c = pass_ctx(r);
     int rc = lr_radiosity_run(&r->rad, &c, &r->gbuffer, restart, e);
     /* The area lights' direct light: the same frame's sample, the same running mean. */
-    if (!rc && lr_area_direct_needed(r->scene))
+    if (!rc && lr_area_direct_pass_needed(r->scene))
         rc = lr_area_direct_run(&r->area, &c, &r->gbuffer, r->rad.F, e);
     return rc;
 }
@@ -498,7 +498,7 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
             return rc;
         /* The area lights' direct grid is a running mean over the map frames: new receivers
          * accumulate it again from the first frame, with the maps. */
-        if ((dirty & LR_DIRTY_RECEIVERS) && lr_area_direct_needed(r->scene)) {
+        if ((dirty & LR_DIRTY_RECEIVERS) && lr_area_direct_pass_needed(r->scene)) {
             dirty |= LR_DIRTY_LIGHT_GEOMETRY;
             lr_area_direct_free(&r->area);
         }

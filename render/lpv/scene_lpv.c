@@ -9,6 +9,7 @@
 #include "render/area/frames.h"
 #include "render/area/poisson_mesh.h"
 #include "render/cpu/recv_grid.h"
+#include "render/cpu/vpl.h"
 #include "render/mesh/bvh.h"
 #include "render/optics/optics.h"
 
@@ -193,17 +194,22 @@ int lr_lpv_scene_indirect(const lr_scene *s, int light, const lr_lpv_scene_desc 
         if (out[i])
             memset(out[i], 0, texels * 3 * sizeof *out[i]);
     const lr_light *li = lr_scene_light_at(s, light);
-    if (!lr_light_is_area(li)) {
+    bool area = lr_light_is_area(li);
+    if (!area && li->type != LR_LIGHT_POINT && li->type != LR_LIGHT_SPOT) {
         if (stats)
             *stats = st;
         return LR_OK;
     }
     lr_area_emitter em;
-    int rc = lr_area_from_light(li, &em, e);
-    if (rc)
-        return rc;
     lr_vec3 pts[EMITTER_POINTS];
-    lr_area_stratified(&em, EMITTER_POINTS, 0x1B0u + (unsigned)light, pts);
+    memset(&em, 0, sizeof em);
+    memset(pts, 0, sizeof pts);
+    int rc = LR_OK;
+    if (area) {
+        if ((rc = lr_area_from_light(li, &em, e)))
+            return rc;
+        lr_area_stratified(&em, EMITTER_POINTS, 0x1B0u + (unsigned)light, pts);
+    }
     lr_lpv *v = NULL;
     if ((rc = build_box(s, n, &v, e)))
         return rc;
@@ -221,11 +227,18 @@ int lr_lpv_scene_indirect(const lr_scene *s, int light, const lr_lpv_scene_desc 
     if (!rc && !phi)
         rc = lr_err_set(e, LR_ENOMEM, "lpv: out of memory");
     for (int k = 0; k < ss.n && !rc; k++) {
-        double E = direct(s, &em, pts, ss.s[k].p, ss.s[k].n);
+        /* Point and spot lights: I cos / d^2 per unit intensity with the spot's cone, 0 when
+         * an object is in the way: the shadow test of the renderer's direct light (the light
+         * G-buffer's, done with rays as in the CPU twin). */
+        double E = area ? direct(s, &em, pts, ss.s[k].p, ss.s[k].n)
+                        : lr_cpu_direct_irradiance(s, li, ss.s[k].p, ss.s[k].n);
         if (ss.s[k].group < nrec)
             st.direct_receivers += E * ss.s[k].area;
-        for (int c = 0; c < 3; c++)
+        for (int c = 0; c < 3; c++) {
             phi[3 * k + c] = ss.s[k].refl[c] * E * ss.s[k].area;
+            if (ss.s[k].group < nrec)
+                st.injected_receivers[c] += phi[3 * k + c];
+        }
     }
     lr_lpv_propagate_fn prop = d && d->propagate ? d->propagate : cpu_propagate;
     void *ctx = d ? d->ctx : NULL;

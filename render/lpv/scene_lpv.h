@@ -28,7 +28,10 @@
  *    R of it back in, once per bounce (a shade's cavity, whose inner wall returns R = 0.79
  *    of paper's light, keeps most of its light for several bounces).
  *
- * Only area lights (quad, disk); other lights get nothing (LR_OK, zero grids). */
+ * Area lights (quad, disk) per unit radiance; point and spot lights per unit intensity, their
+ * direct irradiance I cos / d^2 (spot: times the cone's shape) at every sample, 0 where an
+ * object is in the way (lr_cpu_direct_irradiance: the renderer's shadow test, with rays);
+ * directional lights get nothing (LR_OK, zero grids). */
 #ifndef LR_LPV_SCENE_H
 #define LR_LPV_SCENE_H
 
@@ -49,6 +52,9 @@ typedef struct lr_lpv_scene_desc {
 typedef struct lr_lpv_scene_stats {
     double injected[3];  /* flux injected over all groups, W per unit radiance */
     double gathered[3];  /* flux the receivers' grids account for (sum E A over the texels) */
+    double injected_receivers[3]; /* the receivers' share of the first injection: sum over
+                                   * their samples of albedo E A, W per unit radiance (area
+                                   * lights) or intensity (point, spot) */
     double direct_receivers; /* the receivers' direct power from the light inside the volume
                               * (sum E A over their samples), W per unit radiance */
     int samples_receivers, samples_objects;
@@ -56,8 +62,9 @@ typedef struct lr_lpv_scene_stats {
 } lr_lpv_scene_stats;
 
 /* Fills out[i] (LR_RECV_GRID^2 * 3 doubles, rows t, columns s, RGB) for every plane receiver
- * i of the scene with light `light`'s indirect irradiance per unit radiance; out[i] NULL for
- * a receiver to skip (box receivers are always skipped). stats may be NULL. LR_EINVAL for a
+ * i of the scene with light `light`'s indirect irradiance per unit radiance (area) or
+ * intensity (point, spot); out[i] NULL for a receiver to skip (box receivers are always
+ * skipped). stats may be NULL. LR_EINVAL for a
  * bad light index or n; LR_ENOMEM. */
 int lr_lpv_scene_indirect(const lr_scene *s, int light, const lr_lpv_scene_desc *d,
                           double *const *out, lr_lpv_scene_stats *stats, lr_err *e);

@@ -28,6 +28,24 @@ bool lr_area_direct_needed(const lr_scene *s)
     return false;
 }
 
+bool lr_area_direct_pass_needed(const lr_scene *s)
+{
+    if (lr_area_direct_needed(s))
+        return true;
+    if (lr_scene_render(s)->lpv <= 0)
+        return false;
+    bool lit = false, plane = false;
+    for (int l = 0; l < lr_scene_light_count(s); l++) {
+        enum lr_light_type t = lr_scene_light_at(s, l)->type;
+        lit |= t == LR_LIGHT_POINT || t == LR_LIGHT_SPOT;
+    }
+    for (int i = 0; i < lr_scene_receiver_count(s); i++) {
+        lr_recv_grid_frame f;
+        plane |= lr_recv_grid_frame_of(lr_scene_receiver_at(s, i), &f);
+    }
+    return lit && plane;
+}
+
 int lr_area_direct_check(const lr_scene *s, lr_err *e)
 {
     if (!lr_area_direct_needed(s))
@@ -89,9 +107,9 @@ static int alloc(lr_area_direct *a, const lr_pass_ctx *c, lr_err *e)
     return LR_OK;
 }
 
-/* render.lpv: every area light's indirect irradiance on the plane receivers' grids
- * (render/lpv/scene_lpv.h: injection and gathering on the CPU, propagation on the GPU), per
- * unit radiance, into a->lpv (the layers of a->grid). */
+/* render.lpv: every area, point and spot light's indirect irradiance on the plane
+ * receivers' grids (render/lpv/scene_lpv.h: injection and gathering on the CPU, propagation
+ * on the GPU), per unit radiance or intensity, into a->lpv (the layers of a->grid). */
 static int lpv_build(lr_area_direct *a, const lr_pass_ctx *c, lr_err *e)
 {
     lr_tex_destroy(a->lpv);

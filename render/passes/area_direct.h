@@ -24,6 +24,9 @@ typedef struct lr_area_direct {
 
 /* Whether the scene has an area light (the grid is needed). */
 bool lr_area_direct_needed(const lr_scene *s);
+/* Whether the pass runs: an area light, or render.lpv > 0 with a point or spot light and a
+ * plane receiver (the grid then carries those lights' volume light alone, 0 direct). */
+bool lr_area_direct_pass_needed(const lr_scene *s);
 /* LR_EUNSUPPORTED when the scene has an area light and a box receiver (no grid there),
  * naming both; else LR_OK. */
 int lr_area_direct_check(const lr_scene *s, lr_err *e);

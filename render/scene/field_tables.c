@@ -327,8 +327,8 @@ static const lr_field render_fields[] = {
     {"surface_cache", LR_FT_BOOL, 0, RS(surface_cache), .dflt = {0}, .dirty = LR_DIRTY_CAMERA,
      .help = "objects' B from the per-vertex surface cache (false: Algorithm 1 per pixel)"},
     {"lpv", LR_FT_INT, 0, RS(lpv), 0, 128, Z, .dflt = {0}, .dirty = SET,
-     .help = "light-propagation volume cells per axis for area lights' indirect light on plane "
-             "receivers (seed 004; 0: off, else 2-128, e.g. 32)"},
+     .help = "light-propagation volume cells per axis for area, point and spot lights' "
+             "indirect light on plane receivers (seed 004; 0: off, else 2-128, e.g. 32)"},
 };
 
 const lr_record_desc lr_scene_render_desc = {"render", "render", NULL, NULL, NULL, NULL,

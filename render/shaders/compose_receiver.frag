@@ -56,8 +56,11 @@ void main()
             E[l] = u_area_cached ? lr_grid_bilinear(u_area_grid, u_area_layer + l, x, u_area_c,
                                                     u_area_a, u_area_b)
                                  : vec3(0.0);
-        else
-            E[l] = vec3(lr_lights_direct(l, x, nx));
+        else // the grid's layer of a point or spot light holds its render.lpv light alone
+            E[l] = vec3(lr_lights_direct(l, x, nx)) +
+                   (u_area_cached ? lr_grid_bilinear(u_area_grid, u_area_layer + l, x, u_area_c,
+                                                     u_area_a, u_area_b)
+                                  : vec3(0.0));
     }
     if (u_use_vpl && u_cached) {
         int R = textureSize(u_irr, 0).x;
