@@ -18,11 +18,39 @@ typedef struct dl_ctx {
     double eps;
 } dl_ctx;
 
-static void dl_item(void *vctx, long item)
+/* A point, spot or directional light's irradiance shape(w) cos / d^2 at x, shadowed. */
+static void point_irradiance(const void *vctx, size_t p, unsigned k, lr_vec3 x, lr_vec3 n,
+                             bool trans, double eta, double *e, double *ein)
 {
-    dl_ctx *c = vctx;
-    lr_tr *t = c->t;
-    size_t p = (size_t)item;
+    (void)p, (void)k;
+    const dl_ctx *c = vctx;
+    *e = *ein = 0;
+    lr_vec3 w;
+    double dist, g;
+    if (c->light->type == LR_LIGHT_DIRECTIONAL) {
+        w = lr_v3_scale(c->light->direction, -1);
+        dist = INFINITY;
+        g = 1;
+    } else {
+        lr_vec3 L = lr_v3_sub(c->light->position, x);
+        dist = lr_v3_len(L);
+        if (!(dist > 0))
+            return;
+        w = lr_v3_scale(L, 1 / dist);
+        g = lr_light_shape(c->light, lr_v3_scale(w, -1)) / (dist * dist);
+    }
+    double cs = lr_v3_dot(n, w);
+    if (cs <= 0 || g <= 0)
+        return;
+    lr_vec3 o = lr_v3_add(x, lr_v3_scale(n, c->eps));
+    if (lr_tr_occluded(c->t, o, w, isfinite(dist) ? dist - c->eps : INFINITY))
+        return;
+    *e = g * cs;
+    *ein = g * cs * (trans ? lr_fresnel_transmittance(cs, eta) : 1.0);
+}
+
+void lr_tr_direct_patch(lr_tr *t, size_t p, lr_tr_point_irradiance point, const void *ctx)
+{
     const lr_tr_surf *sf = &t->surf[t->p[p].surface];
     bool trans = sf->d.kind == LR_TR_TRANSLUCENT;
     double eta = trans ? sf->d.coeffs->eta : 1.0;
@@ -31,34 +59,23 @@ static void dl_item(void *vctx, long item)
     double ju = lr_cpu_rng_next(&rng), jv = lr_cpu_rng_next(&rng);
     double e = 0, ein = 0;
     for (unsigned k = 0; k < m; k++) {
-        lr_vec3 x, n, w;
+        lr_vec3 x, n;
         lr_tr_patch_point(t, p, k, m, ju, jv, &x, &n);
-        double dist, g;
-        if (c->light->type == LR_LIGHT_DIRECTIONAL) {
-            w = lr_v3_scale(c->light->direction, -1);
-            dist = INFINITY;
-            g = 1;
-        } else {
-            lr_vec3 L = lr_v3_sub(c->light->position, x);
-            dist = lr_v3_len(L);
-            if (!(dist > 0))
-                continue;
-            w = lr_v3_scale(L, 1 / dist);
-            g = lr_light_shape(c->light, lr_v3_scale(w, -1)) / (dist * dist);
-        }
-        double cs = lr_v3_dot(n, w);
-        if (cs <= 0 || g <= 0)
-            continue;
-        lr_vec3 o = lr_v3_add(x, lr_v3_scale(n, c->eps));
-        if (lr_tr_occluded(t, o, w, isfinite(dist) ? dist - c->eps : INFINITY))
-            continue;
-        e += g * cs;
-        ein += g * cs * (trans ? lr_fresnel_transmittance(cs, eta) : 1.0);
+        double ek, eik;
+        point(ctx, p, k, x, n, trans, eta, &ek, &eik);
+        e += ek;
+        ein += eik;
     }
     for (int b = 0; b < 3; b++) {
         t->Edir[3 * p + (size_t)b] = e / m;
         t->Ein[3 * p + (size_t)b] = ein / m;
     }
+}
+
+static void dl_item(void *vctx, long item)
+{
+    dl_ctx *c = vctx;
+    lr_tr_direct_patch(c->t, (size_t)item, point_irradiance, c);
 }
 
 int lr_tr_direct(lr_tr *t, const lr_light *light, lr_err *e)

@@ -78,30 +78,17 @@ static void point_light(const da_ctx *c, lr_vec3 x, lr_vec3 n, bool trans, doubl
     *ein = E0 * wi / ws;
 }
 
+static void area_point(const void *vctx, size_t p, unsigned k, lr_vec3 x, lr_vec3 n, bool trans,
+                       double eta, double *e, double *ein)
+{
+    const da_ctx *c = vctx;
+    point_light(c, x, n, trans, eta, lr_cpu_key(c->t->set.seed, 0xA7EA, p, k), e, ein);
+}
+
 static void da_item(void *vctx, long item)
 {
     da_ctx *c = vctx;
-    lr_tr *t = c->t;
-    size_t p = (size_t)item;
-    const lr_tr_surf *sf = &t->surf[t->p[p].surface];
-    bool trans = sf->d.kind == LR_TR_TRANSLUCENT;
-    double eta = trans ? sf->d.coeffs->eta : 1.0;
-    unsigned m = (unsigned)t->set.direct_samples;
-    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(t->set.seed, 0xD1EC, p, 0));
-    double ju = lr_cpu_rng_next(&rng), jv = lr_cpu_rng_next(&rng);
-    double e = 0, ein = 0;
-    for (unsigned k = 0; k < m; k++) {
-        lr_vec3 x, n;
-        lr_tr_patch_point(t, p, k, m, ju, jv, &x, &n);
-        double ek, eik;
-        point_light(c, x, n, trans, eta, lr_cpu_key(t->set.seed, 0xA7EA, p, k), &ek, &eik);
-        e += ek;
-        ein += eik;
-    }
-    for (int b = 0; b < 3; b++) {
-        t->Edir[3 * p + (size_t)b] = e / m;
-        t->Ein[3 * p + (size_t)b] = ein / m;
-    }
+    lr_tr_direct_patch(c->t, (size_t)item, area_point, c);
 }
 
 int lr_tr_direct_area(lr_tr *t, const lr_light *light, lr_err *e)

@@ -132,15 +132,7 @@ int lr_tr_build_form_factors(lr_tr *t, lr_err *e)
         memcpy(t->F.val + t->F.row[p], c.vals[p], c.counts[p] * sizeof *t->F.val);
     }
 done:
-    if (c.cols)
-        for (size_t p = 0; p < n; p++)
-            free(c.cols[p]);
-    if (c.vals)
-        for (size_t p = 0; p < n; p++)
-            free(c.vals[p]);
-    free(c.cols);
-    free(c.vals);
-    free(c.counts);
+    lr_tr_row_lists_free(n, c.cols, c.vals, c.counts);
     return rc;
 }
 
@@ -157,4 +149,15 @@ double lr_tr_form_factor(const lr_tr *t, size_t p, size_t q)
 double lr_tr_escape(const lr_tr *t, size_t p)
 {
     return p < t->n ? t->escape[p] : 0;
+}
+
+void lr_tr_row_lists_free(size_t n, uint32_t **cols, float **vals, size_t *counts)
+{
+    for (size_t p = 0; cols && p < n; p++)
+        free(cols[p]);
+    for (size_t p = 0; vals && p < n; p++)
+        free(vals[p]);
+    free(cols);
+    free(vals);
+    free(counts);
 }

@@ -250,15 +250,7 @@ int lr_tr_build_subsurface(lr_tr *t, lr_err *e)
         memcpy(t->S.val + 3 * t->S.row[p], c.vals[p], 3 * c.counts[p] * sizeof *t->S.val);
     }
 done:
-    if (c.cols)
-        for (size_t p = 0; p < n; p++)
-            free(c.cols[p]);
-    if (c.vals)
-        for (size_t p = 0; p < n; p++)
-            free(c.vals[p]);
-    free(c.cols);
-    free(c.vals);
-    free(c.counts);
+    lr_tr_row_lists_free(n, c.cols, c.vals, c.counts);
     return rc;
 }
 

@@ -84,6 +84,17 @@ int lr_tr_optical_distances(const lr_tr *t, int s, double **out, lr_err *e);
 /* subsurface.c */
 int lr_tr_build_subsurface(lr_tr *t, lr_err *e);
 /* direct.c: E and Ein of one light at unit intensity (area lights: direct_area.c). */
+/* Frees the per-patch row lists that F and S are built from before they are packed into their
+ * CSR arrays (formfactor.c, subsurface.c); any of the three may be NULL. */
+void lr_tr_row_lists_free(size_t n, uint32_t **cols, float **vals, size_t *counts);
+/* The irradiance of one light at point k (x, normal n) of patch p, unit intensity: all of it
+ * (*e) and the part that enters a translucent patch (*ein; eta its index). */
+typedef void (*lr_tr_point_irradiance)(const void *ctx, size_t p, unsigned k, lr_vec3 x,
+                                       lr_vec3 n, bool trans, double eta, double *e,
+                                       double *ein);
+/* Patch p's Edir and Ein, all bands: the mean of POINT over its direct_samples points
+ * (direct.c; the point and the area lights' per-patch loop). */
+void lr_tr_direct_patch(lr_tr *t, size_t p, lr_tr_point_irradiance point, const void *ctx);
 int lr_tr_direct(lr_tr *t, const lr_light *light, lr_err *e);
 /* direct_area.c: the same for a quad or disk light at unit radiance; LR_EINVAL for a
  * degenerate emitter. */

@@ -365,52 +365,11 @@ static void test_vpls(void **state)
 /* recv_direct_tol: relative tolerance on the receivers without VPLs (direct light only). */
 static void final_image_of(const char *scene, bool no_vpl, double recv_direct_tol)
 {
-    const int W = 32, H = 24;
     static const char *const more_maps[] = {"render.K=8", NULL};
     lr_scene *s = lr_test_scene(scene, parity_settings, more_maps);
-    lr_renderer *r = lr_test_renderer(gl, s, W, H, no_vpl, 3);
-    lr_test_converge(r, 20);
-    float *hdr = lr_test_hdr(r); /* rows bottom up */
-    lr_cpu_render_desc d = {.scene = s, .width = W, .height = H, .mode = LR_CPU_PASS,
-                            .no_vpl = no_vpl};
-    lr_image twin, var;
-    lr_cpu_render_stats st;
-    lr_err e = {0};
-    if (lr_cpu_render(&d, &twin, &var, &st, &e))
-        fail_msg("%s", e.msg);
-    double sum_g[2] = {0}, sum_c[2] = {0}, v[2] = {0};
-    for (int y = 0; y < H; y++)
-        for (int x = 0; x < W; x++) {
-            lr_vec3 org, dir;
-            lr_cpu_camera_ray(s, W, H, x, y, &org, &dir);
-            lr_hit h;
-            int region = lr_bvh_intersect(lr_scene_object_at(s, 0)->bvh, org, dir, 0, INFINITY, &h) ? 0 : 1;
-            const float *gp = hdr + 3 * ((size_t)(H - 1 - y) * W + x);
-            const float *cp = twin.rgb + 3 * ((size_t)y * W + x);
-            const float *vp = var.rgb + 3 * ((size_t)y * W + x);
-            for (int c = 0; c < 3; c++) {
-                assert_true(isfinite(gp[c]) && gp[c] >= 0.0f);
-                sum_g[region] += gp[c];
-                sum_c[region] += cp[c];
-                v[region] += 2.0 * vp[c];
-            }
-        }
-    const char *names[2] = {"object", "receivers"};
-    for (int i = 0; i < 2; i++) {
-        print_message("final image of %s%s, %s pixels: GPU %.5g, CPU twin %.5g (%+.2f %%, "
-                      "sigma %.2f %%)\n", scene, no_vpl ? " (no VPL)" : "", names[i], sum_g[i],
-                      sum_c[i],
-                      100 * (sum_g[i] / sum_c[i] - 1),
-                      100 * sqrt(v[i]) / sum_c[i]);
-        if (i == 0)
-            assert_near(sum_g[i], sum_c[i], 4.0 * sqrt(v[i]) + 0.05 * sum_c[i]);
-        else
-            assert_near_rel(sum_g[i], sum_c[i], no_vpl ? recv_direct_tol : 0.20);
-    }
-    free(hdr);
-    lr_image_free(&twin);
-    lr_image_free(&var);
-    lr_renderer_destroy(r);
+    char label[64];
+    snprintf(label, sizeof label, "final image of %s", scene);
+    lr_test_final_image_vs_twin(gl, s, 32, 24, label, no_vpl, recv_direct_tol);
     lr_scene_destroy(s);
 }
 

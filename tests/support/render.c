@@ -7,11 +7,14 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "render/base/mat4.h"
+#include "render/cpu/frame.h"
+#include "tests/support/near.h"
 
 const char *const lr_test_small_settings[] = {
     "render.K=6",          "render.N=4",           "render.map_size=48", "render.gbuffer_size=64",
@@ -133,4 +136,52 @@ lr_vec3 lr_test_pixel_on_plane(const lr_scene *s, int w, int h, int x, int y, lr
     lr_vec3 d = lr_v3_sub(b, a);
     double t = lr_v3_dot(lr_v3_sub(c, a), n) / lr_v3_dot(d, n);
     return lr_v3_add(a, lr_v3_scale(d, t));
+}
+
+void lr_test_final_image_vs_twin(lr_gl *gl, lr_scene *s, int w, int h, const char *label,
+                                 bool no_vpl, double recv_tol)
+{
+    lr_renderer *r = lr_test_renderer(gl, s, w, h, no_vpl, 3);
+    lr_test_converge(r, 20);
+    float *hdr = lr_test_hdr(r); /* rows bottom up */
+    lr_cpu_render_desc d = {.scene = s, .width = w, .height = h, .mode = LR_CPU_PASS,
+                            .no_vpl = no_vpl};
+    lr_image twin, var;
+    lr_cpu_render_stats st;
+    lr_err e = {0};
+    if (lr_cpu_render(&d, &twin, &var, &st, &e))
+        fail_msg("%s", e.msg);
+    double sum_g[2] = {0}, sum_c[2] = {0}, v[2] = {0};
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            lr_vec3 org, dir;
+            lr_cpu_camera_ray(s, w, h, x, y, &org, &dir);
+            lr_hit hit;
+            int region = lr_bvh_intersect(lr_scene_object_at(s, 0)->bvh, org, dir, 0, INFINITY,
+                                          &hit) ? 0 : 1;
+            const float *gp = hdr + 3 * ((size_t)(h - 1 - y) * w + x);
+            const float *cp = twin.rgb + 3 * ((size_t)y * w + x);
+            const float *vp = var.rgb + 3 * ((size_t)y * w + x);
+            for (int c = 0; c < 3; c++) {
+                assert_true(isfinite(gp[c]) && gp[c] >= 0.0f);
+                sum_g[region] += gp[c];
+                sum_c[region] += cp[c];
+                v[region] += 2.0 * vp[c];
+            }
+        }
+    const char *names[2] = {"object", "receivers"};
+    for (int i = 0; i < 2; i++) {
+        print_message("%s%s, %s pixels: GPU %.5g, CPU twin %.5g (%+.2f %%, sigma %.2f %%)\n",
+                      label, no_vpl ? " (no VPL)" : "", names[i], sum_g[i], sum_c[i],
+                      100 * (sum_g[i] / sum_c[i] - 1), 100 * sqrt(v[i]) / sum_c[i]);
+        assert_true(sum_c[i] > 0.0);
+        if (i == 0)
+            assert_near(sum_g[i], sum_c[i], 4.0 * sqrt(v[i]) + 0.05 * sum_c[i]);
+        else
+            assert_near_rel(sum_g[i], sum_c[i], no_vpl ? recv_tol : 0.20);
+    }
+    free(hdr);
+    lr_image_free(&twin);
+    lr_image_free(&var);
+    lr_renderer_destroy(r);
 }

@@ -30,6 +30,13 @@ lr_frame_stats lr_test_frame(lr_renderer *r);
 void lr_test_set(lr_scene *s, lr_renderer *r, const char *key, const char *value);
 /* HDR readback (w*h*3 floats, rows bottom up); the caller frees. */
 float *lr_test_hdr(lr_renderer *r);
+/* The GPU's converged final image of S (w x h, seed 3, 20 frames at most) against the CPU
+ * twin's (LR_CPU_PASS), summed over object pixels (the ray meets objects[0]) and receiver
+ * pixels: the object sums within 4 sigma of the twin's variance + 5 %, the receivers' within
+ * RECV_TOL relative (without VPLs: direct light only) or 20 % with them. LABEL heads the
+ * printed line. */
+void lr_test_final_image_vs_twin(lr_gl *gl, lr_scene *s, int w, int h, const char *label,
+                                 bool no_vpl, double recv_tol);
 /* The pixel (GL order: row 0 at the bottom) where the camera sees world point p; false when
  * outside the image. */
 bool lr_test_project(const lr_scene *s, int w, int h, lr_vec3 p, int *x, int *y);
