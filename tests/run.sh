@@ -18,16 +18,26 @@ export CMOCKA_MESSAGE_OUTPUT=stdout
 XDG_CACHE_HOME=$(mktemp -d "${TMPDIR:-/tmp}/lamprig-test-cache.XXXXXX") || exit 1
 export XDG_CACHE_HOME
 trap 'rm -rf "$XDG_CACHE_HOME"' EXIT
+# Each binary's output is also kept in a log of this run, so that a failure's own lines are
+# printed again just above the summary: CI shows only the end of a long run.
+logs=$(mktemp -d "${TMPDIR:-/tmp}/lamprig-test-logs.XXXXXX") || exit 1
+trap 'rm -rf "$XDG_CACHE_HOME" "$logs"' EXIT
 failed=""
 n=0
 for t in "$@"; do
     n=$((n + 1))
-    echo "== $(basename "$t")"
-    if ! "$t"; then
-        failed="$failed $(basename "$t")"
+    name=$(basename "$t")
+    echo "== $name"
+    { "$t" 2>&1; echo $? >"$logs/$name.rc"; } | tee "$logs/$name.log"
+    if [ "$(cat "$logs/$name.rc")" != 0 ]; then
+        failed="$failed $name"
     fi
 done
 if [ -n "$failed" ]; then
+    for f in $failed; do
+        echo "== $f failed (exit $(cat "$logs/$f.rc")); its last 40 lines:"
+        tail -n 40 "$logs/$f.log"
+    done
     echo "tests: $n binaries, FAILED:$failed"
     exit 1
 fi

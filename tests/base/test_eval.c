@@ -409,7 +409,8 @@ static void test_error_falls_with_frames(void **state)
                      LR_OK);
     lr_eval_masks m;
     assert_int_equal(lr_eval_masks_create(s, W, H, &m, &e), LR_OK);
-    print_message("candle: %ld object, %ld receiver pixels\n", m.object_px, m.receiver_px);
+    print_message("candle: %ld object, %ld receiver pixels; reference %s\n", m.object_px,
+                  m.receiver_px, hit ? "from the committed cache" : "rendered (not in the cache)");
     assert_true(m.object_px > 100);
     const char *sets[] = {"render.K=4", "render.N=1", "render.map_size=64",
                           "render.gbuffer_size=128", "render.N_vpl=32"};
