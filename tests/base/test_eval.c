@@ -19,6 +19,7 @@
 #include "render/reference/reference.h"
 #include "tests/support/gl.h"
 #include "tests/support/near.h"
+#include "tests/support/ok.h"
 
 /* ---- metrics --------------------------------------------------------------------------- */
 
@@ -396,26 +397,26 @@ static void test_error_falls_with_frames(void **state)
     snprintf(refdir, sizeof refdir, "%s/bench/references", lr_configs_dir());
     lr_err e = {0};
     lr_scene *s = NULL;
-    assert_int_equal(lr_scene_load(path, NULL, &s, &e), LR_OK);
+    assert_lr_ok(lr_scene_load(path, NULL, &s, &e), e);
     lr_ref_scene *rs = NULL;
     lr_ref_camera cam;
-    assert_int_equal(lr_ref_scene_from_scene(s, &rs, &cam, &e), LR_OK);
+    assert_lr_ok(lr_ref_scene_from_scene(s, &rs, &cam, &e), e);
     lr_ref_image mean, var;
     bool hit;
     /* The bench's reference settings (tools/bench/sweep.h: 64x48, 512 spp). */
-    assert_int_equal(lr_ref_render_cached(rs, &cam, &(lr_ref_render_desc){.width = W, .height = H,
-                                                                           .spp = 512},
-                                          refdir, NULL, NULL, &mean, &var, &hit, &e),
-                     LR_OK);
+    assert_lr_ok(lr_ref_render_cached(rs, &cam,
+                                      &(lr_ref_render_desc){.width = W, .height = H, .spp = 512},
+                                      refdir, NULL, NULL, &mean, &var, &hit, &e),
+                 e);
     lr_eval_masks m;
-    assert_int_equal(lr_eval_masks_create(s, W, H, &m, &e), LR_OK);
+    assert_lr_ok(lr_eval_masks_create(s, W, H, &m, &e), e);
     print_message("candle: %ld object, %ld receiver pixels; reference %s\n", m.object_px,
                   m.receiver_px, hit ? "from the committed cache" : "rendered (not in the cache)");
     assert_true(m.object_px > 100);
     const char *sets[] = {"render.K=4", "render.N=1", "render.map_size=64",
                           "render.gbuffer_size=128", "render.N_vpl=32"};
     for (size_t i = 0; i < sizeof sets / sizeof sets[0]; i++)
-        assert_int_equal(lr_scene_set_assignment(s, sets[i], NULL, &e), LR_OK);
+        assert_lr_ok(lr_scene_set_assignment(s, sets[i], NULL, &e), e);
     const int checks[] = {1, 4, 16};
     const size_t n = (size_t)W * H;
     unsigned char *both = malloc(n);
@@ -427,14 +428,14 @@ static void test_error_falls_with_frames(void **state)
     double e2[3] = {0}, n2[3] = {0}, o2 = 0.0, sigma2 = 0.0;
     for (int seed = 1; seed <= SEEDS; seed++) {
         lr_eval_series ser;
-        assert_int_equal(lr_eval_series_run(&(lr_eval_series_desc){.gl = gl, .scene = s,
-                                                                   .width = W, .height = H,
-                                                                   .checkpoints = checks,
-                                                                   .ncheck = 3,
-                                                                   .converge_frames = C,
-                                                                   .seed = (unsigned)seed},
-                                            &ser, &e),
-                         LR_OK);
+        assert_lr_ok(lr_eval_series_run(&(lr_eval_series_desc){.gl = gl, .scene = s,
+                                                               .width = W, .height = H,
+                                                               .checkpoints = checks,
+                                                               .ncheck = 3,
+                                                               .converge_frames = C,
+                                                               .seed = (unsigned)seed},
+                                        &ser, &e),
+                     e);
         for (int c = 0; c < 3; c++) {
             double x = lr_eval_rel_rmse(ser.image[c], mean.rgb, m.object, n);
             double y = lr_eval_rel_rmse(ser.image[c], ser.converged, both, n);
