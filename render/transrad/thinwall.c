@@ -30,11 +30,17 @@
  * instead of across it) falls back to the unshifted point, then to patch i itself: the light
  * stays in the object (energy kept), on the side where it entered.
  *
- * The rule (lr_tr_wall_thin): thin when the slab's wider profile holds 90 % of its light within
- * a quarter of the entry points' spacing, r90 <= patch_mm / 64 (0.19 mm at 12 mm): there the
- * point sums of subsurface.c miss the profiles' peaks altogether, while the tangent-plane exit
- * is exact to O(r90 / curvature radius). Shipped: paper 0.1 mm r90 0.15 mm (thin); porcelain
- * 1.5 mm 2.2 mm and wax walls (not thin). */
+ * The rule (lr_tr_wall_thin): thin when the slab's wider profile holds 90 % of its light
+ * within a quarter of a patch, r90 <= patch_mm / 4 (3 mm at 12 mm). Then a column's light
+ * lands in the entry patch's footprint and the next patches, the profiles vary across a patch,
+ * and the centroid sums get the split wrong (at 12 mm patches, paper 0.1 mm, r90 0.15 mm: 0.47
+ * of the light out of the far face for T 0.22; porcelain 1.5 mm, r90 2.2 mm: 0.117 / 0.093 /
+ * 0.061 for T 0.100 / 0.076 / 0.045), while a wall curved over tens of patches is flat over
+ * r90 (the shades' radii are 70-110 mm). Wider spreads (wax 7 mm: r90 13 mm; a non-absorbing
+ * shell, whose far field the truncated multipole misses) reach across patches, round rims and
+ * into floors: there the centroid sums are accurate and the in-object distances matter.
+ * Measured on the fair bench (tools/bench/README.md): led_shade objects / receivers 0.821 /
+ * 0.335 -> 0.160 / 0.081, lamp shade 0.162 / 0.101 -> 0.111 / 0.096. */
 #include "render/transrad/tr_priv.h"
 
 #include <math.h>
@@ -116,7 +122,7 @@ bool lr_tr_wall_thin(const lr_coeffs *c, double d, double patch_mm)
         return false;
     lr_tr_spread sp;
     lr_tr_spread_build(c, d, &sp);
-    return lr_tr_spread_r90(&sp) <= patch_mm / 64;
+    return lr_tr_spread_r90(&sp) <= patch_mm / 4;
 }
 
 /* An orthonormal pair spanning the plane normal to n. */

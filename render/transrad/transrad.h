@@ -139,7 +139,7 @@ int lr_tr_solve_irradiance(lr_tr *t, const double *E, int slot, lr_tr_stats *st,
 
 /* The thin-wall rule (render/transrad/thinwall.c): a slab of thickness d (mm) of medium c is
  * thin against patches of patch_mm when its wider diffusion profile (the multipole's R or T,
- * any band) holds 90 % of its light within patch_mm / 64; its S columns then send the slab's
+ * any band) holds 90 % of its light within patch_mm / 4; its S columns then send the slab's
  * R_tot out of the lit face and T_tot out of the opposite one, spread by the profiles. False
  * for d or patch_mm not positive. */
 bool lr_tr_wall_thin(const lr_coeffs *c, double d, double patch_mm);
