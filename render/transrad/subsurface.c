@@ -25,7 +25,12 @@
  * Energy. The discrete sum over patches misses or double counts the profile's peak when the
  * patches are coarse against 1/sigma_tr, so each column is scaled so that the power leaving
  * all patches, sum_j A_j S_ji / A_i, equals the plane total of i's profile (R + T of its slab,
- * Rd's total for a half-space; 1 without absorption). */
+ * Rd's total for a half-space; 1 without absorption).
+ *
+ * Thin walls. Where the slab's profiles are narrow against the entry points' spacing the sums
+ * see only their tails and split the light evenly between the faces; those columns are built
+ * by thinwall.c instead (the slab's R_tot out of the lit face, T_tot out of the far one),
+ * chosen per patch by lr_tr_wall_thin (or lr_tr_settings.thin_wall). */
 #include "render/transrad/tr_priv.h"
 
 #include <math.h>
