@@ -24,7 +24,9 @@
  *             object's patches (optdist.c), so the profile leaks neither across a concave gap
  *             nor through air. Exit at the patch centroid, entry integrated over the source
  *             patch with more points when near (seed 000 Sec. 4.1); each column scaled so that
- *             the power that leaves equals the model's plane total (subsurface.c);
+ *             the power that leaves equals the model's plane total (subsurface.c); on thin
+ *             walls (lr_tr_wall_thin) the slab's R_tot leaves the lit face and T_tot the far
+ *             one, spread by the profiles and integrated over both patches (thinwall.c);
  *   E         per light, unit intensity, shadowed by every surface, averaged over points of each
  *             patch; on a translucent patch split into the part that enters (F_t(cos)) and the
  *             Fresnel-reflected rest (direct.c); a quad or disk light at unit radiance: the
