@@ -3,8 +3,8 @@
  * 2-core machine) and depends only on the geometry, the materials and the patch settings.
  *
  * File: <dir>/transrad-<key>.bin, key = 64-bit FNV-1a (render/reference's hasher) over a format
- * tag, the settings that shape F and S (patch_mm, receiver_mm, rays_per_patch, seed), every
- * surface's description (kind, albedo, scattering coefficients, model, thickness, plane
+ * tag, the settings that shape F and S (patch_mm, receiver_mm, rays_per_patch, seed,
+ * thin_wall), every surface's description (kind, albedo, scattering coefficients, model, thickness, plane
  * frame, cells), its mesh's vertices and triangles, and the patches built from them (centroid,
  * normal, area, surface). Layout: the magic "LRTRC001", key, n, nnz(F), nnz(S), a hash of the
  * payload, then F's row starts, columns, values, the escapes, S's row starts, columns, values.
@@ -33,7 +33,8 @@ uint64_t lr_tr_cache_key(const lr_tr *t)
 {
     lr_ref_hash h;
     lr_ref_hash_init(&h);
-    lr_ref_hash_str(&h, "lamprig transrad F S v1");
+    /* v2: thin walls' S columns (thinwall.c) */
+    lr_ref_hash_str(&h, "lamprig transrad F S v2");
     /* The file holds native size_t, float and byte order: another machine is another key. */
     const uint32_t order = 0x01020304u;
     lr_ref_hash_u64(&h, sizeof(size_t));
@@ -42,6 +43,7 @@ uint64_t lr_tr_cache_key(const lr_tr *t)
     lr_ref_hash_double(&h, t->set.receiver_mm);
     lr_ref_hash_u64(&h, (uint64_t)t->set.rays_per_patch);
     lr_ref_hash_u64(&h, t->set.seed);
+    lr_ref_hash_u64(&h, (uint64_t)t->set.thin_wall);
     lr_ref_hash_u64(&h, (uint64_t)t->nsurf);
     for (int s = 0; s < t->nsurf; s++) {
         const lr_tr_surface_desc *d = &t->surf[s].d;

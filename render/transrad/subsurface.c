@@ -25,7 +25,12 @@
  * Energy. The discrete sum over patches misses or double counts the profile's peak when the
  * patches are coarse against 1/sigma_tr, so each column is scaled so that the power leaving
  * all patches, sum_j A_j S_ji / A_i, equals the plane total of i's profile (R + T of its slab,
- * Rd's total for a half-space; 1 without absorption). */
+ * Rd's total for a half-space; 1 without absorption).
+ *
+ * Thin walls. Where the slab's profiles are narrow against the entry points' spacing the sums
+ * see only their tails and split the light evenly between the faces; those columns are built
+ * by thinwall.c instead (the slab's R_tot out of the lit face, T_tot out of the far one),
+ * chosen per patch by lr_tr_wall_thin (or lr_tr_settings.thin_wall). */
 #include "render/transrad/tr_priv.h"
 
 #include <math.h>
@@ -45,6 +50,7 @@ typedef struct ss_ctx {
     float **vals;
     size_t *counts;
     double *thick;      /* per patch of the surface: the wall's local thickness, 0: none */
+    unsigned char *thin; /* per patch: its column is a thin wall's (thinwall.c) */
     int failed;
 } ss_ctx;
 
@@ -82,7 +88,13 @@ static void ss_item(void *vctx, long item)
     }
     double sum[3] = {0, 0, 0};
     double ri = sqrt(P[pi].area / M_PI);
-    for (size_t j = 0; j < ns; j++) {
+    bool thin = c->thin && c->thin[i];
+    if (thin) {
+        lr_tr_spread sp;
+        lr_tr_spread_build(sf->d.coeffs, c->thick[i], &sp);
+        lr_tr_thin_column(t, c->s, i, c->thick[i], &sp, col);
+    }
+    for (size_t j = 0; j < ns && !thin; j++) {
         double dopt = c->dist[i * ns + j];
         double *o = col + 3 * j;
         o[0] = o[1] = o[2] = 0;
@@ -124,7 +136,7 @@ static void ss_item(void *vctx, long item)
         lr_dipole_rd_total(sf->d.coeffs, total);
     }
     for (int b = 0; b < 3; b++)
-        scale[b] = sum[b] > 0 ? total[b] / sum[b] : 0;
+        scale[b] = thin ? 1.0 : sum[b] > 0 ? total[b] / sum[b] : 0;
     size_t keep = 0;
     for (size_t j = 0; j < ns; j++) {
         double m = 0;
@@ -198,6 +210,34 @@ static int local_thickness(const lr_tr *t, int s, double **out, lr_err *e)
     return LR_OK;
 }
 
+/* Which columns of surface s are a thin wall's (thinwall.c): by the rule lr_tr_wall_thin on
+ * each patch's slab (auto), none (off) or every slab patch (on). *out NULL: none. */
+static int thin_columns(const lr_tr *t, int s, const double *thick, unsigned char **out,
+                        lr_err *e)
+{
+    const lr_tr_surf *sf = &t->surf[s];
+    *out = NULL;
+    if (!thick || t->set.thin_wall == LR_TR_THIN_OFF)
+        return LR_OK;
+    unsigned char *th = calloc(sf->count ? sf->count : 1, 1);
+    if (!th)
+        return lr_err_set(e, LR_ENOMEM, "transrad: surface %d: out of memory (thin walls)", s);
+    double h = sf->d.patch_mm > 0 ? sf->d.patch_mm : t->set.patch_mm;
+    double last_d = -1;
+    bool last = false;
+    for (size_t i = 0; i < sf->count; i++) {
+        if (!(thick[i] > 0))
+            continue;
+        if (thick[i] != last_d) { /* a given thickness_mm: one evaluation */
+            last_d = thick[i];
+            last = t->set.thin_wall == LR_TR_THIN_ON || lr_tr_wall_thin(sf->d.coeffs, last_d, h);
+        }
+        th[i] = last;
+    }
+    *out = th;
+    return LR_OK;
+}
+
 int lr_tr_build_subsurface(lr_tr *t, lr_err *e)
 {
     size_t n = t->n;
@@ -215,20 +255,28 @@ int lr_tr_build_subsurface(lr_tr *t, lr_err *e)
         if (t->surf[s].d.kind != LR_TR_TRANSLUCENT)
             continue;
         double *dist = NULL;
-        rc = lr_tr_optical_distances(t, s, &dist, e);
-        if (rc)
-            goto done;
         c.s = s;
-        c.dist = dist;
         c.thick = NULL;
+        c.thin = NULL;
         rc = local_thickness(t, s, &c.thick, e);
+        if (!rc)
+            rc = thin_columns(t, s, c.thick, &c.thin, e);
+        /* In-object distances only where a column is built from them. */
+        bool need = !c.thin;
+        for (size_t i = 0; c.thin && i < t->surf[s].count; i++)
+            need = need || !c.thin[i];
+        if (!rc && need)
+            rc = lr_tr_optical_distances(t, s, &dist, e);
         if (rc) {
-            free(dist);
+            free(c.thick);
+            free(c.thin);
             goto done;
         }
+        c.dist = dist;
         lr_cpu_parallel_for((long)t->surf[s].count, t->set.threads, ss_item, &c);
         free(dist);
         free(c.thick);
+        free(c.thin);
         if (c.failed) {
             rc = lr_err_set(e, LR_ENOMEM, "transrad: surface %d: out of memory (subsurface)", s);
             goto done;

@@ -83,6 +83,24 @@ int lr_tr_build_form_factors(lr_tr *t, lr_err *e);
 int lr_tr_optical_distances(const lr_tr *t, int s, double **out, lr_err *e);
 /* subsurface.c */
 int lr_tr_build_subsurface(lr_tr *t, lr_err *e);
+/* thinwall.c: the slab's lateral spread, R (which 0) and T (which 1) per band: its plane
+ * totals (lr_multipole_total) and the radial CDFs int_0^r 2 pi r' P(r') dr' / total on a grid
+ * of LR_TR_SPREAD_RADII radii; the radius where band b's CDF reaches u (linear between grid
+ * points); r90 the largest radius holding 90 % of either profile in any band. */
+#define LR_TR_SPREAD_RADII 96
+typedef struct lr_tr_spread {
+    double total[2][3];
+    double r[LR_TR_SPREAD_RADII];
+    double cdf[2][3][LR_TR_SPREAD_RADII];
+    double L; /* d + 2 z_b */
+} lr_tr_spread;
+void lr_tr_spread_build(const lr_coeffs *c, double d, lr_tr_spread *sp);
+double lr_tr_spread_radius(const lr_tr_spread *sp, int which, int band, double u);
+double lr_tr_spread_r90(const lr_tr_spread *sp);
+/* Column i (patch index within translucent surface s, slab thickness d, sp its spread) of a
+ * thin wall's S: out[3 j + b] = S_{j i}, j over the surface's patches (n_s x 3, overwritten). */
+void lr_tr_thin_column(const lr_tr *t, int s, size_t i, double d, const lr_tr_spread *sp,
+                       double *out);
 /* direct.c: E and Ein of one light at unit intensity (area lights: direct_area.c). */
 /* Frees the per-patch row lists that F and S are built from before they are packed into their
  * CSR arrays (formfactor.c, subsurface.c); any of the three may be NULL. */

@@ -57,6 +57,9 @@ int lr_tr_create(const lr_tr_surface_desc *surfaces, int count, const lr_tr_sett
     if (s.area_samples < 0 || s.area_samples > 256)
         return lr_err_set(e, LR_EINVAL, "transrad: field 'area_samples': %d outside [0, 256]",
                           s.area_samples);
+    if (s.thin_wall < LR_TR_THIN_AUTO || s.thin_wall > LR_TR_THIN_ON)
+        return lr_err_set(e, LR_EINVAL, "transrad: field 'thin_wall': %d, not auto (0), off (1) "
+                          "or on (2)", s.thin_wall);
     if (s.patch_mm == 0)
         s.patch_mm = 12;
     if (s.receiver_mm == 0)

@@ -24,7 +24,9 @@
  *             object's patches (optdist.c), so the profile leaks neither across a concave gap
  *             nor through air. Exit at the patch centroid, entry integrated over the source
  *             patch with more points when near (seed 000 Sec. 4.1); each column scaled so that
- *             the power that leaves equals the model's plane total (subsurface.c);
+ *             the power that leaves equals the model's plane total (subsurface.c); on thin
+ *             walls (lr_tr_wall_thin) the slab's R_tot leaves the lit face and T_tot the far
+ *             one, spread by the profiles and integrated over both patches (thinwall.c);
  *   E         per light, unit intensity, shadowed by every surface, averaged over points of each
  *             patch; on a translucent patch split into the part that enters (F_t(cos)) and the
  *             Fresnel-reflected rest (direct.c); a quad or disk light at unit radiance: the
@@ -97,10 +99,16 @@ typedef struct lr_tr_settings {
                              * Over the budget the warm-started sweeps solve instead. Off by
                              * default: measured slower than the warm sweeps after a light
                              * move (render/transrad/README.md) */
+    int thin_wall;          /* S on slab walls (render/transrad/thinwall.c): LR_TR_THIN_AUTO
+                             * (0, default) by lr_tr_wall_thin per patch, LR_TR_THIN_OFF the
+                             * profile at in-object distances everywhere, LR_TR_THIN_ON the
+                             * thin-wall column on every slab patch */
     const char *cache_dir;  /* F and S cached in this folder (cache.c), keyed by a hash of the
                              * geometry, materials and the settings above; NULL: no cache.
                              * Read during create only (the pointer is not kept in use) */
 } lr_tr_settings;
+
+enum { LR_TR_THIN_AUTO = 0, LR_TR_THIN_OFF = 1, LR_TR_THIN_ON = 2 };
 
 #define LR_TR_MAX_SURFACES 32
 #define LR_TR_MAX_SLOTS 4
@@ -131,6 +139,13 @@ int lr_tr_solve_light(lr_tr *t, const lr_light *light, int slot, lr_tr_stats *st
  * diffuse light). */
 int lr_tr_solve_irradiance(lr_tr *t, const double *E, int slot, lr_tr_stats *st, lr_err *e);
 
+/* The thin-wall rule (render/transrad/thinwall.c): a slab of thickness d (mm) of medium c is
+ * thin against patches of patch_mm when its wider diffusion profile (the multipole's R or T,
+ * any band) holds 90 % of its light within patch_mm / 4; its S columns then send the slab's
+ * R_tot out of the lit face and T_tot out of the opposite one, spread by the profiles. False
+ * for d or patch_mm not positive. */
+bool lr_tr_wall_thin(const lr_coeffs *c, double d, double patch_mm);
+
 /* ---- Queries ------------------------------------------------------------------------------- */
 /* Whether create took F and S from the cache (settings.cache_dir) instead of building them. */
 bool lr_tr_cache_hit(const lr_tr *t);
@@ -157,6 +172,11 @@ double lr_tr_form_factor(const lr_tr *t, size_t p, size_t q);
 double lr_tr_escape(const lr_tr *t, size_t p);
 /* S_qp per band: radiosity leaving q per unit irradiance entering p (0 across objects). */
 void lr_tr_subsurface(const lr_tr *t, size_t q, size_t p, double out[3]);
+/* Where S sends the light that enters translucent surface s under unit irradiance on every
+ * patch, per unit power entered and band: out of patches facing the same way as the entry
+ * (lit face, n_p . n_q >= 0) and the opposite way (the far face of a wall). For a slab these
+ * are its R_tot and T_tot; zeros for another kind of surface. */
+void lr_tr_subsurface_split(const lr_tr *t, int s, double lit[3], double opposite[3]);
 /* Slot's solution: W leaving p (all of it), the irradiance H arriving at p (direct + bounce),
  * the indirect part of H, and the renderer's map value W_sss / T_hem. */
 void lr_tr_radiosity(const lr_tr *t, int slot, size_t p, double out[3]);

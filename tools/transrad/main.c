@@ -6,6 +6,8 @@
  *   lamprig-transrad SCENE.json [--set KEY=VALUE]... [--patch MM] [--receiver MM] [--rays N]
  *                    [--transfer-mb MB]   (build the precomputed transfer within MB; default
  *                                          none: the warm-started sweeps)
+ *                    [--thin-wall auto|off|on]  (S on slab walls, render/transrad/thinwall.c:
+ *                                          by its rule (default), never, on every slab patch)
  *                    [--no-cache]         (build F and S even when $XDG_CACHE_HOME/lamprig has
  *                                          them; by default they are read from and written to
  *                                          the cache, render/transrad/cache.c)
@@ -30,7 +32,8 @@ int main(int argc, char **argv)
 {
     if (argc < 2) {
         fprintf(stderr, "usage: lamprig-transrad SCENE.json [--set K=V]... [--patch MM] "
-                        "[--receiver MM] [--rays N] [--transfer-mb MB] [--no-cache]\n");
+                        "[--receiver MM] [--rays N] [--transfer-mb MB] [--thin-wall auto|off|on] "
+                        "[--no-cache]\n");
         return 2;
     }
     lr_err e = {0};
@@ -55,6 +58,15 @@ int main(int argc, char **argv)
             set.cache_dir = NULL;
         } else if (!strcmp(argv[i], "--transfer-mb") && i + 1 < argc) {
             set.transfer_mb = atoi(argv[++i]);
+        } else if (!strcmp(argv[i], "--thin-wall") && i + 1 < argc) {
+            const char *v = argv[++i];
+            set.thin_wall = !strcmp(v, "off") ? LR_TR_THIN_OFF
+                            : !strcmp(v, "on") ? LR_TR_THIN_ON
+                            : !strcmp(v, "auto") ? LR_TR_THIN_AUTO : -1;
+            if (set.thin_wall < 0) {
+                fprintf(stderr, "lamprig-transrad: --thin-wall: '%s', not auto, off or on\n", v);
+                return 2;
+            }
         } else if (!strcmp(argv[i], "--rays") && i + 1 < argc) {
             set.rays_per_patch = atoi(argv[++i]);
         } else {
@@ -80,6 +92,25 @@ int main(int argc, char **argv)
     printf("), precomputation (F, S%s) %.2f s, transfer %s (%.1f MB)\n",
            lr_tr_cache_hit(t) ? " from the cache" : "", t1 - t0, xb ? "built" : "not built",
            xb / 1048576.0);
+    /* Where S sends the light that enters each object: its lit face and the far face, against
+     * the slab's R and T where the object has a wall thickness. */
+    for (int i = 0; i < no; i++) {
+        const lr_scene_object *o = lr_scene_object_at(s, i);
+        double lit[3], opp[3];
+        lr_tr_subsurface_split(t, i, lit, opp);
+        printf("object %d: S sends out of the lit face %.4f %.4f %.4f, the opposite face "
+               "%.4f %.4f %.4f", i, lit[0], lit[1], lit[2], opp[0], opp[1], opp[2]);
+        if (o->thickness_mm > 0) {
+            double R[3], T[3];
+            lr_multipole_total(&o->coeffs, o->thickness_mm, R, T);
+            printf("; slab %.3g mm: R %.4f %.4f %.4f, T %.4f %.4f %.4f, thin wall (rule at %g mm "
+                   "patches): %s", o->thickness_mm, R[0], R[1], R[2], T[0], T[1], T[2],
+                   set.patch_mm > 0 ? set.patch_mm : 12.0,
+                   lr_tr_wall_thin(&o->coeffs, o->thickness_mm,
+                                   set.patch_mm > 0 ? set.patch_mm : 12.0) ? "yes" : "no");
+        }
+        printf("\n");
+    }
     for (int l = 0; l < lr_scene_light_count(s) && l < LR_TR_MAX_SLOTS; l++) {
         lr_tr_stats st = {0};
         if (lr_tr_solve_light(t, lr_scene_light_at(s, l), l, &st, &e)) {
