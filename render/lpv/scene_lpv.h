@@ -29,10 +29,10 @@
  *    is never gathered on itself: a plane cannot light itself, but the volume's diffusion
  *    would return part of its own lobe. Light blocked by a surface is absorbed; with
  *    `bounces` > 0 the objects' samples gather what the volumes delivered to them and send
- *    R of it back in, and thin walls T of it out of the other face, once per bounce (the
- *    objects lit by the receivers and by their own cavity; all of it injected, none of it is
- *    in the maps; a shade's cavity, whose inner wall returns R = 0.79
- *    of paper's light, keeps most of its light for several bounces).
+ *    R of it back in (and, with `transmit`, thin walls T of it out of the other face), once
+ *    per bounce (the objects lit by the receivers and by their own cavity; a shade's cavity,
+ *    whose inner wall returns R = 0.79 of paper's light, keeps most of its light for several
+ *    bounces).
  *
  * Area lights (quad, disk) per unit radiance; point and spot lights per unit intensity, their
  * direct irradiance I cos / d^2 (spot: times the cone's shape) at every sample, 0 where an
@@ -51,6 +51,8 @@ typedef int (*lr_lpv_propagate_fn)(void *ctx, lr_lpv *v, int steps, lr_err *e);
 typedef struct lr_lpv_scene_desc {
     int n;                         /* cells per axis; 0: 32 */
     int bounces;                   /* further bounces off the objects (0: one bounce) */
+    bool transmit;                 /* in those bounces thin walls also send T of the volume's
+                                    * light out of their other face (false: R only) */
     lr_lpv_propagate_fn propagate; /* NULL: the CPU */
     void *ctx;
 } lr_lpv_scene_desc;
