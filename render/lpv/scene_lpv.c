@@ -145,9 +145,15 @@ static int object_samples(const lr_scene *s, const lr_lpv *v, int group, samples
             lr_multipole_total(&o->coeffs, o->thickness_mm, R, T);
         else
             lr_dipole_rd_total(&o->coeffs, R);
+        /* r_min = h / 3, but at most 1/16 of the object's largest extent: a volume widened
+         * to a wall (build_box) has cells of a third of a votive, and the TPLs' midpoint
+         * rule over a cup lit from 22 mm away then lost a quarter of the emergent flux. */
+        lr_vec3 lo, hi;
+        lr_mesh_bounds(o->mesh, &lo, &hi);
+        lr_vec3 ext = lr_v3_sub(hi, lo);
+        double rmin = fmin(lr_lpv_h(v) / 3.0, fmax(ext.x, fmax(ext.y, ext.z)) / 16.0);
         lr_poisson_set set = {0};
-        int rc = lr_poisson_mesh(o->mesh, lr_lpv_h(v) / 3.0, 200000, 2000, 0x1F5u + (unsigned)i,
-                                 &set, e);
+        int rc = lr_poisson_mesh(o->mesh, rmin, 200000, 2000, 0x1F5u + (unsigned)i, &set, e);
         if (rc)
             return rc;
         for (int k = 0; k < set.n; k++) {
@@ -199,10 +205,29 @@ static int build_box(const lr_scene *s, int n, lr_lpv **out, lr_err *e)
     if (lr_scene_object_count(s) == 0)
         return lr_err_set(e, LR_EINVAL, "lpv: the scene has no objects to place the volume");
     lr_vec3 ext = lr_v3_sub(hi, lo);
+    double E = fmax(ext.x, fmax(ext.y, ext.z)), margin = 1.25 * E;
+    /* At least 1.25 extents: a wall or table near the lamp lies a few cells inside the box
+     * (light that reaches the border leaves; a receiver on it would gather nothing). A plane
+     * receiver within 3 extents of the objects' box widens it to one cell beyond the plane:
+     * margin = d + h with h = (E + 2 margin) / n, so that the table and the wall behind a
+     * lamp both take part (table <-> wall interreflection, issue 12 part 4). */
+    for (int i = 0; i < lr_scene_receiver_count(s); i++) {
+        const lr_receiver *r = lr_scene_receiver_at(s, i);
+        if (r->type != LR_RECEIVER_PLANE)
+            continue;
+        double dmin = INFINITY, dmax = -INFINITY;
+        for (int k = 0; k < 8; k++) {
+            lr_vec3 q = lr_v3(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z);
+            double t = lr_v3_dot(lr_v3_sub(q, r->center), r->normal);
+            dmin = fmin(dmin, t);
+            dmax = fmax(dmax, t);
+        }
+        double dist = dmin > 0.0 ? dmin : dmax < 0.0 ? -dmax : 0.0;
+        if (n > 4 && dist <= 3.0 * E)
+            margin = fmax(margin, (dist + E / n) / (1.0 - 2.0 / n));
+    }
     lr_lpv_desc d;
-    /* 1.25 extents: a wall or table near the lamp lies a few cells inside the box (light that
-     * reaches the border leaves; a receiver on it would gather nothing). */
-    int rc = lr_lpv_desc_around(lo, hi, 1.25 * fmax(ext.x, fmax(ext.y, ext.z)), n, &d, e);
+    int rc = lr_lpv_desc_around(lo, hi, margin, n, &d, e);
     return rc ? rc : lr_lpv_create(&d, out, e);
 }
 
