@@ -6,10 +6,11 @@
  * voxel's centre, area = the object's area over the TPL count, intensity from the ESLPV,
  * Eq. 5). Here each TPL is the merge of the TPDS of one voxel of a coarse grid whose emission
  * faces the same dominant axis direction: flux-weighted position and normal (the position
- * lifted along the normal onto the plane touching the outermost member), summed area and flux. Merging keeps the emitted flux exactly (sum of the TPLs' phi = sum of the samples'),
- * which the seed's nearest-sample pick does not.
+ * lifted along the normal onto the plane touching the outermost member), summed area and
+ * flux. Merging keeps the emitted flux exactly (sum of the TPLs' phi = sum of the samples'),
+ * which the seed's nearest-sample pick does not. The cell is 2h of the volume (scene_lpv.c).
  *
- * Gathering, Eq. 6a without rho/pi (the caller multiplies by its albedo): a TPL of flux phi
+ * Gathering, Eq. 6a-6b without rho/pi (the caller multiplies by its albedo): a TPL of flux phi
  * and area A emitting (phi / pi) cos_t into its hemisphere gives a point x of normal n_x
  *   E = sum_k phi_k / pi * cos_k cos_x / max(|x - x_k|^2, A_k)
  * (the bound of PIPELINE.md's VPL geometry term), 0 where an object is in the way. */
