@@ -11,22 +11,28 @@
  *    r_min = h/3), each blocking its interfaces (lpv.h).
  *  - Injection, per source group (each plane receiver, and the objects together):
  *      (a) DPDS on a receiver: its direct irradiance E from the area light (64 stratified
- *          emitter points, shadow rays through the objects), reflected flux rho E A as the
- *          lobe of Eq. 3b-4 one cell off the plane;
+ *          emitter points, shadow rays through the objects) and E_TPL from the objects' TPLs
+ *          (the light they emit where the VPLs carry it, Eq. 6b, tpl.h), reflected flux
+ *          rho (E + E_TPL) A as the lobe of Eq. 3b-4 one cell off the plane;
  *      (b) TPDS on the objects: the part R of the direct light that the wall sends back to
  *          the side it came from (the slab's total diffuse reflectance, Donner-Jensen
  *          multipole for objects with thickness_mm, else the semi-infinite dipole's), as the
  *          lobe along the lit face's normal: light the inner face of a shade returns into the
- *          cavity and that leaves through the openings. (The seed's TPLs carry the object's
- *          emergent radiosity; here the reflected share of the direct light, which the maps
- *          only show to the camera and the outer-surface VPLs never send to the receivers.)
+ *          cavity and that leaves through the openings. Thin walls (thickness_mm) send T E A
+ *          out of the other face (the multipole's total transmittance). Light leaving a side
+ *          that is the outermost surface facing out (the VPLs' surface, render/cpu/vpl.h) is
+ *          not injected but becomes a TPL: the VPLs give the receivers its first bounce, the
+ *          volume the receivers' reflection of it (a votive's outer glow on the table, then
+ *          table to wall). Light leaving any other side (a cavity's inner wall) is a lobe.
  *  - Propagation: 4 n steps per group (lpv.h; on the CPU, or the caller's, e.g. the compute
  *    shader), gather from the absorbed record at the receiver grid's texel centres. A group
  *    is never gathered on itself: a plane cannot light itself, but the volume's diffusion
  *    would return part of its own lobe. Light blocked by a surface is absorbed; with
  *    `bounces` > 0 the objects' samples gather what the volumes delivered to them and send
- *    R of it back in, once per bounce (a shade's cavity, whose inner wall returns R = 0.79
- *    of paper's light, keeps most of its light for several bounces).
+ *    R of it back in (and, with `transmit`, thin walls T of it out of the other face), once
+ *    per bounce (the objects lit by the receivers and by their own cavity; a shade's cavity,
+ *    whose inner wall returns R = 0.79 of paper's light, keeps most of its light for several
+ *    bounces).
  *
  * Area lights (quad, disk) per unit radiance; point and spot lights per unit intensity, their
  * direct irradiance I cos / d^2 (spot: times the cone's shape) at every sample, 0 where an
@@ -45,6 +51,8 @@ typedef int (*lr_lpv_propagate_fn)(void *ctx, lr_lpv *v, int steps, lr_err *e);
 typedef struct lr_lpv_scene_desc {
     int n;                         /* cells per axis; 0: 32 */
     int bounces;                   /* further bounces off the objects (0: one bounce) */
+    bool transmit;                 /* in those bounces thin walls also send T of the volume's
+                                    * light out of their other face (false: R only) */
     lr_lpv_propagate_fn propagate; /* NULL: the CPU */
     void *ctx;
 } lr_lpv_scene_desc;
@@ -57,6 +65,14 @@ typedef struct lr_lpv_scene_stats {
                                    * lights) or intensity (point, spot) */
     double direct_receivers; /* the receivers' direct power from the light inside the volume
                               * (sum E A over their samples), W per unit radiance */
+    double emergent[3];      /* flux the objects send out of their outermost surface (what the
+                              * VPLs carry): the TPLs' total, sum R E A or T E A (tpl.h) */
+    double injected_emergent[3]; /* the receivers' injection of it: sum rho E_TPL A (Eq. 6b),
+                                  * included in injected[] (not in injected_receivers) */
+    double gathered_objects[3];  /* the part of gathered[] from the objects' injections */
+    double object_irradiance[3]; /* sum E A the objects' samples gathered from the volumes
+                                  * (both sides of open sheets), over all bounces but the last */
+    int tpls;
     int samples_receivers, samples_objects;
     double cell_mm;
 } lr_lpv_scene_stats;
