@@ -19,6 +19,10 @@ PUBLIC_TARGETS := all build test run bench install deb test-install
 
 ifndef LAMPRIG_INNER
 # Outer make: install dependencies first, then re-enter with pkg-config available.
+# The outer make runs its goals one after another: `make -j2 build/test/A build/test/B` would
+# otherwise start two inner makes at once, each rebuilding the same static library (rm + ar)
+# under the other's linker. Each inner make still builds in parallel (-j reaches it).
+.NOTPARALLEL:
 .PHONY: $(PUBLIC_TARGETS) deps clean
 $(PUBLIC_TARGETS): deps
 	@$(MAKE) --no-print-directory LAMPRIG_INNER=1 $@
