@@ -192,6 +192,54 @@ static void test_candle_scene(void **state)
     lr_scene_destroy(s);
 }
 
+/* jar_candle.json, issue 12's scene not tuned on: a candle burnt down into a deep pool, the
+ * flame 30 mm below the rim. The escape cone follows from the paraboloid pool (depth 35 at
+ * the axis, radius 36; the flame 5 mm above its bottom at z = 65): a ray at elevation t
+ * (slope) meets z = 65 + 35 r^2 / 36^2 where 35 r^2 / 1296 - t r - 5 = 0, inside the rim
+ * (r < 36) for t < 30 / 36 (40 degrees), so rays at 35 degrees hit the wax (r = 31.8 mm) and
+ * at 50 degrees leave through the opening (r = 48 > 36): 4 mm of margin over the facets. */
+static void test_jar_candle_scene(void **state)
+{
+    (void)state;
+    lr_scene *s = load("configs/scenes/jar_candle.json");
+    assert_string_equal(lr_scene_name(s), "jar_candle");
+    assert_int_equal(lr_scene_object_count(s), 1);
+    const lr_scene_object *o = lr_scene_object_at(s, 0);
+    assert_int_equal(o->kind, LR_MESH_CANDLE);
+    assert_true(o->closed);
+    assert_string_equal(o->material.name, "candle_wax");
+    /* The shipped model is the default; the wall thickness is there for the multipole rows. */
+    assert_int_equal(o->sss_model, LR_SSS_DIRECTIONAL_DIPOLE);
+    assert_true(o->thickness_mm == 16.0);
+    lr_vec3 lo, hi;
+    lr_mesh_bounds(o->mesh, &lo, &hi);
+    assert_true(fabs(hi.x - lo.x - 80) < 1e-4 && fabs(hi.z - 100) < 1e-4 && fabs(lo.z) < 1e-9);
+    assert_int_equal(lr_scene_light_count(s), 1);
+    const lr_light *l = lr_scene_light_at(s, 0);
+    assert_int_equal(l->type, LR_LIGHT_POINT);
+    assert_true(l->position.z == 70.0);
+    int obj = -2;
+    assert_int_equal(lr_scene_light_enclosure(s, 0, &obj), LR_ENCLOSURE_HULL);
+    assert_int_equal(obj, 0);
+    /* The pool's bottom (the axis vertex at 100 - 35) is 5 mm under the flame. */
+    lr_hit h;
+    assert_true(lr_bvh_intersect(o->bvh, l->position, lr_v3(0, 0, -1), 0, 1e4, &h));
+    assert_true(fabs(h.t - 5.0) < 1e-4);
+    for (int k = 0; k < 16; k++) {
+        double a = 2 * M_PI * k / 16;
+        for (int j = 0; j < 2; j++) {
+            double el = (j ? 35.0 : 0.0) * M_PI / 180;
+            lr_vec3 d = lr_v3(cos(a) * cos(el), sin(a) * cos(el), sin(el));
+            assert_true(lr_bvh_occluded(o->bvh, l->position, d, 0, 1e4));
+        }
+        double el = 50.0 * M_PI / 180;
+        assert_false(lr_bvh_occluded(o->bvh, l->position,
+                                     lr_v3(cos(a) * cos(el), sin(a) * cos(el), sin(el)), 0, 1e4));
+    }
+    assert_true(lr_scene_find_receiver(s, "table") >= 0 && lr_scene_find_receiver(s, "wall") >= 0);
+    lr_scene_destroy(s);
+}
+
 static void test_lampshade_scene(void **state)
 {
     (void)state;
@@ -861,6 +909,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_candle_scene),
+        cmocka_unit_test(test_jar_candle_scene),
         cmocka_unit_test(test_lampshade_scene),
         cmocka_unit_test(test_sphere_and_votive_scenes),
         cmocka_unit_test(test_object_normalize_field),

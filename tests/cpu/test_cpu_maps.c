@@ -276,8 +276,8 @@ static void scan_finite(const lr_image *img, const char *what)
 static void test_images_all_scenes(void **state)
 {
     (void)state;
-    const char *names[] = {"candle", "lampshade", "sphere", "votive"};
-    for (int i = 0; i < 4; i++) {
+    const char *names[] = {"candle", "lampshade", "sphere", "votive", "jar_candle"};
+    for (int i = 0; i < 5; i++) {
         lr_scene *s = load(names[i]);
         lr_cpu_render_desc d = {.scene = s, .width = 24, .height = 18, .mode = LR_CPU_PASS,
                                 .frames = 2, .K = 8, .map_size = 24, .N = 8, .vpl_count = 32};

@@ -163,6 +163,41 @@ static void test_render_writes_images_and_stats(void **state)
     lr_image_free(&img);
 }
 
+/* configs/scenes/jar_candle.json (issue 12's untuned scene) renders headless through the
+ * command: its radiance is finite and non-negative everywhere, and light reaches the image
+ * (82 % of the flame's light enters the wax, the rest leaves through the opening onto the
+ * wall: test_scene's escape cone), so the sum is positive. */
+static void test_render_jar_candle(void **state)
+{
+    (void)state;
+    int st = run("./build/bin/lamprig render --scene configs/scenes/jar_candle.json " SMALL
+                 " --frames 2 --hdr %s/j.pfm --stats %s/s.json", dir, dir);
+    char *err = slurp("err");
+    if (st != 0)
+        fail_msg("exit %d: %s", st, err);
+    free(err);
+    lr_json *j = load_stats();
+    lr_err e = {0};
+    char name[64];
+    assert_int_equal(lr_json_get_string(j, lr_json_root(j), "scene", true, name, sizeof name, &e),
+                     LR_OK);
+    assert_string_equal(name, "jar_candle");
+    lr_json_destroy(j);
+    char path[512];
+    lr_image img = {0};
+    snprintf(path, sizeof path, "%s/j.pfm", dir);
+    if (lr_image_read_pfm(path, &img, &e))
+        fail_msg("%s", e.msg);
+    assert_int_equal(img.width, 32);
+    double sum = 0.0;
+    for (int i = 0; i < 32 * 24 * 3; i++) {
+        assert_true(img.rgb[i] >= 0.0f && img.rgb[i] < 1e30f);
+        sum += img.rgb[i];
+    }
+    assert_true(sum > 0.0);
+    lr_image_free(&img);
+}
+
 static void expect_usage(const char *args, const char *needle)
 {
     int st = run("./build/bin/lamprig render %s", args);
@@ -229,6 +264,7 @@ static void test_output_paths_checked_first(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_render_jar_candle),
         cmocka_unit_test(test_render_writes_images_and_stats),
         cmocka_unit_test(test_bad_arguments),
         cmocka_unit_test(test_output_paths_checked_first),
