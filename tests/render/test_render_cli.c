@@ -92,6 +92,27 @@ static lr_json *load_stats(void)
     return j;
 }
 
+/* The sum of a 32x24 HDR image the command wrote into dir, every value of which must be finite
+ * and non-negative (radiance). */
+static double radiance_sum(const char *file)
+{
+    char path[512];
+    lr_image img = {0};
+    lr_err e = {0};
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    if (lr_image_read_pfm(path, &img, &e))
+        fail_msg("%s", e.msg);
+    assert_int_equal(img.width, 32);
+    assert_int_equal(img.height, 24);
+    double sum = 0.0;
+    for (int i = 0; i < 32 * 24 * 3; i++) {
+        assert_true(img.rgb[i] >= 0.0f && img.rgb[i] < 1e30f);
+        sum += img.rgb[i];
+    }
+    lr_image_free(&img);
+    return sum;
+}
+
 static void test_render_writes_images_and_stats(void **state)
 {
     char ev[512];
@@ -142,20 +163,9 @@ static void test_render_writes_images_and_stats(void **state)
     assert_int_equal(lr_json_get_number(j, f3, "total_ms", true, &total, &e), LR_OK);
     assert_near(total, 0.0, 0.0);
     lr_json_destroy(j);
+    assert_true(radiance_sum("c.pfm") > 0.0);
     char path[512];
     lr_image img = {0};
-    snprintf(path, sizeof path, "%s/c.pfm", dir);
-    if (lr_image_read_pfm(path, &img, &e))
-        fail_msg("%s", e.msg);
-    assert_int_equal(img.width, 32);
-    assert_int_equal(img.height, 24);
-    double sum = 0.0;
-    for (int i = 0; i < 32 * 24 * 3; i++) {
-        assert_true(img.rgb[i] >= 0.0f && img.rgb[i] < 1e30f);
-        sum += img.rgb[i];
-    }
-    assert_true(sum > 0.0);
-    lr_image_free(&img);
     snprintf(path, sizeof path, "%s/c.png", dir);
     if (lr_image_read_png(path, &img, &e))
         fail_msg("%s", e.msg);
@@ -183,19 +193,7 @@ static void test_render_jar_candle(void **state)
                      LR_OK);
     assert_string_equal(name, "jar_candle");
     lr_json_destroy(j);
-    char path[512];
-    lr_image img = {0};
-    snprintf(path, sizeof path, "%s/j.pfm", dir);
-    if (lr_image_read_pfm(path, &img, &e))
-        fail_msg("%s", e.msg);
-    assert_int_equal(img.width, 32);
-    double sum = 0.0;
-    for (int i = 0; i < 32 * 24 * 3; i++) {
-        assert_true(img.rgb[i] >= 0.0f && img.rgb[i] < 1e30f);
-        sum += img.rgb[i];
-    }
-    assert_true(sum > 0.0);
-    lr_image_free(&img);
+    assert_true(radiance_sum("j.pfm") > 0.0);
 }
 
 static void expect_usage(const char *args, const char *needle)
