@@ -76,7 +76,7 @@ static lr_pass_ctx pass_ctx(const lr_renderer *r)
                      .objs = &r->objs, .prog = &r->prog, .shader_dir = r->shader_dir,
                      .width = r->width, .height = r->height, .n_lights = r->n_lights,
                      .map_format = r->map_format, .seed = r->seed, .no_vpl = r->no_vpl,
-                     .vpl_visibility = r->vpl_visibility};
+                     .vpl_visibility = r->vpl_visibility || r->rs.vpl_visibility};
     for (int l = 0; l < r->n_lights && l < LR_MAX_LIGHTS; l++) {
         lr_light_rgb(lr_scene_light_at(r->scene, l), c.I[l]);
         double f = lr_renderer_flicker(r, l);

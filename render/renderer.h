@@ -36,7 +36,8 @@ typedef struct lr_renderer_desc {
     int width, height;     /* output image; 0 = 640 x 480 */
     bool no_vpl;           /* skip emergent light (pass 4) */
     bool vpl_visibility;   /* shadow the VPLs by the objects (beyond seed 003; costs
-                            * N_vpl x 8 cube-map lookups per receiver pixel) */
+                            * N_vpl x 32 cube-map lookups per receiver pixel); on when this
+                            * or the scene's render.vpl_visibility is true */
     unsigned seed;         /* base of the per-texel/map/frame sample seeds; 0 = 1 */
     bool half_maps;        /* RGBA16F radiosity maps even where RGBA32F blending exists (the
                             * fallback for drivers without EXT_float_blend; for its tests) */

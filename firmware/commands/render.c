@@ -41,7 +41,8 @@ static const lr_argspec opts[] = {
              "\"converged\",\"time_s\"},...]}"},
     {.name = "--no-vpl", .help = "no emergent light on the receivers (direct light only)"},
     {.name = "--vpl-visibility",
-     .help = "shadow the VPLs' light by the objects (beyond seed 003; slower)"},
+     .help = "shadow the VPLs' light by the objects (beyond seed 003; slower);\n"
+             "the same as --set render.vpl_visibility=true"},
     {.name = "--set", .type = LR_ARG_STRING, .metavar = "key=value", .repeat = MAX_SETS,
      .help = "change a scene parameter before rendering (repeatable), names as\n"
              "in the scene file: light.intensity=0.01, render.K=8,\n"

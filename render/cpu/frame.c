@@ -218,9 +218,11 @@ static void grid_item(void *p, long item)
     lr_recv_grid_frame_of(rc, &f);
     lr_vec3 x = lr_recv_grid_point(&f, k % LR_RECV_GRID, k / LR_RECV_GRID);
     double *E = r->grid[i] + 6 * (size_t)k;
+    const lr_scene *vis = lr_scene_render(r->s)->vpl_visibility ? r->s : NULL;
     for (int o = 0; o < r->nobj; o++)
-        lr_cpu_vpl_irradiance(r->vpl + (size_t)o * r->nvpl, r->nvpl,
-                              lr_scene_object_at(r->s, o)->coeffs.eta, x, rc->normal, E, E + 3);
+        lr_cpu_vpl_irradiance_vis(vis, r->vpl + (size_t)o * r->nvpl, r->nvpl,
+                                  lr_scene_object_at(r->s, o)->coeffs.eta, x, rc->normal, E,
+                                  E + 3);
     /* Translucent radiosity: what the VPLs do not carry, per light at unit intensity
      * (render/passes/irradiance.c adds the same to the GPU's grid). */
     for (int l = 0; l < r->nlight; l++) {
@@ -338,9 +340,10 @@ static void pixel_item(void *p, long item)
                     EV[c] += tw[q] * r->grid[idx][6 * (size_t)ti[q] + 3 + c];
                 }
         } else if (!r->d->no_vpl) {
+            const lr_scene *vis = lr_scene_render(r->s)->vpl_visibility ? r->s : NULL;
             for (int o = 0; o < r->nobj; o++)
-                lr_cpu_vpl_irradiance(r->vpl + (size_t)o * r->nvpl, r->nvpl,
-                                      lr_scene_object_at(r->s, o)->coeffs.eta, x, n, E, EV);
+                lr_cpu_vpl_irradiance_vis(vis, r->vpl + (size_t)o * r->nvpl, r->nvpl,
+                                          lr_scene_object_at(r->s, o)->coeffs.eta, x, n, E, EV);
         }
         for (int c = 0; c < 3; c++) {
             L[c] = rc->albedo[c] / M_PI * E[c];

@@ -36,6 +36,25 @@ void lr_cpu_vpl_place(const lr_scene_object *obj, int count, lr_cpu_vpl *out)
 void lr_cpu_vpl_irradiance(const lr_cpu_vpl *v, int count, double eta, lr_vec3 x, lr_vec3 n,
                            double E[3], double var[3])
 {
+    lr_cpu_vpl_irradiance_vis(NULL, v, count, eta, x, n, E, var);
+}
+
+/* Whether any object of s blocks the segment from VPL p to x (dist = |x - x_v|, w its unit
+ * direction). The VPL lies on its object's surface and the segment leaves it outward
+ * (cos_v > 0): tmin 1e-6 of each object's radius, as the direct light's shadow rays. */
+static bool vpl_hidden(const lr_scene *s, const lr_cpu_vpl *p, lr_vec3 w, double dist)
+{
+    for (int i = 0; i < lr_scene_object_count(s); i++) {
+        const lr_scene_object *o = lr_scene_object_at(s, i);
+        if (lr_bvh_occluded(o->bvh, p->x, w, 1e-6 * o->radius, dist * (1.0 - 1e-9)))
+            return true;
+    }
+    return false;
+}
+
+void lr_cpu_vpl_irradiance_vis(const lr_scene *s, const lr_cpu_vpl *v, int count, double eta,
+                               lr_vec3 x, lr_vec3 n, double E[3], double var[3])
+{
     for (int i = 0; i < count; i++) {
         const lr_cpu_vpl *p = &v[i];
         if (!p->valid)
@@ -47,6 +66,8 @@ void lr_cpu_vpl_irradiance(const lr_cpu_vpl *v, int count, double eta, lr_vec3 x
         lr_vec3 wh = lr_v3_scale(w, 1.0 / sqrt(d2));
         double cv = lr_v3_dot(p->n, wh), cx = -lr_v3_dot(n, wh);
         if (!(cv > 0.0) || !(cx > 0.0))
+            continue;
+        if (s && vpl_hidden(s, p, wh, sqrt(d2)))
             continue;
         double g = lr_fresnel_transmittance(cv, eta) / M_PI * p->area * cv * cx /
                    (d2 > p->area ? d2 : p->area); /* bounded geometry term */

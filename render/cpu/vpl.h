@@ -33,6 +33,14 @@ void lr_cpu_vpl_place(const lr_scene_object *obj, int count, lr_cpu_vpl *out);
 void lr_cpu_vpl_irradiance(const lr_cpu_vpl *v, int count, double eta, lr_vec3 x, lr_vec3 n,
                            double E[3], double var[3]);
 
+/* The same with VPL visibility (render.vpl_visibility): a VPL whose segment to x meets any
+ * object of s (ray cast against the BVHs) adds nothing. The GPU tests the same segment
+ * against the outer envelope's cube map at 8 points (render/shaders/lib/vpl_irradiance.glsl),
+ * which agrees where the segment crosses the object well inside its envelope and can miss a
+ * grazing one. s NULL: no visibility (lr_cpu_vpl_irradiance). */
+void lr_cpu_vpl_irradiance_vis(const lr_scene *s, const lr_cpu_vpl *v, int count, double eta,
+                               lr_vec3 x, lr_vec3 n, double E[3], double var[3]);
+
 /* Direct irradiance at x (normal n) from light l of unit intensity (directional: unit
  * radiance), 0 when any translucent object of the scene is in the way (the light G-buffer's
  * shadow test done with rays). */

@@ -329,6 +329,11 @@ static const lr_field render_fields[] = {
     {"lpv", LR_FT_INT, 0, RS(lpv), 0, 128, Z, .dflt = {0}, .dirty = SET,
      .help = "light-propagation volume cells per axis for area, point and spot lights' "
              "indirect light on plane receivers (seed 004; 0: off, else 2-128, e.g. 32)"},
+    /* Beyond seed 003 (its VPLs have no visibility): each VPL's light on the receivers is
+     * shadowed by the objects (render/shaders/lib/vpl_irradiance.glsl). The VPL images and the
+     * irradiance grids change, so a settings change (render/README.md "VPL visibility"). */
+    {"vpl_visibility", LR_FT_BOOL, 0, RS(vpl_visibility), .dflt = {0}, .dirty = SET,
+     .help = "shadow each VPL's light on the receivers by the objects (beyond seed 003)"},
 };
 
 const lr_record_desc lr_scene_render_desc = {"render", "render", NULL, NULL, NULL, NULL,

@@ -210,6 +210,9 @@ typedef struct lr_render_settings {
     /* Light-propagation volume (render/lpv/, seed 004) for the area lights' indirect light on
      * the plane receivers: cells per axis, 0 off. */
     int lpv;
+    /* Shadow each VPL's light on the receivers by the objects (beyond seed 003, whose VPLs
+     * have no visibility term; lr_renderer_desc.vpl_visibility also turns it on). */
+    bool vpl_visibility;
 } lr_render_settings;
 
 typedef struct lr_quality {

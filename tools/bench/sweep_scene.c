@@ -30,6 +30,21 @@ int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e)
     const char *lpv = getenv("LRB_SWEEP_LPV");
     if (lpv && *lpv && (rc = lr_scene_set(s, "render.lpv", lpv, NULL, e)))
         return rc;
+    /* LRB_SWEEP_SET="render.vpl_visibility=true;render.lpv=32": scene assignments applied to
+     * every setting (';'-separated, as --set takes them). */
+    const char *sets = getenv("LRB_SWEEP_SET");
+    for (const char *p = sets; p && *p;) {
+        const char *q = strchr(p, ';');
+        size_t n = q ? (size_t)(q - p) : strlen(p);
+        char a[256];
+        if (n >= sizeof a)
+            return lr_err_set(e, LR_EINVAL, "LRB_SWEEP_SET: assignment longer than %zu", sizeof a);
+        memcpy(a, p, n);
+        a[n] = 0;
+        if (n && (rc = lr_scene_set_assignment(s, a, NULL, e)))
+            return lr_err_prefix(e, "LRB_SWEEP_SET");
+        p = q ? q + 1 : p + n;
+    }
     /* The model is per object; the sweep switches every object that can take it (the
      * multipole needs thickness_mm); lrb_sweep_takes says whether any can. */
     enum lr_sss_model m;

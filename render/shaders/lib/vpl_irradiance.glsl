@@ -21,7 +21,9 @@ uniform highp samplerCube u_outer_pos;
 uniform vec3 u_center;
 uniform float u_vis_eps; // mm: the start is moved this far off the surface along n_v
 
-#define LR_VIS_STEPS 8
+// 32 points: on jar_candle the segments from the pool's VPLs that graze the rim slip between
+// 8 points (the wall then kept 2x the visible VPLs' light; tests/render/test_render_vplvis.c).
+#define LR_VIS_STEPS 32
 
 bool lr_vpl_visible(vec3 xv, vec3 nv, vec3 x)
 {
