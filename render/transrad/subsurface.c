@@ -170,11 +170,19 @@ static void ss_item(void *vctx, long item)
     free(col);
 }
 
+#define TH_POINTS 16
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
 /* The wall's thickness under each patch: the multipole's slab (seed 000 indexes a half-space
  * profile by distance, which misses light that crosses a wall: issue 12 measures 3x). Given
  * ("thickness_mm" with the multipole or translucent radiosity): that value everywhere. Not
- * given, for translucent_radiosity: measured, the distance along -n from the patch centroid to
- * where the ray leaves the material; beyond 10 diffusion lengths the wall is a half-space (0:
+ * given, for translucent_radiosity: measured, the median over 16 points on the patch of the
+ * distance along -n to where the ray leaves the material; beyond 10 diffusion lengths the wall is a half-space (0:
  * the standard dipole). Other models: none (their half-space profile). */
 static int local_thickness(const lr_tr *t, int s, double **out, lr_err *e)
 {
@@ -197,12 +205,27 @@ static int local_thickness(const lr_tr *t, int s, double **out, lr_err *e)
         }
         if (sf->d.model != LR_SSS_TRANSLUCENT_RADIOSITY)
             continue;
-        const lr_tr_patch *p = &t->p[sf->first + i];
-        lr_vec3 in = lr_v3_scale(p->n, -1);
-        lr_hit h;
-        if (lr_bvh_intersect(sf->d.bvh, lr_v3_add(p->c, lr_v3_scale(in, eps)), in, 0.0, INFINITY,
-                             &h)) {
-            double d = h.t + eps;
+        /* From points on the surface, not the centroid: a patch is a cluster of triangles,
+         * and on a curved face its centroid lies off the surface (a candle's melt-pool dish:
+         * 0.03-0.2 mm above it, in the air, so the ray measured the air gap down to the wax
+         * and the pool floor became a 0.1 mm "wall", thin by lr_tr_wall_thin: its light
+         * stayed in the entry patch, and without the thin-wall rule the centroid sums of
+         * that narrow profile pushed 64 % of it onto the outer wall). The median over the
+         * patch's points ignores the few that graze an edge. */
+        double dk[TH_POINTS];
+        int nk = 0;
+        for (unsigned k = 0; k < TH_POINTS; k++) {
+            lr_vec3 x, n;
+            lr_tr_patch_point(t, sf->first + i, k, TH_POINTS, 0.5, 0.5, &x, &n);
+            lr_vec3 in = lr_v3_scale(n, -1);
+            lr_hit h;
+            if (lr_bvh_intersect(sf->d.bvh, lr_v3_add(x, lr_v3_scale(in, eps)), in, 0.0,
+                                 INFINITY, &h))
+                dk[nk++] = h.t + eps;
+        }
+        if (nk > 0) {
+            qsort(dk, (size_t)nk, sizeof *dk, cmp_double);
+            double d = nk % 2 ? dk[nk / 2] : 0.5 * (dk[nk / 2 - 1] + dk[nk / 2]);
             th[i] = str > 0 && d * str > 10 ? 0 : fmax(d, LR_MULTIPOLE_D_MIN);
         }
     }

@@ -8,6 +8,8 @@
  *                                          none: the warm-started sweeps)
  *                    [--thin-wall auto|off|on]  (S on slab walls, render/transrad/thinwall.c:
  *                                          by its rule (default), never, on every slab patch)
+ *                    [--split]            (per light and object: where S sends the light
+ *                                          that entered, by distance and facing; split.c)
  *                    [--no-cache]         (build F and S even when $XDG_CACHE_HOME/lamprig has
  *                                          them; by default they are read from and written to
  *                                          the cache, render/transrad/cache.c)
@@ -20,6 +22,7 @@
 
 #include "render/scene/scene.h"
 #include "render/transrad/transrad.h"
+#include "tools/transrad/split.h"
 
 static double now_s(void)
 {
@@ -33,7 +36,7 @@ int main(int argc, char **argv)
     if (argc < 2) {
         fprintf(stderr, "usage: lamprig-transrad SCENE.json [--set K=V]... [--patch MM] "
                         "[--receiver MM] [--rays N] [--transfer-mb MB] [--thin-wall auto|off|on] "
-                        "[--no-cache]\n");
+                        "[--split] [--no-cache]\n");
         return 2;
     }
     lr_err e = {0};
@@ -43,6 +46,7 @@ int main(int argc, char **argv)
         return 1;
     }
     char cdir[1024];
+    int split = 0;
     lr_tr_settings set = {.cache_dir = lr_tr_cache_default_dir(cdir, sizeof cdir)};
     for (int i = 2; i < argc; i++) {
         if (!strcmp(argv[i], "--set") && i + 1 < argc) {
@@ -54,6 +58,8 @@ int main(int argc, char **argv)
             set.patch_mm = atof(argv[++i]);
         } else if (!strcmp(argv[i], "--receiver") && i + 1 < argc) {
             set.receiver_mm = atof(argv[++i]);
+        } else if (!strcmp(argv[i], "--split")) {
+            split = 1;
         } else if (!strcmp(argv[i], "--no-cache")) {
             set.cache_dir = NULL;
         } else if (!strcmp(argv[i], "--transfer-mb") && i + 1 < argc) {
@@ -162,6 +168,8 @@ int main(int argc, char **argv)
                from_obj[0], from_obj[1], from_obj[2], from_rcv[0], from_rcv[1], from_rcv[2],
                100 * from_rcv[1] / (dir[1] + ind[1]));
         printf("  leaves the scene %.4g %.4g %.4g\n", esc[0], esc[1], esc[2]);
+        for (int i = 0; split && i < no; i++)
+            lr_trtool_print_split(t, i, l, &lr_scene_object_at(s, i)->coeffs);
         /* A light move: 1 mm along x, warm-started. */
         lr_light moved = *lr_scene_light_at(s, l);
         moved.position.x += 1.0;
