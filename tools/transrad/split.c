@@ -45,7 +45,9 @@ void lr_trtool_print_split(const lr_tr *t, int s, int slot, const lr_coeffs *c)
     lr_vec3 *pc = malloc(n * sizeof *pc), *pn = malloc(n * sizeof *pn);
     double *pa = malloc(n * sizeof *pa);
     if (!pc || !pn || !pa) {
-        free(pc), free(pn), free(pa);
+        free(pc);
+        free(pn);
+        free(pa);
         return;
     }
     for (size_t i = 0; i < n; i++) {
@@ -58,7 +60,9 @@ void lr_trtool_print_split(const lr_tr *t, int s, int slot, const lr_coeffs *c)
     double selfsh[3] = {0, 0, 0}, selfdip[3] = {0, 0, 0}, win[3] = {0, 0, 0};
     int *rg = malloc(n * sizeof *rg);
     if (!rg) {
-        free(pc), free(pn), free(pa);
+        free(pc);
+        free(pn);
+        free(pa);
         return;
     }
     for (size_t j = 0; j < n; j++) {
@@ -144,5 +148,8 @@ void lr_trtool_print_split(const lr_tr *t, int s, int slot, const lr_coeffs *c)
     for (int r = 0; r < NR; r++)
         printf("    %-14s %8.0f %10.4g %10.4g %10.4g %10.4g\n", rname[r], Ar[r], Hp[r], Ip[r],
                Wp[r], Ar[r] > 0 ? Wp[r] / Ar[r] : 0);
-    free(rg), free(pc), free(pn), free(pa);
+    free(rg);
+    free(pc);
+    free(pn);
+    free(pa);
 }
