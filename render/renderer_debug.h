@@ -105,6 +105,9 @@ typedef struct lr_debug_surface_info {
     double h[8];
 } lr_debug_surface_info;
 void lr_renderer_debug_surface_info(const lr_renderer *r, lr_debug_surface_info *out);
+/* Light l's surface cache as drawn by the surface pass: 4 floats per entry (B rgb in the
+ * maps' scale, a map saw it), info.entries of them into out. */
+int lr_renderer_debug_read_surface(lr_renderer *r, int l, float *out, lr_err *e);
 
 /* ---- the bench's floor (issue 11) ---------------------------------------------------------- */
 
