@@ -66,8 +66,8 @@ typedef struct rctx {
     lr_light **fl;
     int *nfl;
     /* PASS with render.surface_cache: per object its lattice (render/mesh/lattice.h) and,
-     * per light, side and lattice point, B (3 doubles), its variance (3) and whether a map saw it (1): the GPU's
-     * surface cache (render/cpu/surface.h), interpolated per pixel. NULL: per pixel. */
+     * per light, side and lattice point, B (3 doubles), its variance (3) and whether a map
+     * saw it (1): the GPU's surface cache (render/cpu/surface.h), interpolated per pixel. NULL: per pixel. */
     lr_refined *ref;
     double **cache;
     long *cache_first; /* item -> (object, light, side, vertex): prefix over objects */

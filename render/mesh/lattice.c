@@ -53,7 +53,8 @@ int lr_refine_lattice(const lr_mesh *m, double h, size_t max_vertices, lr_refine
         double R = ceil(longest_edge(P, ix + 3 * t) / h);
         R = R < 1.0 ? 1.0 : R;
         size_t verts = (size_t)((R + 1.0) * (R + 2.0) / 2.0);
-        if (R > 65535.0 || (max_vertices && nv + verts > max_vertices) || nv + verts >= UINT32_MAX) {
+        if (R > 65535.0 || (max_vertices && nv + verts > max_vertices) ||
+            nv + verts >= UINT32_MAX) {
             lr_refined_free(&r);
             return lr_err_set(e, LR_EUNSUPPORTED,
                               "mesh %s: lattice of edges %.3g mm would exceed %zu vertices",
@@ -95,7 +96,8 @@ int lr_refine_lattice(const lr_mesh *m, double h, size_t max_vertices, lr_refine
             for (size_t i = 0; i + j < R; i++)
                 for (int up = 0; up < 2 && (up == 0 || i + j + 2 <= R); up++) {
                     size_t q = r.first[t] + lat_tri(R, i, j, up);
-                    /* Corners as (i, j) offsets: lower (0,0) (1,0) (0,1), upper (1,0) (1,1) (0,1). */
+                    /* Corners as (i, j) offsets: lower (0,0) (1,0) (0,1),
+                     * upper (1,0) (1,1) (0,1). */
                     static const int off[2][3][2] = {{{0, 0}, {1, 0}, {0, 1}},
                                                      {{1, 0}, {1, 1}, {0, 1}}};
                     for (int a = 0; a < 3; a++) {

@@ -198,7 +198,8 @@ static int run(FILE *out)
         fprintf(stderr, "bench camera: no GL context: %s\n", e.msg);
         return 1;
     }
-    fprintf(out, "| scene | size | moves | gather wall ms median (min) | gather CPU ms | cache wall "
+    fprintf(out, "| scene | size | moves | gather wall ms median (min) | gather CPU ms | "
+                 "cache wall "
                  "ms | cache CPU ms | gather / cache, wall | gather / cache, CPU |\n"
                  "|---|---|---|---|---|---|---|---|---|\n");
     int rc = 0;

@@ -7,8 +7,8 @@
  *     that the maps have converged after them), median total; DIMMER_FRAMES dimmer-only frames
  *     (light.intensity alternately halved and restored: the blend pass alone), median total;
  *     CAMERA_FRAMES camera-only frames (compose + blend; wall time; with the per-pixel gather,
- *     then with the surface cache: issue 11's camera ratio, gather / cache); the floor (issue 11): a fullscreen
- *     pass reading one RGBA16F texture into the output (lr_renderer_debug_floor_ms), timed as
+ *     then with the surface cache: issue 11's camera ratio, gather / cache); the floor
+ *     (issue 11): a fullscreen pass reading one RGBA16F texture into the output (lr_renderer_debug_floor_ms), timed as
  *     a frame's pass is (inside a renderer timer section; wall time glFinish to glFinish
  *     around the whole, as for the dimmer frames). Ratios: full update / dimmer, compose /
  *     dimmer (the dimmer against a composition), dimmer / floor by the timers and by wall
@@ -485,7 +485,8 @@ static int run(FILE *out)
                      "per-pixel gather (\"camera\": render.surface_cache false, Algorithm 1 per "
                      "object pixel) and with the surface cache (\"camera, cache\"); "
                      "\"gather / cache\" is issue 11's camera ratio in this run, against today's "
-                     "per-pixel composition, itself cheaper than the issue's 520 ms composition; floor: a fullscreen "
+                     "per-pixel composition, itself cheaper than the issue's 520 ms "
+                     "composition; floor: a fullscreen "
                      "pass reading one RGBA16F texture into the output, median of %d). Pass times "
                      "are the renderer's timers; \"wall\" is wall time from glFinish to glFinish "
                      "(what a caller waits). The floor is measured as a frame's pass is: its draw "
