@@ -8,8 +8,8 @@
  *     (light.intensity alternately halved and restored: the blend pass alone), median total;
  *     CAMERA_FRAMES camera-only frames (compose + blend; wall time; with the per-pixel gather,
  *     then with the surface cache: issue 11's camera ratio, gather / cache); the floor
- *     (issue 11): a fullscreen pass reading one RGBA16F texture into the output (lr_renderer_debug_floor_ms), timed as
- *     a frame's pass is (inside a renderer timer section; wall time glFinish to glFinish
+ *     (issue 11): a fullscreen pass reading one RGBA16F texture into the output
+ *     (lr_renderer_debug_floor_ms), timed as a frame's pass is (inside a renderer timer section; wall time glFinish to glFinish
  *     around the whole, as for the dimmer frames). Ratios: full update / dimmer, compose /
  *     dimmer (the dimmer against a composition), dimmer / floor by the timers and by wall
  *     time, compose / camera.
