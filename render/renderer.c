@@ -90,10 +90,11 @@ static lr_pass_ctx pass_ctx(const lr_renderer *r)
 static int check_programs(lr_renderer *r, lr_err *e)
 {
     lr_program *ps[] = {r->prog.surface, r->prog.depth, r->prog.radiosity, r->prog.vpl,
-                        r->prog.obj,     r->prog.recv,  r->prog.blit,      r->prog.irr,
+                        r->prog.obj,     r->prog.recv[0], r->prog.blit,    r->prog.irr,
                         r->prog.area,
                         r->prog.cache,   r->prog.obj_cached[0], r->prog.obj_cached[1],
-                        r->prog.obj_cached[2], r->prog.obj_cached[3]};
+                        r->prog.obj_cached[2], r->prog.obj_cached[3], r->prog.recv[1],
+                        r->prog.recv[2], r->prog.recv[3]};
     for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++) {
         int rc = ps[i] ? lr_program_check(ps[i], e) : LR_OK;
         if (rc)
@@ -379,24 +380,30 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
         (rc = program(r, "radiosity.vert", "radiosity.frag", &pr->radiosity, e)) ||
         (rc = program(r, "fullscreen.vert", "vpl.frag", &pr->vpl, e)) ||
         (rc = program(r, "mesh.vert", "compose_object.frag", &pr->obj, e)) ||
-        (rc = program(r, "mesh.vert", "compose_receiver.frag", &pr->recv, e)) ||
         (rc = program(r, "fullscreen.vert", "blit.frag", &pr->blit, e)) ||
         (rc = program(r, "fullscreen.vert", "irradiance.frag", &pr->irr, e)) ||
         (rc = program(r, "fullscreen.vert", "area_direct.frag", &pr->area, e)) ||
         (rc = program(r, "fullscreen.vert", "surface_cache.frag", &pr->cache, e)))
         goto fail;
-    /* Composition from the surface cache, one program per light count (its varyings). */
+    /* Composition from the surface cache and of the receivers, one program per light count
+     * (LR_CACHE_LIGHTS, LR_RECV_LIGHTS): llvmpipe runs a loop's body for every light up to
+     * the bound whatever u_n_lights says (a camera move's receivers cost 1.8x for one light
+     * with the bound at 4, tools/bench/README.md "Camera move, profiled"). */
     for (int n = 1; n <= LR_MAX_LIGHTS; n++) {
         lr_shader_defines d = r->defines;
         for (int i = 0; i < d.n; i++)
             d.list[i] = d.text[i]; /* the copy's own text */
-        if (!lr_shader_defines_add(&d, "LR_CACHE_LIGHTS", n)) {
+        if (!lr_shader_defines_add(&d, "LR_CACHE_LIGHTS", n) ||
+            !lr_shader_defines_add(&d, "LR_RECV_LIGHTS", n)) {
             rc = lr_err_set(e, LR_EINVAL, "renderer: too many shader defines");
             goto fail;
         }
         lr_program_desc pd = {.vertex = "compose_cached.vert", .fragment = "compose_cached.frag",
                               .dir = r->shader_dir, .defines = d.list};
-        if ((rc = lr_program_create(&pd, &pr->obj_cached[n - 1], e)))
+        lr_program_desc pr_d = {.vertex = "mesh.vert", .fragment = "compose_receiver.frag",
+                                .dir = r->shader_dir, .defines = d.list};
+        if ((rc = lr_program_create(&pd, &pr->obj_cached[n - 1], e)) ||
+            (rc = lr_program_create(&pr_d, &pr->recv[n - 1], e)))
             goto fail;
     }
     if ((rc = alloc_resources(r, e)) || (rc = lr_pass_objects_upload(&r->objs, r->scene, e)))
@@ -426,9 +433,10 @@ void lr_renderer_destroy(lr_renderer *r)
     lr_pass_objects_free(&r->objs);
     const lr_pass_programs *pr = &r->prog;
     lr_program *ps[] = {pr->surface,       pr->depth,         pr->radiosity,     pr->vpl,
-                        pr->obj,           pr->recv,          pr->blit,          pr->irr,
+                        pr->obj,           pr->recv[0],       pr->blit,          pr->irr,
                         pr->cache,         pr->obj_cached[0], pr->obj_cached[1],
-                        pr->obj_cached[2], pr->obj_cached[3], pr->area};
+                        pr->obj_cached[2], pr->obj_cached[3], pr->area,
+                        pr->recv[1],       pr->recv[2],       pr->recv[3]};
     for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
         lr_program_destroy(ps[i]);
     lr_timer_destroy(r->timer);

@@ -249,6 +249,19 @@ void lr_renderer_debug_surface_info(const lr_renderer *r, lr_debug_surface_info 
     }
 }
 
+int lr_renderer_debug_read_surface(lr_renderer *r, int l, float *out, lr_err *e)
+{
+    const lr_surface *sc = parts(r).surface;
+    if (!sc->valid || l < 0 || l >= sc->n_lights)
+        return lr_err_set(e, LR_EINVAL, "debug surface cache: not drawn, or no light %d", l);
+    float *p = read_fb(sc->fb, l, LR_SURFACE_ROW, sc->rows, e);
+    if (!p)
+        return e ? e->code : LR_EIO;
+    memcpy(out, p, (size_t)sc->entries * 4 * sizeof *out);
+    free(p);
+    return LR_OK;
+}
+
 struct lr_debug_floor {
     lr_renderer_parts pt;
     lr_program *p;

@@ -96,14 +96,18 @@ int lr_renderer_debug_uncovered(lr_renderer *r, int *count, lr_err *e);
  * rather than reading the surface cache (render/passes/surface.h). */
 bool lr_renderer_debug_compose_gathered(const lr_renderer *r);
 
-/* The surface cache: entries (refined vertices, both sides of open objects), and object i's
- * refined vertex count and edge bound in mm (0 when the cache is not built). */
+/* The surface cache: entries (lattice points, render/mesh/lattice.h, both sides of open
+ * objects), and object i's lattice point count and edge bound in mm (0 when the cache is not
+ * built). */
 typedef struct lr_debug_surface_info {
     int entries, n_objects;
     int nv[8]; /* LR_MAX_OBJECTS (render/passes/material_pack.h) */
     double h[8];
 } lr_debug_surface_info;
 void lr_renderer_debug_surface_info(const lr_renderer *r, lr_debug_surface_info *out);
+/* Light l's surface cache as drawn by the surface pass: 4 floats per entry (B rgb in the
+ * maps' scale, a map saw it), info.entries of them into out. */
+int lr_renderer_debug_read_surface(lr_renderer *r, int l, float *out, lr_err *e);
 
 /* ---- the bench's floor (issue 11) ---------------------------------------------------------- */
 

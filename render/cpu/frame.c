@@ -65,9 +65,9 @@ typedef struct rctx {
      * any other light itself once. */
     lr_light **fl;
     int *nfl;
-    /* PASS with render.surface_cache: per object its refined mesh and, per light, side and
-     * refined vertex, B (3 doubles), its variance (3) and whether a map saw it (1): the GPU's
-     * surface cache (render/cpu/surface.h), interpolated per pixel. NULL: per pixel. */
+    /* PASS with render.surface_cache: per object its lattice (render/mesh/lattice.h) and,
+     * per light, side and lattice point, B (3 doubles), its variance (3) and whether a map
+     * saw it (1): the GPU's surface cache (render/cpu/surface.h), interpolated per pixel. NULL: per pixel. */
     lr_refined *ref;
     double **cache;
     long *cache_first; /* item -> (object, light, side, vertex): prefix over objects */
@@ -153,14 +153,14 @@ static void vpl_item(void *p, long item)
 /* Sides cached for object o: an open object also for its reversed normal. */
 static int sides(const rctx *r, int o) { return lr_scene_object_at(r->s, o)->closed ? 1 : 2; }
 
-/* The cache entry of object o, light l, side, refined vertex v. */
+/* The cache entry of object o, light l, side, lattice point v. */
 static double *cache_at(const rctx *r, int o, int l, int side, size_t v)
 {
     size_t nv = r->ref[o].nv;
     return r->cache[o] + CACHE_DOUBLES * (((size_t)l * (size_t)sides(r, o) + (size_t)side) * nv + v);
 }
 
-/* Algorithm 1 at one refined vertex for every light (item over all objects' entries). */
+/* Algorithm 1 at one lattice point for every light (item over all objects' entries). */
 static void cache_item(void *p, long item)
 {
     rctx *r = p;
@@ -185,7 +185,8 @@ static void cache_item(void *p, long item)
 }
 
 /* B of object o for light l at the camera hit (parent triangle t, barycentrics u, v): the
- * cache interpolated over the refined triangle, as the GPU's rasteriser does. */
+ * cache interpolated over the lattice sub-triangle holding it (lr_lattice_locate), as
+ * compose_cached.frag does. */
 static void cached_at(const rctx *r, int o, int l, int side, size_t t, double u, double v,
                       double B[3], double var[3], bool *fallback)
 {
@@ -516,7 +517,7 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
                                 samples += 3.0 * md.N * frames;
             }
     }
-    /* The GPU's surface cache (render.surface_cache): B at the refined vertices. */
+    /* The GPU's surface cache (render.surface_cache): B at the lattice points. */
     if (!ref && rs->surface_cache) {
         int msize = d->map_size ? d->map_size : rs->map_size;
         r.ref = calloc((size_t)r.nobj, sizeof *r.ref);

@@ -4,6 +4,8 @@
 
 #include <math.h>
 
+#include "render/mesh/lattice.h"
+
 double lr_surface_edge_bound(const lr_scene *s, int object, int map_size)
 {
     (void)object;
@@ -24,7 +26,7 @@ int lr_surface_refine(const lr_scene *s, int object, int map_size, size_t budget
     *h = lr_surface_edge_bound(s, object, map_size);
     for (int tries = 0;; tries++) {
         lr_err e2 = {0};
-        int rc = lr_refine(o->mesh, *h, budget > 0 ? budget : 1, out, &e2);
+        int rc = lr_refine_lattice(o->mesh, *h, budget > 0 ? budget : 1, out, &e2);
         if (rc != LR_EUNSUPPORTED || tries > 40) {
             if (rc && e)
                 *e = e2;

@@ -1,7 +1,7 @@
 /* lamprig — the objects' surface cache, shared by the GPU pass (render/passes/surface.h) and
- * its CPU twin (render/cpu/frame.c): the edge bound each object's mesh is refined to
- * (render/mesh/refine.h) and the refinement itself, so that both sides cache B at the same
- * vertices (PIPELINE.md "Surface cache"). */
+ * its CPU twin (render/cpu/frame.c): the edge bound of each object's lattice and the lattice
+ * itself (render/mesh/lattice.h, in an lr_refined), so that both sides cache B at the same
+ * points and interpolate alike (PIPELINE.md "Surface cache"). */
 #ifndef LR_CPU_SURFACE_H
 #define LR_CPU_SURFACE_H
 
@@ -24,8 +24,8 @@
  * per-object rule needs no new signature. */
 double lr_surface_edge_bound(const lr_scene *s, int object, int map_size);
 
-/* Object i refined to its edge bound, doubled while the result would have more than `budget`
- * vertices; *h receives the bound used. */
+/* Object i's lattice (lr_refine_lattice) for its edge bound, doubled while the result would
+ * have more than `budget` points; *h receives the bound used. */
 int lr_surface_refine(const lr_scene *s, int object, int map_size, size_t budget,
                       lr_refined *out, double *h, lr_err *e);
 

@@ -1,5 +1,6 @@
 /* Conforming midpoint refinement of a triangle mesh (render/mesh/refine.h). */
 #include "render/mesh/refine.h"
+#include "render/mesh/lattice.h"
 
 #include <math.h>
 #include <stdbool.h>
@@ -162,6 +163,8 @@ void lr_refined_free(lr_refined *r)
     free(r->parent);
     free(r->uv);
     free(r->first);
+    free(r->lat_R);
+    free(r->lat_base);
     memset(r, 0, sizeof *r);
 }
 
@@ -295,6 +298,8 @@ int lr_refine(const lr_mesh *m, double h, size_t max_vertices, lr_refined *out, 
 
 size_t lr_refined_locate(const lr_refined *r, size_t t, double u, double v, double w[3])
 {
+    if (r->lat_R)
+        return lr_lattice_locate(r, t, u, v, w);
     size_t best = r->first[t];
     double best_out = INFINITY;
     for (size_t k = r->first[t]; k < r->first[t + 1]; k++) {

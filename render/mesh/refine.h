@@ -29,6 +29,9 @@ typedef struct lr_refined {
     size_t *first;     /* per original triangle t: its refined triangles are first[t] ..
                         * first[t + 1] - 1 (n_parents + 1 entries) */
     size_t n_parents;
+    /* Lattice refinement only (lr_refine_lattice; NULL for lr_refine): per original
+     * triangle t its lattice resolution R and its first vertex (render/mesh/lattice.h). */
+    uint32_t *lat_R, *lat_base;
 } lr_refined;
 
 /* Refines m so that no edge is longer than h (mm, > 0). max_vertices (0: no limit) bounds
@@ -37,7 +40,8 @@ int lr_refine(const lr_mesh *m, double h, size_t max_vertices, lr_refined *out, 
 void lr_refined_free(lr_refined *r);
 
 /* The refined triangle holding barycentrics (u, v) of original triangle t, and the
- * barycentrics (w0, w1, w2) of the point in it (sum 1). Returns that triangle's index. */
+ * barycentrics (w0, w1, w2) of the point in it (sum 1). Returns that triangle's index. A
+ * lattice refinement (lat_R set) is located by arithmetic (lr_lattice_locate). */
 size_t lr_refined_locate(const lr_refined *r, size_t t, double u, double v, double w[3]);
 
 #endif

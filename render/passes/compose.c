@@ -86,7 +86,9 @@ static void draw_objects_gather(const lr_compose *img, const lr_radiosity *rad,
     }
 }
 
-/* B from the surface cache over the refined meshes (compose_cached.vert/.frag): no gather. */
+/* B from the surface cache, looked up per pixel in the lattice of the pixel's triangle
+ * (compose_cached.vert/.frag, render/mesh/lattice.h): no gather, and no refined mesh to
+ * rasterise. */
 static void draw_objects_cached(const lr_compose *img, const lr_surface *sc,
                                 const lr_pass_ctx *c, lr_program *p)
 {
@@ -102,9 +104,8 @@ static void draw_objects_cached(const lr_compose *img, const lr_surface *sc,
         lr_passes_uniform_v3_array(p, "u_gain", g, LR_MAX_LIGHTS);
         lr_passes_uniform_i(p, "u_object", i);
         lr_passes_uniform_i(p, "u_two_sided", o->two_sided[i]);
-        lr_passes_uniform_i(p, "u_base", sc->base[i]);
         lr_passes_uniform_i(p, "u_nv", sc->nv[i]);
-        lr_passes_draw(&sc->mesh[i]);
+        lr_surface_draw(sc, i);
     }
 }
 
@@ -156,7 +157,7 @@ int lr_compose_run(lr_compose *img, const lr_pass_ctx *c, const lr_compose_input
     else
         draw_objects_gather(img, in->radiosity, c, p);
 
-    p = c->prog->recv;
+    p = c->prog->recv[img->n - 1];
     glUseProgram(lr_program_id(p));
     lr_passes_set_coeffs(o, p);
     lr_gbuffer_bind_lights(in->gbuffer, c, p);

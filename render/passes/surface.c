@@ -1,9 +1,10 @@
-/* The objects' surface cache (render/passes/surface.h; PIPELINE.md "Surface cache"): every
- * object mesh refined to edges of at most h (render/mesh/refine.h), and Algorithm 1
- * (lib/gather.glsl, lr_gather_each) evaluated once per refined vertex and light into a
- * texture, one texel per entry, by a fullscreen draw. B does not depend on the view (only
- * F_t(w_o) / pi does), so composition (compose_cached.vert/.frag) reads three entries per
- * triangle instead of K x 4 map taps per pixel, and a camera move costs no gather. */
+/* The objects' surface cache (render/passes/surface.h; PIPELINE.md "Surface cache"): a
+ * lattice over every triangle of every object mesh, sub-triangle edges at most h
+ * (render/mesh/lattice.h), and Algorithm 1 (lib/gather.glsl, lr_gather_each) evaluated once
+ * per lattice point and light into a texture, one texel per entry, by a fullscreen draw. B
+ * does not depend on the view (only F_t(w_o) / pi does), so composition
+ * (compose_cached.vert/.frag) draws the original mesh and reads three entries per pixel
+ * instead of K x 4 map taps, and a camera move costs no gather. */
 #include "render/passes/surface.h"
 
 #include <math.h>
@@ -31,6 +32,54 @@ void lr_surface_invalidate_geometry(lr_surface *sc)
 {
     sc->built = false;
     sc->valid = false;
+}
+
+/* Object mesh m unindexed for compose_cached.vert: per corner its position and normal
+ * (attributes 0, 1) and its triangle's lattice, (first cache entry, R) (attribute 2,
+ * integer), render/mesh/lattice.h. */
+static int upload_lattice_mesh(lr_gpu_mesh *g, const lr_mesh *m, const lr_refined *ref,
+                               int base, lr_err *e)
+{
+    size_t nt = lr_mesh_triangle_count(m);
+    if (nt * 3 > 0x7fffffff || !ref->lat_R || ref->n_parents != nt)
+        return lr_err_set(e, LR_EINVAL, "surface cache: mesh %s: %zu triangles, no lattice for "
+                          "them", lr_mesh_name(m), nt);
+    const float *P = lr_mesh_positions(m), *N = lr_mesh_normals(m);
+    const uint32_t *ix = lr_mesh_indices(m);
+    float *pn = malloc(nt * 3 * 6 * sizeof *pn);
+    GLint *lat = malloc(nt * 3 * 2 * sizeof *lat);
+    if (!pn || !lat) {
+        free(pn);
+        free(lat);
+        return lr_err_set(e, LR_ENOMEM, "surface cache: out of memory");
+    }
+    for (size_t t = 0; t < nt; t++)
+        for (int c = 0; c < 3; c++) {
+            size_t q = 3 * t + (size_t)c, v = ix[3 * t + (size_t)c];
+            memcpy(pn + 6 * q, P + 3 * v, 3 * sizeof *pn);
+            memcpy(pn + 6 * q + 3, N + 3 * v, 3 * sizeof *pn);
+            lat[2 * q] = base + (GLint)ref->lat_base[t];
+            lat[2 * q + 1] = (GLint)ref->lat_R[t];
+        }
+    glGenVertexArrays(1, &g->vao);
+    glGenBuffers(2, g->vbo);
+    glBindVertexArray(g->vao);
+    glBindBuffer(GL_ARRAY_BUFFER, g->vbo[0]);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nt * 3 * 6 * sizeof *pn), pn, GL_STATIC_DRAW);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), 0);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
+                          (const void *)(3 * sizeof(float)));
+    glEnableVertexAttribArray(1);
+    glBindBuffer(GL_ARRAY_BUFFER, g->vbo[1]);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nt * 3 * 2 * sizeof *lat), lat, GL_STATIC_DRAW);
+    glVertexAttribIPointer(2, 2, GL_INT, 0, 0);
+    glEnableVertexAttribArray(2);
+    glBindVertexArray(0);
+    g->count = (GLsizei)(nt * 3);
+    free(pn);
+    free(lat);
+    return lr_gl_check("surface cache mesh upload", e);
 }
 
 static int build(lr_surface *sc, const lr_pass_ctx *c, const lr_radiosity *rad, lr_err *e)
@@ -73,8 +122,8 @@ static int build(lr_surface *sc, const lr_pass_ctx *c, const lr_radiosity *rad, 
                 }
                 pos[4 * k + 3] = 1.0f;
             }
-        rc = lr_passes_upload_arrays(&sc->mesh[i], ref[i].pos, ref[i].nrm, ref[i].nv, ref[i].idx,
-                                     ref[i].nt, lr_scene_object_at(c->scene, i)->name, e);
+        rc = upload_lattice_mesh(&sc->mesh[i], lr_scene_object_at(c->scene, i)->mesh, &ref[i],
+                                 sc->base[i], e);
     }
     for (int i = 0; i < no; i++)
         lr_refined_free(&ref[i]);
@@ -135,6 +184,13 @@ int lr_surface_run(lr_surface *sc, const lr_pass_ctx *c, const lr_radiosity *rad
         return rc;
     sc->valid = true;
     return LR_OK;
+}
+
+void lr_surface_draw(const lr_surface *sc, int object)
+{
+    glBindVertexArray(sc->mesh[object].vao);
+    glDrawArrays(GL_TRIANGLES, 0, sc->mesh[object].count);
+    glBindVertexArray(0);
 }
 
 void lr_surface_bind(const lr_surface *sc, lr_program *p)

@@ -1,37 +1,26 @@
-// Composition of the objects from the surface cache (render/passes/surface.h): the refined
-// mesh's vertex gl_VertexID of this object is cache entry u_base + gl_VertexID (its back side,
-// for an open object, u_base + u_nv + gl_VertexID); B_l of each light is passed on to be
-// interpolated over the triangle. Position and normal pass through as in mesh.vert.
-// LR_CACHE_LIGHTS: the scene's lights (one program per count, render/renderer.c), so that a
-// one-light scene interpolates two vec4 per fragment rather than eight.
-#ifndef LR_CACHE_LIGHTS
-#define LR_CACHE_LIGHTS LR_MAX_LIGHTS
-#endif
+// Composition of the objects from the surface cache (render/passes/surface.h): the object's
+// original mesh, drawn unindexed (glDrawArrays), so that gl_VertexID / 3 is the triangle and
+// gl_VertexID % 3 its corner; the corner's barycentrics (u, v) of p1 and p2 are interpolated
+// (perspective-correct: the surface point's barycentrics in its triangle) and the triangle's
+// lattice, a_lat = (first cache entry, resolution R; render/mesh/lattice.h), passes flat, so
+// that compose_cached.frag finds the point's three cache entries by arithmetic. GLSL ES 3.1
+// has no gl_PrimitiveID in fragment shaders, hence the flat varying. Position and normal pass
+// through as in mesh.vert.
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_nrm;
+layout(location = 2) in ivec2 a_lat;
 uniform mat4 u_vp;
-uniform highp sampler2DArray u_surface_B; // layer l: light l's B (rgb), a map saw it (a)
-uniform int u_surface_row;                 // entries per row
-uniform int u_base, u_nv;
-uniform bool u_two_sided;
 out vec3 v_pos;
 out vec3 v_nrm;
-out vec4 v_front[LR_CACHE_LIGHTS];
-out vec4 v_back[LR_CACHE_LIGHTS];
-
-vec4 entry(int k, int l)
-{
-    return texelFetch(u_surface_B, ivec3(k % u_surface_row, k / u_surface_row, l), 0);
-}
+out vec2 v_uv;
+flat out ivec2 v_lat;
 
 void main()
 {
     v_pos = a_pos;
     v_nrm = a_nrm;
-    int k = u_base + gl_VertexID;
-    for (int l = 0; l < LR_CACHE_LIGHTS; l++) {
-        v_front[l] = entry(k, l);
-        v_back[l] = u_two_sided ? entry(k + u_nv, l) : vec4(0.0);
-    }
+    int c = gl_VertexID % 3;
+    v_uv = vec2(c == 1 ? 1.0 : 0.0, c == 2 ? 1.0 : 0.0);
+    v_lat = a_lat;
     gl_Position = u_vp * vec4(a_pos, 1.0);
 }

@@ -26,6 +26,11 @@ uniform vec3 u_area_c, u_area_a, u_area_b;
 // Image l holds u_image_scale[l] L_l (half floats in their normal range; compose.h).
 uniform float u_image_scale[LR_MAX_LIGHTS];
 // Output l is light l's image (unrolled writes: GLSL ES indexes outputs by constants only).
+// LR_RECV_LIGHTS: the scene's lights (one program per count, render/renderer.c), the bound of
+// the per-light loops: llvmpipe runs a loop body for every index up to it.
+#ifndef LR_RECV_LIGHTS
+#define LR_RECV_LIGHTS LR_MAX_LIGHTS
+#endif
 layout(location = 0) out vec4 o_light[LR_MAX_LIGHTS];
 
 // Bilinear over the texel centres of an R x R grid of layer z (clamped at the edges).
@@ -49,7 +54,9 @@ void main()
     vec3 x = v_pos;
     vec3 nx = normalize(v_nrm);
     vec3 E[LR_MAX_LIGHTS];
-    for (int l = 0; l < LR_MAX_LIGHTS; l++) {
+    for (int l = 0; l < LR_MAX_LIGHTS; l++)
+        E[l] = vec3(0.0);
+    for (int l = 0; l < LR_RECV_LIGHTS; l++) {
         if (l >= u_n_lights)
             E[l] = vec3(0.0);
         else if (lr_lights_is_area(l))
@@ -70,7 +77,7 @@ void main()
         vec2 w = f - i0;
         ivec2 a = clamp(ivec2(i0), ivec2(0), ivec2(R - 1));
         ivec2 b = clamp(ivec2(i0) + 1, ivec2(0), ivec2(R - 1));
-        for (int l = 0; l < LR_MAX_LIGHTS; l++) {
+        for (int l = 0; l < LR_RECV_LIGHTS; l++) {
             if (l >= u_n_lights)
                 break;
             int z = u_irr_layer + l;

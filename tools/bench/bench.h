@@ -29,6 +29,7 @@ extern const lrb_section lrb_rig_section;
 extern const lrb_section lrb_sweep_section;
 extern const lrb_section lrb_models_section;
 extern const lrb_section lrb_dimmer_section;
+extern const lrb_section lrb_camera_section;
 
 /* Shared timing helpers (timing.c). */
 

@@ -13,6 +13,7 @@ static const lrb_section *const sections[] = {
     &lrb_sweep_section,
     &lrb_models_section,
     &lrb_dimmer_section,
+    &lrb_camera_section,
 };
 #define NSECTIONS (sizeof sections / sizeof sections[0])
 

@@ -6,9 +6,10 @@
  *     (nothing dirty: radiosity + vpl + compose; render.frames is set to 1 + ACCUM_FRAMES so
  *     that the maps have converged after them), median total; DIMMER_FRAMES dimmer-only frames
  *     (light.intensity alternately halved and restored: the blend pass alone), median total;
- *     CAMERA_FRAMES camera-only frames (compose + blend); the floor (issue 11): a fullscreen
- *     pass reading one RGBA16F texture into the output (lr_renderer_debug_floor_ms), timed as
- *     a frame's pass is (inside a renderer timer section; wall time glFinish to glFinish
+ *     CAMERA_FRAMES camera-only frames (compose + blend; wall time; with the per-pixel gather,
+ *     then with the surface cache: issue 11's camera ratio, gather / cache); the floor
+ *     (issue 11): a fullscreen pass reading one RGBA16F texture into the output
+ *     (lr_renderer_debug_floor_ms), timed as a frame's pass is (inside a renderer timer section; wall time glFinish to glFinish
  *     around the whole, as for the dimmer frames). Ratios: full update / dimmer, compose /
  *     dimmer (the dimmer against a composition), dimmer / floor by the timers and by wall
  *     time, compose / camera.
@@ -47,7 +48,7 @@
 #include "render/renderer_debug.h"
 #include "render/scene/scene.h"
 
-enum { FULL_FRAMES = 3, ACCUM_FRAMES = 4, DIMMER_FRAMES = 5, CAMERA_FRAMES = 3, FLOOR_REPS = 9 };
+enum { FULL_FRAMES = 3, ACCUM_FRAMES = 4, DIMMER_FRAMES = 5, CAMERA_FRAMES = 5, FLOOR_REPS = 9 };
 enum { ERR_W = 160, ERR_H = 120, ERR_K = 8, ERR_MAP = 64, ERR_N = 4, SELF_FRAMES = 256,
        REF_SAMPLES = 4096 };
 
@@ -102,7 +103,8 @@ typedef struct timing_row {
                        * frame's pass is */
     double floor_timer_ms; /* the same draw by the renderer's timer (as dimmer_ms is) */
     double dimmer_wall_ms; /* a dimmer frame the same way: lr_renderer_frame + glFinish */
-    double camera_ms; /* camera-only change (composition of the per-light images + blend) */
+    double camera_ms; /* camera-only change (compose + blend), per-pixel gather, wall */
+    double camera_cache_ms; /* the same with the surface cache (render.surface_cache) */
 } timing_row;
 
 static int frame(lr_renderer *r, lr_frame_stats *st)
@@ -166,27 +168,47 @@ static int time_one(lr_gl *gl, const char *name, int w, int h, timing_row *row)
                     st.passes);
         dim[i] = st.total_ms;
     }
-    /* Camera-only changes: the camera moved 1 mm sideways and back. */
-    double cam[CAMERA_FRAMES];
+    /* Camera-only changes: the camera moved 1 mm sideways and back, wall time glFinish to
+     * glFinish; first with the per-pixel gather (render.surface_cache false: Algorithm 1 per
+     * object pixel, today's composition without the cache), then with the surface cache (its
+     * first frame after the switch draws the cache and is not counted). */
+    double cam[2][CAMERA_FRAMES];
     lr_vec3 c0 = lr_scene_camera(s)->position;
-    for (int i = 0; i < CAMERA_FRAMES; i++) {
-        char val[96];
-        snprintf(val, sizeof val, "%.17g,%.17g,%.17g", c0.x + (i % 2 ? 0.0 : 1.0), c0.y, c0.z);
+    for (int pass = 0; pass < 2; pass++) {
         unsigned dirty = 0;
-        if (lr_scene_set(s, "camera.position", val, &dirty, &e)) {
-            fprintf(stderr, "bench render: camera.position: %s\n", e.msg);
+        if (lr_scene_set(s, "render.surface_cache", pass ? "true" : "false", &dirty, &e)) {
+            fprintf(stderr, "bench render: render.surface_cache: %s\n", e.msg);
             goto done;
         }
         lr_renderer_invalidate(r, dirty);
         if (frame(r, &st))
             goto done;
-        cam[i] = st.total_ms;
+        for (int i = 0; i < CAMERA_FRAMES; i++) {
+            char val[96];
+            snprintf(val, sizeof val, "%.17g,%.17g,%.17g", c0.x + (i % 2 ? 0.0 : 1.0), c0.y, c0.z);
+            dirty = 0;
+            if (lr_scene_set(s, "camera.position", val, &dirty, &e)) {
+                fprintf(stderr, "bench render: camera.position: %s\n", e.msg);
+                goto done;
+            }
+            lr_renderer_invalidate(r, dirty);
+            glFinish();
+            double w0 = lrb_now();
+            if (frame(r, &st))
+                goto done;
+            glFinish();
+            cam[pass][i] = (lrb_now() - w0) * 1e3;
+            if (st.passes != (LR_PASS_COMPOSE | LR_PASS_BLEND))
+                fprintf(stderr, "bench render: camera move ran passes 0x%x, not compose + "
+                        "blend\n", st.passes);
+        }
     }
     if (lr_renderer_debug_floor_ms(r, FLOOR_REPS, &row->floor_ms, &row->floor_timer_ms, &e)) {
         fprintf(stderr, "bench render: floor pass: %s\n", e.msg);
         goto done;
     }
-    row->camera_ms = lr_median_finite(cam, CAMERA_FRAMES);
+    row->camera_ms = lr_median_finite(cam[0], CAMERA_FRAMES);
+    row->camera_cache_ms = lr_median_finite(cam[1], CAMERA_FRAMES);
     row->dimmer_wall_ms = lr_median_finite(dimw, DIMMER_FRAMES);
     for (int p = 0; p < LR_PASS_COUNT; p++)
         row->pass_ms[p] = lr_median_finite(full[p], FULL_FRAMES);
@@ -380,14 +402,15 @@ static int write_csvs(const timing_row *t, int nt, const error_row *er, int ne)
     f = lr_atomic_file_stream(af);
     fprintf(f, "scene,resolution,gbuffer_ms,radiosity_ms,vpl_ms,compose_ms,total_ms,accum_ms,"
                "dimmer_ms,ratio,blend_ms,floor_ms,camera_ms,dimmer_wall_ms,floor_timer_ms,"
-               "surface_ms\n");
+               "surface_ms,camera_cache_ms\n");
     for (int i = 0; i < nt; i++)
-        fprintf(f, "%s,%dx%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n",
+        fprintf(f, "%s,%dx%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,"
+                   "%.3f\n",
                 t[i].scene,
                 t[i].w, t[i].h, t[i].pass_ms[0], t[i].pass_ms[1], t[i].pass_ms[2],
                 t[i].pass_ms[3], t[i].total_ms, t[i].accum_ms, t[i].dimmer_ms,
                 t[i].total_ms / t[i].dimmer_ms, t[i].pass_ms[4], t[i].floor_ms, t[i].camera_ms,
-                t[i].dimmer_wall_ms, t[i].floor_timer_ms, t[i].pass_ms[6]);
+                t[i].dimmer_wall_ms, t[i].floor_timer_ms, t[i].pass_ms[6], t[i].camera_cache_ms);
     if (lr_atomic_file_commit(af, &e))
         goto fail;
 errors:
@@ -458,7 +481,12 @@ static int run(FILE *out)
     if (nt) {
         fprintf(out, "Frame times, ms (full update: every pass, median of %d; accumulation: radiosity "
                      "+ vpl + compose + blend, median of %d; dimmer: the blend alone, median of %d; "
-                     "camera: a camera move, compose + blend, median of %d; floor: a fullscreen "
+                     "camera: a camera move, compose + blend, wall time, median of %d, with the "
+                     "per-pixel gather (\"camera\": render.surface_cache false, Algorithm 1 per "
+                     "object pixel) and with the surface cache (\"camera, cache\"); "
+                     "\"gather / cache\" is issue 11's camera ratio in this run, against today's "
+                     "per-pixel composition, itself cheaper than the issue's 520 ms "
+                     "composition; floor: a fullscreen "
                      "pass reading one RGBA16F texture into the output, median of %d). Pass times "
                      "are the renderer's timers; \"wall\" is wall time from glFinish to glFinish "
                      "(what a caller waits). The floor is measured as a frame's pass is: its draw "
@@ -471,18 +499,20 @@ static int run(FILE *out)
         fprintf(out, "| scene | size | gbuffer | radiosity | vpl | surface | compose | blend | full update | "
                      "accumulation | dimmer | dimmer wall | floor | floor wall | camera | "
                      "full / dimmer | compose / dimmer | dimmer / floor | "
-                     "dimmer wall / floor wall | compose / camera |\n");
-        fprintf(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+                     "dimmer wall / floor wall | compose / camera | camera, cache | gather / cache |\n");
+        fprintf(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
         for (int i = 0; i < nt; i++)
             fprintf(out, "| %s | %d×%d | %.1f | %.1f | %.1f | %.1f | %.1f | %.2f | %.1f | %.1f | %.2f | "
-                         "%.2f | %.2f | %.2f | %.1f | %.0f | %.0f | %.2f | %.2f | %.2f |\n",
+                         "%.2f | %.2f | %.2f | %.1f | %.0f | %.0f | %.2f | %.2f | %.2f | %.1f | "
+                         "%.1f |\n",
                     t[i].scene, t[i].w, t[i].h, t[i].pass_ms[0], t[i].pass_ms[1], t[i].pass_ms[2],
                     t[i].pass_ms[6], t[i].pass_ms[3], t[i].pass_ms[4], t[i].total_ms,
                     t[i].accum_ms, t[i].dimmer_ms,
                     t[i].dimmer_wall_ms, t[i].floor_timer_ms, t[i].floor_ms, t[i].camera_ms,
                     t[i].total_ms / t[i].dimmer_ms, t[i].pass_ms[3] / t[i].dimmer_ms,
                     t[i].dimmer_ms / t[i].floor_timer_ms, t[i].dimmer_wall_ms / t[i].floor_ms,
-                    t[i].pass_ms[3] / t[i].camera_ms);
+                    t[i].pass_ms[3] / t[i].camera_ms, t[i].camera_cache_ms,
+                    t[i].camera_ms / t[i].camera_cache_ms);
     }
     fprintf(out, "\nRenderer: %s.\n\n", info_line);
     fprintf(out, "Relative RMSE (linear light, sqrt(Σ(g−r)²/Σr²) over the bands of the masked "
