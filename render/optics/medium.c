@@ -78,6 +78,7 @@ int lr_coeffs_derive(const lr_medium *m, lr_coeffs *out, lr_err *e)
         c.de[j] = c.albedo_prime[j] > 0.0 ? 2.131 * c.D[j] / sqrt(c.albedo_prime[j]) : INFINITY;
         c.sigma_t[j] = sa + ssp / (1.0 - m->g);
     }
+    c.t_hem = lr_hemi_transmittance(eta);
     lr_dirpole_energy_norm(&c, c.sd_norm); /* needs every other field */
     *out = c;
     return LR_OK;

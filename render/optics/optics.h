@@ -90,6 +90,10 @@ typedef struct lr_coeffs {
     /* Energy normalisation of the directional dipole per band (lr_dirpole_energy_norm): the
      * passes multiply S_d by it unless the object asks for the raw model. */
     double sd_norm[3];
+    /* lr_hemi_transmittance(eta): composition emits L_o = F_t(w_o) B / pi, whose exitance is
+     * t_hem B, so a model whose profile gives the exitance divides by it (PIPELINE.md
+     * "Energy"; lr_scene_object_sd_norm). */
+    double t_hem;
 } lr_coeffs;
 
 /* Rejects NaN, Inf, negative coefficients, sigma_t' outside [LR_SIGMA_T_PRIME_MIN,

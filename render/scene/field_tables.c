@@ -209,7 +209,8 @@ static const lr_field object_fields[] = {
      .help = "diffusion_grid: heterogeneous sigma_a, sigma_s' volume file (render/diffusion)"},
     {"normalize", LR_FT_BOOL, 0, O(pub.sd_raw), .flags = LR_FF_INVERT, .dflt = {1},
      .dirty = LR_DIRTY_MATERIAL,
-     .help = "false: the published directional dipole, without the energy normalisation"},
+     .help = "false: the profile as published (the directional dipole without its energy "
+             "normalisation; the standard dipole and multipole without the exit's 1 / T_hem)"},
 };
 
 const lr_record_desc lr_scene_object_desc = {"objects[i]", "an object", NULL, NULL, NULL, NULL,

@@ -77,10 +77,14 @@ typedef struct lr_scene_object {
                            * coeffs.sd_norm (PIPELINE.md "Energy"); default: normalised */
 } lr_scene_object;
 
-/* The factor S_d is multiplied by for band c (0..2): coeffs.sd_norm[c] for the directional
- * dipole, 1 for the raw model (sd_raw) and for the standard dipole (sd_norm scales the
- * directional dipole's half-space total to the standard dipole's R_d total, so the standard
- * dipole is its own reference: factor 1). The GLSL pass and the CPU twin both use it. */
+/* The factor S_d is multiplied by for band c (0..2), so that the map holds B with exitance
+ * t_hem B = the profile's (composition emits L_o = F_t(w_o) B / pi, whose hemispherical
+ * integral is t_hem B): coeffs.sd_norm[c] for the directional dipole (it scales [14]'s
+ * half-space total t_hem pi int S_d dA to the standard dipole's R_d total), 1 / t_hem for the
+ * standard dipole and the multipole (their R_d, R and T are exitances: Jensen 2001's
+ * F_t(w_o) / pi alone lets out only t_hem of them, 0.908 at eta 1.5), 1 for the raw models
+ * as published (sd_raw) and for the models that write B themselves. The GLSL pass and the
+ * CPU twin both use it. */
 /* Why object o cannot render with model m as it stands ("needs thickness_mm": the multipole
  * models a wall of the object's thickness_mm), or NULL when it can. The planner and the
  * bench use it to leave such a model out for that object. */
@@ -88,7 +92,17 @@ const char *lr_scene_object_model_unmet(const lr_scene_object *o, enum lr_sss_mo
 
 static inline double lr_scene_object_sd_norm(const lr_scene_object *o, int c)
 {
-    return o->sd_raw || o->sss_model != LR_SSS_DIRECTIONAL_DIPOLE ? 1.0 : o->coeffs.sd_norm[c];
+    if (o->sd_raw)
+        return 1.0;
+    switch (o->sss_model) {
+    case LR_SSS_DIRECTIONAL_DIPOLE:
+        return o->coeffs.sd_norm[c];
+    case LR_SSS_STANDARD_DIPOLE:
+    case LR_SSS_MULTIPOLE:
+        return 1.0 / o->coeffs.t_hem;
+    default:
+        return 1.0;
+    }
 }
 
 /* ---- Lights ------------------------------------------------------------------------------- */

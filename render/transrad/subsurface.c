@@ -50,7 +50,10 @@ typedef struct ss_ctx {
     float **vals;
     size_t *counts;
     double *thick;      /* per patch of the surface: the wall's local thickness, 0: none */
-    unsigned char *thin; /* per patch: its column is a thin wall's (thinwall.c) */
+    /* Per patch: index into spreads of its thin wall's column (thinwall.c), -1: not thin.
+     * One spread per distinct thickness, shared by the patches that have it. */
+    int *thin;
+    lr_tr_spread *spreads;
     int failed;
 } ss_ctx;
 
@@ -88,12 +91,9 @@ static void ss_item(void *vctx, long item)
     }
     double sum[3] = {0, 0, 0};
     double ri = sqrt(P[pi].area / M_PI);
-    bool thin = c->thin && c->thin[i];
-    if (thin) {
-        lr_tr_spread sp;
-        lr_tr_spread_build(sf->d.coeffs, c->thick[i], &sp);
-        lr_tr_thin_column(t, c->s, i, c->thick[i], &sp, col);
-    }
+    bool thin = c->thin && c->thin[i] >= 0;
+    if (thin)
+        lr_tr_thin_column(t, c->s, i, c->thick[i], &c->spreads[c->thin[i]], col);
     for (size_t j = 0; j < ns && !thin; j++) {
         double dopt = c->dist[i * ns + j];
         double *o = col + 3 * j;
@@ -182,8 +182,9 @@ static int cmp_double(const void *a, const void *b)
  * profile by distance, which misses light that crosses a wall: issue 12 measures 3x). Given
  * ("thickness_mm" with the multipole or translucent radiosity): that value everywhere. Not
  * given, for translucent_radiosity: measured, the median over 16 points on the patch of the
- * distance along -n to where the ray leaves the material; beyond 10 diffusion lengths the wall is a half-space (0:
- * the standard dipole). Other models: none (their half-space profile). */
+ * distance along -n to where the ray leaves the material; beyond 10 diffusion lengths the
+ * wall is a half-space (0: the standard dipole). Other models: none (their half-space
+ * profile). */
 static int local_thickness(const lr_tr *t, int s, double **out, lr_err *e)
 {
     const lr_tr_surf *sf = &t->surf[s];
@@ -234,31 +235,53 @@ static int local_thickness(const lr_tr *t, int s, double **out, lr_err *e)
 }
 
 /* Which columns of surface s are a thin wall's (thinwall.c): by the rule lr_tr_wall_thin on
- * each patch's slab (auto), none (off) or every slab patch (on). *out NULL: none. */
-static int thin_columns(const lr_tr *t, int s, const double *thick, unsigned char **out,
-                        lr_err *e)
+ * each patch's slab (auto), none (off) or every slab patch (on). Each distinct thickness's
+ * spread is built once (a run of equal thicknesses, as an object's thickness_mm gives, shares
+ * it) and kept for the columns. *out NULL: none. */
+static int thin_columns(const lr_tr *t, int s, const double *thick, int **out,
+                        lr_tr_spread **spreads, lr_err *e)
 {
     const lr_tr_surf *sf = &t->surf[s];
     *out = NULL;
+    *spreads = NULL;
     if (!thick || t->set.thin_wall == LR_TR_THIN_OFF)
         return LR_OK;
-    unsigned char *th = calloc(sf->count ? sf->count : 1, 1);
+    size_t n = sf->count ? sf->count : 1, used = 0, cap = 0;
+    int *th = malloc(n * sizeof *th);
+    lr_tr_spread *sp = NULL;
     if (!th)
-        return lr_err_set(e, LR_ENOMEM, "transrad: surface %d: out of memory (thin walls)", s);
+        goto oom;
     double h = sf->d.patch_mm > 0 ? sf->d.patch_mm : t->set.patch_mm;
     double last_d = -1;
-    bool last = false;
+    int last = -1;
     for (size_t i = 0; i < sf->count; i++) {
+        th[i] = -1;
         if (!(thick[i] > 0))
             continue;
-        if (thick[i] != last_d) { /* a given thickness_mm: one evaluation */
+        if (thick[i] != last_d) { /* a new thickness: one spread, one evaluation of the rule */
             last_d = thick[i];
-            last = t->set.thin_wall == LR_TR_THIN_ON || lr_tr_wall_thin(sf->d.coeffs, last_d, h);
+            if (used == cap) {
+                size_t ncap = cap ? 2 * cap : 4;
+                lr_tr_spread *g = realloc(sp, ncap * sizeof *g);
+                if (!g)
+                    goto oom;
+                sp = g;
+                cap = ncap;
+            }
+            lr_tr_spread_build(sf->d.coeffs, last_d, &sp[used]);
+            last = -1;
+            if (t->set.thin_wall == LR_TR_THIN_ON || lr_tr_spread_thin(&sp[used], h))
+                last = (int)used++;
         }
         th[i] = last;
     }
     *out = th;
+    *spreads = sp;
     return LR_OK;
+oom:
+    free(th);
+    free(sp);
+    return lr_err_set(e, LR_ENOMEM, "transrad: surface %d: out of memory (thin walls)", s);
 }
 
 int lr_tr_build_subsurface(lr_tr *t, lr_err *e)
@@ -281,18 +304,20 @@ int lr_tr_build_subsurface(lr_tr *t, lr_err *e)
         c.s = s;
         c.thick = NULL;
         c.thin = NULL;
+        c.spreads = NULL;
         rc = local_thickness(t, s, &c.thick, e);
         if (!rc)
-            rc = thin_columns(t, s, c.thick, &c.thin, e);
+            rc = thin_columns(t, s, c.thick, &c.thin, &c.spreads, e);
         /* In-object distances only where a column is built from them. */
         bool need = !c.thin;
         for (size_t i = 0; c.thin && i < t->surf[s].count; i++)
-            need = need || !c.thin[i];
+            need = need || c.thin[i] < 0;
         if (!rc && need)
             rc = lr_tr_optical_distances(t, s, &dist, e);
         if (rc) {
             free(c.thick);
             free(c.thin);
+            free(c.spreads);
             goto done;
         }
         c.dist = dist;
@@ -300,6 +325,7 @@ int lr_tr_build_subsurface(lr_tr *t, lr_err *e)
         free(dist);
         free(c.thick);
         free(c.thin);
+        free(c.spreads);
         if (c.failed) {
             rc = lr_err_set(e, LR_ENOMEM, "transrad: surface %d: out of memory (subsurface)", s);
             goto done;

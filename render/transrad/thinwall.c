@@ -116,13 +116,18 @@ double lr_tr_spread_r90(const lr_tr_spread *sp)
     return r;
 }
 
+bool lr_tr_spread_thin(const lr_tr_spread *sp, double patch_mm)
+{
+    return patch_mm > 0 && lr_tr_spread_r90(sp) <= patch_mm / 4;
+}
+
 bool lr_tr_wall_thin(const lr_coeffs *c, double d, double patch_mm)
 {
     if (!c || !(d > 0) || !(patch_mm > 0))
         return false;
     lr_tr_spread sp;
     lr_tr_spread_build(c, d, &sp);
-    return lr_tr_spread_r90(&sp) <= patch_mm / 4;
+    return lr_tr_spread_thin(&sp, patch_mm);
 }
 
 /* An orthonormal pair spanning the plane normal to n. */

@@ -742,9 +742,12 @@ static void test_object_normalize_field(void **state)
     assert_true(lr_scene_object_sd_norm(o, 1) == o->coeffs.sd_norm[1]);
     assert_true(o->coeffs.sd_norm[1] > 0.75 && o->coeffs.sd_norm[1] < 0.85); /* marble 0.81 */
     get(s, "objects[b].normalize", "true");
-    /* The standard dipole is the normalisation's reference: factor 1 whatever "normalize". */
+    /* The standard dipole's R_d is an exitance: its maps hold R_d / T_hem (composition lets
+     * out T_hem of B), 1 / 0.908 at marble's eta 1.5 (render/scene/scene.h). */
     assert_int_equal(lr_scene_set(s, "objects[b].model", "standard_dipole", &dirty, &e), LR_OK);
-    assert_true(lr_scene_object_sd_norm(lr_scene_object_at(s, 0), 1) == 1.0);
+    o = lr_scene_object_at(s, 0);
+    assert_true(lr_scene_object_sd_norm(o, 1) == 1.0 / lr_hemi_transmittance(o->coeffs.eta));
+    assert_true(o->coeffs.t_hem > 0.90 && o->coeffs.t_hem < 0.92);
     assert_int_equal(lr_scene_set(s, "objects[b].model", "directional_dipole", &dirty, &e),
                      LR_OK);
     o = lr_scene_object_at(s, 0);
@@ -796,7 +799,9 @@ static void test_model_switch_and_light_cap(void **state)
     assert_true(lr_scene_object_at(s, 0)->thickness_mm == 1.5);
     set_bad(s, "objects[0].thickness_mm", "0", "the multipole needs a thickness > 0 mm");
     assert_true(lr_scene_object_at(s, 0)->thickness_mm == 1.5);
-    assert_true(lr_scene_object_sd_norm(lr_scene_object_at(s, 0), 0) == 1.0);
+    /* The multipole's R and T are exitances too: 1 / T_hem. */
+    assert_true(lr_scene_object_sd_norm(lr_scene_object_at(s, 0), 0) ==
+                1.0 / lr_scene_object_at(s, 0)->coeffs.t_hem);
     lr_scene_destroy(s);
     scene_text(t, sizeof t, ",\n     \"model\": \"multipole\", \"thickness_mm\": 7", "", NULL);
     assert_int_equal(parse(t, &s, &e), LR_OK);

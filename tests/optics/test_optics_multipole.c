@@ -355,10 +355,13 @@ static void check_slab(const char *name, double d, uint64_t photons, double tol)
         double t_mc = res.t_total.value - res.t_unscattered.value, se = res.t_total.se;
         double t_mp = ft0 * T[j], r_mp = ft0 * R[j];
         double t_dd = ft0 * dirpole_transmittance(&c, d, j);
+        /* As rendered: the multipole's maps hold T / T_hem (lr_scene_object_sd_norm) and
+         * composition lets out T_hem of B, so it emits T itself; the directional dipole's
+         * normalised S_d is defined with the exit's T_hem (render/optics/dirpole_norm.c). */
         print_message("%-10s %5.1f mm band %d: T photons %.4f +- %.4f | multipole %.4f (x%.3f, "
-                      "rendered x T_hem %.3f) | directional dipole %.4f (x%.3f, rendered %.3f) | "
+                      "also as rendered) | directional dipole %.4f (x%.3f, rendered %.3f) | "
                       "R diffuse photons %.4f multipole %.4f (x%.3f)\n",
-                      name, d, j, t_mc, se, t_mp, t_mp / t_mc, th * t_mp / t_mc, t_dd,
+                      name, d, j, t_mc, se, t_mp, t_mp / t_mc, t_dd,
                       t_dd / t_mc, th * t_dd / t_mc, res.r_diffuse.value, r_mp,
                       r_mp / res.r_diffuse.value);
         assert_true(se < 0.01 * t_mc && res.r_diffuse.se < 0.01 * res.r_diffuse.value);

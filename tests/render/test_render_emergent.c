@@ -18,6 +18,7 @@
 #include "tests/support/gl.h"
 #include "tests/support/near.h"
 #include "tests/support/render.h"
+#include "tests/support/vpl_probe.h"
 
 #define W 96
 #define H 72
@@ -29,51 +30,6 @@ typedef struct probe {
     int receiver;   /* index in the scene */
     lr_vec3 point;  /* a world point in the light's shadow */
 } probe;
-
-/* E_vpl for unit intensity at x with normal n from the renderer's VPL list, the formula of
- * PIPELINE.md pass 4 evaluated in double; each VPL's B times the cavity gain composition
- * applies to its object (PIPELINE.md "Energy"). */
-static void vpl_irradiance(lr_renderer *r, const lr_scene *s, const lr_debug_vpl *v, int n,
-                           lr_vec3 x, lr_vec3 nx, double E[3])
-{
-    E[0] = E[1] = E[2] = 0.0;
-    for (int i = 0; i < n; i++) {
-        if (!v[i].valid)
-            continue;
-        lr_vec3 d = lr_v3_sub(x, v[i].pos);
-        double d2 = lr_v3_dot(d, d);
-        lr_vec3 w = lr_v3_scale(d, 1.0 / sqrt(d2));
-        double cv = lr_v3_dot(v[i].nrm, w), cx = -lr_v3_dot(nx, w);
-        if (!(cv > 0.0 && cx > 0.0))
-            continue;
-        double eta = lr_scene_object_at(s, v[i].object)->coeffs.eta;
-        double g = lr_fresnel_transmittance(cv, eta) / M_PI * v[i].area * cv * cx / fmax(d2, v[i].area);
-        double gain[3];
-        lr_renderer_debug_cavity_gain(r, v[i].object, gain);
-        for (int c = 0; c < 3; c++)
-            E[c] += g * v[i].B[c] * gain[c];
-    }
-}
-
-/* The same read the way composition reads it on a plane receiver: bilinear over the receiver
- * irradiance grid's texel centres (render/cpu/recv_grid.h), each evaluated as above. */
-static void grid_irradiance(lr_renderer *r, const lr_scene *s, const lr_debug_vpl *v, int n,
-                            const lr_receiver *rc, lr_vec3 x, double E[3])
-{
-    lr_recv_grid_frame f;
-    assert_true(lr_recv_grid_frame_of(rc, &f));
-    int idx[4];
-    double w[4];
-    lr_recv_grid_taps(&f, x, idx, w);
-    E[0] = E[1] = E[2] = 0.0;
-    for (int q = 0; q < 4; q++) {
-        double Eq[3];
-        lr_vec3 p = lr_recv_grid_point(&f, idx[q] % LR_RECV_GRID, idx[q] / LR_RECV_GRID);
-        vpl_irradiance(r, s, v, n, p, rc->normal, Eq);
-        for (int c = 0; c < 3; c++)
-            E[c] += w[q] * Eq[c];
-    }
-}
 
 static void check_scene(const char *name, const probe *probes, int np)
 {
@@ -102,8 +58,8 @@ static void check_scene(const char *name, const probe *probes, int np)
         lr_vec3 p = lr_test_pixel_on_plane(s, W, H, x, y, rc->center, rc->normal);
         size_t k = 3 * ((size_t)y * W + x);
         double E[3], Ex[3];
-        grid_irradiance(lit, s, v, nv, rc, p, E);
-        vpl_irradiance(lit, s, v, nv, p, rc->normal, Ex);
+        lr_test_grid_irradiance(lit, s, v, nv, rc, p, false, E);
+        lr_test_vpl_irradiance(lit, s, v, nv, p, rc->normal, false, Ex);
         double d = lr_v3_len(lr_v3_sub(p, l->position));
         for (int c = 0; c < 3; c++) {
             /* No VPLs: the light cannot see the point, so exactly nothing arrives. */

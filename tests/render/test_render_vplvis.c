@@ -23,6 +23,7 @@
 #include "tests/support/gl.h"
 #include "tests/support/near.h"
 #include "tests/support/render.h"
+#include "tests/support/vpl_probe.h"
 
 #define W 96
 #define H 72
@@ -84,47 +85,6 @@ static void test_field(void **state)
         assert_int_not_equal(lr_scene_parse(doc, strlen(doc), "t.json", NULL, &t, &e), LR_OK);
         assert_null(t);
         assert_non_null(strstr(e.msg, "vpl_visibility"));
-    }
-}
-
-/* E_vpl at x (normal nx, unit intensity) over the renderer's own VPLs, evaluated by the CPU
- * twin's gather (render/cpu/vpl.h; `vis`: with its ray-cast visibility), each VPL's B times
- * the cavity gain composition applies to its object (PIPELINE.md "Energy"). */
-static void vpl_irradiance(lr_renderer *r, const lr_scene *s, const lr_debug_vpl *v, int n,
-                           lr_vec3 x, lr_vec3 nx, bool vis, double E[3])
-{
-    E[0] = E[1] = E[2] = 0.0;
-    for (int i = 0; i < n; i++) {
-        if (!v[i].valid)
-            continue;
-        lr_cpu_vpl c = {.valid = true, .x = v[i].pos, .n = v[i].nrm, .u = v[i].u,
-                        .area = v[i].area};
-        double gain[3];
-        lr_renderer_debug_cavity_gain(r, v[i].object, gain);
-        for (int b = 0; b < 3; b++)
-            c.B[b] = v[i].B[b] * gain[b];
-        lr_cpu_vpl_irradiance_vis(vis ? s : NULL, &c, 1,
-                                  lr_scene_object_at(s, v[i].object)->coeffs.eta, x, nx, E, NULL);
-    }
-}
-
-/* The same read as composition reads a plane receiver: bilinear over the irradiance grid's
- * texel centres (render/cpu/recv_grid.h). */
-static void grid_irradiance(lr_renderer *r, const lr_scene *s, const lr_debug_vpl *v, int n,
-                            const lr_receiver *rc, lr_vec3 x, bool vis, double E[3])
-{
-    lr_recv_grid_frame f;
-    assert_true(lr_recv_grid_frame_of(rc, &f));
-    int idx[4];
-    double w[4];
-    lr_recv_grid_taps(&f, x, idx, w);
-    E[0] = E[1] = E[2] = 0.0;
-    for (int q = 0; q < 4; q++) {
-        double Eq[3];
-        lr_vec3 p = lr_recv_grid_point(&f, idx[q] % LR_RECV_GRID, idx[q] / LR_RECV_GRID);
-        vpl_irradiance(r, s, v, n, p, rc->normal, vis, Eq);
-        for (int c = 0; c < 3; c++)
-            E[c] += w[q] * Eq[c];
     }
 }
 
@@ -201,8 +161,8 @@ static void test_jar_wall(void **state)
         lr_vec3 p = lr_test_pixel_on_plane(s, W, H, x, y, wall->center, wall->normal);
         size_t k = 3 * ((size_t)y * W + x);
         double Ea[3], Ev[3];
-        grid_irradiance(r, s, v, nv, wall, p, false, Ea);
-        grid_irradiance(r, s, v, nv, wall, p, true, Ev);
+        lr_test_grid_irradiance(r, s, v, nv, wall, p, false, Ea);
+        lr_test_grid_irradiance(r, s, v, nv, wall, p, true, Ev);
         for (int c = 0; c < 3; c++) {
             assert_true(hd[k + c] == 0.0f); /* in the jar's shadow */
             double La = I[c] * wall->albedo[c] / M_PI * Ea[c];
