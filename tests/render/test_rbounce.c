@@ -300,11 +300,30 @@ static void test_object_blocks(void **state)
 static void test_field(void **state)
 {
     (void)state;
-    lr_scene *s = lr_test_scene("candle", NULL, NULL);
-    assert_false(lr_scene_render(s)->receiver_bounce);
-    assert_false(lr_rbounce_needed(s));
+    /* The field's default is off; the shipped candle scenes turn it on. */
+    lr_scene *t = scene("{\"name\":\"floor\",\"type\":\"plane\",\"center\":[0,0,0],"
+                        "\"normal\":[0,0,1],\"size\":[100,100],\"albedo\":[0.5,0.5,0.5]}",
+                        NULL, lr_v3(0, 0, 50));
     lr_err e = {0};
     unsigned dirty = 0;
+    assert_true(lr_scene_render(t)->receiver_bounce); /* scene() sets it */
+    assert_int_equal(lr_scene_set(t, "render.receiver_bounce", "false", &dirty, &e), LR_OK);
+    assert_true(dirty & LR_DIRTY_SETTINGS);
+    assert_false(lr_rbounce_needed(t));
+    lr_scene_destroy(t);
+    static const char plain[] =
+        "{\"name\":\"t\",\"objects\":[{\"name\":\"o\",\"material\":\"candle_wax\","
+        "\"mesh\":{\"type\":\"sphere\",\"radius\":20}}],"
+        "\"lights\":[{\"type\":\"point\",\"position\":[0,0,100],\"intensity\":0.01}],"
+        "\"camera\":{\"position\":[0,-300,100],\"target\":[0,0,0]}}";
+    t = lr_test_scene_text(plain, NULL);
+    assert_false(lr_scene_render(t)->receiver_bounce);
+    lr_scene_destroy(t);
+    lr_scene *s = lr_test_scene("candle", NULL, NULL);
+    assert_true(lr_scene_render(s)->receiver_bounce);
+    assert_true(lr_rbounce_needed(s));
+    assert_int_equal(lr_scene_set(s, "render.receiver_bounce", "false", &dirty, &e), LR_OK);
+    assert_false(lr_rbounce_needed(s));
     assert_int_equal(lr_scene_set(s, "render.receiver_bounce", "true", &dirty, &e), LR_OK);
     assert_true(dirty & LR_DIRTY_SETTINGS);
     assert_true(lr_rbounce_needed(s));

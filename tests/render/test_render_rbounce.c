@@ -72,7 +72,8 @@ static void test_gpu_vs_twin(void **state)
     (void)state;
     /* A steady flame: the twin has no clock. */
     static const char *const steady[] = {"lights[0].flicker.amplitude=0",
-                                         "lights[0].flicker.jitter_mm=0", NULL};
+                                         "lights[0].flicker.jitter_mm=0",
+                                         "render.receiver_bounce=false", NULL};
     lr_scene *s = lr_test_scene("candle_spot", lr_test_small_settings, steady);
     lr_renderer *r = lr_test_renderer(gl, s, W, H, false, 3);
     lr_test_converge(r, 20);
