@@ -39,6 +39,10 @@ bool lr_rbounce_needed(const lr_scene *s)
 {
     if (!s || !lr_scene_render(s)->receiver_bounce || lr_scene_light_count(s) < 1)
         return false;
+    /* render.lpv's volumes carry the receivers' interreflection of their own (render/lpv/):
+     * not twice. */
+    if (lr_scene_render(s)->lpv > 0)
+        return false;
     for (int i = 0; i < lr_scene_object_count(s); i++)
         if (lr_scene_object_at(s, i)->sss_model == LR_SSS_TRANSLUCENT_RADIOSITY)
             return false; /* its solve has the receivers in F (render/transrad/tr_scene.h) */

@@ -39,7 +39,8 @@
 typedef struct lr_rbounce lr_rbounce;
 
 /* Whether scene s asks for it (render.receiver_bounce) and it has work: a plane receiver, a
- * light, and no object using translucent_radiosity. */
+ * light, no object using translucent_radiosity and no light-propagation volume (render.lpv:
+ * its volumes bounce between the receivers already). */
 bool lr_rbounce_needed(const lr_scene *s);
 /* Creates *rb on first use; destroys it and sets *rb = NULL when not needed. Rebuilds the
  * patches and F when the objects' or receivers' geometry (or albedo) changed since the last

@@ -9,7 +9,8 @@
  *    texel grids; the same with a uniform VPL irradiance X and no light: rho X A / (1 - rho);
  *  - linearity in intensity (another slot at 2.5x) and superposition of direct and VPL light;
  *  - an object between two plates cuts their exchange;
- *  - the field (default off, a SETTINGS change) and not needed with translucent_radiosity. */
+ *  - the field (default off, a SETTINGS change) and not needed with translucent_radiosity or
+ *    render.lpv (both bounce between the receivers already). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -330,6 +331,11 @@ static void test_field(void **state)
     e = (lr_err){0};
     assert_int_not_equal(lr_scene_set(s, "render.receiver_bounce", "1", NULL, &e), LR_OK);
     assert_non_null(strstr(e.msg, "receiver_bounce"));
+    /* render.lpv's volumes carry the receivers' interreflection already: not twice. */
+    assert_int_equal(lr_scene_set(s, "render.lpv", "16", NULL, &e), LR_OK);
+    assert_false(lr_rbounce_needed(s));
+    assert_int_equal(lr_scene_set(s, "render.lpv", "0", NULL, &e), LR_OK);
+    assert_true(lr_rbounce_needed(s));
     /* translucent_radiosity's solve has the receivers in F already: not twice. */
     assert_int_equal(lr_scene_set(s, "objects[0].model", "translucent_radiosity", NULL, &e), LR_OK);
     assert_false(lr_rbounce_needed(s));
