@@ -23,6 +23,7 @@ struct lr_rbounce {
     double lkey[MAX_LIGHTS][LKEY];
     bool lvalid[MAX_LIGHTS];
     double *Evpl;           /* n x 3: the VPL grids' patch means */
+    int *cnt;               /* n: scratch, texels per patch */
     double *E;              /* n x 3 scratch */
     float *out[LR_TR_MAX_SURFACES][LR_TR_MAX_SLOTS]; /* per receiver, slot: R^2 x 3 */
     double build_s, direct_s, solve_s;
@@ -105,7 +106,9 @@ static void free_solver(lr_rbounce *rb)
     }
     free(rb->Evpl);
     free(rb->E);
+    free(rb->cnt);
     rb->Evpl = rb->E = NULL;
+    rb->cnt = NULL;
     for (int r = 0; r < LR_TR_MAX_SURFACES; r++)
         for (int sl = 0; sl < LR_TR_MAX_SLOTS; sl++) {
             free(rb->out[r][sl]);
@@ -157,7 +160,8 @@ static int build(lr_rbounce *rb, const lr_scene *s, lr_err *e)
     size_t n3 = 3 * (rb->n ? rb->n : 1);
     rb->Evpl = calloc(n3, sizeof *rb->Evpl);
     rb->E = calloc(n3, sizeof *rb->E);
-    if (!rb->Evpl || !rb->E)
+    rb->cnt = calloc(rb->n ? rb->n : 1, sizeof *rb->cnt);
+    if (!rb->Evpl || !rb->E || !rb->cnt)
         return lr_err_set(e, LR_ENOMEM, "receiver bounce: out of memory (%zu patches)", rb->n);
     rb->n_obj = no;
     rb->n_rcv = nr;
@@ -218,7 +222,7 @@ int lr_rbounce_update(lr_rbounce **rbp, const lr_scene *s, lr_err *e)
 /* Patch means of grid texels: the patch of texel (s, t) is the cell holding its centre. */
 static void vpl_means(lr_rbounce *rb, int r, const float *gf, const double *gd, int stride)
 {
-    if (!rb || r < 0 || r >= rb->n_rcv)
+    if (!rb || !rb->tr || r < 0 || r >= rb->n_rcv)
         return;
     int si = rb->n_obj + r, nu, nv;
     size_t first, count;
@@ -229,9 +233,8 @@ static void vpl_means(lr_rbounce *rb, int r, const float *gf, const double *gd, 
     memset(m, 0, 3 * count * sizeof *m);
     if ((!gf && !gd) || stride < 3)
         return;
-    int *cnt = calloc(count, sizeof *cnt);
-    if (!cnt)
-        return; /* the bounce then lacks the VPLs' share: no crash, no error channel here */
+    int *cnt = rb->cnt;
+    memset(cnt, 0, count * sizeof *cnt);
     const int R = LR_RECV_GRID;
     for (int t = 0; t < R; t++) {
         int v = (int)((t + 0.5) * nv / R);
@@ -248,7 +251,6 @@ static void vpl_means(lr_rbounce *rb, int r, const float *gf, const double *gd, 
     for (size_t p = 0; p < count; p++)
         for (int b = 0; b < 3; b++)
             m[3 * p + (size_t)b] = cnt[p] ? m[3 * p + (size_t)b] / cnt[p] : 0;
-    free(cnt);
 }
 
 void lr_rbounce_vpl_f(lr_rbounce *rb, int r, const float *grid, int stride)
