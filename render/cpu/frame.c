@@ -11,6 +11,7 @@
 #include "render/cpu/cavity.h"
 #include "render/cpu/maps.h"
 #include "render/cpu/parallel.h"
+#include "render/bounce/rbounce.h"
 #include "render/cpu/recv_grid.h"
 #include "render/lpv/scene_lpv.h"
 #include "render/transrad/tr_scene.h"
@@ -231,6 +232,32 @@ static void grid_item(void *p, long item)
         for (int c = 0; X && c < 3; c++)
             E[c] += r->I[l][c] * X[3 * (size_t)k + (size_t)c];
     }
+}
+
+/* render.receiver_bounce (render/bounce/rbounce.h): the receivers' radiosity with
+ * E = sum_l I_l E_dir,l + the grid's E_vpl (this grid sums the lights with their intensities;
+ * by linearity the GPU's per-light solves at unit intensity give the same), its bounce added
+ * to the grid as the GPU's irradiance pass adds it to its own. */
+static int receiver_bounce(rctx *r, lr_err *e)
+{
+    lr_rbounce *rb = NULL;
+    int rc = lr_rbounce_update(&rb, r->s, e);
+    if (rc || !rb) {
+        lr_rbounce_destroy(rb);
+        return rc;
+    }
+    for (int i = 0; i < r->nrecv; i++)
+        lr_rbounce_vpl_d(rb, i, r->grid[i], 6);
+    rc = lr_rbounce_solve(rb, 0, (const double(*)[3])r->I, e);
+    const size_t n = (size_t)LR_RECV_GRID * LR_RECV_GRID;
+    for (int i = 0; i < r->nrecv && !rc; i++) {
+        const float *Eb = lr_rbounce_grid(rb, i, 0);
+        for (size_t k = 0; Eb && r->grid[i] && k < n; k++)
+            for (int c = 0; c < 3; c++)
+                r->grid[i][6 * k + (size_t)c] += Eb[3 * k + (size_t)c];
+    }
+    lr_rbounce_destroy(rb);
+    return rc;
 }
 
 /* Nearest hit of the camera ray among objects (kind 0) and receivers (kind 1). */
@@ -574,6 +601,8 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
             }
         }
         lr_cpu_parallel_for((long)(r.nrecv * n), d->threads, grid_item, &r);
+        if ((rc = receiver_bounce(&r, e)))
+            goto fail;
     }
     if (!ref && lr_scene_render(s)->lpv > 0 && r.nrecv > 0 &&
         (rc = lpv_grids(&r, lr_scene_render(s)->lpv, e)))

@@ -10,6 +10,7 @@
 
 #include <stdlib.h>
 
+#include "render/bounce/rbounce.h"
 #include "render/cpu/recv_grid.h"
 #include "render/passes/radiosity.h"
 
@@ -47,8 +48,50 @@ static int tr_upload(lr_irradiance *irr, const lr_pass_ctx *c, const lr_radiosit
     return rc;
 }
 
+/* Receiver inter-reflection (render/bounce/rbounce.h): each light's drawn grids (E_vpl at unit
+ * intensity) read back, the receivers' radiosity solved with E = E_dir,l + E_vpl,l (slot l),
+ * and the bounce E_b added to the grids in place; composition then reads it like E_vpl. */
+static int bounce(lr_irradiance *irr, const lr_pass_ctx *c, lr_err *e)
+{
+    int rc = lr_rbounce_update(&irr->rb, c->scene, e);
+    if (rc || !irr->rb)
+        return rc;
+    const size_t n = (size_t)LR_RECV_GRID * LR_RECV_GRID;
+    int nr = irr->n_receivers;
+    float *buf = malloc((size_t)(nr ? nr : 1) * 4 * n * sizeof *buf);
+    if (!buf)
+        return lr_err_set(e, LR_ENOMEM, "irradiance pass: receiver bounce: out of memory");
+    for (int l = 0; l < irr->n_lights && l < LR_TR_MAX_SLOTS && !rc; l++) {
+        for (int i = 0; i < nr && !rc; i++) {
+            if (irr->layer[i] < 0)
+                continue;
+            float *g = buf + (size_t)i * 4 * n;
+            rc = lr_fb_read(irr->fb[i], l, 0, 0, LR_RECV_GRID, LR_RECV_GRID, g, e);
+            lr_rbounce_vpl_f(irr->rb, i, rc ? NULL : g, 4);
+        }
+        double w[LR_MAX_LIGHTS][3] = {{0}};
+        w[l][0] = w[l][1] = w[l][2] = 1.0; /* unit intensity: the dimmer stays blend-only */
+        if (!rc)
+            rc = lr_rbounce_solve(irr->rb, l, (const double(*)[3])w, e);
+        for (int i = 0; i < nr && !rc; i++) {
+            const float *Eb = lr_rbounce_grid(irr->rb, i, l);
+            if (irr->layer[i] < 0 || !Eb)
+                continue;
+            float *g = buf + (size_t)i * 4 * n;
+            for (size_t k = 0; k < n; k++)
+                for (int b = 0; b < 3; b++)
+                    g[4 * k + (size_t)b] += Eb[3 * k + (size_t)b];
+            rc = lr_tex_upload(irr->grid, irr->layer[i] + l, g, e);
+        }
+    }
+    free(buf);
+    return rc;
+}
+
 void lr_irradiance_free(lr_irradiance *irr)
 {
+    lr_rbounce_destroy(irr->rb);
+    irr->rb = NULL;
     for (int i = 0; i < LR_MAX_RECEIVERS; i++) {
         lr_fb_destroy(irr->fb[i]);
         irr->fb[i] = NULL;
@@ -127,7 +170,8 @@ int lr_irradiance_run(lr_irradiance *irr, const lr_pass_ctx *c, const lr_vpl *v,
         lr_passes_uniform_i(p, "u_tr_layer", irr->layer[i]);
         lr_gl_draw_fullscreen(c->gl);
     }
-    if ((rc = lr_gl_check("receiver irradiance pass", e)))
+    if ((rc = lr_gl_check("receiver irradiance pass", e)) || (rc = bounce(irr, c, e)) ||
+        (rc = lr_gl_check("receiver irradiance pass (bounce)", e)))
         return rc;
     irr->valid = true;
     return LR_OK;

@@ -20,6 +20,10 @@ typedef struct lr_irradiance {
      * inter-reflection, objects' inner faces), laid out like grid; NULL when no object uses
      * the model. */
     lr_tex *tr_E;
+    /* Receiver inter-reflection for every model (render/bounce/rbounce.h; render.receiver_bounce):
+     * after the grids are drawn they are read back, the receivers' radiosity solved per light
+     * and the bounce added to them; NULL when off. */
+    struct lr_rbounce *rb;
 } lr_irradiance;
 
 /* Frees the grids (they are laid out again at the next run). */

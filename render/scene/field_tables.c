@@ -335,6 +335,10 @@ static const lr_field render_fields[] = {
      * irradiance grids change, so a settings change (render/README.md "VPL visibility"). */
     {"vpl_visibility", LR_FT_BOOL, 0, RS(vpl_visibility), .dflt = {0}, .dirty = SET,
      .help = "shadow each VPL's light on the receivers by the objects (beyond seed 003)"},
+    /* The receivers' own radiosity solve (render/bounce/README.md): their bounce joins the
+     * receiver irradiance grid, so a settings change. */
+    {"receiver_bounce", LR_FT_BOOL, 0, RS(receiver_bounce), .dflt = {0}, .dirty = SET,
+     .help = "light bounced between the plane receivers (seed 000 radiosity, objects occlude)"},
 };
 
 const lr_record_desc lr_scene_render_desc = {"render", "render", NULL, NULL, NULL, NULL,

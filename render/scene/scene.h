@@ -227,6 +227,9 @@ typedef struct lr_render_settings {
     /* Shadow each VPL's light on the receivers by the objects (beyond seed 003, whose VPLs
      * have no visibility term; lr_renderer_desc.vpl_visibility also turns it on). */
     bool vpl_visibility;
+    /* Receiver inter-reflection for every model (render/bounce/, issue 12 part 4): the plane
+     * receivers' radiosity solve, its bounce added to the receiver irradiance grid. */
+    bool receiver_bounce;
 } lr_render_settings;
 
 typedef struct lr_quality {

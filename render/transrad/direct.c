@@ -8,6 +8,7 @@
 #include "render/transrad/tr_priv.h"
 
 #include <math.h>
+#include <string.h>
 
 #include "render/cpu/parallel.h"
 #include "render/cpu/rng.h"
@@ -85,4 +86,14 @@ int lr_tr_direct(lr_tr *t, const lr_light *light, lr_err *e)
     dl_ctx c = {t, light, lr_tr_eps(t)};
     lr_cpu_parallel_for((long)t->n, t->set.threads, dl_item, &c);
     return LR_OK;
+}
+
+int lr_tr_direct_irradiance(lr_tr *t, const lr_light *light, double *E, lr_err *e)
+{
+    if (!t || !light || !E)
+        return lr_err_set(e, LR_EINVAL, "transrad: direct irradiance: NULL argument");
+    int rc = lr_tr_direct(t, light, e);
+    if (!rc)
+        memcpy(E, t->Edir, 3 * t->n * sizeof *E);
+    return rc;
 }

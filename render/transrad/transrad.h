@@ -139,6 +139,11 @@ int lr_tr_solve_light(lr_tr *t, const lr_light *light, int slot, lr_tr_stats *st
  * diffuse light). */
 int lr_tr_solve_irradiance(lr_tr *t, const double *E, int slot, lr_tr_stats *st, lr_err *e);
 
+/* The direct irradiance of a unit-intensity light per patch (n x 3, W/mm^2 into E), shadowed by
+ * every surface: lr_tr_solve_light's E, for callers that add light of their own before
+ * lr_tr_solve_irradiance (render/bounce/: the receivers' bounce adds the VPLs' light). */
+int lr_tr_direct_irradiance(lr_tr *t, const lr_light *light, double *E, lr_err *e);
+
 /* The thin-wall rule (render/transrad/thinwall.c): a slab of thickness d (mm) of medium c is
  * thin against patches of patch_mm when its wider diffusion profile (the multipole's R or T,
  * any band) holds 90 % of its light within patch_mm / 4; its S columns then send the slab's

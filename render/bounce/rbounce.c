@@ -1,0 +1,345 @@
+/* lamprig — receiver inter-reflection for every model: see rbounce.h. */
+#include "render/bounce/rbounce.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "render/cpu/recv_grid.h"
+
+#define KEY_MAX (LR_TR_MAX_SURFACES * 20)
+#define LKEY 20 /* doubles per light shape */
+#define MAX_LIGHTS 8
+
+struct lr_rbounce {
+    lr_tr *tr;
+    double key[KEY_MAX];
+    int nkey;
+    int n_obj, n_rcv, n_lights;
+    size_t n;               /* patches */
+    double *Edir[MAX_LIGHTS]; /* n x 3 per light, unit intensity */
+    double lkey[MAX_LIGHTS][LKEY];
+    bool lvalid[MAX_LIGHTS];
+    double *Evpl;           /* n x 3: the VPL grids' patch means */
+    int *cnt;               /* n: scratch, texels per patch */
+    double *E;              /* n x 3 scratch */
+    float *out[LR_TR_MAX_SURFACES][LR_TR_MAX_SLOTS]; /* per receiver, slot: R^2 x 3 */
+    double build_s, direct_s, solve_s;
+};
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+bool lr_rbounce_needed(const lr_scene *s)
+{
+    if (!s || !lr_scene_render(s)->receiver_bounce || lr_scene_light_count(s) < 1)
+        return false;
+    /* render.lpv's volumes carry the receivers' interreflection of their own (render/lpv/):
+     * not twice. */
+    if (lr_scene_render(s)->lpv > 0)
+        return false;
+    for (int i = 0; i < lr_scene_object_count(s); i++)
+        if (lr_scene_object_at(s, i)->sss_model == LR_SSS_TRANSLUCENT_RADIOSITY)
+            return false; /* its solve has the receivers in F (render/transrad/tr_scene.h) */
+    for (int i = 0; i < lr_scene_receiver_count(s); i++)
+        if (lr_scene_receiver_at(s, i)->type == LR_RECEIVER_PLANE)
+            return true;
+    return false;
+}
+
+static void put_mesh(double *k, int *n, const lr_mesh *m, const lr_bvh *b)
+{
+    /* A new mesh (a new address) means a new F, even with the same shape. */
+    k[(*n)++] = (double)(uintptr_t)m;
+    k[(*n)++] = (double)(uintptr_t)b;
+    lr_vec3 lo, hi;
+    lr_mesh_bounds(m, &lo, &hi);
+    double v[] = {(double)lr_mesh_triangle_count(m), (double)lr_mesh_vertex_count(m), lo.x,
+                  lo.y, lo.z, hi.x, hi.y, hi.z, lr_mesh_area(m)};
+    for (size_t i = 0; i < sizeof v / sizeof v[0]; i++)
+        k[(*n)++] = v[i];
+}
+
+/* What the patches, F and the albedos depend on: the objects' and receivers' shapes. */
+static int scene_key(const lr_scene *s, double *k)
+{
+    int n = 0;
+    k[n++] = lr_scene_object_count(s);
+    k[n++] = lr_scene_receiver_count(s);
+    for (int i = 0; i < lr_scene_object_count(s); i++)
+        put_mesh(k, &n, lr_scene_object_at(s, i)->mesh, lr_scene_object_at(s, i)->bvh);
+    for (int i = 0; i < lr_scene_receiver_count(s); i++) {
+        const lr_receiver *r = lr_scene_receiver_at(s, i);
+        put_mesh(k, &n, r->mesh, r->bvh);
+        for (int b = 0; b < 3; b++)
+            k[n++] = r->albedo[b];
+    }
+    return n;
+}
+
+/* What a light's direct irradiance at unit intensity depends on (not its intensity, colour or
+ * flicker: those scale it). */
+static void light_key(const lr_light *l, double *k)
+{
+    double v[LKEY] = {l->type,        l->position.x,  l->position.y,  l->position.z,
+                      l->direction.x, l->direction.y, l->direction.z, l->edge_u.x,
+                      l->edge_u.y,    l->edge_u.z,    l->edge_v.x,    l->edge_v.y,
+                      l->edge_v.z,    l->radius,      l->two_sided,   l->inner_deg,
+                      l->outer_deg,   0,              0,              0};
+    memcpy(k, v, sizeof v);
+}
+
+static void free_solver(lr_rbounce *rb)
+{
+    lr_tr_destroy(rb->tr);
+    rb->tr = NULL;
+    for (int l = 0; l < MAX_LIGHTS; l++) {
+        free(rb->Edir[l]);
+        rb->Edir[l] = NULL;
+        rb->lvalid[l] = false;
+    }
+    free(rb->Evpl);
+    free(rb->E);
+    free(rb->cnt);
+    rb->Evpl = rb->E = NULL;
+    rb->cnt = NULL;
+    for (int r = 0; r < LR_TR_MAX_SURFACES; r++)
+        for (int sl = 0; sl < LR_TR_MAX_SLOTS; sl++) {
+            free(rb->out[r][sl]);
+            rb->out[r][sl] = NULL;
+        }
+    rb->nkey = 0;
+}
+
+void lr_rbounce_destroy(lr_rbounce *rb)
+{
+    if (!rb)
+        return;
+    free_solver(rb);
+    free(rb);
+}
+
+/* The objects as occluders (diffuse, albedo 0: one patch per facing, their F rows unused)
+ * and the receivers (planes as grids, boxes as meshes) with their albedo. */
+static int build(lr_rbounce *rb, const lr_scene *s, lr_err *e)
+{
+    int no = lr_scene_object_count(s), nr = lr_scene_receiver_count(s), n = 0;
+    if (no + nr > LR_TR_MAX_SURFACES)
+        return lr_err_set(e, LR_EINVAL,
+                          "receiver bounce: %s: %d objects and receivers, at most %d",
+                          lr_scene_name(s), no + nr, LR_TR_MAX_SURFACES);
+    lr_tr_surface_desc d[LR_TR_MAX_SURFACES];
+    for (int i = 0; i < no; i++) {
+        const lr_scene_object *o = lr_scene_object_at(s, i);
+        d[n++] = (lr_tr_surface_desc){.kind = LR_TR_DIFFUSE, .mesh = o->mesh, .bvh = o->bvh,
+                                      .patch_mm = 1e5};
+    }
+    for (int i = 0; i < nr; i++) {
+        const lr_receiver *r = lr_scene_receiver_at(s, i);
+        lr_tr_surface_desc x = {.kind = r->type == LR_RECEIVER_PLANE ? LR_TR_PLANE : LR_TR_DIFFUSE,
+                                .mesh = r->mesh, .bvh = r->bvh, .center = r->center,
+                                .normal = r->normal, .u_dir = r->u_dir, .size_u = r->size[0],
+                                .size_v = r->size[1], .patch_mm = 30};
+        for (int b = 0; b < 3; b++)
+            x.albedo[b] = r->albedo[b];
+        d[n++] = x;
+    }
+    char cdir[1024];
+    lr_tr_settings set = {.rays_per_patch = 512,
+                          .cache_dir = lr_tr_cache_default_dir(cdir, sizeof cdir)};
+    int rc = lr_tr_create(d, n, &set, &rb->tr, e);
+    if (rc)
+        return rc;
+    rb->n = lr_tr_patch_count(rb->tr);
+    size_t n3 = 3 * (rb->n ? rb->n : 1);
+    rb->Evpl = calloc(n3, sizeof *rb->Evpl);
+    rb->E = calloc(n3, sizeof *rb->E);
+    rb->cnt = calloc(rb->n ? rb->n : 1, sizeof *rb->cnt);
+    if (!rb->Evpl || !rb->E || !rb->cnt)
+        return lr_err_set(e, LR_ENOMEM, "receiver bounce: out of memory (%zu patches)", rb->n);
+    rb->n_obj = no;
+    rb->n_rcv = nr;
+    return LR_OK;
+}
+
+int lr_rbounce_update(lr_rbounce **rbp, const lr_scene *s, lr_err *e)
+{
+    if (!rbp)
+        return lr_err_set(e, LR_EINVAL, "receiver bounce: NULL handle");
+    if (!lr_rbounce_needed(s)) {
+        lr_rbounce_destroy(*rbp);
+        *rbp = NULL;
+        return LR_OK;
+    }
+    if (lr_scene_light_count(s) > MAX_LIGHTS)
+        return lr_err_set(e, LR_EINVAL, "receiver bounce: %s: %d lights, at most %d",
+                          lr_scene_name(s), lr_scene_light_count(s), MAX_LIGHTS);
+    lr_rbounce *rb = *rbp;
+    if (!rb) {
+        if (!(rb = calloc(1, sizeof *rb)))
+            return lr_err_set(e, LR_ENOMEM, "receiver bounce: out of memory");
+        *rbp = rb;
+    }
+    double key[KEY_MAX];
+    int nk = scene_key(s, key), rc;
+    double t0 = now_s();
+    rb->build_s = 0;
+    if (!rb->tr || nk != rb->nkey || memcmp(key, rb->key, (size_t)nk * sizeof *key)) {
+        free_solver(rb);
+        if ((rc = build(rb, s, e))) {
+            free_solver(rb);
+            return rc;
+        }
+        memcpy(rb->key, key, (size_t)nk * sizeof *key);
+        rb->nkey = nk;
+        rb->build_s = now_s() - t0;
+    }
+    double t1 = now_s();
+    rb->n_lights = lr_scene_light_count(s);
+    for (int l = 0; l < rb->n_lights; l++) {
+        double lk[LKEY];
+        light_key(lr_scene_light_at(s, l), lk);
+        if (rb->lvalid[l] && !memcmp(lk, rb->lkey[l], sizeof lk))
+            continue;
+        if (!rb->Edir[l] && !(rb->Edir[l] = calloc(3 * (rb->n ? rb->n : 1), sizeof *rb->Edir[l])))
+            return lr_err_set(e, LR_ENOMEM, "receiver bounce: out of memory (direct light)");
+        if ((rc = lr_tr_direct_irradiance(rb->tr, lr_scene_light_at(s, l), rb->Edir[l], e)))
+            return rc;
+        memcpy(rb->lkey[l], lk, sizeof lk);
+        rb->lvalid[l] = true;
+    }
+    rb->direct_s = now_s() - t1;
+    memset(rb->Evpl, 0, 3 * rb->n * sizeof *rb->Evpl);
+    return LR_OK;
+}
+
+/* Patch means of grid texels: the patch of texel (s, t) is the cell holding its centre. */
+static void vpl_means(lr_rbounce *rb, int r, const float *gf, const double *gd, int stride)
+{
+    if (!rb || !rb->tr || r < 0 || r >= rb->n_rcv)
+        return;
+    int si = rb->n_obj + r, nu, nv;
+    size_t first, count;
+    lr_tr_surface_patches(rb->tr, si, &first, &count);
+    if (!lr_tr_plane_grid(rb->tr, si, &nu, &nv) || (size_t)nu * (size_t)nv != count)
+        return;
+    double *m = rb->Evpl + 3 * first;
+    memset(m, 0, 3 * count * sizeof *m);
+    if ((!gf && !gd) || stride < 3)
+        return;
+    int *cnt = rb->cnt;
+    memset(cnt, 0, count * sizeof *cnt);
+    const int R = LR_RECV_GRID;
+    for (int t = 0; t < R; t++) {
+        int v = (int)((t + 0.5) * nv / R);
+        for (int s = 0; s < R; s++) {
+            int u = (int)((s + 0.5) * nu / R);
+            size_t k = (size_t)t * R + (size_t)s, p = (size_t)v * (size_t)nu + (size_t)u;
+            for (int b = 0; b < 3; b++) {
+                double x = gf ? gf[k * (size_t)stride + (size_t)b] : gd[k * (size_t)stride + (size_t)b];
+                m[3 * p + (size_t)b] += isfinite(x) && x > 0 ? x : 0;
+            }
+            cnt[p]++;
+        }
+    }
+    for (size_t p = 0; p < count; p++)
+        for (int b = 0; b < 3; b++)
+            m[3 * p + (size_t)b] = cnt[p] ? m[3 * p + (size_t)b] / cnt[p] : 0;
+}
+
+void lr_rbounce_vpl_f(lr_rbounce *rb, int r, const float *grid, int stride)
+{
+    vpl_means(rb, r, grid, NULL, stride);
+}
+
+void lr_rbounce_vpl_d(lr_rbounce *rb, int r, const double *grid, int stride)
+{
+    vpl_means(rb, r, NULL, grid, stride);
+}
+
+/* E_b of receiver r on the texel grid: bilinear between patch centres ((u + 1/2)/nu of the
+ * plane, as the texels' (s + 1/2)/R), clamped at the edges (as render/transrad/tr_scene.c). */
+static int write_grid(lr_rbounce *rb, int r, int slot, lr_err *e)
+{
+    int si = rb->n_obj + r, nu, nv;
+    size_t first, count;
+    lr_tr_surface_patches(rb->tr, si, &first, &count);
+    if (!lr_tr_plane_grid(rb->tr, si, &nu, &nv) || (size_t)nu * (size_t)nv != count)
+        return LR_OK;
+    const int R = LR_RECV_GRID;
+    float **out = &rb->out[r][slot];
+    if (!*out && !(*out = malloc((size_t)R * R * 3 * sizeof **out)))
+        return lr_err_set(e, LR_ENOMEM, "receiver bounce: out of memory (grid)");
+    double *X = rb->E; /* the scratch E is free after the solve */
+    for (size_t p = 0; p < count; p++)
+        lr_tr_indirect(rb->tr, slot, first + p, X + 3 * p);
+    for (int t = 0; t < R; t++)
+        for (int s = 0; s < R; s++) {
+            double u = (s + 0.5) / R * nu - 0.5, v = (t + 0.5) / R * nv - 0.5;
+            u = u < 0 ? 0 : u > nu - 1 ? nu - 1 : u;
+            v = v < 0 ? 0 : v > nv - 1 ? nv - 1 : v;
+            int u0 = (int)floor(u), v0 = (int)floor(v);
+            int u1 = u0 + 1 < nu ? u0 + 1 : u0, v1 = v0 + 1 < nv ? v0 + 1 : v0;
+            double fu = u - u0, fv = v - v0;
+            for (int b = 0; b < 3; b++) {
+                double a00 = X[3 * ((size_t)v0 * nu + u0) + b], a10 = X[3 * ((size_t)v0 * nu + u1) + b];
+                double a01 = X[3 * ((size_t)v1 * nu + u0) + b], a11 = X[3 * ((size_t)v1 * nu + u1) + b];
+                (*out)[3 * ((size_t)t * R + s) + b] =
+                    (float)((1 - fv) * ((1 - fu) * a00 + fu * a10) + fv * ((1 - fu) * a01 + fu * a11));
+            }
+        }
+    return LR_OK;
+}
+
+int lr_rbounce_solve(lr_rbounce *rb, int slot, const double (*w)[3], lr_err *e)
+{
+    if (!rb || !rb->tr)
+        return lr_err_set(e, LR_EINVAL, "receiver bounce: solve before update");
+    if (slot < 0 || slot >= LR_TR_MAX_SLOTS)
+        return lr_err_set(e, LR_EINVAL, "receiver bounce: field 'slot': %d outside [0, %d)",
+                          slot, LR_TR_MAX_SLOTS);
+    double t0 = now_s();
+    size_t first0, cnt0;
+    lr_tr_surface_patches(rb->tr, rb->n_obj, &first0, &cnt0);
+    for (size_t p = 0; p < rb->n; p++)
+        for (int b = 0; b < 3; b++) {
+            size_t i = 3 * p + (size_t)b;
+            double x = p >= first0 ? rb->Evpl[i] : 0;
+            for (int l = 0; w && l < rb->n_lights && p >= first0; l++)
+                if (rb->Edir[l] && w[l][b] > 0)
+                    x += w[l][b] * rb->Edir[l][i];
+            rb->E[i] = isfinite(x) && x > 0 ? x : 0;
+        }
+    int rc = lr_tr_solve_irradiance(rb->tr, rb->E, slot, NULL, e);
+    for (int r = 0; r < rb->n_rcv && !rc; r++)
+        rc = write_grid(rb, r, slot, e);
+    rb->solve_s = now_s() - t0;
+    return rc;
+}
+
+const float *lr_rbounce_grid(const lr_rbounce *rb, int r, int slot)
+{
+    if (!rb || r < 0 || r >= rb->n_rcv || slot < 0 || slot >= LR_TR_MAX_SLOTS)
+        return NULL;
+    return rb->out[r][slot];
+}
+
+const lr_tr *lr_rbounce_solver(const lr_rbounce *rb) { return rb ? rb->tr : NULL; }
+
+int lr_rbounce_first_receiver(const lr_rbounce *rb) { return rb ? rb->n_obj : 0; }
+
+void lr_rbounce_times(const lr_rbounce *rb, double *build_s, double *direct_s, double *solve_s)
+{
+    if (build_s)
+        *build_s = rb ? rb->build_s : 0;
+    if (direct_s)
+        *direct_s = rb ? rb->direct_s : 0;
+    if (solve_s)
+        *solve_s = rb ? rb->solve_s : 0;
+}
