@@ -214,7 +214,7 @@ int lr_plan_table_parse(const char *text, size_t len, const char *name, lr_plan_
     memcpy(buf, text, len);
     buf[len] = '\0';
     int at[C_COUNT], nheader = 0, rc = LR_OK, line = 0;
-    char *f[MAX_FIELDS];
+    char *f[MAX_FIELDS], empty[1] = {0};
     char *p = buf;
     while (p && !rc) {
         char *nl = strchr(p, '\n');
@@ -253,11 +253,18 @@ int lr_plan_table_parse(const char *text, size_t len, const char *name, lr_plan_
             nheader = n;
             continue;
         }
-        if (n != nheader) {
+        /* A row may stop before optional trailing columns (rows written before a column was
+         * appended to the header, e.g. lpv and ms_lpv): they read empty. */
+        bool short_ok = n < nheader;
+        for (int c = 0; c < C_COUNT && short_ok; c++)
+            short_ok = !(at[c] >= n && cols[c].required);
+        if (n != nheader && !short_ok) {
             rc = lr_err_set(e, LR_EPARSE, "%s:%d: %d cells, the header has %d", name, line, n,
                             nheader);
             break;
         }
+        for (int i = n; i < nheader; i++)
+            f[i] = empty;
         if (t->n == t->cap) {
             int cap = t->cap ? 2 * t->cap : 32;
             lr_plan_row *r = realloc(t->rows, (size_t)cap * sizeof *r);

@@ -487,6 +487,21 @@ static void test_lpv_rows(void **state)
     expect_table_error("scene,model,frame_ms,rel_rmse,K,N,N_vpl,map_size,gbuffer_size,frames,"
                        "vpl,lpv\ncandle,directional_dipole,100,0.2,8,8,32,128,128,16,on,-1\n",
                        "lpv");
+    /* A row written before the optional lpv columns were appended reads them empty (0, NaN);
+     * a short row missing a required column is still refused. */
+    const char *mixed =
+        "scene,model,frame_ms,rel_rmse,K,N,N_vpl,map_size,gbuffer_size,frames,vpl,lpv,ms_lpv\n"
+        "candle,directional_dipole,100,0.20,8,8,32,128,128,16,on\n"
+        "candle,directional_dipole,100,0.15,8,8,32,128,128,16,on,16,3000\n";
+    assert_int_equal(lr_plan_table_parse(mixed, strlen(mixed), "mixed.csv", &t, &e), LR_OK);
+    assert_int_equal(lr_plan_table_count(t), 2);
+    assert_int_equal(lr_plan_table_row(t, 0)->lpv, 0);
+    assert_true(isnan(lr_plan_table_row(t, 0)->ms_lpv));
+    assert_int_equal(lr_plan_table_row(t, 1)->lpv, 16);
+    lr_plan_table_destroy(t);
+    expect_table_error("scene,model,frame_ms,rel_rmse,K,N,N_vpl,map_size,gbuffer_size,frames,"
+                       "vpl,lpv\ncandle,directional_dipole,100,0.2,8,8,32,128,128,16\n",
+                       "10 cells, the header has 12");
 }
 
 /* Seed 002's sh_translucency is a table model like the dipoles: with a loose budget its cheap
