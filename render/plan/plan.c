@@ -460,11 +460,12 @@ size_t lr_plan_format(const lr_plan *p, char *buf, size_t cap)
     const lr_render_settings *s = &p->settings;
     put(&o, "plan: %s: budget ", p->scene);
     put_budget(&o, &p->budget);
-    put(&o, "%s; render K=%d N=%d N_vpl=%d map_size=%d gbuffer_size=%d frames=%d, VPL pass %s; "
-            "after %d frames no pass runs until something changes\n",
+    put(&o, "%s; render K=%d N=%d N_vpl=%d map_size=%d gbuffer_size=%d frames=%d, VPL pass %s",
         p->feasible ? " met" : " NOT MET (infeasible: closest settings chosen)", s->K, s->N,
-        p->vpl ? s->N_vpl : 0, s->map_size, s->gbuffer_size, s->frames, p->vpl ? "on" : "off",
-        s->frames);
+        p->vpl ? s->N_vpl : 0, s->map_size, s->gbuffer_size, s->frames, p->vpl ? "on" : "off");
+    if (s->lpv > 0)
+        put(&o, ", lpv=%d", s->lpv);
+    put(&o, "; after %d frames no pass runs until something changes\n", s->frames);
     return o.len;
 }
 
