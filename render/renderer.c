@@ -60,6 +60,8 @@ struct lr_renderer {
     /* Area lights' direct light on the plane receivers, accumulated with the maps
      * (render/passes/area_direct.h); unallocated without area lights. */
     lr_area_direct area;
+    /* render.lpv: the light-propagation volume (render/passes/lpv_pass.h). */
+    lr_lpv_pass lpv;
 
     unsigned dirty;
     int frame_index;
@@ -126,6 +128,21 @@ static int gbuffer_run(lr_renderer *r, unsigned dirty, lr_err *e)
     return lr_gbuffer_run(&r->gbuffer, &c, frame, e);
 }
 
+/* render.lpv > 0: the volume is on and, once built, read by the area pass and composition. */
+static bool lpv_on(const lr_renderer *r) { return r->rs.lpv > 0; }
+static const lr_lpv_pass *lpv_live(const lr_renderer *r)
+{
+    return lpv_on(r) && r->lpv.valid ? &r->lpv : NULL;
+}
+static void lpv_free(lr_renderer *r) { lr_lpv_pass_free(&r->lpv); }
+static bool lpv_due(const lr_renderer *r) { return !r->lpv.valid; }
+static int lpv_run(lr_renderer *r, unsigned dirty, lr_err *e)
+{
+    (void)dirty;
+    lr_pass_ctx c = pass_ctx(r);
+    return lr_lpv_pass_run(&r->lpv, &c, e);
+}
+
 static int radiosity_alloc(lr_renderer *r, lr_err *e)
 {
     lr_pass_ctx c = pass_ctx(r);
@@ -146,7 +163,8 @@ static int radiosity_run(lr_renderer *r, unsigned dirty, lr_err *e)
     int rc = lr_radiosity_run(&r->rad, &c, &r->gbuffer, restart, e);
     /* The area lights' direct light: the same frame's sample, the same running mean. */
     if (!rc && lr_area_direct_pass_needed(r->scene))
-        rc = lr_area_direct_run(&r->area, &c, &r->gbuffer, r->rad.F, e);
+        rc = lr_area_direct_run(&r->area, &c, &r->gbuffer, r->rad.F,
+                                lpv_live(r) ? r->lpv.recv : NULL, e);
     return rc;
 }
 
@@ -201,7 +219,7 @@ static int compose_run(lr_renderer *r, unsigned dirty, lr_err *e)
     (void)dirty;
     lr_pass_ctx c = pass_ctx(r);
     lr_compose_inputs in = {.gbuffer = &r->gbuffer, .radiosity = &r->rad, .vpl = &r->vpl,
-                            .irradiance = &r->irr, .area = &r->area,
+                            .irradiance = &r->irr, .area = &r->area, .lpv = lpv_live(r),
                             .surface = r->rs.surface_cache && r->surf.valid ? &r->surf : NULL};
     return lr_compose_run(&r->img, &c, &in, e);
 }
@@ -243,6 +261,8 @@ enum {
 static const lr_pass_desc pass_table[LR_PASS_COUNT] = {
     {"gbuffer", LR_PASS_GBUFFER, D_TRANSPORT, 0, false, gbuffer_alloc, gbuffer_free, gbuffer_due,
      gbuffer_run, NULL},
+    {"lpv", LR_PASS_LPV, D_GRIDS, LR_PASS_COMPOSE, false, NULL, lpv_free, lpv_due, lpv_run,
+     lpv_on},
     {"radiosity", LR_PASS_RADIOSITY, D_MAPS, LR_PASS_VPL | LR_PASS_SURFACE | LR_PASS_COMPOSE,
      false, radiosity_alloc, radiosity_free, radiosity_due, radiosity_run, NULL},
     {"vpl", LR_PASS_VPL, D_MAPS, LR_PASS_IRRADIANCE, true, vpl_alloc, vpl_free, NULL, vpl_run, NULL},

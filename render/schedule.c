@@ -12,7 +12,12 @@
  *  - view: composition and blend (the radiosity maps, the grids and the objects' surface
  *    cache are view-independent);
  *  - receivers: their irradiance grids, composition and blend (receivers are lit at
- *    composition and take no part in the transport through the object). */
+ *    composition and take no part in the transport through the object);
+ *  - the light-propagation volume (render.lpv): the light geometry, the objects, their
+ *    material, the receivers and the settings (it injects the receivers' and the objects'
+ *    reflection and propagates between them), never the camera or a dimmer; it feeds
+ *    composition (the objects' term) and, through the area pass, the receivers' grids, which
+ *    restart with the maps on every one of those changes. */
 
 unsigned lr_dirty_passes(unsigned dirty)
 {

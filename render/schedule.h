@@ -22,10 +22,12 @@ enum lr_pass {
     LR_PASS_BLEND = 1u << 4,     /* sum_l I_l image_l, tone mapping, output (passes/blend.h) */
     LR_PASS_IRRADIANCE = 1u << 5, /* receiver irradiance grids from the VPLs (before compose) */
     LR_PASS_SURFACE = 1u << 6,    /* the objects' B per refined vertex (passes/surface.h) */
+    LR_PASS_LPV = 1u << 7,        /* render.lpv: the light-propagation volume (before the
+                                   * radiosity pass; passes/lpv_pass.h) */
 };
 
-/* gbuffer, radiosity, vpl, compose, blend, irradiance, surface (bit index order). */
-enum { LR_PASS_COUNT = 7 };
+/* gbuffer, radiosity, vpl, compose, blend, irradiance, surface, lpv (bit index order). */
+enum { LR_PASS_COUNT = 8 };
 
 typedef struct lr_renderer lr_renderer; /* render/renderer.h */
 
@@ -66,8 +68,8 @@ unsigned lr_dirty_passes(unsigned dirty);
  * passes whose `on` says they are off. */
 unsigned lr_schedule_close(const lr_renderer *r, unsigned passes, bool no_emergent);
 
-/* "gbuffer", "radiosity", "vpl", "compose", "blend", "irradiance", "surface" for bit index
- * 0..6; "?" otherwise. */
+/* "gbuffer", "radiosity", "vpl", "compose", "blend", "irradiance", "surface", "lpv" for bit
+ * index 0..7; "?" otherwise. */
 const char *lr_pass_name(int index);
 
 #endif

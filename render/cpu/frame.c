@@ -59,6 +59,10 @@ typedef struct rctx {
      * render/lpv/scene_lpv.h), [receiver * nlight + light], NULL where none; the GPU adds
      * the same to its area lights' direct grid (render/passes/area_direct.c). */
     double **lpv;
+    /* render.lpv (PASS): per light, the volume's irradiance on the objects (objfield.h), and
+     * per object its factors kR, kT ([obj * 6]: kR rgb, kT rgb), as lpv_pass.c gives the GPU. */
+    lr_lpv_objfield **lpv_obj;
+    double *lpv_k;
     lr_tr_scene *tr;     /* translucent radiosity (PASS): the solver's B and receiver extra */
     lr_dscene *dscene; /* diffusion_grid objects' fields (NULL when the scene has none) */
     /* Per light, the lights the transport sees frame by frame (render/area/frames.h): an area
@@ -260,6 +264,19 @@ static int receiver_bounce(rctx *r, lr_err *e)
     return rc;
 }
 
+/* render.lpv: adds to B the volume's light on object o for light l at (x, n), per unit
+ * intensity: kR E(x, n) + kT E(x, -n) (render/lpv/objfield.h; lib/lpv_object.glsl). */
+static void lpv_object_B(const rctx *r, int o, int l, lr_vec3 x, lr_vec3 n, double B[3])
+{
+    const double *k = r->lpv_k + 6 * (size_t)o;
+    double E[3], Eb[3] = {0, 0, 0};
+    lr_lpv_objfield_irradiance(r->lpv_obj[l], x, n, E);
+    if (k[3] > 0.0 || k[4] > 0.0 || k[5] > 0.0)
+        lr_lpv_objfield_irradiance(r->lpv_obj[l], x, lr_v3_scale(n, -1.0), Eb);
+    for (int c = 0; c < 3; c++)
+        B[c] += k[c] * E[c] + k[3 + c] * Eb[c];
+}
+
 /* Nearest hit of the camera ray among objects (kind 0) and receivers (kind 1). */
 static bool trace(const lr_scene *s, lr_vec3 org, lr_vec3 dir, int *kind, int *index, lr_vec3 *x,
                   lr_vec3 *n)
@@ -329,6 +346,8 @@ static void pixel_item(void *p, long item)
                              lr_cpu_key(seed_of(r), (uint64_t)item, (uint64_t)l, 1), B, var, &fb);
             if (fb)
                 r->fallback_px[item] = 1;
+            if (r->lpv_obj && r->lpv_obj[l])
+                lpv_object_B(r, idx, l, x, n, B);
             for (int c = 0; c < 3; c++) {
                 double k = r->I[l][c] * ft / M_PI; /* seed 003 Eq. 5 */
                 L[c] += k * B[c];
@@ -396,9 +415,21 @@ static int lpv_grids(rctx *r, int n, lr_err *e)
     double **out = calloc((size_t)r->nrecv, sizeof *out);
     if (!out)
         return lr_err_set(e, LR_ENOMEM, "cpu render: out of memory");
+    r->lpv_obj = calloc((size_t)r->nlight, sizeof *r->lpv_obj);
+    r->lpv_k = calloc((size_t)r->nobj * 6, sizeof *r->lpv_k);
+    if (!r->lpv_obj || !r->lpv_k) {
+        free(out);
+        return lr_err_set(e, LR_ENOMEM, "cpu render: out of memory");
+    }
+    for (int o = 0; o < r->nobj; o++)
+        lr_lpv_object_factors(lr_scene_object_at(r->s, o), r->lpv_k + 6 * (size_t)o,
+                              r->lpv_k + 6 * (size_t)o + 3);
     lr_lpv_scene_desc d = {.n = n, .bounces = 2};
     int rc = LR_OK;
     for (int l = 0; l < r->nlight && !rc; l++) {
+        if ((rc = lr_lpv_objfield_create(&r->lpv_obj[l], e)))
+            break;
+        d.objects = r->lpv_obj[l];
         for (int i = 0; i < r->nrecv && !rc; i++) {
             out[i] = NULL;
             lr_recv_grid_frame f;
@@ -641,6 +672,10 @@ fail:
         for (int i = 0; i < r.nrecv * r.nlight; i++)
             free(r.lpv[i]);
     free(r.lpv);
+    for (int l = 0; r.lpv_obj && l < r.nlight; l++)
+        lr_lpv_objfield_destroy(r.lpv_obj[l]);
+    free(r.lpv_obj);
+    free(r.lpv_k);
     if (r.maps)
         for (int i = 0; i < r.nobj * r.nlight; i++)
             lr_cpu_maps_destroy(r.maps[i]);

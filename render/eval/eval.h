@@ -150,6 +150,10 @@ typedef struct lr_eval_row {
      * s*height and box-filtered, as the reference's pixels are (the times are then those of
      * the larger image). */
     int supersample;
+    /* render.lpv of the run (0: off). The CSV gets two more columns, lpv and ms_lpv (the
+     * volume's pass on a full update, ms[7]), when any row has it on; a table without the
+     * volume keeps the columns above. */
+    int lpv;
 } lr_eval_row;
 
 /* Pass columns of the CSV: ms_gbuffer .. ms_compose. */

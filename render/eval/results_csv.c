@@ -24,7 +24,10 @@ static void num(FILE *f, double v, const char *fmt)
 
 void lr_eval_csv_print(FILE *f, const lr_eval_row *rows, int n)
 {
-    fputs(LR_EVAL_CSV_HEADER "\n", f);
+    bool lpv = false;
+    for (int i = 0; i < n; i++)
+        lpv |= rows[i].lpv > 0;
+    fputs(lpv ? LR_EVAL_CSV_HEADER ",lpv,ms_lpv\n" : LR_EVAL_CSV_HEADER "\n", f);
     for (int i = 0; i < n; i++) {
         const lr_eval_row *r = &rows[i];
         char params[160];
@@ -43,7 +46,12 @@ void lr_eval_csv_print(FILE *f, const lr_eval_row *rows, int n)
         num(f, r->bias_receivers, "%.5f");
         num(f, r->noise_object, "%.5f");
         num(f, r->noise_receivers, "%.5f");
-        fprintf(f, ",%d,%d,%d\n", r->width, r->height, r->supersample);
+        fprintf(f, ",%d,%d,%d", r->width, r->height, r->supersample);
+        if (lpv) {
+            fprintf(f, ",%d", r->lpv);
+            num(f, r->lpv > 0 ? r->ms[7] : NAN, "%.3f"); /* LR_PASS_LPV's bit index */
+        }
+        fputc('\n', f);
     }
 }
 

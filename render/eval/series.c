@@ -82,7 +82,7 @@ int lr_eval_series_run(const lr_eval_series_desc *d, lr_eval_series *out, lr_err
     const int ss = d->supersample > 1 ? d->supersample : 1;
     const int w = d->width * ss, h = d->height * ss;
     float *tmp = malloc((size_t)w * h * 3 * sizeof *tmp);
-    double *acc[LR_PASS_COUNT + 1] = {0}, full[FULL_UPDATES];
+    double *acc[LR_PASS_COUNT + 1] = {0}, full[FULL_UPDATES], full_lpv[FULL_UPDATES];
     for (int p = 0; p <= LR_PASS_COUNT; p++)
         acc[p] = malloc((size_t)d->converge_frames * sizeof(double));
     lr_renderer *r = NULL;
@@ -106,6 +106,7 @@ int lr_eval_series_run(const lr_eval_series_desc *d, lr_eval_series *out, lr_err
         if ((rc = lr_renderer_frame(r, &st, e)))
             goto done;
         full[i] = (st.passes & 1u) ? st.ms[0] : NAN;
+        full_lpv[i] = (st.passes & LR_PASS_LPV) ? st.ms[7] : NAN; /* render.lpv's pass */
     }
     int next = 0, nacc = 0;
     for (;;) {
@@ -144,6 +145,8 @@ int lr_eval_series_run(const lr_eval_series_desc *d, lr_eval_series *out, lr_err
         out->ms[p] = median(acc[p], m);
     }
     out->frame_ms = median(acc[LR_PASS_COUNT], nacc);
+    /* The volume is built on full updates only (its pass is due on the changes they make). */
+    out->ms[7] = isfinite(full_lpv[0]) ? median(full_lpv, FULL_UPDATES) : NAN;
     out->accum_frames = nacc;
 done:
     lr_renderer_destroy(r);

@@ -140,11 +140,8 @@ static int object_samples(const lr_scene *s, const lr_lpv *v, int group, samples
 {
     for (int i = 0; i < lr_scene_object_count(s); i++) {
         const lr_scene_object *o = lr_scene_object_at(s, i);
-        double R[3], T[3] = {0, 0, 0};
-        if (o->thickness_mm > 0.0)
-            lr_multipole_total(&o->coeffs, o->thickness_mm, R, T);
-        else
-            lr_dipole_rd_total(&o->coeffs, R);
+        double R[3], T[3];
+        lr_lpv_object_totals(o, R, T);
         /* r_min = h / 3, but at most 1/16 of the object's largest extent: a volume widened
          * to a wall (build_box) has cells of a third of a votive, and the TPLs' midpoint
          * rule over a cup lit from 22 mm away then lost a quarter of the emergent flux. */
@@ -287,6 +284,8 @@ int lr_lpv_scene_indirect(const lr_scene *s, int light, const lr_lpv_scene_desc 
             memset(out[i], 0, texels * 3 * sizeof *out[i]);
     const lr_light *li = lr_scene_light_at(s, light);
     bool area = lr_light_is_area(li);
+    if (d && d->objects)
+        lr_lpv_objfield_clear(d->objects);
     if (!area && li->type != LR_LIGHT_POINT && li->type != LR_LIGHT_SPOT) {
         if (stats)
             *stats = st;
@@ -306,6 +305,11 @@ int lr_lpv_scene_indirect(const lr_scene *s, int light, const lr_lpv_scene_desc 
     if ((rc = build_box(s, n, &v, e)))
         return rc;
     st.cell_mm = lr_lpv_h(v);
+    lr_lpv_objfield *of = d ? d->objects : NULL;
+    if (of && (rc = lr_lpv_objfield_reset(of, v, e))) {
+        lr_lpv_destroy(v);
+        return rc;
+    }
     samples ss = {0};
     rc = receiver_samples(s, v, &ss, &st.samples_receivers);
     if (rc)
@@ -416,6 +420,9 @@ int lr_lpv_scene_indirect(const lr_scene *s, int light, const lr_lpv_scene_desc 
                 continue;
             if ((rc = prop(ctx, v, 4 * n, e)))
                 break;
+            /* The objects lit by the receivers' reflection (objfield.h). */
+            if (of && g < nrec)
+                lr_lpv_objfield_add(of, v);
             double got[3] = {0, 0, 0};
             gather_receivers(s, v, g, out, got);
             for (int c = 0; c < 3; c++) {

@@ -43,6 +43,7 @@
 
 #include "render/base/err.h"
 #include "render/lpv/lpv.h"
+#include "render/lpv/objfield.h"
 #include "render/scene/scene.h"
 
 /* Propagates v by `steps` (lr_lpv_propagate, or a GPU round trip). */
@@ -55,6 +56,11 @@ typedef struct lr_lpv_scene_desc {
                                     * light out of their other face (false: R only) */
     lr_lpv_propagate_fn propagate; /* NULL: the CPU */
     void *ctx;
+    /* Non-NULL: reset to the volume's box and filled with the irradiance the receivers'
+     * volumes deliver to the objects (objfield.h; the objects' own group is left out: its
+     * light on the objects is a cavity's inter-reflection, the cavity closure's part,
+     * PIPELINE.md "Energy"). */
+    lr_lpv_objfield *objects;
 } lr_lpv_scene_desc;
 
 typedef struct lr_lpv_scene_stats {

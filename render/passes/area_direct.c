@@ -12,13 +12,7 @@
 #include <stdlib.h>
 
 #include "render/cpu/recv_grid.h"
-#include "render/lpv/gpu.h"
-#include "render/lpv/scene_lpv.h"
 #include "render/passes/radiosity.h"
-
-/* Further bounces off the objects in the light-propagation volume (scene_lpv.h): a paper
- * shade's cavity returns 0.79 per bounce. */
-#define LPV_BOUNCES 2
 
 bool lr_area_direct_needed(const lr_scene *s)
 {
@@ -71,8 +65,6 @@ void lr_area_direct_free(lr_area_direct *a)
     }
     lr_tex_destroy(a->grid);
     a->grid = NULL;
-    lr_tex_destroy(a->lpv);
-    a->lpv = NULL;
     a->n_receivers = a->n_lights = 0;
     a->F = 0;
 }
@@ -107,62 +99,8 @@ static int alloc(lr_area_direct *a, const lr_pass_ctx *c, lr_err *e)
     return LR_OK;
 }
 
-/* render.lpv: every area, point and spot light's indirect irradiance on the plane
- * receivers' grids (render/lpv/scene_lpv.h: injection and gathering on the CPU, propagation
- * on the GPU), per unit radiance or intensity, into a->lpv (the layers of a->grid). */
-static int lpv_build(lr_area_direct *a, const lr_pass_ctx *c, lr_err *e)
-{
-    lr_tex_destroy(a->lpv);
-    a->lpv = NULL;
-    int n = c->rs->lpv, nr = c->objs->n_receivers, nl = c->n_lights, layers = 0;
-    for (int i = 0; i < nr; i++)
-        if (a->layer[i] >= 0)
-            layers += nl;
-    if (n <= 0 || layers == 0)
-        return LR_OK;
-    lr_tex_desc td = {.type = LR_TEX_2D_ARRAY, .format = LR_TEX_RGBA32F,
-                      .width = LR_RECV_GRID, .height = LR_RECV_GRID, .layers = layers,
-                      .label = "light-propagation volume's receiver grids"};
-    int rc = lr_tex_create(c->gl, &td, &a->lpv, e);
-    lr_lpv_gpu *g = NULL;
-    if (!rc)
-        rc = lr_lpv_gpu_create(c->gl, n, c->shader_dir, &g, e);
-    size_t texels = (size_t)LR_RECV_GRID * LR_RECV_GRID;
-    double *out[LR_MAX_RECEIVERS] = {NULL};
-    float *px = rc ? NULL : malloc(sizeof *px * texels * 4);
-    if (!rc && !px)
-        rc = lr_err_set(e, LR_ENOMEM, "lpv: out of memory");
-    for (int i = 0; i < nr && !rc; i++)
-        if (a->layer[i] >= 0 && !(out[i] = malloc(sizeof *out[i] * texels * 3)))
-            rc = lr_err_set(e, LR_ENOMEM, "lpv: out of memory");
-    lr_lpv_scene_desc d = {.n = n, .bounces = LPV_BOUNCES, .propagate = lr_lpv_gpu_run, .ctx = g};
-    for (int l = 0; l < nl && !rc; l++) {
-        if ((rc = lr_lpv_scene_indirect(c->scene, l, &d, out, NULL, e)))
-            break;
-        for (int i = 0; i < nr && !rc; i++) {
-            if (!out[i])
-                continue;
-            for (size_t k = 0; k < texels; k++) {
-                for (int q = 0; q < 3; q++)
-                    px[4 * k + q] = (float)out[i][3 * k + q];
-                px[4 * k + 3] = 1.0f;
-            }
-            rc = lr_tex_upload(a->lpv, a->layer[i] + l, px, e);
-        }
-    }
-    for (int i = 0; i < nr; i++)
-        free(out[i]);
-    free(px);
-    lr_lpv_gpu_destroy(g);
-    if (rc) {
-        lr_tex_destroy(a->lpv);
-        a->lpv = NULL;
-    }
-    return rc;
-}
-
 int lr_area_direct_run(lr_area_direct *a, const lr_pass_ctx *c, const lr_gbuffer *gb, int F,
-                       lr_err *e)
+                       const lr_tex *lpv, lr_err *e)
 {
     int rc;
     if ((!a->grid || a->n_receivers != c->objs->n_receivers || a->n_lights != c->n_lights) &&
@@ -170,15 +108,13 @@ int lr_area_direct_run(lr_area_direct *a, const lr_pass_ctx *c, const lr_gbuffer
         return rc;
     if (!a->grid)
         return LR_OK;
-    if (F <= 1 && (rc = lpv_build(a, c, e)))
-        return rc;
     lr_program *p = c->prog->area;
     glDisable(GL_DEPTH_TEST);
     glUseProgram(lr_program_id(p));
     lr_gbuffer_bind_lights(gb, c, p);
     lr_passes_uniform_i(p, "u_grid_size", LR_RECV_GRID);
-    lr_passes_uniform_i(p, "u_lpv_on", a->lpv != NULL);
-    lr_passes_bind_tex(p, "u_lpv", 17, a->lpv);
+    lr_passes_uniform_i(p, "u_lpv_on", lpv != NULL);
+    lr_passes_bind_tex(p, "u_lpv", 17, lpv);
     if (F <= 1) {
         glDisable(GL_BLEND);
     } else {

@@ -16,10 +16,6 @@ typedef struct lr_area_direct {
     int layer[LR_MAX_RECEIVERS];
     int n_receivers, n_lights;
     int F; /* frames in the running mean */
-    /* render.lpv: the light-propagation volume's indirect irradiance per plane receiver and
-     * light (render/lpv/scene_lpv.h), same layers as grid, added to every frame's direct
-     * light so the running mean carries it; computed when the mean restarts (F = 1). */
-    lr_tex *lpv;
 } lr_area_direct;
 
 /* Whether the scene has an area light (the grid is needed). */
@@ -31,9 +27,11 @@ bool lr_area_direct_pass_needed(const lr_scene *s);
  * naming both; else LR_OK. */
 int lr_area_direct_check(const lr_scene *s, lr_err *e);
 void lr_area_direct_free(lr_area_direct *a);
-/* Adds frame F (1-based; 1 restarts the mean) from the G-buffer as drawn for that frame. */
+/* Adds frame F (1-based; 1 restarts the mean) from the G-buffer as drawn for that frame.
+ * lpv: render.lpv's receiver grids (render/passes/lpv_pass.h, the same layers as grid), added
+ * to every frame's direct light so the running mean carries them; NULL: none. */
 int lr_area_direct_run(lr_area_direct *a, const lr_pass_ctx *c, const lr_gbuffer *gb, int F,
-                       lr_err *e);
+                       const lr_tex *lpv, lr_err *e);
 /* Receiver i's grid for compose_receiver.frag (unit 16), or u_area_cached = false. */
 void lr_area_direct_bind(const lr_area_direct *a, const lr_pass_ctx *c, lr_program *p,
                          int receiver);

@@ -7,6 +7,7 @@
 #include "render/passes/area_direct.h"
 #include "render/passes/gbuffer.h"
 #include "render/passes/irradiance.h"
+#include "render/passes/lpv_pass.h"
 #include "render/passes/passes.h"
 #include "render/passes/radiosity.h"
 #include "render/passes/surface.h"
@@ -35,6 +36,8 @@ typedef struct lr_compose_inputs {
     const lr_area_direct *area;     /* area lights' direct light on plane receivers */
     const lr_surface *surface;      /* the objects' B per refined vertex; NULL: Algorithm 1
                                      * per pixel (render.surface_cache off) */
+    const lr_lpv_pass *lpv;         /* render.lpv: the volume's light on the objects; NULL:
+                                     * none (lpv_pass.h) */
 } lr_compose_inputs;
 
 /* Images of the output size for c->n_lights lights. */

@@ -265,6 +265,9 @@ int lr_plan_choose(const lr_scene *s, int index, const lr_plan_table *t, const l
             if (!need_vpl && r->vpl && isfinite(r->ms_vpl))
                 x.fms = fmax(r->frame_ms - r->ms_vpl, 0.0);
             x.conv = (isfinite(r->ms_gbuffer) ? r->ms_gbuffer : 0.0) + r->frames * x.fms;
+            /* render.lpv: the volume is built once, on the first frame (its own pass). */
+            if (r->lpv > 0 && isfinite(r->ms_lpv))
+                x.conv += r->ms_lpv;
             cs[ncand++] = x;
         }
         if (!ncand && nscene && !pass)
@@ -334,6 +337,7 @@ int lr_plan_create(const lr_scene *s, const lr_plan_table *t, const lr_plan_budg
     out->settings = *lr_scene_render(s);
     lr_render_settings *rs = &out->settings;
     rs->K = rs->N = rs->N_vpl = rs->map_size = rs->gbuffer_size = rs->frames = 0;
+    rs->lpv = 0;
     out->feasible = true;
     for (int i = 0; i < no; i++) {
         lr_plan_choice *c = &out->objects[i];
@@ -347,6 +351,7 @@ int lr_plan_create(const lr_scene *s, const lr_plan_table *t, const lr_plan_budg
         rs->map_size = r->map_size > rs->map_size ? r->map_size : rs->map_size;
         rs->gbuffer_size = r->gbuffer_size > rs->gbuffer_size ? r->gbuffer_size : rs->gbuffer_size;
         rs->frames = r->frames > rs->frames ? r->frames : rs->frames;
+        rs->lpv = r->lpv > rs->lpv ? r->lpv : rs->lpv;
         if (c->vpl) {
             out->vpl = true;
             rs->N_vpl = r->N_vpl > rs->N_vpl ? r->N_vpl : rs->N_vpl;
@@ -368,8 +373,13 @@ int lr_plan_apply(const lr_plan *p, lr_scene *s, unsigned *dirty, lr_err *e)
                 {"render.N_vpl", p->settings.N_vpl},
                 {"render.map_size", p->settings.map_size},
                 {"render.gbuffer_size", p->settings.gbuffer_size},
-                {"render.frames", p->settings.frames}};
+                {"render.frames", p->settings.frames},
+                {"render.lpv", p->settings.lpv}};
     for (size_t i = 0; i < sizeof sets / sizeof *sets; i++) {
+        /* render.lpv only where a chosen row measured the volume: rows without it leave the
+         * scene's own setting. */
+        if (!strcmp(sets[i].key, "render.lpv") && sets[i].v <= 0)
+            continue;
         char v[32];
         snprintf(v, sizeof v, "%d", sets[i].v);
         int rc = lr_scene_set(s, sets[i].key, v, dirty, e);
@@ -424,6 +434,8 @@ static void put_choice(out *o, const lr_plan_choice *c)
         c->object, r->model, r->K, r->N, c->vpl ? r->N_vpl : 0, r->map_size, r->gbuffer_size,
         r->frames, c->vpl ? "on" : "off", c->predicted_error, c->predicted_frame_ms,
         c->predicted_converge_ms / 1000.0, c->feasible ? "" : " [INFEASIBLE]");
+    if (r->lpv > 0)
+        put(o, ", light-propagation volume %d^3", r->lpv);
     for (int k = 0; k < c->nreasons; k++)
         put(o, "%s%s", k ? "; " : " (", c->reasons[k]);
     put(o, "%s\n", c->nreasons ? ")" : "");
@@ -448,11 +460,12 @@ size_t lr_plan_format(const lr_plan *p, char *buf, size_t cap)
     const lr_render_settings *s = &p->settings;
     put(&o, "plan: %s: budget ", p->scene);
     put_budget(&o, &p->budget);
-    put(&o, "%s; render K=%d N=%d N_vpl=%d map_size=%d gbuffer_size=%d frames=%d, VPL pass %s; "
-            "after %d frames no pass runs until something changes\n",
+    put(&o, "%s; render K=%d N=%d N_vpl=%d map_size=%d gbuffer_size=%d frames=%d, VPL pass %s",
         p->feasible ? " met" : " NOT MET (infeasible: closest settings chosen)", s->K, s->N,
-        p->vpl ? s->N_vpl : 0, s->map_size, s->gbuffer_size, s->frames, p->vpl ? "on" : "off",
-        s->frames);
+        p->vpl ? s->N_vpl : 0, s->map_size, s->gbuffer_size, s->frames, p->vpl ? "on" : "off");
+    if (s->lpv > 0)
+        put(&o, ", lpv=%d", s->lpv);
+    put(&o, "; after %d frames no pass runs until something changes\n", s->frames);
     return o.len;
 }
 

@@ -48,6 +48,11 @@ typedef struct lr_plan_row {
      * are the fair ones; 0 (absent) or 1: pixel-centre samples (a table from before issue
      * 12, whose errors are biased high where a light pool is a few pixels tall). */
     int supersample;
+    /* Optional: render.lpv of the row (the light-propagation volume's cells per axis, 0 or
+     * absent: off), and the volume's build on the first frame, ms (its pass, counted once in
+     * the time to converge). */
+    int lpv;
+    double ms_lpv;
 } lr_plan_row;
 
 typedef struct lr_plan_table lr_plan_table;
@@ -190,7 +195,7 @@ int lr_plan_create(const lr_scene *s, const lr_plan_table *t, const lr_plan_budg
 bool lr_plan_budget_from_scene(const lr_scene *s, lr_plan_budget *out);
 
 /* Applies plan->settings to the scene through lr_scene_set (render.K, N, N_vpl, map_size,
- * gbuffer_size, frames) and each object's chosen model (objects[i].model), ORing dirty
+ * gbuffer_size, frames, lpv) and each object's chosen model (objects[i].model), ORing dirty
  * flags. */
 int lr_plan_apply(const lr_plan *p, lr_scene *s, unsigned *dirty, lr_err *e);
 

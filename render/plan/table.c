@@ -25,7 +25,7 @@ struct lr_plan_table {
 enum col {
     C_SCENE, C_MODEL, C_PARAMS, C_FRAME_MS, C_RMSE, C_RMSE_OBJ, C_RMSE_REC, C_K, C_N, C_NVPL,
     C_MAP, C_GBUF, C_FRAMES, C_VPL, C_MS_G, C_MS_R, C_MS_V, C_MS_C, C_W, C_H, C_BIAS_O, C_BIAS_R,
-    C_NOISE_O, C_NOISE_R, C_SS, C_COUNT
+    C_NOISE_O, C_NOISE_R, C_SS, C_LPV, C_MS_LPV, C_COUNT
 };
 
 static const struct {
@@ -45,6 +45,7 @@ static const struct {
     [C_H] = {"height", false},            [C_BIAS_O] = {"bias_object", false},
     [C_BIAS_R] = {"bias_receivers", false}, [C_NOISE_O] = {"noise_object", false},
     [C_NOISE_R] = {"noise_receivers", false}, [C_SS] = {"supersample", false},
+    [C_LPV] = {"lpv", false},             [C_MS_LPV] = {"ms_lpv", false},
 };
 
 #define MAX_FIELDS 64
@@ -181,6 +182,8 @@ static int parse_row(const char *name, int line, char **f, const int *at, lr_pla
     NUM(C_NOISE_O, noise_object);
     NUM(C_NOISE_R, noise_receivers);
     INT(C_SS, supersample, 0);
+    INT(C_LPV, lpv, 0);
+    NUM(C_MS_LPV, ms_lpv);
 #undef TXT
 #undef NUM
 #undef INT
@@ -211,7 +214,7 @@ int lr_plan_table_parse(const char *text, size_t len, const char *name, lr_plan_
     memcpy(buf, text, len);
     buf[len] = '\0';
     int at[C_COUNT], nheader = 0, rc = LR_OK, line = 0;
-    char *f[MAX_FIELDS];
+    char *f[MAX_FIELDS], empty[1] = {0};
     char *p = buf;
     while (p && !rc) {
         char *nl = strchr(p, '\n');
@@ -250,11 +253,18 @@ int lr_plan_table_parse(const char *text, size_t len, const char *name, lr_plan_
             nheader = n;
             continue;
         }
-        if (n != nheader) {
+        /* A row may stop before optional trailing columns (rows written before a column was
+         * appended to the header, e.g. lpv and ms_lpv): they read empty. */
+        bool short_ok = n < nheader;
+        for (int c = 0; c < C_COUNT && short_ok; c++)
+            short_ok = !(at[c] >= n && cols[c].required);
+        if (n != nheader && !short_ok) {
             rc = lr_err_set(e, LR_EPARSE, "%s:%d: %d cells, the header has %d", name, line, n,
                             nheader);
             break;
         }
+        for (int i = n; i < nheader; i++)
+            f[i] = empty;
         if (t->n == t->cap) {
             int cap = t->cap ? 2 * t->cap : 32;
             lr_plan_row *r = realloc(t->rows, (size_t)cap * sizeof *r);

@@ -2,9 +2,11 @@
 // l's K maps (Algorithm 1 with the same taps for every light, lr_gather_each; each times this
 // object's cavity gain for light l, PIPELINE.md "Energy": render/passes/compose.c sets
 // u_light_w per object), then L_o,l = F_t(w_o) B_l / pi (seed 003 Eq. 5). The blend pass
-// weights the images with the lights' intensities (render/passes/blend.h).
+// weights the images with the lights' intensities (render/passes/blend.h). render.lpv adds
+// the volume's indirect light on the object to B_l (lib/lpv_object.glsl).
 #include "lib/material.glsl"
 #include "lib/gather.glsl"
+#include "lib/lpv_object.glsl"
 
 in vec3 v_pos;
 in vec3 v_nrm;
@@ -30,8 +32,8 @@ void main()
     float eta = lr_material(u_object).eta;
     float s = lr_fresnel_transmittance(abs(dot(no, wo)), eta) / LR_PI;
     float a = n > 0.0 ? 1.0 : 0.0;
-    o_light[0] = vec4(s * Bl[0], a);
-    o_light[1] = vec4(s * Bl[1], a);
-    o_light[2] = vec4(s * Bl[2], a);
-    o_light[3] = vec4(s * Bl[3], a);
+    o_light[0] = vec4(s * (Bl[0] + lr_lpv_obj_B(0, v_pos, no)), a);
+    o_light[1] = vec4(s * (Bl[1] + lr_lpv_obj_B(1, v_pos, no)), a);
+    o_light[2] = vec4(s * (Bl[2] + lr_lpv_obj_B(2, v_pos, no)), a);
+    o_light[3] = vec4(s * (Bl[3] + lr_lpv_obj_B(3, v_pos, no)), a);
 }

@@ -444,6 +444,66 @@ static void test_multipole_where_the_object_takes_it(void **state)
     lr_plan_table_destroy(t);
 }
 
+/* render.lpv as a planner option: the columns lpv and ms_lpv (the volume's build, counted
+ * once in the time to converge); a budget only the volume's row meets picks it, prints it,
+ * and applying the plan sets render.lpv; a looser one takes the cheaper row without it and
+ * leaves the scene's render.lpv alone; a negative lpv is refused naming the column. */
+static void test_lpv_rows(void **state)
+{
+    (void)state;
+    const char *csv =
+        "scene,model,frame_ms,rel_rmse,K,N,N_vpl,map_size,gbuffer_size,frames,vpl,lpv,ms_lpv\n"
+        "candle,directional_dipole,100,0.20,8,8,32,128,128,16,on,0,nan\n"
+        "candle,directional_dipole,100,0.15,8,8,32,128,128,16,on,16,3000\n";
+    lr_plan_table *t = NULL;
+    lr_err e = {0};
+    assert_int_equal(lr_plan_table_parse(csv, strlen(csv), "lpv.csv", &t, &e), LR_OK);
+    lr_plan *p = malloc(sizeof *p);
+    assert_non_null(p);
+    lr_plan_budget b = {.max_error = 0.18};
+    assert_int_equal(lr_plan_create(candle, t, &b, NULL, p, &e), LR_OK);
+    assert_int_equal(p->objects[0].row.lpv, 16);
+    assert_int_equal(p->settings.lpv, 16);
+    assert_near(p->objects[0].predicted_converge_ms, 3000 + 16 * 100, 1e-9);
+    char text[4096];
+    lr_plan_format(p, text, sizeof text);
+    if (!strstr(text, "light-propagation volume 16^3"))
+        fail_msg("the plan does not name the volume:\n%s", text);
+    lr_scene *s = NULL;
+    assert_int_equal(lr_scene_load("configs/scenes/candle.json", NULL, &s, &e), LR_OK);
+    unsigned dirty = 0;
+    assert_int_equal(lr_plan_apply(p, s, &dirty, &e), LR_OK);
+    assert_int_equal(lr_scene_render(s)->lpv, 16);
+    b.max_error = 0.25; /* both meet it: the row without the build converges sooner */
+    assert_int_equal(lr_plan_create(candle, t, &b, NULL, p, &e), LR_OK);
+    assert_int_equal(p->objects[0].row.lpv, 0);
+    assert_near(p->objects[0].predicted_converge_ms, 16 * 100, 1e-9);
+    assert_int_equal(lr_scene_set(s, "render.lpv", "8", &dirty, &e), LR_OK);
+    assert_int_equal(lr_plan_apply(p, s, &dirty, &e), LR_OK);
+    assert_int_equal(lr_scene_render(s)->lpv, 8);
+    lr_scene_destroy(s);
+    free(p);
+    lr_plan_table_destroy(t);
+    expect_table_error("scene,model,frame_ms,rel_rmse,K,N,N_vpl,map_size,gbuffer_size,frames,"
+                       "vpl,lpv\ncandle,directional_dipole,100,0.2,8,8,32,128,128,16,on,-1\n",
+                       "lpv");
+    /* A row written before the optional lpv columns were appended reads them empty (0, NaN);
+     * a short row missing a required column is still refused. */
+    const char *mixed =
+        "scene,model,frame_ms,rel_rmse,K,N,N_vpl,map_size,gbuffer_size,frames,vpl,lpv,ms_lpv\n"
+        "candle,directional_dipole,100,0.20,8,8,32,128,128,16,on\n"
+        "candle,directional_dipole,100,0.15,8,8,32,128,128,16,on,16,3000\n";
+    assert_int_equal(lr_plan_table_parse(mixed, strlen(mixed), "mixed.csv", &t, &e), LR_OK);
+    assert_int_equal(lr_plan_table_count(t), 2);
+    assert_int_equal(lr_plan_table_row(t, 0)->lpv, 0);
+    assert_true(isnan(lr_plan_table_row(t, 0)->ms_lpv));
+    assert_int_equal(lr_plan_table_row(t, 1)->lpv, 16);
+    lr_plan_table_destroy(t);
+    expect_table_error("scene,model,frame_ms,rel_rmse,K,N,N_vpl,map_size,gbuffer_size,frames,"
+                       "vpl,lpv\ncandle,directional_dipole,100,0.2,8,8,32,128,128,16\n",
+                       "10 cells, the header has 12");
+}
+
 /* Seed 002's sh_translucency is a table model like the dipoles: with a loose budget its cheap
  * row (hand-made, 4 ms at 0.3) wins; under 0.1 it cannot, and excluded it is never chosen. */
 static void test_sh_translucency_rows(void **state)
@@ -833,6 +893,7 @@ int main(void)
         cmocka_unit_test(test_both_budgets_and_infeasible),
         cmocka_unit_test(test_models_and_coverage_filter),
         cmocka_unit_test(test_multipole_where_the_object_takes_it),
+        cmocka_unit_test(test_lpv_rows),
         cmocka_unit_test(test_sh_translucency_rows),
         cmocka_unit_test(test_convexity),
         cmocka_unit_test(test_coverage),

@@ -551,7 +551,7 @@ static void test_set_dirty_flags(void **state)
     set_ok(s, "lights[0].flicker.seed", "4", LR_DIRTY_INTENSITY);
     assert_int_equal(lr_dirty_passes(LR_DIRTY_LIGHT_GEOMETRY),
                      LR_PASS_GBUFFER | LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_IRRADIANCE |
-                         LR_PASS_SURFACE | LR_PASS_COMPOSE | LR_PASS_BLEND);
+                         LR_PASS_SURFACE | LR_PASS_COMPOSE | LR_PASS_BLEND | LR_PASS_LPV);
 
     /* Materials: maps, VPLs and composition, not the light's G-buffer. */
     lr_material marble;
@@ -577,7 +577,7 @@ static void test_set_dirty_flags(void **state)
     get(s, "objects[0].material.scale", "1");
     assert_int_equal(lr_dirty_passes(LR_DIRTY_MATERIAL),
                      LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_IRRADIANCE | LR_PASS_SURFACE |
-                         LR_PASS_COMPOSE | LR_PASS_BLEND);
+                         LR_PASS_COMPOSE | LR_PASS_BLEND | LR_PASS_LPV);
 
     /* View and receivers: composition only. */
     set_ok(s, "camera.position", "0,-500,250", LR_DIRTY_CAMERA);
@@ -587,7 +587,7 @@ static void test_set_dirty_flags(void **state)
     set_ok(s, "receivers[table].center", "0,-75,-1", LR_DIRTY_RECEIVERS);
     assert_true(lr_mesh_vertex(lr_scene_receiver_at(s, 0)->mesh, 0).z == -1.0);
     assert_int_equal(lr_dirty_passes(LR_DIRTY_RECEIVERS),
-                     LR_PASS_IRRADIANCE | LR_PASS_COMPOSE | LR_PASS_BLEND);
+                     LR_PASS_IRRADIANCE | LR_PASS_COMPOSE | LR_PASS_BLEND | LR_PASS_LPV);
     set_ok(s, "render.exposure", "1e6", LR_DIRTY_DISPLAY);
     assert_int_equal(lr_dirty_passes(LR_DIRTY_DISPLAY), LR_PASS_BLEND);
     set_ok(s, "render.K", "32", LR_DIRTY_SETTINGS);
@@ -607,7 +607,7 @@ static void test_set_dirty_flags(void **state)
     assert_true(fabs(o->center.x - 100) < 1e-4);
     assert_int_equal(lr_dirty_passes(LR_DIRTY_GEOMETRY),
                      LR_PASS_GBUFFER | LR_PASS_RADIOSITY | LR_PASS_VPL | LR_PASS_IRRADIANCE |
-                         LR_PASS_SURFACE | LR_PASS_COMPOSE | LR_PASS_BLEND);
+                         LR_PASS_SURFACE | LR_PASS_COMPOSE | LR_PASS_BLEND | LR_PASS_LPV);
     /* The flame stayed at the origin: now outside the moved candle's hull. */
     assert_int_equal(lr_scene_light_enclosure(s, 0, NULL), LR_ENCLOSURE_NONE);
     set_ok(s, "light.position", "100,0,60", LR_DIRTY_LIGHT_GEOMETRY); /* in the wax */

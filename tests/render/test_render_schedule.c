@@ -116,6 +116,44 @@ static void test_dimmer_runs_blend_only_and_scales(void **state)
     free(after);
 }
 
+/* render.lpv: the volume's row (lpv) runs on the first frame with everything, not while the
+ * maps accumulate; a dimmer turn is still the blend alone and scales the image exactly (the
+ * volume's light on the receivers and objects is per unit intensity); a camera move runs
+ * composition alone; a material change makes it due with the maps. The dirty mapping:
+ * transport, material, receivers and settings make it due, camera, intensity and display not. */
+static void test_lpv_row(void **state)
+{
+    fixture *f = *state;
+    assert_true(lr_dirty_passes(LR_DIRTY_MATERIAL) & LR_PASS_LPV);
+    assert_true(lr_dirty_passes(LR_DIRTY_RECEIVERS) & LR_PASS_LPV);
+    assert_true(lr_dirty_passes(LR_DIRTY_LIGHT_GEOMETRY) & LR_PASS_LPV);
+    assert_true(lr_dirty_passes(LR_DIRTY_GEOMETRY | LR_DIRTY_SETTINGS) & LR_PASS_LPV);
+    assert_false(lr_dirty_passes(LR_DIRTY_CAMERA | LR_DIRTY_INTENSITY | LR_DIRTY_DISPLAY) &
+                 LR_PASS_LPV);
+    assert_string_equal(lr_pass_name(7), "lpv");
+    lr_test_set(f->s, f->r, "render.lpv", "8");
+    lr_frame_stats a = lr_test_frame(f->r);
+    assert_int_equal(a.passes, ALL | LR_PASS_LPV);
+    assert_true(a.ms[7] >= 0.0);
+    lr_frame_stats b = lr_test_frame(f->r);
+    assert_int_equal(b.passes, MAPS);
+    float *before = lr_test_hdr(f->r);
+    lr_test_set(f->s, f->r, "light.intensity", "0.002"); /* from 0.005 */
+    lr_frame_stats c = lr_test_frame(f->r);
+    assert_int_equal(c.passes, LR_PASS_BLEND);
+    float *after = lr_test_hdr(f->r);
+    for (int i = 0; i < W * H * 3; i++)
+        assert_near(after[i], 0.4 * before[i], 1e-6 * 0.4 * before[i]);
+    lr_test_set(f->s, f->r, "camera.position", "20,-300,160");
+    assert_int_equal(lr_test_frame(f->r).passes, VIEW);
+    lr_test_set(f->s, f->r, "objects[0].material", "marble");
+    lr_frame_stats d = lr_test_frame(f->r);
+    assert_true(d.passes & LR_PASS_LPV);
+    assert_true(d.passes & LR_PASS_RADIOSITY);
+    free(before);
+    free(after);
+}
+
 static void test_camera_runs_compose_only(void **state)
 {
     fixture *f = *state;
@@ -161,6 +199,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_accumulates_until_converged, each_setup, each_teardown),
         cmocka_unit_test_setup_teardown(test_dimmer_runs_blend_only_and_scales, each_setup, each_teardown),
+        cmocka_unit_test_setup_teardown(test_lpv_row, each_setup, each_teardown),
         cmocka_unit_test_setup_teardown(test_camera_runs_compose_only, each_setup, each_teardown),
         cmocka_unit_test_setup_teardown(test_material_runs_maps_vpl_compose, each_setup, each_teardown),
         cmocka_unit_test_setup_teardown(test_light_move_runs_everything, each_setup, each_teardown),

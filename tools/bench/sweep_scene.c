@@ -330,6 +330,7 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
             snprintf(r.scene, sizeof r.scene, "%s", name);
             snprintf(r.model, sizeof r.model, "%s", st->model);
             memcpy(r.ms, ser.ms, sizeof r.ms);
+            r.lpv = lr_scene_render(s)->lpv;
             rows[(*nrows)++] = r;
         }
         /* On the VPL-free run: receiver pixels the light reaches directly (non-zero without
