@@ -8,8 +8,9 @@
 #include <time.h>
 
 #include "render/cpu/recv_grid.h"
+#include "render/transrad/tr_scene.h"
 
-#define KEY_MAX (LR_TR_MAX_SURFACES * 20)
+#define KEY_MAX (2 + LR_TR_MAX_SURFACES * (LR_TR_KEY_MESH + 3))
 #define LKEY 20 /* doubles per light shape */
 #define MAX_LIGHTS 8
 
@@ -53,19 +54,6 @@ bool lr_rbounce_needed(const lr_scene *s)
     return false;
 }
 
-static void put_mesh(double *k, int *n, const lr_mesh *m, const lr_bvh *b)
-{
-    /* A new mesh (a new address) means a new F, even with the same shape. */
-    k[(*n)++] = (double)(uintptr_t)m;
-    k[(*n)++] = (double)(uintptr_t)b;
-    lr_vec3 lo, hi;
-    lr_mesh_bounds(m, &lo, &hi);
-    double v[] = {(double)lr_mesh_triangle_count(m), (double)lr_mesh_vertex_count(m), lo.x,
-                  lo.y, lo.z, hi.x, hi.y, hi.z, lr_mesh_area(m)};
-    for (size_t i = 0; i < sizeof v / sizeof v[0]; i++)
-        k[(*n)++] = v[i];
-}
-
 /* What the patches, F and the albedos depend on: the objects' and receivers' shapes. */
 static int scene_key(const lr_scene *s, double *k)
 {
@@ -73,10 +61,10 @@ static int scene_key(const lr_scene *s, double *k)
     k[n++] = lr_scene_object_count(s);
     k[n++] = lr_scene_receiver_count(s);
     for (int i = 0; i < lr_scene_object_count(s); i++)
-        put_mesh(k, &n, lr_scene_object_at(s, i)->mesh, lr_scene_object_at(s, i)->bvh);
+        lr_tr_key_mesh(k, &n, lr_scene_object_at(s, i)->mesh, lr_scene_object_at(s, i)->bvh);
     for (int i = 0; i < lr_scene_receiver_count(s); i++) {
         const lr_receiver *r = lr_scene_receiver_at(s, i);
-        put_mesh(k, &n, r->mesh, r->bvh);
+        lr_tr_key_mesh(k, &n, r->mesh, r->bvh);
         for (int b = 0; b < 3; b++)
             k[n++] = r->albedo[b];
     }

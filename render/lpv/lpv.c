@@ -230,49 +230,27 @@ double lr_lpv_absorbed_flux(const lr_lpv *v, int ch)
     return s;
 }
 
+/* The light arriving through side s of interface idx along a, per unit area: what the
+ * blocked part absorbed over the open part's area (lr_lpv_face_fn). */
+static bool volume_face(const void *ctx, const int idx[3], int a, int s, double out[3])
+{
+    const lr_lpv *v = ctx;
+    int n1 = v->d.n + 1;
+    double h2 = v->d.cell * v->d.cell;
+    size_t iface = ((size_t)idx[2] * n1 + idx[1]) * n1 + idx[0];
+    double B = fmin(1.0, v->blk[iface * 4 + a]);
+    if (!(B > 0.0))
+        return false;
+    for (int ch = 0; ch < 3; ch++)
+        out[ch] = v->abs[(iface * 6 + 2 * a + s) * 3 + ch] / (B * h2);
+    return true;
+}
+
 void lr_lpv_irradiance(const lr_lpv *v, lr_vec3 x, lr_vec3 n, double E[3])
 {
-    E[0] = E[1] = E[2] = 0.0;
     lr_vec3 u = to_grid(v, x);
-    double uu[3] = {u.x, u.y, u.z}, nn[3] = {n.x, n.y, n.z};
-    int N = v->d.n, n1 = N + 1;
-    double h2 = v->d.cell * v->d.cell;
-    for (int a = 0; a < 3; a++) {
-        if (nn[a] == 0.0)
-            continue;
-        int s = nn[a] > 0.0; /* light arriving at this side travels toward -axis */
-        double ia = floor(uu[a] + 0.5);
-        if (!(ia >= 0.0 && ia <= N))
-            continue;
-        /* Bilinear over the interface plane between the cells' centres across. */
-        int b1 = (a + 1) % 3, b2 = (a + 2) % 3, i0[2];
-        if (!(uu[b1] >= 0.0 && uu[b1] <= N && uu[b2] >= 0.0 && uu[b2] <= N))
-            continue; /* beside the box */
-        double f[2];
-        for (int q = 0; q < 2; q++) {
-            double c = fmin(fmax(uu[q ? b2 : b1] - 0.5, 0.0), N - 1.0);
-            i0[q] = (int)fmin(floor(c), N - 2.0);
-            f[q] = c - i0[q];
-        }
-        double acc[3] = {0, 0, 0}, wsum = 0.0;
-        for (int corner = 0; corner < 4; corner++) {
-            int idx[3];
-            idx[a] = (int)ia;
-            idx[b1] = i0[0] + (corner & 1);
-            idx[b2] = i0[1] + (corner >> 1);
-            double w = ((corner & 1) ? f[0] : 1.0 - f[0]) * ((corner >> 1) ? f[1] : 1.0 - f[1]);
-            size_t iface = ((size_t)idx[2] * n1 + idx[1]) * n1 + idx[0];
-            double B = fmin(1.0, v->blk[iface * 4 + a]);
-            if (!(B > 0.0) || w <= 0.0)
-                continue;
-            for (int ch = 0; ch < 3; ch++)
-                acc[ch] += w * v->abs[(iface * 6 + 2 * a + s) * 3 + ch] / (B * h2);
-            wsum += w;
-        }
-        if (wsum > 0.0)
-            for (int ch = 0; ch < 3; ch++)
-                E[ch] += fabs(nn[a]) * acc[ch] / wsum;
-    }
+    double uu[3] = {u.x, u.y, u.z};
+    lr_lpv_face_gather(v->d.n, uu, n, volume_face, v, E);
 }
 
 const double *lr_lpv_grid(const lr_lpv *v) { return v->cur; }

@@ -51,6 +51,8 @@
 #ifndef LR_LPV_H
 #define LR_LPV_H
 
+#include <stdbool.h>
+
 #include "render/base/err.h"
 #include "render/base/vec3.h"
 #include "render/lpv/stencil.h"
@@ -116,6 +118,16 @@ double lr_lpv_absorbed_flux(const lr_lpv *v, int ch);
  * the covered interfaces, weighted by |n_a| (exact for axis-aligned surfaces, the table and
  * walls). 0 where nothing covers the interfaces. */
 void lr_lpv_irradiance(const lr_lpv *v, lr_vec3 x, lr_vec3 n, double E[3]);
+
+/* The gather behind lr_lpv_irradiance, over any store of per-interface values (gather.c; the
+ * objects' field, objfield.h, reads its texels with it): for each axis a with n_a != 0, the
+ * interface plane nearest the point along a (uu: grid coordinates, cells of 1, N cells a
+ * side), bilinear across between the cells' centres over the interfaces for which face()
+ * answers true, with out the light arriving through side s (1: toward -a) of interface idx,
+ * per band; each axis weighted by |n_a|. Points beside the box get nothing from that axis. */
+typedef bool (*lr_lpv_face_fn)(const void *ctx, const int idx[3], int a, int s, double out[3]);
+void lr_lpv_face_gather(int N, const double uu[3], lr_vec3 n, lr_lpv_face_fn face,
+                        const void *ctx, double E[3]);
 
 /* The light in flight (n^3 * 12, layout above), e.g. for upload. */
 const double *lr_lpv_grid(const lr_lpv *v);

@@ -120,49 +120,33 @@ lr_vec3 lr_lpv_objfield_origin(const lr_lpv_objfield *f) { return f->origin; }
 double lr_lpv_objfield_h(const lr_lpv_objfield *f) { return f->h; }
 const float *lr_lpv_objfield_texels(const lr_lpv_objfield *f) { return f->E ? f->tex : NULL; }
 
+typedef struct texel_ctx {
+    const float *tex;
+    int N;
+} texel_ctx;
+
+/* Side s of interface idx along a from the texels, where covered (alpha > 0). */
+static bool texel_face(const void *ctx, const int idx[3], int a, int s, double out[3])
+{
+    const texel_ctx *c = ctx;
+    const float *t = c->tex + 4 * texel(c->N, idx[0], idx[1], idx[2], 2 * a + s);
+    if (!(t[3] > 0.0f))
+        return false;
+    for (int ch = 0; ch < 3; ch++)
+        out[ch] = t[ch];
+    return true;
+}
+
 void lr_lpv_objfield_eval(const float *tex, int N, lr_vec3 origin, double h, lr_vec3 x,
                           lr_vec3 n, double E[3])
 {
-    /* lr_lpv_irradiance (lpv.c) step for step, over the texels: per axis the interface
-     * nearest x along it, bilinear across between the cells' centres over the covered ones. */
+    /* lr_lpv_irradiance's gather (lr_lpv_face_gather) over the texels. */
     E[0] = E[1] = E[2] = 0.0;
     if (!tex || N < 2 || !(h > 0.0))
         return;
     double uu[3] = {(x.x - origin.x) / h, (x.y - origin.y) / h, (x.z - origin.z) / h};
-    double nn[3] = {n.x, n.y, n.z};
-    for (int a = 0; a < 3; a++) {
-        if (nn[a] == 0.0)
-            continue;
-        int s = nn[a] > 0.0;
-        double ia = floor(uu[a] + 0.5);
-        int b1 = (a + 1) % 3, b2 = (a + 2) % 3, i0[2];
-        if (!(ia >= 0.0 && ia <= N) ||
-            !(uu[b1] >= 0.0 && uu[b1] <= N && uu[b2] >= 0.0 && uu[b2] <= N))
-            continue;
-        double f[2];
-        for (int q = 0; q < 2; q++) {
-            double c = fmin(fmax(uu[q ? b2 : b1] - 0.5, 0.0), N - 1.0);
-            i0[q] = (int)fmin(floor(c), N - 2.0);
-            f[q] = c - i0[q];
-        }
-        double acc[3] = {0, 0, 0}, wsum = 0.0;
-        for (int corner = 0; corner < 4; corner++) {
-            int idx[3];
-            idx[a] = (int)ia;
-            idx[b1] = i0[0] + (corner & 1);
-            idx[b2] = i0[1] + (corner >> 1);
-            double w = ((corner & 1) ? f[0] : 1.0 - f[0]) * ((corner >> 1) ? f[1] : 1.0 - f[1]);
-            const float *t = tex + 4 * texel(N, idx[0], idx[1], idx[2], 2 * a + s);
-            if (!(t[3] > 0.0f) || w <= 0.0)
-                continue;
-            for (int ch = 0; ch < 3; ch++)
-                acc[ch] += w * t[ch];
-            wsum += w;
-        }
-        if (wsum > 0.0)
-            for (int ch = 0; ch < 3; ch++)
-                E[ch] += fabs(nn[a]) * acc[ch] / wsum;
-    }
+    texel_ctx c = {tex, N};
+    lr_lpv_face_gather(N, uu, n, texel_face, &c, E);
 }
 
 void lr_lpv_objfield_irradiance(const lr_lpv_objfield *f, lr_vec3 x, lr_vec3 n, double E[3])

@@ -37,10 +37,8 @@ bool lr_tr_scene_needed(const lr_scene *s)
     return false;
 }
 
-static void put_mesh(double *k, int *n, const lr_mesh *m, const lr_bvh *b)
+void lr_tr_key_mesh(double *k, int *n, const lr_mesh *m, const lr_bvh *b)
 {
-    /* The solver reads the scene's meshes: a new mesh (a new address) means a new solver,
-     * even with the same shape (user-space addresses fit a double's 53 bits). */
     k[(*n)++] = (double)(uintptr_t)m;
     k[(*n)++] = (double)(uintptr_t)b;
     lr_vec3 lo, hi;
@@ -58,7 +56,7 @@ static int scene_key(const lr_scene *s, double *k)
     int n = 0;
     for (int i = 0; i < lr_scene_object_count(s); i++) {
         const lr_scene_object *o = lr_scene_object_at(s, i);
-        put_mesh(k, &n, o->mesh, o->bvh);
+        lr_tr_key_mesh(k, &n, o->mesh, o->bvh);
         for (int b = 0; b < 3; b++) {
             k[n++] = o->coeffs.sigma_tr[b];
             k[n++] = o->coeffs.sigma_t_prime[b];
@@ -70,7 +68,7 @@ static int scene_key(const lr_scene *s, double *k)
     }
     for (int i = 0; i < lr_scene_receiver_count(s); i++) {
         const lr_receiver *r = lr_scene_receiver_at(s, i);
-        put_mesh(k, &n, r->mesh, r->bvh);
+        lr_tr_key_mesh(k, &n, r->mesh, r->bvh);
         for (int b = 0; b < 3; b++)
             k[n++] = r->albedo[b];
     }

@@ -27,6 +27,13 @@
 
 typedef struct lr_tr_scene lr_tr_scene;
 
+/* Appends to k (at *n, advanced) the LR_TR_KEY_MESH doubles that tell whether a solver built
+ * on mesh m (BVH b) still matches: its and the BVH's addresses (a new mesh means a rebuild,
+ * even with the same shape; user-space addresses fit a double's 53 bits), counts, bounds,
+ * first vertex and area. For in-memory rebuild checks (here and render/bounce). */
+#define LR_TR_KEY_MESH 14
+void lr_tr_key_mesh(double *k, int *n, const lr_mesh *m, const lr_bvh *b);
+
 /* Whether any object of s uses the model. */
 bool lr_tr_scene_needed(const lr_scene *s);
 /* Creates *ts on first use (NULL when no object needs it: *ts stays NULL), rebuilds the

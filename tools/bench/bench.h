@@ -53,6 +53,18 @@ void lrb_cpu_name(char *buf, size_t len);
 typedef double (*lrb_body)(void *ctx, long n);
 double lrb_measure_rate(lrb_body body, void *ctx, double min_run_s, int runs, double *rates);
 
+/* CPU time of the whole process (all threads) in ms: a frame's cost on the machine, whatever
+ * llvmpipe's threads did, beside its wall time. */
+double lrb_process_cpu_ms(void);
+/* The smallest of v[0..n-1] (n >= 1). */
+double lrb_min(const double *v, int n);
+
+/* lr_scene_set, its message printed as "WHO: KEY=VALUE: why" (scene_set.c); the dirty bits are
+ * or-ed into *dirty when it is not NULL. Returns 0, or 1 on a refused value. */
+typedef struct lr_scene lr_scene;
+int lrb_scene_set(const char *who, lr_scene *s, const char *key, const char *value,
+                  unsigned *dirty);
+
 /* Result sink: the bodies' return values go here so the compiler cannot drop the work. */
 extern volatile double lrb_sink;
 

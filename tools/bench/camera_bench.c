@@ -34,34 +34,6 @@ enum { REPS_DEFAULT = 15, REPS_MAX = 1000, N_PATHS = 2 };
 static const char *const scene_names[] = {"candle", "lampshade"};
 static const char *const path_names[N_PATHS] = {"gather", "cache"};
 
-static int set_str(lr_scene *s, const char *key, const char *val, unsigned *dirty)
-{
-    lr_err e = {0};
-    unsigned d = 0;
-    if (lr_scene_set(s, key, val, &d, &e)) {
-        fprintf(stderr, "bench camera: %s=%s: %s\n", key, val, e.msg);
-        return 1;
-    }
-    if (dirty)
-        *dirty |= d;
-    return 0;
-}
-
-static double cpu_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return (double)t.tv_sec * 1e3 + (double)t.tv_nsec * 1e-6;
-}
-
-static double min_of(const double *v, int n)
-{
-    double m = v[0];
-    for (int i = 1; i < n; i++)
-        m = v[i] < m ? v[i] : m;
-    return m;
-}
-
 /* One renderer per path on its own copy of the scene. */
 typedef struct path_state {
     lr_scene *s;
@@ -78,8 +50,10 @@ static int path_open(lr_gl *gl, const char *name, int p, int w, int h, path_stat
         fprintf(stderr, "bench camera: %s\n", e.msg);
         return 1;
     }
-    if (set_str(ps->s, "render.frames", "1", NULL) || set_str(ps->s, "render.N", "1", NULL) ||
-        set_str(ps->s, "render.surface_cache", p == 1 ? "true" : "false", NULL))
+    const char *who = "bench camera";
+    if (lrb_scene_set(who, ps->s, "render.frames", "1", NULL) ||
+        lrb_scene_set(who, ps->s, "render.N", "1", NULL) ||
+        lrb_scene_set(who, ps->s, "render.surface_cache", p == 1 ? "true" : "false", NULL))
         return 1;
     if (lr_renderer_create(&(lr_renderer_desc){.gl = gl, .scene = ps->s, .width = w, .height = h},
                            &ps->r, &e) ||
@@ -104,20 +78,20 @@ static int move(path_state *ps, int i, double *wall, double *cpu)
     snprintf(val, sizeof val, "%.17g,%.17g,%.17g", ps->c0.x + (i % 2 ? 1.0 : 0.0), ps->c0.y,
              ps->c0.z);
     unsigned dirty = 0;
-    if (set_str(ps->s, "camera.position", val, &dirty))
+    if (lrb_scene_set("bench camera", ps->s, "camera.position", val, &dirty))
         return 1;
     lr_renderer_invalidate(ps->r, dirty);
     lr_err e = {0};
     lr_frame_stats st;
     glFinish();
-    double t0 = lrb_now(), c0 = cpu_ms();
+    double t0 = lrb_now(), c0 = lrb_process_cpu_ms();
     if (lr_renderer_frame(ps->r, &st, &e)) {
         fprintf(stderr, "bench camera: %s\n", e.msg);
         return 1;
     }
     glFinish();
     *wall = (lrb_now() - t0) * 1e3;
-    *cpu = cpu_ms() - c0;
+    *cpu = lrb_process_cpu_ms() - c0;
     if (st.passes != (LR_PASS_COMPOSE | LR_PASS_BLEND)) {
         fprintf(stderr, "bench camera: a camera move ran passes 0x%x, not compose + blend\n",
                 st.passes);
@@ -153,8 +127,8 @@ static int row(lr_gl *gl, const char *name, int w, int h, int reps, FILE *out)
     for (int p = 0; p < N_PATHS; p++) {
         med[p][0] = lr_median_finite(&t[(2 * p) * reps], reps);
         med[p][1] = lr_median_finite(&t[(2 * p + 1) * reps], reps);
-        fprintf(out, " | %.1f (%.1f) | %.1f (%.1f)", med[p][0], min_of(&t[(2 * p) * reps], reps),
-                med[p][1], min_of(&t[(2 * p + 1) * reps], reps));
+        fprintf(out, " | %.1f (%.1f) | %.1f (%.1f)", med[p][0], lrb_min(&t[(2 * p) * reps], reps),
+                med[p][1], lrb_min(&t[(2 * p + 1) * reps], reps));
     }
     fprintf(out, " | %.2f | %.2f |\n", med[0][0] / med[1][0], med[0][1] / med[1][1]);
     fflush(out);

@@ -45,31 +45,7 @@ static int set_num(lr_scene *s, const char *key, double v, unsigned *dirty)
 {
     char val[64];
     snprintf(val, sizeof val, "%.17g", v);
-    lr_err e = {0};
-    unsigned d = 0;
-    if (lr_scene_set(s, key, val, &d, &e)) {
-        fprintf(stderr, "bench dimmer: %s=%s: %s\n", key, val, e.msg);
-        return 1;
-    }
-    if (dirty)
-        *dirty |= d;
-    return 0;
-}
-
-/* CPU time of the whole process (all threads) in ms. */
-static double cpu_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return (double)t.tv_sec * 1e3 + (double)t.tv_nsec * 1e-6;
-}
-
-static double min_of(const double *v, int n)
-{
-    double m = v[0];
-    for (int i = 1; i < n; i++)
-        m = v[i] < m ? v[i] : m;
-    return m;
+    return lrb_scene_set("bench dimmer", s, key, val, dirty);
 }
 
 /* One row: reps pairs of (dimmer frame, floor pass). */
@@ -116,14 +92,14 @@ static int row(lr_gl *gl, const char *name, int w, int h, int reps, FILE *out)
         lr_renderer_invalidate(r, dirty);
         lr_frame_stats st;
         glFinish();
-        double t0 = lrb_now(), c0 = cpu_ms();
+        double t0 = lrb_now(), c0 = lrb_process_cpu_ms();
         if (lr_renderer_frame(r, &st, &e)) {
             fprintf(stderr, "bench dimmer: %s\n", e.msg);
             goto done;
         }
         glFinish();
         dim[i] = (lrb_now() - t0) * 1e3;
-        cdim[i] = cpu_ms() - c0;
+        cdim[i] = lrb_process_cpu_ms() - c0;
         if (st.passes != LR_PASS_BLEND) {
             fprintf(stderr, "bench dimmer: a dimmer frame ran passes 0x%x, not the blend alone\n",
                     st.passes);
@@ -138,7 +114,7 @@ static int row(lr_gl *gl, const char *name, int w, int h, int reps, FILE *out)
         cratio[i] = cdim[i] / cflo[i];
     }
     double md = lr_median_finite(dim, reps), mf = lr_median_finite(flo, reps);
-    double nd = min_of(dim, reps), nf = min_of(flo, reps);
+    double nd = lrb_min(dim, reps), nf = lrb_min(flo, reps);
     fprintf(out, "| %s | %d×%d | %d | %.2f (%.2f) | %.2f (%.2f) | %.2f | %.2f | %.2f | %.2f | %.2f "
                  "| %.2f |\n",
             name, w, h, reps, md, nd, mf, nf, md / mf, lr_median_finite(ratio, reps), nd / nf,

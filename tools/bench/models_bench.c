@@ -50,19 +50,6 @@ typedef struct row {
     unsigned dimmer_passes;
 } row;
 
-static int set(lr_scene *s, const char *key, const char *value, unsigned *dirty)
-{
-    lr_err e = {0};
-    unsigned d = 0;
-    if (lr_scene_set(s, key, value, &d, &e)) {
-        fprintf(stderr, "bench models: %s=%s: %s\n", key, value, e.msg);
-        return 1;
-    }
-    if (dirty)
-        *dirty |= d;
-    return 0;
-}
-
 static lr_scene *load(const char *name, const char *model)
 {
     char path[1024];
@@ -74,12 +61,12 @@ static lr_scene *load(const char *name, const char *model)
         return NULL;
     }
     for (size_t k = 0; k < sizeof settings / sizeof *settings; k++)
-        if (set(s, settings[k][0], settings[k][1], NULL))
+        if (lrb_scene_set("bench models", s, settings[k][0], settings[k][1], NULL))
             goto fail;
     for (int i = 0; i < lr_scene_object_count(s); i++) {
         char key[32];
         snprintf(key, sizeof key, "objects[%d].model", i);
-        if (set(s, key, model, NULL))
+        if (lrb_scene_set("bench models", s, key, model, NULL))
             goto fail;
     }
     return s;
@@ -165,7 +152,7 @@ static int time_model(lr_gl *gl, const char *scene, const char *model, row *out)
         unsigned dirty = 0;
         snprintf(v, sizeof v, "%.17g,%.17g,%.17g", p0.x + (k % 2 ? 0.0 : LIGHT_MOVE_MM), p0.y,
                  p0.z);
-        if (set(s, "lights[0].position", v, &dirty))
+        if (lrb_scene_set("bench models", s, "lights[0].position", v, &dirty))
             goto fail;
         lr_renderer_invalidate(r, dirty);
         light[k] = timed_frame(r, NULL);
@@ -181,7 +168,7 @@ static int time_model(lr_gl *gl, const char *scene, const char *model, row *out)
             }
             snprintf(v, sizeof v, "%.17g", strtod(cur, NULL) * (k % 2 ? 1.0 / MATERIAL_STEP
                                                                         : MATERIAL_STEP));
-            if (set(s, key, v, &dirty))
+            if (lrb_scene_set("bench models", s, key, v, &dirty))
                 goto fail;
         }
         lr_renderer_invalidate(r, dirty);
@@ -189,7 +176,7 @@ static int time_model(lr_gl *gl, const char *scene, const char *model, row *out)
 
         dirty = 0;
         snprintf(v, sizeof v, "%.17g", k % 2 ? I0 : 0.5 * I0);
-        if (set(s, "light.intensity", v, &dirty))
+        if (lrb_scene_set("bench models", s, "light.intensity", v, &dirty))
             goto fail;
         lr_renderer_invalidate(r, dirty);
         dim[k] = timed_frame(r, &out->dimmer_passes);
