@@ -267,21 +267,7 @@ static int write_grid(lr_rbounce *rb, int r, int slot, lr_err *e)
     double *X = rb->E; /* the scratch E is free after the solve */
     for (size_t p = 0; p < count; p++)
         lr_tr_indirect(rb->tr, slot, first + p, X + 3 * p);
-    for (int t = 0; t < R; t++)
-        for (int s = 0; s < R; s++) {
-            double u = (s + 0.5) / R * nu - 0.5, v = (t + 0.5) / R * nv - 0.5;
-            u = u < 0 ? 0 : u > nu - 1 ? nu - 1 : u;
-            v = v < 0 ? 0 : v > nv - 1 ? nv - 1 : v;
-            int u0 = (int)floor(u), v0 = (int)floor(v);
-            int u1 = u0 + 1 < nu ? u0 + 1 : u0, v1 = v0 + 1 < nv ? v0 + 1 : v0;
-            double fu = u - u0, fv = v - v0;
-            for (int b = 0; b < 3; b++) {
-                double a00 = X[3 * ((size_t)v0 * nu + u0) + b], a10 = X[3 * ((size_t)v0 * nu + u1) + b];
-                double a01 = X[3 * ((size_t)v1 * nu + u0) + b], a11 = X[3 * ((size_t)v1 * nu + u1) + b];
-                (*out)[3 * ((size_t)t * R + s) + b] =
-                    (float)((1 - fv) * ((1 - fu) * a00 + fu * a10) + fv * ((1 - fu) * a01 + fu * a11));
-            }
-        }
+    lr_tr_plane_to_grid(X, nu, nv, *out);
     return LR_OK;
 }
 

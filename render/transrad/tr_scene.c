@@ -37,6 +37,28 @@ bool lr_tr_scene_needed(const lr_scene *s)
     return false;
 }
 
+void lr_tr_plane_to_grid(const double *X, int nu, int nv, float *out)
+{
+    const int R = LR_RECV_GRID;
+    for (int t = 0; t < R; t++)
+        for (int s = 0; s < R; s++) {
+            double u = (s + 0.5) / R * nu - 0.5, v = (t + 0.5) / R * nv - 0.5;
+            u = u < 0 ? 0 : u > nu - 1 ? nu - 1 : u;
+            v = v < 0 ? 0 : v > nv - 1 ? nv - 1 : v;
+            int u0 = (int)floor(u), v0 = (int)floor(v);
+            int u1 = u0 + 1 < nu ? u0 + 1 : u0, v1 = v0 + 1 < nv ? v0 + 1 : v0;
+            double fu = u - u0, fv = v - v0;
+            for (int b = 0; b < 3; b++) {
+                double a00 = X[3 * ((size_t)v0 * nu + u0) + b];
+                double a10 = X[3 * ((size_t)v0 * nu + u1) + b];
+                double a01 = X[3 * ((size_t)v1 * nu + u0) + b];
+                double a11 = X[3 * ((size_t)v1 * nu + u1) + b];
+                out[3 * ((size_t)t * R + s) + b] = (float)((1 - fv) * ((1 - fu) * a00 + fu * a10) +
+                                                           fv * ((1 - fu) * a01 + fu * a11));
+            }
+        }
+}
+
 void lr_tr_key_mesh(double *k, int *n, const lr_mesh *m, const lr_bvh *b)
 {
     k[(*n)++] = (double)(uintptr_t)m;
@@ -199,21 +221,7 @@ static int receiver_values(lr_tr_scene *ts, const lr_scene *s, int ri, int l, lr
         free(use);
         return LR_OK;
     }
-    for (int tt = 0; tt < LR_RECV_GRID; tt++)
-        for (int ss = 0; ss < LR_RECV_GRID; ss++) {
-            double u = (ss + 0.5) / LR_RECV_GRID * nu - 0.5, v = (tt + 0.5) / LR_RECV_GRID * nv - 0.5;
-            u = u < 0 ? 0 : u > nu - 1 ? nu - 1 : u;
-            v = v < 0 ? 0 : v > nv - 1 ? nv - 1 : v;
-            int u0 = (int)floor(u), v0 = (int)floor(v);
-            int u1 = u0 + 1 < nu ? u0 + 1 : u0, v1 = v0 + 1 < nv ? v0 + 1 : v0;
-            double fu = u - u0, fv = v - v0;
-            for (int b = 0; b < 3; b++) {
-                double a00 = X[3 * ((size_t)v0 * nu + u0) + b], a10 = X[3 * ((size_t)v0 * nu + u1) + b];
-                double a01 = X[3 * ((size_t)v1 * nu + u0) + b], a11 = X[3 * ((size_t)v1 * nu + u1) + b];
-                out[3 * ((size_t)tt * LR_RECV_GRID + ss) + b] =
-                    (float)((1 - fv) * ((1 - fu) * a00 + fu * a10) + fv * ((1 - fu) * a01 + fu * a11));
-            }
-        }
+    lr_tr_plane_to_grid(X, nu, nv, out);
     free(X);
     free(use);
     ts->rE[ri][l] = out;

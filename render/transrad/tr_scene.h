@@ -32,6 +32,10 @@ typedef struct lr_tr_scene lr_tr_scene;
  * even with the same shape; user-space addresses fit a double's 53 bits), counts, bounds,
  * first vertex and area. For in-memory rebuild checks (here and render/bounce). */
 #define LR_TR_KEY_MESH 14
+/* Values X (3 per patch, row v of nu patches at X + 3 nu v) on a plane receiver's nu x nv
+ * patch grid, bilinear between the patch centres (clamped at the edges) at the LR_RECV_GRID^2
+ * texel centres of its receiver grid, into out (3 floats per texel, s + LR_RECV_GRID t). */
+void lr_tr_plane_to_grid(const double *X, int nu, int nv, float *out);
 void lr_tr_key_mesh(double *k, int *n, const lr_mesh *m, const lr_bvh *b);
 
 /* Whether any object of s uses the model. */

@@ -65,6 +65,15 @@ typedef struct lr_scene lr_scene;
 int lrb_scene_set(const char *who, lr_scene *s, const char *key, const char *value,
                   unsigned *dirty);
 
+/* Whether `name` is one of the comma-separated names of `list` (whole names: "candle" must
+ * not select "candle_spot"; listed.c). */
+bool lrb_listed(const char *list, const char *name);
+/* The same, where an unset or empty list selects every name (the LRB_*_SCENES knobs). */
+static inline bool lrb_wanted(const char *list, const char *name)
+{
+    return !list || !*list || lrb_listed(list, name);
+}
+
 /* Result sink: the bodies' return values go here so the compiler cannot drop the work. */
 extern volatile double lrb_sink;
 

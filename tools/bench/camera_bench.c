@@ -140,17 +140,6 @@ done:
     return rc;
 }
 
-static bool wanted(const char *list, const char *name)
-{
-    if (!list || !*list)
-        return true;
-    size_t n = strlen(name);
-    for (const char *p = list; (p = strstr(p, name)) != NULL; p += n)
-        if ((p == list || p[-1] == ',') && (p[n] == ',' || p[n] == '\0'))
-            return true;
-    return false;
-}
-
 static int run(FILE *out)
 {
     const char *rs = getenv("LRB_CAMERA_REPS");
@@ -178,7 +167,7 @@ static int run(FILE *out)
                  "|---|---|---|---|---|---|---|---|---|\n");
     int rc = 0;
     for (size_t k = 0; k < sizeof scene_names / sizeof scene_names[0] && !rc; k++)
-        if (wanted(scenes, scene_names[k]))
+        if (lrb_wanted(scenes, scene_names[k]))
             rc = row(gl, scene_names[k], w, h, reps, out);
     lr_gl_destroy(gl);
     return rc;

@@ -201,18 +201,6 @@ fail:
     return 1;
 }
 
-static bool wanted(const char *scene)
-{
-    const char *list = getenv("LRB_MODELS_SCENES");
-    if (!list || !*list)
-        return true;
-    size_t n = strlen(scene);
-    for (const char *p = list; (p = strstr(p, scene)); p += n)
-        if ((p == list || p[-1] == ',') && (p[n] == ',' || p[n] == '\0'))
-            return true;
-    return false;
-}
-
 static int write_csv(const row *t, int n)
 {
     lr_err e = {0};
@@ -250,7 +238,7 @@ static int run(FILE *out)
     int n = 0, status = 0;
     char skipped[2048] = "";
     for (size_t si = 0; si < sizeof scene_names / sizeof *scene_names; si++) {
-        if (!wanted(scene_names[si]))
+        if (!lrb_wanted(getenv("LRB_MODELS_SCENES"), scene_names[si]))
             continue;
         for (int m = 0; m < LR_SSS_MODEL_COUNT && n < MAX_ROWS; m++) {
             const char *name = lr_sss_model_name((enum lr_sss_model)m);

@@ -70,22 +70,6 @@ static bool skipped(const char *name)
     return !strcmp(name, "sphere");
 }
 
-/* Whether `name` is one of the comma-separated names of `list` (whole names: "candle" must
- * not select "candle_spot"). */
-bool lrb_listed(const char *list, const char *name)
-{
-    size_t n = strlen(name);
-    for (const char *p = list; *p;) {
-        size_t len = strcspn(p, ",");
-        if (len == n && !strncmp(p, name, n))
-            return true;
-        p += len;
-        if (*p == ',')
-            p++;
-    }
-    return false;
-}
-
 static int run_opts(FILE *out, const lrb_options *opt)
 {
     double t0 = lrb_now(), load[2][3] = {{0}};

@@ -76,9 +76,6 @@ typedef struct lrb_scene_result {
         ss_mal[LRB_SWEEP_SS_MAX];
 } lrb_scene_result;
 
-/* Whether name is one of the comma-separated names of list (whole names: "candle" does not
- * select "candle_spot"). */
-bool lrb_listed(const char *list, const char *name);
 
 /* The supersampling factor of this run (LRB_SWEEP_SS or LRB_SWEEP_SUPERSAMPLE). */
 int lrb_sweep_supersample(void);
