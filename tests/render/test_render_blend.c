@@ -57,6 +57,7 @@ static lr_scene *scene(const char *I, const char *color, const char *amp, const 
              "{\"type\": \"candle\", \"radius\": 35, \"height\": 120, \"pool_depth\": 8}}],\n"
              " \"lights\": [%s%s%s],\n"
              " \"camera\": {\"position\": [0, -450, 230], \"target\": [0, 40, 70], \"fov_deg\": 40},\n"
+             " \"render\": {\"exposure\": 1.5e7},\n"
              " \"receivers\": [{\"name\": \"table\", \"type\": \"plane\", \"center\": [0, -75, 0],"
              " \"normal\": [0, 0, 1], \"size\": [1200, 650], \"albedo\": [0.75, 0.72, 0.68]},\n"
              "  {\"name\": \"wall\", \"type\": \"plane\", \"center\": [0, 250, 400], \"normal\":"
@@ -85,6 +86,31 @@ static void rerender(lr_scene *s, float **hdr, unsigned char **bytes)
     lr_renderer_destroy(r);
 }
 
+/* The displayed bytes are the exact output curve of the linear sum (read from the RGBA32F
+ * images) to one step; returns how many are one step off. The pass encodes with
+ * lr_srgb_encode_fast (within a quarter step of the exact encode, test_image) from the
+ * RGBA16F display copy (2^-10 relative at worst: a tenth of a step), so a stale display copy
+ * fails here. rgba8 rows are top-down, the HDR rows bottom-up (GL order). */
+static int bytes_off_curve(const char *what, lr_renderer *r, const float *got,
+                           const unsigned char *got_bytes)
+{
+    lr_tonemap tm;
+    lr_renderer_tonemap(r, &tm);
+    int off = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            for (int c = 0; c < 3; c++) {
+                float v = got[3 * ((H - 1 - y) * W + x) + c];
+                int a = (int)lrintf(lr_srgb_encode(lr_tonemap_apply(&tm, v)) * 255.0f);
+                int b = got_bytes[4 * (y * W + x) + c];
+                if (abs(a - b) > 1)
+                    fail_msg("%s: pixel %d,%d band %d: byte %d, the exact curve %d", what, x,
+                             y, c, b, a);
+                off += a != b;
+            }
+    return off;
+}
+
 /* got equals want to 1e-5 relative per value (1e-7 of the largest value near 0), the
  * tone-mapped bytes exactly, and the image is lit (the check is not vacuous). */
 static void assert_same(const char *what, lr_renderer *r, const float *want,
@@ -111,23 +137,7 @@ static void assert_same(const char *what, lr_renderer *r, const float *want,
     for (int i = 0; i < W * H * 4; i++)
         if (abs((int)got_bytes[i] - (int)want_bytes[i]) > 1)
             fail_msg("%s: byte %d: %d, the re-render %d", what, i, got_bytes[i], want_bytes[i]);
-    /* The pass encodes with lr_srgb_encode_fast (within a quarter step of the exact encode,
-     * test_image): the bytes are the exact curve's of the linear sum, or one step off. rgba8
-     * rows are top-down, the HDR rows bottom-up (GL order). */
-    lr_tonemap tm;
-    lr_renderer_tonemap(r, &tm);
-    int off = 0;
-    for (int y = 0; y < H; y++)
-        for (int x = 0; x < W; x++)
-            for (int c = 0; c < 3; c++) {
-                float v = got[3 * ((H - 1 - y) * W + x) + c];
-                int a = (int)lrintf(lr_srgb_encode(lr_tonemap_apply(&tm, v)) * 255.0f);
-                int b = got_bytes[4 * (y * W + x) + c];
-                if (abs(a - b) > 1)
-                    fail_msg("%s: pixel %d,%d band %d: byte %d, the exact curve %d", what, x,
-                             y, c, b, a);
-                off += a != b;
-            }
+    int off = bytes_off_curve(what, r, got, got_bytes);
     print_message("%s: worst relative difference %.3g; %d of %d bytes one step from the "
                   "exact curve\n", what, worst, off, W * H * 3);
     free(got);
@@ -151,6 +161,24 @@ static void test_one_light_dimmer(void **state)
     assert_int_equal(st.passes, LR_PASS_BLEND);
     assert_false(lr_renderer_needs_frame(r));
     assert_same("dimmed after convergence", r, want, want_bytes);
+    /* A camera move recomposes the images: the next displayed frame must show the new view,
+     * not the display copy of the old one (blend.h). */
+    unsigned char *before = ldr(r);
+    lr_test_set(s, r, "camera.position", "[300, -300, 150]");
+    st = lr_test_frame(r);
+    assert_true(st.passes & LR_PASS_COMPOSE);
+    float *moved = lr_test_hdr(r);
+    unsigned char *moved_bytes = ldr(r);
+    int changed = 0;
+    for (int i = 0; i < W * H * 4; i++)
+        changed += moved_bytes[i] != before[i];
+    print_message("after a camera move: %d of %d bytes changed\n", changed, W * H * 4);
+    assert_true(changed > W * H / 4); /* the view did change on screen */
+    bytes_off_curve("after a camera move", r, moved, moved_bytes);
+    lr_test_set(s, r, "camera.position", "[0, -450, 230]"); /* the scene of the next part */
+    free(before);
+    free(moved);
+    free(moved_bytes);
     lr_renderer_destroy(r);
 
     /* In the middle of accumulation: after the first of the two frames. The dimmer frame is
