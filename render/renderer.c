@@ -240,7 +240,7 @@ static int blend_run(lr_renderer *r, unsigned dirty, lr_err *e)
 {
     (void)dirty;
     lr_pass_ctx c = pass_ctx(r);
-    lr_blend_input in = {.images = r->img.images, .n = r->img.n, .gen = r->img.gen,
+    lr_blend_input in = {.images = r->img.images, .n = r->img.n,
                          .exposure = (float)r->rs.exposure, .tonemap_op = LR_RENDER_TONEMAP};
     for (int l = 0; l < r->img.n && l < LR_BLEND_MAX_IMAGES && l < LR_MAX_LIGHTS; l++)
         for (int b = 0; b < 3; b++)

@@ -11,7 +11,6 @@
 
 struct lr_blend {
     lr_gl *gl;
-    int width, height;
     /* prog[op][n]: the pass for tone curve op (LR_BLEND_OPS: the linear sum) and n images of
      * non-zero weight (LR_BLEND_OP, LR_BLEND_N), built on first use: a candle's frame reads
      * one image and runs no per-pixel loop or branch. */
@@ -20,14 +19,6 @@ struct lr_blend {
     const char *const *defines;
     lr_tex *ldr, *hdr;
     lr_fb *fb_ldr, *fb_hdr;
-    /* The display copy (blend.h): RGBA16F layers of the images of generation display_gen,
-     * drawn by copy_prog[n] (n layers at once, one output each). */
-    lr_program *copy_prog[LR_BLEND_MAX_IMAGES + 1];
-    lr_tex *display;
-    lr_fb *fb_display;
-    int display_n;
-    unsigned display_gen;
-    bool display_valid;
     lr_blend_input in; /* of the last run */
     bool have_input, hdr_valid;
     /* The output is SRGB8_ALPHA8 (the store encodes, LR_BLEND_SRGB_STORE 1), or RGBA8 that
@@ -44,8 +35,6 @@ int lr_blend_create(const lr_blend_desc *d, lr_blend **out, lr_err *e)
     if (!b)
         return lr_err_set(e, LR_ENOMEM, "blend pass: out of memory");
     b->gl = d->gl;
-    b->width = d->width;
-    b->height = d->height;
     b->shader_dir = d->shader_dir;
     b->defines = d->defines;
     lr_tex_desc hdr = {.format = LR_TEX_RGBA32F, .width = d->width, .height = d->height,
@@ -72,23 +61,10 @@ int lr_blend_create(const lr_blend_desc *d, lr_blend **out, lr_err *e)
     return LR_OK;
 }
 
-static void display_free(lr_blend *b)
-{
-    lr_fb_destroy(b->fb_display);
-    lr_tex_destroy(b->display);
-    b->fb_display = NULL;
-    b->display = NULL;
-    b->display_n = 0;
-    b->display_valid = false;
-}
-
 void lr_blend_destroy(lr_blend *b)
 {
     if (!b)
         return;
-    display_free(b);
-    for (int n = 0; n <= LR_BLEND_MAX_IMAGES; n++)
-        lr_program_destroy(b->copy_prog[n]);
     lr_fb_destroy(b->fb_ldr);
     lr_fb_destroy(b->fb_hdr);
     lr_tex_destroy(b->ldr);
@@ -106,18 +82,6 @@ static void uniform_i(lr_program *p, const char *name, int v)
         glUniform1i(loc, v);
 }
 
-/* Copies the caller's defines into defs (room for 2 LR_DEFINES_MAX + 1); *k: how many. */
-static int caller_defines(const lr_blend *b, const char **defs, int *k, lr_err *e)
-{
-    *k = 0;
-    for (; b->defines && b->defines[*k] && *k < LR_DEFINES_MAX; (*k)++)
-        defs[*k] = b->defines[*k];
-    if (b->defines && b->defines[*k])
-        return lr_err_set(e, LR_EINVAL, "blend pass: more than %d shader defines",
-                          LR_DEFINES_MAX);
-    return LR_OK;
-}
-
 /* The program for tone curve op (LR_BLEND_OPS: the linear sum, LR_BLEND_LINEAR in GLSL) and
  * n images of non-zero weight: the caller's defines (render/passes/defines.h: the curves'
  * names) plus LR_BLEND_OP and LR_BLEND_N. */
@@ -126,9 +90,12 @@ static int program(lr_blend *b, int op, int n, lr_program **out, lr_err *e)
     if (!b->prog[op][n]) {
         lr_shader_defines own = {0};
         const char *defs[2 * LR_DEFINES_MAX + 1];
-        int k, rc = caller_defines(b, defs, &k, e);
-        if (rc)
-            return rc;
+        int k = 0;
+        for (; b->defines && b->defines[k] && k < LR_DEFINES_MAX; k++)
+            defs[k] = b->defines[k];
+        if (b->defines && b->defines[k])
+            return lr_err_set(e, LR_EINVAL, "blend pass: more than %d shader defines",
+                              LR_DEFINES_MAX);
         lr_shader_defines_add(&own, "LR_BLEND_OP", op);
         lr_shader_defines_add(&own, "LR_BLEND_N", n);
         lr_shader_defines_add(&own, "LR_BLEND_SRGB_STORE", b->srgb_store ? 1 : 0);
@@ -137,77 +104,17 @@ static int program(lr_blend *b, int op, int n, lr_program **out, lr_err *e)
         defs[k] = NULL;
         lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "blend.frag",
                               .dir = b->shader_dir, .defines = defs};
-        if ((rc = lr_program_create(&pd, &b->prog[op][n], e)))
+        int rc = lr_program_create(&pd, &b->prog[op][n], e);
+        if (rc)
             return rc;
     }
     *out = b->prog[op][n];
     return LR_OK;
 }
 
-/* Brings the display copy up to the input's images (blend.h): reallocated when the layer
- * count changes, redrawn when their generation does. */
-static int display_update(lr_blend *b, lr_err *e)
-{
-    const lr_blend_input *in = &b->in;
-    int rc;
-    if (b->display_n != in->n) {
-        display_free(b);
-        lr_tex_desc td = {.type = LR_TEX_2D_ARRAY, .format = LR_TEX_RGBA16F,
-                          .width = b->width, .height = b->height, .layers = in->n,
-                          .label = "per-light images, display copy"};
-        lr_fb_desc fd = {.label = "per-light images, display copy"};
-        if ((rc = lr_tex_create(b->gl, &td, &b->display, e)))
-            return rc;
-        for (int l = 0; l < in->n; l++)
-            fd.color[l] = (lr_fb_attachment){b->display, l};
-        if ((rc = lr_fb_create(b->gl, &fd, &b->fb_display, e))) {
-            display_free(b);
-            return rc;
-        }
-        b->display_n = in->n;
-    }
-    if (b->display_valid && b->display_gen == in->gen)
-        return LR_OK;
-    if (!b->copy_prog[in->n]) {
-        lr_shader_defines own = {0};
-        const char *defs[2 * LR_DEFINES_MAX + 1];
-        int k;
-        if ((rc = caller_defines(b, defs, &k, e)))
-            return rc;
-        lr_shader_defines_add(&own, "LR_COPY_N", in->n);
-        for (int i = 0; i < own.n; i++)
-            defs[k++] = own.list[i];
-        defs[k] = NULL;
-        lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "blend_copy.frag",
-                              .dir = b->shader_dir, .defines = defs};
-        if ((rc = lr_program_create(&pd, &b->copy_prog[in->n], e)))
-            return rc;
-    }
-    lr_program *p = b->copy_prog[in->n];
-    lr_fb_bind(b->fb_display);
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_BLEND);
-    glUseProgram(lr_program_id(p));
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, lr_tex_id(in->images));
-    uniform_i(p, "u_images", 0);
-    if ((rc = lr_program_check(p, e)))
-        return rc;
-    lr_gl_draw_fullscreen(b->gl);
-    if ((rc = lr_gl_check("blend pass (display copy)", e)))
-        return rc;
-    b->display_gen = in->gen;
-    b->display_valid = true;
-    return LR_OK;
-}
-
 static int draw(lr_blend *b, lr_fb *fb, bool linear, lr_err *e)
 {
     const lr_blend_input *in = &b->in;
-    int rc;
-    /* The displayed frame reads the display copy, the linear sum the images (blend.h). */
-    if (!linear && (rc = display_update(b, e)))
-        return rc;
     /* Exposure multiplies the weights here rather than every pixel (lr_tonemap_apply's rule:
      * exposure 0 means 1); the linear sum for readback takes the weights alone. */
     double x = linear ? 1.0 : in->exposure != 0.0f ? (double)in->exposure : 1.0;
@@ -224,14 +131,15 @@ static int draw(lr_blend *b, lr_fb *fb, bool linear, lr_err *e)
     int op = linear ? LR_BLEND_OPS
                     : in->tonemap_op >= 0 && in->tonemap_op < LR_BLEND_OPS ? in->tonemap_op : 0;
     lr_program *p = NULL;
-    if ((rc = program(b, op, n, &p, e)))
+    int rc = program(b, op, n, &p, e);
+    if (rc)
         return rc;
     lr_fb_bind(fb);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
     glUseProgram(lr_program_id(p));
     glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, lr_tex_id(linear ? in->images : b->display));
+    glBindTexture(GL_TEXTURE_2D_ARRAY, lr_tex_id(in->images));
     uniform_i(p, "u_images", 0);
     GLint loc = lr_program_uniform(p, "u_w");
     if (loc < 0)

@@ -12,14 +12,6 @@
  * (lr_blend_input); nothing here reads the renderer. The linear sum is only needed for
  * readback (lr_renderer_read_hdr, tests), so the displayed frame writes the tone-mapped target
  * alone and the HDR sum is drawn on demand from the same images and weights.
- *
- * The displayed frame reads a half-float copy of the images (the display copy, RGBA16F, drawn
- * once per change of the images: input `gen`), not the RGBA32F images: on a GPU this pass is
- * bandwidth-bound, and it then reads as many bytes per image as the bench's floor (an H200
- * measured the blend from RGBA32F at 1.7x the floor's time). fp16 rounds to 2^-11 relative
- * (llvmpipe truncates: up to 2^-10), under a tenth of an 8-bit sRGB step at any level, so the
- * tone-mapped bytes are those of the exact images; the linear sum for readback reads the
- * RGBA32F images themselves and stays exact.
  */
 #ifndef LR_BLEND_H
 #define LR_BLEND_H
@@ -44,8 +36,6 @@ typedef struct lr_blend_input {
     const lr_tex *images;  /* 2D array, layer l = light l's unit-intensity linear radiance;
                             * alpha of layer 0 is copied to the HDR sum (coverage) */
     int n;                 /* layers to sum, 1..LR_BLEND_MAX_IMAGES */
-    unsigned gen;          /* changes whenever the images' contents change (lr_compose.gen):
-                            * the display copy is redrawn then */
     double w[LR_BLEND_MAX_IMAGES][3]; /* weight per image and band */
     float exposure;
     int tonemap_op;        /* lr_tonemap_op */

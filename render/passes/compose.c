@@ -33,8 +33,7 @@ static int images_alloc(lr_compose *img, const lr_pass_ctx *c, int n, lr_err *e)
     /* RGBA32F: half floats (half the bytes for the blend) were tried and measured no faster
      * on llvmpipe, which truncates on the store (-2e-4 relative, beyond the 1e-4 of
      * test_render_emergent). The images hold S_l L_l (lr_compose.scale), which would put them
-     * in fp16's normal range (PIPELINE.md "Blend"); the blend's display copy of them is
-     * RGBA16F (blend.h). */
+     * in fp16's normal range (PIPELINE.md "Blend"). */
     lr_tex_desc td = {.type = LR_TEX_2D_ARRAY, .format = LR_TEX_RGBA32F, .width = c->width,
                       .height = c->height, .layers = n, .label = "per-light images"};
     int rc = lr_tex_create(c->gl, &td, &img->images, e);
@@ -184,6 +183,5 @@ int lr_compose_run(lr_compose *img, const lr_pass_ctx *c, const lr_compose_input
     if ((rc = lr_gl_check("compose pass", e)))
         return rc;
     img->valid = true;
-    img->gen++;
     return LR_OK;
 }

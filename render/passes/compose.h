@@ -22,7 +22,6 @@ typedef struct lr_compose {
     int n;      /* layers (the scene's lights when allocated) */
     bool valid; /* composed since the last (re)allocation */
     bool gathered; /* the last run ran Algorithm 1 per pixel (no surface cache) */
-    unsigned gen;  /* runs so far: the blend's display copy of other contents is stale */
     /* Per light: the images hold scale[l] L_l (the maps' scale, R^2 for point and spot
      * lights: O(1) values, as half floats would need); the blend divides it out. */
     float scale[LR_MAX_LIGHTS];

@@ -20,6 +20,13 @@ const char *lr_plan_model_limit(const lr_scene_object *o, enum lr_sss_model m, c
                      100.0 * (1.0 - acosh(1.0 + 0.5 * s * h * s * h) / (s * h)));
             return buf;
         }
+        /* A wall thinner than the spacing has cells with no interior node: the grid's
+         * boundary ghosts have nothing to couple to (render/diffusion/system.c refuses it). */
+        if (o->thickness_mm > 0.0 && o->thickness_mm < h) {
+            snprintf(buf, cap, "the wall (%.3g mm) is thinner than the grid spacing %.3g mm",
+                     o->thickness_mm, h);
+            return buf;
+        }
     }
     if (m == LR_SSS_SH_TRANSLUCENCY && o->thickness_mm > 0.0) {
         double mfp = fmax(c->mfp[0], fmax(c->mfp[1], c->mfp[2]));

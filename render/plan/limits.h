@@ -11,7 +11,8 @@
  *                    lambda h = acosh(1 + (sigma_tr h)^2 / 2): at sigma_tr h = 1 the decay rate
  *                    is 3.8 % low and the error grows as (sigma_tr h)^2 / 24 beyond. The limit
  *                    is LR_PLAN_GRID_MAX_SIGMA_H for the largest band's sigma_tr and the spacing
- *                    the object gets (lr_dscene_spacing).
+ *                    the object gets (lr_dscene_spacing). A wall (thickness_mm) thinner than
+ *                    that spacing has cells with no interior node and is refused too.
  *   sh_translucency  seed 002 attenuates by the crossed thickness d through
  *                    a_c = exp(-sigma_tr max(d, 1/sigma_t')) (render/optics/sh_translucency.h: the
  *                    clamp at one transport mean free path). A wall (thickness_mm) thinner than

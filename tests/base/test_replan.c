@@ -95,6 +95,27 @@ static void test_limits(void **state)
     why = lr_plan_model_limit(o, LR_SSS_SH_TRANSLUCENCY, buf, sizeof buf);
     assert_non_null(why);
     assert_non_null(strstr(why, "thinner than one transport mean free path"));
+
+    /* The grid on a wall thinner than its spacing: no interior node (the led shade's paper
+     * failed there in the sweep). Candle wax keeps sigma_tr h under the limit. */
+    set(shade, "objects[0].material", "candle_wax", NULL);
+    set(shade, "objects[0].thickness_mm", "1.5", NULL);
+    o = lr_scene_object_at(shade, 0);
+    h = lr_dscene_spacing(o);
+    x = h * fmax(o->coeffs.sigma_tr[0], fmax(o->coeffs.sigma_tr[1], o->coeffs.sigma_tr[2]));
+    assert_true(x < LR_PLAN_GRID_MAX_SIGMA_H);
+    assert_true(h > 1.5);
+    why = lr_plan_model_limit(o, LR_SSS_DIFFUSION_GRID, buf, sizeof buf);
+    assert_non_null(why);
+    assert_non_null(strstr(why, "thinner than the grid spacing"));
+    char wall[32];
+    snprintf(wall, sizeof wall, "%.3g mm", h);
+    assert_non_null(strstr(why, wall));
+    char thick[32];
+    snprintf(thick, sizeof thick, "%.3g", 1.5 * h);
+    set(shade, "objects[0].thickness_mm", thick, NULL);
+    assert_null(lr_plan_model_limit(lr_scene_object_at(shade, 0), LR_SSS_DIFFUSION_GRID, buf,
+                                    sizeof buf));
     lr_scene_destroy(shade);
 }
 

@@ -86,11 +86,10 @@ static void rerender(lr_scene *s, float **hdr, unsigned char **bytes)
     lr_renderer_destroy(r);
 }
 
-/* The displayed bytes are the exact output curve of the linear sum (read from the RGBA32F
- * images) to one step; returns how many are one step off. The pass encodes with
- * lr_srgb_encode_fast (within a quarter step of the exact encode, test_image) from the
- * RGBA16F display copy (2^-10 relative at worst: a tenth of a step), so a stale display copy
- * fails here. rgba8 rows are top-down, the HDR rows bottom-up (GL order). */
+/* The displayed bytes are the exact output curve of the linear sum to one step; returns how
+ * many are one step off. The pass encodes with lr_srgb_encode_fast (within a quarter step of
+ * the exact encode, test_image), so bytes drawn from other images than the linear sum's (a
+ * stale cache) fail here. rgba8 rows are top-down, the HDR rows bottom-up (GL order). */
 static int bytes_off_curve(const char *what, lr_renderer *r, const float *got,
                            const unsigned char *got_bytes)
 {
@@ -162,7 +161,7 @@ static void test_one_light_dimmer(void **state)
     assert_false(lr_renderer_needs_frame(r));
     assert_same("dimmed after convergence", r, want, want_bytes);
     /* A camera move recomposes the images: the next displayed frame must show the new view,
-     * not the display copy of the old one (blend.h). */
+     * and its bytes must follow the new images. */
     unsigned char *before = ldr(r);
     lr_test_set(s, r, "camera.position", "[300, -300, 150]");
     st = lr_test_frame(r);

@@ -85,9 +85,10 @@ void lrb_sweep_fair_md(FILE *f, const lrb_scene_result *scenes, int nscenes);
 
 /* Applies a setting to a scene (render.* and every object's model). */
 int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e);
-/* Whether any object of s can take the setting's model (lr_scene_object_model_unmet); when
- * none can, *why says why and the sweep skips the setting for that scene. */
-bool lrb_sweep_takes(const lr_scene *s, const lrb_setting *st, const char **why);
+/* Whether any object of s can take the setting's model (lr_scene_object_model_unmet, and the
+ * model's validity limits for the object's material: render/plan/limits.h); when none can,
+ * why (cap bytes) says why and the sweep skips the setting for that scene. */
+bool lrb_sweep_takes(const lr_scene *s, const lrb_setting *st, char *why, size_t cap);
 
 /* Frame times of the base setting at 640x480 (sweep_table.c). */
 typedef struct lrb_timing_640 {

@@ -9,6 +9,7 @@
 
 #include "render/base/paths.h"
 #include "render/image/image.h"
+#include "render/plan/limits.h"
 #include "render/reference/reference.h"
 
 static int set_int(lr_scene *s, const char *key, int v, lr_err *e)
@@ -16,6 +17,21 @@ static int set_int(lr_scene *s, const char *key, int v, lr_err *e)
     char val[32];
     snprintf(val, sizeof val, "%d", v);
     return lr_scene_set(s, key, val, NULL, e);
+}
+
+/* Whether object o cannot take model m: its geometry (the multipole needs thickness_mm) or
+ * the model's validity limits for its material (render/plan/limits.h: the grid on the lamp
+ * shade's porcelain is 6 diffusion lengths per cell, where its solve diverges). *why: the
+ * reason. The models section (models_bench.c) skips the same. */
+static bool object_refuses(const lr_scene_object *o, enum lr_sss_model m, char *why,
+                           size_t cap)
+{
+    const char *w = lr_scene_object_model_unmet(o, m);
+    if (!w)
+        w = lr_plan_model_limit(o, m, why, cap);
+    if (w && w != why)
+        snprintf(why, cap, "%s", w);
+    return w != NULL;
 }
 
 int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e)
@@ -46,13 +62,15 @@ int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e)
         p = q ? q + 1 : p + n;
     }
     /* The model is per object; the sweep switches every object that can take it (the
-     * multipole needs thickness_mm); lrb_sweep_takes says whether any can. */
+     * multipole needs thickness_mm; the grid a material within its validity limit);
+     * lrb_sweep_takes says whether any can. */
     enum lr_sss_model m;
     if (!lr_sss_model_parse(st->model, &m))
         return lr_err_set(e, LR_EINVAL, "sweep setting %s: unknown model '%s'", st->label,
                           st->model);
     for (int k = 0; k < lr_scene_object_count(s); k++) {
-        if (lr_scene_object_model_unmet(lr_scene_object_at(s, k), m))
+        char why[160];
+        if (object_refuses(lr_scene_object_at(s, k), m, why, sizeof why))
             continue;
         char key[64];
         snprintf(key, sizeof key, "objects[%d].model", k);
@@ -62,14 +80,14 @@ int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e)
     return LR_OK;
 }
 
-bool lrb_sweep_takes(const lr_scene *s, const lrb_setting *st, const char **why)
+bool lrb_sweep_takes(const lr_scene *s, const lrb_setting *st, char *why, size_t cap)
 {
     enum lr_sss_model m;
-    *why = "unknown model";
+    snprintf(why, cap, "unknown model");
     if (!lr_sss_model_parse(st->model, &m))
         return false;
     for (int k = 0; k < lr_scene_object_count(s); k++)
-        if (!(*why = lr_scene_object_model_unmet(lr_scene_object_at(s, k), m)))
+        if (!object_refuses(lr_scene_object_at(s, k), m, why, cap))
             return true;
     return false;
 }
@@ -282,9 +300,9 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
         if (k && getenv("LRB_SWEEP_SETTINGS") && !lrb_listed(getenv("LRB_SWEEP_SETTINGS"),
                                                             st->label))
             continue;
-        const char *why;
-        if (!lrb_sweep_takes(s, st, &why)) {
-            fprintf(stderr, "lamprig-bench: sweep: %s: setting %s skipped: no object %s\n",
+        char why[160];
+        if (!lrb_sweep_takes(s, st, why, sizeof why)) {
+            fprintf(stderr, "lamprig-bench: sweep: %s: setting %s skipped: no object can take it (%s)\n",
                     lr_scene_name(s), st->label, why);
             continue;
         }
