@@ -53,6 +53,9 @@ typedef struct rctx {
      * texel; render/cpu/recv_grid.h, the GPU's receiver irradiance grid), NULL for a receiver
      * without a grid. */
     double **grid;
+    /* render.receiver_bounce: per receiver, the bounced irradiance F B on the receiver grid
+     * (3 per texel; NULL: none), added at every pixel in both modes. */
+    double **bounce;
     int nrecv;
     /* render.lpv (PASS): per receiver and light, the light-propagation volume's indirect
      * irradiance per unit radiance at the grid's texel centres (3 doubles per texel;
@@ -240,8 +243,10 @@ static void grid_item(void *p, long item)
 
 /* render.receiver_bounce (render/bounce/rbounce.h): the receivers' radiosity with
  * E = sum_l I_l E_dir,l + the grid's E_vpl (this grid sums the lights with their intensities;
- * by linearity the GPU's per-light solves at unit intensity give the same), its bounce added
- * to the grid as the GPU's irradiance pass adds it to its own. */
+ * by linearity the GPU's per-light solves at unit intensity give the same), its bounce kept
+ * per receiver grid texel (r->bounce) and added at every receiver pixel, as the GPU's
+ * irradiance pass adds it to its own grid. The reference mode solves from the same VPL grid
+ * (the GPU's E), so its receivers differ from the GPU's by the VPL sum alone. */
 static int receiver_bounce(rctx *r, lr_err *e)
 {
     lr_rbounce *rb = NULL;
@@ -254,11 +259,18 @@ static int receiver_bounce(rctx *r, lr_err *e)
         lr_rbounce_vpl_d(rb, i, r->grid[i], 6);
     rc = lr_rbounce_solve(rb, 0, (const double(*)[3])r->I, e);
     const size_t n = (size_t)LR_RECV_GRID * LR_RECV_GRID;
+    if (!rc && !(r->bounce = calloc((size_t)r->nrecv, sizeof *r->bounce)))
+        rc = lr_err_set(e, LR_ENOMEM, "cpu render: receiver bounce: out of memory");
     for (int i = 0; i < r->nrecv && !rc; i++) {
         const float *Eb = lr_rbounce_grid(rb, i, 0);
-        for (size_t k = 0; Eb && r->grid[i] && k < n; k++)
-            for (int c = 0; c < 3; c++)
-                r->grid[i][6 * k + (size_t)c] += Eb[3 * k + (size_t)c];
+        if (!Eb || !r->grid[i])
+            continue;
+        if (!(r->bounce[i] = malloc(3 * n * sizeof **r->bounce))) {
+            rc = lr_err_set(e, LR_ENOMEM, "cpu render: receiver bounce: out of memory");
+            break;
+        }
+        for (size_t k = 0; k < 3 * n; k++)
+            r->bounce[i][k] = Eb[k];
     }
     lr_rbounce_destroy(rb);
     return rc;
@@ -391,6 +403,17 @@ static void pixel_item(void *p, long item)
             for (int o = 0; o < r->nobj; o++)
                 lr_cpu_vpl_irradiance_vis(vis, r->vpl + (size_t)o * r->nvpl, r->nvpl,
                                           lr_scene_object_at(r->s, o)->coeffs.eta, x, n, E, EV);
+        }
+        if (!r->d->no_vpl && r->bounce && r->bounce[idx]) {
+            /* The receivers' bounce (receiver_bounce), bilinear like the GPU's grid. */
+            lr_recv_grid_frame f;
+            lr_recv_grid_frame_of(rc, &f);
+            int ti[4];
+            double tw[4];
+            lr_recv_grid_taps(&f, x, ti, tw);
+            for (int q = 0; q < 4; q++)
+                for (int c = 0; c < 3; c++)
+                    E[c] += tw[q] * r->bounce[idx][3 * (size_t)ti[q] + c];
         }
         for (int c = 0; c < 3; c++) {
             L[c] = rc->albedo[c] / M_PI * E[c];
@@ -612,10 +635,12 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
         if (ref)
             samples += 3.0 * r.samples * nv * r.nlight;
     }
-    /* The twin of the GPU's receiver irradiance grids (PASS only: the reference sums the VPLs
-     * at every pixel). The variance is interpolated like E (the taps share their VPLs). */
+    /* The twin of the GPU's receiver irradiance grids (PASS; the reference sums the VPLs at
+     * every pixel, and builds them only for the receiver bounce's E). The variance is
+     * interpolated like E (the taps share their VPLs). */
     r.nrecv = lr_scene_receiver_count(s);
-    if (!ref && r.nvpl > 0 && r.nrecv > 0) {
+    const bool bounce = lr_rbounce_needed(s);
+    if ((!ref || bounce) && r.nvpl > 0 && r.nrecv > 0) {
         const size_t n = (size_t)LR_RECV_GRID * LR_RECV_GRID;
         r.grid = calloc((size_t)r.nrecv, sizeof *r.grid);
         if (!r.grid) {
@@ -634,6 +659,12 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
         lr_cpu_parallel_for((long)(r.nrecv * n), d->threads, grid_item, &r);
         if ((rc = receiver_bounce(&r, e)))
             goto fail;
+        if (ref) { /* the reference's pixels sum the VPLs themselves */
+            for (int i = 0; i < r.nrecv; i++)
+                free(r.grid[i]);
+            free(r.grid);
+            r.grid = NULL;
+        }
     }
     if (!ref && lr_scene_render(s)->lpv > 0 && r.nrecv > 0 &&
         (rc = lpv_grids(&r, lr_scene_render(s)->lpv, e)))
@@ -668,6 +699,10 @@ fail:
         for (int i = 0; i < r.nrecv; i++)
             free(r.grid[i]);
     free(r.grid);
+    if (r.bounce)
+        for (int i = 0; i < r.nrecv; i++)
+            free(r.bounce[i]);
+    free(r.bounce);
     if (r.lpv)
         for (int i = 0; i < r.nrecv * r.nlight; i++)
             free(r.lpv[i]);

@@ -53,18 +53,23 @@ static int receiver_at(const lr_scene *s, int x, int y)
     return who;
 }
 
-static lr_image twin(lr_scene *s, bool bounce, bool no_vpl)
+static lr_image twin_mode(lr_scene *s, bool bounce, bool no_vpl, enum lr_cpu_sampler mode)
 {
     lr_err e = {0};
     if (lr_scene_set(s, "render.receiver_bounce", bounce ? "true" : "false", NULL, &e))
         fail_msg("%s", e.msg);
-    lr_cpu_render_desc d = {.scene = s, .width = W, .height = H, .mode = LR_CPU_PASS,
-                            .no_vpl = no_vpl};
+    lr_cpu_render_desc d = {.scene = s, .width = W, .height = H, .mode = mode,
+                            .no_vpl = no_vpl, .samples = 64};
     lr_image rgb, var;
     if (lr_cpu_render(&d, &rgb, &var, NULL, &e))
         fail_msg("%s", e.msg);
     lr_image_free(&var);
     return rgb;
+}
+
+static lr_image twin(lr_scene *s, bool bounce, bool no_vpl)
+{
+    return twin_mode(s, bounce, no_vpl, LR_CPU_PASS);
 }
 
 static void test_gpu_vs_twin(void **state)
@@ -139,10 +144,68 @@ static void test_gpu_vs_twin(void **state)
     lr_scene_destroy(s);
 }
 
+/* The CPU reference of the model (LR_CPU_REFERENCE: the bench's "ref" column) includes the
+ * bounce too. Its source is E_dir + E_vpl, E_dir the same code as the twin's, E_vpl from the
+ * reference's own VPLs (their power from the reference estimator, not from maps). So, as for
+ * the GPU above, per receiver the bounce's reference / twin ratio must lie between 1 and the
+ * receivers' VPL-light ratios, widened by 3 %. */
+static void test_reference_has_bounce(void **state)
+{
+    (void)state;
+    static const char *const steady[] = {"lights[0].flicker.amplitude=0",
+                                         "lights[0].flicker.jitter_mm=0", NULL};
+    lr_scene *s = lr_test_scene("candle_spot", lr_test_small_settings, steady);
+    enum { PASS, REF };
+    lr_image off[2], on[2], dir[2];
+    for (int m = 0; m < 2; m++) {
+        enum lr_cpu_sampler mode = m == PASS ? LR_CPU_PASS : LR_CPU_REFERENCE;
+        off[m] = twin_mode(s, false, false, mode);
+        on[m] = twin_mode(s, true, false, mode);
+        dir[m] = twin_mode(s, false, true, mode);
+    }
+    int nr = lr_scene_receiver_count(s);
+    assert_true(nr == 2);
+    double d[2][2] = {{0}}, v[2][2] = {{0}};
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            int i = receiver_at(s, x, y);
+            if (i < 0)
+                continue;
+            for (int m = 0; m < 2; m++)
+                for (int c = 0; c < 3; c++) {
+                    size_t k = 3 * ((size_t)y * W + x) + c;
+                    assert_true(on[m].rgb[k] >= off[m].rgb[k] * (1 - 1e-6f));
+                    d[m][i] += on[m].rgb[k] - off[m].rgb[k];
+                    v[m][i] += off[m].rgb[k] - dir[m].rgb[k];
+                }
+        }
+    double lo = 1, hi = 1;
+    for (int i = 0; i < nr; i++) {
+        assert_true(v[PASS][i] > 0 && d[PASS][i] > 0);
+        double rv = v[REF][i] / v[PASS][i], rd = d[REF][i] / d[PASS][i];
+        print_message("%s: bounce reference %.5g, twin %.5g (%+.2f %%); VPL light %+.2f %%\n",
+                      lr_scene_receiver_at(s, i)->name, d[REF][i], d[PASS][i],
+                      100 * (rd - 1), 100 * (rv - 1));
+        lo = fmin(lo, rv);
+        hi = fmax(hi, rv);
+    }
+    for (int i = 0; i < nr; i++) {
+        double rd = d[REF][i] / d[PASS][i];
+        assert_true(rd >= lo - 0.03 && rd <= hi + 0.03);
+    }
+    for (int m = 0; m < 2; m++) {
+        lr_image_free(&off[m]);
+        lr_image_free(&on[m]);
+        lr_image_free(&dir[m]);
+    }
+    lr_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_gpu_vs_twin),
+        cmocka_unit_test(test_reference_has_bounce),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
