@@ -187,11 +187,15 @@ void lr_multipole_sd_n(const lr_coeffs *c, double d, int n, lr_vec3 xi, lr_vec3 
                        lr_vec3 no, double out[3])
 {
     lr_vec3 x = lr_v3_sub(xo, xi);
-    /* Opposite faces: light crossed the wall, and the slab's lateral offset is x_o's
-     * tangent-plane distance (the plane the estimator samples in). Same face: the distance. */
+    /* Opposite faces: light crossed the wall, and the slab's lateral offset is what is left of
+     * the distance once the wall's thickness is taken out, sqrt(|x|^2 - d^2): on a flat slab
+     * exactly the tangent-plane distance (|h| = d there). Not the tangent-plane distance
+     * itself: two faces with opposed normals are also the two sides of a shade across its
+     * inside (|x| = its diameter, x along the normal), which that distance would put at
+     * r_perp = 0, as if the light had crossed one wall. Same face: the distance. */
     bool far = lr_v3_dot(ni, no) < 0.0;
-    double h = lr_v3_dot(x, no), x2 = lr_v3_dot(x, x);
-    double r = far ? sqrt(fmax(x2 - h * h, 0.0)) : sqrt(x2);
+    double x2 = lr_v3_dot(x, x);
+    double r = far ? sqrt(fmax(x2 - d * d, 0.0)) : sqrt(x2);
     for (int j = 0; j < 3; j++)
         out[j] = face(c, d, n, r, j, far) / M_PI;
 }

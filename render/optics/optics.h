@@ -171,9 +171,11 @@ int lr_multipole_thickness_validate(double d, lr_err *e);
 void lr_multipole_total(const lr_coeffs *c, double d, double R[3], double T[3]);
 void lr_multipole_total_n(const lr_coeffs *c, double d, int n, double R[3], double T[3]);
 /* As a BSSRDF diffusion term, mm^-2 sr^-1, without Fresnel factors (like lr_dipole_sd):
- * n_i . n_o < 0 (entry and exit on opposite faces of the wall): T(r_perp) / pi with r_perp
- * the distance from x_o to x_i's projection on x_o's tangent plane; otherwise (same face)
- * R(|x_o - x_i|) / pi. n_i, n_o unit, pointing out of the medium. */
+ * n_i . n_o < 0 (entry and exit on opposite faces of the wall): T(r_perp) / pi with
+ * r_perp = sqrt(|x_o - x_i|^2 - d^2), on a flat slab the distance from x_o to x_i's
+ * projection on x_o's tangent plane, and about |x_o - x_i| between the two sides of a shade
+ * across its inside; otherwise (same face) R(|x_o - x_i|) / pi. n_i, n_o unit, pointing out
+ * of the medium. */
 void lr_multipole_sd(const lr_coeffs *c, double d, lr_vec3 xi, lr_vec3 ni, lr_vec3 xo,
                      lr_vec3 no, double out[3]);
 /* The same times F_t(w_i); 0 when w_i . n_i <= 0. */

@@ -253,6 +253,18 @@ static void test_sd_faces(void **state)
     lr_multipole_profile(&c, d, 0.7, R, T);
     for (int j = 0; j < 3; j++)
         assert_near_rel(sd[j], T[j] / M_PI, 1e-12);
+    /* The two sides of a shade of radius 75 mm across its inside: outer faces with opposed
+     * normals, but 150 mm apart along them. Not the wall's T(0) (what the tangent-plane
+     * distance, 0 here, would give): T at sqrt(150^2 - d^2), e^{-sigma_tr 150} small. */
+    double T0[3];
+    lr_multipole_profile(&c, d, 0.0, R, T0);
+    lr_multipole_sd(&c, d, lr_v3(75, 0, 0), lr_v3(1, 0, 0), lr_v3(-75, 0, 0), lr_v3(-1, 0, 0),
+                    sd);
+    lr_multipole_profile(&c, d, sqrt(150.0 * 150.0 - d * d), R, T);
+    for (int j = 0; j < 3; j++) {
+        assert_near_rel(sd[j], T[j] / M_PI, 1e-12);
+        assert_true(sd[j] < 1e-30 * T0[j]);
+    }
     /* Same face. */
     lr_multipole_sd(&c, d, lr_v3(0, 0, 0), up, lr_v3(0.3, 0.4, 0), up, sd);
     lr_multipole_profile(&c, d, 0.5, R, T);

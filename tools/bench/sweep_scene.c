@@ -110,6 +110,15 @@ int lrb_sweep_supersample(void)
     return s >= 1 && s <= 16 ? s : LRB_SWEEP_SS;
 }
 
+/* LRB_SWEEP_SEED: the renderer's seed (0 or unset: its default), for a second run of the
+ * same rows whose converged figures differ by the model's own residual noise alone. */
+static unsigned sweep_seed(void)
+{
+    const char *v = getenv("LRB_SWEEP_SEED");
+    long n = v ? strtol(v, NULL, 10) : 0;
+    return n > 0 && n < 1000000000 ? (unsigned)n : 0u;
+}
+
 static int run_series(lr_gl *gl, lr_scene *s, const lrb_setting *st, int ss, lr_eval_series *ser,
                       lr_err *e)
 {
@@ -120,7 +129,8 @@ static int run_series(lr_gl *gl, lr_scene *s, const lrb_setting *st, int ss, lr_
                                                        .checkpoints = st->checkpoints,
                                                        .ncheck = st->ncheck,
                                                        .converge_frames = st->converge_frames,
-                                                       .supersample = ss},
+                                                       .supersample = ss,
+                                                       .seed = sweep_seed()},
                                 &ser[0], e);
     if (rc)
         lr_err_prefix(e, "setting %s (supersampled %d)", st->label, ss);

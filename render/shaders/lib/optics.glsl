@@ -215,9 +215,10 @@ float lr_multipole_sd_band(lr_coeffs_gl c, lr_sss_gl s, int j, vec3 xi, vec3 ni,
     float zb = 0.5 * (s.z_v[j] - s.z_r[j]);
     float l = min(s.z_r[j], 0.5 * d);
     float L = d + 2.0 * zb;
+    // Across: sqrt(|x|^2 - d^2), the tangent-plane distance on a flat slab, ~|x| for the two
+    // sides of a shade across its inside (multipole.c says why).
     bool across = dot(ni, no) < 0.0;
-    float h = dot(x, no);
-    float r = across ? sqrt(max(dot(x, x) - h * h, 0.0)) : length(x);
+    float r = across ? sqrt(max(dot(x, x) - d * d, 0.0)) : length(x);
     float sum = 0.0;
     for (int i = -s.pairs; i <= s.pairs; i++) {
         float zr = 2.0 * float(i) * L + l, zv = 2.0 * float(i) * L - l - 2.0 * zb;
