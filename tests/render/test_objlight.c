@@ -8,6 +8,7 @@
  *    table, the parallel-rectangle closed form (Howell B-3 over four corner rectangles);
  *  - occlusion: a square plate under the sphere takes exactly the parallel-square view factor
  *    from the bottom vertex (W (F_table - F_plate)), within 1 % of W;
+ *  - a closed thin wall (a shade, multipole): E- is the far face's E+ (the opposite vertex's);
  *  - linearity: twice X gives twice E, vertex by vertex;
  *  - the factors: kR = <F_t> R_d / t_hem = R_d (the two integrals agree) for a half-space;
  *  - the field: default true, a SETTINGS change, off: no objects' light. */
@@ -240,6 +241,75 @@ static void test_occluder(void **state)
     lr_scene_destroy(s);
 }
 
+/* A closed thin wall (a shade of 2 mm porcelain, rims, multipole): E- of a vertex is E+ of the
+ * wall's far face where the ray along -n leaves it; the shade's inner and outer faces are
+ * meshed ring by ring, so that point is near the opposite face's vertex nearest x - d n.
+ * The walls' vertices find their far face (a rim's, 2 mm wide, lies beyond 2 d along -n, and
+ * a top rim sees no receiver), and there E- matches that
+ * vertex's E+ within 2 % of W (E varies over the segment, 6 mm here, much less). */
+static void test_far_face(void **state)
+{
+    (void)state;
+    const double X = 1.0e-3, W = RHO * X, d = 2;
+    char doc[2048];
+    snprintf(doc, sizeof doc,
+             "{\"name\":\"t\",\"objects\":[{\"name\":\"s\",\"material\":\"porcelain\","
+             "\"model\":\"multipole\",\"thickness_mm\":%g,\"mesh\":{\"type\":\"shade\","
+             "\"radius_bottom\":60,\"radius_top\":40,\"height\":80,\"thickness\":%g,"
+             "\"rims\":true,\"segments\":48},\"transform\":{\"translate\":[0,0,100]}}],"
+             "\"lights\":[{\"type\":\"point\",\"position\":[0,0,3000],\"intensity\":1}],"
+             "\"camera\":{\"position\":[0,-3000,100],\"target\":[0,0,0]},"
+             "\"receivers\":[{\"name\":\"table\",\"type\":\"plane\",\"center\":[0,0,0],"
+             "\"normal\":[0,0,1],\"size\":[%g,%g],\"albedo\":[%g,%g,%g]}]}",
+             d, d, 2 * HALF, 2 * HALF, RHO, RHO, RHO);
+    lr_scene *s = lr_test_scene_text(doc, on);
+    assert_true(lr_scene_object_at(s, 0)->closed);
+    lr_rbounce *rb = solved(s, X);
+    const lr_objlight *ol = lr_rbounce_objects(rb);
+    assert_non_null(ol);
+    const lr_mesh *m = lr_scene_object_at(s, 0)->mesh;
+    const float *E = lr_objlight_E(ol, 0, 0), *P = lr_mesh_positions(m), *N = lr_mesh_normals(m);
+    size_t nv = lr_mesh_vertex_count(m), found = 0, compared = 0, walls = 0;
+    double worst = 0;
+    for (size_t v = 0; v < nv; v++) {
+        /* Not a rim nor a wall's end ring (whose ray along -n may leave through a rim that
+         * sees no receiver): the far face lies within 2 d. */
+        double z = P[3 * v + 2];
+        bool wall = fabs(N[3 * v + 2]) < 0.9 && z > 100 + 3 * d && z < 180 - 3 * d;
+        walls += wall;
+        if (!(E[6 * v + 3] > 0.0f))
+            continue;
+        found += wall;
+        lr_vec3 n = lr_v3(N[3 * v], N[3 * v + 1], N[3 * v + 2]);
+        lr_vec3 y = lr_v3_sub(lr_v3(P[3 * v], P[3 * v + 1], P[3 * v + 2]), lr_v3_scale(n, d));
+        size_t best = nv;
+        double bd = INFINITY;
+        for (size_t u = 0; u < nv; u++) {
+            lr_vec3 nu = lr_v3(N[3 * u], N[3 * u + 1], N[3 * u + 2]);
+            if (lr_v3_dot(nu, n) > -0.9)
+                continue;
+            double du = lr_v3_len(lr_v3_sub(lr_v3(P[3 * u], P[3 * u + 1], P[3 * u + 2]), y));
+            if (du < bd) {
+                bd = du;
+                best = u;
+            }
+        }
+        if (best == nv || bd > 1.0)
+            continue; /* no opposite vertex at the far point (rims, slanted ends) */
+        compared++;
+        worst = fmax(worst, fabs(E[6 * v + 3] - E[6 * best]) / W);
+    }
+    print_message("thin wall: %zu vertices, %zu of the %zu wall vertices (off the rims) found their "
+                  "far face, %zu compared with the opposite vertex: worst |E- - E+(opposite)| / "
+                  "W %.4f\n",
+                  nv, found, walls, compared, worst);
+    assert_true(found >= walls * 98 / 100);
+    assert_true(compared > nv / 2);
+    assert_true(worst < 0.02);
+    lr_rbounce_destroy(rb);
+    lr_scene_destroy(s);
+}
+
 static void test_factors_and_field(void **state)
 {
     (void)state;
@@ -270,6 +340,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sphere_over_plane),
         cmocka_unit_test(test_occluder),
+        cmocka_unit_test(test_far_face),
         cmocka_unit_test(test_factors_and_field),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
