@@ -399,7 +399,7 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
         (rc = program(r, "mesh.vert", "depth.frag", &pr->depth, e)) ||
         (rc = program(r, "radiosity.vert", "radiosity.frag", &pr->radiosity, e)) ||
         (rc = program(r, "fullscreen.vert", "vpl.frag", &pr->vpl, e)) ||
-        (rc = program(r, "mesh.vert", "compose_object.frag", &pr->obj, e)) ||
+        (rc = program(r, "compose_object.vert", "compose_object.frag", &pr->obj, e)) ||
         (rc = program(r, "fullscreen.vert", "blit.frag", &pr->blit, e)) ||
         (rc = program(r, "fullscreen.vert", "irradiance.frag", &pr->irr, e)) ||
         (rc = program(r, "fullscreen.vert", "area_direct.frag", &pr->area, e)) ||

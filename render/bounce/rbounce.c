@@ -7,10 +7,11 @@
 #include <string.h>
 #include <time.h>
 
+#include "render/bounce/objlight.h"
 #include "render/cpu/recv_grid.h"
 #include "render/transrad/tr_scene.h"
 
-#define KEY_MAX (2 + LR_TR_MAX_SURFACES * (LR_TR_KEY_MESH + 3))
+#define KEY_MAX (3 + LR_TR_MAX_SURFACES * (LR_TR_KEY_MESH + 5))
 #define LKEY 20 /* doubles per light shape */
 #define MAX_LIGHTS 8
 
@@ -27,6 +28,7 @@ struct lr_rbounce {
     int *cnt;               /* n: scratch, texels per patch */
     double *E;              /* n x 3 scratch */
     float *out[LR_TR_MAX_SURFACES][LR_TR_MAX_SLOTS]; /* per receiver, slot: R^2 x 3 */
+    lr_objlight *ol;        /* render.receiver_light_on_objects: the objects' E (objlight.h) */
     double build_s, direct_s, solve_s;
 };
 
@@ -60,8 +62,13 @@ static int scene_key(const lr_scene *s, double *k)
     int n = 0;
     k[n++] = lr_scene_object_count(s);
     k[n++] = lr_scene_receiver_count(s);
-    for (int i = 0; i < lr_scene_object_count(s); i++)
-        lr_tr_key_mesh(k, &n, lr_scene_object_at(s, i)->mesh, lr_scene_object_at(s, i)->bvh);
+    k[n++] = lr_scene_render(s)->receiver_light_on_objects;
+    for (int i = 0; i < lr_scene_object_count(s); i++) {
+        const lr_scene_object *o = lr_scene_object_at(s, i);
+        lr_tr_key_mesh(k, &n, o->mesh, o->bvh);
+        k[n++] = o->closed; /* the objects' light: E- (objlight.h) */
+        k[n++] = o->thickness_mm;
+    }
     for (int i = 0; i < lr_scene_receiver_count(s); i++) {
         const lr_receiver *r = lr_scene_receiver_at(s, i);
         lr_tr_key_mesh(k, &n, r->mesh, r->bvh);
@@ -85,6 +92,8 @@ static void light_key(const lr_light *l, double *k)
 
 static void free_solver(lr_rbounce *rb)
 {
+    lr_objlight_destroy(rb->ol);
+    rb->ol = NULL;
     lr_tr_destroy(rb->tr);
     rb->tr = NULL;
     for (int l = 0; l < MAX_LIGHTS; l++) {
@@ -153,7 +162,20 @@ static int build(lr_rbounce *rb, const lr_scene *s, lr_err *e)
         return lr_err_set(e, LR_ENOMEM, "receiver bounce: out of memory (%zu patches)", rb->n);
     rb->n_obj = no;
     rb->n_rcv = nr;
-    return LR_OK;
+    if (!lr_scene_render(s)->receiver_light_on_objects || no == 0)
+        return LR_OK;
+    /* The receivers' light on the objects: rows of every object vertex against the
+     * receivers' patches (objlight.h); E- from the far face of a closed wall with
+     * thickness_mm (the multipole's T), by rays on the back of an open one. */
+    lr_objlight_desc od[LR_TR_MAX_SURFACES];
+    for (int i = 0; i < no; i++) {
+        const lr_scene_object *o = lr_scene_object_at(s, i);
+        od[i] = (lr_objlight_desc){.mesh = o->mesh, .bvh = o->bvh, .two_sided = !o->closed,
+                                   .far_mm = o->thickness_mm > 0 ? 2 * o->thickness_mm + 1 : 0};
+    }
+    size_t first, count;
+    lr_tr_surface_patches(rb->tr, no, &first, &count);
+    return lr_objlight_create(rb->tr, first, od, no, 0, &rb->ol, e);
 }
 
 int lr_rbounce_update(lr_rbounce **rbp, const lr_scene *s, lr_err *e)
@@ -291,6 +313,8 @@ int lr_rbounce_solve(lr_rbounce *rb, int slot, const double (*w)[3], lr_err *e)
             rb->E[i] = isfinite(x) && x > 0 ? x : 0;
         }
     int rc = lr_tr_solve_irradiance(rb->tr, rb->E, slot, NULL, e);
+    if (!rc && rb->ol)
+        rc = lr_objlight_eval(rb->ol, rb->tr, slot, e);
     for (int r = 0; r < rb->n_rcv && !rc; r++)
         rc = write_grid(rb, r, slot, e);
     rb->solve_s = now_s() - t0;
@@ -305,6 +329,8 @@ const float *lr_rbounce_grid(const lr_rbounce *rb, int r, int slot)
 }
 
 const lr_tr *lr_rbounce_solver(const lr_rbounce *rb) { return rb ? rb->tr : NULL; }
+
+const lr_objlight *lr_rbounce_objects(const lr_rbounce *rb) { return rb ? rb->ol : NULL; }
 
 int lr_rbounce_first_receiver(const lr_rbounce *rb) { return rb ? rb->n_obj : 0; }
 

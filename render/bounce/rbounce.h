@@ -37,6 +37,7 @@
 #include "render/transrad/transrad.h"
 
 typedef struct lr_rbounce lr_rbounce;
+typedef struct lr_objlight lr_objlight;
 
 /* Whether scene s asks for it (render.receiver_bounce) and it has work: a plane receiver, a
  * light, no object using translucent_radiosity and no light-propagation volume (render.lpv:
@@ -64,6 +65,9 @@ const float *lr_rbounce_grid(const lr_rbounce *rb, int r, int slot);
 /* The solver (receivers' patches after the objects': lr_rbounce_first_receiver). */
 const lr_tr *lr_rbounce_solver(const lr_rbounce *rb);
 int lr_rbounce_first_receiver(const lr_rbounce *rb);
+/* With render.receiver_light_on_objects: the receivers' light on the objects' vertices,
+ * evaluated by every lr_rbounce_solve for its slot (objlight.h); else NULL. */
+const lr_objlight *lr_rbounce_objects(const lr_rbounce *rb);
 /* Seconds: the last F build (0 when reused), the last direct-light update, the last solve
  * (patch means, sweeps and grid write). */
 void lr_rbounce_times(const lr_rbounce *rb, double *build_s, double *direct_s, double *solve_s);

@@ -11,6 +11,7 @@
 #include "render/cpu/cavity.h"
 #include "render/cpu/maps.h"
 #include "render/cpu/parallel.h"
+#include "render/bounce/objlight.h"
 #include "render/bounce/rbounce.h"
 #include "render/cpu/recv_grid.h"
 #include "render/lpv/scene_lpv.h"
@@ -67,6 +68,11 @@ typedef struct rctx {
     lr_lpv_objfield **lpv_obj;
     double *lpv_k;
     lr_tr_scene *tr;     /* translucent radiosity (PASS): the solver's B and receiver extra */
+    /* render.receiver_bounce with receiver_light_on_objects (PASS): the solve (its slot 0 sums
+     * the lights with their intensities) and per object kR, kT ([obj * 6]) of the receivers'
+     * light on the objects (render/bounce/objlight.h), as the GPU's compose pass applies. */
+    lr_rbounce *rb;
+    double *rl_k;
     lr_dscene *dscene; /* diffusion_grid objects' fields (NULL when the scene has none) */
     /* Per light, the lights the transport sees frame by frame (render/area/frames.h): an area
      * light's frame samples (PASS: the `frames` accumulated; REFERENCE: LR_REF_AREA_FRAMES),
@@ -272,8 +278,42 @@ static int receiver_bounce(rctx *r, lr_err *e)
         for (size_t k = 0; k < 3 * n; k++)
             r->bounce[i][k] = Eb[k];
     }
-    lr_rbounce_destroy(rb);
-    return rc;
+    if (rc || !lr_rbounce_objects(rb)) {
+        lr_rbounce_destroy(rb);
+        return rc;
+    }
+    /* Kept for the pixels: the receivers' light on the objects. */
+    if (!(r->rl_k = calloc((size_t)r->nobj * 6, sizeof *r->rl_k))) {
+        lr_rbounce_destroy(rb);
+        return lr_err_set(e, LR_ENOMEM, "cpu render: out of memory");
+    }
+    for (int o = 0; o < r->nobj; o++)
+        lr_objlight_factors(lr_scene_object_at(r->s, o), r->rl_k + 6 * (size_t)o,
+                            r->rl_k + 6 * (size_t)o + 3);
+    r->rb = rb;
+    return LR_OK;
+}
+
+/* render.receiver_light_on_objects: the receivers' light on object o at the camera ray's hit
+ * of its triangle (barycentrics, as the GPU interpolates its per-vertex varyings), on the side
+ * the GPU takes (gl_FrontFacing: the triangle's winding against the ray), already weighted by
+ * the lights' intensities: F_t(w_o) / pi (kR E+ + kT E-), the back side of an open object
+ * kR E- + kT E+ (objlight.h). Adds to L. */
+static void receiver_light(const rctx *r, int o, lr_vec3 org, lr_vec3 dir, double ft,
+                           double L[3])
+{
+    const lr_scene_object *ob = lr_scene_object_at(r->s, o);
+    lr_hit hit;
+    if (!lr_bvh_intersect(ob->bvh, org, dir, 0.0, INFINITY, &hit))
+        return;
+    double E[6];
+    lr_objlight_at(lr_rbounce_objects(r->rb), o, 0, hit.triangle, hit.u, hit.v, E);
+    bool back = !ob->closed && lr_v3_dot(lr_mesh_triangle_normal(ob->mesh, hit.triangle), dir) > 0.0;
+    const double *k = r->rl_k + 6 * (size_t)o;
+    for (int c = 0; c < 3; c++) {
+        double B = back ? k[c] * E[3 + c] + k[3 + c] * E[c] : k[c] * E[c] + k[3 + c] * E[3 + c];
+        L[c] += ft / M_PI * B; /* seed 003 Eq. 5 */
+    }
 }
 
 /* render.lpv: adds to B the volume's light on object o for light l at (x, n), per unit
@@ -366,6 +406,8 @@ static void pixel_item(void *p, long item)
                 V[c] += k * k * var[c];
             }
         }
+        if (r->rb)
+            receiver_light(r, idx, org, dir, ft, L);
     } else {
         const lr_receiver *rc = lr_scene_receiver_at(r->s, idx);
         double E[3] = {0}, EV[3] = {0};
@@ -687,6 +729,8 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
         stats->vpls = nv;
     }
 fail:
+    lr_rbounce_destroy(r.rb);
+    free(r.rl_k);
     lr_tr_scene_destroy(r.tr);
     for (int o = 0; o < r.nobj && r.ref; o++)
         lr_refined_free(&r.ref[o]);

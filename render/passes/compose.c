@@ -68,7 +68,8 @@ static void cavity_w(const lr_compose *img, const lr_pass_objects *o, int i,
 /* Algorithm 1 per pixel (compose_object.frag): the cavity gains are the gather's per-light
  * weights. */
 static void draw_objects_gather(const lr_compose *img, const lr_radiosity *rad,
-                                const lr_lpv_pass *lpv, const lr_pass_ctx *c, lr_program *p)
+                                const lr_lpv_pass *lpv, const lr_irradiance *irr,
+                                const lr_pass_ctx *c, lr_program *p)
 {
     const lr_pass_objects *o = c->objs;
     double unit[LR_MAX_LIGHTS][3];
@@ -81,6 +82,7 @@ static void draw_objects_gather(const lr_compose *img, const lr_radiosity *rad,
         cavity_w(img, o, i, w);
         lr_radiosity_set_light_w(rad, p, w);
         lr_lpv_pass_bind_objects(lpv, c, p, i, img->scale);
+        lr_irradiance_bind_objects(irr, c, p, i, false, img->scale);
         lr_passes_uniform_i(p, "u_object", i);
         lr_passes_uniform_i(p, "u_two_sided", o->two_sided[i]);
         lr_passes_draw(&o->obj[i]);
@@ -91,7 +93,8 @@ static void draw_objects_gather(const lr_compose *img, const lr_radiosity *rad,
  * (compose_cached.vert/.frag, render/mesh/lattice.h): no gather, and no refined mesh to
  * rasterise. */
 static void draw_objects_cached(const lr_compose *img, const lr_surface *sc,
-                                const lr_lpv_pass *lpv, const lr_pass_ctx *c, lr_program *p)
+                                const lr_lpv_pass *lpv, const lr_irradiance *irr,
+                                const lr_pass_ctx *c, lr_program *p)
 {
     const lr_pass_objects *o = c->objs;
     lr_surface_bind(sc, p);
@@ -104,6 +107,7 @@ static void draw_objects_cached(const lr_compose *img, const lr_surface *sc,
                 g[3 * l + b] = (float)w[l][b];
         lr_passes_uniform_v3_array(p, "u_gain", g, LR_MAX_LIGHTS);
         lr_lpv_pass_bind_objects(lpv, c, p, i, img->scale);
+        lr_irradiance_bind_objects(irr, c, p, i, true, img->scale);
         lr_passes_uniform_i(p, "u_object", i);
         lr_passes_uniform_i(p, "u_two_sided", o->two_sided[i]);
         lr_passes_uniform_i(p, "u_nv", sc->nv[i]);
@@ -155,9 +159,9 @@ int lr_compose_run(lr_compose *img, const lr_pass_ctx *c, const lr_compose_input
     lr_passes_uniform_i(p, "u_ortho", cam->orthographic);
     img->gathered = !in->surface;
     if (in->surface)
-        draw_objects_cached(img, in->surface, in->lpv, c, p);
+        draw_objects_cached(img, in->surface, in->lpv, in->irradiance, c, p);
     else
-        draw_objects_gather(img, in->radiosity, in->lpv, c, p);
+        draw_objects_gather(img, in->radiosity, in->lpv, in->irradiance, c, p);
 
     p = c->prog->recv[img->n - 1];
     glUseProgram(lr_program_id(p));

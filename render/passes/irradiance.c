@@ -10,6 +10,7 @@
 
 #include <stdlib.h>
 
+#include "render/bounce/objlight.h"
 #include "render/bounce/rbounce.h"
 #include "render/cpu/recv_grid.h"
 #include "render/passes/radiosity.h"
@@ -48,14 +49,103 @@ static int tr_upload(lr_irradiance *irr, const lr_pass_ctx *c, const lr_radiosit
     return rc;
 }
 
+static void rl_free(lr_irradiance *irr)
+{
+    for (int i = 0; i < LR_MAX_OBJECTS; i++) {
+        lr_tex_destroy(irr->rl[i]);
+        lr_tex_destroy(irr->rlu[i]);
+        irr->rl[i] = irr->rlu[i] = NULL;
+        irr->rl_rows[i] = irr->rlu_rows[i] = 0;
+    }
+}
+
+/* One texture of n entries (vertex k's values at entry k, or corner 3 t + c's from vertex
+ * idx[3 t + c] when idx is given) for every light and side. */
+static int rl_texture(const lr_pass_ctx *c, const lr_objlight *ol, int i, const uint32_t *idx,
+                      size_t n, lr_tex **out, int *rows_out, lr_err *e)
+{
+    int L = c->n_lights, rows = (int)((n + LR_RL_TEX_WIDTH - 1) / LR_RL_TEX_WIDTH);
+    rows = rows < 1 ? 1 : rows;
+    size_t W = LR_RL_TEX_WIDTH, blk = (size_t)rows * W;
+    float *data = calloc(blk * 2 * (size_t)L * 4, sizeof *data);
+    if (!data)
+        return lr_err_set(e, LR_ENOMEM, "irradiance pass: out of memory (objects' receiver light)");
+    for (int l = 0; l < L; l++) {
+        const float *E = lr_objlight_E(ol, i, l);
+        for (size_t k = 0; E && k < n; k++) {
+            size_t v = idx ? idx[k] : k;
+            for (int s = 0; s < 2; s++)
+                for (int b = 0; b < 3; b++)
+                    data[4 * ((size_t)(2 * l + s) * blk + k) + (size_t)b] =
+                        E[6 * v + 3 * (size_t)s + (size_t)b];
+        }
+    }
+    lr_tex_desc d = {.type = LR_TEX_2D, .format = LR_TEX_RGBA32F, .width = LR_RL_TEX_WIDTH,
+                     .height = rows * 2 * L, .label = "objects' receiver light"};
+    int rc = lr_tex_create(c->gl, &d, out, e);
+    if (!rc)
+        rc = lr_tex_upload(*out, 0, data, e);
+    free(data);
+    *rows_out = rows;
+    return rc;
+}
+
+/* The receivers' light on the objects of every solved slot, uploaded per object. */
+static int rl_upload(lr_irradiance *irr, const lr_pass_ctx *c, lr_err *e)
+{
+    rl_free(irr);
+    const lr_objlight *ol = lr_rbounce_objects(irr->rb);
+    if (!ol || c->n_lights > LR_TR_MAX_SLOTS)
+        return LR_OK;
+    int rc = LR_OK;
+    for (int i = 0; i < lr_objlight_count(ol) && i < LR_MAX_OBJECTS && !rc; i++) {
+        const lr_mesh *m = lr_scene_object_at(c->scene, i)->mesh;
+        rc = rl_texture(c, ol, i, NULL, lr_objlight_vertex_count(ol, i), &irr->rl[i],
+                        &irr->rl_rows[i], e);
+        if (!rc)
+            rc = rl_texture(c, ol, i, lr_mesh_indices(m), 3 * lr_mesh_triangle_count(m),
+                            &irr->rlu[i], &irr->rlu_rows[i], e);
+    }
+    return rc;
+}
+
+void lr_irradiance_bind_objects(const lr_irradiance *irr, const lr_pass_ctx *c, lr_program *p,
+                                int object, bool unindexed, const float scale[LR_MAX_LIGHTS])
+{
+    const lr_tex *t = NULL;
+    int rows = 0;
+    if (irr && irr->valid && object >= 0 && object < LR_MAX_OBJECTS &&
+        object < lr_scene_object_count(c->scene)) {
+        t = unindexed ? irr->rlu[object] : irr->rl[object];
+        rows = unindexed ? irr->rlu_rows[object] : irr->rl_rows[object];
+    }
+    lr_passes_uniform_i(p, "u_rl_on", t != NULL);
+    lr_passes_bind_tex(p, "u_rl", 19, t);
+    if (!t)
+        return;
+    lr_passes_uniform_i(p, "u_rl_rows", rows);
+    double kR[3], kT[3];
+    lr_objlight_factors(lr_scene_object_at(c->scene, object), kR, kT);
+    float r[3 * LR_MAX_LIGHTS], tt[3 * LR_MAX_LIGHTS];
+    for (int l = 0; l < LR_MAX_LIGHTS; l++)
+        for (int b = 0; b < 3; b++) {
+            r[3 * l + b] = (float)(kR[b] * scale[l]);
+            tt[3 * l + b] = (float)(kT[b] * scale[l]);
+        }
+    lr_passes_uniform_v3_array(p, "u_rl_r", r, LR_MAX_LIGHTS);
+    lr_passes_uniform_v3_array(p, "u_rl_t", tt, LR_MAX_LIGHTS);
+}
+
 /* Receiver inter-reflection (render/bounce/rbounce.h): each light's drawn grids (E_vpl at unit
  * intensity) read back, the receivers' radiosity solved with E = E_dir,l + E_vpl,l (slot l),
  * and the bounce E_b added to the grids in place; composition then reads it like E_vpl. */
 static int bounce(lr_irradiance *irr, const lr_pass_ctx *c, lr_err *e)
 {
     int rc = lr_rbounce_update(&irr->rb, c->scene, e);
-    if (rc || !irr->rb)
+    if (rc || !irr->rb) {
+        rl_free(irr);
         return rc;
+    }
     const size_t n = (size_t)LR_RECV_GRID * LR_RECV_GRID;
     int nr = irr->n_receivers;
     float *buf = malloc((size_t)(nr ? nr : 1) * 4 * n * sizeof *buf);
@@ -85,11 +175,15 @@ static int bounce(lr_irradiance *irr, const lr_pass_ctx *c, lr_err *e)
         }
     }
     free(buf);
+    /* The receivers' light on the objects (render/bounce/objlight.h), every slot solved. */
+    if (!rc)
+        rc = rl_upload(irr, c, e);
     return rc;
 }
 
 void lr_irradiance_free(lr_irradiance *irr)
 {
+    rl_free(irr);
     lr_rbounce_destroy(irr->rb);
     irr->rb = NULL;
     for (int i = 0; i < LR_MAX_RECEIVERS; i++) {
@@ -144,8 +238,10 @@ int lr_irradiance_run(lr_irradiance *irr, const lr_pass_ctx *c, const lr_vpl *v,
         return rc;
     /* Nothing to cache (no plane receiver, no VPLs): up to date as it is. */
     irr->valid = !irr->grid || c->no_vpl || !v->fb;
-    if (irr->valid)
+    if (irr->valid) {
+        rl_free(irr); /* no bounce solved: no receiver light on the objects either */
         return LR_OK;
+    }
     if ((rc = tr_upload(irr, c, rad, e)))
         return rc;
     lr_program *p = c->prog->irr;

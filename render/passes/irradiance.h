@@ -24,7 +24,16 @@ typedef struct lr_irradiance {
      * after the grids are drawn they are read back, the receivers' radiosity solved per light
      * and the bounce added to them; NULL when off. */
     struct lr_rbounce *rb;
+    /* The receivers' light on the objects (render/bounce/objlight.h;
+     * render.receiver_light_on_objects), per object: E+ and E- per vertex and light at unit
+     * intensity, LR_RL_TEX_WIDTH texels a row, light l side s (0: E+, 1: E-) from row
+     * (2 l + s) rl_rows[i]; by vertex index (rl, compose_object.vert) and by corner 3 t + c of
+     * the unindexed mesh (rlu, compose_cached.vert). NULL when off. */
+    lr_tex *rl[LR_MAX_OBJECTS], *rlu[LR_MAX_OBJECTS];
+    int rl_rows[LR_MAX_OBJECTS], rlu_rows[LR_MAX_OBJECTS];
 } lr_irradiance;
+
+#define LR_RL_TEX_WIDTH 1024 /* render/shaders/lib/recv_light_vert.glsl */
 
 /* Frees the grids (they are laid out again at the next run). */
 void lr_irradiance_free(lr_irradiance *irr);
@@ -34,5 +43,10 @@ int lr_irradiance_run(lr_irradiance *irr, const lr_pass_ctx *c, const lr_vpl *v,
 /* Receiver i's grid for compose_receiver.frag (unit 15), or u_cached = false. */
 void lr_irradiance_bind(const lr_irradiance *irr, const lr_pass_ctx *c, lr_program *p,
                         int receiver);
+/* Object i's receiver light for compose_object / compose_cached (unit 19; unindexed: the
+ * surface cache's mesh): u_rl_on, the texture and row, kR and kT times the images' scale per
+ * light (lib/recv_light.glsl). */
+void lr_irradiance_bind_objects(const lr_irradiance *irr, const lr_pass_ctx *c, lr_program *p,
+                                int object, bool unindexed, const float scale[LR_MAX_LIGHTS]);
 
 #endif

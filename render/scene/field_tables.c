@@ -339,6 +339,11 @@ static const lr_field render_fields[] = {
      * receiver irradiance grid, so a settings change. */
     {"receiver_bounce", LR_FT_BOOL, 0, RS(receiver_bounce), .dflt = {0}, .dirty = SET,
      .help = "light bounced between the plane receivers (seed 000 radiosity, objects occlude)"},
+    /* With receiver_bounce: the receivers' radiosity lights the objects too (render/bounce/
+     * objlight.h); per vertex and light, read by composition, so a settings change. */
+    {"receiver_light_on_objects", LR_FT_BOOL, 0, RS(receiver_light_on_objects), .dflt = {1},
+     .dirty = SET,
+     .help = "with receiver_bounce: the receivers' light (direct, VPL, bounced) lights the objects"},
 };
 
 const lr_record_desc lr_scene_render_desc = {"render", "render", NULL, NULL, NULL, NULL,

@@ -230,6 +230,9 @@ typedef struct lr_render_settings {
     /* Receiver inter-reflection for every model (render/bounce/, issue 12 part 4): the plane
      * receivers' radiosity solve, its bounce added to the receiver irradiance grid. */
     bool receiver_bounce;
+    /* With receiver_bounce: the receivers' radiosity (direct + VPL + bounced) lights the
+     * objects too (render/bounce/objlight.h; issue 12 part 3). Default true. */
+    bool receiver_light_on_objects;
 } lr_render_settings;
 
 typedef struct lr_quality {

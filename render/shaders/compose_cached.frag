@@ -4,9 +4,11 @@
 // lr_lattice_locate, the CPU twin's), times this object's cavity gain for light l (u_gain,
 // PIPELINE.md "Energy"), then L_o,l = F_t(w_o) B_l / pi (seed 003 Eq. 5), the view-dependent
 // factor. compose_object.frag is the per-pixel gather this replaces (render.surface_cache).
-// render.lpv adds the volume's indirect light on the object per pixel (lib/lpv_object.glsl).
+// render.lpv adds the volume's indirect light on the object per pixel (lib/lpv_object.glsl),
+// render.receiver_light_on_objects the receivers' light on it (lib/recv_light.glsl).
 #include "lib/material.glsl"
 #include "lib/lpv_object.glsl"
+#include "lib/recv_light.glsl"
 #ifndef LR_CACHE_LIGHTS
 #define LR_CACHE_LIGHTS LR_MAX_LIGHTS
 #endif
@@ -89,8 +91,12 @@ void main()
 #endif
     // Coverage as compose_object.frag's: 0 where the entries mostly took the fallback.
     float a = b0.a >= 0.5 ? 1.0 : 0.0;
-    o_light[0] = vec4(s * (u_gain[0] * b0.rgb + lr_lpv_obj_B(0, v_pos, no)), a);
-    o_light[1] = vec4(s * (u_gain[1] * b1.rgb + lr_lpv_obj_B(1, v_pos, no)), a);
-    o_light[2] = vec4(s * (u_gain[2] * b2.rgb + lr_lpv_obj_B(2, v_pos, no)), a);
-    o_light[3] = vec4(s * (u_gain[3] * b3.rgb + lr_lpv_obj_B(3, v_pos, no)), a);
+    o_light[0] = vec4(s * (u_gain[0] * b0.rgb + lr_lpv_obj_B(0, v_pos, no) +
+                        lr_rl_B(0, v_rlp[0], v_rlm[0], back)), a);
+    o_light[1] = vec4(s * (u_gain[1] * b1.rgb + lr_lpv_obj_B(1, v_pos, no) +
+                        lr_rl_B(1, v_rlp[1], v_rlm[1], back)), a);
+    o_light[2] = vec4(s * (u_gain[2] * b2.rgb + lr_lpv_obj_B(2, v_pos, no) +
+                        lr_rl_B(2, v_rlp[2], v_rlm[2], back)), a);
+    o_light[3] = vec4(s * (u_gain[3] * b3.rgb + lr_lpv_obj_B(3, v_pos, no) +
+                        lr_rl_B(3, v_rlp[3], v_rlm[3], back)), a);
 }

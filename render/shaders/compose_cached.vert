@@ -5,7 +5,9 @@
 // lattice, a_lat = (first cache entry, resolution R; render/mesh/lattice.h), passes flat, so
 // that compose_cached.frag finds the point's three cache entries by arithmetic. GLSL ES 3.1
 // has no gl_PrimitiveID in fragment shaders, hence the flat varying. Position and normal pass
-// through as in mesh.vert.
+// through as in mesh.vert. The receivers' light on the object per corner
+// (lib/recv_light_vert.glsl, its texture laid out by corner 3 t + c).
+#include "lib/recv_light_vert.glsl"
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_nrm;
 layout(location = 2) in ivec2 a_lat;
@@ -22,5 +24,6 @@ void main()
     int c = gl_VertexID % 3;
     v_uv = vec2(c == 1 ? 1.0 : 0.0, c == 2 ? 1.0 : 0.0);
     v_lat = a_lat;
+    lr_rl_vertex(gl_VertexID);
     gl_Position = u_vp * vec4(a_pos, 1.0);
 }

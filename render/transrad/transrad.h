@@ -191,4 +191,19 @@ void lr_tr_map_radiosity(const lr_tr *t, int slot, size_t p, double out[3]);
 /* Power per band that leaves the scene (escaping rays) in slot's solution, W per W/sr. */
 void lr_tr_escaped_power(const lr_tr *t, int slot, double out[3]);
 
+/* A ray's first hit over every surface (the solver's own caster, cast.c): false when it leaves
+ * the scene; n 0 for a back face (absorbed: a one-sided receiver from behind, a wall from
+ * inside); else the hit surface and n patches with weights summing to 1: the hit's patch on a
+ * mesh, on a plane the up to 4 cells around it, bilinear between their centres (clamped at
+ * the edges, as the receivers' grid is written). */
+typedef struct lr_tr_cast_hit {
+    int surface, n;
+    size_t patch[4];
+    double w[4];
+    double dist;
+} lr_tr_cast_hit;
+bool lr_tr_cast(const lr_tr *t, lr_vec3 o, lr_vec3 d, lr_tr_cast_hit *h);
+/* The ray-origin offset the solver uses off a surface (scale of the scene). */
+double lr_tr_ray_eps(const lr_tr *t);
+
 #endif
