@@ -12,6 +12,7 @@
 #include "render/cpu/maps.h"
 #include "render/cpu/parallel.h"
 #include "render/bounce/rbounce.h"
+#include "render/openings/openings.h"
 #include "render/cpu/recv_grid.h"
 #include "render/lpv/scene_lpv.h"
 #include "render/transrad/tr_scene.h"
@@ -236,6 +237,25 @@ static void grid_item(void *p, long item)
         for (int c = 0; X && c < 3; c++)
             E[c] += r->I[l][c] * X[3 * (size_t)k + (size_t)c];
     }
+}
+
+/* render.opening_light (render/openings/openings.h): the inner faces' light through the
+ * openings, per light at unit intensity times the intensity, added to the grid before the
+ * bounce reads it (as the GPU's irradiance pass adds the same grids to its own). */
+static int opening_light(rctx *r, lr_err *e)
+{
+    lr_openings *op = NULL;
+    int rc = lr_openings_update(&op, r->s, r->d->threads, e);
+    const size_t n = (size_t)LR_RECV_GRID * LR_RECV_GRID;
+    for (int i = 0; i < r->nrecv && !rc && op; i++)
+        for (int l = 0; l < r->nlight; l++) {
+            const float *X = lr_openings_grid(op, i, l);
+            for (size_t k = 0; X && r->grid[i] && k < n; k++)
+                for (int c = 0; c < 3; c++)
+                    r->grid[i][6 * k + (size_t)c] += r->I[l][c] * X[3 * k + (size_t)c];
+        }
+    lr_openings_destroy(op);
+    return rc;
 }
 
 /* render.receiver_bounce (render/bounce/rbounce.h): the receivers' radiosity with
@@ -632,7 +652,7 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
             }
         }
         lr_cpu_parallel_for((long)(r.nrecv * n), d->threads, grid_item, &r);
-        if ((rc = receiver_bounce(&r, e)))
+        if ((rc = opening_light(&r, e)) || (rc = receiver_bounce(&r, e)))
             goto fail;
     }
     if (!ref && lr_scene_render(s)->lpv > 0 && r.nrecv > 0 &&

@@ -24,6 +24,9 @@ typedef struct lr_irradiance {
      * after the grids are drawn they are read back, the receivers' radiosity solved per light
      * and the bounce added to them; NULL when off. */
     struct lr_rbounce *rb;
+    /* The objects' inner faces' light through their openings (render/openings/openings.h;
+     * render.opening_light): added to the read-back grids before the bounce; NULL when off. */
+    struct lr_openings *op;
 } lr_irradiance;
 
 /* Frees the grids (they are laid out again at the next run). */

@@ -230,6 +230,9 @@ typedef struct lr_render_settings {
     /* Receiver inter-reflection for every model (render/bounce/, issue 12 part 4): the plane
      * receivers' radiosity solve, its bounce added to the receiver irradiance grid. */
     bool receiver_bounce;
+    /* The light the objects' inner faces send to the plane receivers through their openings
+     * (render/openings/, issue 12 part 3), added to the receiver irradiance grid. */
+    bool opening_light;
 } lr_render_settings;
 
 typedef struct lr_quality {
