@@ -40,10 +40,10 @@
 #include "render/scene/scene.h"
 
 /* Receiver cells, mm (at most LR_OPENINGS_MAX_CELLS a side). */
-#define LR_OPENINGS_CELL_MM 20.0
+#define LR_OPENINGS_CELL_MM 30.0
 #define LR_OPENINGS_MAX_CELLS 64
 /* Emitter points drawn per object (uniform by area over all of it; the inner ones are kept). */
-#define LR_OPENINGS_POINTS 1024
+#define LR_OPENINGS_POINTS 512
 /* Samples per band of each emitter's B (lr_cpu_radiosity, LR_CPU_REFERENCE). */
 #define LR_OPENINGS_N 64
 
