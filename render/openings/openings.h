@@ -45,7 +45,7 @@
 /* Emitter points drawn per object (uniform by area over all of it; the inner ones are kept). */
 #define LR_OPENINGS_POINTS 512
 /* Samples per band of each emitter's B (lr_cpu_radiosity, LR_CPU_REFERENCE). */
-#define LR_OPENINGS_N 64
+#define LR_OPENINGS_N 256
 
 typedef struct lr_openings lr_openings;
 
