@@ -213,6 +213,8 @@ static void test_lampshade(void **state)
     assert_int_equal(lr_scene_set(s, "lights[0].intensity", "0.5", NULL, &e), LR_OK);
     assert_int_equal(lr_openings_update(&op, s, 0, &e), LR_OK);
     lr_openings_times(op, &build_s, &light_s);
+    printf("lampshade: after an intensity change: kernel %.3f s, B and grids %.3f s\n", build_s,
+           light_s);
     assert_true(build_s == 0.0);
     assert_true(grid_sum(lr_openings_grid(op, 0, 0)) == st);
     /* A light move recomputes B (not the kernel) and changes the light. */
