@@ -65,6 +65,7 @@ typedef struct rctx {
     lr_lpv_objfield **lpv_obj;
     double *lpv_k;
     lr_tr_scene *tr;     /* translucent radiosity (PASS): the solver's B and receiver extra */
+    lr_openings *op;     /* render.opening_light (render/openings/openings.h); NULL: off */
     lr_dscene *dscene; /* diffusion_grid objects' fields (NULL when the scene has none) */
     /* Per light, the lights the transport sees frame by frame (render/area/frames.h): an area
      * light's frame samples (PASS: the `frames` accumulated; REFERENCE: LR_REF_AREA_FRAMES),
@@ -244,18 +245,16 @@ static void grid_item(void *p, long item)
  * bounce reads it (as the GPU's irradiance pass adds the same grids to its own). */
 static int opening_light(rctx *r, lr_err *e)
 {
-    lr_openings *op = NULL;
-    int rc = lr_openings_update(&op, r->s, r->d->threads, e);
     const size_t n = (size_t)LR_RECV_GRID * LR_RECV_GRID;
-    for (int i = 0; i < r->nrecv && !rc && op; i++)
+    for (int i = 0; i < r->nrecv && r->op; i++)
         for (int l = 0; l < r->nlight; l++) {
-            const float *X = lr_openings_grid(op, i, l);
+            const float *X = lr_openings_grid(r->op, i, l);
             for (size_t k = 0; X && r->grid[i] && k < n; k++)
                 for (int c = 0; c < 3; c++)
                     r->grid[i][6 * k + (size_t)c] += r->I[l][c] * X[3 * k + (size_t)c];
         }
-    lr_openings_destroy(op);
-    return rc;
+    (void)e;
+    return LR_OK;
 }
 
 /* render.receiver_bounce (render/bounce/rbounce.h): the receivers' radiosity with
@@ -411,6 +410,13 @@ static void pixel_item(void *p, long item)
             for (int o = 0; o < r->nobj; o++)
                 lr_cpu_vpl_irradiance_vis(vis, r->vpl + (size_t)o * r->nvpl, r->nvpl,
                                           lr_scene_object_at(r->s, o)->coeffs.eta, x, n, E, EV);
+            /* render.opening_light at the pixel itself (the PASS grid's cells, exactly). */
+            for (int l = 0; r->op && l < r->nlight; l++) {
+                double Eo[3] = {0, 0, 0};
+                lr_openings_irradiance_at(r->op, r->s, l, x, n, Eo);
+                for (int c = 0; c < 3; c++)
+                    E[c] += r->I[l][c] * Eo[c];
+            }
         }
         for (int c = 0; c < 3; c++) {
             L[c] = rc->albedo[c] / M_PI * E[c];
@@ -623,6 +629,9 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
         lr_cpu_parallel_for(r.cache_first[r.nobj], d->threads, cache_item, &r);
     }
     int nv = 0;
+    /* render.opening_light: both modes (PASS through the grid, REFERENCE per pixel). */
+    if (r.nvpl > 0 && (rc = lr_openings_update(&r.op, s, d->threads, e)))
+        goto fail;
     if (r.nvpl > 0) {
         for (int o = 0; o < r.nobj; o++)
             lr_cpu_vpl_place(lr_scene_object_at(s, o), r.nvpl, r.vpl + (size_t)o * r.nvpl);
@@ -677,6 +686,7 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
     }
 fail:
     lr_tr_scene_destroy(r.tr);
+    lr_openings_destroy(r.op);
     for (int o = 0; o < r.nobj && r.ref; o++)
         lr_refined_free(&r.ref[o]);
     for (int o = 0; o < r.nobj && r.cache; o++)

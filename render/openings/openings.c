@@ -246,34 +246,46 @@ typedef struct kernel_ctx {
     const lr_scene *s;
 } kernel_ctx;
 
-/* Row p of the kernel: every emitter's geometry term to cell centre p, 0 where hidden. */
+/* Emitter m's geometry term to receiver point x (normal nx), 0 where hidden. */
+static double kernel_at(const emitter *m, const lr_scene *s, lr_vec3 x, lr_vec3 nx)
+{
+    lr_vec3 d = lr_v3_sub(x, m->x);
+    double d2 = lr_v3_dot(d, d), dist = sqrt(d2);
+    if (!(dist > 0.0))
+        return 0.0;
+    lr_vec3 w = lr_v3_scale(d, 1.0 / dist);
+    double cj = lr_v3_dot(m->n, w), cx = -lr_v3_dot(nx, w);
+    if (!(cj > 0.0) || !(cx > 0.0))
+        return 0.0;
+    for (int i = 0; i < lr_scene_object_count(s); i++) {
+        const lr_scene_object *o = lr_scene_object_at(s, i);
+        if (lr_bvh_occluded(o->bvh, m->x, w, 1e-6 * o->radius, dist * (1.0 - 1e-9)))
+            return 0.0;
+    }
+    double eta = lr_scene_object_at(s, m->obj)->coeffs.eta;
+    return lr_fresnel_transmittance(cj, eta) / M_PI * m->a * cj * cx / fmax(d2, m->a);
+}
+
+/* Row p of the kernel: every emitter's geometry term to cell centre p. */
 static void kernel_item(void *ctx, long p)
 {
     kernel_ctx *k = ctx;
     lr_openings *op = k->op;
-    lr_vec3 x = op->px[p], nx = op->pn[p];
     float *row = op->K + (size_t)p * op->ne;
-    for (size_t j = 0; j < op->ne; j++) {
-        const emitter *m = &op->em[j];
-        row[j] = 0.0f;
-        lr_vec3 d = lr_v3_sub(x, m->x);
-        double d2 = lr_v3_dot(d, d), dist = sqrt(d2);
-        if (!(dist > 0.0))
+    for (size_t j = 0; j < op->ne; j++)
+        row[j] = (float)kernel_at(&op->em[j], k->s, op->px[p], op->pn[p]);
+}
+
+void lr_openings_irradiance_at(const lr_openings *op, const lr_scene *s, int l, lr_vec3 x,
+                               lr_vec3 n, double E[3])
+{
+    const double *B = lr_openings_B(op, l);
+    for (size_t j = 0; B && j < op->ne; j++) {
+        if (!(B[3 * j] > 0.0 || B[3 * j + 1] > 0.0 || B[3 * j + 2] > 0.0))
             continue;
-        lr_vec3 w = lr_v3_scale(d, 1.0 / dist);
-        double cj = lr_v3_dot(m->n, w), cx = -lr_v3_dot(nx, w);
-        if (!(cj > 0.0) || !(cx > 0.0))
-            continue;
-        bool hidden = false;
-        for (int i = 0; i < lr_scene_object_count(k->s) && !hidden; i++) {
-            const lr_scene_object *o = lr_scene_object_at(k->s, i);
-            hidden = lr_bvh_occluded(o->bvh, m->x, w, 1e-6 * o->radius, dist * (1.0 - 1e-9));
-        }
-        if (hidden)
-            continue;
-        double eta = lr_scene_object_at(k->s, m->obj)->coeffs.eta;
-        row[j] = (float)(lr_fresnel_transmittance(cj, eta) / M_PI * m->a * cj * cx /
-                         fmax(d2, m->a));
+        double k = kernel_at(&op->em[j], s, x, n);
+        for (int c = 0; k > 0.0 && c < 3; c++)
+            E[c] += k * B[3 * j + (size_t)c];
     }
 }
 

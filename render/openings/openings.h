@@ -62,6 +62,12 @@ void lr_openings_destroy(lr_openings *op);
  * texel, s + LR_RECV_GRID t; W/mm^2 per W/sr), NULL when r has no grid or l is out of range. */
 const float *lr_openings_grid(const lr_openings *op, int r, int l);
 
+/* Light l's irradiance at receiver point x (unit normal n), per band, added into E: the
+ * kernel's sum evaluated at x itself (a ray cast per emitter; the CPU twin's REFERENCE mode,
+ * which sums the VPLs per pixel too, uses it instead of the cells' grid). */
+void lr_openings_irradiance_at(const lr_openings *op, const lr_scene *s, int l, lr_vec3 x,
+                               lr_vec3 n, double E[3]);
+
 /* Diagnosis and tests. Emitters kept (all objects) and their total area, mm^2. */
 size_t lr_openings_emitter_count(const lr_openings *op, double *area);
 /* Emitter j's point, the normal of its emitting side and the area it stands for (false when
