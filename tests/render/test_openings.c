@@ -205,6 +205,29 @@ static void test_lampshade(void **state)
         E0 += w[i] * t0[3 * (size_t)idx[i] + 1];
     printf("lampshade: E under the shade (G, unit intensity) %.4g W/mm^2\n", E0);
     assert_true(E0 > 0.0);
+    /* At the cells' centres the per-point sum (the twin's REFERENCE mode) is the kernel's
+     * (float entries: 1e-5). */
+    int nu, nv;
+    assert_true(lr_openings_cells(op, 0, &nu, &nv));
+    double *X = malloc(3 * (size_t)nu * (size_t)nv * sizeof *X);
+    assert_non_null(X);
+    lr_err e0 = {0};
+    assert_int_equal(lr_openings_apply(op, 0, lr_openings_B(op, 0), X, &e0), LR_OK);
+    int checked = 0;
+    for (int v = 0; v < nv; v += 3)
+        for (int u = 0; u < nu; u += 3) {
+            lr_vec3 x = lr_v3_add(f.c, lr_v3_add(lr_v3_scale(f.a, ((u + 0.5) / nu - 0.5) * f.w),
+                                                 lr_v3_scale(f.b, ((v + 0.5) / nv - 0.5) * f.h)));
+            double Ex[3] = {0, 0, 0};
+            lr_openings_irradiance_at(op, s, 0, x, lr_scene_receiver_at(s, 0)->normal, Ex);
+            for (int c = 0; c < 3; c++) {
+                double k = X[3 * ((size_t)v * nu + u) + c];
+                assert_true(fabs(Ex[c] - k) <= 1e-5 * k + 1e-30);
+            }
+            checked += X[3 * ((size_t)v * nu + u) + 1] > 0.0;
+        }
+    assert_true(checked > 10);
+    free(X);
     double build_s, light_s;
     lr_openings_times(op, &build_s, &light_s);
     printf("lampshade: kernel %.2f s, B and grids %.2f s\n", build_s, light_s);
