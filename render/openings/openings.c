@@ -314,6 +314,11 @@ static int build(lr_openings *op, const lr_scene *s, int threads, lr_err *e)
         maxc = c > maxc ? c : maxc;
     }
     op->np = np;
+    if (op->ne > 0 && np > LR_OPENINGS_MAX_ENTRIES / op->ne)
+        return lr_err_set(e, LR_EINVAL,
+                          "openings: %s: %zu receiver cells x %zu emitters exceed the kernel's "
+                          "%u entries (render.opening_light: fewer or smaller receivers)",
+                          lr_scene_name(s), np, op->ne, (unsigned)LR_OPENINGS_MAX_ENTRIES);
     op->px = malloc((np ? np : 1) * sizeof *op->px);
     op->pn = malloc((np ? np : 1) * sizeof *op->pn);
     op->K = malloc((np ? np : 1) * (op->ne ? op->ne : 1) * sizeof *op->K);

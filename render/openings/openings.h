@@ -44,6 +44,8 @@
 #define LR_OPENINGS_MAX_CELLS 64
 /* Emitter points drawn per object (uniform by area over all of it; the inner ones are kept). */
 #define LR_OPENINGS_POINTS 512
+/* Kernel budget, entries (4 bytes each: 64 MB); a scene beyond it is refused. */
+#define LR_OPENINGS_MAX_ENTRIES (16u << 20)
 /* Samples per band of each emitter's B (lr_cpu_radiosity, LR_CPU_REFERENCE). */
 #define LR_OPENINGS_N 256
 
