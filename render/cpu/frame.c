@@ -13,6 +13,7 @@
 #include "render/cpu/parallel.h"
 #include "render/bounce/objlight.h"
 #include "render/bounce/rbounce.h"
+#include "render/openings/openings.h"
 #include "render/cpu/recv_grid.h"
 #include "render/lpv/scene_lpv.h"
 #include "render/transrad/tr_scene.h"
@@ -73,6 +74,7 @@ typedef struct rctx {
      * light on the objects (render/bounce/objlight.h), as the GPU's compose pass applies. */
     lr_rbounce *rb;
     double *rl_k;
+    lr_openings *op;     /* render.opening_light (render/openings/openings.h); NULL: off */
     lr_dscene *dscene; /* diffusion_grid objects' fields (NULL when the scene has none) */
     /* Per light, the lights the transport sees frame by frame (render/area/frames.h): an area
      * light's frame samples (PASS: the `frames` accumulated; REFERENCE: LR_REF_AREA_FRAMES),
@@ -245,6 +247,23 @@ static void grid_item(void *p, long item)
         for (int c = 0; X && c < 3; c++)
             E[c] += r->I[l][c] * X[3 * (size_t)k + (size_t)c];
     }
+}
+
+/* render.opening_light (render/openings/openings.h): the inner faces' light through the
+ * openings, per light at unit intensity times the intensity, added to the grid before the
+ * bounce reads it (as the GPU's irradiance pass adds the same grids to its own). */
+static int opening_light(rctx *r, lr_err *e)
+{
+    const size_t n = (size_t)LR_RECV_GRID * LR_RECV_GRID;
+    for (int i = 0; i < r->nrecv && r->op; i++)
+        for (int l = 0; l < r->nlight; l++) {
+            const float *X = lr_openings_grid(r->op, i, l);
+            for (size_t k = 0; X && r->grid[i] && k < n; k++)
+                for (int c = 0; c < 3; c++)
+                    r->grid[i][6 * k + (size_t)c] += r->I[l][c] * X[3 * k + (size_t)c];
+        }
+    (void)e;
+    return LR_OK;
 }
 
 /* render.receiver_bounce (render/bounce/rbounce.h): the receivers' radiosity with
@@ -445,6 +464,13 @@ static void pixel_item(void *p, long item)
             for (int o = 0; o < r->nobj; o++)
                 lr_cpu_vpl_irradiance_vis(vis, r->vpl + (size_t)o * r->nvpl, r->nvpl,
                                           lr_scene_object_at(r->s, o)->coeffs.eta, x, n, E, EV);
+            /* render.opening_light at the pixel itself (the PASS grid's cells, exactly). */
+            for (int l = 0; r->op && l < r->nlight; l++) {
+                double Eo[3] = {0, 0, 0};
+                lr_openings_irradiance_at(r->op, r->s, l, x, n, Eo);
+                for (int c = 0; c < 3; c++)
+                    E[c] += r->I[l][c] * Eo[c];
+            }
         }
         if (!r->d->no_vpl && r->bounce && r->bounce[idx]) {
             /* The receivers' bounce (receiver_bounce), bilinear like the GPU's grid. */
@@ -668,6 +694,9 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
         lr_cpu_parallel_for(r.cache_first[r.nobj], d->threads, cache_item, &r);
     }
     int nv = 0;
+    /* render.opening_light: both modes (PASS through the grid, REFERENCE per pixel). */
+    if (r.nvpl > 0 && (rc = lr_openings_update(&r.op, s, d->threads, e)))
+        goto fail;
     if (r.nvpl > 0) {
         for (int o = 0; o < r.nobj; o++)
             lr_cpu_vpl_place(lr_scene_object_at(s, o), r.nvpl, r.vpl + (size_t)o * r.nvpl);
@@ -699,7 +728,7 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
             }
         }
         lr_cpu_parallel_for((long)(r.nrecv * n), d->threads, grid_item, &r);
-        if ((rc = receiver_bounce(&r, e)))
+        if ((rc = opening_light(&r, e)) || (rc = receiver_bounce(&r, e)))
             goto fail;
         if (ref) { /* the reference's pixels sum the VPLs themselves */
             for (int i = 0; i < r.nrecv; i++)
@@ -732,6 +761,7 @@ fail:
     lr_rbounce_destroy(r.rb);
     free(r.rl_k);
     lr_tr_scene_destroy(r.tr);
+    lr_openings_destroy(r.op);
     for (int o = 0; o < r.nobj && r.ref; o++)
         lr_refined_free(&r.ref[o]);
     for (int o = 0; o < r.nobj && r.cache; o++)

@@ -13,6 +13,7 @@
 #include "render/bounce/objlight.h"
 #include "render/bounce/rbounce.h"
 #include "render/cpu/recv_grid.h"
+#include "render/openings/openings.h"
 #include "render/passes/radiosity.h"
 
 /* Uploads the translucent-radiosity extra of every plane receiver and light (tr_scene.h) into
@@ -142,10 +143,14 @@ void lr_irradiance_bind_objects(const lr_irradiance *irr, const lr_pass_ctx *c, 
 static int bounce(lr_irradiance *irr, const lr_pass_ctx *c, lr_err *e)
 {
     int rc = lr_rbounce_update(&irr->rb, c->scene, e);
-    if (rc || !irr->rb) {
-        rl_free(irr);
+    /* render.opening_light (render/openings/openings.h): rebuilt only when the geometry, a
+     * light or a material changed; its grid joins E_vpl before the bounce reads it. */
+    if (!rc)
+        rc = lr_openings_update(&irr->op, c->scene, 0, e);
+    if (rc || !irr->rb)
+        rl_free(irr); /* no bounce: no receiver light on the objects either */
+    if (rc || (!irr->rb && !irr->op))
         return rc;
-    }
     const size_t n = (size_t)LR_RECV_GRID * LR_RECV_GRID;
     int nr = irr->n_receivers;
     float *buf = malloc((size_t)(nr ? nr : 1) * 4 * n * sizeof *buf);
@@ -157,18 +162,23 @@ static int bounce(lr_irradiance *irr, const lr_pass_ctx *c, lr_err *e)
                 continue;
             float *g = buf + (size_t)i * 4 * n;
             rc = lr_fb_read(irr->fb[i], l, 0, 0, LR_RECV_GRID, LR_RECV_GRID, g, e);
-            lr_rbounce_vpl_f(irr->rb, i, rc ? NULL : g, 4);
+            const float *Eo = rc ? NULL : lr_openings_grid(irr->op, i, l);
+            for (size_t k = 0; Eo && k < n; k++)
+                for (int b = 0; b < 3; b++)
+                    g[4 * k + (size_t)b] += Eo[3 * k + (size_t)b];
+            if (irr->rb)
+                lr_rbounce_vpl_f(irr->rb, i, rc ? NULL : g, 4);
         }
         double w[LR_MAX_LIGHTS][3] = {{0}};
         w[l][0] = w[l][1] = w[l][2] = 1.0; /* unit intensity: the dimmer stays blend-only */
-        if (!rc)
+        if (!rc && irr->rb)
             rc = lr_rbounce_solve(irr->rb, l, (const double(*)[3])w, e);
         for (int i = 0; i < nr && !rc; i++) {
-            const float *Eb = lr_rbounce_grid(irr->rb, i, l);
-            if (irr->layer[i] < 0 || !Eb)
+            const float *Eb = irr->rb ? lr_rbounce_grid(irr->rb, i, l) : NULL;
+            if (irr->layer[i] < 0 || (!Eb && !lr_openings_grid(irr->op, i, l)))
                 continue;
             float *g = buf + (size_t)i * 4 * n;
-            for (size_t k = 0; k < n; k++)
+            for (size_t k = 0; Eb && k < n; k++)
                 for (int b = 0; b < 3; b++)
                     g[4 * k + (size_t)b] += Eb[3 * k + (size_t)b];
             rc = lr_tex_upload(irr->grid, irr->layer[i] + l, g, e);
@@ -186,6 +196,8 @@ void lr_irradiance_free(lr_irradiance *irr)
     rl_free(irr);
     lr_rbounce_destroy(irr->rb);
     irr->rb = NULL;
+    lr_openings_destroy(irr->op);
+    irr->op = NULL;
     for (int i = 0; i < LR_MAX_RECEIVERS; i++) {
         lr_fb_destroy(irr->fb[i]);
         irr->fb[i] = NULL;

@@ -31,6 +31,9 @@ typedef struct lr_irradiance {
      * the unindexed mesh (rlu, compose_cached.vert). NULL when off. */
     lr_tex *rl[LR_MAX_OBJECTS], *rlu[LR_MAX_OBJECTS];
     int rl_rows[LR_MAX_OBJECTS], rlu_rows[LR_MAX_OBJECTS];
+    /* The objects' inner faces' light through their openings (render/openings/openings.h;
+     * render.opening_light): added to the read-back grids before the bounce; NULL when off. */
+    struct lr_openings *op;
 } lr_irradiance;
 
 #define LR_RL_TEX_WIDTH 1024 /* render/shaders/lib/recv_light_vert.glsl */

@@ -344,6 +344,11 @@ static const lr_field render_fields[] = {
     {"receiver_light_on_objects", LR_FT_BOOL, 0, RS(receiver_light_on_objects), .dflt = {1},
      .dirty = SET,
      .help = "with receiver_bounce: the receivers' light (direct, VPL, bounced) lights the objects"},
+    /* The objects' inner faces' light through their openings (render/openings/README.md): it
+     * joins the receiver irradiance grid, so a settings change. */
+    {"opening_light", LR_FT_BOOL, 0, RS(opening_light), .dflt = {0}, .dirty = SET,
+     .help = "light a shade's or cup's inner face sends to the plane receivers through its "
+             "openings (issue 12)"},
 };
 
 const lr_record_desc lr_scene_render_desc = {"render", "render", NULL, NULL, NULL, NULL,

@@ -233,6 +233,9 @@ typedef struct lr_render_settings {
     /* With receiver_bounce: the receivers' radiosity (direct + VPL + bounced) lights the
      * objects too (render/bounce/objlight.h; issue 12 part 3). Default true. */
     bool receiver_light_on_objects;
+    /* The light the objects' inner faces send to the plane receivers through their openings
+     * (render/openings/, issue 12 part 3), added to the receiver irradiance grid. */
+    bool opening_light;
 } lr_render_settings;
 
 typedef struct lr_quality {

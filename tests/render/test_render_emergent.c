@@ -34,8 +34,10 @@ typedef struct probe {
 static void check_scene(const char *name, const probe *probes, int np)
 {
     /* The VPLs' light alone: the receivers' own bounce (render/bounce, on in the shipped
-     * candle scenes) is test_rbounce's. */
-    static const char *const no_bounce[] = {"render.receiver_bounce=false", NULL};
+     * candle scenes) is test_rbounce's, the light through the openings (render/openings, on in
+     * the shipped lamp shade) test_openings'. */
+    static const char *const no_bounce[] = {"render.receiver_bounce=false",
+                                            "render.opening_light=false", NULL};
     lr_scene *s = lr_test_scene(name, lr_test_small_settings, no_bounce);
     lr_renderer *dark = lr_test_renderer(gl, s, W, H, true, 1);
     lr_test_converge(dark, 8);
