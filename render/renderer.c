@@ -553,7 +553,9 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
     if (dirty & (LR_DIRTY_GEOMETRY | LR_DIRTY_SETTINGS | LR_DIRTY_RECEIVERS | LR_DIRTY_MATERIAL)) {
         if ((rc = lr_pass_objects_upload(&r->objs, r->scene, e)))
             return rc;
-        lr_irradiance_free(&r->irr); /* receivers may have changed kind: grids laid out again */
+        /* Receivers may have changed kind: grids laid out again (the bounce's and the
+         * openings' own state stays: keyed, it rebuilds only what changed). */
+        lr_irradiance_free_grids(&r->irr);
     }
     lr_pass_objects_update_coeffs(&r->objs, r->scene);
     /* The cavity gain depends on the light, the geometry and the material: measured (a few

@@ -191,13 +191,9 @@ static int bounce(lr_irradiance *irr, const lr_pass_ctx *c, lr_err *e)
     return rc;
 }
 
-void lr_irradiance_free(lr_irradiance *irr)
+void lr_irradiance_free_grids(lr_irradiance *irr)
 {
     rl_free(irr);
-    lr_rbounce_destroy(irr->rb);
-    irr->rb = NULL;
-    lr_openings_destroy(irr->op);
-    irr->op = NULL;
     for (int i = 0; i < LR_MAX_RECEIVERS; i++) {
         lr_fb_destroy(irr->fb[i]);
         irr->fb[i] = NULL;
@@ -211,9 +207,18 @@ void lr_irradiance_free(lr_irradiance *irr)
     irr->valid = false;
 }
 
+void lr_irradiance_free(lr_irradiance *irr)
+{
+    lr_irradiance_free_grids(irr);
+    lr_rbounce_destroy(irr->rb);
+    irr->rb = NULL;
+    lr_openings_destroy(irr->op);
+    irr->op = NULL;
+}
+
 static int alloc(lr_irradiance *irr, const lr_pass_ctx *c, lr_err *e)
 {
-    lr_irradiance_free(irr);
+    lr_irradiance_free_grids(irr); /* the bounce and the openings keep what still holds */
     int nl = c->n_lights, nr = c->objs->n_receivers, planes = 0, rc;
     for (int i = 0; i < nr; i++) {
         lr_recv_grid_frame f;

@@ -40,6 +40,11 @@ typedef struct lr_irradiance {
 
 /* Frees the grids (they are laid out again at the next run). */
 void lr_irradiance_free(lr_irradiance *irr);
+/* The grids and textures alone: the receiver bounce's patches, F and per-vertex rows and the
+ * openings' geometry stay (their own keys rebuild them when the geometry, the receivers or a
+ * light change), so a material change (which lays the grids out again) does not rebuild them:
+ * the objects' rows cost about a second per change on llvmpipe's machine. */
+void lr_irradiance_free_grids(lr_irradiance *irr);
 /* The grids from the VPLs v (rad: their visibility scale). */
 int lr_irradiance_run(lr_irradiance *irr, const lr_pass_ctx *c, const lr_vpl *v,
                       const lr_radiosity *rad, lr_err *e);
