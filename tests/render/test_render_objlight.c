@@ -23,6 +23,7 @@
 #include "render/image/image.h"
 #include "render/renderer.h"
 #include "tests/support/gl.h"
+#include "tests/support/pixel_hit.h"
 #include "tests/support/near.h"
 #include "tests/support/render.h"
 
@@ -31,27 +32,9 @@
 
 LR_TEST_GL_FIXTURE(gl) /* tests/support/gl.h: setup(), teardown() */
 
-/* What the ray through pixel (x, y) (rows top down) meets first: 0 an object, 1 + i receiver
- * i, -1 nothing. */
 static int hit_at(const lr_scene *s, int x, int y)
 {
-    lr_vec3 org, dir;
-    lr_cpu_camera_ray(s, W, H, x, y, &org, &dir);
-    lr_hit h;
-    double best = INFINITY;
-    int who = -1;
-    for (int i = 0; i < lr_scene_object_count(s); i++)
-        if (lr_bvh_intersect(lr_scene_object_at(s, i)->bvh, org, dir, 0, best, &h) && h.t < best) {
-            best = h.t;
-            who = 0;
-        }
-    for (int i = 0; i < lr_scene_receiver_count(s); i++)
-        if (lr_bvh_intersect(lr_scene_receiver_at(s, i)->bvh, org, dir, 0, best, &h) &&
-            h.t < best) {
-            best = h.t;
-            who = 1 + i;
-        }
-    return who;
+    return lr_test_pixel_hit(s, W, H, x, y);
 }
 
 static void set(lr_scene *s, const char *k, const char *v)

@@ -22,6 +22,7 @@
 #include "render/image/image.h"
 #include "render/renderer.h"
 #include "tests/support/gl.h"
+#include "tests/support/pixel_hit.h"
 #include "tests/support/near.h"
 #include "tests/support/render.h"
 
@@ -30,27 +31,9 @@
 
 LR_TEST_GL_FIXTURE(gl) /* tests/support/gl.h: setup(), teardown() */
 
-/* The receiver the ray through pixel (x, y) (rows top down) meets first; -1 for an object or
- * nothing. */
 static int receiver_at(const lr_scene *s, int x, int y)
 {
-    lr_vec3 org, dir;
-    lr_cpu_camera_ray(s, W, H, x, y, &org, &dir);
-    lr_hit h;
-    double best = INFINITY;
-    int who = -1;
-    for (int i = 0; i < lr_scene_object_count(s); i++)
-        if (lr_bvh_intersect(lr_scene_object_at(s, i)->bvh, org, dir, 0, best, &h) && h.t < best) {
-            best = h.t;
-            who = -1;
-        }
-    for (int i = 0; i < lr_scene_receiver_count(s); i++)
-        if (lr_bvh_intersect(lr_scene_receiver_at(s, i)->bvh, org, dir, 0, best, &h) &&
-            h.t < best) {
-            best = h.t;
-            who = i;
-        }
-    return who;
+    return lr_test_pixel_receiver(s, W, H, x, y);
 }
 
 static lr_image twin_mode(lr_scene *s, bool bounce, bool no_vpl, enum lr_cpu_sampler mode)
