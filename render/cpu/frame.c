@@ -313,6 +313,22 @@ static int receiver_bounce(rctx *r, lr_err *e)
     return LR_OK;
 }
 
+/* Adds w times the bilinear value at x of a receiver grid (LR_RECV_GRID^2 texels, `stride`
+ * values each, the three read from `off`), as the GPU samples its grids: over texel centres. */
+static void grid_bilinear_add(const lr_receiver *rc, lr_vec3 x, const double *g, int stride,
+                              int off, const double w[3], double E[3])
+{
+    lr_recv_grid_frame f;
+    if (!lr_recv_grid_frame_of(rc, &f))
+        return;
+    int ti[4];
+    double tw[4];
+    lr_recv_grid_taps(&f, x, ti, tw);
+    for (int q = 0; q < 4; q++)
+        for (int c = 0; c < 3; c++)
+            E[c] += w[c] * tw[q] * g[(size_t)stride * (size_t)ti[q] + (size_t)off + (size_t)c];
+}
+
 /* render.receiver_light_on_objects: the receivers' light on object o at the camera ray's hit
  * of its triangle (barycentrics, as the GPU interpolates its per-vertex varyings), on the side
  * the GPU takes (gl_FrontFacing: the triangle's winding against the ray), already weighted by
@@ -435,30 +451,16 @@ static void pixel_item(void *p, long item)
             for (int c = 0; c < 3; c++)
                 E[c] += r->I[l][c] * ed;
         }
+        static const double one[3] = {1.0, 1.0, 1.0};
         for (int l = 0; r->lpv && l < r->nlight; l++) {
             const double *g = r->lpv[(size_t)idx * r->nlight + l];
-            lr_recv_grid_frame f;
-            if (!g || !lr_recv_grid_frame_of(rc, &f))
-                continue;
-            int ti[4];
-            double tw[4];
-            lr_recv_grid_taps(&f, x, ti, tw);
-            for (int q = 0; q < 4; q++)
-                for (int c = 0; c < 3; c++)
-                    E[c] += r->I[l][c] * tw[q] * g[3 * (size_t)ti[q] + c];
+            if (g)
+                grid_bilinear_add(rc, x, g, 3, 0, r->I[l], E);
         }
         if (!r->d->no_vpl && r->grid && r->grid[idx]) {
-            /* The GPU's receiver irradiance grid: bilinear over texel centres. */
-            lr_recv_grid_frame f;
-            lr_recv_grid_frame_of(rc, &f);
-            int ti[4];
-            double tw[4];
-            lr_recv_grid_taps(&f, x, ti, tw);
-            for (int q = 0; q < 4; q++)
-                for (int c = 0; c < 3; c++) {
-                    E[c] += tw[q] * r->grid[idx][6 * (size_t)ti[q] + c];
-                    EV[c] += tw[q] * r->grid[idx][6 * (size_t)ti[q] + 3 + c];
-                }
+            /* The GPU's receiver irradiance grid (E, then its variance). */
+            grid_bilinear_add(rc, x, r->grid[idx], 6, 0, one, E);
+            grid_bilinear_add(rc, x, r->grid[idx], 6, 3, one, EV);
         } else if (!r->d->no_vpl) {
             const lr_scene *vis = lr_scene_render(r->s)->vpl_visibility ? r->s : NULL;
             for (int o = 0; o < r->nobj; o++)
@@ -472,17 +474,8 @@ static void pixel_item(void *p, long item)
                     E[c] += r->I[l][c] * Eo[c];
             }
         }
-        if (!r->d->no_vpl && r->bounce && r->bounce[idx]) {
-            /* The receivers' bounce (receiver_bounce), bilinear like the GPU's grid. */
-            lr_recv_grid_frame f;
-            lr_recv_grid_frame_of(rc, &f);
-            int ti[4];
-            double tw[4];
-            lr_recv_grid_taps(&f, x, ti, tw);
-            for (int q = 0; q < 4; q++)
-                for (int c = 0; c < 3; c++)
-                    E[c] += tw[q] * r->bounce[idx][3 * (size_t)ti[q] + c];
-        }
+        if (!r->d->no_vpl && r->bounce && r->bounce[idx]) /* the receivers' bounce */
+            grid_bilinear_add(rc, x, r->bounce[idx], 3, 0, one, E);
         for (int c = 0; c < 3; c++) {
             L[c] = rc->albedo[c] / M_PI * E[c];
             V[c] = rc->albedo[c] * rc->albedo[c] / (M_PI * M_PI) * EV[c];
