@@ -4,6 +4,7 @@
 
 #include "render/area/poisson_mesh.h"
 #include "render/cpu/rng.h"
+#include "render/mesh/area_pick.h"
 
 /* A hash grid of r_min cells: cell -> chain of sample indices. */
 typedef struct grid {
@@ -43,20 +44,6 @@ static bool far_enough(const grid *g, const lr_surface_sample *s, lr_vec3 p, dou
     return true;
 }
 
-/* Index of the first cumulative area > u (binary search). */
-static size_t pick(const double *cdf, size_t n, double u)
-{
-    size_t lo = 0, hi = n - 1;
-    while (lo < hi) {
-        size_t mid = (lo + hi) / 2;
-        if (cdf[mid] > u)
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
-    return lo;
-}
-
 int lr_poisson_mesh(const lr_mesh *m, double r_min, int cap, int max_fails, uint64_t seed,
                     lr_poisson_set *out, lr_err *e)
 {
@@ -89,7 +76,7 @@ int lr_poisson_mesh(const lr_mesh *m, double r_min, int cap, int max_fails, uint
     double r2 = r_min * r_min;
     int n = 0, fails = 0;
     while (n < cap && fails < max_fails) {
-        size_t t = pick(cdf, nt, lr_cpu_rng_next(&rng) * total);
+        size_t t = lr_cdf_pick(cdf, nt, lr_cpu_rng_next(&rng) * total);
         lr_vec3 q[3];
         lr_mesh_triangle(m, t, q);
         /* Uniform in the triangle: the square root folds the unit square onto it. */

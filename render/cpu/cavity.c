@@ -7,6 +7,7 @@
 #include "render/cpu/parallel.h"
 #include "render/cpu/radiosity.h"
 #include "render/cpu/rng.h"
+#include "render/mesh/area_pick.h"
 #include "render/mesh/bvh.h"
 #include "render/optics/optics.h"
 
@@ -41,22 +42,10 @@ static void point_item(void *p, long i)
      * mesh's triangle order), which keeps the points spread over the whole surface. */
     double pick = (i + lr_cpu_rng_next(&rng)) / k->npts;
     double s = lr_cpu_rng_next(&rng), t = lr_cpu_rng_next(&rng);
-    size_t lo = 0, hi = k->nt - 1; /* first triangle with cdf > pick */
-    while (lo < hi) {
-        size_t mid = (lo + hi) / 2;
-        if (k->cdf[mid] > pick)
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
+    size_t lo = lr_cdf_pick(k->cdf, k->nt, pick); /* first triangle with cdf > pick */
     lr_vec3 v[3];
     lr_mesh_triangle(o->mesh, lo, v);
-    if (s + t > 1.0) {
-        s = 1.0 - s;
-        t = 1.0 - t;
-    }
-    lr_vec3 x = lr_v3_add(v[0], lr_v3_add(lr_v3_scale(lr_v3_sub(v[1], v[0]), s),
-                                          lr_v3_scale(lr_v3_sub(v[2], v[0]), t)));
+    lr_vec3 x = lr_triangle_fold_point(v, s, t);
     lr_vec3 n = lr_v3_normalize(lr_v3_cross(lr_v3_sub(v[1], v[0]), lr_v3_sub(v[2], v[0])));
     /* Closed: the outward side only. Open (two-sided): both sides emit. */
     for (int side = 0; side < (o->closed ? 1 : 2); side++) {

@@ -12,6 +12,7 @@
 #include "render/cpu/radiosity.h"
 #include "render/cpu/recv_grid.h"
 #include "render/cpu/rng.h"
+#include "render/mesh/area_pick.h"
 #include "render/mesh/bvh.h"
 #include "render/optics/optics.h"
 #include "render/transrad/tr_scene.h"
@@ -192,22 +193,10 @@ static int add_emitters(lr_openings *op, const lr_scene_object *o, int oi, size_
     for (int i = 0; i < M; i++) {
         double pick = (i + lr_cpu_rng_next(&rng)) / M * area;
         double s = lr_cpu_rng_next(&rng), t = lr_cpu_rng_next(&rng);
-        size_t lo = 0, hi = nt - 1;
-        while (lo < hi) {
-            size_t mid = (lo + hi) / 2;
-            if (cdf[mid] > pick)
-                hi = mid;
-            else
-                lo = mid + 1;
-        }
+        size_t lo = lr_cdf_pick(cdf, nt, pick);
         lr_vec3 v[3];
         lr_mesh_triangle(o->mesh, lo, v);
-        if (s + t > 1.0) {
-            s = 1.0 - s;
-            t = 1.0 - t;
-        }
-        lr_vec3 x = lr_v3_add(v[0], lr_v3_add(lr_v3_scale(lr_v3_sub(v[1], v[0]), s),
-                                              lr_v3_scale(lr_v3_sub(v[2], v[0]), t)));
+        lr_vec3 x = lr_triangle_fold_point(v, s, t);
         lr_vec3 cr = lr_v3_cross(lr_v3_sub(v[1], v[0]), lr_v3_sub(v[2], v[0]));
         if (!(lr_v3_len(cr) > 0.0))
             continue;
