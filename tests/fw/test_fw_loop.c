@@ -293,9 +293,11 @@ static void append_env(const char *name, const char *fallback, const char *extra
 
 static void child_env(void)
 {
-    append_env("ASAN_OPTIONS", "detect_leaks=1:abort_on_error=0", "exitcode=86");
+    append_env("ASAN_OPTIONS", "detect_leaks=1:abort_on_error=0:intercept_tls_get_addr=0",
+               "exitcode=86");
     append_env("LSAN_OPTIONS",
-               "suppressions=" LR_SOURCE_CONFIGS "/../tests/lsan.supp:print_suppressions=0",
+               "suppressions=" LR_SOURCE_CONFIGS
+               "/../tests/lsan.supp:print_suppressions=0:intercept_tls_get_addr=0",
                "exitcode=86");
     setenv("UBSAN_OPTIONS", "print_stacktrace=1:halt_on_error=1", 1);
 }
