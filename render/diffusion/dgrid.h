@@ -154,6 +154,9 @@ typedef struct lr_dsystem lr_dsystem;
 
 /* eta: the medium's relative index (A and F_dr). */
 int lr_dsystem_create(const lr_dgrid *g, double eta, lr_dsystem **out, lr_err *e);
+/* A copy of s with its own values and parameters: the pattern and the coefficient terms do not
+ * depend on the parameters, so the solver assembles each level once and copies it per band. */
+int lr_dsystem_clone(const lr_dsystem *s, lr_dsystem **out, lr_err *e);
 void lr_dsystem_destroy(lr_dsystem *s);
 const lr_dgrid *lr_dsystem_grid(const lr_dsystem *s);
 double lr_dsystem_A(const lr_dsystem *s);

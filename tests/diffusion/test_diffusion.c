@@ -276,6 +276,69 @@ static void test_warm_start(void **state)
     lr_dsolver_destroy(s);
 }
 
+/* ---- a cloned system (the solver assembles each level once, copies it per band) ---- */
+
+static void params(size_t n_in, double scale, double *D, double *mu)
+{
+    for (size_t p = 0; p < n_in; p++) {
+        D[p] = scale * (0.3 + 0.01 * (double)(p % 7));
+        mu[p] = scale * (0.002 + 0.001 * (double)(p % 5));
+    }
+}
+
+static void test_clone_is_independent(void **state)
+{
+    (void)state;
+    lr_dsphere sph = {lr_v3(0.2, 0.1, -0.3), 6.0};
+    lr_dshape shape = lr_dshape_sphere(&sph);
+    lr_dgrid *g;
+    lr_dsystem *a, *b, *fresh_a, *fresh_b;
+    lr_err e = {0};
+    assert_int_equal(lr_dgrid_create(&shape, 1.0, &g, &e), LR_OK);
+    size_t n_in = lr_dgrid_inside_count(g), n = lr_dgrid_unknown_count(g);
+    double *D = malloc(n_in * sizeof *D), *mu = malloc(n_in * sizeof *mu);
+    double *x = malloc(n * sizeof *x), *ya = malloc(n * sizeof *ya), *yb = malloc(n * sizeof *yb);
+    assert_non_null(D);
+    assert_non_null(mu);
+    assert_non_null(x);
+    assert_non_null(ya);
+    assert_non_null(yb);
+    for (size_t u = 0; u < n; u++)
+        x[u] = sin(0.37 * (double)u) + 1.5;
+    assert_int_equal(lr_dsystem_create(g, 1.4, &a, &e), LR_OK);
+    params(n_in, 1.0, D, mu);
+    assert_int_equal(lr_dsystem_set_params(a, D, mu, &e), LR_OK);
+    assert_int_equal(lr_dsystem_clone(a, &b, &e), LR_OK);
+    params(n_in, 2.5, D, mu);
+    assert_int_equal(lr_dsystem_set_params(b, D, mu, &e), LR_OK);
+    /* Each against a system assembled afresh with its own parameters: equal to the bit. */
+    assert_int_equal(lr_dsystem_create(g, 1.4, &fresh_b, &e), LR_OK);
+    assert_int_equal(lr_dsystem_set_params(fresh_b, D, mu, &e), LR_OK);
+    assert_int_equal(lr_dsystem_create(g, 1.4, &fresh_a, &e), LR_OK);
+    params(n_in, 1.0, D, mu);
+    assert_int_equal(lr_dsystem_set_params(fresh_a, D, mu, &e), LR_OK);
+    lr_dsystem_apply(b, x, ya);
+    lr_dsystem_apply(fresh_b, x, yb);
+    assert_memory_equal(ya, yb, n * sizeof *ya);
+    lr_dsystem_apply(a, x, ya);
+    lr_dsystem_apply(fresh_a, x, yb);
+    assert_memory_equal(ya, yb, n * sizeof *ya);
+    /* the ghost rows' phi(b) weights came along */
+    size_t nb = lr_dgrid_unknown_count(g) - n_in;
+    for (size_t q = 0; q < nb; q += 17)
+        assert_true(lr_dsystem_ghost_phi(b, q, x) == lr_dsystem_ghost_phi(fresh_b, q, x));
+    lr_dsystem_destroy(a);
+    lr_dsystem_destroy(b);
+    lr_dsystem_destroy(fresh_a);
+    lr_dsystem_destroy(fresh_b);
+    lr_dgrid_destroy(g);
+    free(D);
+    free(mu);
+    free(x);
+    free(ya);
+    free(yb);
+}
+
 /* ---- volume files ---- */
 
 static void test_volume(void **state)
@@ -336,6 +399,7 @@ int main(void)
         cmocka_unit_test(test_slab),
         cmocka_unit_test(test_sphere),
         cmocka_unit_test(test_warm_start),
+        cmocka_unit_test(test_clone_is_independent),
         cmocka_unit_test(test_volume),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
