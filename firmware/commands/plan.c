@@ -17,6 +17,10 @@ static const lr_argspec opts[] = {
      .help = "relative RMSE budget (replaces the scene's quality block with --frame-ms)"},
     {.name = "--frame-ms", .type = LR_ARG_NUMBER, .metavar = "T", .flags = LR_ARG_ABOVE_MIN,
      .help = "milliseconds per accumulation frame"},
+    {.name = "--change-ms", .type = LR_ARG_NUMBER, .metavar = "T", .flags = LR_ARG_ABOVE_MIN,
+     .help = "longest wait after a material change: models measured slower\n"
+             "(configs/bench/models.csv) are left out (default: the scene's\n"
+             "quality.change_ms)"},
     {.name = "--table", .type = LR_ARG_PATH, .metavar = "CSV",
      .help = "the measured table (default: build/bench/results.csv when at least as\n"
              "new as configs/bench/front.csv, else that one)"},
@@ -81,7 +85,8 @@ static int run_plan(const lr_cli *c)
     unsigned models;
     int st;
     if ((st = lr_cli_check(c, lr_args_double(a, "--max-error", &b.max_error, &e) ||
-                                  lr_args_double(a, "--frame-ms", &b.frame_ms, &e),
+                                  lr_args_double(a, "--frame-ms", &b.frame_ms, &e) ||
+                                  lr_args_double(a, "--change-ms", &b.change_ms, &e),
                            &e)) ||
         (st = models_arg(c, lr_args_get(a, "--models"), &models)))
         return st;
@@ -97,6 +102,8 @@ static int run_plan(const lr_cli *c)
         return lr_cli_usage(c->path, "the scene has no quality budget (quality.max_error or "
                            "quality.frame_ms): give --max-error or --frame-ms");
     }
+    if (!(b.change_ms > 0))
+        b.change_ms = lr_scene_quality(scene)->change_ms;
     char table[1024];
     const char *why = "given";
     const char *tp = lr_args_get(a, "--table");

@@ -52,6 +52,7 @@ bool lr_plan_budget_from_scene(const lr_scene *s, lr_plan_budget *out)
     const lr_quality *q = lr_scene_quality(s);
     out->max_error = q->max_error;
     out->frame_ms = q->frame_ms;
+    out->change_ms = q->change_ms;
     return q->max_error > 0 || q->frame_ms > 0;
 }
 
@@ -247,10 +248,37 @@ int lr_plan_choose(const lr_scene *s, int index, const lr_plan_table *t, const l
     cand *cs = malloc((size_t)(n > 0 ? n : 1) * sizeof *cs);
     if (!cs)
         return lr_err_set(e, LR_ENOMEM, "planner: out of memory");
+    /* Models whose material change is measured slower than the budget's change_ms are left
+     * out while another remains (change_slow: one bit per model, said once). */
+    unsigned change_slow = 0;
+    if (b->change_ms > 0)
+        for (int i = 0; i < n; i++) {
+            const lr_plan_row *r = lr_plan_table_row(t, i);
+            enum lr_sss_model m;
+            if (!strcmp(r->scene, c->table_scene) && r->ms_change > b->change_ms &&
+                lr_sss_model_parse(r->model, &m) && (models & LR_PLAN_MODEL_BIT(m)) &&
+                !(change_slow & LR_PLAN_MODEL_BIT(m))) {
+                change_slow |= LR_PLAN_MODEL_BIT(m);
+            }
+        }
+    for (int i = 0; i < n && change_slow; i++) {
+        const lr_plan_row *r = lr_plan_table_row(t, i);
+        enum lr_sss_model m;
+        if (!strcmp(r->scene, c->table_scene) && lr_sss_model_parse(r->model, &m) &&
+            (change_slow & LR_PLAN_MODEL_BIT(m)) && !(said & LR_PLAN_MODEL_BIT(m))) {
+            said |= LR_PLAN_MODEL_BIT(m);
+            reason(c, "%s rows left out: a material change costs %.1f s on '%s' "
+                      "(configs/bench/models.csv), over the budget's change_ms %.0f",
+                   r->model, r->ms_change * 1e-3, r->scene, b->change_ms);
+        }
+    }
+retry:
     for (int pass = 0; pass < 2 && !ncand; pass++) {
         for (int i = 0; i < n; i++) {
             const lr_plan_row *r = lr_plan_table_row(t, i);
+            enum lr_sss_model rm;
             if (strcmp(r->scene, c->table_scene) || (vpl_rows >= 0 && r->vpl != (vpl_rows > 0)) ||
+                (lr_sss_model_parse(r->model, &rm) && (change_slow & LR_PLAN_MODEL_BIT(rm))) ||
                 !model_ok(r->model, models, o, c, &said))
                 continue;
             if (!pass) {
@@ -275,6 +303,12 @@ int lr_plan_choose(const lr_scene *s, int index, const lr_plan_table *t, const l
                    a->K_cover, kmax);
         if (!nscene)
             break;
+    }
+    if (!ncand && change_slow) {
+        reason(c, "no other model has usable rows: the slow material changes kept");
+        change_slow = 0;
+        nscene = kmax = 0;
+        goto retry;
     }
     if (!ncand) {
         free(cs);
@@ -491,8 +525,10 @@ size_t lr_plan_format_json(const lr_plan *p, char *buf, size_t cap)
         buf[0] = '\0';
     put(&o, "{\"scene\":");
     put_json_string(&o, p->scene);
-    put(&o, ",\"budget\":{\"max_error\":%.17g,\"frame_ms\":%.17g},\"feasible\":%s,\"objects\":[",
-        p->budget.max_error, p->budget.frame_ms, p->feasible ? "true" : "false");
+    put(&o, ",\"budget\":{\"max_error\":%.17g,\"frame_ms\":%.17g,\"change_ms\":%.17g},"
+            "\"feasible\":%s,\"objects\":[",
+        p->budget.max_error, p->budget.frame_ms, p->budget.change_ms,
+        p->feasible ? "true" : "false");
     for (int i = 0; i < p->nobjects; i++) {
         const lr_plan_choice *c = &p->objects[i];
         const lr_plan_row *r = &c->row;

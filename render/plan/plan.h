@@ -53,6 +53,11 @@ typedef struct lr_plan_row {
      * the time to converge). */
     int lpv;
     double ms_lpv;
+    /* Not a column of this table: the time from a material edit to the next shown frame for
+     * the row's scene and model (models.csv, `lamprig-bench models`: a σ edit at its fixed
+     * settings, the model's own rebuild included: translucent radiosity's F and S, the
+     * grid's re-solve); NaN when not measured. */
+    double ms_change;
 } lr_plan_row;
 
 typedef struct lr_plan_table lr_plan_table;
@@ -67,7 +72,14 @@ double lr_plan_row_error(const lr_plan_row *r);
  * column names line 1). Blank lines and lines starting with '#' are skipped. */
 int lr_plan_table_parse(const char *text, size_t len, const char *name, lr_plan_table **out,
                         lr_err *e);
+/* Reads a table file and merges the change costs (lr_plan_row.ms_change) of the models table
+ * models.csv beside it, then of CONFIGS/bench/models.csv for the (scene, model) pairs that one
+ * lacks; either may be missing. */
 int lr_plan_table_load(const char *path, lr_plan_table **out, lr_err *e);
+/* Merges models-table CSV text (columns scene, model, material_ms; others ignored) into the
+ * rows of t that have no change cost yet. Errors name "NAME:LINE: column 'C'". */
+int lr_plan_table_merge_changes(lr_plan_table *t, const char *text, size_t len, const char *name,
+                                lr_err *e);
 void lr_plan_table_destroy(lr_plan_table *t);
 int lr_plan_table_count(const lr_plan_table *t);
 const lr_plan_row *lr_plan_table_row(const lr_plan_table *t, int i);
@@ -126,6 +138,10 @@ bool lr_plan_mesh_convex(const lr_mesh *m, bool closed, double tol, double *viol
 typedef struct lr_plan_budget {
     double max_error; /* relative RMSE; 0: none */
     double frame_ms;  /* ms per accumulation frame; 0: none */
+    /* Longest wait, ms, from a material change (a preset button, a translucency knob) to the
+     * next frame: models whose measured change cost (lr_plan_row.ms_change) is over it are
+     * left out while any other model remains; 0: none. Not a budget by itself. */
+    double change_ms;
 } lr_plan_budget;
 
 #define LR_PLAN_REASONS 10

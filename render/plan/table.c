@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "render/base/file.h"
 #include "render/base/paths.h"
@@ -141,6 +142,7 @@ static int parse_row(const char *name, int line, char **f, const int *at, lr_pla
 {
     memset(r, 0, sizeof *r);
     r->line = line;
+    r->ms_change = NAN; /* from models.csv, merged after the parse */
 #define TXT(c, field, req) \
     if ((rc = cell_text(name, line, cols[c].name, at[c] >= 0 ? f[at[c]] : "", r->field, \
                         sizeof r->field, req, e))) \
@@ -291,6 +293,88 @@ int lr_plan_table_parse(const char *text, size_t len, const char *name, lr_plan_
     return LR_OK;
 }
 
+/* Rows still without a change cost, of scene and model: ms. */
+static int set_change(lr_plan_table *t, const char *scene, const char *model, double ms)
+{
+    int n = 0;
+    for (int i = 0; i < t->n; i++)
+        if (isnan(t->rows[i].ms_change) && !strcmp(t->rows[i].scene, scene) &&
+            !strcmp(t->rows[i].model, model)) {
+            t->rows[i].ms_change = ms;
+            n++;
+        }
+    return n;
+}
+
+int lr_plan_table_merge_changes(lr_plan_table *t, const char *text, size_t len, const char *name,
+                                lr_err *e)
+{
+    if (!name)
+        name = "models table";
+    char *buf = malloc(len + 1);
+    if (!buf)
+        return lr_err_set(e, LR_ENOMEM, "%s: out of memory", name);
+    memcpy(buf, text, len);
+    buf[len] = '\0';
+    static const char *const need[3] = {"scene", "model", "material_ms"};
+    int at[3] = {-1, -1, -1}, nheader = 0, line = 0, rc = LR_OK;
+    char *f[MAX_FIELDS];
+    for (char *p = buf, *nl; p && !rc; p = nl ? nl + 1 : NULL) {
+        if ((nl = strchr(p, '\n')))
+            *nl = '\0';
+        line++;
+        p += strspn(p, " \t\r");
+        if (!*p || *p == '#')
+            continue;
+        int n = split(p, f, MAX_FIELDS);
+        if (n > MAX_FIELDS) {
+            rc = lr_err_set(e, LR_EPARSE, "%s:%d: more than %d columns", name, line, MAX_FIELDS);
+        } else if (!nheader) {
+            for (int c = 0; c < 3; c++) {
+                for (int i = 0; i < n; i++)
+                    if (!strcmp(f[i], need[c]))
+                        at[c] = i;
+                if (at[c] < 0 && !rc)
+                    rc = lr_err_set(e, LR_EPARSE, "%s:%d: column '%s': missing from the header",
+                                    name, line, need[c]);
+            }
+            nheader = n;
+        } else if (n != nheader) {
+            rc = lr_err_set(e, LR_EPARSE, "%s:%d: %d cells, the header has %d", name, line, n,
+                            nheader);
+        } else {
+            char scene[LR_PLAN_TEXT_MAX], model[LR_PLAN_TEXT_MAX];
+            double ms;
+            enum lr_sss_model m;
+            if (!(rc = cell_text(name, line, "scene", f[at[0]], scene, sizeof scene, true, e)) &&
+                !(rc = cell_text(name, line, "model", f[at[1]], model, sizeof model, true, e)) &&
+                !(rc = cell_number(name, line, "material_ms", f[at[2]], true, &ms, e)) &&
+                !lr_sss_model_parse(model, &m))
+                rc = cell_err(name, line, "model", e, "expected a diffusion model name", model);
+            if (!rc)
+                set_change(t, scene, model, ms);
+        }
+    }
+    free(buf);
+    return rc;
+}
+
+/* Merges the models table at path when it exists (a missing one is not an error: the rows
+ * keep no change cost). */
+static int merge_changes_file(lr_plan_table *t, const char *path, lr_err *e)
+{
+    if (access(path, R_OK) != 0)
+        return LR_OK;
+    char *data;
+    size_t len;
+    int rc = lr_file_read(path, &data, &len, e);
+    if (rc)
+        return rc;
+    rc = lr_plan_table_merge_changes(t, data, len, path, e);
+    free(data);
+    return rc;
+}
+
 int lr_plan_table_load(const char *path, lr_plan_table **out, lr_err *e)
 {
     char *data;
@@ -301,6 +385,23 @@ int lr_plan_table_load(const char *path, lr_plan_table **out, lr_err *e)
         return rc;
     rc = lr_plan_table_parse(data, len, path, out, e);
     free(data);
+    if (rc)
+        return rc;
+    /* The change costs: the models table beside this one (a bench run's build/bench, or the
+     * committed configs/bench), then the committed one for the pairs it lacks. */
+    char sib[1024];
+    const char *slash = strrchr(path, '/');
+    int w = slash ? snprintf(sib, sizeof sib, "%.*s/models.csv", (int)(slash - path), path)
+                  : snprintf(sib, sizeof sib, "models.csv");
+    if (w > 0 && (size_t)w < sizeof sib)
+        rc = merge_changes_file(*out, sib, e);
+    w = snprintf(sib, sizeof sib, "%s/bench/models.csv", lr_configs_dir());
+    if (!rc && w > 0 && (size_t)w < sizeof sib)
+        rc = merge_changes_file(*out, sib, e);
+    if (rc) {
+        lr_plan_table_destroy(*out);
+        *out = NULL;
+    }
     return rc;
 }
 

@@ -63,7 +63,7 @@ static lr_plan *plan_of(const lr_scene *s, double max_error, double frame_ms, un
 {
     lr_plan *p = calloc(1, sizeof *p);
     lr_err e = {0};
-    lr_plan_budget b = {max_error, frame_ms};
+    lr_plan_budget b = {max_error, frame_ms, 0};
     if (lr_plan_create(s, table, &b, &(lr_plan_options){.models = models}, p, &e))
         fail_msg("plan: %s", e.msg);
     return p;
@@ -318,7 +318,7 @@ static void test_committed_front_both_scenes(void **state)
             double err = lr_plan_row_error(r);
             assert_true(err >= fmax(r->bias_object, isnan(r->bias_receivers) ? 0.0 : r->bias_receivers));
             lr_plan p;
-            assert_int_equal(lr_plan_create(scenes[s], t, &(lr_plan_budget){err, 0}, NULL, &p, &e),
+            assert_int_equal(lr_plan_create(scenes[s], t, &(lr_plan_budget){err, 0, 0}, NULL, &p, &e),
                              LR_OK);
             assert_true(p.feasible);
             assert_true(p.objects[0].predicted_error <= err);
@@ -385,7 +385,7 @@ static void test_both_budgets_and_infeasible(void **state)
     /* No budget at all is an error, not a plan. */
     lr_plan q;
     lr_err e = {0};
-    assert_int_equal(lr_plan_create(candle, table, &(lr_plan_budget){0, 0}, NULL, &q, &e),
+    assert_int_equal(lr_plan_create(candle, table, &(lr_plan_budget){0, 0, 0}, NULL, &q, &e),
                      LR_EINVAL);
     assert_non_null(strstr(e.msg, "no budget"));
 }
@@ -441,6 +441,66 @@ static void test_multipole_where_the_object_takes_it(void **state)
     assert_int_equal(lr_plan_create(candle, t, &b, &o, p, &e), LR_EINVAL);
     assert_non_null(strstr(e.msg, "that the object can take"));
     free(p);
+    lr_plan_table_destroy(t);
+}
+
+/* quality.change_ms: a model whose measured material change (models.csv, merged into the
+ * rows) is slower than the budget is left out while another model remains, with the reason;
+ * with none left, the slow ones stay; a malformed models table is refused naming the line. */
+static void test_change_budget(void **state)
+{
+    (void)state;
+    const char *csv =
+        HDR "candle,directional_dipole,100,0.15,8,8,32,128,128,16,on\n"
+            "candle,translucent_radiosity,100,0.08,8,8,32,128,128,16,on\n";
+    const char *models = "scene,model,cold_ms,material_ms\n"
+                         "candle,translucent_radiosity,12000,11000\n"
+                         "candle,directional_dipole,1300,1000\n"
+                         "lampshade,directional_dipole,1,99999\n";
+    lr_plan_table *t = NULL;
+    lr_err e = {0};
+    assert_int_equal(lr_plan_table_parse(csv, strlen(csv), "ch.csv", &t, &e), LR_OK);
+    assert_true(isnan(lr_plan_table_row(t, 0)->ms_change));
+    assert_int_equal(lr_plan_table_merge_changes(t, models, strlen(models), "models.csv", &e),
+                     LR_OK);
+    assert_near(lr_plan_table_row(t, 0)->ms_change, 1000, 0);
+    assert_near(lr_plan_table_row(t, 1)->ms_change, 11000, 0);
+    lr_plan *p = malloc(sizeof *p);
+    assert_non_null(p);
+    /* no change budget: the more accurate model */
+    lr_plan_budget b = {.max_error = 0.1};
+    assert_int_equal(lr_plan_create(candle, t, &b, NULL, p, &e), LR_OK);
+    assert_string_equal(p->objects[0].row.model, "translucent_radiosity");
+    /* 3 s: translucent radiosity's 11 s rebuild is left out, said */
+    b.change_ms = 3000;
+    assert_int_equal(lr_plan_create(candle, t, &b, NULL, p, &e), LR_OK);
+    assert_string_equal(p->objects[0].row.model, "directional_dipole");
+    assert_false(p->objects[0].feasible); /* 0.15 > 0.1: the closest of what is left */
+    assert_true(has_reason(&p->objects[0], "translucent_radiosity rows left out: a material "
+                                           "change costs 11.0 s on 'candle'"));
+    /* 0.5 s: both are slower; none is left out for it */
+    b.change_ms = 500;
+    assert_int_equal(lr_plan_create(candle, t, &b, NULL, p, &e), LR_OK);
+    assert_string_equal(p->objects[0].row.model, "translucent_radiosity");
+    assert_true(has_reason(&p->objects[0], "slow material changes kept"));
+    free(p);
+    /* a later merge fills only rows still without a cost */
+    const char *again = "scene,model,material_ms\ncandle,directional_dipole,5\n";
+    assert_int_equal(lr_plan_table_merge_changes(t, again, strlen(again), "b.csv", &e), LR_OK);
+    assert_near(lr_plan_table_row(t, 0)->ms_change, 1000, 0);
+    const char *bad[] = {"scene,model\ncandle,directional_dipole\n",
+                         "scene,model,material_ms\ncandle,directional_dipole,-3\n",
+                         "scene,model,material_ms\ncandle,no_such_model,3\n",
+                         "scene,model,material_ms\ncandle,directional_dipole\n"};
+    const char *want[] = {"bad.csv:1: column 'material_ms'", "bad.csv:2: column 'material_ms'",
+                          "bad.csv:2: column 'model'", "bad.csv:2: 2 cells"};
+    for (int i = 0; i < 4; i++) {
+        e = (lr_err){0};
+        assert_int_equal(lr_plan_table_merge_changes(t, bad[i], strlen(bad[i]), "bad.csv", &e),
+                         LR_EPARSE);
+        if (!strstr(e.msg, want[i]))
+            fail_msg("models table %d: '%s' lacks '%s'", i, e.msg, want[i]);
+    }
     lr_plan_table_destroy(t);
 }
 
@@ -522,7 +582,7 @@ static void test_sh_translucency_rows(void **state)
     for (int k = 0; k < 3; k++) {
         lr_plan *p = calloc(1, sizeof *p);
         assert_non_null(p);
-        lr_plan_budget b = {budgets[k], 0};
+        lr_plan_budget b = {budgets[k], 0, 0};
         if (lr_plan_create(candle, t, &b, &(lr_plan_options){.models = models[k]}, p, &e))
             fail_msg("plan: %s", e.msg);
         assert_string_equal(p->objects[0].row.model, want[k]);
@@ -635,7 +695,7 @@ static void test_receivers_in_sight(void **state)
         "  \"normal\": [0, 1, 0], \"size\": [200, 200], \"albedo\": [0.5, 0.5, 0.5]}]";
     s = parse_scene("unseen_ball.json", ball, "[0, 0, 0]", unseen);
     lr_plan *p = calloc(1, sizeof *p);
-    assert_int_equal(lr_plan_create(s, table, &(lr_plan_budget){0.05, 0}, NULL, p, &e), LR_OK);
+    assert_int_equal(lr_plan_create(s, table, &(lr_plan_budget){0.05, 0, 0}, NULL, p, &e), LR_OK);
     const lr_plan_choice *c = &p->objects[0];
     assert_int_equal(c->analysis.receivers_seeing, 0u);
     assert_false(c->vpl);
@@ -893,6 +953,7 @@ int main(void)
         cmocka_unit_test(test_both_budgets_and_infeasible),
         cmocka_unit_test(test_models_and_coverage_filter),
         cmocka_unit_test(test_multipole_where_the_object_takes_it),
+        cmocka_unit_test(test_change_budget),
         cmocka_unit_test(test_lpv_rows),
         cmocka_unit_test(test_sh_translucency_rows),
         cmocka_unit_test(test_convexity),

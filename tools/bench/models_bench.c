@@ -6,15 +6,19 @@
  *               solve, the patches' transfer, the SH projection; radiosity, VPLs, compose);
  *   light move  a frame after lights[0].position moved by LIGHT_MOVE_MM (alternately there and
  *               back): LR_DIRTY_LIGHT_GEOMETRY;
- *   material    a frame after objects[*].material.scale changed by MATERIAL_STEP (alternately,
- *               a sigma edit: sigma_a and sigma_s' scale together): LR_DIRTY_MATERIAL;
+ *   material    a frame after objects[*].material.scale grew by MATERIAL_STEP (a sigma edit:
+ *               sigma_a and sigma_s' scale together; each run a material not seen before):
+ *               LR_DIRTY_MATERIAL;
  *   dimmer      a frame after light.intensity was halved or restored: LR_DIRTY_INTENSITY, the
  *               blend pass alone for every model (the contract of issue 14).
  *
  * Each is the median of RUNS runs, wall time from glFinish to glFinish (what a caller waits:
  * the CPU work of the grid and the patches included). One settings block for every model
  * (render.K etc. below) with render.frames = 1, so that after a change exactly one frame of
- * each due pass runs. Progress on stderr; build/bench/models.csv (atomic). LRB_MODELS_SCENES
+ * each due pass runs. The on-disk caches point at an empty folder of the section (cleared
+ * before each cold start), so cold starts and material edits pay their rebuilds. The planner
+ * reads material_ms (configs/bench/models.csv, committed from this file) against a scene's
+ * quality.change_ms. Progress on stderr; build/bench/models.csv (atomic). LRB_MODELS_SCENES
  * (comma-separated) runs a subset. */
 #include "tools/bench/bench.h"
 
@@ -23,6 +27,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <ftw.h>
 #include <sys/stat.h>
 
 #include "render/base/atomic_file.h"
@@ -119,15 +124,37 @@ static bool takes(const char *scene, enum lr_sss_model m, char *why, size_t cap)
     return ok;
 }
 
-static int time_model(lr_gl *gl, const char *scene, const char *model, row *out)
+static int rm_entry(const char *path, const struct stat *st, int flag, struct FTW *ftw)
+{
+    (void)st;
+    (void)flag;
+    (void)ftw;
+    return remove(path);
+}
+
+/* Points the on-disk caches (translucent radiosity's F and S, render/transrad/cache.c) at a
+ * new empty folder under base: every cold start and material edit below pays its own
+ * rebuild, as a designer's first start and first visit of a material do, instead of reading
+ * what an earlier run of this section (or the user's renders) left in ~/.cache. */
+static void fresh_cache(const char *base, const char *what)
+{
+    char dir[1024];
+    snprintf(dir, sizeof dir, "%s/%s", base, what);
+    nftw(dir, rm_entry, 16, FTW_DEPTH | FTW_PHYS);
+    setenv("XDG_CACHE_HOME", dir, 1);
+}
+
+static int time_model(lr_gl *gl, const char *base, const char *scene, const char *model,
+                      row *out)
 {
     *out = (row){.scene = scene, .model = model};
     double cold[RUNS], light[RUNS], mat[RUNS], dim[RUNS];
     lr_scene *s = NULL;
     lr_renderer *r = NULL;
     lr_err e = {0};
-    /* cold: a new renderer each run */
+    /* cold: a new renderer each run, on an empty cache */
     for (int k = 0; k < RUNS; k++) {
+        fresh_cache(base, "cold");
         lr_renderer_destroy(r);
         r = NULL;
         lr_scene_destroy(s);
@@ -166,8 +193,9 @@ static int time_model(lr_gl *gl, const char *scene, const char *model, row *out)
                 fprintf(stderr, "bench models: %s\n", e.msg);
                 goto fail;
             }
-            snprintf(v, sizeof v, "%.17g", strtod(cur, NULL) * (k % 2 ? 1.0 / MATERIAL_STEP
-                                                                        : MATERIAL_STEP));
+            /* A material not seen before in this section: each edit rebuilds (cumulative
+             * steps, never back to an earlier value that a cache could hold). */
+            snprintf(v, sizeof v, "%.17g", strtod(cur, NULL) * MATERIAL_STEP);
             if (lrb_scene_set("bench models", s, key, v, &dirty))
                 goto fail;
         }
@@ -237,6 +265,17 @@ static int run(FILE *out)
     row t[MAX_ROWS];
     int n = 0, status = 0;
     char skipped[2048] = "";
+    const char *tmp = getenv("TMPDIR");
+    char base[512];
+    snprintf(base, sizeof base, "%s/lamprig-models-cache.XXXXXX", tmp && *tmp ? tmp : "/tmp");
+    char *old_cache = getenv("XDG_CACHE_HOME") ? strdup(getenv("XDG_CACHE_HOME")) : NULL;
+    if (!mkdtemp(base)) {
+        fprintf(stderr, "bench models: cannot create a cache folder %s: %s\n", base,
+                strerror(errno));
+        lr_gl_destroy(gl);
+        free(old_cache);
+        return 1;
+    }
     for (size_t si = 0; si < sizeof scene_names / sizeof *scene_names; si++) {
         if (!lrb_wanted(getenv("LRB_MODELS_SCENES"), scene_names[si]))
             continue;
@@ -250,13 +289,19 @@ static int run(FILE *out)
                 continue;
             }
             fprintf(stderr, "bench models: %s %s ...\n", scene_names[si], name);
-            if (time_model(gl, scene_names[si], name, &t[n]) == 0)
+            if (time_model(gl, base, scene_names[si], name, &t[n]) == 0)
                 n++;
             else
                 status = 1;
         }
     }
     lr_gl_destroy(gl);
+    nftw(base, rm_entry, 16, FTW_DEPTH | FTW_PHYS);
+    if (old_cache)
+        setenv("XDG_CACHE_HOME", old_cache, 1);
+    else
+        unsetenv("XDG_CACHE_HOME");
+    free(old_cache);
 
     fprintf(out, "## Models (`lamprig-bench models`)\n\n");
     fprintf(out, "Per model and scene, wall time in ms (glFinish to glFinish, median of %d): "
