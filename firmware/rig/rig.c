@@ -701,9 +701,18 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
     r->ar_dirty = true;
     if (!rc && ensure_rgba(r))
         rc = lr_err_set(e, LR_ENOMEM, "out of memory");
+    /* The first frame is the costly one: the G-buffers and maps, the receivers' bounce and the
+     * objects' light from it, a diffusion grid's first solve (2-3 s on the 2-core proxy, many
+     * more under the sanitizers or on a loaded machine). It is made here, before the devices
+     * open, so that the rig takes controls once it shows an image: events that came in
+     * during it would all wait for it, and a short run would play less of its script. */
+    if (!rc) {
+        lr_rig_view_set_time(r->view, 0.0);
+        frame(r, lr_now_ns());
+    }
     /* The devices come last, and --duration counts from then: a sim script's time 0 and the
-     * duration's start are the same instant, however long the GL set-up above took (0.2 s on
-     * an idle machine, seconds on a loaded one), so a run plays the same part of the script. */
+     * duration's start are the same instant, however long the GL set-up and the first frame
+     * above took, so a run plays the same part of the script. */
     if (!rc)
         rc = set_devices(r, &r->set, e);
     if (rc) {
