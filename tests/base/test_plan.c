@@ -452,11 +452,13 @@ static void test_change_budget(void **state)
     (void)state;
     const char *csv =
         HDR "candle,directional_dipole,100,0.15,8,8,32,128,128,16,on\n"
-            "candle,translucent_radiosity,100,0.08,8,8,32,128,128,16,on\n";
+            "candle,translucent_radiosity,100,0.08,8,8,32,128,128,16,on\n"
+            "lampshade,directional_dipole,100,0.15,32,8,32,128,128,16,on\n"
+            "lampshade,translucent_radiosity,100,0.08,32,8,32,128,128,16,on\n";
     const char *models = "scene,model,cold_ms,material_ms\n"
                          "candle,translucent_radiosity,12000,11000\n"
                          "candle,directional_dipole,1300,1000\n"
-                         "lampshade,directional_dipole,1,99999\n";
+                         "lampshade,standard_dipole,1,99999\n";
     lr_plan_table *t = NULL;
     lr_err e = {0};
     assert_int_equal(lr_plan_table_parse(csv, strlen(csv), "ch.csv", &t, &e), LR_OK);
@@ -483,6 +485,14 @@ static void test_change_budget(void **state)
     assert_int_equal(lr_plan_create(candle, t, &b, NULL, p, &e), LR_OK);
     assert_string_equal(p->objects[0].row.model, "translucent_radiosity");
     assert_true(has_reason(&p->objects[0], "slow material changes kept"));
+    /* The lamp shade has no measured change costs: each model's slowest measured scene
+     * stands in (translucent radiosity 11 s on the candle; the dipole 1 s: kept). */
+    b.change_ms = 3000;
+    assert_true(isnan(lr_plan_table_row(t, 3)->ms_change));
+    assert_int_equal(lr_plan_create(shade, t, &b, NULL, p, &e), LR_OK);
+    assert_string_equal(p->objects[0].row.model, "directional_dipole");
+    assert_true(has_reason(&p->objects[0], "costs 11.0 s on 'candle' (its slowest measured "
+                                           "scene)"));
     free(p);
     /* a later merge fills only rows still without a cost */
     const char *again = "scene,model,material_ms\ncandle,directional_dipole,5\n";
