@@ -65,7 +65,14 @@ static int check_stats(const char *path, int min_frames, int min_events)
         double lat = -1, frame = -1;
         assert_int_equal(lr_json_get_number(j, ev, "latency_ms", true, &lat, &e), LR_OK);
         assert_int_equal(lr_json_get_number(j, ev, "frame", true, &frame, &e), LR_OK);
-        assert_true(lat >= 0 && lat < 5000);
+        if (!(lat >= 0 && lat < 5000)) {
+            char ctl[64] = "?";
+            double t = -1;
+            lr_json_get_string(j, ev, "control", false, ctl, sizeof ctl, &e);
+            lr_json_get_number(j, ev, "t_s", false, &t, &e);
+            fail_msg("%s: event %d (%s at %.2f s, frame %.0f): latency %.0f ms, not in [0, 5000)",
+                     path, i, ctl, t, frame, lat);
+        }
         assert_true(frame >= 0 && frame < (double)frames);
     }
     if (events > 0) {
