@@ -7,7 +7,8 @@
 # an earlier commit, whose render timing and dimmer sections run beside ours in the same call
 # (a before/after on one machine); .gpu/cache, a copy of $XDG_CACHE_HOME/lamprig (the
 # translucent-radiosity and receiver-bounce form factors) so that the sweep does not rebuild
-# them. LRB_GPU_SWEEP_S: the sweep's time limit (default 200 s; 0 skips it).
+# them. LRB_GPU_SWEEP_S: the sweep's time limit (default 200 s; 0 skips it). LRB_GPU_ONLY:
+# run only the named sections (e.g. "models").
 cd "$(dirname "$0")/../../.." || exit 1
 OUT=${OUT:-/tmp/lamprig-gpu}; mkdir -p "$OUT"
 LOG=$OUT/log.md ERR=$OUT/err.log
@@ -36,6 +37,17 @@ section() {
     env "${vars[@]}" timeout "$limit" $L "$@" >>"$LOG" 2>>"$ERR"
     echo "rc $? in $((SECONDS - t0)) s" | tee -a "$LOG"
 }
+
+# LRB_GPU_ONLY="models ...": only these sections of lamprig-bench (name = its argument),
+# 300 s each, then stop.
+if [ -n "${LRB_GPU_ONLY:-}" ]; then
+    for s in $LRB_GPU_ONLY; do
+        section "$s" 300 "$B" "$s"
+        cp "build/bench/$s.csv" "$OUT/" 2>/dev/null
+    done
+    echo "done $(date +%T)" | tee -a "$LOG"
+    exit 0
+fi
 
 section render_timing 60 LRB_RENDER_PARTS=timing $B render
 [ -x $BASE ] && section base_render_timing 60 LRB_RENDER_PARTS=timing $BASE render
