@@ -707,6 +707,9 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
      * open, so that the rig takes controls once it shows an image: events that came in
      * during it would all wait for it, and a short run would play less of its script. */
     if (!rc) {
+        /* The controls' initial values first (a dimmer's start level, a knob's preset), so the
+         * first image is the one the controls ask for; the devices' own states come below. */
+        apply(r, r->start_ns);
         lr_rig_view_set_time(r->view, 0.0);
         frame(r, lr_now_ns());
     }
