@@ -40,7 +40,9 @@ double lr_eval_sum_ratio(const float *img, const float *ref, const unsigned char
 
 /* Which pixels of the scene's camera image see an object and which a receiver, by casting
  * the camera ray of each pixel centre (lr_cpu_camera_ray) against every object's and
- * receiver's BVH: the nearest hit decides. Pixels that see neither are in neither mask. */
+ * receiver's BVH: the nearest hit decides. Pixels that see neither are in neither mask, nor
+ * are those whose ray meets an area light's surface first (the physical reference shows the
+ * emitter there, the real-time renderer the surface behind it). */
 typedef struct lr_eval_masks {
     int width, height;
     unsigned char *object, *receivers; /* width * height, 1 = in the mask */
@@ -49,6 +51,10 @@ typedef struct lr_eval_masks {
 
 int lr_eval_masks_create(const lr_scene *s, int width, int height, lr_eval_masks *out,
                          lr_err *e);
+/* Whether an area light's surface (quad or disk, either side) lies in front of the nearest
+ * object or receiver for any of 4 x 4 sub-pixel camera rays of pixel (x, y), py from the top:
+ * the reference sees the emitter (or its dark back) over part of that pixel. */
+bool lr_eval_emitter_in_pixel(const lr_scene *s, int width, int height, int x, int y);
 void lr_eval_masks_free(lr_eval_masks *m);
 
 /* ---- regions (issue 12: where the model loses light) ----------------------------------------

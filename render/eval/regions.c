@@ -67,6 +67,9 @@ int lr_eval_regions_create(const lr_scene *s, int width, int height, lr_eval_reg
         for (size_t v = 0; v < lr_mesh_vertex_count(o->mesh); v++)
             ax[k].r = fmax(ax[k].r, axial_distance(lr_mesh_vertex(o->mesh, v), o->center, up));
     }
+    bool area = false;
+    for (int k = 0; k < lr_scene_light_count(s); k++)
+        area |= lr_light_is_area(lr_scene_light_at(s, k));
     for (int y = 0; y < height; y++)
         for (int x = 0; x < width; x++) {
             lr_vec3 org, dir;
@@ -84,6 +87,8 @@ int lr_eval_regions_create(const lr_scene *s, int width, int height, lr_eval_reg
                     h.t < best)
                     best = h.t, kind = 2, idx = k, tri = h.triangle;
             int region = LR_EVAL_REGION_NONE;
+            if (kind && area && lr_eval_emitter_in_pixel(s, width, height, x, y))
+                kind = 0; /* an area light in front: no region (masks.c) */
             if (kind == 1) {
                 const lr_scene_object *o = lr_scene_object_at(s, idx);
                 region = supporting(o->mesh, tri, 1e-3 * (ax[idx].r > 0.0 ? ax[idx].r : o->radius))

@@ -262,6 +262,50 @@ static void test_regions_side_view(void **state)
     lr_scene_destroy(s);
 }
 
+/* An LED strip (quad light 30 x 5 mm) in front of a wall, seen by an orthographic camera on
+ * 10 mm pixels: the physical reference shows the emitter over part of 4 x 2 pixels (5 mm is
+ * narrower than a pixel, so pixel centres alone would miss it); those leave the receiver mask
+ * and the regions, from the front and from the back alike. */
+static void test_masks_leave_out_emitters(void **state)
+{
+    (void)state;
+    const char *edges[2] = {"\"edge_u\": [15, 0, 0], \"edge_v\": [0, 0, 2.5]",
+                            "\"edge_u\": [0, 0, 2.5], \"edge_v\": [15, 0, 0]"};
+    for (int side = 0; side < 2; side++) {
+        char json[2048];
+        snprintf(json, sizeof json,
+                 "{\"objects\": [{\"name\": \"box\", \"material\": \"marble\", \"mesh\": "
+                 "{\"type\": \"box\", \"size\": [20, 20, 20]}, \"transform\": {\"translate\": "
+                 "[150, 0, 20]}}],"
+                 " \"lights\": [{\"type\": \"quad\", \"position\": [0, -100, 100], %s,"
+                 " \"radiance\": 1}],"
+                 " \"camera\": {\"type\": \"orthographic\", \"position\": [0, -500, 100],"
+                 " \"target\": [0, 0, 100], \"up\": [0, 0, 1], \"height_mm\": 400},"
+                 " \"receivers\": [{\"name\": \"wall\", \"type\": \"plane\", \"center\": "
+                 "[0, 200, 100], \"normal\": [0, -1, 0], \"size\": [400, 400], \"albedo\": "
+                 "[0.5, 0.5, 0.5]}]}",
+                 edges[side]);
+        lr_scene *s = scene_of(json);
+        lr_eval_masks m;
+        assert_int_equal(lr_eval_masks_create(s, 40, 40, &m, NULL), LR_OK);
+        /* x in [-15, 15] meets columns 18..21, z in [97.5, 102.5] rows 19 and 20 */
+        assert_int_equal(m.object_px + m.receiver_px, 1600 - 8);
+        for (int y = 19; y <= 20; y++)
+            for (int x = 18; x <= 21; x++) {
+                assert_false(m.receivers[y * 40 + x]);
+                assert_true(lr_eval_emitter_in_pixel(s, 40, 40, x, y));
+            }
+        assert_true(m.receivers[19 * 40 + 17] && m.receivers[18 * 40 + 18]);
+        lr_eval_regions rg;
+        assert_int_equal(lr_eval_regions_create(s, 40, 40, &rg, NULL), LR_OK);
+        assert_int_equal(rg.label[19 * 40 + 18], LR_EVAL_REGION_NONE);
+        assert_int_equal(rg.count[LR_EVAL_REGION_NONE], 8);
+        lr_eval_regions_free(&rg);
+        lr_eval_masks_free(&m);
+        lr_scene_destroy(s);
+    }
+}
+
 /* A candle (radius 35 mm, melt pool of radius 31) seen from above on 1 mm pixels: the pool's
  * dish lies below the rim, off the convex hull (inner), the flat rim ring is on it (outer).
  * Counts against the areas pi 31^2 and pi (35^2 - 31^2), within 2 % of the top's area (the
@@ -491,6 +535,7 @@ int main(void)
         cmocka_unit_test(test_regions_top_view),
         cmocka_unit_test(test_regions_side_view),
         cmocka_unit_test(test_regions_candle_pool),
+        cmocka_unit_test(test_masks_leave_out_emitters),
         cmocka_unit_test(test_ratios_by_hand),
         cmocka_unit_test(test_ratio_standard_error),
     };
