@@ -11,26 +11,7 @@
 #include "render/lpv/objfield.h"
 #include "render/optics/optics.h"
 
-/* Sparse rows: entries [row[k], row[k + 1]) of col / val, k = 2 v + side. */
-typedef struct ol_mesh {
-    lr_objlight_desc d;
-    size_t nv;
-    size_t *row;
-    uint32_t *col;
-    float *val;
-    /* Closed walls: per vertex the far face's triangle (SIZE_MAX: none) and barycentrics. */
-    size_t *far_tri;
-    float *far_uv;
-    float *E[LR_TR_MAX_SLOTS]; /* nv x 6 */
-} ol_mesh;
-
-struct lr_objlight {
-    int count;
-    ol_mesh m[LR_TR_MAX_SURFACES];
-    size_t first_source, n_patches;
-    double *W; /* n_patches x 3 scratch */
-    double build_s;
-};
+#include "render/bounce/objlight_priv.h"
 
 static double now_s(void)
 {
@@ -237,7 +218,7 @@ done:
 }
 
 int lr_objlight_create(const lr_tr *t, size_t first_source, const lr_objlight_desc *d, int count,
-                       int rays, lr_objlight **out, lr_err *e)
+                       int rays, const char *cache_dir, lr_objlight **out, lr_err *e)
 {
     *out = NULL;
     if (!t || (count > 0 && !d))
@@ -277,9 +258,18 @@ int lr_objlight_create(const lr_tr *t, size_t first_source, const lr_objlight_de
     ol->n_patches = lr_tr_patch_count(t);
     ol->W = calloc(3 * (ol->n_patches ? ol->n_patches : 1), sizeof *ol->W);
     int rc = ol->W ? LR_OK : lr_err_set(e, LR_ENOMEM, "receiver light on objects: out of memory");
-    for (int i = 0; i < count && !rc; i++) {
+    for (int i = 0; i < count; i++) {
         ol->m[i].d = d[i];
+        ol->m[i].nv = lr_mesh_vertex_count(d[i].mesh);
+    }
+    uint64_t key = cache_dir ? lr_objlight_cache_key(ol, t, rays) : 0;
+    ol->cache_hit = !rc && cache_dir && lr_objlight_cache_load(ol, key, cache_dir);
+    for (int i = 0; i < count && !rc && !ol->cache_hit; i++)
         rc = build_mesh(t, ol, i, (const double(*)[3])dirs, rays, e);
+    if (!rc && !ol->cache_hit && cache_dir) {
+        /* Best effort: a folder that cannot be written costs the next start a rebuild. */
+        lr_err ce = {0};
+        (void)lr_objlight_cache_store(ol, key, cache_dir, &ce);
     }
     free(dirs);
     if (rc) {
@@ -393,3 +383,4 @@ void lr_objlight_factors(const lr_scene_object *o, double kR[3], double kT[3])
 }
 
 double lr_objlight_build_s(const lr_objlight *ol) { return ol ? ol->build_s : 0.0; }
+bool lr_objlight_cache_hit(const lr_objlight *ol) { return ol && ol->cache_hit; }

@@ -62,9 +62,11 @@ typedef struct lr_objlight_desc {
 
 /* The form-factor rows of every vertex of the count meshes against t's patches from
  * first_source on (the receivers; earlier patches, the objects, absorb), rays per hemisphere
- * (0: LR_OBJLIGHT_RAYS). LR_EINVAL, LR_ENOMEM. */
+ * (0: LR_OBJLIGHT_RAYS). cache_dir (NULL: none): the rows are read from
+ * <cache_dir>/objlight-<key>.bin when it holds them for this geometry, else built and written
+ * there (best effort; objlight_cache.c). LR_EINVAL, LR_ENOMEM. */
 int lr_objlight_create(const lr_tr *t, size_t first_source, const lr_objlight_desc *d, int count,
-                       int rays, lr_objlight **out, lr_err *e);
+                       int rays, const char *cache_dir, lr_objlight **out, lr_err *e);
 void lr_objlight_destroy(lr_objlight *ol);
 
 /* E+ and E- of every vertex from slot's solution (lr_tr_radiosity of the source patches). */
@@ -81,5 +83,7 @@ void lr_objlight_at(const lr_objlight *ol, int mesh, int slot, size_t tri, doubl
 void lr_objlight_factors(const lr_scene_object *o, double kR[3], double kT[3]);
 /* Seconds the last create took. */
 double lr_objlight_build_s(const lr_objlight *ol);
+/* Whether create read the rows from the cache instead of casting them. */
+bool lr_objlight_cache_hit(const lr_objlight *ol);
 
 #endif

@@ -175,7 +175,8 @@ static int build(lr_rbounce *rb, const lr_scene *s, lr_err *e)
     }
     size_t first, count;
     lr_tr_surface_patches(rb->tr, no, &first, &count);
-    return lr_objlight_create(rb->tr, first, od, no, 0, &rb->ol, e);
+    return lr_objlight_create(rb->tr, first, od, no, 0, lr_tr_cache_default_dir(cdir, sizeof cdir),
+                              &rb->ol, e);
 }
 
 int lr_rbounce_update(lr_rbounce **rbp, const lr_scene *s, lr_err *e)

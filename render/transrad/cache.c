@@ -88,6 +88,8 @@ uint64_t lr_tr_cache_key(const lr_tr *t)
     return h.h;
 }
 
+uint64_t lr_tr_geometry_key(const lr_tr *t) { return lr_tr_cache_key(t); }
+
 int lr_tr_cache_path(const char *dir, uint64_t key, char *out, size_t cap)
 {
     int k = snprintf(out, cap, "%s/transrad-%016llx.bin", dir, (unsigned long long)key);

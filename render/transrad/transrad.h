@@ -154,6 +154,9 @@ bool lr_tr_wall_thin(const lr_coeffs *c, double d, double patch_mm);
 /* ---- Queries ------------------------------------------------------------------------------- */
 /* Whether create took F and S from the cache (settings.cache_dir) instead of building them. */
 bool lr_tr_cache_hit(const lr_tr *t);
+/* The on-disk cache's key of t (cache.c): its settings, surfaces and patches. Caches of what
+ * is built on t's patches (render/bounce's object rows) start from it. */
+uint64_t lr_tr_geometry_key(const lr_tr *t);
 /* The default cache folder: $XDG_CACHE_HOME/lamprig, else $HOME/.cache/lamprig (absolute
  * paths only); NULL when neither is set. buf receives it. */
 const char *lr_tr_cache_default_dir(char *buf, size_t cap);

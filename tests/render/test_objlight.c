@@ -11,7 +11,9 @@
  *  - a closed thin wall (a shade, multipole): E- is the far face's E+ (the opposite vertex's);
  *  - linearity: twice X gives twice E, vertex by vertex;
  *  - the factors: kR = <F_t> R_d / t_hem = R_d (the two integrals agree) for a half-space;
- *  - the field: default true, a SETTINGS change, off: no objects' light. */
+ *  - the field: default true, a SETTINGS change, off: no objects' light;
+ *  - the on-disk cache of the rows: a second build reads them and gives the same light to
+ *    the bit; a corrupt or truncated file is rebuilt (and rewritten), never read. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -28,6 +30,9 @@
 #include "render/cpu/recv_grid.h"
 #include "render/optics/optics.h"
 #include "render/scene/dirty.h"
+#include <dirent.h>
+
+#include "tests/support/fs.h"
 #include "tests/support/near.h"
 #include "tests/support/render.h"
 
@@ -310,6 +315,103 @@ static void test_far_face(void **state)
     lr_scene_destroy(s);
 }
 
+/* The thin wall's E (E+ and the far faces' E-) of a fresh build; *hit: read from the cache. */
+static float *shade_light(const lr_scene *s, double X, bool *hit, size_t *n)
+{
+    lr_rbounce *rb = solved(s, X);
+    const lr_objlight *ol = lr_rbounce_objects(rb);
+    assert_non_null(ol);
+    *hit = lr_objlight_cache_hit(ol);
+    *n = 6 * lr_objlight_vertex_count(ol, 0);
+    float *E = malloc(*n * sizeof *E);
+    assert_non_null(E);
+    memcpy(E, lr_objlight_E(ol, 0, 0), *n * sizeof *E);
+    lr_rbounce_destroy(rb);
+    return E;
+}
+
+/* The cache file of the rows in dir (one), or NULL. */
+static char *rows_file(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (!d)
+        return NULL;
+    char *found = NULL;
+    struct dirent *de;
+    while ((de = readdir(d)))
+        if (!strncmp(de->d_name, "objlight-", 9))
+            found = lr_test_path(dir, de->d_name);
+    closedir(d);
+    return found;
+}
+
+static void test_cache(void **state)
+{
+    (void)state;
+    char *home = lr_test_tmpdir();
+    const char *old = getenv("XDG_CACHE_HOME");
+    char *saved = old ? strdup(old) : NULL;
+    setenv("XDG_CACHE_HOME", home, 1);
+    char doc[2048];
+    snprintf(doc, sizeof doc,
+             "{\"name\":\"t\",\"objects\":[{\"name\":\"s\",\"material\":\"porcelain\","
+             "\"model\":\"multipole\",\"thickness_mm\":2,\"mesh\":{\"type\":\"shade\","
+             "\"radius_bottom\":60,\"radius_top\":40,\"height\":80,\"thickness\":2,"
+             "\"rims\":true,\"segments\":24},\"transform\":{\"translate\":[0,0,100]}}],"
+             "\"lights\":[{\"type\":\"point\",\"position\":[0,0,3000],\"intensity\":1}],"
+             "\"camera\":{\"position\":[0,-3000,100],\"target\":[0,0,0]},"
+             "\"receivers\":[{\"name\":\"table\",\"type\":\"plane\",\"center\":[0,0,0],"
+             "\"normal\":[0,0,1],\"size\":[%g,%g],\"albedo\":[%g,%g,%g]}]}",
+             2 * HALF, 2 * HALF, RHO, RHO, RHO);
+    lr_scene *s = lr_test_scene_text(doc, on);
+    const double X = 1.0e-3;
+    bool hit;
+    size_t n, n2;
+    float *E = shade_light(s, X, &hit, &n);
+    assert_false(hit);
+    char *dir = lr_test_path(home, "lamprig");
+    char *file = rows_file(dir);
+    assert_non_null(file);
+    float *E2 = shade_light(s, X, &hit, &n2);
+    assert_true(hit);
+    assert_int_equal(n2, n);
+    assert_memory_equal(E2, E, n * sizeof *E);
+    free(E2);
+    /* a flipped byte in the payload, then a file cut in half: rebuilt, the same light */
+    size_t len;
+    unsigned char *bytes = lr_test_read(file, &len);
+    assert_true(len > 200);
+    bytes[len - 7] ^= 0x5a;
+    lr_test_put(file, bytes, len);
+    E2 = shade_light(s, X, &hit, &n2);
+    assert_false(hit);
+    assert_memory_equal(E2, E, n * sizeof *E);
+    free(E2);
+    lr_test_put(file, bytes, len / 2);
+    E2 = shade_light(s, X, &hit, &n2);
+    assert_false(hit);
+    assert_memory_equal(E2, E, n * sizeof *E);
+    free(E2);
+    /* the rebuild wrote it again */
+    E2 = shade_light(s, X, &hit, &n2);
+    assert_true(hit);
+    assert_memory_equal(E2, E, n * sizeof *E);
+    free(E2);
+    print_message("rows cache: %zu bytes, hit after a build; a flipped byte and a half file "
+                  "rebuilt to the same light\n", len);
+    free(bytes);
+    free(E);
+    free(file);
+    free(dir);
+    lr_scene_destroy(s);
+    if (saved)
+        setenv("XDG_CACHE_HOME", saved, 1);
+    else
+        unsetenv("XDG_CACHE_HOME");
+    free(saved);
+    lr_test_rmtree(home);
+}
+
 static void test_factors_and_field(void **state)
 {
     (void)state;
@@ -341,6 +443,7 @@ int main(void)
         cmocka_unit_test(test_sphere_over_plane),
         cmocka_unit_test(test_occluder),
         cmocka_unit_test(test_far_face),
+        cmocka_unit_test(test_cache),
         cmocka_unit_test(test_factors_and_field),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
