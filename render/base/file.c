@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 int lr_file_read(const char *path, char **data, size_t *len, lr_err *e)
 {
@@ -44,5 +45,19 @@ int lr_file_read(const char *path, char **data, size_t *len, lr_err *e)
     buf[n] = '\0';
     *data = buf;
     *len = n;
+    return LR_OK;
+}
+
+int lr_dir_make(const char *dir, const char *what, lr_err *e)
+{
+    char parent[1024];
+    snprintf(parent, sizeof parent, "%s", dir);
+    char *slash = strrchr(parent, '/');
+    if (slash && slash != parent) {
+        *slash = 0;
+        (void)mkdir(parent, 0777);
+    }
+    if (mkdir(dir, 0777) != 0 && errno != EEXIST)
+        return lr_err_set(e, LR_EIO, "%s: %s: %s", what, dir, strerror(errno));
     return LR_OK;
 }

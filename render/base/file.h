@@ -11,4 +11,9 @@
  * "path: <strerror>" when it cannot be opened or read. The caller frees *data. */
 int lr_file_read(const char *path, char **data, size_t *len, lr_err *e);
 
+/* Creates folder dir (mode 0777 less the umask) and, when missing, its parent (one level:
+ * ~/.cache may not exist yet on a fresh account); an existing dir is fine. LR_EIO with
+ * "WHAT: dir: <strerror>" when it cannot be made. */
+int lr_dir_make(const char *dir, const char *what, lr_err *e);
+
 #endif

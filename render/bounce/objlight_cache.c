@@ -61,13 +61,6 @@ static int cache_path(const char *dir, uint64_t key, char *out, size_t cap)
     return k > 0 && (size_t)k < cap ? 0 : -1;
 }
 
-static uint64_t payload_hash(const unsigned char *p, size_t len)
-{
-    lr_ref_hash h;
-    lr_ref_hash_init(&h);
-    lr_ref_hash_bytes(&h, p, len);
-    return h.h;
-}
 
 /* Bytes of mesh i's payload with nv vertices, nnz entries and (has_far) far faces. */
 static size_t mesh_bytes(size_t nv, size_t nnz, bool has_far)
@@ -91,15 +84,9 @@ static void put(unsigned char *buf, size_t *off, const void *src, size_t bytes)
 
 int lr_objlight_cache_store(const lr_objlight *ol, uint64_t key, const char *dir, lr_err *e)
 {
-    char parent[1024];
-    snprintf(parent, sizeof parent, "%s", dir);
-    char *slash = strrchr(parent, '/');
-    if (slash && slash != parent) {
-        *slash = 0;
-        (void)mkdir(parent, 0777);
-    }
-    if (mkdir(dir, 0777) != 0 && errno != EEXIST)
-        return lr_err_set(e, LR_EIO, "objects' light cache: %s: %s", dir, strerror(errno));
+    int rc0 = lr_dir_make(dir, "objects' light cache", e);
+    if (rc0)
+        return rc0;
     char path[1024];
     if (cache_path(dir, key, path, sizeof path))
         return lr_err_set(e, LR_EINVAL, "objects' light cache: field 'dir': path too long");
@@ -132,7 +119,7 @@ int lr_objlight_cache_store(const lr_objlight *ol, uint64_t key, const char *dir
     }
     w[0] = key;
     w[1] = (uint64_t)ol->count;
-    w[2] = payload_hash(buf + head, len - head);
+    w[2] = lr_ref_hash_of(buf + head, len - head);
     for (int i = 0; i < ol->count; i++) {
         w[3 + 2 * i] = ol->m[i].nv;
         w[4 + 2 * i] = ol->m[i].row[2 * ol->m[i].nv];
@@ -233,7 +220,7 @@ bool lr_objlight_cache_load(lr_objlight *ol, uint64_t key, const char *dir)
         ok = f <= 1 && off + mesh_bytes(nv, nnz, far[i]) <= len;
         off += ok ? mesh_bytes(nv, nnz, far[i]) : 0;
     }
-    ok = ok && off == len && payload_hash(u + head, len - head) == w[2];
+    ok = ok && off == len && lr_ref_hash_of(u + head, len - head) == w[2];
     mesh_read r[LR_TR_MAX_SURFACES] = {{0}};
     off = head;
     for (int i = 0; ok && i < ol->count; i++) {

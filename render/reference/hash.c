@@ -51,3 +51,11 @@ void lr_ref_hash_vec3(lr_ref_hash *h, lr_vec3 v)
     lr_ref_hash_double(h, v.y);
     lr_ref_hash_double(h, v.z);
 }
+
+uint64_t lr_ref_hash_of(const void *data, size_t n)
+{
+    lr_ref_hash h;
+    lr_ref_hash_init(&h);
+    lr_ref_hash_bytes(&h, data, n);
+    return h.h;
+}

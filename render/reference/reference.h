@@ -76,6 +76,8 @@ void lr_ref_hash_str(lr_ref_hash *h, const char *s); /* includes the terminating
 void lr_ref_hash_u64(lr_ref_hash *h, uint64_t v);
 void lr_ref_hash_double(lr_ref_hash *h, double v);
 void lr_ref_hash_vec3(lr_ref_hash *h, lr_vec3 v);
+/* The hash of n bytes alone (a file payload's check). */
+uint64_t lr_ref_hash_of(const void *data, size_t n);
 
 /* ---- shapes: the geometry interface ----------------------------------------------------- */
 

@@ -113,26 +113,13 @@ static void pieces(size_t n, size_t nf, size_t ns, piece out[7])
     out[6] = (piece){NULL, 3 * ns * sizeof(float)};
 }
 
-static uint64_t payload_hash(const unsigned char *p, size_t len)
-{
-    lr_ref_hash h;
-    lr_ref_hash_init(&h);
-    lr_ref_hash_bytes(&h, p, len);
-    return h.h;
-}
 
 int lr_tr_cache_store(const lr_tr *t, uint64_t key, const char *dir, lr_err *e)
 {
     /* The folder and its parent (~/.cache may not exist yet). */
-    char parent[1024];
-    snprintf(parent, sizeof parent, "%s", dir);
-    char *slash = strrchr(parent, '/');
-    if (slash && slash != parent) {
-        *slash = 0;
-        (void)mkdir(parent, 0777);
-    }
-    if (mkdir(dir, 0777) != 0 && errno != EEXIST)
-        return lr_err_set(e, LR_EIO, "transrad cache: %s: %s", dir, strerror(errno));
+    int rc0 = lr_dir_make(dir, "transrad cache", e);
+    if (rc0)
+        return rc0;
     char path[1024];
     if (lr_tr_cache_path(dir, key, path, sizeof path))
         return lr_err_set(e, LR_EINVAL, "transrad cache: field 'dir': path too long");
@@ -158,7 +145,7 @@ int lr_tr_cache_store(const lr_tr *t, uint64_t key, const char *dir, lr_err *e)
             memcpy(buf + off, pc[i].p, pc[i].bytes);
         off += pc[i].bytes;
     }
-    uint64_t w[HEADER_WORDS] = {key, n, nf, ns, payload_hash(buf + head, len - head), 0};
+    uint64_t w[HEADER_WORDS] = {key, n, nf, ns, lr_ref_hash_of(buf + head, len - head), 0};
     memcpy(buf, MAGIC, 8);
     memcpy(buf + 8, w, sizeof w);
     int rc = lr_atomic_write(path, buf, len, e);
@@ -207,7 +194,7 @@ bool lr_tr_cache_load(lr_tr *t, uint64_t key, const char *dir)
         pieces(n, (size_t)w[2], (size_t)w[3], pc);
         for (int i = 0; i < 7; i++)
             want += pc[i].bytes;
-        ok = len == want && payload_hash((unsigned char *)data + head, len - head) == w[4];
+        ok = len == want && lr_ref_hash_of((unsigned char *)data + head, len - head) == w[4];
     }
     lr_tr_rows F = {0}, S = {0};
     double *escape = NULL;
