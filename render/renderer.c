@@ -65,6 +65,11 @@ struct lr_renderer {
 
     unsigned dirty;
     int frame_index;
+    /* render.surface_cache_moves: this frame is a camera move on converged maps, which
+     * composes from the surface cache; `coarse`: the current images came from such a frame,
+     * so the next frame without a camera change composes them again with the gather. */
+    bool move_frame;
+    bool coarse;
 
     /* The clock of lr_renderer_set_time (flicker at composition). */
     bool clock_set;
@@ -191,7 +196,10 @@ static int irradiance_run(lr_renderer *r, unsigned dirty, lr_err *e)
 }
 
 static void surface_free(lr_renderer *r) { lr_surface_free(&r->surf); }
-static bool surface_on(const lr_renderer *r) { return r->rs.surface_cache; }
+/* Always with render.surface_cache; with render.surface_cache_moves only on a camera move
+ * (drawn then if the maps changed since: the first move after a change pays for it). */
+static bool cache_now(const lr_renderer *r) { return r->rs.surface_cache || r->move_frame; }
+static bool surface_on(const lr_renderer *r) { return cache_now(r); }
 /* Not drawn yet, or drawn from other maps (accumulation went on while it was off). */
 static bool surface_due(const lr_renderer *r)
 {
@@ -213,15 +221,20 @@ static int compose_alloc(lr_renderer *r, lr_err *e)
 }
 static void compose_free(lr_renderer *r) { lr_compose_free(&r->img); }
 /* The images are composed for as many lights as the scene has now. */
-static bool compose_due(const lr_renderer *r) { return !r->img.valid; }
+static bool compose_due(const lr_renderer *r)
+{
+    return !r->img.valid || (r->coarse && !r->move_frame);
+}
 static int compose_run(lr_renderer *r, unsigned dirty, lr_err *e)
 {
     (void)dirty;
     lr_pass_ctx c = pass_ctx(r);
     lr_compose_inputs in = {.gbuffer = &r->gbuffer, .radiosity = &r->rad, .vpl = &r->vpl,
                             .irradiance = &r->irr, .area = &r->area, .lpv = lpv_live(r),
-                            .surface = r->rs.surface_cache && r->surf.valid ? &r->surf : NULL};
-    return lr_compose_run(&r->img, &c, &in, e);
+                            .surface = cache_now(r) && r->surf.valid ? &r->surf : NULL};
+    int rc = lr_compose_run(&r->img, &c, &in, e);
+    r->coarse = !rc && in.surface && !r->rs.surface_cache;
+    return rc;
 }
 
 static int blend_alloc(lr_renderer *r, lr_err *e)
@@ -506,7 +519,7 @@ static int frames_target(const lr_renderer *r)
 
 bool lr_renderer_needs_frame(const lr_renderer *r)
 {
-    return r->dirty != 0 || r->rad.F < frames_target(r);
+    return r->dirty != 0 || r->rad.F < frames_target(r) || r->coarse;
 }
 
 static bool resources_stale(const lr_renderer *r)
@@ -546,7 +559,15 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
     r->rs.exposure = lr_scene_render(r->scene)->exposure;
     r->rs.frames = frames_target(r);
     r->rs.N = lr_scene_render(r->scene)->N;
+    /* Turning render.surface_cache off is a view-class change too, but not a move. */
+    bool was_cached = r->rs.surface_cache;
     r->rs.surface_cache = lr_scene_render(r->scene)->surface_cache;
+    r->rs.surface_cache_moves = lr_scene_render(r->scene)->surface_cache_moves;
+    /* A camera move on converged maps (nothing that restarts them, nothing left to
+     * accumulate) composes from the surface cache (render/README.md "Camera moves"). */
+    r->move_frame = r->rs.surface_cache_moves && !r->rs.surface_cache && !was_cached &&
+                    (dirty & LR_DIRTY_CAMERA) && !(passes & LR_PASS_RADIOSITY) &&
+                    !radiosity_due(r);
     /* The refined meshes depend on the geometry, sigma_tr and the map size (surface.h). */
     if (dirty & (LR_DIRTY_GEOMETRY | LR_DIRTY_SETTINGS | LR_DIRTY_MATERIAL))
         lr_surface_invalidate_geometry(&r->surf);

@@ -327,6 +327,12 @@ static const lr_field render_fields[] = {
      * by default: its error is not yet shown to be under the converged noise (PIPELINE.md). */
     {"surface_cache", LR_FT_BOOL, 0, RS(surface_cache), .dflt = {0}, .dirty = LR_DIRTY_CAMERA,
      .help = "objects' B from the per-vertex surface cache (false: Algorithm 1 per pixel)"},
+    /* Camera moves from the cache, the still image gathered (render/README.md "Camera
+     * moves"): how composition gets B during a move, a view-class change. */
+    {"surface_cache_moves", LR_FT_BOOL, 0, RS(surface_cache_moves), .dflt = {1},
+     .dirty = LR_DIRTY_CAMERA,
+     .help = "with surface_cache false: camera moves compose from the surface cache, the "
+             "frame after a move with Algorithm 1 per pixel"},
     {"lpv", LR_FT_INT, 0, RS(lpv), 0, 128, Z, .dflt = {0}, .dirty = SET,
      .help = "light-propagation volume cells per axis for area, point and spot lights' "
              "indirect light on plane receivers (seed 004; 0: off, else 2-128, e.g. 32)"},

@@ -221,6 +221,11 @@ typedef struct lr_render_settings {
     /* Composition reads the objects' B from the view-independent surface cache
      * (render/passes/surface.h) instead of running Algorithm 1 per pixel (issue 11). */
     bool surface_cache;
+    /* With surface_cache false: a camera move on converged maps composes from the surface
+     * cache (drawn at the first such move after the maps change), and the first frame
+     * without a camera change composes again with Algorithm 1 per pixel (issue 11: a
+     * camera move costs a lookup, the still image stays the gather's). Default true. */
+    bool surface_cache_moves;
     /* Light-propagation volume (render/lpv/, seed 004) for the area lights' indirect light on
      * the plane receivers: cells per axis, 0 off. */
     int lpv;

@@ -12,6 +12,7 @@
 #include <stdlib.h>
 
 #include "render/renderer.h"
+#include "render/renderer_debug.h"
 #include "tests/support/gl.h"
 #include "tests/support/near.h"
 #include "tests/support/render.h"
@@ -144,8 +145,9 @@ static void test_lpv_row(void **state)
     float *after = lr_test_hdr(f->r);
     for (int i = 0; i < W * H * 3; i++)
         assert_near(after[i], 0.4 * before[i], 1e-6 * 0.4 * before[i]);
+    /* A camera move on converged maps: the surface cache first (render.surface_cache_moves). */
     lr_test_set(f->s, f->r, "camera.position", "20,-300,160");
-    assert_int_equal(lr_test_frame(f->r).passes, VIEW);
+    assert_int_equal(lr_test_frame(f->r).passes, LR_PASS_SURFACE | VIEW);
     lr_test_set(f->s, f->r, "objects[0].material", "marble");
     lr_frame_stats d = lr_test_frame(f->r);
     assert_true(d.passes & LR_PASS_LPV);
@@ -158,10 +160,27 @@ static void test_camera_runs_compose_only(void **state)
 {
     fixture *f = *state;
     lr_test_converge(f->r, 8);
+    /* A move on converged maps composes from the objects' surface cache (drawn now, from the
+     * maps: view-independent), the frame after it with the per-pixel gather
+     * (render.surface_cache_moves, render/README.md "Camera moves"). */
     lr_test_set(f->s, f->r, "camera.position", "100,-400,250");
     lr_frame_stats st = lr_test_frame(f->r);
-    assert_int_equal(st.passes, VIEW);
+    assert_int_equal(st.passes, LR_PASS_SURFACE | VIEW);
     assert_int_equal(st.samples, 2);
+    assert_false(lr_renderer_debug_compose_gathered(f->r));
+    assert_true(lr_renderer_needs_frame(f->r));
+    assert_int_equal(lr_test_frame(f->r).passes, VIEW);
+    assert_true(lr_renderer_debug_compose_gathered(f->r));
+    assert_false(lr_renderer_needs_frame(f->r));
+    /* The next move finds the cache current: composition and blend alone. */
+    lr_test_set(f->s, f->r, "camera.position", "100,-380,250");
+    assert_int_equal(lr_test_frame(f->r).passes, VIEW);
+    assert_int_equal(lr_test_frame(f->r).passes, VIEW);
+    lr_test_set(f->s, f->r, "render.surface_cache_moves", "false");
+    lr_test_set(f->s, f->r, "camera.position", "100,-400,250");
+    assert_int_equal(lr_test_frame(f->r).passes, VIEW);
+    assert_true(lr_renderer_debug_compose_gathered(f->r));
+    assert_false(lr_renderer_needs_frame(f->r));
     lr_test_set(f->s, f->r, "render.exposure", "1e6");
     assert_int_equal(lr_test_frame(f->r).passes, LR_PASS_BLEND);
     /* Receivers: their irradiance grids, then the view. */

@@ -207,6 +207,7 @@ static void cache_against_gather(const char *name)
     lr_renderer_debug_surface_info(r, &si);
     lr_test_set(s, r, "render.surface_cache", "false");
     lr_test_frame(r);
+    assert_true(lr_renderer_debug_compose_gathered(r));
     float *gathered = lr_test_hdr(r);
     lr_renderer *r2 = converged(s, 11, false);
     float *other = lr_test_hdr(r2);
@@ -433,8 +434,100 @@ static void test_default(void **state)
 {
     (void)state;
     /* Off by default (PIPELINE.md "Surface cache": its error is 0.7-0.9 of the converged noise
-     * on the candle and the votive, above the 48-frame noise on the lamp shade). */
+     * on the candle and the votive, above the 48-frame noise on the lamp shade) for the still
+     * image; on for camera moves (render.surface_cache_moves). */
     assert_false(cache_on_by_default());
+    lr_scene *s = lr_test_scene("candle", NULL, NULL);
+    assert_true(lr_scene_render(s)->surface_cache_moves);
+    lr_scene_destroy(s);
+}
+
+/* render.surface_cache_moves (the default): a camera move on converged maps composes from
+ * the cache, drawn at the first move; the frame after it composes again with the gather, and
+ * that still image is the gather's to the bit. */
+static void test_moves_from_cache_still_gathered(void **state)
+{
+    (void)state;
+    lr_scene *s = lr_test_scene("candle", lr_test_small_settings, NULL);
+    lr_renderer *r = converged(s, 3, false);
+    assert_true(lr_renderer_debug_compose_gathered(r));
+    float *before = lr_test_hdr(r);
+    const lr_camera *cam = lr_scene_camera(s);
+    lr_vec3 c0 = cam->position;
+    char moved[96], back[96];
+    snprintf(moved, sizeof moved, "%.17g,%.17g,%.17g", c0.x + 40.0, c0.y, c0.z + 20.0);
+    snprintf(back, sizeof back, "%.17g,%.17g,%.17g", c0.x, c0.y, c0.z);
+    enum { VIEW = LR_PASS_COMPOSE | LR_PASS_BLEND };
+    /* The first move draws the cache from the converged maps, then composes from it. */
+    lr_test_set(s, r, "camera.position", moved);
+    lr_frame_stats st = lr_test_frame(r);
+    assert_int_equal(st.passes, LR_PASS_SURFACE | VIEW);
+    assert_false(lr_renderer_debug_compose_gathered(r));
+    float *moving = lr_test_hdr(r);
+    /* That image is the always-on cache's: switching it on composes the same (no surface
+     * pass: the cache is that of the current maps). */
+    lr_test_set(s, r, "render.surface_cache", "true");
+    st = lr_test_frame(r);
+    assert_int_equal(st.passes, VIEW);
+    float *cached = lr_test_hdr(r);
+    assert_memory_equal(moving, cached, (size_t)W * H * 3 * sizeof *moving);
+    /* Turning it off is not a move: the gather at once. */
+    lr_test_set(s, r, "render.surface_cache", "false");
+    st = lr_test_frame(r);
+    assert_int_equal(st.passes, VIEW);
+    assert_true(lr_renderer_debug_compose_gathered(r));
+    assert_false(lr_renderer_needs_frame(r));
+    /* Moving back: the cache is current, so composition and blend alone ... */
+    lr_test_set(s, r, "camera.position", back);
+    st = lr_test_frame(r);
+    assert_int_equal(st.passes, VIEW);
+    assert_false(lr_renderer_debug_compose_gathered(r));
+    /* ... then the still frame: gathered per pixel, the image from before the moves. */
+    assert_true(lr_renderer_needs_frame(r));
+    st = lr_test_frame(r);
+    assert_int_equal(st.passes, VIEW);
+    assert_true(lr_renderer_debug_compose_gathered(r));
+    assert_false(lr_renderer_needs_frame(r));
+    float *after = lr_test_hdr(r);
+    assert_memory_equal(before, after, (size_t)W * H * 3 * sizeof *before);
+    /* A dimmer right after a move composes the still image too (the blend alone would
+     * weight the moving images). */
+    lr_test_set(s, r, "camera.position", moved);
+    lr_test_frame(r);
+    lr_test_set(s, r, "light.intensity", "0.002");
+    st = lr_test_frame(r);
+    assert_int_equal(st.passes, VIEW);
+    assert_true(lr_renderer_debug_compose_gathered(r));
+    /* Off: a move gathers, and nothing follows it. */
+    lr_test_set(s, r, "render.surface_cache_moves", "false");
+    lr_test_set(s, r, "camera.position", back);
+    st = lr_test_frame(r);
+    assert_int_equal(st.passes, VIEW);
+    assert_true(lr_renderer_debug_compose_gathered(r));
+    assert_false(lr_renderer_needs_frame(r));
+    free(before);
+    free(moving);
+    free(cached);
+    free(after);
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+}
+
+/* While the maps accumulate a camera move gathers (the cache would be redrawn every frame). */
+static void test_moves_while_accumulating_gather(void **state)
+{
+    (void)state;
+    lr_scene *s = lr_test_scene("candle", lr_test_small_settings, NULL);
+    lr_renderer *r = lr_test_renderer(gl, s, W, H, true, 3);
+    lr_test_frame(r);
+    assert_true(lr_renderer_needs_frame(r));
+    lr_test_set(s, r, "camera.position", "100,-400,250");
+    lr_frame_stats st = lr_test_frame(r);
+    assert_true(st.passes & LR_PASS_RADIOSITY);
+    assert_false(st.passes & LR_PASS_SURFACE);
+    assert_true(lr_renderer_debug_compose_gathered(r));
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
 }
 
 int main(void)
@@ -442,6 +535,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_default),
         cmocka_unit_test(test_camera_move_runs_no_gather),
+        cmocka_unit_test(test_moves_from_cache_still_gathered),
+        cmocka_unit_test(test_moves_while_accumulating_gather),
         cmocka_unit_test(test_cache_follows_the_maps),
         cmocka_unit_test(test_twin_follows_cache),
         cmocka_unit_test(test_lookup_is_lattice_interpolation),
