@@ -5,28 +5,26 @@
  * the object meshes.
  *
  * File: <dir>/objlight-<key>.bin beside translucent radiosity's F and S (render/transrad/
- * cache.c, the same rules): the magic "LROLC001", the key, the mesh count, the payload's hash,
- * then per mesh its vertex count and entry count, then the payload: per mesh the row starts,
- * columns, values, a far-face flag and (when set) the far faces' triangles and barycentrics.
- * Written whole through render/base/atomic_file; read back only when everything checks (magic,
+ * cache.c, the same rules; layout by render/reference/cache_file.h): the magic "LROLC002", the
+ * key, the mesh count, per mesh its vertex count and entry count, the payload's hash, then the
+ * payload: per mesh the row starts, columns, values, a far-face flag and (when set) the far
+ * faces' triangles and barycentrics. Written atomically; read back only when everything checks (magic,
  * key, counts, sizes to the byte, the payload hash, rows monotonic and ending at their count,
  * columns among the source patches, values finite and >= 0, far triangles in the mesh or
  * none, barycentrics finite); else ignored and rebuilt (a truncated or corrupt file costs a
  * rebuild, never a wrong answer). Bump the tag when the rows change meaning. */
 #include "render/bounce/objlight_priv.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
-#include "render/base/atomic_file.h"
 #include "render/base/file.h"
+#include "render/reference/cache_file.h"
 #include "render/reference/reference.h"
 
-#define MAGIC "LROLC001"
+#define MAGIC "LROLC002"
 
 uint64_t lr_objlight_cache_key(const lr_objlight *ol, const lr_tr *t, int rays)
 {
@@ -72,15 +70,9 @@ static size_t mesh_bytes(size_t nv, size_t nnz, bool has_far)
     return b;
 }
 
-/* Header: magic, then key, count, payload hash, then (nv, nnz) per mesh. */
-static size_t header_bytes(int count) { return 8 + (3 + 2 * (size_t)count) * sizeof(uint64_t); }
-
-static void put(unsigned char *buf, size_t *off, const void *src, size_t bytes)
-{
-    if (bytes > 0)
-        memcpy(buf + *off, src, bytes);
-    *off += bytes;
-}
+/* Header words: key, count, then (nv, nnz) per mesh (render/reference/cache_file.h adds the
+ * magic and the payload hash). */
+static int header_words(int count) { return 2 + 2 * count; }
 
 int lr_objlight_cache_store(const lr_objlight *ol, uint64_t key, const char *dir, lr_err *e)
 {
@@ -90,46 +82,32 @@ int lr_objlight_cache_store(const lr_objlight *ol, uint64_t key, const char *dir
     char path[1024];
     if (cache_path(dir, key, path, sizeof path))
         return lr_err_set(e, LR_EINVAL, "objects' light cache: field 'dir': path too long");
-    size_t head = header_bytes(ol->count), len = head;
-    for (int i = 0; i < ol->count; i++) {
-        const ol_mesh *m = &ol->m[i];
-        len += mesh_bytes(m->nv, m->row[2 * m->nv], m->far_tri != NULL);
-    }
-    unsigned char *buf = malloc(len);
-    if (!buf)
-        return lr_err_set(e, LR_ENOMEM, "objects' light cache: out of memory (%zu bytes)", len);
-    size_t off = head;
+    if (ol->count > LR_TR_MAX_SURFACES)
+        return lr_err_set(e, LR_EINVAL, "objects' light cache: %d meshes; at most %d",
+                          ol->count, LR_TR_MAX_SURFACES);
+    /* Per mesh: row starts, columns, values, the far flag, (far) triangles, barycentrics. */
+    lr_cache_piece pc[6 * LR_TR_MAX_SURFACES];
+    uint64_t w[2 + 2 * LR_TR_MAX_SURFACES], far[LR_TR_MAX_SURFACES];
+    int np = 0;
+    w[0] = key;
+    w[1] = (uint64_t)ol->count;
     for (int i = 0; i < ol->count; i++) {
         const ol_mesh *m = &ol->m[i];
         size_t nnz = m->row[2 * m->nv];
-        uint64_t far = m->far_tri != NULL;
-        put(buf, &off, m->row, (2 * m->nv + 1) * sizeof *m->row);
-        put(buf, &off, m->col, nnz * sizeof *m->col);
-        put(buf, &off, m->val, nnz * sizeof *m->val);
-        put(buf, &off, &far, sizeof far);
-        if (far) {
-            put(buf, &off, m->far_tri, m->nv * sizeof *m->far_tri);
-            put(buf, &off, m->far_uv, 2 * m->nv * sizeof *m->far_uv);
+        far[i] = m->far_tri != NULL;
+        w[2 + 2 * i] = m->nv;
+        w[3 + 2 * i] = nnz;
+        pc[np++] = (lr_cache_piece){m->row, (2 * m->nv + 1) * sizeof *m->row};
+        pc[np++] = (lr_cache_piece){m->col, nnz * sizeof *m->col};
+        pc[np++] = (lr_cache_piece){m->val, nnz * sizeof *m->val};
+        pc[np++] = (lr_cache_piece){&far[i], sizeof far[i]};
+        if (far[i]) {
+            pc[np++] = (lr_cache_piece){m->far_tri, m->nv * sizeof *m->far_tri};
+            pc[np++] = (lr_cache_piece){m->far_uv, 2 * m->nv * sizeof *m->far_uv};
         }
     }
-    uint64_t *w = malloc((3 + 2 * (size_t)ol->count) * sizeof *w);
-    if (!w) {
-        free(buf);
-        return lr_err_set(e, LR_ENOMEM, "objects' light cache: out of memory");
-    }
-    w[0] = key;
-    w[1] = (uint64_t)ol->count;
-    w[2] = lr_ref_hash_of(buf + head, len - head);
-    for (int i = 0; i < ol->count; i++) {
-        w[3 + 2 * i] = ol->m[i].nv;
-        w[4 + 2 * i] = ol->m[i].row[2 * ol->m[i].nv];
-    }
-    memcpy(buf, MAGIC, 8);
-    memcpy(buf + 8, w, head - 8);
-    free(w);
-    int rc = lr_atomic_write(path, buf, len, e);
-    free(buf);
-    return rc;
+    return lr_cache_file_write(path, MAGIC, w, header_words(ol->count), pc, np,
+                               "objects' light cache", e);
 }
 
 /* One mesh's arrays as read, checked, before they replace anything. */
@@ -193,24 +171,19 @@ static bool read_mesh(const ol_mesh *m, const lr_objlight *ol, const unsigned ch
 bool lr_objlight_cache_load(lr_objlight *ol, uint64_t key, const char *dir)
 {
     char path[1024], *data = NULL;
+    const unsigned char *u = NULL;
     size_t len = 0;
-    lr_err e = {0};
-    if (cache_path(dir, key, path, sizeof path) || lr_file_read(path, &data, &len, &e))
+    uint64_t w[2 + 2 * LR_TR_MAX_SURFACES];
+    if (ol->count > LR_TR_MAX_SURFACES || cache_path(dir, key, path, sizeof path) ||
+        !lr_cache_file_read(path, MAGIC, w, header_words(ol->count), &data, &u, &len))
         return false;
-    const unsigned char *u = (const unsigned char *)data;
-    size_t head = header_bytes(ol->count);
-    uint64_t w[3 + 2 * LR_TR_MAX_SURFACES];
-    bool ok = len >= head && !memcmp(data, MAGIC, 8);
-    if (ok) {
-        memcpy(w, data + 8, head - 8);
-        ok = w[0] == key && w[1] == (uint64_t)ol->count;
-    }
+    bool ok = w[0] == key && w[1] == (uint64_t)ol->count;
     /* sizes: each mesh's vertex count as built, its entries and far flag as written */
-    size_t off = head;
+    size_t off = 0;
     bool far[LR_TR_MAX_SURFACES] = {false};
     for (int i = 0; ok && i < ol->count; i++) {
-        size_t nv = ol->m[i].nv, nnz = (size_t)w[4 + 2 * i];
-        ok = w[3 + 2 * i] == nv && nnz <= (size_t)ol->n_patches * 2 * (nv + 1) &&
+        size_t nv = ol->m[i].nv, nnz = (size_t)w[3 + 2 * i];
+        ok = w[2 + 2 * i] == nv && nnz <= (size_t)ol->n_patches * 2 * (nv + 1) &&
              off + mesh_bytes(nv, nnz, false) <= len;
         if (!ok)
             break;
@@ -220,11 +193,11 @@ bool lr_objlight_cache_load(lr_objlight *ol, uint64_t key, const char *dir)
         ok = f <= 1 && off + mesh_bytes(nv, nnz, far[i]) <= len;
         off += ok ? mesh_bytes(nv, nnz, far[i]) : 0;
     }
-    ok = ok && off == len && lr_ref_hash_of(u + head, len - head) == w[2];
+    ok = ok && off == len;
     mesh_read r[LR_TR_MAX_SURFACES] = {{0}};
-    off = head;
+    off = 0;
     for (int i = 0; ok && i < ol->count; i++) {
-        size_t nnz = (size_t)w[4 + 2 * i];
+        size_t nnz = (size_t)w[3 + 2 * i];
         ok = read_mesh(&ol->m[i], ol, u + off, nnz, far[i], &r[i]);
         off += mesh_bytes(ol->m[i].nv, nnz, far[i]);
     }

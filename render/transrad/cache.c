@@ -6,28 +6,26 @@
  * tag, the settings that shape F and S (patch_mm, receiver_mm, rays_per_patch, seed,
  * thin_wall), every surface's description (kind, albedo, scattering coefficients, model, thickness, plane
  * frame, cells), its mesh's vertices and triangles, and the patches built from them (centroid,
- * normal, area, surface). Layout: the magic "LRTRC001", key, n, nnz(F), nnz(S), a hash of the
- * payload, then F's row starts, columns, values, the escapes, S's row starts, columns, values.
- * Written whole through render/base/atomic_file (a temp file renamed over), so a reader sees
- * the old file or the new one. Read back only when everything checks: magic, key, sizes to the
- * byte, the payload hash, rows monotonic and ending at nnz, columns < n, values finite; else
+ * normal, area, surface). Layout (render/reference/cache_file.h: magic, header words, payload
+ * hash, payload; written atomically): the magic "LRTRC002", key, n, nnz(F), nnz(S), then F's
+ * row starts, columns, values, the escapes, S's row starts, columns, values. Read back only
+ * when everything checks: magic, key, sizes to the byte, the payload hash, rows monotonic and
+ * ending at nnz, columns < n, values finite; else
  * it is ignored, rebuilt and overwritten (a truncated or corrupt file costs a rebuild, never a
  * wrong answer). Bump the tag when F or S change meaning. */
 #include "render/transrad/tr_priv.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
-#include "render/base/atomic_file.h"
 #include "render/base/file.h"
+#include "render/reference/cache_file.h"
 #include "render/reference/reference.h"
 
-#define MAGIC "LRTRC001"
-#define HEADER_WORDS 6 /* key, n, nnzF, nnzS, payload hash; after the 8-byte magic */
+#define MAGIC "LRTRC002"
+#define HEADER_WORDS 4 /* key, n, nnzF, nnzS (render/reference/cache_file.h adds the hash) */
 
 uint64_t lr_tr_cache_key(const lr_tr *t)
 {
@@ -96,23 +94,18 @@ int lr_tr_cache_path(const char *dir, uint64_t key, char *out, size_t cap)
     return k > 0 && (size_t)k < cap ? 0 : -1;
 }
 
-/* The payload's pieces in file order. */
-typedef struct piece {
-    void *p;
-    size_t bytes;
-} piece;
-
-static void pieces(size_t n, size_t nf, size_t ns, piece out[7])
+/* The payload's sizes in file order: F's row starts, columns, values, the escapes, S's row
+ * starts, columns, values. */
+static void piece_sizes(size_t n, size_t nf, size_t ns, size_t out[7])
 {
-    out[0] = (piece){NULL, (n + 1) * sizeof(size_t)};
-    out[1] = (piece){NULL, nf * sizeof(uint32_t)};
-    out[2] = (piece){NULL, nf * sizeof(float)};
-    out[3] = (piece){NULL, n * sizeof(double)};
-    out[4] = (piece){NULL, (n + 1) * sizeof(size_t)};
-    out[5] = (piece){NULL, ns * sizeof(uint32_t)};
-    out[6] = (piece){NULL, 3 * ns * sizeof(float)};
+    out[0] = (n + 1) * sizeof(size_t);
+    out[1] = nf * sizeof(uint32_t);
+    out[2] = nf * sizeof(float);
+    out[3] = n * sizeof(double);
+    out[4] = (n + 1) * sizeof(size_t);
+    out[5] = ns * sizeof(uint32_t);
+    out[6] = 3 * ns * sizeof(float);
 }
-
 
 int lr_tr_cache_store(const lr_tr *t, uint64_t key, const char *dir, lr_err *e)
 {
@@ -123,34 +116,14 @@ int lr_tr_cache_store(const lr_tr *t, uint64_t key, const char *dir, lr_err *e)
     char path[1024];
     if (lr_tr_cache_path(dir, key, path, sizeof path))
         return lr_err_set(e, LR_EINVAL, "transrad cache: field 'dir': path too long");
-    size_t n = t->n, nf = t->F.row[n], ns = t->S.row[n];
-    piece pc[7];
-    pieces(n, nf, ns, pc);
-    pc[0].p = t->F.row;
-    pc[1].p = t->F.col;
-    pc[2].p = t->F.val;
-    pc[3].p = t->escape;
-    pc[4].p = t->S.row;
-    pc[5].p = t->S.col;
-    pc[6].p = t->S.val;
-    size_t head = 8 + HEADER_WORDS * sizeof(uint64_t), len = head;
+    size_t n = t->n, nf = t->F.row[n], ns = t->S.row[n], b[7];
+    piece_sizes(n, nf, ns, b);
+    const void *src[7] = {t->F.row, t->F.col, t->F.val, t->escape, t->S.row, t->S.col, t->S.val};
+    lr_cache_piece pc[7];
     for (int i = 0; i < 7; i++)
-        len += pc[i].bytes;
-    unsigned char *buf = malloc(len);
-    if (!buf)
-        return lr_err_set(e, LR_ENOMEM, "transrad cache: out of memory (%zu bytes)", len);
-    size_t off = head;
-    for (int i = 0; i < 7; i++) {
-        if (pc[i].bytes)
-            memcpy(buf + off, pc[i].p, pc[i].bytes);
-        off += pc[i].bytes;
-    }
-    uint64_t w[HEADER_WORDS] = {key, n, nf, ns, lr_ref_hash_of(buf + head, len - head), 0};
-    memcpy(buf, MAGIC, 8);
-    memcpy(buf + 8, w, sizeof w);
-    int rc = lr_atomic_write(path, buf, len, e);
-    free(buf);
-    return rc;
+        pc[i] = (lr_cache_piece){src[i], b[i]};
+    uint64_t w[HEADER_WORDS] = {key, n, nf, ns};
+    return lr_cache_file_write(path, MAGIC, w, HEADER_WORDS, pc, 7, "transrad cache", e);
 }
 
 static bool rows_ok(const size_t *row, size_t n, size_t nnz, const uint32_t *col)
@@ -177,42 +150,37 @@ static bool finite_f(const float *v, size_t m)
 bool lr_tr_cache_load(lr_tr *t, uint64_t key, const char *dir)
 {
     char path[1024], *data = NULL;
-    size_t len = 0;
-    lr_err e = {0};
-    if (lr_tr_cache_path(dir, key, path, sizeof path) || lr_file_read(path, &data, &len, &e))
-        return false;
-    size_t head = 8 + HEADER_WORDS * sizeof(uint64_t), n = t->n;
+    const unsigned char *payload = NULL;
+    size_t len = 0, n = t->n;
     uint64_t w[HEADER_WORDS];
-    bool ok = len >= head && !memcmp(data, MAGIC, 8);
+    if (lr_tr_cache_path(dir, key, path, sizeof path) ||
+        !lr_cache_file_read(path, MAGIC, w, HEADER_WORDS, &data, &payload, &len))
+        return false;
+    bool ok = w[0] == key && w[1] == n && w[2] <= (uint64_t)n * n && w[3] <= (uint64_t)n * n;
+    size_t b[7], want = 0;
     if (ok) {
-        memcpy(w, data + 8, sizeof w);
-        ok = w[0] == key && w[1] == n && w[2] <= (uint64_t)n * n && w[3] <= (uint64_t)n * n;
-    }
-    piece pc[7];
-    size_t want = head;
-    if (ok) {
-        pieces(n, (size_t)w[2], (size_t)w[3], pc);
+        piece_sizes(n, (size_t)w[2], (size_t)w[3], b);
         for (int i = 0; i < 7; i++)
-            want += pc[i].bytes;
-        ok = len == want && lr_ref_hash_of((unsigned char *)data + head, len - head) == w[4];
+            want += b[i];
+        ok = len == want;
     }
     lr_tr_rows F = {0}, S = {0};
     double *escape = NULL;
     if (ok) {
         size_t nf = (size_t)w[2], ns = (size_t)w[3];
-        F.row = malloc(pc[0].bytes);
-        F.col = malloc(pc[1].bytes ? pc[1].bytes : 1);
-        F.val = malloc(pc[2].bytes ? pc[2].bytes : 1);
-        escape = malloc(pc[3].bytes ? pc[3].bytes : 1);
-        S.row = malloc(pc[4].bytes);
-        S.col = malloc(pc[5].bytes ? pc[5].bytes : 1);
-        S.val = malloc(pc[6].bytes ? pc[6].bytes : 1);
+        F.row = malloc(b[0]);
+        F.col = malloc(b[1] ? b[1] : 1);
+        F.val = malloc(b[2] ? b[2] : 1);
+        escape = malloc(b[3] ? b[3] : 1);
+        S.row = malloc(b[4]);
+        S.col = malloc(b[5] ? b[5] : 1);
+        S.val = malloc(b[6] ? b[6] : 1);
         void *dst[7] = {F.row, F.col, F.val, escape, S.row, S.col, S.val};
         ok = F.row && F.col && F.val && escape && S.row && S.col && S.val;
-        size_t off = head;
+        size_t off = 0;
         for (int i = 0; ok && i < 7; i++) {
-            memcpy(dst[i], data + off, pc[i].bytes);
-            off += pc[i].bytes;
+            memcpy(dst[i], payload + off, b[i]);
+            off += b[i];
         }
         ok = ok && rows_ok(F.row, n, nf, F.col) && rows_ok(S.row, n, ns, S.col) &&
              finite_f(F.val, nf) && finite_f(S.val, 3 * ns);

@@ -5,7 +5,10 @@
  *  - a corrupt cache (a flipped payload byte, a flipped key byte, a truncated file, garbage,
  *    an empty file) is never used: create rebuilds, solves to the same W, and rewrites it, so
  *    the next create hits again;
- *  - a folder that cannot be written costs only the cache (create succeeds, no hit). */
+ *  - a folder that cannot be written costs only the cache (create succeeds, no hit);
+ *  - the checked file under both caches (render/reference/cache_file.h): pieces read back as
+ *    written, and a flipped magic, header or payload byte, a short file or an absent one read
+ *    as absent. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -20,6 +23,7 @@
 #include <unistd.h>
 
 #include "render/base/paths.h"
+#include "render/reference/cache_file.h"
 #include "render/transrad/transrad.h"
 
 static char dir[256];
@@ -193,6 +197,67 @@ static void test_corrupt(void **state)
     lr_scene_destroy(s);
 }
 
+/* Flips byte `at` of path (or truncates it to `at` bytes) and expects the read to fail. */
+static void cache_file_refused(const char *path, const unsigned char *good, size_t len, long at,
+                               bool truncate)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    unsigned char *copy = malloc(len);
+    assert_non_null(copy);
+    memcpy(copy, good, len);
+    if (!truncate)
+        copy[at] ^= 0x10;
+    assert_int_equal(fwrite(copy, 1, truncate ? (size_t)at : len, f), truncate ? (size_t)at : len);
+    fclose(f);
+    free(copy);
+    uint64_t w[2];
+    char *data = NULL;
+    const unsigned char *payload;
+    size_t n;
+    assert_false(lr_cache_file_read(path, "LRTEST01", w, 2, &data, &payload, &n));
+    assert_null(data);
+}
+
+static void test_cache_file(void **state)
+{
+    (void)state;
+    char path[512];
+    snprintf(path, sizeof path, "%s/blob.bin", dir);
+    const uint64_t words[2] = {0x1122334455667788ull, 3};
+    const float a[3] = {1.0f, 2.5f, -4.0f};
+    const uint32_t b[2] = {7, 9};
+    lr_cache_piece pc[3] = {{a, sizeof a}, {NULL, 0}, {b, sizeof b}};
+    lr_err e = {0};
+    assert_int_equal(lr_cache_file_write(path, "LRTEST01", words, 2, pc, 3, "test", &e), LR_OK);
+    uint64_t w[2];
+    char *data = NULL;
+    const unsigned char *payload;
+    size_t n;
+    assert_true(lr_cache_file_read(path, "LRTEST01", w, 2, &data, &payload, &n));
+    assert_int_equal(w[0], words[0]);
+    assert_int_equal(w[1], words[1]);
+    assert_int_equal(n, sizeof a + sizeof b);
+    assert_memory_equal(payload, a, sizeof a);
+    assert_memory_equal(payload + sizeof a, b, sizeof b);
+    /* The header is 8 + 3 x 8 bytes: magic, two words, the hash. */
+    size_t len = 8 + 3 * 8 + n;
+    unsigned char *good = malloc(len);
+    assert_non_null(good);
+    memcpy(good, data, len);
+    free(data);
+    char *other = NULL;
+    assert_false(lr_cache_file_read(path, "LRTEST02", w, 2, &other, &payload, &n));
+    const long flips[] = {0, 9, 24, 32, (long)len - 1};
+    for (size_t k = 0; k < sizeof flips / sizeof flips[0]; k++)
+        cache_file_refused(path, good, len, flips[k], false);
+    cache_file_refused(path, good, len, (long)len - 1, true);
+    cache_file_refused(path, good, len, 20, true);
+    unlink(path);
+    assert_false(lr_cache_file_read(path, "LRTEST01", w, 2, &other, &payload, &n));
+    free(good);
+}
+
 static void test_unwritable_folder(void **state)
 {
     (void)state;
@@ -209,6 +274,7 @@ int main(void)
         cmocka_unit_test(test_hit_and_keys),
         cmocka_unit_test(test_corrupt),
         cmocka_unit_test(test_unwritable_folder),
+        cmocka_unit_test(test_cache_file),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
