@@ -192,7 +192,7 @@ test-install: deb
 run: build/bin/lamprig
 	@mkdir -p build/out
 	./build/bin/lamprig plan --scene configs/scenes/candle.json
-	./build/bin/lamprig render --scene configs/scenes/candle.json --frames 8 --no-plan \
+	./build/bin/lamprig render --scene configs/scenes/candle.json --frames 8 --plan-models \
 	    --out build/out/candle.png --hdr build/out/candle.pfm --stats build/out/candle-stats.json
 
 bench: build/bin/lamprig $(TOOLS:%=build/bin/lamprig-%)

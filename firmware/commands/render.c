@@ -12,6 +12,7 @@
 #include "render/base/json_write.h"
 #include "render/gl/gl.h"
 #include "render/image/image.h"
+#include "render/optics/optics.h"
 #include "render/renderer.h"
 #include "render/renderer_debug.h"
 #include "render/scene/scene.h"
@@ -56,6 +57,9 @@ static const lr_argspec opts[] = {
              "drives the lights' flicker (default 30; lights[0].flicker.amplitude=0\n"
              "makes a light steady)"},
     {.name = "--no-plan", .help = "keep the scene's render settings even when it has a quality budget"},
+    {.name = "--plan-models",
+     .help = "take the plan's model per object but keep the scene's render settings\n"
+             "(K, N, N_vpl, maps, frames, lpv) and its VPL pass"},
     {.name = "--help-scene", .flags = LR_ARG_ALONE,
      .help = "print every scene field (type, range, default, what a change\n"
              "re-renders) as markdown, and exit"},
@@ -74,6 +78,8 @@ const lr_command lr_render_command = {
         "A scene with a \"quality\" block (max_error, frame_ms) is planned first (`lamprig plan`):\n"
         "the chosen settings replace its render settings and one line per object says the choice,\n"
         "predicted error and time; --set render.* is applied after the plan and wins.\n"
+        "--plan-models takes the plan's model per object and keeps the scene's render settings\n"
+        "(how `make run` renders the candle); --no-plan keeps the scene's models too.\n"
         "\n"
         "Files are written atomically. Output paths (--out, --hdr, --stats) are checked before\n"
         "anything renders: a directory or a missing folder is a bad argument.\n"
@@ -137,6 +143,13 @@ static int write_stats(const char *path, const lr_scene *scene, lr_renderer *r,
     lr_jw_int(jw, "vpl_map_size", rs->vpl_map_size);
     lr_jw_int(jw, "frames", rs->frames);
     lr_jw_object_end(jw);
+    /* Per object the model it rendered with (the scene's, or the plan's). */
+    lr_jw_object(jw, "models");
+    for (int i = 0; i < lr_scene_object_count(scene); i++) {
+        const lr_scene_object *o = lr_scene_object_at(scene, i);
+        lr_jw_string(jw, o->name, lr_sss_model_name(o->sss_model));
+    }
+    lr_jw_object_end(jw);
     lr_jw_array(jw, "frames");
     for (int i = 0; i < log->n; i++) {
         const lr_frame_stats *s = &log->v[i];
@@ -170,8 +183,31 @@ static int write_stats(const char *path, const lr_scene *scene, lr_renderer *r,
 /* The planner (firmware/plan_scene.h) for a scene with a quality budget: applies its settings
  * and prints its lines. A missing or unusable table is not fatal: the scene's own settings
  * render, and a "plan: skipped: WHY" line says so. */
-static int plan(lr_scene *scene, const char *table, bool *no_vpl, bool *planned)
+/* --plan-models: the scene's render settings the plan replaced, set back (the plan's models
+ * stay). Integers, as the plan sets them (lr_plan_apply). */
+static int keep_scene_settings(lr_scene *scene, const lr_render_settings *rs, lr_err *e)
 {
+    const struct {
+        const char *key;
+        int v;
+    } sets[] = {{"render.K", rs->K},           {"render.N", rs->N},
+                {"render.N_vpl", rs->N_vpl},   {"render.map_size", rs->map_size},
+                {"render.gbuffer_size", rs->gbuffer_size}, {"render.frames", rs->frames},
+                {"render.lpv", rs->lpv}};
+    for (size_t i = 0; i < sizeof sets / sizeof *sets; i++) {
+        char v[32];
+        snprintf(v, sizeof v, "%d", sets[i].v);
+        int rc = lr_scene_set(scene, sets[i].key, v, NULL, e);
+        if (rc)
+            return rc;
+    }
+    return LR_OK;
+}
+
+static int plan(const char *path, lr_scene *scene, const char *table, bool models_only,
+                bool *no_vpl, bool *planned)
+{
+    lr_render_settings own = *lr_scene_render(scene);
     lr_plan_scene_result *res = calloc(1, sizeof *res);
     if (!res)
         return LR_EXIT_FAIL;
@@ -185,8 +221,17 @@ static int plan(lr_scene *scene, const char *table, bool *no_vpl, bool *planned)
             fputs(text, stdout);
         free(text);
         *planned = true;
-        if (!res->vpl)
+        if (models_only) {
+            if (keep_scene_settings(scene, &own, &e)) {
+                free(res);
+                return lr_cli_fail(path, "--plan-models: %s", e.msg);
+            }
+            printf("plan: --plan-models: the plan's models, the scene's render settings (K=%d "
+                   "N=%d N_vpl=%d map_size=%d gbuffer_size=%d frames=%d)\n",
+                   own.K, own.N, own.N_vpl, own.map_size, own.gbuffer_size, own.frames);
+        } else if (!res->vpl) {
             *no_vpl = true;
+        }
     }
     free(res);
     return LR_EXIT_OK;
@@ -239,7 +284,7 @@ static int run_render(const lr_cli *c)
     const char *stats_path = lr_args_get(a, "--stats"), *events_path = lr_args_get(a, "--events");
     bool no_vpl = lr_args_has(a, "--no-vpl");
     bool vpl_vis = lr_args_has(a, "--vpl-visibility");
-    bool no_plan = lr_args_has(a, "--no-plan");
+    bool no_plan = lr_args_has(a, "--no-plan"), plan_models = lr_args_has(a, "--plan-models");
     const char *table = lr_args_get(a, "--table");
     for (int i = 0; i < nsets; i++)
         if (!strchr(sets[i], '='))
@@ -270,7 +315,11 @@ static int run_render(const lr_cli *c)
         goto done;
     }
     bool planned = false;
-    if (!no_plan && (status = plan(scene, table, &no_vpl, &planned)))
+    if (no_plan && plan_models) {
+        status = lr_cli_usage(c->path, "--no-plan and --plan-models: choose one");
+        goto done;
+    }
+    if (!no_plan && (status = plan(c->path, scene, table, plan_models, &no_vpl, &planned)))
         goto done;
     for (int i = 0; planned && i < nsets; i++) {
         if (lr_scene_set_assignment(scene, sets[i], NULL, &e)) {

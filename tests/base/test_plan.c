@@ -817,6 +817,20 @@ static void expect_settings(long K, long N, long N_vpl, long map_size, long gbuf
     lr_json_destroy(j);
 }
 
+/* The model object `name` rendered with, from the --stats file. */
+static void expect_model(const char *name, const char *want)
+{
+    lr_json *j = load_stats();
+    lr_err e = {0};
+    lr_jnode m = lr_json_get(j, lr_json_root(j), "models");
+    char got[64];
+    if (lr_json_get_string(j, m, name, true, got, sizeof got, &e))
+        fail_msg("%s", e.msg);
+    if (strcmp(got, want) != 0)
+        fail_msg("models.%s = %s, expected %s", name, got, want);
+    lr_json_destroy(j);
+}
+
 /* The passes of the first frame in the --stats file, as LR_PASS_* bits. */
 static void expect_first_passes(unsigned want)
 {
@@ -897,6 +911,40 @@ static void test_cli_render_applies_plan(void **state)
     assert_null(strstr(t, "plan:"));
     free(t);
     expect_settings(2, 1, 64, 32, 32); /* N_vpl: the scene file's */
+
+    /* --plan-models: the plan's model, the scene's settings. The candle made a standard
+     * dipole in its file; the fixture's plan picks the directional dipole. */
+    size_t clen;
+    char *pillar = (char *)lr_test_read("configs/scenes/candle.json", &clen);
+    const char *at = "\"mesh\": {\"type\": \"candle\"";
+    char *m = strstr(pillar, at);
+    assert_non_null(m);
+    size_t pre = (size_t)(m - pillar);
+    const char *ins = "\"model\": \"standard_dipole\", ";
+    char *sd = malloc(clen + strlen(ins) + 1);
+    assert_non_null(sd);
+    memcpy(sd, pillar, pre);
+    strcpy(sd + pre, ins);
+    strcat(sd, pillar + pre);
+    char *sdp = lr_test_write(dir, "candle_sd.json", sd, (size_t)-1);
+    const char *small = "--frames 1 --width 16 --height 12 --set render.map_size=32 "
+                        "--set render.gbuffer_size=32 --set render.vpl_map_size=8";
+    assert_int_equal(run("./build/bin/lamprig render --scene %s --no-plan %s --stats %s", sdp,
+                         small, stats), 0);
+    expect_model("pillar", "standard_dipole");
+    assert_int_equal(run("./build/bin/lamprig render --scene %s --plan-models --table " FIXTURE
+                         " %s --stats %s", sdp, small, stats), 0);
+    expect_in("out", "plan: pillar: directional_dipole K=8");
+    expect_in("out", "plan: --plan-models: the plan's models, the scene's render settings (K=16 "
+                     "N=16 N_vpl=64");
+    expect_settings(16, 16, 64, 32, 32); /* the scene's K and N; map sizes from --set */
+    expect_model("pillar", "directional_dipole");
+    free(pillar);
+    free(sd);
+    free(sdp);
+    assert_int_equal(run("./build/bin/lamprig render --scene configs/scenes/candle.json "
+                         "--plan-models --no-plan --frames 1"), 2);
+    expect_in("err", "--no-plan and --plan-models: choose one");
 
     /* A ball whose only receiver faces away: the plan cuts the VPL pass, and the renderer
      * runs without it (the frame's passes in the stats). */

@@ -3,6 +3,8 @@
  * configs/bench/front.csv. Output is markdown, ready for tools/bench/README.md. */
 #include "tools/bench/bench.h"
 
+#include <sched.h>
+#include <stdbool.h>
 #include <string.h>
 
 static const lrb_section *const sections[] = {
@@ -25,9 +27,18 @@ static const lrb_section *find(const char *name)
     return NULL;
 }
 
+/* A section may pin the process to one CPU for its single-threaded timings (optics, cpu:
+ * lrb_pin_to_current_cpu); the next section gets the CPUs the process started with back, or
+ * llvmpipe, the rig's children and every later figure would run on one core (the whole
+ * `make bench` of 27 Nov 04:51 did, after the optics section). */
 static int run_one(const lrb_section *s, const lrb_options *opt)
 {
-    return s->run_opts ? s->run_opts(stdout, opt) : s->run(stdout);
+    cpu_set_t cpus;
+    bool saved = sched_getaffinity(0, sizeof cpus, &cpus) == 0;
+    int rc = s->run_opts ? s->run_opts(stdout, opt) : s->run(stdout);
+    if (saved && sched_setaffinity(0, sizeof cpus, &cpus) != 0)
+        fprintf(stderr, "lamprig-bench: %s: could not restore the CPU affinity\n", s->name);
+    return rc;
 }
 
 int main(int argc, char **argv)
