@@ -102,7 +102,7 @@ static int program(lr_blend *b, int op, int n, lr_program **out, lr_err *e)
         for (int i = 0; i < own.n; i++)
             defs[k++] = own.list[i];
         defs[k] = NULL;
-        lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "blend.frag",
+        lr_program_desc pd = {.vertex = "blend.vert", .fragment = "blend.frag",
                               .dir = b->shader_dir, .defines = defs};
         int rc = lr_program_create(&pd, &b->prog[op][n], e);
         if (rc)

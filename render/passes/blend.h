@@ -28,7 +28,7 @@ typedef struct lr_blend lr_blend;
 typedef struct lr_blend_desc {
     lr_gl *gl;
     int width, height;
-    const char *shader_dir;      /* where blend.frag and fullscreen.vert are */
+    const char *shader_dir;      /* where blend.vert and blend.frag are */
     const char *const *defines;  /* the renderer's shader defines (LR_MAX_LIGHTS, ...) */
 } lr_blend_desc;
 

@@ -1,4 +1,4 @@
-// The blend pass (render/passes/blend.h): sum_k u_w[k] image_{u_layer[k]} over the per-light
+// The blend pass (render/passes/blend.h): sum_k w[k] image_{layer[k]} over the per-light
 // unit-intensity linear images whose weight is not zero (LR_BLEND_N of them, a compile-time
 // count: no loop, no branch per pixel), then the tone curve (LR_BLEND_OP, an lr_tonemap_op,
 // compile-time) and the sRGB encode, or, with LR_BLEND_LINEAR, the linear sum for readback (a
@@ -16,25 +16,28 @@
 #error blend.frag needs the renderer defines (render/passes/defines.h) and LR_BLEND_OP, LR_BLEND_N, LR_BLEND_SRGB_STORE
 #endif
 uniform highp sampler2DArray u_images;
-uniform vec3 u_w[4];
-uniform int u_layer[4];
+flat in vec3 v_w[4];    // u_w, u_layer through blend.vert: see there why
+flat in ivec4 v_layer;
 layout(location = 0) out vec4 o_color;
 
 void main()
 {
     ivec2 p = ivec2(gl_FragCoord.xy);
+    // The sum starts from its first term, not from 0 + term (x + 0.0 is not x in IEEE: -0.0,
+    // so a compiler keeps that add). N = 0: every light is off.
+#if LR_BLEND_N == 0
     vec3 c = vec3(0.0);
-#if LR_BLEND_N >= 1
-    c += u_w[0] * texelFetch(u_images, ivec3(p, u_layer[0]), 0).rgb;
+#else
+    vec3 c = v_w[0] * texelFetch(u_images, ivec3(p, v_layer[0]), 0).rgb;
 #endif
 #if LR_BLEND_N >= 2
-    c += u_w[1] * texelFetch(u_images, ivec3(p, u_layer[1]), 0).rgb;
+    c += v_w[1] * texelFetch(u_images, ivec3(p, v_layer[1]), 0).rgb;
 #endif
 #if LR_BLEND_N >= 3
-    c += u_w[2] * texelFetch(u_images, ivec3(p, u_layer[2]), 0).rgb;
+    c += v_w[2] * texelFetch(u_images, ivec3(p, v_layer[2]), 0).rgb;
 #endif
 #if LR_BLEND_N >= 4
-    c += u_w[3] * texelFetch(u_images, ivec3(p, u_layer[3]), 0).rgb;
+    c += v_w[3] * texelFetch(u_images, ivec3(p, v_layer[3]), 0).rgb;
 #endif
 #if LR_BLEND_OP == LR_BLEND_LINEAR
     // Alpha of layer 0: coverage (compose_object.frag), whichever lights are lit.
@@ -43,7 +46,12 @@ void main()
     // lr_tonemap_apply (render/image/image.c): curve of the exposed value, clip to [0, 1]. The
     // max stays: ACES of a value below -0.012 is positive. The clip to 1 is the store's with
     // LR_BLEND_SRGB_STORE (the curves end at or above 1 only where the clip makes them 1).
+#if LR_BLEND_OP == LR_TONEMAP_CLAMP && LR_BLEND_SRGB_STORE
+    // The clip is the SRGB8_ALPHA8 store's (a unorm conversion clamps to [0, 1]).
+    vec3 v = c;
+#else
     vec3 v = max(c, vec3(0.0));
+#endif
 #if LR_BLEND_OP == LR_TONEMAP_REINHARD
     v = v / (1.0 + v);
 #elif LR_BLEND_OP == LR_TONEMAP_ACES
