@@ -5,7 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-int lr_plan_scene(lr_scene *scene, const char *table, lr_plan_scene_result *res, lr_err *e)
+int lr_plan_scene(lr_scene *scene, const char *table, bool models_only,
+                  lr_plan_scene_result *res, lr_err *e)
 {
     memset(res, 0, sizeof *res);
     res->vpl = true;
@@ -25,7 +26,8 @@ int lr_plan_scene(lr_scene *scene, const char *table, lr_plan_scene_result *res,
     rc = lr_plan_create(scene, t, &b, NULL, &res->plan, e);
     lr_plan_table_destroy(t);
     if (!rc)
-        rc = lr_plan_apply(&res->plan, scene, NULL, e);
+        rc = models_only ? lr_plan_apply_models(&res->plan, scene, NULL, e)
+                         : lr_plan_apply(&res->plan, scene, NULL, e);
     if (rc)
         return rc;
     res->planned = true;

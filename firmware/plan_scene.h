@@ -21,10 +21,12 @@ typedef struct lr_plan_scene_result {
 } lr_plan_scene_result;
 
 /* Plans `scene` when its quality block sets a budget (nothing to do otherwise: *res says
- * planned = false) and applies the settings. table: a CSV path, or NULL for
- * lr_plan_default_table. Errors (no table, bad table, no usable row) leave the scene as it
- * was; the caller decides whether that is fatal. */
-int lr_plan_scene(lr_scene *scene, const char *table, lr_plan_scene_result *res, lr_err *e);
+ * planned = false) and applies the settings and models, or with models_only each object's
+ * model alone (the scene's render settings stay: `lamprig render --plan-models`). table: a
+ * CSV path, or NULL for lr_plan_default_table. Errors (no table, bad table, no usable row)
+ * leave the scene as it was; the caller decides whether that is fatal. */
+int lr_plan_scene(lr_scene *scene, const char *table, bool models_only,
+                  lr_plan_scene_result *res, lr_err *e);
 
 /* A re-planner (render/plan/replan.h) for the scene a successful lr_plan_scene planned, over
  * the same table (loaded again). Call it once the settings that win over the plan (the rig's

@@ -181,38 +181,17 @@ static int write_stats(const char *path, const lr_scene *scene, lr_renderer *r,
 }
 
 /* The planner (firmware/plan_scene.h) for a scene with a quality budget: applies its settings
- * and prints its lines. A missing or unusable table is not fatal: the scene's own settings
- * render, and a "plan: skipped: WHY" line says so. */
-/* --plan-models: the scene's render settings the plan replaced, set back (the plan's models
- * stay). Integers, as the plan sets them (lr_plan_apply). */
-static int keep_scene_settings(lr_scene *scene, const lr_render_settings *rs, lr_err *e)
-{
-    const struct {
-        const char *key;
-        int v;
-    } sets[] = {{"render.K", rs->K},           {"render.N", rs->N},
-                {"render.N_vpl", rs->N_vpl},   {"render.map_size", rs->map_size},
-                {"render.gbuffer_size", rs->gbuffer_size}, {"render.frames", rs->frames},
-                {"render.lpv", rs->lpv}};
-    for (size_t i = 0; i < sizeof sets / sizeof *sets; i++) {
-        char v[32];
-        snprintf(v, sizeof v, "%d", sets[i].v);
-        int rc = lr_scene_set(scene, sets[i].key, v, NULL, e);
-        if (rc)
-            return rc;
-    }
-    return LR_OK;
-}
-
+ * (with --plan-models its models alone) and prints its lines. A missing or unusable table
+ * is not fatal: the scene's own settings render, and a "plan: skipped: WHY" line says so. */
 static int plan(const char *path, lr_scene *scene, const char *table, bool models_only,
                 bool *no_vpl, bool *planned)
 {
-    lr_render_settings own = *lr_scene_render(scene);
+    const lr_render_settings own = *lr_scene_render(scene);
     lr_plan_scene_result *res = calloc(1, sizeof *res);
     if (!res)
         return LR_EXIT_FAIL;
     lr_err e = {0};
-    if (lr_plan_scene(scene, table, res, &e)) {
+    if (lr_plan_scene(scene, table, models_only, res, &e)) {
         /* Informational like the plan itself (stdout): the render goes on. */
         printf("plan: skipped: %s; rendering with the scene's settings\n", e.msg);
     } else if (res->planned) {
@@ -222,10 +201,6 @@ static int plan(const char *path, lr_scene *scene, const char *table, bool model
         free(text);
         *planned = true;
         if (models_only) {
-            if (keep_scene_settings(scene, &own, &e)) {
-                free(res);
-                return lr_cli_fail(path, "--plan-models: %s", e.msg);
-            }
             printf("plan: --plan-models: the plan's models, the scene's render settings (K=%d "
                    "N=%d N_vpl=%d map_size=%d gbuffer_size=%d frames=%d)\n",
                    own.K, own.N, own.N_vpl, own.map_size, own.gbuffer_size, own.frames);

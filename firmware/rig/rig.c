@@ -241,7 +241,7 @@ static int plan_scene(lr_rig *r, const lr_rig_config *cfg, lr_scene *scene, bool
         return lr_err_set(e, LR_ENOMEM, "plan: out of memory");
     lr_err pe = {0};
     int rc = LR_OK;
-    if (lr_plan_scene(scene, r->opts.plan_table, res, &pe)) {
+    if (lr_plan_scene(scene, r->opts.plan_table, false, res, &pe)) {
         lr_log_write(&r->log, LR_LOG_WARN, "plan: %s; running with the scene's settings", pe.msg);
     } else if (res->planned) {
         char *text = lr_plan_scene_text(res);

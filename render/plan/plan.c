@@ -426,6 +426,11 @@ int lr_plan_apply(const lr_plan *p, lr_scene *s, unsigned *dirty, lr_err *e)
         if (rc)
             return lr_err_prefix(e, "applying the plan");
     }
+    return lr_plan_apply_models(p, s, dirty, e);
+}
+
+int lr_plan_apply_models(const lr_plan *p, lr_scene *s, unsigned *dirty, lr_err *e)
+{
     /* The model is the one per-object choice the renderer takes as it is. */
     for (int i = 0; i < p->nobjects; i++) {
         char key[32];

@@ -214,6 +214,9 @@ bool lr_plan_budget_from_scene(const lr_scene *s, lr_plan_budget *out);
  * gbuffer_size, frames, lpv) and each object's chosen model (objects[i].model), ORing dirty
  * flags. */
 int lr_plan_apply(const lr_plan *p, lr_scene *s, unsigned *dirty, lr_err *e);
+/* Each object's chosen model alone (the scene's render settings stay): what `lamprig render
+ * --plan-models` and the bench's "shipped" setting render. */
+int lr_plan_apply_models(const lr_plan *p, lr_scene *s, unsigned *dirty, lr_err *e);
 
 /* One line per object, "plan: OBJECT: MODEL K=.. N=.. N_vpl=.. map=.. gbuffer=.. frames=..
  * vpl=on|off, error 0.05, 150 ms/frame, converged in 4.8 s[ [INFEASIBLE]] (reason; ...)",

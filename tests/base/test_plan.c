@@ -734,6 +734,22 @@ static void test_no_pass_after_convergence(void **state)
     lr_plan *p = plan_of(s, 0.13, 0, 0);
     assert_int_equal(p->settings.K, 4);
     assert_int_equal(p->settings.frames, 8);
+    /* The models alone (--plan-models): each object's model, the scene's K 16, 256² maps. */
+    lr_scene *own;
+    assert_int_equal(lr_scene_load("configs/scenes/candle.json", NULL, &own, &e), LR_OK);
+    const char *other = strcmp(p->objects[0].row.model, "standard_dipole") ? "standard_dipole"
+                                                                          : "directional_dipole";
+    assert_int_equal(lr_scene_set(own, "objects[0].model", other, NULL, &e), LR_OK);
+    unsigned own_dirty = 0;
+    assert_int_equal(lr_plan_apply_models(p, own, &own_dirty, &e), LR_OK);
+    char got[64];
+    assert_int_equal(lr_scene_get(own, "objects[0].model", got, sizeof got, &e), LR_OK);
+    assert_string_equal(got, p->objects[0].row.model);
+    assert_true(own_dirty != 0);
+    assert_int_equal(lr_scene_render(own)->K, 16);
+    assert_int_equal(lr_scene_render(own)->map_size, 256);
+    assert_int_equal(lr_scene_render(own)->frames, lr_scene_render(s)->frames);
+    lr_scene_destroy(own);
     assert_int_equal(lr_plan_apply(p, s, NULL, &e), LR_OK);
     assert_int_equal(lr_scene_render(s)->K, 4);
     assert_int_equal(lr_scene_render(s)->map_size, 64);
