@@ -30,13 +30,34 @@ typedef struct lrb_setting {
     const char *label; /* "base", "K=4", ... */
     int K, N, N_vpl, map_size, gbuffer_size;
     bool vpl;
-    const char *model; /* an objects[].model name (lr_sss_model_name) */
+    const char *model; /* an objects[].model name (lr_sss_model_name); NULL: see shipped */
     int checkpoints[4], ncheck;
     int converge_frames;
+    /* The scene as it ships (lrb_sweep_shipped): model NULL and N_vpl 0, each object's model
+     * and render.N_vpl as the product renders the scene file. */
+    bool shipped;
 } lrb_setting;
 
 /* The settings (sweep_settings.c): the base, then one-at-a-time changes. Returns the count. */
 int lrb_sweep_settings(lrb_setting *out, int cap);
+/* The "shipped" setting: the base's K, N, map and G-buffer sizes and frame series, each
+ * object's model as `lamprig render --plan-models` renders the scene (the committed table's
+ * plan, configs/bench/front.csv, where the scene has a quality budget; else the file's) and
+ * the file's render.N_vpl and other render settings. Issue 12's figures for what ships. */
+lrb_setting lrb_sweep_shipped(void);
+
+/* Issue 12's figures on one setting's converged, box-filtered image. */
+typedef struct lrb_fair {
+    bool ok;
+    char models[160]; /* "multipole" or "obj: model, obj: model" */
+    int N_vpl;
+    bool planned;     /* the models are the plan's */
+    bool as_base;     /* the same models and N_vpl as the base: its figures, not run again */
+    double frame_ms;  /* accumulation frame at the bench's size */
+    double bias_object, bias_receivers, mal;
+    lr_eval_ratio receiver_ratio;
+    lr_eval_ratio region_ratio[LR_EVAL_REGION_COUNT][4]; /* bands R, G, B, then all pooled */
+} lrb_fair;
 
 /* What one scene's sweep produced. */
 typedef struct lrb_scene_result {
@@ -70,6 +91,7 @@ typedef struct lrb_scene_result {
     long region_px[LR_EVAL_REGION_COUNT];
     lr_eval_ratio region_ratio[LR_EVAL_REGION_COUNT][4]; /* bands R, G, B, then all pooled */
     lr_eval_ratio receiver_ratio, centre_receiver_ratio; /* all receiver pixels, pooled */
+    lrb_fair shipped; /* the scene as it ships (lrb_sweep_shipped) */
     /* LRB_SWEEP_SS_CHECK: base setting converged at each factor. */
     int nss, ss[LRB_SWEEP_SS_MAX];
     double ss_bias_object[LRB_SWEEP_SS_MAX], ss_bias_receivers[LRB_SWEEP_SS_MAX],
@@ -83,7 +105,8 @@ int lrb_sweep_supersample(void);
  * region table (sweep_fair.c). */
 void lrb_sweep_fair_md(FILE *f, const lrb_scene_result *scenes, int nscenes);
 
-/* Applies a setting to a scene (render.* and every object's model). */
+/* Applies a setting to a scene (render.* and every object's model; for the shipped setting
+ * the sizes and the plan's models, on a scene as loaded from its file). */
 int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e);
 /* Whether any object of s can take the setting's model (lr_scene_object_model_unmet, and the
  * model's validity limits for the object's material: render/plan/limits.h); when none can,

@@ -5,6 +5,7 @@
 #include "tools/bench/sweep.h"
 
 #include <math.h>
+#include <string.h>
 
 static void ratio_cell(FILE *f, lr_eval_ratio r)
 {
@@ -22,6 +23,106 @@ static void pair(FILE *f, double a, double b)
         fprintf(f, " %.3f → %.3f |", a, b);
     else
         fprintf(f, " – |");
+}
+
+/* Issue 12's targets, converged model against the physical reference with the matched pixel
+ * filter: bias objects / receivers per scene (the two scenes added untuned take their kind's:
+ * jar_candle the candles', led_shade the lamp shade's, as issue 14 asks of it), median |ln|
+ * over object pixels <= 0.15 everywhere, and no band's power ratio outside 0.85-1.15 on a
+ * region whose reference can tell it from 1. */
+static const struct {
+    const char *scene;
+    double object, receivers;
+} targets[] = {
+    {"candle", 0.10, 0.10},    {"candle_spot", 0.10, 0.10}, {"jar_candle", 0.10, 0.10},
+    {"lampshade", 0.20, 0.15}, {"led_shade", 0.20, 0.15},   {"votive", 0.25, 0.25},
+    {"sphere_shell", 0.06, 0.06},
+};
+enum { BAND_LIST_MAX = 4 };
+static const double MAL_TARGET = 0.15, BAND_LO = 0.85, BAND_HI = 1.15;
+
+/* The region-bands outside BAND_LO..BAND_HI that the reference tells from 1: the count, and
+ * up to BAND_LIST_MAX of them written to f when f is not NULL. */
+static int bands_outside(FILE *f, const lr_eval_ratio rr[LR_EVAL_REGION_COUNT][4])
+{
+    static const char *const band[4] = {"R", "G", "B", "all"};
+    int k = 0;
+    for (int r = 1; r < LR_EVAL_REGION_COUNT; r++)
+        for (int b = 0; b < 4; b++) {
+            lr_eval_ratio x = rr[r][b];
+            if (!isfinite(x.ratio) || !lr_eval_ratio_differs(x) ||
+                (x.ratio >= BAND_LO && x.ratio <= BAND_HI))
+                continue;
+            if (f && k < BAND_LIST_MAX)
+                fprintf(f, "%s%s %s %.2f ± %.2f", k ? "; " : " ", lr_eval_region_name(r),
+                        band[b], x.ratio, x.se);
+            k++;
+        }
+    if (f && k > BAND_LIST_MAX)
+        fprintf(f, "; %d more", k - BAND_LIST_MAX);
+    return k;
+}
+
+/* Per scene, the figures of the scene as it ships, beside issue 12's targets. */
+static void shipped_md(FILE *f, const lrb_scene_result *sc, int n)
+{
+    fprintf(f, "As shipped (issue 12's figures for what the product renders): each object's "
+               "model as `lamprig render --plan-models` takes it (the committed table's plan "
+               "where the scene has a quality budget, marked \\*; else the file's), the file's "
+               "N_vpl and render settings, at the base's K, N, map and G-buffer sizes, "
+               "converged, box-filtered as above. Targets: bias objects / receivers per scene, "
+               "median \\|ln\\| <= %.2f, no band outside %.2f–%.2f where the reference tells it "
+               "from 1 (listed: region, band, ratio ± SE).\n\n",
+            MAL_TARGET, BAND_LO, BAND_HI);
+    fprintf(f, "| scene | models | N_vpl | frame ms | bias objects | bias receivers | median "
+               "\\|ln\\| (floor) | receiver power | bands outside | target | met |\n"
+               "|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for (int k = 0; k < n; k++) {
+        const lrb_scene_result *s = &sc[k];
+        const lrb_fair *h = &s->shipped;
+        if (!h->ok)
+            continue;
+        double to = NAN, tr = NAN;
+        for (size_t i = 0; i < sizeof targets / sizeof targets[0]; i++)
+            if (!strcmp(targets[i].scene, s->name))
+                to = targets[i].object, tr = targets[i].receivers;
+        fprintf(f, "| %s | %s%s%s | %d | %.1f | %.3f |", s->name, h->models,
+                h->planned ? "\\*" : "", h->as_base ? " (the base)" : "", h->N_vpl,
+                h->frame_ms, h->bias_object);
+        if (isfinite(h->bias_receivers)) /* the shell has no receivers */
+            fprintf(f, " %.3f |", h->bias_receivers);
+        else
+            fprintf(f, " – |");
+        fprintf(f, " %.3f (%.3f) |", h->mal, s->mal_floor);
+        if (isfinite(h->receiver_ratio.ratio))
+            fprintf(f, " %.3f ± %.3f |", h->receiver_ratio.ratio, h->receiver_ratio.se);
+        else
+            fprintf(f, " – |");
+        int nb = bands_outside(f, h->region_ratio);
+        if (!nb)
+            fprintf(f, " none");
+        if (!isfinite(to)) {
+            fprintf(f, " | – | – |\n");
+            continue;
+        }
+        /* What is not met; a receiver-free scene (the shell) has a NaN receiver bias. The
+         * median cannot be judged below the two references' own (the floor). */
+        char miss[160] = "";
+        size_t len = 0;
+#define MISS(...) len += (size_t)snprintf(miss + len, len < sizeof miss ? sizeof miss - len : 0, __VA_ARGS__)
+        if (!(h->bias_object <= to))
+            MISS("%sobjects", len ? ", " : "");
+        if (h->bias_receivers > tr)
+            MISS("%sreceivers", len ? ", " : "");
+        if (!(h->mal <= MAL_TARGET))
+            MISS("%smedian%s", len ? ", " : "",
+                 s->mal_floor > MAL_TARGET ? " (the floor is over the target)" : "");
+        if (nb)
+            MISS("%s%d band%s", len ? ", " : "", nb, nb > 1 ? "s" : "");
+#undef MISS
+        fprintf(f, " | %.2f / %.2f | %s%s |\n", to, tr, len ? "no: " : "**yes**", miss);
+    }
+    fprintf(f, "\n");
 }
 
 void lrb_sweep_fair_md(FILE *f, const lrb_scene_result *sc, int n)
@@ -83,4 +184,5 @@ void lrb_sweep_fair_md(FILE *f, const lrb_scene_result *sc, int n)
                         sc[k].ss_mal[j]);
     }
     fprintf(f, "\n");
+    shipped_md(f, sc, n);
 }

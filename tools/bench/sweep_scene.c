@@ -10,6 +10,7 @@
 #include "render/base/paths.h"
 #include "render/image/image.h"
 #include "render/plan/limits.h"
+#include "render/plan/plan.h"
 #include "render/reference/reference.h"
 
 static int set_int(lr_scene *s, const char *key, int v, lr_err *e)
@@ -34,11 +35,33 @@ static bool object_refuses(const lr_scene_object *o, enum lr_sss_model m, char *
     return w != NULL;
 }
 
+/* The shipped setting's models: where the scene has a quality budget, the plan's model per
+ * object from the committed table (what `lamprig render --plan-models` renders with a fresh
+ * build directory); else the file's, left as they are. */
+static int apply_shipped_models(lr_scene *s, lr_err *e)
+{
+    lr_plan_budget b;
+    if (!lr_plan_budget_from_scene(s, &b))
+        return LR_OK;
+    char path[1024];
+    snprintf(path, sizeof path, "%s/bench/front.csv", lr_configs_dir());
+    lr_plan_table *t = NULL;
+    lr_plan *p = malloc(sizeof *p);
+    int rc = p ? lr_plan_table_load(path, &t, e) : lr_err_set(e, LR_ENOMEM, "out of memory");
+    if (!rc)
+        rc = lr_plan_create(s, t, &b, NULL, p, e);
+    if (!rc)
+        rc = lr_plan_apply_models(p, s, NULL, e);
+    lr_plan_table_destroy(t);
+    free(p);
+    return rc ? lr_err_prefix(e, "shipped setting: the plan") : LR_OK;
+}
+
 int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e)
 {
     int rc;
     if ((rc = set_int(s, "render.K", st->K, e)) || (rc = set_int(s, "render.N", st->N, e)) ||
-        (rc = set_int(s, "render.N_vpl", st->N_vpl, e)) ||
+        (st->N_vpl > 0 && (rc = set_int(s, "render.N_vpl", st->N_vpl, e))) ||
         (rc = set_int(s, "render.map_size", st->map_size, e)) ||
         (rc = set_int(s, "render.gbuffer_size", st->gbuffer_size, e)))
         return rc;
@@ -61,6 +84,8 @@ int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e)
             return lr_err_prefix(e, "LRB_SWEEP_SET");
         p = q ? q + 1 : p + n;
     }
+    if (!st->model)
+        return st->shipped ? apply_shipped_models(s, e) : LR_OK;
     /* The model is per object; the sweep switches every object that can take it (the
      * multipole needs thickness_mm; the grid a material within its validity limit);
      * lrb_sweep_takes says whether any can. */
@@ -83,6 +108,8 @@ int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e)
 bool lrb_sweep_takes(const lr_scene *s, const lrb_setting *st, char *why, size_t cap)
 {
     enum lr_sss_model m;
+    if (!st->model) /* the scene's own models */
+        return true;
     snprintf(why, cap, "unknown model");
     if (!lr_sss_model_parse(st->model, &m))
         return false;
@@ -187,17 +214,44 @@ static int second_reference(const lr_ref_scene *rs, const lr_ref_camera *cam, co
  * median |ln ratio| over object pixels. */
 static void fair_figures(const float *C, const lr_ref_image *mean, const lr_ref_image *var,
                          const lr_eval_regions *rg, const lr_eval_masks *m, unsigned char *mask,
-                         lrb_scene_result *res)
+                         long region_px[LR_EVAL_REGION_COUNT],
+                         lr_eval_ratio region_ratio[LR_EVAL_REGION_COUNT][4],
+                         lr_eval_ratio *receiver_ratio, double *mal)
 {
     const size_t n = (size_t)LRB_SWEEP_W * LRB_SWEEP_H;
     for (int r = 0; r < LR_EVAL_REGION_COUNT; r++) {
-        res->region_px[r] = lr_eval_regions_mask(rg, r, mask);
+        region_px[r] = lr_eval_regions_mask(rg, r, mask);
         for (int b = 0; b < 4; b++)
-            res->region_ratio[r][b] =
+            region_ratio[r][b] =
                 lr_eval_power_ratio(C, mean->rgb, var->rgb, mask, n, b < 3 ? b : -1);
     }
-    res->receiver_ratio = lr_eval_power_ratio(C, mean->rgb, var->rgb, m->receivers, n, -1);
-    res->mal_fair = lr_eval_median_abs_log(C, mean->rgb, m->object, n);
+    *receiver_ratio = lr_eval_power_ratio(C, mean->rgb, var->rgb, m->receivers, n, -1);
+    *mal = lr_eval_median_abs_log(C, mean->rgb, m->object, n);
+}
+
+/* The models of a scene's objects as text: "multipole" when they agree, else "name: model"
+ * per object; whether they and render.N_vpl are the base setting's. */
+static void describe_models(const lr_scene *s, const lrb_setting *base, lrb_fair *out)
+{
+    out->models[0] = 0;
+    out->N_vpl = lr_scene_render(s)->N_vpl;
+    bool same = true, as_base = out->N_vpl == base->N_vpl;
+    const int no = lr_scene_object_count(s);
+    const char *m0 = no ? lr_sss_model_name(lr_scene_object_at(s, 0)->sss_model) : "";
+    for (int k = 0; k < no; k++) {
+        const char *mk = lr_sss_model_name(lr_scene_object_at(s, k)->sss_model);
+        same &= !strcmp(mk, m0);
+        as_base &= !strcmp(mk, base->model);
+    }
+    if (same)
+        snprintf(out->models, sizeof out->models, "%s", m0);
+    for (int k = 0; !same && k < no; k++) {
+        size_t len = strlen(out->models);
+        snprintf(out->models + len, sizeof out->models - len, "%s%s: %s", k ? ", " : "",
+                 lr_scene_object_at(s, k)->name,
+                 lr_sss_model_name(lr_scene_object_at(s, k)->sss_model));
+    }
+    out->as_base = as_base;
 }
 
 
@@ -239,7 +293,10 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
                               .fair_bias_object = NAN, .fair_bias_receivers = NAN,
                               .mal_centre = NAN, .mal_fair = NAN, .mal_floor_raw = NAN,
                               .mal_floor = NAN,
-                              .receiver_ratio = {NAN, NAN}, .centre_receiver_ratio = {NAN, NAN}};
+                              .receiver_ratio = {NAN, NAN}, .centre_receiver_ratio = {NAN, NAN},
+                              .shipped = {.frame_ms = NAN, .bias_object = NAN,
+                                          .bias_receivers = NAN, .mal = NAN,
+                                          .receiver_ratio = {NAN, NAN}}};
     snprintf(res->name, sizeof res->name, "%s", name);
     const int w = LRB_SWEEP_W, h = LRB_SWEEP_H;
     const size_t n = (size_t)w * h;
@@ -302,6 +359,7 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
 
     lrb_setting set[32];
     int nset = lrb_sweep_settings(set, 32);
+    double base_frame_ms = NAN;
     double t1 = lrb_now();
     for (int k = 0; k < nset; k++) {
         const lrb_setting *st = &set[k];
@@ -328,7 +386,9 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
         if (k == 0) { /* the base setting */
             res->fair_bias_object = bias_obj;
             res->fair_bias_receivers = bias_rec;
-            fair_figures(C, &mean, &var, &rg, &m, mask, res);
+            fair_figures(C, &mean, &var, &rg, &m, mask, res->region_px, res->region_ratio,
+                         &res->receiver_ratio, &res->mal_fair);
+            base_frame_ms = ser.frame_ms;
             dump_pfm(name, "model", C, w, h);
             dump_pfm(name, "ref", mean.rgb, w, h);
             dump_pfm(name, "ref_var", var.rgb, w, h);
@@ -379,6 +439,45 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
                 name, st->label, ser.frame_ms, st->checkpoints[st->ncheck - 1],
                 rows[*nrows - 1].rel_rmse);
         lr_eval_series_free(&ser);
+    }
+    /* The scene as it ships, from its file again (the settings above changed s). Where its
+     * models and N_vpl are the base's, the base's figures are its own. LRB_SWEEP_SETTINGS
+     * without "shipped" leaves it out. */
+    if (!getenv("LRB_SWEEP_SETTINGS") || lrb_listed(getenv("LRB_SWEEP_SETTINGS"), "shipped")) {
+        const lrb_setting sh = lrb_sweep_shipped();
+        lrb_fair *f = &res->shipped;
+        lr_scene *s2 = NULL;
+        lr_eval_series ser = {0};
+        if ((rc = lr_scene_load(path, NULL, &s2, &e)) || (rc = lrb_sweep_apply(s2, &sh, &e))) {
+            lr_scene_destroy(s2);
+            goto done;
+        }
+        describe_models(s2, &set[0], f);
+        f->planned = lr_plan_budget_from_scene(s2, &(lr_plan_budget){0});
+        if (f->as_base) {
+            f->bias_object = res->fair_bias_object;
+            f->bias_receivers = res->fair_bias_receivers;
+            f->mal = res->mal_fair;
+            f->receiver_ratio = res->receiver_ratio;
+            f->frame_ms = base_frame_ms;
+            memcpy(f->region_ratio, res->region_ratio, sizeof f->region_ratio);
+        } else if ((rc = run_series(gl, s2, &sh, ss, &ser, &e))) {
+            lr_scene_destroy(s2);
+            goto done;
+        } else {
+            long px[LR_EVAL_REGION_COUNT];
+            series_bias(&ser, &sh, mean.rgb, &m, res, &f->bias_object, &f->bias_receivers);
+            fair_figures(ser.converged, &mean, &var, &rg, &m, mask, px, f->region_ratio,
+                         &f->receiver_ratio, &f->mal);
+            f->frame_ms = ser.frame_ms;
+        }
+        f->ok = true;
+        fprintf(stderr, "bench sweep: %s shipped (%s, N_vpl %d%s) bias %.4f / %.4f, median "
+                        "|ln| %.4f\n",
+                name, f->models, f->N_vpl, f->as_base ? ": the base's" : "", f->bias_object,
+                f->bias_receivers, f->mal);
+        lr_eval_series_free(&ser);
+        lr_scene_destroy(s2);
     }
     res->sweep_s = lrb_now() - t1;
     /* The old bench's figures for the same setting: pixel-centre samples (LRB_SWEEP_CENTRE=0

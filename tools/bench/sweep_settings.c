@@ -68,3 +68,13 @@ int lrb_sweep_settings(lrb_setting *out, int cap)
 #undef ADD
     return n;
 }
+
+lrb_setting lrb_sweep_shipped(void)
+{
+    lrb_setting s = base;
+    s.label = "shipped";
+    s.model = NULL;
+    s.N_vpl = 0;
+    s.shipped = true;
+    return s;
+}
