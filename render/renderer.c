@@ -196,10 +196,10 @@ static int irradiance_run(lr_renderer *r, unsigned dirty, lr_err *e)
 }
 
 static void surface_free(lr_renderer *r) { lr_surface_free(&r->surf); }
-/* Always with render.surface_cache; with render.surface_cache_moves only on a camera move
+/* Whether this frame composes from the surface cache, and so whether the surface pass is on:
+ * always with render.surface_cache; with render.surface_cache_moves only on a camera move
  * (drawn then if the maps changed since: the first move after a change pays for it). */
 static bool cache_now(const lr_renderer *r) { return r->rs.surface_cache || r->move_frame; }
-static bool surface_on(const lr_renderer *r) { return cache_now(r); }
 /* Not drawn yet, or drawn from other maps (accumulation went on while it was off). */
 static bool surface_due(const lr_renderer *r)
 {
@@ -282,7 +282,7 @@ static const lr_pass_desc pass_table[LR_PASS_COUNT] = {
     {"irradiance", LR_PASS_IRRADIANCE, D_GRIDS, LR_PASS_COMPOSE, true, NULL, irradiance_free,
      irradiance_due, irradiance_run, NULL},
     {"surface", LR_PASS_SURFACE, D_MAPS, LR_PASS_COMPOSE, false, NULL, surface_free,
-     surface_due, surface_run, surface_on},
+     surface_due, surface_run, cache_now},
     {"compose", LR_PASS_COMPOSE, D_VIEW, LR_PASS_BLEND, false, compose_alloc, compose_free,
      compose_due, compose_run, NULL},
     {"blend", LR_PASS_BLEND, D_OUTPUT, 0, false, blend_alloc, blend_free, NULL, blend_run, NULL},

@@ -125,6 +125,26 @@ static lr_renderer *converged(lr_scene *s, unsigned seed, bool cache)
     return r;
 }
 
+/* Sets key = value (none when key is NULL), runs a frame and asserts its passes and whether
+ * the objects were gathered per pixel (else composed from the cache). */
+static void expect_frame(lr_scene *s, lr_renderer *r, const char *key, const char *value,
+                         unsigned passes, bool gathered)
+{
+    if (key)
+        lr_test_set(s, r, key, value);
+    lr_frame_stats st = lr_test_frame(r);
+    assert_int_equal(st.passes, passes);
+    assert_int_equal(lr_renderer_debug_compose_gathered(r), gathered);
+}
+
+/* The camera moved 40 mm sideways and 20 mm up, and back where it was, as "x,y,z" values. */
+static void camera_moves(const lr_scene *s, char moved[96], char back[96])
+{
+    lr_vec3 c0 = lr_scene_camera(s)->position;
+    snprintf(moved, 96, "%.17g,%.17g,%.17g", c0.x + 40.0, c0.y, c0.z + 20.0);
+    snprintf(back, 96, "%.17g,%.17g,%.17g", c0.x, c0.y, c0.z);
+}
+
 static void test_camera_move_runs_no_gather(void **state)
 {
     (void)state;
@@ -146,30 +166,17 @@ static void test_camera_move_runs_no_gather(void **state)
     print_message("candle: %d cache entries, edge bound %.3f mm\n", si.entries, si.h[0]);
     assert_true(si.entries > 0 && si.h[0] > 0.0);
     float *before = lr_test_hdr(r);
-    const lr_camera *cam = lr_scene_camera(s);
-    lr_vec3 c0 = cam->position;
     char moved[96], back[96];
-    snprintf(moved, sizeof moved, "%.17g,%.17g,%.17g", c0.x + 40.0, c0.y, c0.z + 20.0);
-    snprintf(back, sizeof back, "%.17g,%.17g,%.17g", c0.x, c0.y, c0.z);
-    const char *pos[] = {moved, back};
-    for (int i = 0; i < 2; i++) {
-        lr_test_set(s, r, "camera.position", pos[i]);
-        lr_frame_stats st = lr_test_frame(r);
-        assert_int_equal(st.passes, LR_PASS_COMPOSE | LR_PASS_BLEND);
-        assert_false(lr_renderer_debug_compose_gathered(r));
-    }
+    camera_moves(s, moved, back);
+    enum { VIEW = LR_PASS_COMPOSE | LR_PASS_BLEND };
+    expect_frame(s, r, "camera.position", moved, VIEW, false);
+    expect_frame(s, r, "camera.position", back, VIEW, false);
     float *after = lr_test_hdr(r);
     assert_memory_equal(before, after, (size_t)W * H * 3 * sizeof *before);
     /* The cache off: composition alone again, now with the per-pixel gather. */
-    lr_test_set(s, r, "render.surface_cache", "false");
-    lr_frame_stats st = lr_test_frame(r);
-    assert_int_equal(st.passes, LR_PASS_COMPOSE | LR_PASS_BLEND);
-    assert_true(lr_renderer_debug_compose_gathered(r));
+    expect_frame(s, r, "render.surface_cache", "false", VIEW, true);
     /* ... and on: the cache is still that of the current maps, so no surface pass. */
-    lr_test_set(s, r, "render.surface_cache", "true");
-    st = lr_test_frame(r);
-    assert_int_equal(st.passes, LR_PASS_COMPOSE | LR_PASS_BLEND);
-    assert_false(lr_renderer_debug_compose_gathered(r));
+    expect_frame(s, r, "render.surface_cache", "true", VIEW, false);
     free(before);
     free(after);
     lr_renderer_destroy(r);
@@ -452,58 +459,35 @@ static void test_moves_from_cache_still_gathered(void **state)
     lr_renderer *r = converged(s, 3, false);
     assert_true(lr_renderer_debug_compose_gathered(r));
     float *before = lr_test_hdr(r);
-    const lr_camera *cam = lr_scene_camera(s);
-    lr_vec3 c0 = cam->position;
     char moved[96], back[96];
-    snprintf(moved, sizeof moved, "%.17g,%.17g,%.17g", c0.x + 40.0, c0.y, c0.z + 20.0);
-    snprintf(back, sizeof back, "%.17g,%.17g,%.17g", c0.x, c0.y, c0.z);
+    camera_moves(s, moved, back);
     enum { VIEW = LR_PASS_COMPOSE | LR_PASS_BLEND };
     /* The first move draws the cache from the converged maps, then composes from it. */
-    lr_test_set(s, r, "camera.position", moved);
-    lr_frame_stats st = lr_test_frame(r);
-    assert_int_equal(st.passes, LR_PASS_SURFACE | VIEW);
-    assert_false(lr_renderer_debug_compose_gathered(r));
+    expect_frame(s, r, "camera.position", moved, LR_PASS_SURFACE | VIEW, false);
     float *moving = lr_test_hdr(r);
     /* That image is the always-on cache's: switching it on composes the same (no surface
      * pass: the cache is that of the current maps). */
-    lr_test_set(s, r, "render.surface_cache", "true");
-    st = lr_test_frame(r);
-    assert_int_equal(st.passes, VIEW);
+    expect_frame(s, r, "render.surface_cache", "true", VIEW, false);
     float *cached = lr_test_hdr(r);
     assert_memory_equal(moving, cached, (size_t)W * H * 3 * sizeof *moving);
     /* Turning it off is not a move: the gather at once. */
-    lr_test_set(s, r, "render.surface_cache", "false");
-    st = lr_test_frame(r);
-    assert_int_equal(st.passes, VIEW);
-    assert_true(lr_renderer_debug_compose_gathered(r));
+    expect_frame(s, r, "render.surface_cache", "false", VIEW, true);
     assert_false(lr_renderer_needs_frame(r));
     /* Moving back: the cache is current, so composition and blend alone ... */
-    lr_test_set(s, r, "camera.position", back);
-    st = lr_test_frame(r);
-    assert_int_equal(st.passes, VIEW);
-    assert_false(lr_renderer_debug_compose_gathered(r));
+    expect_frame(s, r, "camera.position", back, VIEW, false);
     /* ... then the still frame: gathered per pixel, the image from before the moves. */
     assert_true(lr_renderer_needs_frame(r));
-    st = lr_test_frame(r);
-    assert_int_equal(st.passes, VIEW);
-    assert_true(lr_renderer_debug_compose_gathered(r));
+    expect_frame(s, r, NULL, NULL, VIEW, true);
     assert_false(lr_renderer_needs_frame(r));
     float *after = lr_test_hdr(r);
     assert_memory_equal(before, after, (size_t)W * H * 3 * sizeof *before);
     /* A dimmer right after a move composes the still image too (the blend alone would
      * weight the moving images). */
-    lr_test_set(s, r, "camera.position", moved);
-    lr_test_frame(r);
-    lr_test_set(s, r, "light.intensity", "0.002");
-    st = lr_test_frame(r);
-    assert_int_equal(st.passes, VIEW);
-    assert_true(lr_renderer_debug_compose_gathered(r));
+    expect_frame(s, r, "camera.position", moved, VIEW, false);
+    expect_frame(s, r, "light.intensity", "0.002", VIEW, true);
     /* Off: a move gathers, and nothing follows it. */
     lr_test_set(s, r, "render.surface_cache_moves", "false");
-    lr_test_set(s, r, "camera.position", back);
-    st = lr_test_frame(r);
-    assert_int_equal(st.passes, VIEW);
-    assert_true(lr_renderer_debug_compose_gathered(r));
+    expect_frame(s, r, "camera.position", back, VIEW, true);
     assert_false(lr_renderer_needs_frame(r));
     free(before);
     free(moving);
