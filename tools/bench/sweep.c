@@ -70,8 +70,35 @@ static bool skipped(const char *name)
     return !strcmp(name, "sphere");
 }
 
+/* A sweep restricted or changed by the diagnosis variables is not the measured table the
+ * planner reads (lr_plan_default_table takes build/bench/results.csv when it is newer than
+ * the committed front): its files get a "-partial" suffix instead, and --update-front is
+ * refused. The variable that makes it so, or NULL. */
+static const char *partial_because(void)
+{
+    static const char *const vars[] = {"LRB_SWEEP_SCENES", "LRB_SWEEP_SETTINGS",
+                                       "LRB_SWEEP_MODEL",  "LRB_SWEEP_SET",
+                                       "LRB_SWEEP_LPV",    "LRB_SWEEP_SUPERSAMPLE",
+                                       "LRB_SWEEP_SEED"};
+    for (size_t i = 0; i < sizeof vars / sizeof vars[0]; i++)
+        if (getenv(vars[i]) && *getenv(vars[i]))
+            return vars[i];
+    return NULL;
+}
+
 static int run_opts(FILE *out, const lrb_options *opt)
 {
+    const char *partial = partial_because();
+    if (partial && opt->update_front) {
+        fprintf(stderr, "bench sweep: --update-front needs the whole sweep (%s is set)\n",
+                partial);
+        return 2;
+    }
+    const char *sfx = partial ? "-partial" : "";
+    char csv[64], png[64], md[64];
+    snprintf(csv, sizeof csv, "build/bench/results%s.csv", sfx);
+    snprintf(png, sizeof png, "build/bench/pareto%s.png", sfx);
+    snprintf(md, sizeof md, "build/bench/summary%s.md", sfx);
     double t0 = lrb_now(), load[2][3] = {{0}};
     getloadavg(load[0], 3);
     if ((mkdir("build", 0777) && errno != EEXIST) || (mkdir("build/bench", 0777) && errno != EEXIST)) {
@@ -133,10 +160,9 @@ static int run_opts(FILE *out, const lrb_options *opt)
     lr_gl_destroy(gl);
     getloadavg(load[1], 3);
     double total = lrb_now() - t0;
-    if (lr_eval_csv_write("build/bench/results.csv", rows, nrows, &e) ||
-        lrb_sweep_plot("build/bench/pareto.png", rows, nrows, res, ns, &e) ||
-        lrb_sweep_summary("build/bench/summary.md", rows, nrows, res, ns, t640, nt, load, total,
-                          info, &e)) {
+    if (lr_eval_csv_write(csv, rows, nrows, &e) ||
+        lrb_sweep_plot(png, rows, nrows, res, ns, &e) ||
+        lrb_sweep_summary(md, rows, nrows, res, ns, t640, nt, load, total, info, &e)) {
         fprintf(stderr, "bench sweep: %s\n", e.msg);
         status = 1;
     }
@@ -151,9 +177,13 @@ static int run_opts(FILE *out, const lrb_options *opt)
     }
     fprintf(out, "## Speed against error (`lamprig-bench sweep`)\n\n");
     fprintf(out, "%d rows over %d scenes in %.0f s at %d×%d (load average %.2f → %.2f). Wrote "
-                 "build/bench/results.csv, build/bench/pareto.png and build/bench/summary.md%s.\n\n",
-            nrows, ns, total, LRB_SWEEP_W, LRB_SWEEP_H, load[0][0], load[1][0],
+                 "%s, %s and %s%s.",
+            nrows, ns, total, LRB_SWEEP_W, LRB_SWEEP_H, load[0][0], load[1][0], csv, png, md,
             !status && opt->update_front ? " and configs/bench/front.csv" : "");
+    if (partial)
+        fprintf(out, " A partial sweep (%s is set): the planner's table build/bench/results.csv "
+                     "is left as it was.", partial);
+    fprintf(out, "\n\n");
     lrb_sweep_table_md(out, rows, nrows, t640, nt);
     lrb_sweep_fair_md(out, res, ns);
     for (int k = 0; k < ns; k++)
