@@ -186,7 +186,6 @@ static int write_stats(const char *path, const lr_scene *scene, lr_renderer *r,
 static int plan(const char *path, lr_scene *scene, const char *table, bool models_only,
                 bool *no_vpl, bool *planned)
 {
-    const lr_render_settings own = *lr_scene_render(scene);
     lr_plan_scene_result *res = calloc(1, sizeof *res);
     if (!res)
         return LR_EXIT_FAIL;
@@ -200,10 +199,11 @@ static int plan(const char *path, lr_scene *scene, const char *table, bool model
             fputs(text, stdout);
         free(text);
         *planned = true;
-        if (models_only) {
+        if (models_only) { /* the scene's settings, which the models-only apply left */
+            const lr_render_settings *own = lr_scene_render(scene);
             printf("plan: --plan-models: the plan's models, the scene's render settings (K=%d "
                    "N=%d N_vpl=%d map_size=%d gbuffer_size=%d frames=%d)\n",
-                   own.K, own.N, own.N_vpl, own.map_size, own.gbuffer_size, own.frames);
+                   own->K, own->N, own->N_vpl, own->map_size, own->gbuffer_size, own->frames);
         } else if (!res->vpl) {
             *no_vpl = true;
         }

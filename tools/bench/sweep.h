@@ -30,12 +30,12 @@ typedef struct lrb_setting {
     const char *label; /* "base", "K=4", ... */
     int K, N, N_vpl, map_size, gbuffer_size;
     bool vpl;
-    const char *model; /* an objects[].model name (lr_sss_model_name); NULL: see shipped */
+    /* An objects[].model name (lr_sss_model_name); NULL: the scene as it ships
+     * (lrb_sweep_shipped), each object's model and render.N_vpl as the product renders the
+     * scene file. */
+    const char *model;
     int checkpoints[4], ncheck;
     int converge_frames;
-    /* The scene as it ships (lrb_sweep_shipped): model NULL and N_vpl 0, each object's model
-     * and render.N_vpl as the product renders the scene file. */
-    bool shipped;
 } lrb_setting;
 
 /* The settings (sweep_settings.c): the base, then one-at-a-time changes. Returns the count. */
@@ -43,21 +43,27 @@ int lrb_sweep_settings(lrb_setting *out, int cap);
 /* The "shipped" setting: the base's K, N, map and G-buffer sizes and frame series, each
  * object's model as `lamprig render --plan-models` renders the scene (the committed table's
  * plan, configs/bench/front.csv, where the scene has a quality budget; else the file's) and
- * the file's render.N_vpl and other render settings. Issue 12's figures for what ships. */
+ * the file's render.N_vpl and other render settings (model NULL, N_vpl 0). Issue 12's figures
+ * for what ships. */
 lrb_setting lrb_sweep_shipped(void);
 
 /* Issue 12's figures on one setting's converged, box-filtered image. */
 typedef struct lrb_fair {
+    double frame_ms; /* accumulation frame at the bench's size */
+    double bias_object, bias_receivers, mal; /* mal: median |ln(model / reference)|, objects */
+    lr_eval_ratio receiver_ratio;            /* all receiver pixels, pooled */
+    lr_eval_ratio region_ratio[LR_EVAL_REGION_COUNT][4]; /* bands R, G, B, then all pooled */
+} lrb_fair;
+
+/* The scene as it ships (lrb_sweep_shipped) and its figures. */
+typedef struct lrb_shipped {
     bool ok;
     char models[160]; /* "multipole" or "obj: model, obj: model" */
     int N_vpl;
     bool planned;     /* the models are the plan's */
     bool as_base;     /* the same models and N_vpl as the base: its figures, not run again */
-    double frame_ms;  /* accumulation frame at the bench's size */
-    double bias_object, bias_receivers, mal;
-    lr_eval_ratio receiver_ratio;
-    lr_eval_ratio region_ratio[LR_EVAL_REGION_COUNT][4]; /* bands R, G, B, then all pooled */
-} lrb_fair;
+    lrb_fair fig;
+} lrb_shipped;
 
 /* What one scene's sweep produced. */
 typedef struct lrb_scene_result {
@@ -80,8 +86,8 @@ typedef struct lrb_scene_result {
     /* Issue 12's fair figures, from the base setting's converged image (C frames). */
     int supersample;                                  /* the sweep's pixel filter */
     double centre_bias_object, centre_bias_receivers; /* pixel-centre samples: the old bench */
-    double fair_bias_object, fair_bias_receivers;     /* box-filtered (the base row's bias) */
-    double mal_centre, mal_fair; /* median |ln(model / reference)| over object pixels */
+    lrb_fair fair; /* box-filtered: the base row's bias and the figures above */
+    double mal_centre; /* median |ln(model / reference)| over object pixels */
     /* The same between the two references (seeds 0 and LRB_SWEEP_SEED2): raw, and scaled to
      * two references of LRB_SWEEP_SPP samples each (x sqrt(2 / (1 + spp / spp2))). NaN when
      * the second reference failed. */
@@ -89,9 +95,8 @@ typedef struct lrb_scene_result {
     int ref2_spp;
     bool ref2_hit;
     long region_px[LR_EVAL_REGION_COUNT];
-    lr_eval_ratio region_ratio[LR_EVAL_REGION_COUNT][4]; /* bands R, G, B, then all pooled */
-    lr_eval_ratio receiver_ratio, centre_receiver_ratio; /* all receiver pixels, pooled */
-    lrb_fair shipped; /* the scene as it ships (lrb_sweep_shipped) */
+    lr_eval_ratio centre_receiver_ratio; /* all receiver pixels, pooled */
+    lrb_shipped shipped; /* the scene as it ships (lrb_sweep_shipped) */
     /* LRB_SWEEP_SS_CHECK: base setting converged at each factor. */
     int nss, ss[LRB_SWEEP_SS_MAX];
     double ss_bias_object[LRB_SWEEP_SS_MAX], ss_bias_receivers[LRB_SWEEP_SS_MAX],

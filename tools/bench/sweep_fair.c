@@ -79,15 +79,16 @@ static void shipped_md(FILE *f, const lrb_scene_result *sc, int n)
                "|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (int k = 0; k < n; k++) {
         const lrb_scene_result *s = &sc[k];
-        const lrb_fair *h = &s->shipped;
-        if (!h->ok)
+        const lrb_shipped *sh = &s->shipped;
+        const lrb_fair *h = &sh->fig;
+        if (!sh->ok)
             continue;
         double to = NAN, tr = NAN;
         for (size_t i = 0; i < sizeof targets / sizeof targets[0]; i++)
             if (!strcmp(targets[i].scene, s->name))
                 to = targets[i].object, tr = targets[i].receivers;
-        fprintf(f, "| %s | %s%s%s | %d | %.1f | %.3f |", s->name, h->models,
-                h->planned ? "\\*" : "", h->as_base ? " (the base)" : "", h->N_vpl,
+        fprintf(f, "| %s | %s%s%s | %d | %.1f | %.3f |", s->name, sh->models,
+                sh->planned ? "\\*" : "", sh->as_base ? " (the base)" : "", sh->N_vpl,
                 h->frame_ms, h->bias_object);
         if (isfinite(h->bias_receivers)) /* the shell has no receivers */
             fprintf(f, " %.3f |", h->bias_receivers);
@@ -142,17 +143,17 @@ void lrb_sweep_fair_md(FILE *f, const lrb_scene_result *sc, int n)
     for (int k = 0; k < n; k++) {
         const lrb_scene_result *s = &sc[k];
         fprintf(f, "| %s |", s->name);
-        pair(f, s->centre_bias_object, s->fair_bias_object);
-        pair(f, s->centre_bias_receivers, s->fair_bias_receivers);
-        pair(f, s->mal_centre, s->mal_fair);
+        pair(f, s->centre_bias_object, s->fair.bias_object);
+        pair(f, s->centre_bias_receivers, s->fair.bias_receivers);
+        pair(f, s->mal_centre, s->fair.mal);
         if (isfinite(s->mal_floor))
             fprintf(f, " %.3f (%d vs %d spp: %.3f) |", s->mal_floor, LRB_SWEEP_SPP, s->ref2_spp,
                     s->mal_floor_raw);
         else
             fprintf(f, " – |");
-        if (isfinite(s->receiver_ratio.ratio))
+        if (isfinite(s->fair.receiver_ratio.ratio))
             fprintf(f, " %.3f → %.3f ± %.3f |\n", s->centre_receiver_ratio.ratio,
-                    s->receiver_ratio.ratio, s->receiver_ratio.se);
+                    s->fair.receiver_ratio.ratio, s->fair.receiver_ratio.se);
         else
             fprintf(f, " – |\n");
     }
@@ -167,7 +168,7 @@ void lrb_sweep_fair_md(FILE *f, const lrb_scene_result *sc, int n)
             fprintf(f, "| %s | %s | %ld |", sc[k].name, lr_eval_region_name(r),
                     sc[k].region_px[r]);
             for (int b = 0; b < 4; b++)
-                ratio_cell(f, sc[k].region_ratio[r][b]);
+                ratio_cell(f, sc[k].fair.region_ratio[r][b]);
             fprintf(f, "\n");
         }
     bool check = false;

@@ -7,10 +7,10 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "firmware/plan_scene.h"
 #include "render/base/paths.h"
 #include "render/image/image.h"
 #include "render/plan/limits.h"
-#include "render/plan/plan.h"
 #include "render/reference/reference.h"
 
 static int set_int(lr_scene *s, const char *key, int v, lr_err *e)
@@ -36,24 +36,16 @@ static bool object_refuses(const lr_scene_object *o, enum lr_sss_model m, char *
 }
 
 /* The shipped setting's models: where the scene has a quality budget, the plan's model per
- * object from the committed table (what `lamprig render --plan-models` renders with a fresh
- * build directory); else the file's, left as they are. */
+ * object from the committed table (lr_plan_scene with models_only, as `lamprig render
+ * --plan-models` with a fresh build directory); else the file's, left as they are. */
 static int apply_shipped_models(lr_scene *s, lr_err *e)
 {
-    lr_plan_budget b;
-    if (!lr_plan_budget_from_scene(s, &b))
-        return LR_OK;
     char path[1024];
     snprintf(path, sizeof path, "%s/bench/front.csv", lr_configs_dir());
-    lr_plan_table *t = NULL;
-    lr_plan *p = malloc(sizeof *p);
-    int rc = p ? lr_plan_table_load(path, &t, e) : lr_err_set(e, LR_ENOMEM, "out of memory");
-    if (!rc)
-        rc = lr_plan_create(s, t, &b, NULL, p, e);
-    if (!rc)
-        rc = lr_plan_apply_models(p, s, NULL, e);
-    lr_plan_table_destroy(t);
-    free(p);
+    lr_plan_scene_result *res = calloc(1, sizeof *res);
+    int rc = res ? lr_plan_scene(s, path, true, res, e)
+                 : lr_err_set(e, LR_ENOMEM, "out of memory");
+    free(res);
     return rc ? lr_err_prefix(e, "shipped setting: the plan") : LR_OK;
 }
 
@@ -85,7 +77,7 @@ int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e)
         p = q ? q + 1 : p + n;
     }
     if (!st->model)
-        return st->shipped ? apply_shipped_models(s, e) : LR_OK;
+        return apply_shipped_models(s, e);
     /* The model is per object; the sweep switches every object that can take it (the
      * multipole needs thickness_mm; the grid a material within its validity limit);
      * lrb_sweep_takes says whether any can. */
@@ -214,24 +206,22 @@ static int second_reference(const lr_ref_scene *rs, const lr_ref_camera *cam, co
  * median |ln ratio| over object pixels. */
 static void fair_figures(const float *C, const lr_ref_image *mean, const lr_ref_image *var,
                          const lr_eval_regions *rg, const lr_eval_masks *m, unsigned char *mask,
-                         long region_px[LR_EVAL_REGION_COUNT],
-                         lr_eval_ratio region_ratio[LR_EVAL_REGION_COUNT][4],
-                         lr_eval_ratio *receiver_ratio, double *mal)
+                         long region_px[LR_EVAL_REGION_COUNT], lrb_fair *out)
 {
     const size_t n = (size_t)LRB_SWEEP_W * LRB_SWEEP_H;
     for (int r = 0; r < LR_EVAL_REGION_COUNT; r++) {
         region_px[r] = lr_eval_regions_mask(rg, r, mask);
         for (int b = 0; b < 4; b++)
-            region_ratio[r][b] =
+            out->region_ratio[r][b] =
                 lr_eval_power_ratio(C, mean->rgb, var->rgb, mask, n, b < 3 ? b : -1);
     }
-    *receiver_ratio = lr_eval_power_ratio(C, mean->rgb, var->rgb, m->receivers, n, -1);
-    *mal = lr_eval_median_abs_log(C, mean->rgb, m->object, n);
+    out->receiver_ratio = lr_eval_power_ratio(C, mean->rgb, var->rgb, m->receivers, n, -1);
+    out->mal = lr_eval_median_abs_log(C, mean->rgb, m->object, n);
 }
 
 /* The models of a scene's objects as text: "multipole" when they agree, else "name: model"
  * per object; whether they and render.N_vpl are the base setting's. */
-static void describe_models(const lr_scene *s, const lrb_setting *base, lrb_fair *out)
+static void describe_models(const lr_scene *s, const lrb_setting *base, lrb_shipped *out)
 {
     out->models[0] = 0;
     out->N_vpl = lr_scene_render(s)->N_vpl;
@@ -290,13 +280,12 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
                               .direct_se = NAN, .row0 = *nrows,
                               .supersample = lrb_sweep_supersample(),
                               .centre_bias_object = NAN, .centre_bias_receivers = NAN,
-                              .fair_bias_object = NAN, .fair_bias_receivers = NAN,
-                              .mal_centre = NAN, .mal_fair = NAN, .mal_floor_raw = NAN,
-                              .mal_floor = NAN,
-                              .receiver_ratio = {NAN, NAN}, .centre_receiver_ratio = {NAN, NAN},
-                              .shipped = {.frame_ms = NAN, .bias_object = NAN,
-                                          .bias_receivers = NAN, .mal = NAN,
-                                          .receiver_ratio = {NAN, NAN}}};
+                              .fair = {.frame_ms = NAN, .bias_object = NAN,
+                                       .bias_receivers = NAN, .mal = NAN,
+                                       .receiver_ratio = {NAN, NAN}},
+                              .mal_centre = NAN, .mal_floor_raw = NAN, .mal_floor = NAN,
+                              .centre_receiver_ratio = {NAN, NAN}};
+    res->shipped.fig = res->fair;
     snprintf(res->name, sizeof res->name, "%s", name);
     const int w = LRB_SWEEP_W, h = LRB_SWEEP_H;
     const size_t n = (size_t)w * h;
@@ -359,7 +348,6 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
 
     lrb_setting set[32];
     int nset = lrb_sweep_settings(set, 32);
-    double base_frame_ms = NAN;
     double t1 = lrb_now();
     for (int k = 0; k < nset; k++) {
         const lrb_setting *st = &set[k];
@@ -384,11 +372,10 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
         double bias_obj, bias_rec;
         series_bias(&ser, st, mean.rgb, &m, res, &bias_obj, &bias_rec);
         if (k == 0) { /* the base setting */
-            res->fair_bias_object = bias_obj;
-            res->fair_bias_receivers = bias_rec;
-            fair_figures(C, &mean, &var, &rg, &m, mask, res->region_px, res->region_ratio,
-                         &res->receiver_ratio, &res->mal_fair);
-            base_frame_ms = ser.frame_ms;
+            res->fair.bias_object = bias_obj;
+            res->fair.bias_receivers = bias_rec;
+            res->fair.frame_ms = ser.frame_ms;
+            fair_figures(C, &mean, &var, &rg, &m, mask, res->region_px, &res->fair);
             dump_pfm(name, "model", C, w, h);
             dump_pfm(name, "ref", mean.rgb, w, h);
             dump_pfm(name, "ref_var", var.rgb, w, h);
@@ -445,7 +432,7 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
      * without "shipped" leaves it out. */
     if (!getenv("LRB_SWEEP_SETTINGS") || lrb_listed(getenv("LRB_SWEEP_SETTINGS"), "shipped")) {
         const lrb_setting sh = lrb_sweep_shipped();
-        lrb_fair *f = &res->shipped;
+        lrb_shipped *f = &res->shipped;
         lr_scene *s2 = NULL;
         lr_eval_series ser = {0};
         if ((rc = lr_scene_load(path, NULL, &s2, &e)) || (rc = lrb_sweep_apply(s2, &sh, &e))) {
@@ -455,27 +442,22 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
         describe_models(s2, &set[0], f);
         f->planned = lr_plan_budget_from_scene(s2, &(lr_plan_budget){0});
         if (f->as_base) {
-            f->bias_object = res->fair_bias_object;
-            f->bias_receivers = res->fair_bias_receivers;
-            f->mal = res->mal_fair;
-            f->receiver_ratio = res->receiver_ratio;
-            f->frame_ms = base_frame_ms;
-            memcpy(f->region_ratio, res->region_ratio, sizeof f->region_ratio);
+            f->fig = res->fair;
         } else if ((rc = run_series(gl, s2, &sh, ss, &ser, &e))) {
             lr_scene_destroy(s2);
             goto done;
         } else {
             long px[LR_EVAL_REGION_COUNT];
-            series_bias(&ser, &sh, mean.rgb, &m, res, &f->bias_object, &f->bias_receivers);
-            fair_figures(ser.converged, &mean, &var, &rg, &m, mask, px, f->region_ratio,
-                         &f->receiver_ratio, &f->mal);
-            f->frame_ms = ser.frame_ms;
+            series_bias(&ser, &sh, mean.rgb, &m, res, &f->fig.bias_object,
+                        &f->fig.bias_receivers);
+            fair_figures(ser.converged, &mean, &var, &rg, &m, mask, px, &f->fig);
+            f->fig.frame_ms = ser.frame_ms;
         }
         f->ok = true;
         fprintf(stderr, "bench sweep: %s shipped (%s, N_vpl %d%s) bias %.4f / %.4f, median "
                         "|ln| %.4f\n",
-                name, f->models, f->N_vpl, f->as_base ? ": the base's" : "", f->bias_object,
-                f->bias_receivers, f->mal);
+                name, f->models, f->N_vpl, f->as_base ? ": the base's" : "", f->fig.bias_object,
+                f->fig.bias_receivers, f->fig.mal);
         lr_eval_series_free(&ser);
         lr_scene_destroy(s2);
     }
@@ -486,8 +468,8 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
     if (!centre || strcmp(centre, "0")) {
         lr_eval_series ser = {0};
         if (ss == 1) {
-            res->centre_bias_object = res->fair_bias_object;
-            res->centre_bias_receivers = res->fair_bias_receivers;
+            res->centre_bias_object = res->fair.bias_object;
+            res->centre_bias_receivers = res->fair.bias_receivers;
         } else if ((rc = run_series(gl, s, &set[0], 1, &ser, &e)))
             goto done;
         const float *C = ss == 1 ? NULL : ser.converged;
@@ -498,8 +480,8 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
             res->centre_receiver_ratio =
                 lr_eval_power_ratio(C, mean.rgb, var.rgb, m.receivers, n, -1);
         } else {
-            res->mal_centre = res->mal_fair;
-            res->centre_receiver_ratio = res->receiver_ratio;
+            res->mal_centre = res->fair.mal;
+            res->centre_receiver_ratio = res->fair.receiver_ratio;
         }
         lr_eval_series_free(&ser);
     }

@@ -75,6 +75,5 @@ lrb_setting lrb_sweep_shipped(void)
     s.label = "shipped";
     s.model = NULL;
     s.N_vpl = 0;
-    s.shipped = true;
     return s;
 }
