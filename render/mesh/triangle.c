@@ -13,11 +13,11 @@ bool lr_ray_triangle(lr_vec3 o, lr_vec3 d, lr_vec3 a, lr_vec3 b, lr_vec3 c, doub
     double inv = 1.0 / det;
     lr_vec3 s = lr_v3_sub(o, a);
     double uu = lr_v3_dot(s, p) * inv;
-    if (uu < 0.0 || uu > 1.0)
+    if (uu < -LR_RAY_TRIANGLE_EDGE_TOL || uu > 1.0 + LR_RAY_TRIANGLE_EDGE_TOL)
         return false;
     lr_vec3 q = lr_v3_cross(s, e1);
     double vv = lr_v3_dot(d, q) * inv;
-    if (vv < 0.0 || uu + vv > 1.0)
+    if (vv < -LR_RAY_TRIANGLE_EDGE_TOL || uu + vv > 1.0 + LR_RAY_TRIANGLE_EDGE_TOL)
         return false;
     double tt = lr_v3_dot(e2, q) * inv;
     if (!(tt >= tmin && tt <= tmax))

@@ -8,7 +8,14 @@
 
 /* Ray o + t d against triangle (a, b, c), Moller & Trumbore 1997, both sides. True when it
  * hits with tmin <= t <= tmax; then *t and the barycentrics (u, v) of the hit point
- * a + u (b - a) + v (c - a) are set. d need not be unit length (t is in its units). */
+ * a + u (b - a) + v (c - a) are set. d need not be unit length (t is in its units).
+ *
+ * The barycentric bounds are widened by LR_RAY_TRIANGLE_EDGE_TOL (dimensionless, so
+ * scale-free): a ray through the shared edge of two triangles otherwise could miss both by
+ * rounding (a 1 m box refined to 12 mm edges let a projector ray through its top face onto
+ * the bottom, test_calib_ar). An edge hit may now report either triangle; callers that count
+ * crossings already step past equal t (render/diffusion/shape.c). */
+#define LR_RAY_TRIANGLE_EDGE_TOL 1e-9
 bool lr_ray_triangle(lr_vec3 o, lr_vec3 d, lr_vec3 a, lr_vec3 b, lr_vec3 c, double tmin,
                      double tmax, double *t, double *u, double *v);
 

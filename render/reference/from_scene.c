@@ -77,7 +77,7 @@ int lr_ref_scene_from_scene(const lr_scene *sc, lr_ref_scene **out, lr_ref_camer
         int id;
         lr_ref_shape *shape;
         if ((rc = lr_ref_scene_add_medium(s, &md, &id, e)) ||
-            (rc = lr_ref_mesh_create((lr_mesh *)ob->mesh, false, &shape, e)))
+            (rc = lr_ref_mesh_create((lr_mesh *)ob->built_mesh, false, &shape, e)))
             break;
         lr_ref_object_desc od = {.kind = LR_REF_BOUNDARY, .shape = shape, .inside = id,
                                  .name = ob->name};

@@ -8,6 +8,7 @@
 #include "render/base/json.h"
 #include "render/base/mat4.h"
 #include "render/mesh/mesh_io.h"
+#include "render/mesh/refine.h"
 #include "render/scene/scene_internal.h"
 
 int lr_scene_resolve_path(const lr_scene *s, const char *rel, char *out, size_t cap)
@@ -32,11 +33,64 @@ static void prefixed_warn(void *user, const char *msg)
     lr_warn(p->inner, "%s: %s", p->prefix, msg);
 }
 
-int lr_scene_build_object(const lr_scene *s, const char *where, const mesh_spec *ms,
-                          const xform_spec *xf, lr_mesh **world, lr_bvh **bvh, double model[16],
-                          lr_err *e)
+static double longest_edge(const lr_mesh *m)
 {
-    *world = NULL;
+    double longest = 0.0;
+    for (size_t t = 0; t < lr_mesh_triangle_count(m); t++) {
+        lr_vec3 p[3];
+        lr_mesh_triangle(m, t, p);
+        for (int k = 0; k < 3; k++)
+            longest = fmax(longest, lr_v3_len(lr_v3_sub(p[k], p[(k + 1) % 3])));
+    }
+    return longest;
+}
+
+/* The renderer's copy of the surface (scene_internal.h, LR_SCENE_MAX_EDGE_MM): `built` itself
+ * when no edge is longer, else its midpoint refinement (render/mesh/refine.h), which keeps
+ * the surface and the linearly interpolated normal field. `built` was checked and repaired
+ * already, so the copy is taken as it is (its winding, open edges, no warnings). */
+static int refine_for_renderer(lr_mesh *built, lr_mesh **out, lr_err *e)
+{
+    *out = built;
+    if (longest_edge(built) <= LR_SCENE_MAX_EDGE_MM)
+        return LR_OK;
+    lr_refined r;
+    int rc = lr_refine(built, LR_SCENE_MAX_EDGE_MM, LR_SCENE_REFINED_MAX_VERTICES, &r, e);
+    if (rc)
+        return rc;
+    double *pos = malloc(r.nv * 3 * sizeof *pos), *nrm = malloc(r.nv * 3 * sizeof *nrm);
+    if (!pos || !nrm) {
+        rc = lr_err_set(e, LR_ENOMEM, "mesh %s: out of memory", lr_mesh_name(built));
+    } else {
+        for (size_t i = 0; i < 3 * r.nv; i++) {
+            pos[i] = r.pos[i];
+            nrm[i] = r.nrm[i];
+        }
+        lr_mesh_desc d = {.name = lr_mesh_name(built), .vertex_count = r.nv, .positions = pos,
+                          .normals = nrm, .triangle_count = r.nt, .indices = r.idx,
+                          .checks = {.flags = LR_MESH_OPEN_OK | LR_MESH_KEEP_WINDING}};
+        rc = lr_mesh_create(&d, out, e);
+        if (rc)
+            *out = built;
+    }
+    free(pos);
+    free(nrm);
+    lr_refined_free(&r);
+    return rc;
+}
+
+void lr_scene_object_meshes_destroy(lr_mesh *world, lr_mesh *built)
+{
+    if (world != built)
+        lr_mesh_destroy(world);
+    lr_mesh_destroy(built);
+}
+
+int lr_scene_build_object(const lr_scene *s, const char *where, const mesh_spec *ms,
+                          const xform_spec *xf, lr_mesh **world, lr_mesh **built, lr_bvh **bvh,
+                          double model[16], lr_err *e)
+{
+    *world = *built = NULL;
     *bvh = NULL;
     char prefix[LR_SCENE_PATH_MAX + 80];
     snprintf(prefix, sizeof prefix, "%s: %s", s->path, where);
@@ -89,21 +143,22 @@ int lr_scene_build_object(const lr_scene *s, const char *where, const mesh_spec 
     lr_mat4_mul(sc, pre, model);
     lr_mat4_mul(r, model, model);
     lr_mat4_mul(t, model, model);
-    rc = lr_mesh_transform(local, model, world, e);
+    rc = lr_mesh_transform(local, model, built, e);
     lr_mesh_destroy(local);
     if (rc)
         return rc;
-    rc = lr_bvh_create(*world, bvh, e);
-    if (rc) {
-        lr_mesh_destroy(*world);
-        *world = NULL;
+    if ((rc = refine_for_renderer(*built, world, e)) || (rc = lr_bvh_create(*world, bvh, e))) {
+        lr_scene_object_meshes_destroy(*world, *built);
+        *world = *built = NULL;
     }
     return rc;
 }
 
-void lr_scene_object_attach(lr_scene_object *pub, const lr_mesh *world, const lr_bvh *bvh)
+void lr_scene_object_attach(lr_scene_object *pub, const lr_mesh *world, const lr_mesh *built,
+                            const lr_bvh *bvh)
 {
     pub->mesh = world;
+    pub->built_mesh = built;
     pub->bvh = bvh;
     lr_mesh_bounding_sphere(world, &pub->center, &pub->radius);
     pub->area = lr_mesh_area(world);

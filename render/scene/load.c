@@ -320,7 +320,7 @@ static int parse_object(ctx *c, lr_jnode obj, int i, obj_rec *o)
         return lr_json_fail(c->j, mat, cat(f, sizeof f, where, "material"), c->e, rc, "%s",
                             inner.msg);
     o->pub.kind = o->mesh.kind;
-    if ((rc = lr_scene_build_object(c->s, where, &o->mesh, &o->xf, &o->world, &o->bvh,
+    if ((rc = lr_scene_build_object(c->s, where, &o->mesh, &o->xf, &o->world, &o->built, &o->bvh,
                                     o->pub.model, &inner))) {
         /* A file that cannot be read or is broken: point at the path in the scene. */
         lr_jnode at = o->mesh.kind == LR_MESH_FILE ? lr_json_get(c->j, mesh, "path") : mesh;
@@ -328,7 +328,7 @@ static int parse_object(ctx *c, lr_jnode obj, int i, obj_rec *o)
                                           o->mesh.kind == LR_MESH_FILE ? "mesh.path" : "mesh"),
                             c->e, rc, "%s", inner.msg);
     }
-    lr_scene_object_attach(&o->pub, o->world, o->bvh);
+    lr_scene_object_attach(&o->pub, o->world, o->built, o->bvh);
     return LR_OK;
 }
 

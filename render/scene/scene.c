@@ -11,7 +11,7 @@ void lr_scene_destroy(lr_scene *s)
         return;
     for (int i = 0; i < s->nobj; i++) {
         lr_bvh_destroy(s->obj[i].bvh);
-        lr_mesh_destroy(s->obj[i].world);
+        lr_scene_object_meshes_destroy(s->obj[i].world, s->obj[i].built);
     }
     for (int i = 0; i < s->nrecv; i++) {
         lr_bvh_destroy(s->recv[i].bvh);

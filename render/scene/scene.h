@@ -62,7 +62,11 @@ typedef struct lr_scene_object {
     enum lr_mesh_kind kind;
     lr_material material; /* effective (base and scale applied) */
     lr_coeffs coeffs;     /* lr_coeffs_derive(&material.medium) */
-    const lr_mesh *mesh;  /* world space */
+    const lr_mesh *mesh;  /* world space, what the renderer draws: no edge longer than 12 mm
+                           * (per-vertex values; render/scene/scene_internal.h) */
+    const lr_mesh *built_mesh; /* the same surface as described (file or generator), world
+                           * space, unrefined: what the physical reference traces, so that its
+                           * cache key does not move with the refinement; may equal mesh */
     const lr_bvh *bvh;    /* over mesh */
     double model[16];     /* object to world (column-major) */
     lr_vec3 center;       /* world bounding sphere (lr_mesh_bounding_sphere): the K map */

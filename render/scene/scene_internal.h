@@ -44,7 +44,8 @@ typedef struct obj_rec {
     mat_spec mat;
     mesh_spec mesh;
     xform_spec xf;
-    lr_mesh *world;
+    lr_mesh *world; /* refined (the renderer's) */
+    lr_mesh *built; /* as described; may be world */
     lr_bvh *bvh;
 } obj_rec;
 
@@ -90,15 +91,34 @@ void lr_scene_render_defaults(lr_render_settings *r);
 
 /* ---- building (build.c) --------------------------------------------------------------------- */
 
-/* Builds the world mesh and BVH of an object from its mesh and transform specs (replacing
- * nothing: the caller swaps them in on success). `where` names the object in messages. */
+/* No edge of the mesh the renderer draws is longer than this (mm). Translucent radiosity's
+ * solved B and the receivers' light on objects (render/bounce/objlight.h) are values per
+ * vertex, interpolated linearly over each triangle: a mockup mesh whose wall is one quad from
+ * foot to rim (configs/meshes/votive.obj, 65 mm) showed its wall only as the mean of the foot
+ * and the rim (translucent radiosity's outer wall 0.63-0.71 of the reference, evenly in the
+ * three bands). Translucent radiosity's patch (12 mm), over which its B is averaged: the
+ * votive read the same with 6 mm (0.146 / 0.346 objects / receivers against 0.150 / 0.346),
+ * which would have tripled the lamp shade's triangles (10 mm edges, untouched at 12). The
+ * midpoint split keeps the surface and the interpolated normal field, so the profile models'
+ * maps do not change (the votive's directional dipole 0.299 / 0.532 before, 0.298 / 0.536
+ * after). */
+#define LR_SCENE_MAX_EDGE_MM 12.0
+#define LR_SCENE_REFINED_MAX_VERTICES ((size_t)1 << 22)
+
+/* Builds the world meshes and BVH of an object from its mesh and transform specs (replacing
+ * nothing: the caller swaps them in on success). `built` is the surface as the spec describes
+ * it; `world` the renderer's copy, refined so that no edge is longer than
+ * LR_SCENE_MAX_EDGE_MM (`built` itself where none is); the BVH is over `world`. Free both
+ * with lr_scene_object_meshes_destroy. `where` names the object in messages. */
 int lr_scene_build_object(const lr_scene *s, const char *where, const mesh_spec *ms,
-                          const xform_spec *xf, lr_mesh **world, lr_bvh **bvh, double model[16],
-                          lr_err *e);
+                          const xform_spec *xf, lr_mesh **world, lr_mesh **built, lr_bvh **bvh,
+                          double model[16], lr_err *e);
+void lr_scene_object_meshes_destroy(lr_mesh *world, lr_mesh *built);
 int lr_scene_build_receiver(const lr_scene *s, lr_receiver *r, lr_mesh **mesh, lr_bvh **bvh,
                             lr_err *e);
-/* Fills pub's mesh-derived fields (mesh, bvh, bounds, area, closed) from world and bvh. */
-void lr_scene_object_attach(lr_scene_object *pub, const lr_mesh *world, const lr_bvh *bvh);
+/* Fills pub's mesh-derived fields (mesh, built_mesh, bvh, bounds, area, closed). */
+void lr_scene_object_attach(lr_scene_object *pub, const lr_mesh *world, const lr_mesh *built,
+                            const lr_bvh *bvh);
 
 /* Resolves a material spec by writing it as JSON and reading it back through
  * lr_material_from_json (the file's semantics, base and scale included); `where` names it. */

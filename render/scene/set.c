@@ -267,19 +267,20 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
     } else {
         return lr_field_fail(o, LR_EINVAL, "an object has no parameter '%s' (%s)", f, OBJECT_KNOWN);
     }
-    lr_mesh *world;
+    lr_mesh *world, *built;
     lr_bvh *bvh;
     double model[16];
-    if ((rc = lr_scene_build_object(s, where, &ms, &xf, &world, &bvh, model, &inner)))
+    if ((rc = lr_scene_build_object(s, where, &ms, &xf, &world, &built, &bvh, model, &inner)))
         return lr_err_set(o->e, rc, "%s: %s", o->key, inner.msg);
     lr_bvh_destroy(rec->bvh);
-    lr_mesh_destroy(rec->world);
+    lr_scene_object_meshes_destroy(rec->world, rec->built);
     rec->world = world;
+    rec->built = built;
     rec->bvh = bvh;
     rec->mesh = ms;
     rec->xf = xf;
     memcpy(rec->pub.model, model, sizeof model);
-    lr_scene_object_attach(&rec->pub, world, bvh);
+    lr_scene_object_attach(&rec->pub, world, built, bvh);
     return LR_OK;
 }
 
