@@ -57,6 +57,7 @@
 void lr_tr_spread_build(const lr_coeffs *c, double d, lr_tr_spread *sp)
 {
     memset(sp, 0, sizeof *sp);
+    sp->d = d;
     double zb = 0;
     for (int b = 0; b < 3; b++)
         zb = fmax(zb, 2 * c->A * c->D[b]);
@@ -118,7 +119,7 @@ double lr_tr_spread_r90(const lr_tr_spread *sp)
 
 bool lr_tr_spread_thin(const lr_tr_spread *sp, double patch_mm)
 {
-    return patch_mm > 0 && lr_tr_spread_r90(sp) <= patch_mm / 4;
+    return patch_mm > 0 && sp->d <= patch_mm;
 }
 
 bool lr_tr_wall_thin(const lr_coeffs *c, double d, double patch_mm)

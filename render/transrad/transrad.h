@@ -145,10 +145,14 @@ int lr_tr_solve_irradiance(lr_tr *t, const double *E, int slot, lr_tr_stats *st,
 int lr_tr_direct_irradiance(lr_tr *t, const lr_light *light, double *E, lr_err *e);
 
 /* The thin-wall rule (render/transrad/thinwall.c): a slab of thickness d (mm) of medium c is
- * thin against patches of patch_mm when its wider diffusion profile (the multipole's R or T,
- * any band) holds 90 % of its light within patch_mm / 4; its S columns then send the slab's
- * R_tot out of the lit face and T_tot out of the opposite one, spread by the profiles. False
- * for d or patch_mm not positive. */
+ * thin against patches of patch_mm when it is no thicker than a patch, d <= patch_mm; its S
+ * columns then send the slab's R_tot out of the lit face and T_tot out of the opposite one,
+ * spread by the profiles. Why: T spreads over about d, and the two faces' patches overlap,
+ * so exit centroids a patch apart sample T too coarsely to split the light between the faces
+ * (the votive's 7 mm wax at 12 mm patches: 0.69 / 0.26 out of the lit / far face against the
+ * slab's 0.76 / 0.19). The rule before 27 Nov (the wider profile's r90 <= patch_mm / 4) left
+ * such walls to those centroid sums; it implied d <= patch_mm, as T's r90 is at least about
+ * d. False for c NULL, d or patch_mm not positive. */
 bool lr_tr_wall_thin(const lr_coeffs *c, double d, double patch_mm);
 
 /* ---- Queries ------------------------------------------------------------------------------- */

@@ -10,8 +10,8 @@
  *    above it the share of T that the profile's convolution with the square gives (a
  *    quadrature), and keeps the share of R that lands in itself;
  *  - energy: a slab without absorption lets out all that entered;
- *  - the rule: r90 <= patch_mm / 4 (paper 0.1 mm and porcelain 1.5 mm thin at 12 mm patches;
- *    porcelain 3 mm, wax 7 mm not), and bad settings.
+ *  - the rule: d <= patch_mm (paper 0.1 mm, porcelain 1.5 and 3 mm, wax 7 and 12 mm thin at
+ *    12 mm patches; wax 40 mm not), and bad settings.
  *
  * Tolerances. The lit and far faces' shares are sums of the same numbers the column was
  * built from, so they hold to what the sparse S drops: entries below 1e-7 of a column's input
@@ -311,19 +311,21 @@ static void test_rule(void **state)
     assert_int_equal(lr_coeffs_derive(&wm, &wax, &e), LR_OK);
     assert_true(lr_tr_wall_thin(&pa, 0.1, 12));
     assert_true(lr_tr_wall_thin(&po, 1.5, 12));
-    assert_false(lr_tr_wall_thin(&po, 3, 12));
-    assert_false(lr_tr_wall_thin(&pa, 0.1, 0.5));
-    assert_false(lr_tr_wall_thin(&wax, 7, 12));
+    assert_true(lr_tr_wall_thin(&po, 3, 12));
+    assert_true(lr_tr_wall_thin(&wax, 7, 12));
+    assert_false(lr_tr_wall_thin(&wax, 40, 12));
     assert_false(lr_tr_wall_thin(&pa, 0, 12));
     assert_false(lr_tr_wall_thin(&pa, 0.1, 0));
     assert_false(lr_tr_wall_thin(NULL, 0.1, 12));
-    /* The boundary: r90 = patch_mm / 4. */
+    /* The boundary: d = patch_mm. Wax's r90 (diffusion lengths 8-17 mm) is far over a
+     * quarter of the patch, which the rule before 27 Nov asked for. */
     lr_tr_spread sp;
-    lr_tr_spread_build(&po, 1.5, &sp);
-    double r90 = lr_tr_spread_r90(&sp);
-    printf("  porcelain 1.5 mm r90 %.3f mm\n", r90);
-    assert_true(lr_tr_wall_thin(&po, 1.5, 4 * r90 * (1 + 1e-9)));
-    assert_false(lr_tr_wall_thin(&po, 1.5, 4 * r90 * (1 - 1e-3)));
+    lr_tr_spread_build(&wax, 12, &sp);
+    assert_true(lr_tr_spread_r90(&sp) > 3);
+    assert_true(lr_tr_wall_thin(&wax, 12, 12));
+    assert_false(lr_tr_wall_thin(&wax, 12 * (1 + 1e-3), 12));
+    assert_true(lr_tr_wall_thin(&pa, 0.1, 0.1));
+    assert_false(lr_tr_wall_thin(&pa, 0.1, 0.1 * (1 - 1e-3)));
     /* The tabulated CDFs reach their closed-form totals' profiles: r90 of the T profile of
      * the paper sheet lies between its thickness and the slab with both extrapolated
      * boundaries, and the CDF inverse is monotone. */
