@@ -21,6 +21,7 @@
 #include "render/mesh/mesh.h"
 #include "render/mesh/mesh_io.h"
 #include "render/mesh/shapes.h"
+#include "render/mesh/triangle.h"
 
 /* ---- helpers ---------------------------------------------------------------------------- */
 
@@ -1157,6 +1158,42 @@ static void test_winding_and_hull(void **state)
     lr_mesh_destroy(m);
 }
 
+/* A ray through the shared edge of two triangles hits one of them (render/mesh/triangle.h):
+ * the cells of a 1 m square split at 7.8125 mm (its refinement to 12 mm edges), rays from
+ * 500 mm above through points on their diagonals, at float positions as the mesh stores
+ * them. With the exact bounds of Moller-Trumbore some slipped between the two halves
+ * (test_calib_ar saw one reach the box's bottom). */
+static void test_ray_through_shared_edge(void **state)
+{
+    (void)state;
+    const double h = 1000.0 / 128;
+    int missed = 0, rays = 0;
+    for (int i = 0; i < 128; i += 3)
+        for (int j = 0; j < 128; j += 5) {
+            lr_vec3 a = lr_v3((float)(-500 + i * h), (float)(-500 + j * h), 0);
+            lr_vec3 c = lr_v3((float)(-500 + (i + 1) * h), (float)(-500 + (j + 1) * h), 0);
+            lr_vec3 b = lr_v3(c.x, a.y, 0), d = lr_v3(a.x, c.y, 0);
+            for (int k = 1; k < 8; k++) {
+                lr_vec3 x = lr_v3_add(a, lr_v3_scale(lr_v3_sub(c, a), k / 8.0));
+                lr_vec3 o = lr_v3(0.0, 0.0, 500.0), dir = lr_v3_normalize(lr_v3_sub(x, o));
+                double t, u, v;
+                bool hit = lr_ray_triangle(o, dir, a, b, c, 0, INFINITY, &t, &u, &v) ||
+                           lr_ray_triangle(o, dir, a, c, d, 0, INFINITY, &t, &u, &v);
+                missed += !hit;
+                rays++;
+            }
+        }
+    printf("  %d rays through shared edges, %d missed\n", rays, missed);
+    assert_int_equal(missed, 0);
+    /* The tolerance is a hair: a ray 1e-6 of the cell outside the square misses both. */
+    lr_vec3 a = lr_v3(0, 0, 0), b = lr_v3(1, 0, 0), c = lr_v3(1, 1, 0), d = lr_v3(0, 1, 0);
+    double t, u, v;
+    assert_false(lr_ray_triangle(lr_v3(1 + 1e-6, 0.5, 1), lr_v3(0, 0, -1), a, b, c, 0,
+                                 INFINITY, &t, &u, &v));
+    assert_false(lr_ray_triangle(lr_v3(-1e-6, 0.5, 1), lr_v3(0, 0, -1), a, c, d, 0, INFINITY,
+                                 &t, &u, &v));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1181,6 +1218,7 @@ int main(void)
         cmocka_unit_test(test_closest_point_and_hits_exact),
         cmocka_unit_test(test_winding_and_hull),
         cmocka_unit_test(test_nested_cavity_orientation),
+        cmocka_unit_test(test_ray_through_shared_edge),
     };
     return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
 }

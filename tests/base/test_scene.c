@@ -14,6 +14,7 @@
 
 #include "render/base/mat4.h"
 #include "render/mesh/shapes.h"
+#include "render/mesh/triangle.h"
 #include "render/scene/scene.h"
 #include "render/schedule.h"
 #include "tests/support/doc_block.h"
@@ -308,6 +309,75 @@ static void test_sphere_and_votive_scenes(void **state)
     assert_int_equal(lr_scene_light_enclosure(s, 0, NULL), LR_ENCLOSURE_HULL);
     get(s, "objects[votive].material.scale", "1.5");
     get(s, "objects[votive].mesh.path", "../meshes/votive.obj");
+    lr_scene_destroy(s);
+}
+
+static double longest_edge(const lr_mesh *m)
+{
+    double longest = 0;
+    for (size_t t = 0; t < lr_mesh_triangle_count(m); t++) {
+        lr_vec3 p[3];
+        lr_mesh_triangle(m, t, p);
+        for (int k = 0; k < 3; k++)
+            longest = fmax(longest, lr_v3_len(lr_v3_sub(p[k], p[(k + 1) % 3])));
+    }
+    return longest;
+}
+
+/* The refined copy lies on the described surface: every vertex of it on a triangle of the
+ * built mesh (float positions: 1e-4 mm at these 100 mm sizes), its normal within the crease
+ * angle (60 degrees) of that triangle's face, and the same area. */
+static void expect_refined_copy(const lr_scene_object *o)
+{
+    const lr_mesh *m = o->mesh, *b = o->built_mesh;
+    assert_true(longest_edge(m) <= 12.0 + 1e-9);
+    assert_near_rel(lr_mesh_area(m), lr_mesh_area(b), 1e-6);
+    const float *N = lr_mesh_normals(m);
+    for (size_t v = 0; v < lr_mesh_vertex_count(m); v++) {
+        lr_vec3 x = lr_mesh_vertex(m, v), n = lr_v3(N[3 * v], N[3 * v + 1], N[3 * v + 2]);
+        double best = INFINITY, cos_best = -2;
+        for (size_t t = 0; t < lr_mesh_triangle_count(b); t++) {
+            lr_vec3 p[3];
+            double w[3];
+            lr_mesh_triangle(b, t, p);
+            double d = lr_v3_len(lr_v3_sub(lr_closest_on_triangle(x, p[0], p[1], p[2], w), x));
+            double c = lr_v3_dot(n, lr_mesh_triangle_normal(b, t));
+            if (d < best - 1e-6 || (d < best + 1e-6 && c > cos_best)) {
+                best = fmin(best, d);
+                cos_best = c;
+            }
+        }
+        assert_true(best < 1e-4);
+        assert_near(lr_v3_len(n), 1.0, 1e-6);
+        assert_true(cos_best > 0.5 - 1e-6);
+    }
+}
+
+/* The renderer draws each object's mesh refined to edges of at most 12 mm (per-vertex values:
+ * translucent radiosity's B, the receivers' light on objects); the physical reference traces
+ * built_mesh, the surface as described. */
+static void test_refined_mesh(void **state)
+{
+    (void)state;
+    lr_scene *s = load("configs/scenes/votive.json");
+    const lr_scene_object *o = lr_scene_object_at(s, 0);
+    assert_true(o->mesh != o->built_mesh);
+    assert_near(longest_edge(o->built_mesh), hypot(65.0, 2 * 40.0 * sin(M_PI / 32)), 1e-3);
+    assert_true(lr_mesh_triangle_count(o->mesh) > 10 * lr_mesh_triangle_count(o->built_mesh));
+    expect_refined_copy(o);
+    /* A rebuilt object (a transform change) is refined again. */
+    lr_err e = {0};
+    assert_int_equal(lr_scene_set(s, "objects[0].transform.scale", "1.5,1.5,1.5", NULL, &e),
+                     LR_OK);
+    o = lr_scene_object_at(s, 0);
+    assert_near(longest_edge(o->built_mesh), 1.5 * hypot(65.0, 2 * 40.0 * sin(M_PI / 32)), 2e-3);
+    expect_refined_copy(o);
+    lr_scene_destroy(s);
+    /* A mesh fine enough already is drawn as built. */
+    s = load_warns("configs/scenes/sphere.json", "inside the material");
+    o = lr_scene_object_at(s, 0);
+    assert_true(longest_edge(o->built_mesh) <= 12.0);
+    assert_ptr_equal(o->mesh, o->built_mesh);
     lr_scene_destroy(s);
 }
 
@@ -926,6 +996,7 @@ int main(void)
         cmocka_unit_test(test_set_rejects_bad_values),
         cmocka_unit_test(test_set_shade_and_file_mesh),
         cmocka_unit_test(test_model_switch_and_light_cap),
+        cmocka_unit_test(test_refined_mesh),
         cmocka_unit_test(test_readme_field_reference),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
