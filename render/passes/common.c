@@ -52,8 +52,10 @@ void lr_passes_release_mesh(lr_gpu_mesh *g)
 
 void lr_pass_objects_free(lr_pass_objects *o)
 {
-    for (int i = 0; i < LR_MAX_OBJECTS; i++)
+    for (int i = 0; i < LR_MAX_OBJECTS; i++) {
         lr_passes_release_mesh(&o->obj[i]);
+        lr_passes_release_mesh(&o->built[i]);
+    }
     for (int i = 0; i < LR_MAX_RECEIVERS; i++)
         lr_passes_release_mesh(&o->recv[i]);
     o->n_objects = o->n_receivers = 0;
@@ -71,6 +73,8 @@ int lr_pass_objects_upload(lr_pass_objects *objs, const lr_scene *s, lr_err *e)
     for (int i = 0; i < no; i++) {
         const lr_scene_object *o = lr_scene_object_at(s, i);
         int rc = upload(&objs->obj[i], o->mesh, e);
+        if (!rc && o->built_mesh && o->built_mesh != o->mesh)
+            rc = upload(&objs->built[i], o->built_mesh, e);
         if (rc)
             return rc;
         objs->two_sided[i] = !o->closed;

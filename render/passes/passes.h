@@ -47,6 +47,11 @@ typedef struct lr_gpu_mesh {
 typedef struct lr_pass_objects {
     int n_objects, n_receivers;
     lr_gpu_mesh obj[LR_MAX_OBJECTS];
+    /* The object's surface as built (lr_scene_object.built_mesh), where the scene refined it
+     * (vao 0 where not): the radiosity pass draws this one unless the object's B comes per
+     * vertex (translucent radiosity), as the refined copy's small triangles cost llvmpipe
+     * about twice the fragment work for the same texels (the votive, 16x the triangles). */
+    lr_gpu_mesh built[LR_MAX_OBJECTS];
     lr_gpu_mesh recv[LR_MAX_RECEIVERS];
     bool two_sided[LR_MAX_OBJECTS];
     float coef[5 * 4 * LR_MAX_OBJECTS];

@@ -222,6 +222,16 @@ static int tr_refresh(lr_radiosity *rad, const lr_pass_ctx *c, lr_err *e)
     return LR_OK;
 }
 
+/* What the maps draw of object i: its surface as built, except where its B comes per vertex
+ * of the refined copy (translucent radiosity's u_tr_B by gl_VertexID) or the scene did not
+ * refine it (lr_pass_objects.built). The depth prepass and the gather draw the same, so
+ * their depths agree. */
+static const lr_gpu_mesh *radiosity_mesh(const lr_pass_ctx *c, const lr_radiosity *rad, int i)
+{
+    bool per_vertex = i < LR_MAX_OBJECTS && rad->trB[i];
+    return !per_vertex && c->objs->built[i].vao ? &c->objs->built[i] : &c->objs->obj[i];
+}
+
 int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *gb, bool restart,
                      lr_err *e)
 {
@@ -260,7 +270,7 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
                 glDepthFunc(GL_LESS);
                 lr_passes_uniform_mat4(c->prog->depth, "u_vp", rad->vp[k]);
                 for (int i = 0; i < c->objs->n_objects; i++)
-                    lr_passes_draw(&c->objs->obj[i]);
+                    lr_passes_draw(radiosity_mesh(c, rad, i));
                 glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
                 glDisable(GL_BLEND);
             } else if (F == 1) {
@@ -313,7 +323,7 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
                 lr_passes_uniform_i(p, "u_tr_on", tr);
                 lr_passes_bind_tex(p, "u_tr_B", 10, tr ? rad->trB[i] : NULL);
                 lr_passes_uniform_i(p, "u_tr_row0", tr ? l * rad->tr_rows[i] : 0);
-                lr_passes_draw(&c->objs->obj[i]);
+                lr_passes_draw(radiosity_mesh(c, rad, i));
             }
         }
     glDisable(GL_BLEND);
