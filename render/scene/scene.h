@@ -62,8 +62,10 @@ typedef struct lr_scene_object {
     enum lr_mesh_kind kind;
     lr_material material; /* effective (base and scale applied) */
     lr_coeffs coeffs;     /* lr_coeffs_derive(&material.medium) */
-    const lr_mesh *mesh;  /* world space, what the renderer draws: no edge longer than 12 mm
-                           * (per-vertex values; render/scene/scene_internal.h) */
+    const lr_mesh *mesh;  /* world space, refined: no edge longer than 12 mm (per-vertex
+                           * values; render/scene/scene_internal.h); the passes, the CPU twin
+                           * and the ray casts use it (the radiosity maps draw built_mesh
+                           * where B is not per vertex: render/passes/passes.h) */
     const lr_mesh *built_mesh; /* the same surface as described (file or generator), world
                            * space, unrefined: what the physical reference traces, so that its
                            * cache key does not move with the refinement; may equal mesh */

@@ -98,10 +98,11 @@ void lr_scene_render_defaults(lr_render_settings *r);
  * and the rim (translucent radiosity's outer wall 0.63-0.71 of the reference, evenly in the
  * three bands). Translucent radiosity's patch (12 mm), over which its B is averaged: the
  * votive read the same with 6 mm (0.146 / 0.346 objects / receivers against 0.150 / 0.346),
- * which would have tripled the lamp shade's triangles (10 mm edges, untouched at 12). The
- * midpoint split keeps the surface and the interpolated normal field, so the profile models'
- * maps do not change (the votive's directional dipole 0.299 / 0.532 before, 0.298 / 0.536
- * after). */
+ * which would have tripled the lamp shade's triangles (10 mm edges, untouched at 12); 24 mm
+ * left the multipole votive's inner wall at 0.83 of the reference (the receivers' light on
+ * it, per vertex). The midpoint split keeps the surface and the interpolated normal field.
+ * The radiosity maps draw the built mesh unless B is per vertex (render/passes/passes.h
+ * lr_pass_objects.built: small triangles doubled llvmpipe's radiosity pass). */
 #define LR_SCENE_MAX_EDGE_MM 12.0
 #define LR_SCENE_REFINED_MAX_VERTICES ((size_t)1 << 22)
 
