@@ -279,6 +279,26 @@ static void test_maps_lampshade_multipole(void **state)
     lr_scene_destroy(s);
 }
 
+/* The votive mockup (65 mm wall quads): the scene refines it for per-vertex values, and the
+ * radiosity maps draw the mesh as built (render/passes/passes.h lr_pass_objects.built) while
+ * the twin evaluates the refined copy: the same surface and normal field, so the same maps. */
+static void test_maps_votive_built_mesh(void **state)
+{
+    (void)state;
+    lr_scene *s = lr_test_scene("votive", parity_settings, NULL); /* ships the multipole */
+    const lr_scene_object *o = lr_scene_object_at(s, 0);
+    assert_true(o->built_mesh != o->mesh);
+    assert_true(lr_mesh_triangle_count(o->mesh) > 10 * lr_mesh_triangle_count(o->built_mesh));
+    lr_renderer *r = lr_test_renderer(gl, s, 16, 12, true, 3);
+    lr_test_converge(r, 20);
+    parity p;
+    compare_maps(r, s, 256, true, &p);
+    report("votive maps, multipole, maps drawn on the file's mesh", &p);
+    check_parity(&p);
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+}
+
 /* VPLs: the GPU places them from a cube map of the outer surface (vpl_map_size^2 faces), the
  * CPU by exact rays along the same directions u_v = lr_halton_sphere(v + 1) from the same
  * centre. Same validity; positions within 1.5 cube texels (|x_v - c| * 2 / size * 1.5 /
@@ -425,6 +445,7 @@ int main(void)
         cmocka_unit_test(test_maps_sphere_outside_light),
         cmocka_unit_test(test_maps_standard_dipole),
         cmocka_unit_test(test_maps_lampshade_multipole),
+        cmocka_unit_test(test_maps_votive_built_mesh),
         cmocka_unit_test(test_vpls),
         cmocka_unit_test(test_final_image),
         cmocka_unit_test(test_two_lights),
