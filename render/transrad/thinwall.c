@@ -30,15 +30,17 @@
  * instead of across it) falls back to the unshifted point, then to patch i itself: the light
  * stays in the object (energy kept), on the side where it entered.
  *
- * The rule (lr_tr_wall_thin): thin when the slab's wider profile holds 90 % of its light
- * within a quarter of a patch, r90 <= patch_mm / 4 (3 mm at 12 mm). Then a column's light
- * lands in the entry patch's footprint and the next patches, the profiles vary across a patch,
- * and the centroid sums get the split wrong (at 12 mm patches, paper 0.1 mm, r90 0.15 mm: 0.47
- * of the light out of the far face for T 0.22; porcelain 1.5 mm, r90 2.2 mm: 0.117 / 0.093 /
- * 0.061 for T 0.100 / 0.076 / 0.045), while a wall curved over tens of patches is flat over
- * r90 (the shades' radii are 70-110 mm). Wider spreads (wax 7 mm: r90 13 mm; a non-absorbing
- * shell, whose far field the truncated multipole misses) reach across patches, round rims and
- * into floors: there the centroid sums are accurate and the in-object distances matter.
+ * The rule (lr_tr_wall_thin): thin when the wall is no thicker than a patch, d <= patch_mm.
+ * T spreads over about d and the two faces' patches overlap, so the centroid sums, which fix
+ * the exit at one centroid per patch, get the split between the faces wrong: at 12 mm
+ * patches paper 0.1 mm sent 0.47 of the light out of the far face for T 0.22, porcelain
+ * 1.5 mm 0.117 / 0.093 / 0.061 for T 0.100 / 0.076 / 0.045, and the votive's 7 mm wax (once
+ * its mesh was refined into 12 mm patches) 0.26 for T 0.19. Until 27 Nov the rule was
+ * r90 <= patch_mm / 4 (the wider profile's 90 % radius), which left the wax to the sums on the
+ * belief that wide profiles make them accurate; a wall curved over tens of patches is still
+ * flat over d (the shades' radii are 70-110 mm, the votive's 33-40 mm). Thicker bodies (the
+ * candle's 40-120 mm under its pool) keep the sums, whose in-object distances carry light
+ * round rims and into floors.
  * Measured on the fair bench (tools/bench/README.md): led_shade objects / receivers 0.821 /
  * 0.335 -> 0.160 / 0.081, lamp shade 0.162 / 0.101 -> 0.111 / 0.096. */
 #include "render/transrad/tr_priv.h"
