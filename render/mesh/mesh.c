@@ -578,6 +578,18 @@ double lr_mesh_area(const lr_mesh *m)
     return a;
 }
 
+double lr_mesh_longest_edge(const lr_mesh *m)
+{
+    double longest = 0.0;
+    for (size_t t = 0; t < m->nt; t++) {
+        lr_vec3 p[3];
+        lr_mesh_triangle(m, t, p);
+        for (int k = 0; k < 3; k++)
+            longest = fmax(longest, lr_v3_len(lr_v3_sub(p[k], p[(k + 1) % 3])));
+    }
+    return longest;
+}
+
 double lr_mesh_volume(const lr_mesh *m)
 {
     /* Sum of signed tetrahedra (origin, a, b, c); taken about the first vertex instead of the

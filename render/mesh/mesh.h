@@ -102,6 +102,8 @@ void lr_mesh_triangle(const lr_mesh *m, size_t t, lr_vec3 p[3]);
 lr_vec3 lr_mesh_triangle_normal(const lr_mesh *m, size_t t);
 double lr_mesh_triangle_area(const lr_mesh *m, size_t t);
 double lr_mesh_area(const lr_mesh *m);
+/* The longest triangle edge, mm (0 for no triangles). */
+double lr_mesh_longest_edge(const lr_mesh *m);
 /* Signed enclosed volume (divergence theorem, about the origin): positive for a closed mesh
  * with outward faces; meaningless for an open one. */
 double lr_mesh_volume(const lr_mesh *m);

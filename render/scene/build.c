@@ -33,18 +33,6 @@ static void prefixed_warn(void *user, const char *msg)
     lr_warn(p->inner, "%s: %s", p->prefix, msg);
 }
 
-static double longest_edge(const lr_mesh *m)
-{
-    double longest = 0.0;
-    for (size_t t = 0; t < lr_mesh_triangle_count(m); t++) {
-        lr_vec3 p[3];
-        lr_mesh_triangle(m, t, p);
-        for (int k = 0; k < 3; k++)
-            longest = fmax(longest, lr_v3_len(lr_v3_sub(p[k], p[(k + 1) % 3])));
-    }
-    return longest;
-}
-
 /* The renderer's copy of the surface (scene_internal.h, LR_SCENE_MAX_EDGE_MM): `built` itself
  * when no edge is longer, else its midpoint refinement (render/mesh/refine.h), which keeps
  * the surface and the linearly interpolated normal field. `built` was checked and repaired
@@ -52,7 +40,7 @@ static double longest_edge(const lr_mesh *m)
 static int refine_for_renderer(lr_mesh *built, lr_mesh **out, lr_err *e)
 {
     *out = built;
-    if (longest_edge(built) <= LR_SCENE_MAX_EDGE_MM)
+    if (lr_mesh_longest_edge(built) <= LR_SCENE_MAX_EDGE_MM)
         return LR_OK;
     lr_refined r;
     int rc = lr_refine(built, LR_SCENE_MAX_EDGE_MM, LR_SCENE_REFINED_MAX_VERTICES, &r, e);

@@ -1184,6 +1184,14 @@ static void test_ray_through_shared_edge(void **state)
             }
         }
     printf("  %d rays through shared edges, %d missed\n", rays, missed);
+    /* The longest edge the scene's refinement tests (lr_mesh_longest_edge): a 10 x 20 x 30 box
+     * is two triangles a face, so its longest edge is the 20 x 30 face's diagonal. */
+    lr_box_desc bd = {.size = lr_v3(10, 20, 30)};
+    lr_mesh *m;
+    lr_err e = {0};
+    assert_int_equal(lr_mesh_box(&bd, &m, &e), LR_OK);
+    assert_true(fabs(lr_mesh_longest_edge(m) - hypot(20.0, 30.0)) < 1e-5);
+    lr_mesh_destroy(m);
     assert_int_equal(missed, 0);
     /* The tolerance is a hair: a ray 1e-6 of the cell outside the square misses both. */
     lr_vec3 a = lr_v3(0, 0, 0), b = lr_v3(1, 0, 0), c = lr_v3(1, 1, 0), d = lr_v3(0, 1, 0);

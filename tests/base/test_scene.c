@@ -312,25 +312,13 @@ static void test_sphere_and_votive_scenes(void **state)
     lr_scene_destroy(s);
 }
 
-static double longest_edge(const lr_mesh *m)
-{
-    double longest = 0;
-    for (size_t t = 0; t < lr_mesh_triangle_count(m); t++) {
-        lr_vec3 p[3];
-        lr_mesh_triangle(m, t, p);
-        for (int k = 0; k < 3; k++)
-            longest = fmax(longest, lr_v3_len(lr_v3_sub(p[k], p[(k + 1) % 3])));
-    }
-    return longest;
-}
-
 /* The refined copy lies on the described surface: every vertex of it on a triangle of the
  * built mesh (float positions: 1e-4 mm at these 100 mm sizes), its normal within the crease
  * angle (60 degrees) of that triangle's face, and the same area. */
 static void expect_refined_copy(const lr_scene_object *o)
 {
     const lr_mesh *m = o->mesh, *b = o->built_mesh;
-    assert_true(longest_edge(m) <= 12.0 + 1e-9);
+    assert_true(lr_mesh_longest_edge(m) <= 12.0 + 1e-9);
     assert_near_rel(lr_mesh_area(m), lr_mesh_area(b), 1e-6);
     const float *N = lr_mesh_normals(m);
     for (size_t v = 0; v < lr_mesh_vertex_count(m); v++) {
@@ -362,7 +350,7 @@ static void test_refined_mesh(void **state)
     lr_scene *s = load("configs/scenes/votive.json");
     const lr_scene_object *o = lr_scene_object_at(s, 0);
     assert_true(o->mesh != o->built_mesh);
-    assert_near(longest_edge(o->built_mesh), hypot(65.0, 2 * 40.0 * sin(M_PI / 32)), 1e-3);
+    assert_near(lr_mesh_longest_edge(o->built_mesh), hypot(65.0, 2 * 40.0 * sin(M_PI / 32)), 1e-3);
     assert_true(lr_mesh_triangle_count(o->mesh) > 10 * lr_mesh_triangle_count(o->built_mesh));
     expect_refined_copy(o);
     /* A rebuilt object (a transform change) is refined again. */
@@ -370,13 +358,13 @@ static void test_refined_mesh(void **state)
     assert_int_equal(lr_scene_set(s, "objects[0].transform.scale", "1.5,1.5,1.5", NULL, &e),
                      LR_OK);
     o = lr_scene_object_at(s, 0);
-    assert_near(longest_edge(o->built_mesh), 1.5 * hypot(65.0, 2 * 40.0 * sin(M_PI / 32)), 2e-3);
+    assert_near(lr_mesh_longest_edge(o->built_mesh), 1.5 * hypot(65.0, 2 * 40.0 * sin(M_PI / 32)), 2e-3);
     expect_refined_copy(o);
     lr_scene_destroy(s);
     /* A mesh fine enough already is drawn as built. */
     s = load_warns("configs/scenes/sphere.json", "inside the material");
     o = lr_scene_object_at(s, 0);
-    assert_true(longest_edge(o->built_mesh) <= 12.0);
+    assert_true(lr_mesh_longest_edge(o->built_mesh) <= 12.0);
     assert_ptr_equal(o->mesh, o->built_mesh);
     lr_scene_destroy(s);
 }

@@ -160,6 +160,15 @@ static const char *const parity_settings[] = {
     "render.K=3", "render.N=16", "render.map_size=24", "render.gbuffer_size=256",
     "render.vpl_map_size=32", "render.N_vpl=48", "render.frames=8", NULL};
 
+/* The GPU's maps against the twin's (G-buffer emulated), reported and checked. */
+static void maps_parity(lr_renderer *r, const lr_scene *s, const char *what)
+{
+    parity p;
+    compare_maps(r, s, 256, true, &p);
+    report(what, &p);
+    check_parity(&p);
+}
+
 static void test_maps_lampshade(void **state)
 {
     (void)state;
@@ -291,10 +300,7 @@ static void test_maps_votive_built_mesh(void **state)
     assert_true(lr_mesh_triangle_count(o->mesh) > 10 * lr_mesh_triangle_count(o->built_mesh));
     lr_renderer *r = lr_test_renderer(gl, s, 16, 12, true, 3);
     lr_test_converge(r, 20);
-    parity p;
-    compare_maps(r, s, 256, true, &p);
-    report("votive maps, multipole, maps drawn on the file's mesh", &p);
-    check_parity(&p);
+    maps_parity(r, s, "votive maps, multipole, maps drawn on the file's mesh");
     lr_renderer_destroy(r);
     lr_scene_destroy(s);
 }
