@@ -161,7 +161,7 @@ static const char *const parity_settings[] = {
     "render.vpl_map_size=32", "render.N_vpl=48", "render.frames=8", NULL};
 
 /* The GPU's maps against the twin's (G-buffer emulated), reported and checked. */
-static void maps_parity(lr_renderer *r, const lr_scene *s, const char *what)
+static void maps_parity(lr_renderer *r, lr_scene *s, const char *what)
 {
     parity p;
     compare_maps(r, s, 256, true, &p);
