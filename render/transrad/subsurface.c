@@ -258,20 +258,22 @@ static int thin_columns(const lr_tr *t, int s, const double *thick, int **out,
         th[i] = -1;
         if (!(thick[i] > 0))
             continue;
-        if (thick[i] != last_d) { /* a new thickness: one spread, one evaluation of the rule */
+        if (thick[i] != last_d) { /* a new thickness: one evaluation of the rule, and a
+                                    * spread where it is thin */
             last_d = thick[i];
-            if (used == cap) {
-                size_t ncap = cap ? 2 * cap : 4;
-                lr_tr_spread *g = realloc(sp, ncap * sizeof *g);
-                if (!g)
-                    goto oom;
-                sp = g;
-                cap = ncap;
-            }
-            lr_tr_spread_build(sf->d.coeffs, last_d, &sp[used]);
             last = -1;
-            if (t->set.thin_wall == LR_TR_THIN_ON || lr_tr_spread_thin(&sp[used], h))
+            if (t->set.thin_wall == LR_TR_THIN_ON || lr_tr_wall_thin(sf->d.coeffs, last_d, h)) {
+                if (used == cap) {
+                    size_t ncap = cap ? 2 * cap : 4;
+                    lr_tr_spread *g = realloc(sp, ncap * sizeof *g);
+                    if (!g)
+                        goto oom;
+                    sp = g;
+                    cap = ncap;
+                }
+                lr_tr_spread_build(sf->d.coeffs, last_d, &sp[used]);
                 last = (int)used++;
+            }
         }
         th[i] = last;
     }

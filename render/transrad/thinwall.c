@@ -59,7 +59,6 @@
 void lr_tr_spread_build(const lr_coeffs *c, double d, lr_tr_spread *sp)
 {
     memset(sp, 0, sizeof *sp);
-    sp->d = d;
     double zb = 0;
     for (int b = 0; b < 3; b++)
         zb = fmax(zb, 2 * c->A * c->D[b]);
@@ -119,18 +118,9 @@ double lr_tr_spread_r90(const lr_tr_spread *sp)
     return r;
 }
 
-bool lr_tr_spread_thin(const lr_tr_spread *sp, double patch_mm)
-{
-    return patch_mm > 0 && sp->d <= patch_mm;
-}
-
 bool lr_tr_wall_thin(const lr_coeffs *c, double d, double patch_mm)
 {
-    if (!c || !(d > 0) || !(patch_mm > 0))
-        return false;
-    lr_tr_spread sp;
-    lr_tr_spread_build(c, d, &sp);
-    return lr_tr_spread_thin(&sp, patch_mm);
+    return c && d > 0 && patch_mm > 0 && d <= patch_mm;
 }
 
 /* An orthonormal pair spanning the plane normal to n. */

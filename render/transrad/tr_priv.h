@@ -93,13 +93,10 @@ typedef struct lr_tr_spread {
     double r[LR_TR_SPREAD_RADII];
     double cdf[2][3][LR_TR_SPREAD_RADII];
     double L; /* d + 2 z_b */
-    double d; /* the slab's thickness */
 } lr_tr_spread;
 void lr_tr_spread_build(const lr_coeffs *c, double d, lr_tr_spread *sp);
 double lr_tr_spread_radius(const lr_tr_spread *sp, int which, int band, double u);
 double lr_tr_spread_r90(const lr_tr_spread *sp);
-/* The thin-wall rule on a built spread: d <= patch_mm (lr_tr_wall_thin). */
-bool lr_tr_spread_thin(const lr_tr_spread *sp, double patch_mm);
 /* Column i (patch index within translucent surface s, slab thickness d, sp its spread) of a
  * thin wall's S: out[3 j + b] = S_{j i}, j over the surface's patches (n_s x 3, overwritten). */
 void lr_tr_thin_column(const lr_tr *t, int s, size_t i, double d, const lr_tr_spread *sp,
