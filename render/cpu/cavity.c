@@ -61,31 +61,13 @@ static void point_item(void *p, long i)
     }
 }
 
-int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
-                          enum lr_enclosure enclosure, const lr_cpu_cavity_desc *d,
-                          lr_cpu_cavity *out, lr_err *e)
+/* C, R_1, F and the power entering (cavity.h): the light's power per unit intensity over
+ * Halton directions (4 pi / ndir each, weighted by the spot profile) where the first surface is
+ * the object's front; from each such point one cosine-distributed ray into the cavity tells
+ * whether the light it sends back meets the object again. */
+static void cavity_geometry(const lr_scene_object *obj, const lr_light *l, int ndir,
+                            unsigned seed, lr_cpu_cavity *out)
 {
-    if (!obj || !l || !out)
-        return lr_err_set(e, LR_EINVAL, "cavity: NULL %s", !obj ? "object" : !l ? "light" : "out");
-    int ndir = d && d->directions > 0 ? d->directions : 4096;
-    int npts = d && d->points > 0 ? d->points : 256;
-    int N = d && d->N > 0 ? d->N : 64;
-    unsigned seed = d && d->seed ? d->seed : 1;
-    *out = (lr_cpu_cavity){.gain = {1.0, 1.0, 1.0}};
-    /* Not for the raw directional dipole (its total exceeds 1); the standard dipole is the
-     * normalisation's reference, so "normalize" does not change it (lr_scene_object_sd_norm). */
-    out->applies = enclosure == LR_ENCLOSURE_HULL && l->type != LR_LIGHT_DIRECTIONAL &&
-                   !(obj->sd_raw && obj->sss_model == LR_SSS_DIRECTIONAL_DIPOLE) &&
-                   /* the models that close the cavity themselves or are fitted
-                    * (lr_sss_model_props: no_closure says why) */
-                   !lr_sss_model_props_of(obj->sss_model)->no_closure;
-    if (!out->applies)
-        return LR_OK;
-
-    /* C, R_1 and F: the light's power per unit intensity over Halton directions (4 pi / ndir
-     * each, weighted by the spot profile) where the first surface is the object's front; from
-     * each such point one cosine-distributed ray into the cavity tells whether the light it
-     * sends back meets the object again. */
     double eta = obj->coeffs.eta, hit = 0.0, entered = 0.0, rehit = 0.0, w = 4.0 * M_PI / ndir;
     lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(seed, 0xCA70, 0, 0));
     for (int i = 0; i < ndir; i++) {
@@ -114,33 +96,85 @@ int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
     out->R1 = hit > 0.0 ? 1.0 - entered / hit : 0.0;
     out->F = hit > 0.0 ? rehit / hit : 0.0;
     out->entered = entered;
-    if (!(entered > 0.0))
+}
+
+/* The triangle-area CDF of obj's mesh (last entry 1) and the total area; NULL when out of
+ * memory or the mesh has no area. */
+static double *area_cdf(const lr_scene_object *obj, double *area)
+{
+    size_t nt = lr_mesh_triangle_count(obj->mesh);
+    double *cdf = nt ? malloc(nt * sizeof *cdf) : NULL;
+    *area = 0.0;
+    if (!cdf)
+        return NULL;
+    for (size_t t = 0; t < nt; t++) {
+        lr_vec3 v[3];
+        lr_mesh_triangle(obj->mesh, t, v);
+        *area += 0.5 * lr_v3_len(lr_v3_cross(lr_v3_sub(v[1], v[0]), lr_v3_sub(v[2], v[0])));
+        cdf[t] = *area;
+    }
+    if (!(*area > 0.0)) {
+        free(cdf);
+        return NULL;
+    }
+    for (size_t t = 0; t < nt; t++)
+        cdf[t] /= *area;
+    cdf[nt - 1] = 1.0;
+    return cdf;
+}
+
+/* The gain from C, R_1, F, b (cavity.h's geometric series), per band. */
+static void cavity_gain(lr_cpu_cavity *out, double T)
+{
+    for (int c = 0; c < 3; c++) {
+        double R1 = out->R1, F = out->F;
+        double rho1 = R1 + (1.0 - R1) * out->b[c];
+        double rhod = (1.0 - T) + T * out->b[c];
+        double den = (1.0 - R1) * (1.0 - rhod * F);
+        double g = den > 0.0 ? 1.0 + T * rho1 * F / den : LR_CAVITY_GAIN_MAX;
+        out->gain[c] = isfinite(g) ? fmin(fmax(g, 1.0), LR_CAVITY_GAIN_MAX) : LR_CAVITY_GAIN_MAX;
+    }
+}
+
+int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
+                          enum lr_enclosure enclosure, const lr_cpu_cavity_desc *d,
+                          lr_cpu_cavity *out, lr_err *e)
+{
+    if (!obj || !l || !out)
+        return lr_err_set(e, LR_EINVAL, "cavity: NULL %s", !obj ? "object" : !l ? "light" : "out");
+    int ndir = d && d->directions > 0 ? d->directions : 4096;
+    int npts = d && d->points > 0 ? d->points : 256;
+    int N = d && d->N > 0 ? d->N : 64;
+    unsigned seed = d && d->seed ? d->seed : 1;
+    *out = (lr_cpu_cavity){.gain = {1.0, 1.0, 1.0}};
+    /* Not for the raw directional dipole (its total exceeds 1); the standard dipole is the
+     * normalisation's reference, so "normalize" does not change it (lr_scene_object_sd_norm). */
+    out->applies = enclosure == LR_ENCLOSURE_HULL && l->type != LR_LIGHT_DIRECTIONAL &&
+                   !(obj->sd_raw && obj->sss_model == LR_SSS_DIRECTIONAL_DIPOLE) &&
+                   /* the models that close the cavity themselves or are fitted
+                    * (lr_sss_model_props: no_closure says why) */
+                   !lr_sss_model_props_of(obj->sss_model)->no_closure;
+    if (!out->applies)
+        return LR_OK;
+
+    cavity_geometry(obj, l, ndir, seed, out);
+    if (!(out->entered > 0.0))
         return LR_OK;
 
     /* a: power out of the surface the light does not see, T_hem int B dA, by points uniform
      * over the surface's area. */
-    size_t nt = lr_mesh_triangle_count(obj->mesh);
-    double *cdf = malloc((nt ? nt : 1) * sizeof *cdf);
+    if (lr_mesh_triangle_count(obj->mesh) == 0)
+        return lr_err_set(e, LR_EINVAL, "cavity: object '%s' has no triangles", obj->name);
+    double area, *cdf = area_cdf(obj, &area);
     double(*P)[3] = calloc((size_t)npts, sizeof *P);
-    if (!cdf || !P || nt == 0) {
+    if (!cdf || !P) {
         free(cdf);
         free(P);
-        return nt ? lr_err_set(e, LR_ENOMEM, "cavity: out of memory for %d points", npts)
-                  : lr_err_set(e, LR_EINVAL, "cavity: object '%s' has no triangles", obj->name);
+        return lr_err_set(e, LR_ENOMEM, "cavity: out of memory for %d points", npts);
     }
-    double area = 0.0;
-    for (size_t t = 0; t < nt; t++) {
-        lr_vec3 v[3];
-        lr_mesh_triangle(obj->mesh, t, v);
-        area += 0.5 * lr_v3_len(lr_v3_cross(lr_v3_sub(v[1], v[0]), lr_v3_sub(v[2], v[0])));
-        cdf[t] = area;
-    }
-    for (size_t t = 0; t < nt; t++)
-        cdf[t] /= area;
-    cdf[nt - 1] = 1.0;
-    point_ctx pc = {obj, l, cdf, nt, npts, N, seed, P};
+    point_ctx pc = {obj, l, cdf, lr_mesh_triangle_count(obj->mesh), npts, N, seed, P};
     lr_cpu_parallel_for(npts, d ? d->threads : 0, point_item, &pc);
-    double T = lr_hemi_transmittance(eta), A[3];
+    double T = lr_hemi_transmittance(obj->coeffs.eta), A[3];
     /* The normalised model's half-space total; for the multipole the slab's R + T total
      * (what entered and was not absorbed: a thin wall absorbs less than a half-space). */
     lr_sss_total(obj->sss_model, &obj->coeffs, obj->thickness_mm, A);
@@ -149,17 +183,67 @@ int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
         for (int i = 0; i < npts; i++)
             sum += P[i][c];
         out->out[c] = T * sum * area / npts;
-        out->a[c] = out->out[c] / entered;
+        out->a[c] = out->out[c] / out->entered;
         out->b[c] = fmax(0.0, A[c] - out->a[c]);
-        double R1 = out->R1, F = out->F;
-        double rho1 = R1 + (1.0 - R1) * out->b[c];
-        double rhod = (1.0 - T) + T * out->b[c];
-        double den = (1.0 - R1) * (1.0 - rhod * F);
-        double g = den > 0.0 ? 1.0 + T * rho1 * F / den : LR_CAVITY_GAIN_MAX;
-        out->gain[c] = isfinite(g) ? fmin(fmax(g, 1.0), LR_CAVITY_GAIN_MAX) : LR_CAVITY_GAIN_MAX;
     }
+    cavity_gain(out, T);
     free(cdf);
     free(P);
+    return LR_OK;
+}
+
+int lr_cpu_cavity_measure_field(const lr_scene_object *obj, const lr_light *l,
+                                enum lr_enclosure enclosure, const lr_cpu_cavity_desc *d,
+                                lr_cavity_b_fn B, const void *ctx, lr_cpu_cavity *out, lr_err *e)
+{
+    if (!obj || !l || !B || !out)
+        return lr_err_set(e, LR_EINVAL, "cavity: NULL %s",
+                          !obj ? "object" : !l ? "light" : !B ? "B" : "out");
+    int ndir = d && d->directions > 0 ? d->directions : 4096;
+    int npts = d && d->points > 0 ? d->points : 4096;
+    unsigned seed = d && d->seed ? d->seed : 1;
+    *out = (lr_cpu_cavity){.gain = {1.0, 1.0, 1.0}};
+    out->applies = enclosure == LR_ENCLOSURE_HULL && l->type != LR_LIGHT_DIRECTIONAL;
+    if (!out->applies)
+        return LR_OK;
+    cavity_geometry(obj, l, ndir, seed, out);
+    if (!(out->entered > 0.0))
+        return LR_OK;
+    if (lr_mesh_triangle_count(obj->mesh) == 0)
+        return lr_err_set(e, LR_EINVAL, "cavity: object '%s' has no triangles", obj->name);
+    double area, *cdf = area_cdf(obj, &area);
+    if (!cdf)
+        return lr_err_set(e, LR_ENOMEM, "cavity: out of memory");
+    /* The model's own split of what entered: power out of the surface the light does not see
+     * (a) and out of the one it sees (b, the cavity side), both as the renderer emits them
+     * (T_hem int B dA), by points stratified over the area. A finite-geometry model's
+     * cavity-side B is what that side really sends back, so b comes from it, not from the
+     * energy balance of a half-space profile (lr_cpu_cavity_measure). Closed meshes: the
+     * outward side only. */
+    size_t nt = lr_mesh_triangle_count(obj->mesh);
+    double lit[3] = {0.0, 0.0, 0.0}, unlit[3] = {0.0, 0.0, 0.0};
+    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(seed, 0xCA73, 0, 0));
+    for (int i = 0; i < npts; i++) {
+        double pick = (i + lr_cpu_rng_next(&rng)) / npts;
+        double s = lr_cpu_rng_next(&rng), t = lr_cpu_rng_next(&rng);
+        lr_vec3 v[3];
+        lr_mesh_triangle(obj->mesh, lr_cdf_pick(cdf, nt, pick), v);
+        lr_vec3 x = lr_triangle_fold_point(v, s, t);
+        lr_vec3 n = lr_v3_normalize(lr_v3_cross(lr_v3_sub(v[1], v[0]), lr_v3_sub(v[2], v[0])));
+        double b[3] = {0.0, 0.0, 0.0};
+        B(ctx, x, n, b);
+        double *sum = lit_side(obj, l->position, x, n) ? lit : unlit;
+        for (int c = 0; c < 3; c++)
+            sum[c] += isfinite(b[c]) ? b[c] : 0.0;
+    }
+    free(cdf);
+    double T = lr_hemi_transmittance(obj->coeffs.eta);
+    for (int c = 0; c < 3; c++) {
+        out->out[c] = T * unlit[c] * area / npts;
+        out->a[c] = out->out[c] / out->entered;
+        out->b[c] = fmax(0.0, T * lit[c] * area / npts / out->entered);
+    }
+    cavity_gain(out, T);
     return LR_OK;
 }
 

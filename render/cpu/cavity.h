@@ -61,6 +61,18 @@ int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
                           enum lr_enclosure enclosure, const lr_cpu_cavity_desc *d,
                           lr_cpu_cavity *out, lr_err *e);
 
+/* B per unit intensity leaving an object at surface point x, outward normal n, as a model
+ * that is not a profile solved it (the grid's field: render/diffusion/dscene.c). */
+typedef void (*lr_cavity_b_fn)(const void *ctx, lr_vec3 x, lr_vec3 n, double B[3]);
+
+/* The closure for a model with its own finite geometry (diffusion_grid): C, R_1, F as above;
+ * a and b from that model's solved B (b: what the cavity side really sends back, not
+ * max(0, A - a)). d->points: surface points, 0: 4096 (B is cheap to evaluate); d->N unused.
+ * Applies to point and spot lights with LR_ENCLOSURE_HULL whatever the object's model. */
+int lr_cpu_cavity_measure_field(const lr_scene_object *obj, const lr_light *l,
+                                enum lr_enclosure enclosure, const lr_cpu_cavity_desc *d,
+                                lr_cavity_b_fn B, const void *ctx, lr_cpu_cavity *out, lr_err *e);
+
 /* The gains the renderer (GLSL composition) and lr_cpu_render apply, so that both get the same
  * numbers: for light `light` of scene s, gain[o] for every object o < nobj, 1 except for the
  * object that encloses the light (lr_scene_light_enclosure: LR_ENCLOSURE_HULL), measured with

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "render/base/paths.h"
+#include "render/cpu/cavity.h"
 #include "render/diffusion/dscene.h"
 #include "render/optics/optics.h"
 
@@ -24,6 +25,7 @@ typedef struct dobj {
     lr_dvolume *volume;
     lr_dsolver *solver;
     float *field[LR_SCENE_MAX_LIGHTS];
+    double gain[LR_SCENE_MAX_LIGHTS][3]; /* cavity closure applied to field[l] */
     bool rebuilt;
 } dobj;
 
@@ -102,6 +104,63 @@ static double q_fn(const void *ctx, lr_vec3 b, lr_vec3 n)
 {
     const qctx *q = ctx;
     return lr_dscene_irradiance(q->obj, q->light, b, n);
+}
+
+/* The solver's B is the exitance, (1 - F_dr) J+ (dgrid.h). Composition renders every model's B
+ * as L_o = F_t(w_o) B / pi (seed 003 Eq. 5), whose exitance is T_hem B, T_hem the hemispherical
+ * transmittance (PIPELINE.md "Energy"; the profiles' B is defined that way). So the pipeline
+ * gets exitance / T_hem; without it the grid rendered T_hem (0.91 for wax) of its light. */
+static void to_pipeline_b(float *field, size_t nodes, double eta)
+{
+    float k = (float)(1.0 / lr_hemi_transmittance(eta));
+    for (size_t j = 0; j < nodes; j++)
+        for (int c = 0; c < 3; c++)
+            field[4 * j + c] *= k;
+}
+
+typedef struct field_ctx {
+    const float *field;
+    int n[3];
+    lr_vec3 origin;
+    double h;
+} field_ctx;
+
+static void field_b(const void *ctx, lr_vec3 x, lr_vec3 n, double B[3])
+{
+    (void)n;
+    const field_ctx *f = ctx;
+    lr_dfield_eval(f->field, f->n, f->origin, f->h, x, B);
+}
+
+/* Cavity closure (render/cpu/cavity.h) from the grid's own solved field: q is the light's
+ * direct irradiance only, so the light the lit surface sends back into a cavity around the
+ * light (Fresnel reflection and what re-emerges there) and that meets the object again is
+ * added as the closure's gain on every B, the same assumption as the profile models' (the
+ * bounced light spread over the walls like the direct light). The grid's cavity side is
+ * finite geometry, so its B gives the cavity-side albedo directly. */
+static int close_cavity(dobj *D, const lr_scene *s, int i, int l, lr_err *e)
+{
+    D->gain[l][0] = D->gain[l][1] = D->gain[l][2] = 1.0;
+    int k = -1;
+    enum lr_enclosure enc = lr_scene_light_enclosure(s, l, &k);
+    if (enc != LR_ENCLOSURE_HULL || k != i)
+        return LR_OK;
+    const lr_dgrid *g = lr_dsolver_grid(D->solver);
+    field_ctx f = {.field = D->field[l], .origin = lr_dgrid_origin(g), .h = lr_dgrid_h(g)};
+    lr_dgrid_dims(g, f.n);
+    lr_cpu_cavity_desc cd = {.directions = LR_DSCENE_CAVITY_DIRECTIONS,
+                             .points = LR_DSCENE_CAVITY_POINTS, .seed = 1};
+    lr_cpu_cavity cav;
+    int rc = lr_cpu_cavity_measure_field(lr_scene_object_at(s, i), lr_scene_light_at(s, l), enc,
+                                         &cd, field_b, &f, &cav, e);
+    if (rc)
+        return rc;
+    size_t nodes = lr_dgrid_node_count(g);
+    for (size_t j = 0; j < nodes; j++)
+        for (int c = 0; c < 3; c++)
+            D->field[l][4 * j + c] *= (float)cav.gain[c];
+    memcpy(D->gain[l], cav.gain, sizeof D->gain[l]);
+    return LR_OK;
 }
 
 /* A volume path as written: relative to the scene file's folder, else to the configs
@@ -233,7 +292,10 @@ int lr_dscene_update(lr_dscene *d, const lr_scene *s, lr_err *e)
             if (!D->field[l] && !(D->field[l] = malloc(4 * nodes * sizeof(float))))
                 return lr_err_set(e, LR_ENOMEM, "diffusion grid: out of memory");
             if ((rc = lr_dsolver_field(D->solver, l, q_fn, &q, D->field[l], e)))
-                return rc;
+                return lr_err_prefix(e, "objects[%d] (%s), light %d", i, o->name, l);
+            to_pipeline_b(D->field[l], nodes, o->material.medium.eta);
+            if ((rc = close_cavity(D, s, i, l, e)))
+                return lr_err_prefix(e, "objects[%d] (%s), light %d", i, o->name, l);
         }
     }
     return LR_OK;
@@ -251,6 +313,15 @@ bool lr_dscene_field(const lr_dscene *d, int object, int light, lr_dfield_view *
     lr_dgrid_dims(g, out->n);
     out->origin = lr_dgrid_origin(g);
     out->h = lr_dgrid_h(g);
+    return true;
+}
+
+bool lr_dscene_cavity_gain(const lr_dscene *d, int object, int light, double gain[3])
+{
+    lr_dfield_view v;
+    if (!lr_dscene_field(d, object, light, &v))
+        return false;
+    memcpy(gain, d->obj[object].gain[light], 3 * sizeof(double));
     return true;
 }
 

@@ -11,6 +11,11 @@
  * F_t(cos) cos / r^2 (spot: times the pass's smoothstep profile), directional lights F_t(cos)
  * cos; zero where the object itself shadows b (a ray against its BVH; other objects do not
  * shadow, as in the pass: "no scattering between objects").
+ *
+ * Cavity closure: q is the direct light only. When a point or spot light sits in the object's
+ * hull (the flame in its melt pool), the light the lit surface sends back into the cavity and
+ * that meets the object again is the closure's gain (render/cpu/cavity.h), measured from the
+ * solved field itself (lr_cpu_cavity_measure_field) and applied to the field.
  */
 #ifndef LR_DSCENE_H
 #define LR_DSCENE_H
@@ -21,6 +26,10 @@
 
 /* Default grid spacing: the object's bounding radius over this (objects[i].dgrid_h_mm = 0). */
 #define LR_DSCENE_AUTO_CELLS 20.0
+/* The cavity closure's measurement (render/cpu/cavity.h): light directions and surface points;
+ * the field is cheap to evaluate, so many points (a few ms). */
+#define LR_DSCENE_CAVITY_DIRECTIONS 4096
+#define LR_DSCENE_CAVITY_POINTS 8192
 /* Objects per scene this holds (the passes' LR_MAX_OBJECTS). */
 #define LR_DSCENE_MAX_OBJECTS 8
 
@@ -38,8 +47,12 @@ int lr_dscene_create(lr_dscene **out, lr_err *e);
 void lr_dscene_destroy(lr_dscene *d);
 /* Brings every diffusion_grid object of s up to date for every light. */
 int lr_dscene_update(lr_dscene *d, const lr_scene *s, lr_err *e);
-/* Object i's field for light l; false when the object has none (another model). */
+/* Object i's field for light l; false when the object has none (another model). The field
+ * includes the cavity closure's gain when the light sits in the object's hull. */
 bool lr_dscene_field(const lr_dscene *d, int object, int light, lr_dfield_view *out);
+/* The cavity gain per band applied to object i's field for light l (1 where the closure does
+ * not apply); false when the object has no field. */
+bool lr_dscene_cavity_gain(const lr_dscene *d, int object, int light, double gain[3]);
 /* Whether the last update rebuilt object i's grid (a change of geometry or material). */
 bool lr_dscene_rebuilt(const lr_dscene *d, int object);
 /* Finest-grid BiCGSTAB iterations of the last update, all objects, lights and bands. */

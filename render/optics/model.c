@@ -20,10 +20,9 @@ static const lr_sss_model_props props[LR_SSS_MODEL_COUNT] = {
     [LR_SSS_DIFFUSION_GRID] = {.no_profile = true,
                                .needs_closed = "needs a closed mesh (the grid diffusion solves "
                                                "inside a solid body)",
-                               .no_closure = "not a profile: the closure's split of what "
-                                             "entered is measured with the profile's sampler; "
-                                             "the grid has no closure (its boundary source "
-                                             "is the light's direct irradiance only)"},
+                               .no_closure = "the grid closes the cavity in its own field "
+                                             "(render/diffusion/dscene.h: the gain measured "
+                                             "from its solved B)"},
     [LR_SSS_SH_TRANSLUCENCY] = {.no_profile = true,
                                 .no_closure = "its energy is fitted, not closed"},
 };
