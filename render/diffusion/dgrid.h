@@ -13,9 +13,11 @@
  *
  *     B = (1 - F_dr) J+ = (phi - 2 q) / (2 A)             (W/mm^2 per unit intensity)
  *
- * (seed 001 Eq. 3 integrated over the outgoing hemisphere, before F_t(w_o) / pi; composition
- * applies that). Energy: the integral of q - B over the surface equals the integral of mu phi
- * over the volume (divergence theorem), which the tests check on the discrete solution.
+ * (seed 001 Eq. 3 integrated over the outgoing hemisphere): the exitance, Fresnel included.
+ * Composition renders every model's B as F_t(w_o) B / pi, whose exitance is T_hem B, so the
+ * renderer's field is this B / T_hem (render/diffusion/dscene.c). Energy: the integral of
+ * q - B over the surface equals the integral of mu phi over the volume (divergence theorem),
+ * which the tests check on the discrete solution.
  *
  * Discretisation (our choice; the paper's polygrid needs a hand-built polycube per object):
  * a regular grid of spacing h over the object's bounds, classified with the mesh BVH. Nodes
