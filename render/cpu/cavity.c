@@ -98,15 +98,16 @@ static void cavity_geometry(const lr_scene_object *obj, const lr_light *l, int n
     out->entered = entered;
 }
 
-/* The triangle-area CDF of obj's mesh (last entry 1) and the total area; NULL when out of
- * memory or the mesh has no area. */
+/* The triangle-area CDF of obj's mesh (last entry 1) and the total area; NULL with *area -1
+ * when out of memory, 0 when the mesh has no area. */
 static double *area_cdf(const lr_scene_object *obj, double *area)
 {
     size_t nt = lr_mesh_triangle_count(obj->mesh);
     double *cdf = nt ? malloc(nt * sizeof *cdf) : NULL;
-    *area = 0.0;
+    *area = nt ? -1.0 : 0.0;
     if (!cdf)
         return NULL;
+    *area = 0.0;
     for (size_t t = 0; t < nt; t++) {
         lr_vec3 v[3];
         lr_mesh_triangle(obj->mesh, t, v);
@@ -121,6 +122,13 @@ static double *area_cdf(const lr_scene_object *obj, double *area)
         cdf[t] /= *area;
     cdf[nt - 1] = 1.0;
     return cdf;
+}
+
+static int no_area(const lr_scene_object *obj, double area, lr_err *e)
+{
+    return area < 0.0 ? lr_err_set(e, LR_ENOMEM, "cavity: out of memory")
+                      : lr_err_set(e, LR_EINVAL, "cavity: object '%s' has no surface area",
+                                   obj->name);
 }
 
 /* The gain from C, R_1, F, b (cavity.h's geometric series), per band. */
@@ -163,13 +171,12 @@ int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
 
     /* a: power out of the surface the light does not see, T_hem int B dA, by points uniform
      * over the surface's area. */
-    if (lr_mesh_triangle_count(obj->mesh) == 0)
-        return lr_err_set(e, LR_EINVAL, "cavity: object '%s' has no triangles", obj->name);
     double area, *cdf = area_cdf(obj, &area);
+    if (!cdf)
+        return no_area(obj, area, e);
     double(*P)[3] = calloc((size_t)npts, sizeof *P);
-    if (!cdf || !P) {
+    if (!P) {
         free(cdf);
-        free(P);
         return lr_err_set(e, LR_ENOMEM, "cavity: out of memory for %d points", npts);
     }
     point_ctx pc = {obj, l, cdf, lr_mesh_triangle_count(obj->mesh), npts, N, seed, P};
@@ -209,11 +216,9 @@ int lr_cpu_cavity_measure_field(const lr_scene_object *obj, const lr_light *l,
     cavity_geometry(obj, l, ndir, seed, out);
     if (!(out->entered > 0.0))
         return LR_OK;
-    if (lr_mesh_triangle_count(obj->mesh) == 0)
-        return lr_err_set(e, LR_EINVAL, "cavity: object '%s' has no triangles", obj->name);
     double area, *cdf = area_cdf(obj, &area);
     if (!cdf)
-        return lr_err_set(e, LR_ENOMEM, "cavity: out of memory");
+        return no_area(obj, area, e);
     /* The model's own split of what entered: power out of the surface the light does not see
      * (a) and out of the one it sees (b, the cavity side), both as the renderer emits them
      * (T_hem int B dA), by points stratified over the area. A finite-geometry model's
