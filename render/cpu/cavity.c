@@ -33,20 +33,27 @@ static bool lit_side(const lr_scene_object *o, lr_vec3 xl, lr_vec3 x, lr_vec3 n)
     return !lr_bvh_occluded(o->bvh, xl, u, 1e-9 * o->radius, d - 1e-6 * o->radius);
 }
 
+/* Surface point i of npts, stratified over the area CDF (point i in the i-th 1/npts of the
+ * surface's area, in the mesh's triangle order), which keeps the points spread over the whole
+ * surface; n its face's outward normal. */
+static void surface_point(const lr_scene_object *o, const double *cdf, size_t nt, long i,
+                          int npts, lr_cpu_rng *rng, lr_vec3 *x, lr_vec3 *n)
+{
+    double pick = (i + lr_cpu_rng_next(rng)) / npts;
+    double s = lr_cpu_rng_next(rng), t = lr_cpu_rng_next(rng);
+    lr_vec3 v[3];
+    lr_mesh_triangle(o->mesh, lr_cdf_pick(cdf, nt, pick), v); /* first triangle with cdf > pick */
+    *x = lr_triangle_fold_point(v, s, t);
+    *n = lr_v3_normalize(lr_v3_cross(lr_v3_sub(v[1], v[0]), lr_v3_sub(v[2], v[0])));
+}
+
 static void point_item(void *p, long i)
 {
     point_ctx *k = p;
     const lr_scene_object *o = k->obj;
     lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(k->seed, 0xCA71, (uint64_t)i, 0));
-    /* Stratified over the area CDF (point i in the i-th 1/npts of the surface's area, in the
-     * mesh's triangle order), which keeps the points spread over the whole surface. */
-    double pick = (i + lr_cpu_rng_next(&rng)) / k->npts;
-    double s = lr_cpu_rng_next(&rng), t = lr_cpu_rng_next(&rng);
-    size_t lo = lr_cdf_pick(k->cdf, k->nt, pick); /* first triangle with cdf > pick */
-    lr_vec3 v[3];
-    lr_mesh_triangle(o->mesh, lo, v);
-    lr_vec3 x = lr_triangle_fold_point(v, s, t);
-    lr_vec3 n = lr_v3_normalize(lr_v3_cross(lr_v3_sub(v[1], v[0]), lr_v3_sub(v[2], v[0])));
+    lr_vec3 x, n;
+    surface_point(o, k->cdf, k->nt, i, k->npts, &rng, &x, &n);
     /* Closed: the outward side only. Open (two-sided): both sides emit. */
     for (int side = 0; side < (o->closed ? 1 : 2); side++) {
         lr_vec3 ns = side ? lr_v3_scale(n, -1.0) : n;
@@ -131,6 +138,24 @@ static int no_area(const lr_scene_object *obj, double area, lr_err *e)
                                    obj->name);
 }
 
+/* What both measurements start with: *out reset, and where the closure applies and light
+ * enters, C, R_1, F and the power entering, and the surface's area CDF in *cdf (the caller
+ * frees it). *cdf stays NULL when there is nothing more to measure. */
+static int cavity_begin(const lr_scene_object *obj, const lr_light *l, bool applies,
+                        const lr_cpu_cavity_desc *d, lr_cpu_cavity *out, double **cdf,
+                        double *area, lr_err *e)
+{
+    *out = (lr_cpu_cavity){.gain = {1.0, 1.0, 1.0}, .applies = applies};
+    *cdf = NULL;
+    if (!applies)
+        return LR_OK;
+    cavity_geometry(obj, l, d && d->directions > 0 ? d->directions : 4096,
+                    d && d->seed ? d->seed : 1, out);
+    if (!(out->entered > 0.0))
+        return LR_OK;
+    return (*cdf = area_cdf(obj, area)) ? LR_OK : no_area(obj, *area, e);
+}
+
 /* The gain from C, R_1, F, b (cavity.h's geometric series), per band. */
 static void cavity_gain(lr_cpu_cavity *out, double T)
 {
@@ -150,30 +175,23 @@ int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
 {
     if (!obj || !l || !out)
         return lr_err_set(e, LR_EINVAL, "cavity: NULL %s", !obj ? "object" : !l ? "light" : "out");
-    int ndir = d && d->directions > 0 ? d->directions : 4096;
     int npts = d && d->points > 0 ? d->points : 256;
     int N = d && d->N > 0 ? d->N : 64;
     unsigned seed = d && d->seed ? d->seed : 1;
-    *out = (lr_cpu_cavity){.gain = {1.0, 1.0, 1.0}};
     /* Not for the raw directional dipole (its total exceeds 1); the standard dipole is the
      * normalisation's reference, so "normalize" does not change it (lr_scene_object_sd_norm). */
-    out->applies = enclosure == LR_ENCLOSURE_HULL && l->type != LR_LIGHT_DIRECTIONAL &&
+    bool applies = enclosure == LR_ENCLOSURE_HULL && l->type != LR_LIGHT_DIRECTIONAL &&
                    !(obj->sd_raw && obj->sss_model == LR_SSS_DIRECTIONAL_DIPOLE) &&
                    /* the models that close the cavity themselves or are fitted
                     * (lr_sss_model_props: no_closure says why) */
                    !lr_sss_model_props_of(obj->sss_model)->no_closure;
-    if (!out->applies)
-        return LR_OK;
-
-    cavity_geometry(obj, l, ndir, seed, out);
-    if (!(out->entered > 0.0))
-        return LR_OK;
+    double area, *cdf;
+    int rc = cavity_begin(obj, l, applies, d, out, &cdf, &area, e);
+    if (rc || !cdf)
+        return rc;
 
     /* a: power out of the surface the light does not see, T_hem int B dA, by points uniform
      * over the surface's area. */
-    double area, *cdf = area_cdf(obj, &area);
-    if (!cdf)
-        return no_area(obj, area, e);
     double(*P)[3] = calloc((size_t)npts, sizeof *P);
     if (!P) {
         free(cdf);
@@ -206,19 +224,13 @@ int lr_cpu_cavity_measure_field(const lr_scene_object *obj, const lr_light *l,
     if (!obj || !l || !B || !out)
         return lr_err_set(e, LR_EINVAL, "cavity: NULL %s",
                           !obj ? "object" : !l ? "light" : !B ? "B" : "out");
-    int ndir = d && d->directions > 0 ? d->directions : 4096;
     int npts = d && d->points > 0 ? d->points : 4096;
     unsigned seed = d && d->seed ? d->seed : 1;
-    *out = (lr_cpu_cavity){.gain = {1.0, 1.0, 1.0}};
-    out->applies = enclosure == LR_ENCLOSURE_HULL && l->type != LR_LIGHT_DIRECTIONAL;
-    if (!out->applies)
-        return LR_OK;
-    cavity_geometry(obj, l, ndir, seed, out);
-    if (!(out->entered > 0.0))
-        return LR_OK;
-    double area, *cdf = area_cdf(obj, &area);
-    if (!cdf)
-        return no_area(obj, area, e);
+    double area, *cdf;
+    int rc = cavity_begin(obj, l, enclosure == LR_ENCLOSURE_HULL && l->type != LR_LIGHT_DIRECTIONAL,
+                          d, out, &cdf, &area, e);
+    if (rc || !cdf)
+        return rc;
     /* The model's own split of what entered: power out of the surface the light does not see
      * (a) and out of the one it sees (b, the cavity side), both as the renderer emits them
      * (T_hem int B dA), by points stratified over the area. A finite-geometry model's
@@ -229,12 +241,8 @@ int lr_cpu_cavity_measure_field(const lr_scene_object *obj, const lr_light *l,
     double lit[3] = {0.0, 0.0, 0.0}, unlit[3] = {0.0, 0.0, 0.0};
     lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(seed, 0xCA73, 0, 0));
     for (int i = 0; i < npts; i++) {
-        double pick = (i + lr_cpu_rng_next(&rng)) / npts;
-        double s = lr_cpu_rng_next(&rng), t = lr_cpu_rng_next(&rng);
-        lr_vec3 v[3];
-        lr_mesh_triangle(obj->mesh, lr_cdf_pick(cdf, nt, pick), v);
-        lr_vec3 x = lr_triangle_fold_point(v, s, t);
-        lr_vec3 n = lr_v3_normalize(lr_v3_cross(lr_v3_sub(v[1], v[0]), lr_v3_sub(v[2], v[0])));
+        lr_vec3 x, n;
+        surface_point(obj, cdf, nt, i, npts, &rng, &x, &n);
         double b[3] = {0.0, 0.0, 0.0};
         B(ctx, x, n, b);
         double *sum = lit_side(obj, l->position, x, n) ? lit : unlit;

@@ -76,6 +76,17 @@ static void sphere_power(const lr_dfield_view *v, double r, int n, double P[3])
     }
 }
 
+/* The scene's grid objects solved, with their closure. */
+static lr_dscene *solved(const lr_scene *s)
+{
+    lr_dscene *d;
+    lr_err e = {0};
+    assert_int_equal(lr_dscene_create(&d, &e), LR_OK);
+    if (lr_dscene_update(d, s, &e))
+        fail_msg("%s", e.msg);
+    return d;
+}
+
 static void check_closed_shell(double eta)
 {
     char *dir = lr_test_tmpdir();
@@ -91,10 +102,7 @@ static void check_closed_shell(double eta)
     const lr_scene_object *o = lr_scene_object_at(s, 0);
     assert_true(o->closed);
     assert_near(lr_dscene_spacing(o), 0.5, 0.01);
-    lr_dscene *d;
-    assert_int_equal(lr_dscene_create(&d, &e), LR_OK);
-    if (lr_dscene_update(d, s, &e))
-        fail_msg("%s", e.msg);
+    lr_dscene *d = solved(s);
     double gain[3];
     assert_true(lr_dscene_cavity_gain(d, 0, 0, gain));
     lr_dfield_view v;
@@ -157,11 +165,8 @@ static void test_closure_only_where_it_applies(void **state)
     static const char *const sets[] = {"objects[0].model=diffusion_grid",
                                        "objects[0].dgrid_h_mm=6", NULL};
     lr_scene *s = lr_test_scene("candle", sets, NULL);
+    lr_dscene *d = solved(s);
     lr_err e = {0};
-    lr_dscene *d;
-    assert_int_equal(lr_dscene_create(&d, &e), LR_OK);
-    if (lr_dscene_update(d, s, &e))
-        fail_msg("%s", e.msg);
     double g[3];
     assert_true(lr_dscene_cavity_gain(d, 0, 0, g));
     print_message("candle, flame in the pool: gain %.4f %.4f %.4f\n", g[0], g[1], g[2]);
