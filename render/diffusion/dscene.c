@@ -110,26 +110,34 @@ static double q_fn(const void *ctx, lr_vec3 b, lr_vec3 n)
  * as L_o = F_t(w_o) B / pi (seed 003 Eq. 5), whose exitance is T_hem B, T_hem the hemispherical
  * transmittance (PIPELINE.md "Energy"; the profiles' B is defined that way). So the pipeline
  * gets exitance / T_hem; without it the grid rendered T_hem (0.91 for wax) of its light. */
-static void to_pipeline_b(float *field, size_t nodes, double eta)
+static void scale_field(float *field, size_t nodes, const double k[3])
 {
-    float k = (float)(1.0 / lr_hemi_transmittance(eta));
     for (size_t j = 0; j < nodes; j++)
         for (int c = 0; c < 3; c++)
-            field[4 * j + c] *= k;
+            field[4 * j + c] *= (float)k[c];
 }
 
-typedef struct field_ctx {
-    const float *field;
-    int n[3];
-    lr_vec3 origin;
-    double h;
-} field_ctx;
+static void to_pipeline_b(float *field, size_t nodes, double eta)
+{
+    double k = 1.0 / lr_hemi_transmittance(eta);
+    scale_field(field, nodes, (const double[3]){k, k, k});
+}
+
+/* Light l's solved field of D as a view (the renderer's and the closure's). */
+static void view_of(const dobj *D, int l, lr_dfield_view *out)
+{
+    const lr_dgrid *g = lr_dsolver_grid(D->solver);
+    out->data = D->field[l];
+    lr_dgrid_dims(g, out->n);
+    out->origin = lr_dgrid_origin(g);
+    out->h = lr_dgrid_h(g);
+}
 
 static void field_b(const void *ctx, lr_vec3 x, lr_vec3 n, double B[3])
 {
     (void)n;
-    const field_ctx *f = ctx;
-    lr_dfield_eval(f->field, f->n, f->origin, f->h, x, B);
+    const lr_dfield_view *f = ctx;
+    lr_dfield_eval(f->data, f->n, f->origin, f->h, x, B);
 }
 
 /* Cavity closure (render/cpu/cavity.h) from the grid's own solved field: q is the light's
@@ -145,9 +153,8 @@ static int close_cavity(dobj *D, const lr_scene *s, int i, int l, lr_err *e)
     enum lr_enclosure enc = lr_scene_light_enclosure(s, l, &k);
     if (enc != LR_ENCLOSURE_HULL || k != i)
         return LR_OK;
-    const lr_dgrid *g = lr_dsolver_grid(D->solver);
-    field_ctx f = {.field = D->field[l], .origin = lr_dgrid_origin(g), .h = lr_dgrid_h(g)};
-    lr_dgrid_dims(g, f.n);
+    lr_dfield_view f;
+    view_of(D, l, &f);
     lr_cpu_cavity_desc cd = {.directions = LR_DSCENE_CAVITY_DIRECTIONS,
                              .points = LR_DSCENE_CAVITY_POINTS, .seed = 1};
     lr_cpu_cavity cav;
@@ -155,10 +162,7 @@ static int close_cavity(dobj *D, const lr_scene *s, int i, int l, lr_err *e)
                                          &cd, field_b, &f, &cav, e);
     if (rc)
         return rc;
-    size_t nodes = lr_dgrid_node_count(g);
-    for (size_t j = 0; j < nodes; j++)
-        for (int c = 0; c < 3; c++)
-            D->field[l][4 * j + c] *= (float)cav.gain[c];
+    scale_field(D->field[l], lr_dgrid_node_count(lr_dsolver_grid(D->solver)), cav.gain);
     memcpy(D->gain[l], cav.gain, sizeof D->gain[l]);
     return LR_OK;
 }
@@ -308,11 +312,7 @@ bool lr_dscene_field(const lr_dscene *d, int object, int light, lr_dfield_view *
     const dobj *D = &d->obj[object];
     if (!D->active || !D->field[light])
         return false;
-    const lr_dgrid *g = lr_dsolver_grid(D->solver);
-    out->data = D->field[light];
-    lr_dgrid_dims(g, out->n);
-    out->origin = lr_dgrid_origin(g);
-    out->h = lr_dgrid_h(g);
+    view_of(D, light, out);
     return true;
 }
 
