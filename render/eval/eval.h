@@ -121,6 +121,12 @@ lr_eval_ratio lr_eval_power_ratio(const float *img, const float *ref, const floa
                                   const unsigned char *mask, size_t n, int band);
 /* |R - 1| > 2 se (finite values only). */
 bool lr_eval_ratio_differs(lr_eval_ratio r);
+/* How far R is from 1 beyond what the reference can tell, in log units: |ln R| less two
+ * standard errors of ln R (2 se / R, the delta method), 0 when within them; NaN when R or se
+ * is not finite or R <= 0 (a model that renders none of the light: +Inf). The planner ranks by
+ * the worst region-band's excess (issue 12: "no band outside 0.85-1.15 where the reference
+ * can tell"), which does not jump where a band crosses the 2 se line. */
+double lr_eval_ratio_excess(lr_eval_ratio r);
 
 /* The median over masked pixels of |ln(sum_b a / sum_b b)| (band sums per pixel). Pixels
  * where both sums are zero are skipped; where one of them is zero |ln| is +Inf and counts
@@ -160,6 +166,16 @@ typedef struct lr_eval_row {
      * volume's pass on a full update, ms[7]), when any row has it on; a table without the
      * volume keeps the columns above. */
     int lpv;
+    /* What a person sees (issue 12), on the setting's converged image like the bias columns;
+     * NaN when not measured. The CSV gets three more columns, median_ln_object,
+     * median_ln_floor, band_excess, when any row has a median (> 0):
+     * - median_ln_object: median |ln(model / reference)| over object pixels
+     *   (lr_eval_median_abs_log), the typical pixel;
+     * - median_ln_floor: the same between two independent references of the scene: what the
+     *   reference's own noise gives;
+     * - band_excess: the worst region-band power ratio's lr_eval_ratio_excess (regions of
+     *   lr_eval_regions, bands R, G, B and all), 0 when every one is within its 2 se of 1. */
+    double median_ln_object, median_ln_floor, band_excess;
 } lr_eval_row;
 
 /* Pass columns of the CSV: ms_gbuffer .. ms_compose. */

@@ -28,6 +28,15 @@ bool lr_eval_ratio_differs(lr_eval_ratio r)
     return isfinite(r.ratio) && isfinite(r.se) && fabs(r.ratio - 1.0) > 2.0 * r.se;
 }
 
+double lr_eval_ratio_excess(lr_eval_ratio r)
+{
+    if (!isfinite(r.ratio) || !isfinite(r.se) || r.ratio < 0.0)
+        return NAN;
+    if (r.ratio == 0.0)
+        return INFINITY;
+    return fmax(fabs(log(r.ratio)) - 2.0 * r.se / r.ratio, 0.0);
+}
+
 static int cmp_double(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;

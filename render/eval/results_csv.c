@@ -24,10 +24,15 @@ static void num(FILE *f, double v, const char *fmt)
 
 void lr_eval_csv_print(FILE *f, const lr_eval_row *rows, int n)
 {
-    bool lpv = false;
-    for (int i = 0; i < n; i++)
+    bool lpv = false, seen = false;
+    for (int i = 0; i < n; i++) {
         lpv |= rows[i].lpv > 0;
-    fputs(lpv ? LR_EVAL_CSV_HEADER ",lpv,ms_lpv\n" : LR_EVAL_CSV_HEADER "\n", f);
+        /* A measured median over real pixels is > 0 (a zero-initialised row has none). */
+        seen |= isfinite(rows[i].median_ln_object) && rows[i].median_ln_object > 0.0;
+    }
+    fputs(LR_EVAL_CSV_HEADER, f);
+    fputs(lpv ? ",lpv,ms_lpv" : "", f);
+    fputs(seen ? ",median_ln_object,median_ln_floor,band_excess\n" : "\n", f);
     for (int i = 0; i < n; i++) {
         const lr_eval_row *r = &rows[i];
         char params[160];
@@ -50,6 +55,11 @@ void lr_eval_csv_print(FILE *f, const lr_eval_row *rows, int n)
         if (lpv) {
             fprintf(f, ",%d", r->lpv);
             num(f, r->lpv > 0 ? r->ms[7] : NAN, "%.3f"); /* LR_PASS_LPV's bit index */
+        }
+        if (seen) {
+            num(f, r->median_ln_object, "%.5f");
+            num(f, r->median_ln_floor, "%.5f");
+            num(f, r->band_excess, "%.5f");
         }
         fputc('\n', f);
     }

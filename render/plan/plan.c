@@ -481,6 +481,10 @@ static void put_choice(out *o, const lr_plan_choice *c)
         c->predicted_converge_ms / 1000.0, c->feasible ? "" : " [INFEASIBLE]");
     if (r->lpv > 0)
         put(o, ", light-propagation volume %d^3", r->lpv);
+    lr_plan_error_parts ep = lr_plan_row_error_parts(r);
+    if (isfinite(ep.median) || isfinite(ep.band))
+        put(o, " (error: RMSE %.3g, median |ln| over the references' floor %.3g, worst band "
+               "%.3g)", ep.rmse, ep.median, ep.band);
     for (int k = 0; k < c->nreasons; k++)
         put(o, "%s%s", k ? "; " : " (", c->reasons[k]);
     put(o, "%s\n", c->nreasons ? ")" : "");
@@ -555,6 +559,16 @@ size_t lr_plan_format_json(const lr_plan *p, char *buf, size_t cap)
             c->scene_matched ? "true" : "false", r->model, r->K, r->N, r->N_vpl, r->map_size,
             r->gbuffer_size, r->frames, c->vpl ? "true" : "false", r->line, c->predicted_error,
             c->predicted_frame_ms, c->predicted_converge_ms, c->feasible ? "true" : "false");
+        /* The error's parts where the table has them (JSON has no NaN). */
+        lr_plan_error_parts ep = lr_plan_row_error_parts(r);
+        const struct {
+            const char *key;
+            double v;
+        } parts[] = {{"predicted_rmse", ep.rmse}, {"predicted_median_excess", ep.median},
+                     {"predicted_band_excess", ep.band}};
+        for (size_t k = 0; k < sizeof parts / sizeof parts[0]; k++)
+            if (isfinite(parts[k].v))
+                put(&o, "\"%s\":%.6g,", parts[k].key, parts[k].v);
         put(&o, "\"convex\":%s,\"shell\":%s,\"enclosed\":%s,\"K_cover\":%d,\"coverage\":%.4f,"
                 "\"receivers_seeing\":%d,\"reasons\":[",
             a->features.convex ? "true" : "false", a->features.shell ? "true" : "false",

@@ -26,7 +26,7 @@ struct lr_plan_table {
 enum col {
     C_SCENE, C_MODEL, C_PARAMS, C_FRAME_MS, C_RMSE, C_RMSE_OBJ, C_RMSE_REC, C_K, C_N, C_NVPL,
     C_MAP, C_GBUF, C_FRAMES, C_VPL, C_MS_G, C_MS_R, C_MS_V, C_MS_C, C_W, C_H, C_BIAS_O, C_BIAS_R,
-    C_NOISE_O, C_NOISE_R, C_SS, C_LPV, C_MS_LPV, C_COUNT
+    C_NOISE_O, C_NOISE_R, C_SS, C_LPV, C_MS_LPV, C_MAL, C_MAL_FLOOR, C_BAND, C_COUNT
 };
 
 static const struct {
@@ -47,6 +47,8 @@ static const struct {
     [C_BIAS_R] = {"bias_receivers", false}, [C_NOISE_O] = {"noise_object", false},
     [C_NOISE_R] = {"noise_receivers", false}, [C_SS] = {"supersample", false},
     [C_LPV] = {"lpv", false},             [C_MS_LPV] = {"ms_lpv", false},
+    [C_MAL] = {"median_ln_object", false}, [C_MAL_FLOOR] = {"median_ln_floor", false},
+    [C_BAND] = {"band_excess", false},
 };
 
 #define MAX_FIELDS 64
@@ -186,6 +188,9 @@ static int parse_row(const char *name, int line, char **f, const int *at, lr_pla
     INT(C_SS, supersample, 0);
     INT(C_LPV, lpv, 0);
     NUM(C_MS_LPV, ms_lpv);
+    NUM(C_MAL, median_ln_object);
+    NUM(C_MAL_FLOOR, median_ln_floor);
+    NUM(C_BAND, band_excess);
 #undef TXT
 #undef NUM
 #undef INT
@@ -470,7 +475,7 @@ static double region_error(double bias, double noise)
     return isfinite(bias) && isfinite(noise) ? sqrt(bias * bias + noise * noise) : NAN;
 }
 
-double lr_plan_row_error(const lr_plan_row *r)
+static double rmse_part(const lr_plan_row *r)
 {
     double o = region_error(r->bias_object, r->noise_object);
     double v = region_error(r->bias_receivers, r->noise_receivers);
@@ -481,4 +486,26 @@ double lr_plan_row_error(const lr_plan_row *r)
     if (isnan(v))
         return o;
     return o > v ? o : v;
+}
+
+lr_plan_error_parts lr_plan_row_error_parts(const lr_plan_row *r)
+{
+    lr_plan_error_parts p = {rmse_part(r), NAN, r->band_excess};
+    /* Two references differ by the floor where both are noisy (the candle's dim sides: 0.44);
+     * only what the model adds to it is the model's. */
+    if (isfinite(r->median_ln_object))
+        p.median = fmax(r->median_ln_object -
+                            (isfinite(r->median_ln_floor) ? r->median_ln_floor : 0.0), 0.0);
+    return p;
+}
+
+double lr_plan_row_error(const lr_plan_row *r)
+{
+    lr_plan_error_parts p = lr_plan_row_error_parts(r);
+    double e = p.rmse;
+    if (p.median > e || isnan(e))
+        e = p.median;
+    if (p.band > e || isnan(e))
+        e = p.band;
+    return e;
 }

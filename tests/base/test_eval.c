@@ -111,6 +111,20 @@ static void test_csv(void **state)
                                  "frames=1 vpl=off,3.000,nan,"));
     assert_null(fgets(line, sizeof line, f));
     fclose(f);
+    /* Rows with what a person sees (issue 12): three more columns, after lpv's when on. */
+    r[0].median_ln_object = 0.25, r[0].median_ln_floor = 0.125, r[0].band_excess = 0.0;
+    r[1].median_ln_object = NAN, r[1].median_ln_floor = NAN, r[1].band_excess = 0.5;
+    r[1].lpv = 16;
+    assert_int_equal(lr_eval_csv_write(path, r, 2, &e), LR_OK);
+    assert_non_null(f = fopen(path, "r"));
+    assert_non_null(fgets(line, sizeof line, f));
+    assert_non_null(strstr(line, ",supersample,lpv,ms_lpv,median_ln_object,median_ln_floor,"
+                                 "band_excess\n"));
+    assert_non_null(fgets(line, sizeof line, f));
+    assert_non_null(strstr(line, ",64,48,4,0,nan,0.25000,0.12500,0.00000\n"));
+    assert_non_null(fgets(line, sizeof line, f));
+    assert_non_null(strstr(line, ",64,48,1,16,0.000,nan,nan,0.50000\n"));
+    fclose(f);
     unlink(path);
     rmdir(dir);
     /* An unwritable place: an error naming it, no crash. */
@@ -353,6 +367,13 @@ static void test_ratios_by_hand(void **state)
     assert_false(lr_eval_ratio_differs((lr_eval_ratio){0.95, 0.04}));
     assert_true(lr_eval_ratio_differs((lr_eval_ratio){0.33, 0.02}));
     assert_false(lr_eval_ratio_differs((lr_eval_ratio){NAN, 0.02}));
+    /* Excess in log units beyond 2 se: 0.5 +- 0.05 is ln 2 - 0.2 out; within 2 se it is 0. */
+    assert_near(lr_eval_ratio_excess((lr_eval_ratio){0.5, 0.05}), log(2.0) - 0.2, 1e-12);
+    assert_near(lr_eval_ratio_excess((lr_eval_ratio){2.0, 0.1}), log(2.0) - 0.1, 1e-12);
+    assert_near(lr_eval_ratio_excess((lr_eval_ratio){1.05, 0.04}), 0.0, 0.0);
+    assert_near(lr_eval_ratio_excess((lr_eval_ratio){0.9, 0.0}), -log(0.9), 1e-12);
+    assert_true(isinf(lr_eval_ratio_excess((lr_eval_ratio){0.0, 0.0})));
+    assert_true(isnan(lr_eval_ratio_excess((lr_eval_ratio){NAN, 0.02})));
 
     /* Median |ln|: band sums a = 2, 4, 8, 1, 0, 0 against b = 2, 2, 2, 4, 0, 1: |ln| = 0,
      * ln 2, ln 4, ln 4, (both dark: skipped), +Inf. Five values: the median is ln 4; without

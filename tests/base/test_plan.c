@@ -444,6 +444,59 @@ static void test_multipole_where_the_object_takes_it(void **state)
     lr_plan_table_destroy(t);
 }
 
+/* What a person sees (issue 12): with the median and band columns the predicted error is the
+ * largest of the RMSE part, the median |ln| beyond the references' floor and the worst band's
+ * excess. A model that wins on RMSE but renders a region at 0.7 of its light (band excess
+ * |ln 0.7| - 2 se / R = 0.30) loses to one 0.02 worse in RMSE whose regions hold; the reason
+ * names the parts. */
+static void test_error_sees_regions(void **state)
+{
+    (void)state;
+    const char *csv =
+        "scene,model,frame_ms,rel_rmse,K,N,N_vpl,map_size,gbuffer_size,frames,vpl,"
+        "bias_object,noise_object,bias_receivers,noise_receivers,median_ln_object,"
+        "median_ln_floor,band_excess\n"
+        "candle,directional_dipole,100,0.15,8,8,32,128,128,16,on,0.15,0,0.09,0,0.81,0.44,0.30\n"
+        "candle,diffusion_grid,100,0.17,8,8,32,128,128,16,on,0.17,0,0.10,0,0.43,0.44,0.08\n"
+        "candle,standard_dipole,100,0.16,8,8,32,128,128,16,on,0.16,0,0.09,0,nan,nan,nan\n"
+        "candle,multipole,100,0.16,8,8,32,128,128,16,on,0.16,0,0.09,0,0.9,nan,0\n";
+    lr_plan_table *t = NULL;
+    lr_err e = {0};
+    assert_int_equal(lr_plan_table_parse(csv, strlen(csv), "seen.csv", &t, &e), LR_OK);
+    const lr_plan_row *dd = lr_plan_table_row(t, 0), *grid = lr_plan_table_row(t, 1);
+    lr_plan_error_parts pd = lr_plan_row_error_parts(dd);
+    assert_near(pd.rmse, 0.15, 1e-15);
+    assert_near(pd.median, 0.81 - 0.44, 1e-12);
+    assert_near(pd.band, 0.30, 1e-15);
+    assert_near(lr_plan_row_error(dd), 0.81 - 0.44, 1e-12);
+    assert_near(lr_plan_row_error_parts(grid).median, 0.0, 0.0); /* under the floor */
+    assert_near(lr_plan_row_error(grid), 0.17, 1e-15);
+    /* Without the columns the RMSE part alone; without a floor the whole median. */
+    assert_true(isnan(lr_plan_row_error_parts(lr_plan_table_row(t, 2)).median));
+    assert_near(lr_plan_row_error(lr_plan_table_row(t, 2)), 0.16, 1e-15);
+    assert_near(lr_plan_row_error(lr_plan_table_row(t, 3)), 0.9, 1e-15);
+
+    lr_plan_budget b = {.max_error = 0.05};
+    lr_plan *p = malloc(sizeof *p);
+    assert_non_null(p);
+    lr_plan_options o = {.models = LR_PLAN_MODEL_BIT(LR_SSS_DIRECTIONAL_DIPOLE) |
+                                   LR_PLAN_MODEL_BIT(LR_SSS_DIFFUSION_GRID)};
+    assert_int_equal(lr_plan_create(candle, t, &b, &o, p, &e), LR_OK);
+    assert_string_equal(p->objects[0].row.model, "diffusion_grid");
+    assert_near(p->objects[0].predicted_error, 0.17, 1e-15);
+    char text[4096];
+    lr_plan_format(p, text, sizeof text);
+    if (!strstr(text, "(error: RMSE 0.17, median |ln| over the references' floor 0, worst band "
+                      "0.08)"))
+        fail_msg("the plan does not name the error's parts:\n%s", text);
+    lr_plan_format_json(p, text, sizeof text);
+    if (!strstr(text, "\"predicted_rmse\":0.17,\"predicted_median_excess\":0,"
+                      "\"predicted_band_excess\":0.08,"))
+        fail_msg("the JSON plan does not carry the error's parts:\n%s", text);
+    free(p);
+    lr_plan_table_destroy(t);
+}
+
 /* quality.change_ms: a model whose measured material change (models.csv, merged into the
  * rows) is slower than the budget is left out while another model remains, with the reason;
  * with none left, the slow ones stay; a malformed models table is refused naming the line. */
@@ -1027,6 +1080,7 @@ int main(void)
         cmocka_unit_test(test_both_budgets_and_infeasible),
         cmocka_unit_test(test_models_and_coverage_filter),
         cmocka_unit_test(test_multipole_where_the_object_takes_it),
+        cmocka_unit_test(test_error_sees_regions),
         cmocka_unit_test(test_change_budget),
         cmocka_unit_test(test_lpv_rows),
         cmocka_unit_test(test_sh_translucency_rows),

@@ -109,6 +109,10 @@ int lrb_sweep_supersample(void);
 /* Per scene, the fair figures as markdown: the summary table (one line per scene) and the
  * region table (sweep_fair.c). */
 void lrb_sweep_fair_md(FILE *f, const lrb_scene_result *scenes, int nscenes);
+/* The worst region-band power ratio's lr_eval_ratio_excess over the regions (background left
+ * out) and bands R, G, B, all: the results' band_excess column; 0 when every one is within
+ * two standard errors of 1, NaN when none is measured. */
+double lrb_band_excess(const lr_eval_ratio rr[LR_EVAL_REGION_COUNT][4]);
 
 /* Applies a setting to a scene (render.* and every object's model; for the shipped setting
  * the sizes and the plan's models, on a scene as loaded from its file). */

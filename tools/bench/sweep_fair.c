@@ -63,6 +63,18 @@ static int bands_outside(FILE *f, const lr_eval_ratio rr[LR_EVAL_REGION_COUNT][4
     return k;
 }
 
+double lrb_band_excess(const lr_eval_ratio rr[LR_EVAL_REGION_COUNT][4])
+{
+    double worst = NAN;
+    for (int r = 1; r < LR_EVAL_REGION_COUNT; r++)
+        for (int b = 0; b < 4; b++) {
+            double x = lr_eval_ratio_excess(rr[r][b]);
+            if (!isnan(x) && !(x <= worst))
+                worst = x;
+        }
+    return worst;
+}
+
 /* Per scene, the figures of the scene as it ships, beside issue 12's targets. */
 static void shipped_md(FILE *f, const lrb_scene_result *sc, int n)
 {

@@ -371,11 +371,14 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
          * image's own noise. */
         double bias_obj, bias_rec;
         series_bias(&ser, st, mean.rgb, &m, res, &bias_obj, &bias_rec);
+        /* What a person sees on this setting's converged image (the rows' last columns). */
+        lrb_fair seen = {0};
+        fair_figures(C, &mean, &var, &rg, &m, mask, res->region_px, &seen);
         if (k == 0) { /* the base setting */
+            res->fair = seen;
             res->fair.bias_object = bias_obj;
             res->fair.bias_receivers = bias_rec;
             res->fair.frame_ms = ser.frame_ms;
-            fair_figures(C, &mean, &var, &rg, &m, mask, res->region_px, &res->fair);
             dump_pfm(name, "model", C, w, h);
             dump_pfm(name, "ref", mean.rgb, w, h);
             dump_pfm(name, "ref_var", var.rgb, w, h);
@@ -401,6 +404,8 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
                 .noise_object = lr_eval_rel_rmse(I, C, m.object, n) * fix,
                 .noise_receivers = lr_eval_rel_rmse(I, C, m.receivers, n) * fix,
                 .width = w, .height = h, .supersample = ss,
+                .median_ln_object = seen.mal, .median_ln_floor = res->mal_floor,
+                .band_excess = lrb_band_excess(seen.region_ratio),
             };
             snprintf(r.scene, sizeof r.scene, "%s", name);
             snprintf(r.model, sizeof r.model, "%s", st->model);
