@@ -548,16 +548,20 @@ size_t lr_plan_format_json(const lr_plan *p, char *buf, size_t cap)
         const lr_plan_choice *c = &p->objects[i];
         const lr_plan_row *r = &c->row;
         const lr_plan_analysis *a = &c->analysis;
+        /* JSON has no Inf: a row that leaves a region dark (band_excess inf) writes null. */
+        char error_text[32] = "null";
+        if (isfinite(c->predicted_error))
+            snprintf(error_text, sizeof error_text, "%.6g", c->predicted_error);
         put(&o, "%s{\"object\":", i ? "," : "");
         put_json_string(&o, c->object);
         put(&o, ",\"table_scene\":");
         put_json_string(&o, c->table_scene);
         put(&o, ",\"scene_matched\":%s,\"model\":\"%s\",\"K\":%d,\"N\":%d,\"N_vpl\":%d,"
                 "\"map_size\":%d,\"gbuffer_size\":%d,\"frames\":%d,\"vpl\":%s,\"table_line\":%d,"
-                "\"predicted_error\":%.6g,\"predicted_frame_ms\":%.6g,"
+                "\"predicted_error\":%s,\"predicted_frame_ms\":%.6g,"
                 "\"predicted_converge_ms\":%.6g,\"feasible\":%s,",
             c->scene_matched ? "true" : "false", r->model, r->K, r->N, r->N_vpl, r->map_size,
-            r->gbuffer_size, r->frames, c->vpl ? "true" : "false", r->line, c->predicted_error,
+            r->gbuffer_size, r->frames, c->vpl ? "true" : "false", r->line, error_text,
             c->predicted_frame_ms, c->predicted_converge_ms, c->feasible ? "true" : "false");
         /* The error's parts where the table has them (JSON has no NaN). */
         lr_plan_error_parts ep = lr_plan_row_error_parts(r);

@@ -190,7 +190,11 @@ static int parse_row(const char *name, int line, char **f, const int *at, lr_pla
     NUM(C_MS_LPV, ms_lpv);
     NUM(C_MAL, median_ln_object);
     NUM(C_MAL_FLOOR, median_ln_floor);
-    NUM(C_BAND, band_excess);
+    /* A region the setting leaves dark (the wall without VPLs) is infinitely off: "inf". */
+    if (at[C_BAND] >= 0 && !strcmp(f[at[C_BAND]], "inf"))
+        r->band_excess = INFINITY;
+    else
+        NUM(C_BAND, band_excess);
 #undef TXT
 #undef NUM
 #undef INT

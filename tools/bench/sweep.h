@@ -60,8 +60,9 @@ typedef struct lrb_shipped {
     bool ok;
     char models[160]; /* "multipole" or "obj: model, obj: model" */
     int N_vpl;
+    int K;            /* the file's render.K: the shipped setting keeps it */
     bool planned;     /* the models are the plan's */
-    bool as_base;     /* the same models and N_vpl as the base: its figures, not run again */
+    bool as_base;     /* the same models, N_vpl and K as the base: its figures, not run again */
     lrb_fair fig;
 } lrb_shipped;
 

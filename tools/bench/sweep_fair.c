@@ -81,14 +81,15 @@ static void shipped_md(FILE *f, const lrb_scene_result *sc, int n)
     fprintf(f, "As shipped (issue 12's figures for what the product renders): each object's "
                "model as `lamprig render --plan-models` takes it (the committed table's plan "
                "where the scene has a quality budget, marked \\*; else the file's), the file's "
-               "N_vpl and render settings, at the base's K, N, map and G-buffer sizes, "
-               "converged, box-filtered as above. Targets: bias objects / receivers per scene, "
-               "median \\|ln\\| <= %.2f, no band outside %.2f–%.2f where the reference tells it "
-               "from 1 (listed: region, band, ratio ± SE).\n\n",
+               "N_vpl, K (render.K: the maps the product renders with) and render settings, "
+               "at the base's N, map and G-buffer sizes, converged, box-filtered as above. "
+               "Targets: bias objects / receivers per scene, median \\|ln\\| <= %.2f, no "
+               "band outside %.2f–%.2f where the reference tells it from 1 (listed: region, "
+               "band, ratio ± SE).\n\n",
             MAL_TARGET, BAND_LO, BAND_HI);
-    fprintf(f, "| scene | models | N_vpl | frame ms | bias objects | bias receivers | median "
+    fprintf(f, "| scene | models | K | N_vpl | frame ms | bias objects | bias receivers | median "
                "\\|ln\\| (floor) | receiver power | bands outside | target | met |\n"
-               "|---|---|---|---|---|---|---|---|---|---|---|\n");
+               "|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (int k = 0; k < n; k++) {
         const lrb_scene_result *s = &sc[k];
         const lrb_shipped *sh = &s->shipped;
@@ -99,8 +100,8 @@ static void shipped_md(FILE *f, const lrb_scene_result *sc, int n)
         for (size_t i = 0; i < sizeof targets / sizeof targets[0]; i++)
             if (!strcmp(targets[i].scene, s->name))
                 to = targets[i].object, tr = targets[i].receivers;
-        fprintf(f, "| %s | %s%s%s | %d | %.1f | %.3f |", s->name, sh->models,
-                sh->planned ? "\\*" : "", sh->as_base ? " (the base)" : "", sh->N_vpl,
+        fprintf(f, "| %s | %s%s%s | %d | %d | %.1f | %.3f |", s->name, sh->models,
+                sh->planned ? "\\*" : "", sh->as_base ? " (the base)" : "", sh->K, sh->N_vpl,
                 h->frame_ms, h->bias_object);
         if (isfinite(h->bias_receivers)) /* the shell has no receivers */
             fprintf(f, " %.3f |", h->bias_receivers);

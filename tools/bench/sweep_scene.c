@@ -52,7 +52,9 @@ static int apply_shipped_models(lr_scene *s, lr_err *e)
 int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e)
 {
     int rc;
-    if ((rc = set_int(s, "render.K", st->K, e)) || (rc = set_int(s, "render.N", st->N, e)) ||
+    /* K 0 (the shipped setting): the file's render.K, the maps the product renders with. */
+    if ((st->K > 0 && (rc = set_int(s, "render.K", st->K, e))) ||
+        (rc = set_int(s, "render.N", st->N, e)) ||
         (st->N_vpl > 0 && (rc = set_int(s, "render.N_vpl", st->N_vpl, e))) ||
         (rc = set_int(s, "render.map_size", st->map_size, e)) ||
         (rc = set_int(s, "render.gbuffer_size", st->gbuffer_size, e)))
@@ -220,12 +222,13 @@ static void fair_figures(const float *C, const lr_ref_image *mean, const lr_ref_
 }
 
 /* The models of a scene's objects as text: "multipole" when they agree, else "name: model"
- * per object; whether they and render.N_vpl are the base setting's. */
+ * per object; whether they, render.N_vpl and render.K are the base setting's. */
 static void describe_models(const lr_scene *s, const lrb_setting *base, lrb_shipped *out)
 {
     out->models[0] = 0;
     out->N_vpl = lr_scene_render(s)->N_vpl;
-    bool same = true, as_base = out->N_vpl == base->N_vpl;
+    out->K = lr_scene_render(s)->K;
+    bool same = true, as_base = out->N_vpl == base->N_vpl && out->K == base->K;
     const int no = lr_scene_object_count(s);
     const char *m0 = no ? lr_sss_model_name(lr_scene_object_at(s, 0)->sss_model) : "";
     for (int k = 0; k < no; k++) {
@@ -433,7 +436,7 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
         lr_eval_series_free(&ser);
     }
     /* The scene as it ships, from its file again (the settings above changed s). Where its
-     * models and N_vpl are the base's, the base's figures are its own. LRB_SWEEP_SETTINGS
+     * models, N_vpl and K are the base's, the base's figures are its own. LRB_SWEEP_SETTINGS
      * without "shipped" leaves it out. */
     if (!getenv("LRB_SWEEP_SETTINGS") || lrb_listed(getenv("LRB_SWEEP_SETTINGS"), "shipped")) {
         const lrb_setting sh = lrb_sweep_shipped();
@@ -459,9 +462,10 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
             f->fig.frame_ms = ser.frame_ms;
         }
         f->ok = true;
-        fprintf(stderr, "bench sweep: %s shipped (%s, N_vpl %d%s) bias %.4f / %.4f, median "
-                        "|ln| %.4f\n",
-                name, f->models, f->N_vpl, f->as_base ? ": the base's" : "", f->fig.bias_object,
+        fprintf(stderr, "bench sweep: %s shipped (%s, K %d, N_vpl %d%s) bias %.4f / %.4f, "
+                        "median |ln| %.4f\n",
+                name, f->models, f->K, f->N_vpl, f->as_base ? ": the base's" : "",
+                f->fig.bias_object,
                 f->fig.bias_receivers, f->fig.mal);
         lr_eval_series_free(&ser);
         lr_scene_destroy(s2);

@@ -80,5 +80,6 @@ lrb_setting lrb_sweep_shipped(void)
     s.label = "shipped";
     s.model = NULL;
     s.N_vpl = 0;
+    s.K = 0; /* the file's: every shipped scene renders K 16 maps (the field's default) */
     return s;
 }
