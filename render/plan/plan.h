@@ -82,8 +82,8 @@ lr_plan_error_parts lr_plan_row_error_parts(const lr_plan_row *r);
  * decided by a few bright pixels (the candles' six rim pixels by the flame are 94 % of
  * candle_spot's squared error), so a model that renders a whole wall at 0.7 of its light can
  * rank first on it; the median and the worst band are what a person sees (issue 12's
- * targets), and none of the three may be over the budget. Rows without the last two columns
- * (tables from before them, hand-made tables) predict the RMSE part alone. */
+ * targets), and none of the three may be over the budget. Rows without the median and band
+ * columns (tables from before them, hand-made tables) predict the RMSE part alone. */
 double lr_plan_row_error(const lr_plan_row *r);
 
 /* Parses CSV text. The first line is the header; columns are looked up by name, in any order;
