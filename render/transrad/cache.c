@@ -32,7 +32,7 @@ uint64_t lr_tr_cache_key(const lr_tr *t)
     lr_ref_hash h;
     lr_ref_hash_init(&h);
     /* v2: thin walls' S columns (thinwall.c) */
-    lr_ref_hash_str(&h, "lamprig transrad F S v4");
+    lr_ref_hash_str(&h, "lamprig transrad F S v5");
     /* The file holds native size_t, float and byte order: another machine is another key. */
     const uint32_t order = 0x01020304u;
     lr_ref_hash_u64(&h, sizeof(size_t));

@@ -26,9 +26,13 @@
  * so every column leaves exactly R_tot + T_tot, split between the faces as the slab does; the
  * exit is integrated over the exit patch (no centroid), so a paper wall's light lands under the
  * patch where it entered instead of at whichever centroid an entry point happened to fall
- * next to. An exit that finds no face (past an open edge; a rim, whose ray runs along the wall
- * instead of across it) falls back to the unshifted point, then to patch i itself: the light
- * stays in the object (energy kept), on the side where it entered.
+ * next to. An exit past the wall's end (a rim: the votive's 7 mm wax, spread over
+ * millimetres) leaves through the end face the spread crosses (end_patch: a ray at mid-wall
+ * along the spread); until 27 Nov it stayed where it entered, and the votive's rim, which
+ * glows in the reference, rendered at the wall's level: 83 % of its receiver error (render/
+ * transrad/README.md). One that finds no face at all (an open one-sided edge; a rim patch's
+ * own ray, which runs along the wall instead of across it) falls back to the unshifted point,
+ * then to patch i itself: the light stays in the object (energy kept).
  *
  * The rule (lr_tr_wall_thin): thin when the wall is no thicker than a patch, d <= patch_mm.
  * T spreads over about d and the two faces' patches overlap, so the centroid sums, which fix
@@ -155,6 +159,23 @@ static size_t exit_patch(const lr_tr *t, int s, lr_vec3 o, lr_vec3 dir, double d
     return SIZE_MAX;
 }
 
+/* The end face the spread crosses: light spread past a wall's end (a rim) leaves through the
+ * end, not back where it entered. A ray at mid-wall from the entry x (normal n) along the
+ * spread's direction w, as far as the exit radius r: the first face it leaves the material by
+ * (a back face), within r. SIZE_MAX when the spread ends inside the wall or the mesh has no
+ * end face there (a one-sided shade). */
+static size_t end_patch(const lr_tr *t, int s, lr_vec3 x, lr_vec3 n, lr_vec3 w, double r,
+                        double d)
+{
+    const lr_tr_surf *sf = &t->surf[s];
+    lr_vec3 o = lr_v3_sub(x, lr_v3_scale(n, 0.5 * d));
+    lr_hit h;
+    if (!lr_bvh_intersect(sf->d.bvh, o, w, 0, r, &h) ||
+        lr_v3_dot(lr_mesh_triangle_normal(sf->d.mesh, h.triangle), w) < 0)
+        return SIZE_MAX;
+    return sf->tri_patch[h.triangle];
+}
+
 void lr_tr_thin_column(const lr_tr *t, int s, size_t i, double d, const lr_tr_spread *sp,
                        double *out)
 {
@@ -182,7 +203,9 @@ void lr_tr_thin_column(const lr_tr *t, int s, size_t i, double d, const lr_tr_sp
                     double delta = eps + 0.5 * r;
                     lr_vec3 o = lr_v3_add(x, lr_v3_add(lr_v3_scale(w, r), lr_v3_scale(n, delta)));
                     j = exit_patch(t, s, o, dir, delta, d, which == 0);
-                    if (j == SIZE_MAX) /* past an edge: the unshifted exit */
+                    if (j == SIZE_MAX) /* past an edge: out of its end face */
+                        j = end_patch(t, s, x, n, w, r, d);
+                    if (j == SIZE_MAX) /* no end face: the unshifted exit */
                         j = exit_patch(t, s, lr_v3_add(x, lr_v3_scale(n, eps)), dir, eps, d,
                                        which == 0);
                     if (j == SIZE_MAX) /* a rim or an open edge: it stays where it entered */

@@ -1,9 +1,12 @@
 /* Translucent radiosity on thin walls (render/transrad/thinwall.c): S columns that send the
  * slab multipole's R_tot out of the lit face and T_tot out of the far one.
  *  - a flat 0.1 mm paper slab (a 60 x 60 x 0.1 mm box, 12 mm patches) lit from below by a point
- *    light: the power leaving the lit face over the power that entered is the multipole's
- *    R_tot, the far face's T_tot, the rims' none; with the rule off (the profile at the
- *    centroids) the far face gets 1.26 T_tot (2.1 T_tot on the led_shade);
+ *    light: the power leaving the lit face, the far face and the rims over the power that
+ *    entered is the multipole's R_tot + T_tot, the rims' share (light spread past the edge)
+ *    at most the uniform-entry estimate, the faces R_tot and T_tot less it; with the rule off
+ *    (the profile at the centroids) the far face gets 1.26 T_tot (2.1 T_tot on the led_shade);
+ *  - the votive's 7 mm wax wall: its end faces (rims) let out the share of the light the
+ *    spread carries past the edge, 4 E[r] / (pi side) per profile for uniform entry;
  *  - the same forced on for an index-mismatched (eta 1.5) 0.3 mm wall under diffuse light: the
  *    split of the T_hem that enters, and the Fresnel-reflected rest;
  *  - the lateral spread: one lit 4 mm patch of a 1.5 mm porcelain slab sends into the patch
@@ -122,6 +125,23 @@ static void light_below(slab *s)
         fail_msg("%s", e.msg);
 }
 
+/* The share of the light entering a side x side face that a spread of profile `which` carries
+ * past the face's edge, for entry uniform over the face: a displacement r in a uniform
+ * direction crosses an edge x away with probability E[max(0, r cos phi - x)] over x uniform,
+ * E[r] / (pi side) per edge (Buffon), 4 E[r] / (pi side) for the square. E[r] from the
+ * tabulated inverse CDF (midpoint rule). A point light below weights the middle more, so the
+ * measured share is below this. */
+static double edge_share(const lr_coeffs *co, double d, int which, int b, double side)
+{
+    lr_tr_spread sp;
+    lr_tr_spread_build(co, d, &sp);
+    double mean = 0;
+    enum { U = 4096 };
+    for (int k = 0; k < U; k++)
+        mean += lr_tr_spread_radius(&sp, which, b, (k + 0.5) / U) / U;
+    return 4 * mean / (M_PI * side);
+}
+
 static void test_paper_slab_split(void **state)
 {
     (void)state;
@@ -134,12 +154,19 @@ static void test_paper_slab_split(void **state)
     entered_bottom(&s, in);
     faces(&s, false, bot, top, rim);
     for (int b = 0; b < 3; b++) {
-        printf("  band %d: lit face %.5f (R %.5f), far face %.5f (T %.5f), rims %.2e\n", b,
-               bot[b] / in[b], R[b], top[b] / in[b], T[b], rim[b] / in[b]);
+        /* Light spread past the slab's edge leaves through its rims (the end faces), at most
+         * the uniform-entry share of each profile; the rest splits as R and T. */
+        double rim_max = R[b] * edge_share(&s.co, 0.1, 0, b, 60) +
+                         T[b] * edge_share(&s.co, 0.1, 1, b, 60);
+        printf("  band %d: lit face %.5f (R %.5f), far face %.5f (T %.5f), rims %.2e (uniform "
+               "entry %.2e)\n", b, bot[b] / in[b], R[b], top[b] / in[b], T[b], rim[b] / in[b],
+               rim_max);
         assert_true(in[b] > 0);
-        assert_near_rel(bot[b] / in[b], R[b], 1e-4);
-        assert_near_rel(top[b] / in[b], T[b], 1e-4);
-        assert_true(rim[b] <= 1e-4 * in[b]);
+        assert_near_rel((bot[b] + top[b] + rim[b]) / in[b], R[b] + T[b], 1e-4);
+        assert_true(rim[b] <= 1.5 * rim_max * in[b]);
+        assert_true(bot[b] / in[b] <= R[b] * (1 + 1e-4) && top[b] / in[b] <= T[b] * (1 + 1e-4));
+        assert_true(bot[b] / in[b] >= R[b] * (1 - 1e-4) - 1.5 * rim_max);
+        assert_true(top[b] / in[b] >= T[b] * (1 - 1e-4) - 1.5 * rim_max);
     }
     /* The split query lights every patch, the rims too (4 x 60 x 0.1 mm of 7224 mm^2); a rim
      * keeps its light (its ray along -n runs along the wall, not across it). */
@@ -187,10 +214,68 @@ static void test_fresnel_slab_split(void **state)
     faces(&s, true, bot, top, rim);
     faces(&s, false, wb, wt, rim);
     for (int b = 0; b < 3; b++) {
-        assert_near_rel(bot[b], R[b] * th * Ab, 1e-4);
-        assert_near_rel(top[b], T[b] * th * Ab, 1e-4);
+        /* Uniform entry: the rims (end faces) take the share edge_share gives, the faces the
+         * rest; energy to the sparse S's 1e-4. */
+        double rim_share = R[b] * edge_share(&s.co, 0.3, 0, b, 60) +
+                           T[b] * edge_share(&s.co, 0.3, 1, b, 60);
+        printf("  band %d: rims %.3e of what entered (uniform entry %.3e)\n", b,
+               rim[b] / (th * Ab), rim_share);
+        assert_near_rel(bot[b] + top[b] + rim[b], (R[b] + T[b]) * th * Ab, 1e-4);
+        /* A 0.3 mm strip by the edge is thinner than the 256 entry points' spacing in a
+         * 12 mm patch (0.75 mm), so the column's count of entries there is a quadrature of
+         * the strip, not its area (measured 0.60 of the estimate); the wax slab below, whose
+         * spread is millimetres, checks the estimate itself. */
+        assert_true(rim[b] > 0 && rim[b] <= 1.5 * rim_share * th * Ab);
+        assert_true(bot[b] <= R[b] * th * Ab * (1 + 1e-4) &&
+                    bot[b] >= (R[b] * (1 - 1e-4) - 1.25 * rim_share) * th * Ab);
+        assert_true(top[b] <= T[b] * th * Ab * (1 + 1e-4) &&
+                    top[b] >= (T[b] * (1 - 1e-4) - 1.25 * rim_share) * th * Ab);
         assert_near_rel(wt[b], top[b], 1e-6);                 /* nothing reflected on top */
         assert_near_rel(wb[b] - bot[b], (1 - th) * Ab, 1e-4); /* the Fresnel-reflected rest */
+    }
+    free(E);
+    slab_free(&s);
+}
+
+/* A 7 mm wax wall (the votive's), thin by the rule at 12 mm patches, under diffuse light on
+ * its lit face: light spread past the wall's edge leaves through the end faces (the votive's
+ * rim glows in the reference; until 27 Nov it stayed where it entered), the share the
+ * uniform-entry estimate gives (edge_share: its spread is millimetres, wide against the
+ * entries' 0.75 mm spacing). Monte Carlo over the 16 edge patches' 4096 entries, a rim share
+ * of a few per cent: 10 % allowed. */
+static void test_wall_end_faces(void **state)
+{
+    (void)state;
+    const lr_medium wax = {.sigma_a = {0.00105, 0.00205, 0.00355},
+                           .sigma_s_prime = {1.095, 1.31, 1.5}, .eta = 1.44};
+    slab s;
+    slab_make(&s, &wax, 60, 7, 12, LR_TR_THIN_AUTO);
+    assert_true(lr_tr_wall_thin(&s.co, 7, 12));
+    size_t n = lr_tr_patch_count(s.t);
+    double *E = calloc(3 * n, sizeof *E), Ab = 0;
+    for (size_t p = 0; p < n; p++) {
+        lr_vec3 nn;
+        double A;
+        lr_tr_patch_geometry(s.t, p, NULL, &nn, &A);
+        if (nn.z < -0.5) {
+            E[3 * p] = E[3 * p + 1] = E[3 * p + 2] = 1;
+            Ab += A;
+        }
+    }
+    lr_tr_stats st;
+    lr_err e = {0};
+    assert_int_equal(lr_tr_solve_irradiance(s.t, E, 0, &st, &e), LR_OK);
+    double th = lr_hemi_transmittance(1.44), R[3], T[3], bot[3], top[3], rim[3];
+    lr_multipole_total(&s.co, 7, R, T);
+    faces(&s, true, bot, top, rim);
+    for (int b = 0; b < 3; b++) {
+        double rim_share = R[b] * edge_share(&s.co, 7, 0, b, 60) +
+                           T[b] * edge_share(&s.co, 7, 1, b, 60);
+        printf("  band %d: lit face %.4f (R %.4f), far face %.4f (T %.4f), rims %.4f "
+               "(estimate %.4f)\n", b, bot[b] / (th * Ab), R[b], top[b] / (th * Ab), T[b],
+               rim[b] / (th * Ab), rim_share);
+        assert_near_rel(bot[b] + top[b] + rim[b], (R[b] + T[b]) * th * Ab, 1e-4);
+        assert_near_rel(rim[b], rim_share * th * Ab, 0.10);
     }
     free(E);
     slab_free(&s);
@@ -372,6 +457,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_paper_slab_split),
         cmocka_unit_test(test_fresnel_slab_split),
+        cmocka_unit_test(test_wall_end_faces),
         cmocka_unit_test(test_lateral_spread),
         cmocka_unit_test(test_energy_no_absorption),
         cmocka_unit_test(test_rule),
