@@ -142,6 +142,31 @@ static double edge_share(const lr_coeffs *co, double d, int which, int b, double
     return 4 * mean / (M_PI * side);
 }
 
+/* Irradiance 1 on every patch of the bottom face (diffuse light from below), solved; returns
+ * the face's area. */
+static double light_bottom_evenly(slab *s)
+{
+    size_t n = lr_tr_patch_count(s->t);
+    double *E = calloc(3 * n, sizeof *E), Ab = 0;
+    assert_non_null(E);
+    for (size_t p = 0; p < n; p++) {
+        lr_vec3 nn;
+        double A;
+        lr_tr_patch_geometry(s->t, p, NULL, &nn, &A);
+        if (nn.z < -0.5) {
+            E[3 * p] = E[3 * p + 1] = E[3 * p + 2] = 1;
+            Ab += A;
+        }
+    }
+    lr_tr_stats st;
+    lr_err e = {0};
+    int rc = lr_tr_solve_irradiance(s->t, E, 0, &st, &e);
+    free(E);
+    if (rc)
+        fail_msg("%s", e.msg);
+    return Ab;
+}
+
 static void test_paper_slab_split(void **state)
 {
     (void)state;
@@ -195,20 +220,7 @@ static void test_fresnel_slab_split(void **state)
     (void)state;
     slab s;
     slab_make(&s, &porcelain, 60, 0.3, 12, LR_TR_THIN_ON);
-    size_t n = lr_tr_patch_count(s.t);
-    double *E = calloc(3 * n, sizeof *E), Ab = 0;
-    for (size_t p = 0; p < n; p++) {
-        lr_vec3 nn;
-        double A;
-        lr_tr_patch_geometry(s.t, p, NULL, &nn, &A);
-        if (nn.z < -0.5) {
-            E[3 * p] = E[3 * p + 1] = E[3 * p + 2] = 1;
-            Ab += A;
-        }
-    }
-    lr_tr_stats st;
-    lr_err e = {0};
-    assert_int_equal(lr_tr_solve_irradiance(s.t, E, 0, &st, &e), LR_OK);
+    double Ab = light_bottom_evenly(&s);
     double th = lr_hemi_transmittance(1.5), R[3], T[3], bot[3], top[3], rim[3], wb[3], wt[3];
     lr_multipole_total(&s.co, 0.3, R, T);
     faces(&s, true, bot, top, rim);
@@ -233,7 +245,6 @@ static void test_fresnel_slab_split(void **state)
         assert_near_rel(wt[b], top[b], 1e-6);                 /* nothing reflected on top */
         assert_near_rel(wb[b] - bot[b], (1 - th) * Ab, 1e-4); /* the Fresnel-reflected rest */
     }
-    free(E);
     slab_free(&s);
 }
 
@@ -251,20 +262,7 @@ static void test_wall_end_faces(void **state)
     slab s;
     slab_make(&s, &wax, 60, 7, 12, LR_TR_THIN_AUTO);
     assert_true(lr_tr_wall_thin(&s.co, 7, 12));
-    size_t n = lr_tr_patch_count(s.t);
-    double *E = calloc(3 * n, sizeof *E), Ab = 0;
-    for (size_t p = 0; p < n; p++) {
-        lr_vec3 nn;
-        double A;
-        lr_tr_patch_geometry(s.t, p, NULL, &nn, &A);
-        if (nn.z < -0.5) {
-            E[3 * p] = E[3 * p + 1] = E[3 * p + 2] = 1;
-            Ab += A;
-        }
-    }
-    lr_tr_stats st;
-    lr_err e = {0};
-    assert_int_equal(lr_tr_solve_irradiance(s.t, E, 0, &st, &e), LR_OK);
+    double Ab = light_bottom_evenly(&s);
     double th = lr_hemi_transmittance(1.44), R[3], T[3], bot[3], top[3], rim[3];
     lr_multipole_total(&s.co, 7, R, T);
     faces(&s, true, bot, top, rim);
@@ -277,7 +275,6 @@ static void test_wall_end_faces(void **state)
         assert_near_rel(bot[b] + top[b] + rim[b], (R[b] + T[b]) * th * Ab, 1e-4);
         assert_near_rel(rim[b], rim_share * th * Ab, 0.10);
     }
-    free(E);
     slab_free(&s);
 }
 
