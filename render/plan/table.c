@@ -32,6 +32,7 @@ enum col {
 static const struct {
     const char *name;
     bool required;
+    bool inf_ok; /* "inf" is a value: band_excess of a row that leaves a region dark */
 } cols[C_COUNT] = {
     [C_SCENE] = {"scene", true},          [C_MODEL] = {"model", true},
     [C_PARAMS] = {"params", false},       [C_FRAME_MS] = {"frame_ms", true},
@@ -48,7 +49,7 @@ static const struct {
     [C_NOISE_R] = {"noise_receivers", false}, [C_SS] = {"supersample", false},
     [C_LPV] = {"lpv", false},             [C_MS_LPV] = {"ms_lpv", false},
     [C_MAL] = {"median_ln_object", false}, [C_MAL_FLOOR] = {"median_ln_floor", false},
-    [C_BAND] = {"band_excess", false},
+    [C_BAND] = {"band_excess", false, true},
 };
 
 #define MAX_FIELDS 64
@@ -150,8 +151,10 @@ static int parse_row(const char *name, int line, char **f, const int *at, lr_pla
                         sizeof r->field, req, e))) \
         return rc
 #define NUM(c, field) \
-    if ((rc = cell_number(name, line, cols[c].name, at[c] >= 0 ? f[at[c]] : "", cols[c].required, \
-                          &r->field, e))) \
+    if (cols[c].inf_ok && at[c] >= 0 && !strcmp(f[at[c]], "inf")) \
+        r->field = INFINITY; \
+    else if ((rc = cell_number(name, line, cols[c].name, at[c] >= 0 ? f[at[c]] : "", \
+                               cols[c].required, &r->field, e))) \
         return rc
 #define INT(c, field, min) \
     if ((rc = cell_int(name, line, cols[c].name, at[c] >= 0 ? f[at[c]] : "", cols[c].required, \
@@ -190,11 +193,7 @@ static int parse_row(const char *name, int line, char **f, const int *at, lr_pla
     NUM(C_MS_LPV, ms_lpv);
     NUM(C_MAL, median_ln_object);
     NUM(C_MAL_FLOOR, median_ln_floor);
-    /* A region the setting leaves dark (the wall without VPLs) is infinitely off: "inf". */
-    if (at[C_BAND] >= 0 && !strcmp(f[at[C_BAND]], "inf"))
-        r->band_excess = INFINITY;
-    else
-        NUM(C_BAND, band_excess);
+    NUM(C_BAND, band_excess); /* "inf": a region the setting leaves dark */
 #undef TXT
 #undef NUM
 #undef INT
