@@ -204,6 +204,9 @@ typedef struct lr_dmaterial {
 /* Transmitted irradiance q(b) for a unit-intensity light at surface point b, normal n (out):
  * E cos / r^2 times F_t and visibility; the caller's light model. */
 typedef double (*lr_dirradiance_fn)(const void *ctx, lr_vec3 b, lr_vec3 n);
+/* The same per band (q[0..2]): a source that is not one light's, e.g. the light an object's
+ * own emission sends back into it across a cavity (render/diffusion/bounce.c). */
+typedef void (*lr_dirradiance_rgb_fn)(const void *ctx, lr_vec3 b, lr_vec3 n, double q[3]);
 
 typedef struct lr_dsolver lr_dsolver;
 /* Levels: grids of spacing h 2^(levels-1) .. h (levels 1..4). */
@@ -218,6 +221,9 @@ const lr_dsystem *lr_dsolver_system(const lr_dsolver *s, int band);
 #define LR_DSOLVER_SLOTS 8
 int lr_dsolver_solve(lr_dsolver *s, int slot, lr_dirradiance_fn q, const void *qctx, double tol,
                      lr_err *e);
+/* The same with a source per band. */
+int lr_dsolver_solve_rgb(lr_dsolver *s, int slot, lr_dirradiance_rgb_fn q, const void *qctx,
+                         double tol, lr_err *e);
 /* New coefficients on the same grids (a material edit, seed 001 Sec. 5.4): the slots' last
  * solutions stay as warm starts. */
 int lr_dsolver_set_material(lr_dsolver *s, const lr_dmaterial *m, lr_err *e);
@@ -235,6 +241,9 @@ int lr_dsolver_last_iters(const lr_dsolver *s);
  * x fastest. */
 int lr_dsolver_field(const lr_dsolver *s, int slot, lr_dirradiance_fn q, const void *qctx,
                      float *out, lr_err *e);
+/* The same with the slot's source per band (lr_dsolver_solve_rgb). */
+int lr_dsolver_field_rgb(const lr_dsolver *s, int slot, lr_dirradiance_rgb_fn q,
+                         const void *qctx, float *out, lr_err *e);
 /* Trilinear evaluation of such a field at p (renormalised over valid corners; 0 when none):
  * what the GLSL pass does (render/shaders/lib/dgrid.glsl). */
 void lr_dfield_eval(const float *field, const int n[3], lr_vec3 origin, double h, lr_vec3 p,

@@ -36,4 +36,17 @@ int lr_dgrid_corners(const lr_dgrid *g, lr_vec3 p, size_t node[8], double w[8]);
  * (the caller falls back to trilinear). */
 int lr_dgrid_triquadratic(const lr_dgrid *g, lr_vec3 p, size_t idx[27], double w[27]);
 
+/* A one-light source as a source per band (the same q in each): the scalar entry points are
+ * the per-band ones over this. */
+typedef struct lr_dgrey {
+    lr_dirradiance_fn q;
+    const void *ctx;
+} lr_dgrey;
+
+static inline void lr_dgrey_q(const void *ctx, lr_vec3 b, lr_vec3 n, double q[3])
+{
+    const lr_dgrey *g = ctx;
+    q[0] = q[1] = q[2] = g->q(g->ctx, b, n);
+}
+
 #endif

@@ -7,6 +7,7 @@
 
 #include "render/base/paths.h"
 #include "render/cpu/cavity.h"
+#include "render/diffusion/bounce.h"
 #include "render/diffusion/dscene.h"
 #include "render/optics/optics.h"
 
@@ -140,12 +141,66 @@ static void field_b(const void *ctx, lr_vec3 x, lr_vec3 n, double B[3])
     lr_dfield_eval(f->data, f->n, f->origin, f->h, x, B);
 }
 
+/* The closure's extra light spread like the first bounce across the cavity (bounce.h): one
+ * more solve, in slot LR_SCENE_MAX_LIGHTS + l, with the light field l sends back into the
+ * object as its source; the bounce's field is scaled so that the light it adds is the
+ * closure's, (gain - 1) times the direct field's, per band (over the surface). Returns LR_OK with *spread false when the bounce carries
+ * no light in some band (the caller then scales by the gain). */
+static int spread_by_bounce(dobj *D, const lr_scene_object *o, int l, const double gain[3],
+                            bool *spread, lr_err *e)
+{
+    _Static_assert(2 * LR_SCENE_MAX_LIGHTS <= LR_DSOLVER_SLOTS, "a bounce slot per light");
+    *spread = false;
+    const int slot = LR_SCENE_MAX_LIGHTS + l;
+    size_t nodes = lr_dgrid_node_count(lr_dsolver_grid(D->solver));
+    lr_dbounce bk = {.obj = o, .rays = LR_DSCENE_BOUNCE_RAYS};
+    view_of(D, l, &bk.field);
+    float *f1 = malloc(4 * nodes * sizeof *f1);
+    if (!f1)
+        return lr_err_set(e, LR_ENOMEM, "diffusion grid: out of memory");
+    int rc = lr_dsolver_solve_rgb(D->solver, slot, lr_dbounce_q, &bk, LR_DSCENE_TOL, e);
+    if (!rc)
+        rc = lr_dsolver_field_rgb(D->solver, slot, lr_dbounce_q, &bk, f1, e);
+    if (rc) {
+        free(f1);
+        return lr_err_prefix(e, "cavity bounce");
+    }
+    to_pipeline_b(f1, nodes, o->material.medium.eta);
+    /* Each field's light over the surface, sum of B at triangle centroids times area (the
+     * renderer's refined mesh: no edge over 12 mm). */
+    double s0[3] = {0}, s1[3] = {0}, k[3];
+    float *f0 = D->field[l];
+    const lr_mesh *m = lr_bvh_mesh(o->bvh);
+    for (size_t t = 0; t < lr_mesh_triangle_count(m); t++) {
+        lr_vec3 p[3], g;
+        lr_mesh_triangle(m, t, p);
+        g = lr_v3_scale(lr_v3_add(p[0], lr_v3_add(p[1], p[2])), 1.0 / 3.0);
+        double a = lr_mesh_triangle_area(m, t), b0[3], b1[3];
+        lr_dfield_eval(f0, bk.field.n, bk.field.origin, bk.field.h, g, b0);
+        lr_dfield_eval(f1, bk.field.n, bk.field.origin, bk.field.h, g, b1);
+        for (int c = 0; c < 3; c++)
+            s0[c] += a * b0[c], s1[c] += a * b1[c];
+    }
+    bool ok = true;
+    for (int c = 0; c < 3; c++) {
+        k[c] = (gain[c] - 1.0) * s0[c] / s1[c];
+        ok &= s1[c] > 0.0 && isfinite(k[c]) && k[c] >= 0.0;
+    }
+    if (ok)
+        for (size_t j = 0; j < nodes; j++)
+            for (int c = 0; c < 3; c++)
+                f0[4 * j + c] += (float)(k[c] * f1[4 * j + c]);
+    free(f1);
+    *spread = ok;
+    return LR_OK;
+}
+
 /* Cavity closure (render/cpu/cavity.h) from the grid's own solved field: q is the light's
  * direct irradiance only, so the light the lit surface sends back into a cavity around the
  * light (Fresnel reflection and what re-emerges there) and that meets the object again is
- * added as the closure's gain on every B, the same assumption as the profile models' (the
- * bounced light spread over the walls like the direct light). The grid's cavity side is
- * finite geometry, so its B gives the cavity-side albedo directly. */
+ * added: as much as the closure's gain says, spread like the first bounce across the cavity
+ * (spread_by_bounce; the profile models spread it like the direct light). The grid's cavity
+ * side is finite geometry, so its B gives the cavity-side albedo directly. */
 static int close_cavity(dobj *D, const lr_scene *s, int i, int l, lr_err *e)
 {
     D->gain[l][0] = D->gain[l][1] = D->gain[l][2] = 1.0;
@@ -158,11 +213,16 @@ static int close_cavity(dobj *D, const lr_scene *s, int i, int l, lr_err *e)
     lr_cpu_cavity_desc cd = {.directions = LR_DSCENE_CAVITY_DIRECTIONS,
                              .points = LR_DSCENE_CAVITY_POINTS, .seed = 1};
     lr_cpu_cavity cav;
-    int rc = lr_cpu_cavity_measure_field(lr_scene_object_at(s, i), lr_scene_light_at(s, l), enc,
-                                         &cd, field_b, &f, &cav, e);
+    const lr_scene_object *o = lr_scene_object_at(s, i);
+    int rc = lr_cpu_cavity_measure_field(o, lr_scene_light_at(s, l), enc, &cd, field_b, &f,
+                                         &cav, e);
+    bool spread = false;
+    if (!rc)
+        rc = spread_by_bounce(D, o, l, cav.gain, &spread, e);
     if (rc)
         return rc;
-    scale_field(D->field[l], lr_dgrid_node_count(lr_dsolver_grid(D->solver)), cav.gain);
+    if (!spread)
+        scale_field(D->field[l], lr_dgrid_node_count(lr_dsolver_grid(D->solver)), cav.gain);
     memcpy(D->gain[l], cav.gain, sizeof D->gain[l]);
     return LR_OK;
 }

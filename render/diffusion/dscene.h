@@ -30,6 +30,8 @@
  * the field is cheap to evaluate, so many points (a few ms). */
 #define LR_DSCENE_CAVITY_DIRECTIONS 4096
 #define LR_DSCENE_CAVITY_POINTS 8192
+/* Rays per surface point for the first bounce across a cavity (bounce.h). */
+#define LR_DSCENE_BOUNCE_RAYS 64
 /* Objects per scene this holds (the passes' LR_MAX_OBJECTS). */
 #define LR_DSCENE_MAX_OBJECTS 8
 

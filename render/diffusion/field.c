@@ -15,6 +15,13 @@
 int lr_dsolver_field(const lr_dsolver *s, int slot, lr_dirradiance_fn q, const void *qctx,
                      float *out, lr_err *e)
 {
+    lr_dgrey g = {q, qctx};
+    return lr_dsolver_field_rgb(s, slot, lr_dgrey_q, &g, out, e);
+}
+
+int lr_dsolver_field_rgb(const lr_dsolver *s, int slot, lr_dirradiance_rgb_fn q,
+                         const void *qctx, float *out, lr_err *e)
+{
     if (slot < 0 || slot >= LR_DSOLVER_SLOTS)
         return lr_err_set(e, LR_EINVAL, "diffusion field: slot %d out of range", slot);
     const lr_dgrid *g = lr_dsolver_grid(s);
@@ -22,14 +29,14 @@ int lr_dsolver_field(const lr_dsolver *s, int slot, lr_dirradiance_fn q, const v
     double twoA = 2.0 * lr_dsystem_A(lr_dsolver_system(s, 0));
     for (size_t k = 0; k < g->n_band; k++) {
         lr_vec3 b = g->band_b[k];
-        double qb = q(qctx, b, g->band_n[k]);
-        if (!isfinite(qb) || qb < 0.0)
-            qb = 0.0;
+        double qb[3];
+        q(qctx, b, g->band_n[k], qb);
         float *o = out + 4 * g->band_node[k];
         for (int c = 0; c < 3; c++) {
+            double qc = isfinite(qb[c]) && qb[c] >= 0.0 ? qb[c] : 0.0;
             double phi = lr_dgrid_sample(g, lr_dsolver_phi(s, slot, c), b);
             /* Clamped at 0: interpolation can undershoot where q jumps (a shadow edge). */
-            o[c] = (float)fmax(0.0, (phi - 2.0 * qb) / twoA);
+            o[c] = (float)fmax(0.0, (phi - 2.0 * qc) / twoA);
         }
         o[3] = 1.0f;
     }

@@ -143,29 +143,46 @@ void lr_dsolver_reset(lr_dsolver *s, int slot)
         s->has[slot] = false;
 }
 
-static int ghost_rhs(const lr_dsystem *sys, lr_dirradiance_fn q, const void *qctx, double *rhs,
-                     lr_err *e)
+/* The right-hand side per band: the source at the ghosts' surface points (one evaluation per
+ * ghost for the three bands). */
+static int ghost_rhs(const lr_dsystem *const sys[3], lr_dirradiance_rgb_fn q, const void *qctx,
+                     double *rhs[3], lr_err *e)
 {
-    const lr_dgrid *g = lr_dsystem_grid(sys);
+    const lr_dgrid *g = lr_dsystem_grid(sys[0]);
     size_t ng = lr_dgrid_ghost_count(g);
-    double *qg = malloc((ng ? ng : 1) * sizeof *qg);
-    if (!qg)
+    double *qg[3];
+    for (int c = 0; c < 3; c++)
+        qg[c] = malloc((ng ? ng : 1) * sizeof *qg[c]);
+    if (!qg[0] || !qg[1] || !qg[2]) {
+        for (int c = 0; c < 3; c++)
+            free(qg[c]);
         return lr_err_set(e, LR_ENOMEM, "diffusion solver: out of memory");
+    }
     for (size_t k = 0; k < ng; k++) {
         lr_vec3 b, n;
         size_t u;
         lr_dgrid_ghost_at(g, k, &b, &n, &u);
-        qg[k] = q(qctx, b, n);
-        if (!isfinite(qg[k]) || qg[k] < 0.0)
-            qg[k] = 0.0;
+        double v[3];
+        q(qctx, b, n, v);
+        for (int c = 0; c < 3; c++)
+            qg[c][k] = isfinite(v[c]) && v[c] >= 0.0 ? v[c] : 0.0;
     }
-    lr_dsystem_rhs(sys, qg, rhs);
-    free(qg);
+    for (int c = 0; c < 3; c++) {
+        lr_dsystem_rhs(sys[c], qg[c], rhs[c]);
+        free(qg[c]);
+    }
     return LR_OK;
 }
 
 int lr_dsolver_solve(lr_dsolver *s, int slot, lr_dirradiance_fn q, const void *qctx, double tol,
                      lr_err *e)
+{
+    lr_dgrey g = {q, qctx};
+    return lr_dsolver_solve_rgb(s, slot, lr_dgrey_q, &g, tol, e);
+}
+
+int lr_dsolver_solve_rgb(lr_dsolver *s, int slot, lr_dirradiance_rgb_fn q, const void *qctx,
+                         double tol, lr_err *e)
 {
     if (slot < 0 || slot >= LR_DSOLVER_SLOTS)
         return lr_err_set(e, LR_EINVAL, "diffusion solver: slot %d out of range", slot);
@@ -173,15 +190,17 @@ int lr_dsolver_solve(lr_dsolver *s, int slot, lr_dirradiance_fn q, const void *q
         return lr_err_set(e, LR_EINVAL, "diffusion solver: tol = %g: must be in (0, 1)", tol);
     s->last_iters = 0;
     int first = s->has[slot] ? 0 : s->levels - 1;
-    double *xs[LR_DSOLVER_MAX_LEVELS] = {0}, *rhs[LR_DSOLVER_MAX_LEVELS] = {0};
+    double *xs[LR_DSOLVER_MAX_LEVELS] = {0}, *rhs[LR_DSOLVER_MAX_LEVELS][3] = {{0}};
     int rc = LR_OK;
     /* The right-hand side (the incident light at the ghosts' surface points, one ray cast
-     * each) does not depend on the band: once per level for the three. */
+     * each for a light) once per level for the three bands. */
     for (int l = first; l >= 0 && !rc; l--) {
-        if (!(rhs[l] = malloc(lr_dgrid_unknown_count(s->grid[l]) * sizeof *rhs[l])))
-            rc = lr_err_set(e, LR_ENOMEM, "diffusion solver: out of memory");
-        else
-            rc = ghost_rhs(s->sys[l][0], q, qctx, rhs[l], e);
+        for (int c = 0; c < 3 && !rc; c++)
+            if (!(rhs[l][c] = malloc(lr_dgrid_unknown_count(s->grid[l]) * sizeof *rhs[l][c])))
+                rc = lr_err_set(e, LR_ENOMEM, "diffusion solver: out of memory");
+        if (!rc)
+            rc = ghost_rhs((const lr_dsystem *const[3]){s->sys[l][0], s->sys[l][1], s->sys[l][2]},
+                           q, qctx, rhs[l], e);
     }
     for (int c = 0; c < 3 && !rc; c++) {
         double *prev = NULL;
@@ -204,7 +223,7 @@ int lr_dsolver_solve(lr_dsolver *s, int slot, lr_dirradiance_fn q, const void *q
                 memset(x, 0, n * sizeof *x);
             }
             int it = 0;
-            rc = lr_dsystem_solve(s->sys[l][c], false, rhs[l], x,
+            rc = lr_dsystem_solve(s->sys[l][c], false, rhs[l][c], x,
                                   l == 0 ? tol : fmax(tol, 1e-3), 20000, &it, e);
             if (l == 0)
                 s->last_iters += it;
@@ -216,7 +235,8 @@ int lr_dsolver_solve(lr_dsolver *s, int slot, lr_dirradiance_fn q, const void *q
         }
     }
     for (int l = 0; l < LR_DSOLVER_MAX_LEVELS; l++)
-        free(rhs[l]);
+        for (int c = 0; c < 3; c++)
+            free(rhs[l][c]);
     s->has[slot] = rc == LR_OK;
     if (rc)
         lr_err_prefix(e, "diffusion solver");
