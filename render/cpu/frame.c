@@ -688,7 +688,7 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
     }
     int nv = 0;
     /* render.opening_light: both modes (PASS through the grid, REFERENCE per pixel). */
-    if (r.nvpl > 0 && (rc = lr_openings_update(&r.op, s, d->threads, e)))
+    if (r.nvpl > 0 && (rc = lr_openings_update(&r.op, s, r.dscene, d->threads, e)))
         goto fail;
     if (r.nvpl > 0) {
         for (int o = 0; o < r.nobj; o++)

@@ -10,6 +10,7 @@
 #include "render/cpu/cavity.h"
 #include "render/cpu/parallel.h"
 #include "render/cpu/radiosity.h"
+#include "render/diffusion/dscene.h"
 #include "render/cpu/recv_grid.h"
 #include "render/cpu/rng.h"
 #include "render/mesh/area_pick.h"
@@ -61,11 +62,14 @@ static double now_s(void)
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
-/* The models whose B the profile sampler estimates at any point (the dipoles, the multipole):
- * those the cavity closure applies to. The others write B themselves or carry this light. */
+/* The models whose B is known at any point: the profile sampler's (the dipoles, the
+ * multipole: those the cavity closure applies to) and the diffusion grid's solved field (its
+ * own closure included; the caller passes the field). Translucent radiosity carries this light
+ * in its own receiver grid; SH translucency's energy is fitted, not closed. */
 static bool eligible(const lr_scene_object *o)
 {
-    return !lr_sss_model_props_of(o->sss_model)->no_closure;
+    return o->sss_model == LR_SSS_DIFFUSION_GRID ||
+           !lr_sss_model_props_of(o->sss_model)->no_closure;
 }
 
 bool lr_openings_needed(const lr_scene *s)
@@ -361,6 +365,7 @@ typedef struct b_ctx {
     const lr_scene_object *const *objs;
     int l;
     const double (*gain)[3];
+    const struct lr_dscene *grid;
 } b_ctx;
 
 /* Emitter j's B for light l at unit intensity, times the light's cavity gain. */
@@ -371,6 +376,9 @@ static void b_item(void *ctx, long j)
     double *B = k->op->B[k->l] + 3 * (size_t)j;
     lr_cpu_radiosity_desc d = {.N = LR_OPENINGS_N, .sampler = LR_CPU_REFERENCE,
                                .others = k->objs, .n_others = lr_scene_object_count(k->s)};
+    /* diffusion_grid: B is the solved field (its own closure included; the gain here is 1). */
+    if (k->grid && lr_scene_object_at(k->s, m->obj)->sss_model == LR_SSS_DIFFUSION_GRID)
+        lr_dscene_field(k->grid, m->obj, k->l, &d.dfield);
     lr_cpu_estimate est;
     lr_cpu_radiosity(lr_scene_object_at(k->s, m->obj), lr_scene_light_at(k->s, k->l), m->x, m->n,
                      &d, lr_cpu_key(0x0BE5, (uint64_t)j, (uint64_t)k->l, 0), &est);
@@ -380,7 +388,8 @@ static void b_item(void *ctx, long j)
     }
 }
 
-static int solve_light(lr_openings *op, const lr_scene *s, int l, int threads, lr_err *e)
+static int solve_light(lr_openings *op, const lr_scene *s, const struct lr_dscene *grid, int l,
+                       int threads, lr_err *e)
 {
     if (!op->B[l] && !(op->B[l] = calloc(3 * (op->ne ? op->ne : 1), sizeof *op->B[l])))
         return lr_err_set(e, LR_ENOMEM, "openings: out of memory (light %d)", l);
@@ -394,7 +403,7 @@ static int solve_light(lr_openings *op, const lr_scene *s, int l, int threads, l
         const lr_scene_object *objs[MAXO];
         for (int i = 0; i < op->nobj; i++)
             objs[i] = lr_scene_object_at(s, i);
-        b_ctx bc = {op, s, objs, l, (const double(*)[3])gain};
+        b_ctx bc = {op, s, objs, l, (const double(*)[3])gain, grid};
         lr_cpu_parallel_for((long)op->ne, threads, b_item, &bc);
     }
     const size_t R2 = (size_t)LR_RECV_GRID * LR_RECV_GRID;
@@ -411,7 +420,8 @@ static int solve_light(lr_openings *op, const lr_scene *s, int l, int threads, l
     return LR_OK;
 }
 
-int lr_openings_update(lr_openings **opp, const lr_scene *s, int threads, lr_err *e)
+int lr_openings_update(lr_openings **opp, const lr_scene *s, const struct lr_dscene *grid,
+                       int threads, lr_err *e)
 {
     if (!opp)
         return lr_err_set(e, LR_EINVAL, "openings: NULL handle");
@@ -452,7 +462,7 @@ int lr_openings_update(lr_openings **opp, const lr_scene *s, int threads, lr_err
         if (op->lvalid[l] && !memcmp(lk, op->lkey[l], sizeof lk))
             continue;
         op->lvalid[l] = false;
-        if ((rc = solve_light(op, s, l, threads, e)))
+        if ((rc = solve_light(op, s, grid, l, threads, e)))
             return rc;
         memcpy(op->lkey[l], lk, sizeof lk);
         op->lvalid[l] = true;

@@ -56,8 +56,12 @@ typedef struct lr_openings lr_openings;
  * already: render/transrad/tr_scene.h, render/lpv/). */
 bool lr_openings_needed(const lr_scene *s);
 /* Creates *op on first use, destroys it and sets *op = NULL when not needed; rebuilds what
- * changed (above). threads: 0 = all CPUs. */
-int lr_openings_update(lr_openings **op, const lr_scene *s, int threads, lr_err *e);
+ * changed (above). grid: the scene's solved diffusion_grid objects (render/diffusion/dscene.h),
+ * whose B is their field (it carries their own cavity closure); NULL when the scene has none
+ * (such an object's emitters then give 0). threads: 0 = all CPUs. */
+struct lr_dscene;
+int lr_openings_update(lr_openings **op, const lr_scene *s, const struct lr_dscene *grid,
+                       int threads, lr_err *e);
 void lr_openings_destroy(lr_openings *op);
 
 /* Light l's irradiance on plane receiver r at the receiver grid's texel centres (3 floats per

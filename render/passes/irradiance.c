@@ -140,13 +140,13 @@ void lr_irradiance_bind_objects(const lr_irradiance *irr, const lr_pass_ctx *c, 
 /* Receiver inter-reflection (render/bounce/rbounce.h): each light's drawn grids (E_vpl at unit
  * intensity) read back, the receivers' radiosity solved with E = E_dir,l + E_vpl,l (slot l),
  * and the bounce E_b added to the grids in place; composition then reads it like E_vpl. */
-static int bounce(lr_irradiance *irr, const lr_pass_ctx *c, lr_err *e)
+static int bounce(lr_irradiance *irr, const lr_pass_ctx *c, const lr_radiosity *rad, lr_err *e)
 {
     int rc = lr_rbounce_update(&irr->rb, c->scene, e);
     /* render.opening_light (render/openings/openings.h): rebuilt only when the geometry, a
      * light or a material changed; its grid joins E_vpl before the bounce reads it. */
     if (!rc)
-        rc = lr_openings_update(&irr->op, c->scene, 0, e);
+        rc = lr_openings_update(&irr->op, c->scene, rad ? rad->dscene : NULL, 0, e);
     if (rc || !irr->rb)
         rl_free(irr); /* no bounce: no receiver light on the objects either */
     if (rc || (!irr->rb && !irr->op))
@@ -283,7 +283,7 @@ int lr_irradiance_run(lr_irradiance *irr, const lr_pass_ctx *c, const lr_vpl *v,
         lr_passes_uniform_i(p, "u_tr_layer", irr->layer[i]);
         lr_gl_draw_fullscreen(c->gl);
     }
-    if ((rc = lr_gl_check("receiver irradiance pass", e)) || (rc = bounce(irr, c, e)) ||
+    if ((rc = lr_gl_check("receiver irradiance pass", e)) || (rc = bounce(irr, c, rad, e)) ||
         (rc = lr_gl_check("receiver irradiance pass (bounce)", e)))
         return rc;
     irr->valid = true;

@@ -12,7 +12,9 @@
  *  - the shipped lamp shade: B > 0, per unit intensity (an intensity change reuses it, a light
  *    move does not), the table under the shade lit;
  *  - the field (default off, a SETTINGS change) and not needed with translucent_radiosity or
- *    render.lpv (both carry this light already). */
+ *    render.lpv (both carry this light already);
+ *  - a diffusion_grid object (the jar candle's deep pool): its emitters carry its solved field
+ *    (render/diffusion/dscene.h), to float rounding; without the field they carried 0. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -25,8 +27,10 @@
 #include <string.h>
 
 #include "render/cpu/recv_grid.h"
+#include "render/diffusion/dscene.h"
 #include "render/openings/openings.h"
 #include "render/scene/dirty.h"
+#include "tests/support/near.h"
 #include "tests/support/render.h"
 
 static const char *const on[] = {"render.opening_light=true", NULL};
@@ -60,7 +64,7 @@ static lr_openings *openings_of(const lr_scene *s)
 {
     lr_openings *op = NULL;
     lr_err e = {0};
-    if (lr_openings_update(&op, s, 0, &e))
+    if (lr_openings_update(&op, s, NULL, 0, &e))
         fail_msg("%s", e.msg);
     assert_non_null(op);
     return op;
@@ -234,7 +238,7 @@ static void test_lampshade(void **state)
     /* An intensity change: per unit intensity, nothing recomputed, same grid. */
     lr_err e = {0};
     assert_int_equal(lr_scene_set(s, "lights[0].intensity", "0.5", NULL, &e), LR_OK);
-    assert_int_equal(lr_openings_update(&op, s, 0, &e), LR_OK);
+    assert_int_equal(lr_openings_update(&op, s, NULL, 0, &e), LR_OK);
     lr_openings_times(op, &build_s, &light_s);
     printf("lampshade: after an intensity change: kernel %.3f s, B and grids %.3f s\n", build_s,
            light_s);
@@ -242,7 +246,7 @@ static void test_lampshade(void **state)
     assert_true(grid_sum(lr_openings_grid(op, 0, 0)) == st);
     /* A light move recomputes B (not the kernel) and changes the light. */
     assert_int_equal(lr_scene_set(s, "lights[0].position", "0,0,280", NULL, &e), LR_OK);
-    assert_int_equal(lr_openings_update(&op, s, 0, &e), LR_OK);
+    assert_int_equal(lr_openings_update(&op, s, NULL, 0, &e), LR_OK);
     lr_openings_times(op, &build_s, &light_s);
     assert_true(build_s == 0.0);
     assert_true(grid_sum(lr_openings_grid(op, 0, 0)) != st);
@@ -275,9 +279,55 @@ static void test_field(void **state)
     assert_false(lr_scene_render(c)->opening_light);
     assert_false(lr_openings_needed(c));
     lr_openings *op = NULL;
-    assert_int_equal(lr_openings_update(&op, c, 0, &e), LR_OK);
+    assert_int_equal(lr_openings_update(&op, c, NULL, 0, &e), LR_OK);
     assert_null(op);
     lr_scene_destroy(c);
+}
+
+static void test_grid_emitters_carry_the_field(void **state)
+{
+    (void)state;
+    static const char *const sets[] = {"render.opening_light=true",
+                                       "objects[0].model=diffusion_grid",
+                                       "objects[0].dgrid_h_mm=6", NULL};
+    lr_scene *s = lr_test_scene("jar_candle", sets, NULL);
+    lr_dscene *d = NULL;
+    lr_err e = {0};
+    assert_int_equal(lr_dscene_create(&d, &e), LR_OK);
+    if (lr_dscene_update(d, s, &e))
+        fail_msg("%s", e.msg);
+    lr_openings *op = NULL;
+    if (lr_openings_update(&op, s, d, 0, &e))
+        fail_msg("%s", e.msg);
+    assert_non_null(op);
+    lr_dfield_view f;
+    assert_true(lr_dscene_field(d, 0, 0, &f));
+    const double *B = lr_openings_B(op, 0);
+    assert_non_null(B);
+    size_t ne = lr_openings_emitter_count(op, NULL), lit = 0;
+    assert_true(ne > 50); /* the pool's walls and floor */
+    for (size_t j = 0; j < ne; j++) {
+        lr_vec3 x, n;
+        double a, want[3];
+        assert_true(lr_openings_emitter(op, j, &x, &n, &a));
+        lr_dfield_eval(f.data, f.n, f.origin, f.h, x, want);
+        for (int c = 0; c < 3; c++)
+            assert_near(B[3 * j + c], want[c], 1e-12 + 1e-9 * want[c]);
+        lit += want[0] > 0.0;
+    }
+    assert_true(lit > ne / 2);
+    /* Without the field the grid's emitters give nothing (the twin and the GPU always pass it). */
+    lr_openings *none = NULL;
+    if (lr_openings_update(&none, s, NULL, 0, &e))
+        fail_msg("%s", e.msg);
+    const double *B0 = lr_openings_B(none, 0);
+    for (size_t j = 0; j < 3 * ne; j++)
+        assert_true(B0[j] == 0.0);
+    print_message("jar_candle, diffusion_grid: %zu emitters, %zu lit, carry the field\n", ne, lit);
+    lr_openings_destroy(none);
+    lr_openings_destroy(op);
+    lr_dscene_destroy(d);
+    lr_scene_destroy(s);
 }
 
 int main(void)
@@ -287,6 +337,7 @@ int main(void)
         cmocka_unit_test(test_closed_shell_sends_nothing),
         cmocka_unit_test(test_lampshade),
         cmocka_unit_test(test_field),
+        cmocka_unit_test(test_grid_emitters_carry_the_field),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
