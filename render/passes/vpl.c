@@ -83,6 +83,7 @@ static void draw_outer(lr_vpl *v, const lr_pass_ctx *ctx)
     lr_scene_bounds(ctx->scene, &c, &R);
     R = fmax(R, 1e-3);
     v->center = c;
+    v->radius = R;
     lr_program *p = ctx->prog->surface;
     glUseProgram(lr_program_id(p));
     glEnable(GL_DEPTH_TEST);
@@ -151,6 +152,7 @@ bool lr_vpl_bind(const lr_vpl *v, const lr_pass_ctx *c, const lr_radiosity *rad,
     lr_passes_uniform_i(p, "u_vpl_vis", use_vpl && c->vpl_visibility);
     lr_passes_bind_tex(p, "u_outer_pos", 10, use_vpl ? v->outer_pos : NULL);
     lr_passes_uniform_v3(p, "u_center", v->center);
+    lr_passes_uniform_f(p, "u_outer_r", (float)(v->radius * 1.001));
     lr_passes_uniform_f(p, "u_vis_eps", (float)(2.0 * rad->radius / (v->size > 0 ? v->size : 1)));
     return use_vpl;
 }

@@ -10,6 +10,7 @@
 typedef struct lr_vpl {
     int n, size, n_lights;
     lr_vec3 center;
+    double radius; /* the objects' bounding sphere about center, mm (the cube map lies in it) */
     lr_tex *outer_pos, *outer_nrm, *dirs;
     lr_fb *outer_fb[6];
     lr_tex *pos, *nrm, *B; /* N_vpl x 1; B: N_vpl x n_lights, row l for light l */

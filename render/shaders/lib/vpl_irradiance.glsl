@@ -19,17 +19,31 @@ uniform int u_n_vpl;
 uniform bool u_vpl_vis;
 uniform highp samplerCube u_outer_pos;
 uniform vec3 u_center;
+uniform float u_outer_r; // mm: the objects' bounding sphere about u_center (the cube map's reach)
 uniform float u_vis_eps; // mm: the start is moved this far off the surface along n_v
 
 // 32 points: on jar_candle the segments from the pool's VPLs that graze the rim slip between
 // 8 points (the wall then kept 2x the visible VPLs' light; tests/render/test_render_vplvis.c).
+// They are spread over the part of the segment inside the objects' bounding sphere, the only
+// part the envelope can block: over the whole segment to a wall 400 mm away they were 12 mm
+// apart, and the candle's 4 mm rim came and went between neighbouring receiver texels
+// (stripes on the wall).
 #define LR_VIS_STEPS 32
 
 bool lr_vpl_visible(vec3 xv, vec3 nv, vec3 x)
 {
     vec3 a = xv + u_vis_eps * nv;
+    // |a + t (x - a) - c| = R: t in [t0, t1] is inside the sphere (a is, up to eps).
+    vec3 seg = x - a, ac = a - u_center;
+    float dd = max(dot(seg, seg), 1e-30), b = dot(ac, seg) / dd;
+    float q = b * b - (dot(ac, ac) - u_outer_r * u_outer_r) / dd;
+    if (!(q > 0.0))
+        return true;
+    float t0 = max(0.0, -b - sqrt(q)), t1 = min(1.0, -b + sqrt(q));
+    if (!(t1 > t0))
+        return true;
     for (int s = 1; s <= LR_VIS_STEPS; s++) {
-        vec3 p = mix(a, x, float(s) / float(LR_VIS_STEPS + 1));
+        vec3 p = mix(a, x, mix(t0, t1, float(s) / float(LR_VIS_STEPS + 1)));
         vec3 d = p - u_center;
         vec4 o = texture(u_outer_pos, d);
         vec3 od = o.xyz - u_center;
