@@ -144,8 +144,9 @@ static void field_b(const void *ctx, lr_vec3 x, lr_vec3 n, double B[3])
 /* The closure's extra light spread like the first bounce across the cavity (bounce.h): one
  * more solve, in slot LR_SCENE_MAX_LIGHTS + l, with the light field l sends back into the
  * object as its source; the bounce's field is scaled so that the light it adds is the
- * closure's, (gain - 1) times the direct field's, per band (over the surface). Returns LR_OK with *spread false when the bounce carries
- * no light in some band (the caller then scales by the gain). */
+ * closure's, (gain - 1) times the direct field's, per band (over the surface). Returns LR_OK
+ * with *spread false when the bounce carries no light in some band (the caller then scales
+ * by the gain). */
 static int spread_by_bounce(dobj *D, const lr_scene_object *o, int l, const double gain[3],
                             bool *spread, lr_err *e)
 {
