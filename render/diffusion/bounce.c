@@ -28,9 +28,7 @@ void lr_dbounce_q(const void *ctx, lr_vec3 b, lr_vec3 n, double q[3])
     const lr_scene_object *obj = k->obj;
     const double eta = obj->material.medium.eta, eps = 1e-5 * fmax(obj->radius, 1.0);
     q[0] = q[1] = q[2] = 0.0;
-    int s = (int)sqrt((double)(k->rays > 1 ? k->rays : 1));
-    if (s < 1)
-        s = 1;
+    const int s = (int)sqrt((double)(k->rays > 1 ? k->rays : 1));
     lr_vec3 t1, t2;
     lr_cpu_tangents(n, &t1, &t2);
     const lr_vec3 o = lr_v3_add(b, lr_v3_scale(n, eps));

@@ -62,14 +62,10 @@ static double now_s(void)
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
-/* The models whose B is known at any point: the profile sampler's (the dipoles, the
- * multipole: those the cavity closure applies to) and the diffusion grid's solved field (its
- * own closure included; the caller passes the field). Translucent radiosity carries this light
- * in its own receiver grid; SH translucency's energy is fitted, not closed. */
+/* The models whose B is known at any point (lr_sss_model_props.no_openings says why not). */
 static bool eligible(const lr_scene_object *o)
 {
-    return o->sss_model == LR_SSS_DIFFUSION_GRID ||
-           !lr_sss_model_props_of(o->sss_model)->no_closure;
+    return !lr_sss_model_props_of(o->sss_model)->no_openings;
 }
 
 bool lr_openings_needed(const lr_scene *s)
@@ -376,8 +372,9 @@ static void b_item(void *ctx, long j)
     double *B = k->op->B[k->l] + 3 * (size_t)j;
     lr_cpu_radiosity_desc d = {.N = LR_OPENINGS_N, .sampler = LR_CPU_REFERENCE,
                                .others = k->objs, .n_others = lr_scene_object_count(k->s)};
-    /* diffusion_grid: B is the solved field (its own closure included; the gain here is 1). */
-    if (k->grid && lr_scene_object_at(k->s, m->obj)->sss_model == LR_SSS_DIFFUSION_GRID)
+    /* diffusion_grid: B is the solved field (its own closure included; the gain here is 1);
+     * other objects have none there. */
+    if (k->grid)
         lr_dscene_field(k->grid, m->obj, k->l, &d.dfield);
     lr_cpu_estimate est;
     lr_cpu_radiosity(lr_scene_object_at(k->s, m->obj), lr_scene_light_at(k->s, k->l), m->x, m->n,

@@ -16,7 +16,9 @@ static const char *const names[LR_SSS_MODEL_COUNT] = {"directional_dipole", "sta
 static const lr_sss_model_props props[LR_SSS_MODEL_COUNT] = {
     [LR_SSS_MULTIPOLE] = {.needs_thickness = "needs thickness_mm (the wall the multipole models)"},
     [LR_SSS_TRANSLUCENT_RADIOSITY] = {.no_closure = "translucent radiosity solves the cavity's "
-                                                    "inter-reflection itself"},
+                                                    "inter-reflection itself",
+                                      .no_openings = "its receiver grid carries the inner "
+                                                     "faces' light (render/transrad/tr_scene.h)"},
     [LR_SSS_DIFFUSION_GRID] = {.no_profile = true,
                                .needs_closed = "needs a closed mesh (the grid diffusion solves "
                                                "inside a solid body)",
@@ -24,7 +26,8 @@ static const lr_sss_model_props props[LR_SSS_MODEL_COUNT] = {
                                              "(render/diffusion/dscene.h: the gain measured "
                                              "from its solved B)"},
     [LR_SSS_SH_TRANSLUCENCY] = {.no_profile = true,
-                                .no_closure = "its energy is fitted, not closed"},
+                                .no_closure = "its energy is fitted, not closed",
+                                .no_openings = "its energy is fitted, not closed"},
 };
 
 const lr_sss_model_props *lr_sss_model_props_of(enum lr_sss_model m)

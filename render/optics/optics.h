@@ -243,6 +243,10 @@ typedef struct lr_sss_model_props {
     /* Why the one-gain cavity closure (render/cpu/cavity.h) does not apply to it; NULL: it
      * applies. */
     const char *no_closure;
+    /* Why the light its inner faces send through the openings is not gathered for it
+     * (render/openings); NULL: it is (its B is known at any point: the profile sampler's, or
+     * the grid's solved field). */
+    const char *no_openings;
 } lr_sss_model_props;
 /* The model's row; an all-zero row for a value outside the enum. */
 const lr_sss_model_props *lr_sss_model_props_of(enum lr_sss_model m);

@@ -44,6 +44,7 @@ static void test_profile(void **state)
     assert_null(none->needs_thickness);
     assert_null(none->needs_closed);
     assert_null(none->no_closure);
+    assert_null(none->no_openings);
 }
 
 static lr_scene *load(const char *name)

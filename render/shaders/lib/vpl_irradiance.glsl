@@ -25,9 +25,9 @@ uniform float u_vis_eps; // mm: the start is moved this far off the surface alon
 // 32 points: on jar_candle the segments from the pool's VPLs that graze the rim slip between
 // 8 points (the wall then kept 2x the visible VPLs' light; tests/render/test_render_vplvis.c).
 // They are spread over the part of the segment inside the objects' bounding sphere, the only
-// part the envelope can block: over the whole segment to a wall 400 mm away they were 12 mm
-// apart, and the candle's 4 mm rim came and went between neighbouring receiver texels
-// (stripes on the wall).
+// part the envelope can block (over the whole segment to a wall 400 mm away they were 12 mm
+// apart, three times the candle's rim). The envelope's texels are the test's resolution too:
+// at the default 64^2 a face each VPL's shadow edge stepped with them (render/README.md).
 #define LR_VIS_STEPS 32
 
 bool lr_vpl_visible(vec3 xv, vec3 nv, vec3 x)
