@@ -61,7 +61,13 @@ void lr_dscene_destroy(lr_dscene *d)
 
 double lr_dscene_spacing(const lr_scene_object *o)
 {
-    return o->dgrid_h_mm > 0.0 ? o->dgrid_h_mm : fmax(o->radius, 1e-3) / LR_DSCENE_AUTO_CELLS;
+    if (o->dgrid_h_mm > 0.0)
+        return o->dgrid_h_mm;
+    const double r = fmax(o->radius, 1e-3);
+    double h = r / LR_DSCENE_AUTO_CELLS;
+    if (o->wall_mm > 0.0)
+        h = fmin(h, o->wall_mm / LR_DSCENE_WALL_CELLS);
+    return fmax(h, r / LR_DSCENE_MAX_CELLS);
 }
 
 typedef struct qctx {

@@ -24,8 +24,16 @@
 #include "render/diffusion/dgrid.h"
 #include "render/scene/scene.h"
 
-/* Default grid spacing: the object's bounding radius over this (objects[i].dgrid_h_mm = 0). */
+/* Default grid spacing (objects[i].dgrid_h_mm = 0): the object's bounding radius over
+ * LR_DSCENE_AUTO_CELLS, finer where its thinnest wall (lr_scene_object.wall_mm) would get fewer
+ * than LR_DSCENE_WALL_CELLS cells across: with about one cell across a wall, its two faces'
+ * boundary conditions share nodes and the wall passes too much light (jar_candle's 4 mm rim
+ * at 3.2 mm: the outer face's blue 1.26 of the reference's, 1.17 at 1.6 mm;
+ * render/diffusion/README.md). Never finer than the radius over LR_DSCENE_MAX_CELLS (the
+ * grid's memory and solve go as the cube). */
 #define LR_DSCENE_AUTO_CELLS 20.0
+#define LR_DSCENE_WALL_CELLS 2.5
+#define LR_DSCENE_MAX_CELLS 64.0
 /* The cavity closure's measurement (render/cpu/cavity.h): light directions and surface points;
  * the field is cheap to evaluate, so many points (a few ms). */
 #define LR_DSCENE_CAVITY_DIRECTIONS 4096
@@ -59,7 +67,7 @@ bool lr_dscene_cavity_gain(const lr_dscene *d, int object, int light, double gai
 bool lr_dscene_rebuilt(const lr_dscene *d, int object);
 /* Finest-grid BiCGSTAB iterations of the last update, all objects, lights and bands. */
 int lr_dscene_last_iters(const lr_dscene *d);
-/* The grid spacing object o gets (its dgrid_h_mm, or the auto rule). */
+/* The grid spacing object o gets (its dgrid_h_mm, or the auto rule above). */
 double lr_dscene_spacing(const lr_scene_object *o);
 
 /* q for a unit-intensity light at b (normal n out of the object); shadowed by obj's mesh. */

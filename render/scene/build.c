@@ -9,6 +9,7 @@
 #include "render/base/mat4.h"
 #include "render/mesh/mesh_io.h"
 #include "render/mesh/refine.h"
+#include "render/mesh/wall.h"
 #include "render/scene/scene_internal.h"
 
 int lr_scene_resolve_path(const lr_scene *s, const char *rel, char *out, size_t cap)
@@ -153,6 +154,7 @@ void lr_scene_object_attach(lr_scene_object *pub, const lr_mesh *world, const lr
     lr_mesh_report rep;
     lr_mesh_analyze(world, &rep);
     pub->closed = rep.closed;
+    pub->wall_mm = rep.closed ? lr_mesh_wall_thickness(bvh) : 0.0;
 }
 
 int lr_scene_build_receiver(const lr_scene *s, lr_receiver *r, lr_mesh **mesh, lr_bvh **bvh,

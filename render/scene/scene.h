@@ -75,6 +75,7 @@ typedef struct lr_scene_object {
     double radius;        /*   cameras sit on it */
     double area;          /* world surface area, mm^2 */
     bool closed;          /* watertight (a shade with rims is; one without is not) */
+    double wall_mm;       /* closed: its thinnest wall (lr_mesh_wall_thickness); else 0 */
     enum lr_sss_model sss_model; /* "model": the S_d the radiosity estimator evaluates */
     double thickness_mm;  /* "thickness_mm": the wall the multipole models; 0: not given */
     double dgrid_h_mm;    /* "dgrid_h_mm": diffusion_grid spacing; 0: auto */

@@ -22,6 +22,7 @@
 #include "render/mesh/mesh_io.h"
 #include "render/mesh/shapes.h"
 #include "render/mesh/triangle.h"
+#include "render/mesh/wall.h"
 
 /* ---- helpers ---------------------------------------------------------------------------- */
 
@@ -1117,6 +1118,54 @@ static void test_closest_point_and_hits_exact(void **state)
     lr_mesh_destroy(m);
 }
 
+/* ---- the thinnest wall (wall.h) ------------------------------------------------------------ */
+
+static double wall_of(lr_mesh *m)
+{
+    lr_bvh *b = NULL;
+    lr_err e = {0};
+    assert_int_equal(lr_bvh_create(m, &b, &e), LR_OK);
+    double t = lr_mesh_wall_thickness(b);
+    lr_bvh_destroy(b);
+    lr_mesh_destroy(m);
+    return t;
+}
+
+/* Closed forms: a box's thinnest wall is its smallest side (its two largest faces hold 65 % of
+ * the area, so the percentile lands there); a shade's shell is its thickness along every
+ * facet normal by construction (lr_shade_desc), the rims (the height across) are 2 % of the
+ * area; a sphere's inward normal from a facet centroid is a chord through the centre, 2 R
+ * less the sagitta of a facet at each end (rho^2 / 2R each, rho the facet's circumradius,
+ * about 0.05 R at 5120 facets: under 0.5 % in all). A jar burnt down to
+ * a 4 mm rim: no wall under 4 mm exists, and the thin band by the rim is more than 1 % of the
+ * surface, so the answer lies between 4 mm and the wall halfway down the pool (14.5 mm). */
+static void test_wall_thickness(void **state)
+{
+    (void)state;
+    lr_err e = {0};
+    lr_mesh *m = NULL;
+    assert_int_equal(lr_mesh_box(&(lr_box_desc){.size = lr_v3(100, 60, 20)}, &m, &e), LR_OK);
+    assert_true(fabs(wall_of(m) - 20.0) < 1e-9);
+    double d;
+    assert_int_equal(lr_mesh_shade(&(lr_shade_desc){.thickness = 1.5}, &m, &e), LR_OK);
+    /* Vertices are floats: 100 mm coordinates round by up to 4e-6 mm. */
+    assert_true(fabs(wall_of(m) - 1.5) < 2e-5);
+    assert_int_equal(lr_mesh_sphere(&(lr_sphere_desc){.radius = 40}, &m, &e), LR_OK);
+    d = wall_of(m);
+    assert_true(d > 80.0 * 0.995 && d <= 80.0);
+    assert_int_equal(lr_mesh_candle(&(lr_candle_desc){.radius = 40, .height = 100,
+                                                      .pool_depth = 35, .pool_radius = 36},
+                                    &m, &e),
+                     LR_OK);
+    d = wall_of(m);
+    assert_true(d >= 4.0 - 1e-9 && d < 14.5);
+    /* A pillar without a pool: its thinnest wall is its diameter (70 mm; the top's rays run
+     * 120 mm down). */
+    assert_int_equal(lr_mesh_candle(&(lr_candle_desc){.flat_top = true}, &m, &e), LR_OK);
+    d = wall_of(m);
+    assert_true(d > 70.0 * 0.99 && d <= 70.0 + 1e-9);
+}
+
 /* ---- inside, around ---------------------------------------------------------------------- */
 
 static void test_winding_and_hull(void **state)
@@ -1224,6 +1273,7 @@ int main(void)
         cmocka_unit_test(test_obj_crease_normals),
         cmocka_unit_test(test_bvh_matches_brute_force),
         cmocka_unit_test(test_closest_point_and_hits_exact),
+        cmocka_unit_test(test_wall_thickness),
         cmocka_unit_test(test_winding_and_hull),
         cmocka_unit_test(test_nested_cavity_orientation),
         cmocka_unit_test(test_ray_through_shared_edge),
