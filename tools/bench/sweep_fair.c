@@ -146,7 +146,8 @@ void lrb_sweep_fair_md(FILE *f, const lrb_scene_result *sc, int n)
                "reference's pixels (rendered %d×%d per pixel) against pixel-centre samples (the "
                "bench before). Bias = relative RMSE with both images' noise taken out; median "
                "|ln| over object pixels of ln(model / reference) on the band sums; floor = the "
-               "same between two references of independent seeds (scaled to %d spp each); "
+               "same between two references of independent seeds (scaled to two of the first one's "
+               "samples: the first is %d spp, more where committed); "
                "receiver power = Σ model / Σ reference over receiver pixels ± the reference's "
                "standard error.\n\n",
             ss, ss, LRB_SWEEP_SPP);
@@ -160,7 +161,7 @@ void lrb_sweep_fair_md(FILE *f, const lrb_scene_result *sc, int n)
         pair(f, s->centre_bias_receivers, s->fair.bias_receivers);
         pair(f, s->mal_centre, s->fair.mal);
         if (isfinite(s->mal_floor))
-            fprintf(f, " %.3f (%d vs %d spp: %.3f) |", s->mal_floor, LRB_SWEEP_SPP, s->ref2_spp,
+            fprintf(f, " %.3f (%d vs %d spp: %.3f) |", s->mal_floor, s->ref_spp, s->ref2_spp,
                     s->mal_floor_raw);
         else
             fprintf(f, " – |");

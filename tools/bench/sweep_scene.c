@@ -175,6 +175,28 @@ static void series_bias(const lr_eval_series *ser, const lrb_setting *st, const 
                  lr_eval_rel_rmse(I, C, m->receivers, n) * k);
 }
 
+/* The first reference (seed 0): from the cache at the most samples committed
+ * (LRB_SWEEP_SPP_MAX), else at LRB_SWEEP_SPP, rendered and cached when not there. */
+static int first_reference(const lr_ref_scene *rs, const lr_ref_camera *cam, const char *dir,
+                           lr_ref_image *mean, lr_ref_image *var, int *spp, bool *hit,
+                           lr_err *e)
+{
+    lr_ref_render_desc rd = {.width = LRB_SWEEP_W, .height = LRB_SWEEP_H, .spp = LRB_SWEEP_SPP};
+    for (int n = LRB_SWEEP_SPP_MAX; n > LRB_SWEEP_SPP; n /= 2) {
+        lr_ref_render_desc d = rd;
+        d.spp = n;
+        char key[17], path[1200];
+        lr_ref_cache_key(rs, cam, &d, key);
+        snprintf(path, sizeof path, "%s/%s.pfm", dir, key);
+        if (!access(path, R_OK)) {
+            rd = d;
+            break;
+        }
+    }
+    *spp = rd.spp;
+    return lr_ref_render_cached(rs, cam, &rd, dir, NULL, NULL, mean, var, hit, e);
+}
+
 /* The second reference (seed LRB_SWEEP_SEED2): from the cache at LRB_SWEEP_SPP samples, else
  * at LRB_SWEEP_SPP2, else rendered at LRB_SWEEP_SPP2 and cached beside the first. */
 static int second_reference(const lr_ref_scene *rs, const lr_ref_camera *cam, const char *dir,
@@ -310,11 +332,11 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
     lr_ref_camera cam;
     if ((rc = lr_ref_scene_from_scene(s, &rs, &cam, &e)))
         goto done;
-    lr_ref_render_desc rd = {.width = w, .height = h, .spp = LRB_SWEEP_SPP};
-    fprintf(stderr, "bench sweep: %s: reference %dx%d, %d spp ...\n", name, w, h, rd.spp);
-    if ((rc = lr_ref_render_cached(rs, &cam, &rd, refdir, NULL, NULL, &mean, &var, &res->ref_hit,
-                                   &e)))
+    fprintf(stderr, "bench sweep: %s: reference %dx%d ...\n", name, w, h);
+    if ((rc = first_reference(rs, &cam, refdir, &mean, &var, &res->ref_spp, &res->ref_hit, &e)))
         goto done;
+    fprintf(stderr, "bench sweep: %s: reference at %d spp %s\n", name, res->ref_spp,
+            res->ref_hit ? "from the cache" : "rendered");
     res->ref_s = lrb_now() - t0;
     if ((rc = second_reference(rs, &cam, refdir, &mean2, &var2, &res->ref2_spp, &res->ref2_hit,
                                &e))) {
@@ -332,7 +354,7 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
          * of spp samples times sqrt((1/spp + 1/spp2) / (2/spp)). */
         res->mal_floor_raw = lr_eval_median_abs_log(mean.rgb, mean2.rgb, m.object, n);
         res->mal_floor = res->mal_floor_raw *
-                         sqrt(2.0 / (1.0 + (double)LRB_SWEEP_SPP / res->ref2_spp));
+                         sqrt(2.0 / (1.0 + (double)res->ref_spp / res->ref2_spp));
     }
     both = malloc(n);
     direct = calloc(n, 1);

@@ -20,7 +20,7 @@ static void scene_block(FILE *f, const lrb_scene_result *sc, const lr_eval_row *
                "%.4f (objects) / %.4f (receivers) / %.4f (both). It is taken out of every error "
                "below in quadrature (E[rmse²] = error² + se²). %ld object and %ld receiver "
                "pixels.\n\n",
-            LRB_SWEEP_SPP, LRB_SWEEP_W, LRB_SWEEP_H, sc->ref_hit ? "read from the cache" : "rendered",
+            sc->ref_spp, LRB_SWEEP_W, LRB_SWEEP_H, sc->ref_hit ? "read from the cache" : "rendered",
             sc->ref_s, sc->ref_se_object, sc->ref_se_receivers, sc->ref_se_all, sc->object_px,
             sc->receiver_px);
     if (isfinite(sc->units_ratio))
