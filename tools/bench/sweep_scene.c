@@ -175,6 +175,16 @@ static void series_bias(const lr_eval_series *ser, const lrb_setting *st, const 
                  lr_eval_rel_rmse(I, C, m->receivers, n) * k);
 }
 
+/* Whether the cache in dir holds the reference d describes. */
+static bool cached(const lr_ref_scene *rs, const lr_ref_camera *cam, const char *dir,
+                   const lr_ref_render_desc *d)
+{
+    char key[17], path[1200];
+    lr_ref_cache_key(rs, cam, d, key);
+    snprintf(path, sizeof path, "%s/%s.pfm", dir, key);
+    return !access(path, R_OK);
+}
+
 /* The first reference (seed 0): from the cache at the most samples committed
  * (LRB_SWEEP_SPP_MAX), else at LRB_SWEEP_SPP, rendered and cached when not there. */
 static int first_reference(const lr_ref_scene *rs, const lr_ref_camera *cam, const char *dir,
@@ -185,10 +195,7 @@ static int first_reference(const lr_ref_scene *rs, const lr_ref_camera *cam, con
     for (int n = LRB_SWEEP_SPP_MAX; n > LRB_SWEEP_SPP; n /= 2) {
         lr_ref_render_desc d = rd;
         d.spp = n;
-        char key[17], path[1200];
-        lr_ref_cache_key(rs, cam, &d, key);
-        snprintf(path, sizeof path, "%s/%s.pfm", dir, key);
-        if (!access(path, R_OK)) {
+        if (cached(rs, cam, dir, &d)) {
             rd = d;
             break;
         }
@@ -203,22 +210,16 @@ static int second_reference(const lr_ref_scene *rs, const lr_ref_camera *cam, co
                             lr_ref_image *mean, lr_ref_image *var, int *spp, bool *hit,
                             lr_err *e)
 {
-    const int spps[2] = {LRB_SWEEP_SPP, LRB_SWEEP_SPP2};
     lr_ref_render_desc rd = {.width = LRB_SWEEP_W, .height = LRB_SWEEP_H,
-                             .seed = LRB_SWEEP_SEED2, .spp = LRB_SWEEP_SPP2};
-    bool cached = false;
-    for (int i = 0; i < 2 && !cached; i++) {
-        lr_ref_render_desc d = rd;
-        d.spp = spps[i];
-        char key[17], path[1200];
-        lr_ref_cache_key(rs, cam, &d, key);
-        snprintf(path, sizeof path, "%s/%s.pfm", dir, key);
-        if (!access(path, R_OK))
-            rd = d, cached = true;
+                             .seed = LRB_SWEEP_SEED2, .spp = LRB_SWEEP_SPP};
+    bool found = cached(rs, cam, dir, &rd);
+    if (!found) {
+        rd.spp = LRB_SWEEP_SPP2;
+        found = cached(rs, cam, dir, &rd);
     }
     *spp = rd.spp;
     const char *mode = getenv("LRB_SWEEP_REF2");
-    if (!cached && mode && !strcmp(mode, "cached"))
+    if (!found && mode && !strcmp(mode, "cached"))
         return lr_err_set(e, LR_EIO, "no seed-%d reference at %d or %d spp in %s "
                           "(LRB_SWEEP_REF2=cached)", LRB_SWEEP_SEED2, LRB_SWEEP_SPP,
                           LRB_SWEEP_SPP2, dir);
