@@ -382,5 +382,15 @@ void lr_objlight_factors(const lr_scene_object *o, double kR[3], double kT[3])
     }
 }
 
+void lr_objlight_albedo(const lr_scene_object *o, double rho[3])
+{
+    double R[3], T[3], ft = lr_lpv_fresnel_diffuse(o->coeffs.eta);
+    lr_lpv_object_totals(o, R, T);
+    for (int c = 0; c < 3; c++) {
+        double r = 1.0 - ft + ft * R[c];
+        rho[c] = isfinite(r) && r > 0.0 ? (r < 1.0 ? r : 1.0) : 0.0;
+    }
+}
+
 double lr_objlight_build_s(const lr_objlight *ol) { return ol ? ol->build_s : 0.0; }
 bool lr_objlight_cache_hit(const lr_objlight *ol) { return ol && ol->cache_hit; }

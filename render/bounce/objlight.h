@@ -81,6 +81,11 @@ void lr_objlight_at(const lr_objlight *ol, int mesh, int slot, size_t tri, doubl
                     double E[6]);
 /* Object o's kR, kT (above): B_recv = kR E+ + kT E- on the front side. */
 void lr_objlight_factors(const lr_scene_object *o, double kR[3], double kT[3]);
+/* The diffuse albedo object o shows the receivers' light (rbounce.c's object patches): the
+ * interface's reflection of diffuse light, 1 - <F_t>, plus what enters and its total diffuse
+ * reflectance R sends back out, <F_t> R (kR's exitance). Light the model sends through a wall
+ * (T) is not in it: it leaves on the far side, which the receivers' patches do not tell. */
+void lr_objlight_albedo(const lr_scene_object *o, double rho[3]);
 /* Seconds the last create took. */
 double lr_objlight_build_s(const lr_objlight *ol);
 /* Whether create read the rows from the cache instead of casting them. */

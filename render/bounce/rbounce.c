@@ -14,6 +14,9 @@
 #define KEY_MAX (3 + LR_TR_MAX_SURFACES * (LR_TR_KEY_MESH + 5))
 #define LKEY 20 /* doubles per light shape */
 #define MAX_LIGHTS 8
+/* Object patches: the receivers' light they reflect back varies over a body as the receivers'
+ * does over their 30 mm cells. */
+#define OBJECT_PATCH_MM 30
 
 struct lr_rbounce {
     lr_tr *tr;
@@ -27,6 +30,8 @@ struct lr_rbounce {
     double *Evpl;           /* n x 3: the VPL grids' patch means */
     int *cnt;               /* n: scratch, texels per patch */
     double *E;              /* n x 3 scratch */
+    double *open;           /* n: each patch's open fraction (lr_tr_open_fraction) */
+    unsigned char *covered[LR_TR_MAX_SURFACES]; /* per receiver, R^2: texel inside a body */
     float *out[LR_TR_MAX_SURFACES][LR_TR_MAX_SLOTS]; /* per receiver, slot: R^2 x 3 */
     lr_objlight *ol;        /* render.receiver_light_on_objects: the objects' E (objlight.h) */
     double build_s, direct_s, solve_s;
@@ -104,8 +109,13 @@ static void free_solver(lr_rbounce *rb)
     free(rb->Evpl);
     free(rb->E);
     free(rb->cnt);
-    rb->Evpl = rb->E = NULL;
+    free(rb->open);
+    rb->Evpl = rb->E = rb->open = NULL;
     rb->cnt = NULL;
+    for (int r = 0; r < LR_TR_MAX_SURFACES; r++) {
+        free(rb->covered[r]);
+        rb->covered[r] = NULL;
+    }
     for (int r = 0; r < LR_TR_MAX_SURFACES; r++)
         for (int sl = 0; sl < LR_TR_MAX_SLOTS; sl++) {
             free(rb->out[r][sl]);
@@ -122,8 +132,8 @@ void lr_rbounce_destroy(lr_rbounce *rb)
     free(rb);
 }
 
-/* The objects as occluders (diffuse, albedo 0: one patch per facing, their F rows unused)
- * and the receivers (planes as grids, boxes as meshes) with their albedo. */
+/* The objects (diffuse, the albedo they show diffuse light, no E of their own) and the
+ * receivers (planes as grids, boxes as meshes) with their albedo. */
 static int build(lr_rbounce *rb, const lr_scene *s, lr_err *e)
 {
     int no = lr_scene_object_count(s), nr = lr_scene_receiver_count(s), n = 0;
@@ -134,8 +144,10 @@ static int build(lr_rbounce *rb, const lr_scene *s, lr_err *e)
     lr_tr_surface_desc d[LR_TR_MAX_SURFACES];
     for (int i = 0; i < no; i++) {
         const lr_scene_object *o = lr_scene_object_at(s, i);
-        d[n++] = (lr_tr_surface_desc){.kind = LR_TR_DIFFUSE, .mesh = o->mesh, .bvh = o->bvh,
-                                      .patch_mm = 1e5};
+        /* A closed body covers the receiver cells it stands on (render/transrad/cover.c). */
+        d[n] = (lr_tr_surface_desc){.kind = LR_TR_DIFFUSE, .mesh = o->mesh, .bvh = o->bvh,
+                                    .patch_mm = OBJECT_PATCH_MM, .covers = o->closed};
+        lr_objlight_albedo(o, d[n++].albedo);
     }
     for (int i = 0; i < nr; i++) {
         const lr_receiver *r = lr_scene_receiver_at(s, i);
@@ -158,10 +170,31 @@ static int build(lr_rbounce *rb, const lr_scene *s, lr_err *e)
     rb->Evpl = calloc(n3, sizeof *rb->Evpl);
     rb->E = calloc(n3, sizeof *rb->E);
     rb->cnt = calloc(rb->n ? rb->n : 1, sizeof *rb->cnt);
-    if (!rb->Evpl || !rb->E || !rb->cnt)
+    rb->open = calloc(rb->n ? rb->n : 1, sizeof *rb->open);
+    if (!rb->Evpl || !rb->E || !rb->cnt || !rb->open)
         return lr_err_set(e, LR_ENOMEM, "receiver bounce: out of memory (%zu patches)", rb->n);
     rb->n_obj = no;
     rb->n_rcv = nr;
+    for (size_t p = 0; p < rb->n; p++)
+        rb->open[p] = lr_tr_open_fraction(rb->tr, p);
+    /* The texels inside a body standing on a receiver: left out of the VPL grid's cell means,
+     * which are over the cells' open part like the solver's F and E. */
+    const int R = LR_RECV_GRID;
+    for (int r = 0; r < nr; r++) {
+        size_t first, count;
+        lr_tr_surface_patches(rb->tr, no + r, &first, &count);
+        bool any = false;
+        for (size_t p = first; p < first + count; p++)
+            any = any || rb->open[p] < 1;
+        if (!any)
+            continue;
+        if (!(rb->covered[r] = calloc((size_t)R * R, 1)))
+            return lr_err_set(e, LR_ENOMEM, "receiver bounce: out of memory (covered texels)");
+        for (int t = 0; t < R; t++)
+            for (int c = 0; c < R; c++)
+                rb->covered[r][(size_t)t * R + (size_t)c] =
+                    lr_tr_plane_point_covered(rb->tr, no + r, (c + 0.5) / R, (t + 0.5) / R);
+    }
     if (!lr_scene_render(s)->receiver_light_on_objects || no == 0)
         return LR_OK;
     /* The receivers' light on the objects: rows of every object vertex against the
@@ -230,7 +263,8 @@ int lr_rbounce_update(lr_rbounce **rbp, const lr_scene *s, lr_err *e)
     return LR_OK;
 }
 
-/* Patch means of grid texels: the patch of texel (s, t) is the cell holding its centre. */
+/* Patch means of grid texels: the patch of texel (s, t) is the cell holding its centre; texels
+ * inside a body standing on the receiver are not counted. */
 static void vpl_means(lr_rbounce *rb, int r, const float *gf, const double *gd, int stride)
 {
     if (!rb || !rb->tr || r < 0 || r >= rb->n_rcv)
@@ -247,11 +281,14 @@ static void vpl_means(lr_rbounce *rb, int r, const float *gf, const double *gd, 
     int *cnt = rb->cnt;
     memset(cnt, 0, count * sizeof *cnt);
     const int R = LR_RECV_GRID;
+    const unsigned char *covered = rb->covered[r];
     for (int t = 0; t < R; t++) {
         int v = (int)((t + 0.5) * nv / R);
         for (int s = 0; s < R; s++) {
             int u = (int)((s + 0.5) * nu / R);
             size_t k = (size_t)t * R + (size_t)s, p = (size_t)v * (size_t)nu + (size_t)u;
+            if (covered && covered[k])
+                continue;
             for (int b = 0; b < 3; b++) {
                 double x = gf ? gf[k * (size_t)stride + (size_t)b] : gd[k * (size_t)stride + (size_t)b];
                 m[3 * p + (size_t)b] += isfinite(x) && x > 0 ? x : 0;
@@ -275,7 +312,8 @@ void lr_rbounce_vpl_d(lr_rbounce *rb, int r, const double *grid, int stride)
 }
 
 /* E_b of receiver r on the texel grid: bilinear between patch centres ((u + 1/2)/nu of the
- * plane, as the texels' (s + 1/2)/R), clamped at the edges (as render/transrad/tr_scene.c). */
+ * plane, as the texels' (s + 1/2)/R), clamped at the edges (as render/transrad/tr_scene.c),
+ * weighted by the cells' open parts (each cell's E_b is its open part's mean). */
 static int write_grid(lr_rbounce *rb, int r, int slot, lr_err *e)
 {
     int si = rb->n_obj + r, nu, nv;
@@ -290,7 +328,7 @@ static int write_grid(lr_rbounce *rb, int r, int slot, lr_err *e)
     double *X = rb->E; /* the scratch E is free after the solve */
     for (size_t p = 0; p < count; p++)
         lr_tr_indirect(rb->tr, slot, first + p, X + 3 * p);
-    lr_tr_plane_to_grid(X, nu, nv, *out);
+    lr_tr_plane_to_grid(X, rb->open + first, nu, nv, *out);
     return LR_OK;
 }
 

@@ -8,14 +8,18 @@
  *
  *     B = (I - P F)^-1 P E                                 (seed 000 Eq. 2 / Eq. 14, S = P)
  *
- * over patches of the receivers (render/transrad's plane grids, 30 mm), F by cosine ray casts
- * with the objects as occluders (their patches have albedo 0: light that reaches an object
- * is absorbed, the objects' own lighting by receivers is not this module's), E per patch the
- * light's direct irradiance (shadow rays, spot cone, area lights' closed form) plus the VPLs'
- * emergent irradiance averaged over the patch's texels of the grid, and writes the bounced
- * irradiance E_b = F B (all orders; what the direct and VPL terms do not already carry) at
- * the grid's texel centres, bilinear between patch centres. Composition adds it through the
- * grid (render/passes/irradiance.c on the GPU, render/cpu/frame.c in the twin).
+ * over patches of the receivers (render/transrad's plane grids, 30 mm) and of the objects
+ * (30 mm), F by cosine ray casts. An object's patches reflect the receivers' light with the
+ * albedo its material shows diffuse light (lr_objlight_albedo: the interface's 1 - <F_t> plus
+ * <F_t> R) and get no E of their own (their glow is the VPLs'): the light a wax body sends
+ * back to the table at its foot. A closed body covers the receiver cells it stands on: their
+ * F, E and solution are over their open part (render/transrad/cover.c). E per receiver patch
+ * is the light's direct irradiance (shadow rays, spot cone, area lights' closed form) plus the
+ * VPLs' emergent irradiance averaged over the patch's open texels of the grid; the bounced
+ * irradiance E_b = F B (all orders; what the direct and VPL terms do not already carry) is
+ * written at the grid's texel centres, bilinear between patch centres weighted by their open
+ * fractions. Composition adds it through the grid (render/passes/irradiance.c on the GPU,
+ * render/cpu/frame.c in the twin).
  *
  * Everything is linear in the lights: the GPU solves per light slot at unit intensity (E =
  * E_dir,l + E_vpl,l), so a dimmer turn stays blend-only; the twin, whose grid sums the lights

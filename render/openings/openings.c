@@ -412,7 +412,7 @@ static int solve_light(lr_openings *op, const lr_scene *s, const struct lr_dscen
         int rc = lr_openings_apply(op, r, op->B[l], op->X, e);
         if (rc)
             return rc;
-        lr_tr_plane_to_grid(op->X, op->nu[r], op->nv[r], op->grid[r][l]);
+        lr_tr_plane_to_grid(op->X, NULL, op->nu[r], op->nv[r], op->grid[r][l]);
     }
     return LR_OK;
 }

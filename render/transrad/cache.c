@@ -32,7 +32,8 @@ uint64_t lr_tr_cache_key(const lr_tr *t)
     lr_ref_hash h;
     lr_ref_hash_init(&h);
     /* v2: thin walls' S columns (thinwall.c) */
-    lr_ref_hash_str(&h, "lamprig transrad F S v5");
+    /* v6: rows of plane cells over their open part (cover.c) */
+    lr_ref_hash_str(&h, "lamprig transrad F S v6");
     /* The file holds native size_t, float and byte order: another machine is another key. */
     const uint32_t order = 0x01020304u;
     lr_ref_hash_u64(&h, sizeof(size_t));
@@ -46,6 +47,7 @@ uint64_t lr_tr_cache_key(const lr_tr *t)
     for (int s = 0; s < t->nsurf; s++) {
         const lr_tr_surface_desc *d = &t->surf[s].d;
         lr_ref_hash_u64(&h, (uint64_t)d->kind);
+        lr_ref_hash_u64(&h, (uint64_t)d->covers);
         for (int b = 0; b < 3; b++)
             lr_ref_hash_double(&h, d->albedo[b]);
         if (d->kind == LR_TR_TRANSLUCENT) {

@@ -59,17 +59,22 @@ void lr_tr_direct_patch(lr_tr *t, size_t p, lr_tr_point_irradiance point, const 
     lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(t->set.seed, 0xD1EC, p, 0));
     double ju = lr_cpu_rng_next(&rng), jv = lr_cpu_rng_next(&rng);
     double e = 0, ein = 0;
+    unsigned open = 0;
     for (unsigned k = 0; k < m; k++) {
         lr_vec3 x, n;
         lr_tr_patch_point(t, p, k, m, ju, jv, &x, &n);
+        /* The mean over a plane cell's open part (cover.c). */
+        if (lr_tr_point_covered(t, p, x))
+            continue;
+        open++;
         double ek, eik;
         point(ctx, p, k, x, n, trans, eta, &ek, &eik);
         e += ek;
         ein += eik;
     }
     for (int b = 0; b < 3; b++) {
-        t->Edir[3 * p + (size_t)b] = e / m;
-        t->Ein[3 * p + (size_t)b] = ein / m;
+        t->Edir[3 * p + (size_t)b] = open ? e / open : 0;
+        t->Ein[3 * p + (size_t)b] = open ? ein / open : 0;
     }
 }
 

@@ -49,13 +49,19 @@ static void ff_item(void *vctx, long item)
         c->failed = 1;
         return;
     }
-    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(t->set.seed, 0xF0F0, p, 0));
-    double ju = lr_cpu_rng_next(&rng), jv = lr_cpu_rng_next(&rng);
-    double jd1 = lr_cpu_rng_next(&rng), jd2 = lr_cpu_rng_next(&rng);
+    double jit[4];
+    lr_tr_ff_jitter(t, p, jit);
+    double ju = jit[0], jv = jit[1], jd1 = jit[2], jd2 = jit[3];
     size_t nh = 0, escaped = 0;
+    int open = 0;
     for (int k = 0; k < R; k++) {
         lr_vec3 x, n, t1, t2;
         lr_tr_patch_point(t, p, (unsigned)k, (unsigned)R, ju, jv, &x, &n);
+        /* A point inside a body standing on a plane is no surface (cover.c): the row is
+         * over the cell's open part. */
+        if (lr_tr_point_covered(t, p, x))
+            continue;
+        open++;
         frame_of(n, &t1, &t2);
         double u1 = lr_halton((unsigned)k + 1, 5) + jd1, u2 = lr_halton((unsigned)k + 1, 7) + jd2;
         u1 -= floor(u1);
@@ -90,12 +96,12 @@ static void ff_item(void *vctx, long item)
         while (j < nh && hits[j] == hits[i])
             j++;
         c->cols[p][w] = (uint32_t)hits[i];
-        c->vals[p][w] = (float)((double)(j - i) / R);
+        c->vals[p][w] = (float)((double)(j - i) / open);
         w++;
         i = j;
     }
     c->counts[p] = w;
-    t->escape[p] = (double)escaped / R;
+    t->escape[p] = open ? (double)escaped / open : 0;
     free(hits);
 }
 

@@ -56,7 +56,19 @@ struct lr_tr {
     lr_tr_slot slot[LR_TR_MAX_SLOTS];
     lr_tr_transfer X;
     bool cache_hit;       /* F and S came from the cache (cache.c) */
+    /* cover.c: per patch, whether it is a plane cell that meets a covering body's bounds,
+     * and its open fraction (1 elsewhere); both NULL when no surface covers. */
+    unsigned char *cover_check;
+    double *open;
 };
+
+/* cover.c: the open part of plane cells under closed bodies (the surfaces marked covers).
+ * Builds cover_check and open (after the patches); whether point x of patch p lies inside a
+ * covering body; the jitter of patch p's form-factor rays (formfactor.c's points: origins
+ * u, v, directions). */
+int lr_tr_build_cover(lr_tr *t, lr_err *e);
+bool lr_tr_point_covered(const lr_tr *t, size_t p, lr_vec3 x);
+void lr_tr_ff_jitter(const lr_tr *t, size_t p, double j[4]);
 
 /* patches.c */
 int lr_tr_build_patches(lr_tr *t, lr_err *e);

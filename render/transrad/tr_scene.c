@@ -37,7 +37,7 @@ bool lr_tr_scene_needed(const lr_scene *s)
     return false;
 }
 
-void lr_tr_plane_to_grid(const double *X, int nu, int nv, float *out)
+void lr_tr_plane_to_grid(const double *X, const double *open, int nu, int nv, float *out)
 {
     const int R = LR_RECV_GRID;
     for (int t = 0; t < R; t++)
@@ -48,13 +48,21 @@ void lr_tr_plane_to_grid(const double *X, int nu, int nv, float *out)
             int u0 = (int)floor(u), v0 = (int)floor(v);
             int u1 = u0 + 1 < nu ? u0 + 1 : u0, v1 = v0 + 1 < nv ? v0 + 1 : v0;
             double fu = u - u0, fv = v - v0;
+            size_t c[4] = {(size_t)v0 * nu + u0, (size_t)v0 * nu + u1, (size_t)v1 * nu + u0,
+                           (size_t)v1 * nu + u1};
+            double w[4] = {(1 - fu) * (1 - fv), fu * (1 - fv), (1 - fu) * fv, fu * fv}, ws = 0;
+            /* Weighted by the cells' open parts: a cell mostly under a body's foot holds its
+             * open part's mean over little area, so it pulls its neighbours' texels in
+             * proportion (a covered texel itself is never seen). */
+            for (int k = 0; k < 4; k++) {
+                w[k] *= open ? open[c[k]] : 1.0;
+                ws += w[k];
+            }
             for (int b = 0; b < 3; b++) {
-                double a00 = X[3 * ((size_t)v0 * nu + u0) + b];
-                double a10 = X[3 * ((size_t)v0 * nu + u1) + b];
-                double a01 = X[3 * ((size_t)v1 * nu + u0) + b];
-                double a11 = X[3 * ((size_t)v1 * nu + u1) + b];
-                out[3 * ((size_t)t * R + s) + b] = (float)((1 - fv) * ((1 - fu) * a00 + fu * a10) +
-                                                           fv * ((1 - fu) * a01 + fu * a11));
+                double x = 0;
+                for (int k = 0; k < 4 && ws > 0; k++)
+                    x += w[k] * X[3 * c[k] + (size_t)b];
+                out[3 * ((size_t)t * R + s) + b] = (float)(ws > 0 ? x / ws : 0);
             }
         }
 }
@@ -221,7 +229,7 @@ static int receiver_values(lr_tr_scene *ts, const lr_scene *s, int ri, int l, lr
         free(use);
         return LR_OK;
     }
-    lr_tr_plane_to_grid(X, nu, nv, out);
+    lr_tr_plane_to_grid(X, NULL, nu, nv, out);
     free(X);
     free(use);
     ts->rE[ri][l] = out;

@@ -34,8 +34,10 @@ typedef struct lr_tr_scene lr_tr_scene;
 #define LR_TR_KEY_MESH 14
 /* Values X (3 per patch, row v of nu patches at X + 3 nu v) on a plane receiver's nu x nv
  * patch grid, bilinear between the patch centres (clamped at the edges) at the LR_RECV_GRID^2
- * texel centres of its receiver grid, into out (3 floats per texel, s + LR_RECV_GRID t). */
-void lr_tr_plane_to_grid(const double *X, int nu, int nv, float *out);
+ * texel centres of its receiver grid, into out (3 floats per texel, s + LR_RECV_GRID t). With
+ * open (a fraction per patch, lr_tr_open_fraction) the bilinear weights are scaled by it and
+ * renormalised (0 where every weight is 0); NULL: plain bilinear. */
+void lr_tr_plane_to_grid(const double *X, const double *open, int nu, int nv, float *out);
 void lr_tr_key_mesh(double *k, int *n, const lr_mesh *m, const lr_bvh *b);
 
 /* Whether any object of s uses the model. */

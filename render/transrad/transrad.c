@@ -92,7 +92,7 @@ int lr_tr_create(const lr_tr_surface_desc *surfaces, int count, const lr_tr_sett
         if (surfaces[i].kind != LR_TR_PLANE && (rc = lr_tr_refine(t, i, e)))
             goto fail;
     }
-    if ((rc = lr_tr_build_patches(t, e)))
+    if ((rc = lr_tr_build_patches(t, e)) || (rc = lr_tr_build_cover(t, e)))
         goto fail;
     t->Edir = calloc(3 * (t->n ? t->n : 1), sizeof *t->Edir);
     t->Ein = calloc(3 * (t->n ? t->n : 1), sizeof *t->Ein);
@@ -139,6 +139,8 @@ void lr_tr_destroy(lr_tr *t)
     lr_tr_rows_free(&t->F);
     lr_tr_rows_free(&t->S);
     free(t->escape);
+    free(t->cover_check);
+    free(t->open);
     free(t->Edir);
     free(t->Ein);
     free(t->tris);

@@ -81,6 +81,10 @@ typedef struct lr_tr_surface_desc {
     double size_u, size_v;
     int cells_u, cells_v; /* plane grid; 0: from patch_mm */
     double patch_mm;      /* cluster cell edge; 0: the settings' */
+    /* diffuse or translucent: a closed body; the part of a plane cell inside it is no
+     * surface (render/transrad/cover.c): the plane cells' F, E and solution are over their
+     * open part, lr_tr_open_fraction */
+    bool covers;
 } lr_tr_surface_desc;
 
 typedef struct lr_tr_settings {
@@ -176,6 +180,12 @@ int lr_tr_patch_surface(const lr_tr *t, size_t p);
 /* A plane surface's grid: patch first + u + nu v is the cell (u, v), u along its size_u.
  * False (and 0 x 0) for other kinds. */
 bool lr_tr_plane_grid(const lr_tr *t, int s, int *nu, int *nv);
+/* The fraction of plane cell p outside every covering body (the desc's covers; cover.c):
+ * its F, E and solution are means over that part. 1 for any other patch. */
+double lr_tr_open_fraction(const lr_tr *t, size_t p);
+/* Whether the point at (fu, fv) of plane surface s (fractions of size_u, size_v from its
+ * corner at -size/2, as the receivers' texels) lies inside a covering body. */
+bool lr_tr_plane_point_covered(const lr_tr *t, int s, double fu, double fv);
 /* The patch a surface's triangle belongs to (plane: the cell of the point x on it). */
 size_t lr_tr_patch_of(const lr_tr *t, int surface, size_t triangle, lr_vec3 x);
 /* F_pq: fraction of the light leaving p diffusely that reaches q (first hit). */
