@@ -132,8 +132,8 @@ void lr_rbounce_destroy(lr_rbounce *rb)
     free(rb);
 }
 
-/* The objects (diffuse, the albedo they show diffuse light, no E of their own) and the
- * receivers (planes as grids, boxes as meshes) with their albedo. */
+/* The objects (diffuse, no E of their own) and the receivers (planes as grids, boxes as
+ * meshes) with their albedo. */
 static int build(lr_rbounce *rb, const lr_scene *s, lr_err *e)
 {
     int no = lr_scene_object_count(s), nr = lr_scene_receiver_count(s), n = 0;
@@ -144,10 +144,11 @@ static int build(lr_rbounce *rb, const lr_scene *s, lr_err *e)
     lr_tr_surface_desc d[LR_TR_MAX_SURFACES];
     for (int i = 0; i < no; i++) {
         const lr_scene_object *o = lr_scene_object_at(s, i);
-        /* A closed body covers the receiver cells it stands on (render/transrad/cover.c). */
-        d[n] = (lr_tr_surface_desc){.kind = LR_TR_DIFFUSE, .mesh = o->mesh, .bvh = o->bvh,
-                                    .patch_mm = OBJECT_PATCH_MM, .covers = o->closed};
-        lr_objlight_albedo(o, d[n++].albedo);
+        /* A closed body covers the receiver cells it stands on (render/transrad/cover.c). Its
+         * albedo follows its material (set_object_albedo at every update): 0 here, so that F
+         * and its cache do not depend on the material. */
+        d[n++] = (lr_tr_surface_desc){.kind = LR_TR_DIFFUSE, .mesh = o->mesh, .bvh = o->bvh,
+                                      .patch_mm = OBJECT_PATCH_MM, .covers = o->closed};
     }
     for (int i = 0; i < nr; i++) {
         const lr_receiver *r = lr_scene_receiver_at(s, i);
@@ -212,6 +213,21 @@ static int build(lr_rbounce *rb, const lr_scene *s, lr_err *e)
                               &rb->ol, e);
 }
 
+/* The objects' patches reflect the receivers' light with the albedo their material shows
+ * diffuse light (lr_objlight_albedo): set at every update, as a material can change (a preset,
+ * a translucency knob) without the geometry, and F does not depend on it. */
+static int set_object_albedo(lr_rbounce *rb, const lr_scene *s, lr_err *e)
+{
+    for (int i = 0; i < rb->n_obj; i++) {
+        double rho[3];
+        lr_objlight_albedo(lr_scene_object_at(s, i), rho);
+        int rc = lr_tr_set_albedo(rb->tr, i, rho, e);
+        if (rc)
+            return rc;
+    }
+    return LR_OK;
+}
+
 int lr_rbounce_update(lr_rbounce **rbp, const lr_scene *s, lr_err *e)
 {
     if (!rbp)
@@ -244,6 +260,8 @@ int lr_rbounce_update(lr_rbounce **rbp, const lr_scene *s, lr_err *e)
         rb->nkey = nk;
         rb->build_s = now_s() - t0;
     }
+    if ((rc = set_object_albedo(rb, s, e)))
+        return rc;
     double t1 = now_s();
     rb->n_lights = lr_scene_light_count(s);
     for (int l = 0; l < rb->n_lights; l++) {

@@ -148,6 +148,27 @@ void lr_tr_destroy(lr_tr *t)
     free(t);
 }
 
+int lr_tr_set_albedo(lr_tr *t, int s, const double albedo[3], lr_err *e)
+{
+    if (!t || !albedo || s < 0 || s >= t->nsurf)
+        return lr_err_set(e, LR_EINVAL, "transrad: set albedo: %s",
+                          !t || !albedo ? "NULL argument" : "no such surface");
+    lr_tr_surf *sf = &t->surf[s];
+    if (sf->d.kind == LR_TR_TRANSLUCENT)
+        return lr_err_set(e, LR_EINVAL, "transrad: surface %d: field 'albedo': a translucent "
+                          "surface's S comes from its profile", s);
+    if (t->X.built)
+        return lr_err_set(e, LR_EINVAL, "transrad: surface %d: field 'albedo': the precomputed "
+                          "transfer holds the old one", s);
+    for (int b = 0; b < 3; b++)
+        if (!(albedo[b] >= 0 && albedo[b] <= 1))
+            return lr_err_set(e, LR_EINVAL, "transrad: surface %d: field 'albedo': %g outside "
+                              "[0, 1]", s, albedo[b]);
+    for (int b = 0; b < 3; b++)
+        sf->d.albedo[b] = albedo[b];
+    return LR_OK;
+}
+
 size_t lr_tr_patch_count(const lr_tr *t) { return t ? t->n : 0; }
 
 bool lr_tr_cache_hit(const lr_tr *t) { return t && t->cache_hit; }

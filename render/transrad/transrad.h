@@ -148,6 +148,12 @@ int lr_tr_solve_irradiance(lr_tr *t, const double *E, int slot, lr_tr_stats *st,
  * lr_tr_solve_irradiance (render/bounce/: the receivers' bounce adds the VPLs' light). */
 int lr_tr_direct_irradiance(lr_tr *t, const lr_light *light, double *E, lr_err *e);
 
+/* A diffuse or plane surface's albedo, changed after create: F does not depend on it (the
+ * next solve uses it; the cache key keeps the albedo create had). LR_EINVAL for a translucent
+ * surface, a value outside [0, 1], or when the precomputed transfer was built (its factors
+ * hold the old albedo). render/bounce: an object's albedo follows its material. */
+int lr_tr_set_albedo(lr_tr *t, int s, const double albedo[3], lr_err *e);
+
 /* The thin-wall rule (render/transrad/thinwall.c): a slab of thickness d (mm) of medium c is
  * thin against patches of patch_mm when it is no thicker than a patch, d <= patch_mm; its S
  * columns then send the slab's R_tot out of the lit face and T_tot out of the opposite one,

@@ -11,7 +11,9 @@
  *  - a point light's direct irradiance cos / d^2 over the open part (1024 stratified points),
  *    within 0.5 % (the coaster's edge shadows a 0.02 mm band); 0 under the coaster;
  *  - without `covers` the same coaster leaves the cells' rows at open x F (the deficit the
- *    receivers' bounce had under a candle's foot), which the flag removes. */
+ *    receivers' bounce had under a candle's foot), which the flag removes;
+ *  - lr_tr_set_albedo: a plane's albedo set after create; out of [0, 1], another surface,
+ *    NULL refused. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -21,6 +23,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "render/mesh/shapes.h"
 #include "render/transrad/transrad.h"
@@ -196,6 +199,15 @@ static void test_covered_cells(void **state)
     assert_false(lr_tr_plane_point_covered(r.t, 1, (-20 + FLOOR / 2) / FLOOR, 0.5));
     assert_false(lr_tr_plane_point_covered(r.t, 2, 0.5, 0.5));
     assert_false(lr_tr_plane_point_covered(old.t, 1, (10 + FLOOR / 2) / FLOOR, 0.6));
+    /* The albedo of a diffuse or plane surface changes after create (F does not depend on
+     * it); bad values and surfaces are refused with the field named. */
+    const double grey[3] = {0.3, 0.3, 0.3}, bright[3] = {0.3, 1.5, 0.3};
+    assert_int_equal(lr_tr_set_albedo(r.t, 1, grey, &e), LR_OK);
+    e = (lr_err){0};
+    assert_int_not_equal(lr_tr_set_albedo(r.t, 1, bright, &e), LR_OK);
+    assert_non_null(strstr(e.msg, "albedo"));
+    assert_int_not_equal(lr_tr_set_albedo(r.t, 7, grey, &e), LR_OK);
+    assert_int_not_equal(lr_tr_set_albedo(NULL, 0, grey, &e), LR_OK);
     free(E);
     rig_free(&r);
     rig_free(&old);

@@ -26,7 +26,8 @@ enum { LRB_SWEEP_SPP_MAX = 16384 };
  * setting's converged bias at each listed factor. */
 enum { LRB_SWEEP_SS = 4 };
 /* The second, independent reference (the noise floor of median |ln ratio|): seed
- * LRB_SWEEP_SEED2, read from the cache at LRB_SWEEP_SPP or else LRB_SWEEP_SPP2 samples,
+ * LRB_SWEEP_SEED2, read from the cache at the most samples committed as the first (a measured
+ * floor where both are), else at LRB_SWEEP_SPP or else LRB_SWEEP_SPP2 samples,
  * rendered at LRB_SWEEP_SPP2 when neither is cached (LRB_SWEEP_REF2=cached: left out instead). */
 enum { LRB_SWEEP_SEED2 = 1, LRB_SWEEP_SPP2 = 128, LRB_SWEEP_SS_MAX = 6 };
 

@@ -185,6 +185,17 @@ static bool cached(const lr_ref_scene *rs, const lr_ref_camera *cam, const char 
     return !access(path, R_OK);
 }
 
+/* The most samples at which the cache in dir holds d's reference, from LRB_SWEEP_SPP_MAX
+ * halving down to above LRB_SWEEP_SPP; 0 when none. */
+static int most_cached(const lr_ref_scene *rs, const lr_ref_camera *cam, const char *dir,
+                       lr_ref_render_desc d)
+{
+    for (d.spp = LRB_SWEEP_SPP_MAX; d.spp > LRB_SWEEP_SPP; d.spp /= 2)
+        if (cached(rs, cam, dir, &d))
+            return d.spp;
+    return 0;
+}
+
 /* The first reference (seed 0): from the cache at the most samples committed
  * (LRB_SWEEP_SPP_MAX), else at LRB_SWEEP_SPP, rendered and cached when not there. */
 static int first_reference(const lr_ref_scene *rs, const lr_ref_camera *cam, const char *dir,
@@ -192,27 +203,25 @@ static int first_reference(const lr_ref_scene *rs, const lr_ref_camera *cam, con
                            lr_err *e)
 {
     lr_ref_render_desc rd = {.width = LRB_SWEEP_W, .height = LRB_SWEEP_H, .spp = LRB_SWEEP_SPP};
-    for (int n = LRB_SWEEP_SPP_MAX; n > LRB_SWEEP_SPP; n /= 2) {
-        lr_ref_render_desc d = rd;
-        d.spp = n;
-        if (cached(rs, cam, dir, &d)) {
-            rd = d;
-            break;
-        }
-    }
+    int most = most_cached(rs, cam, dir, rd);
+    rd.spp = most ? most : LRB_SWEEP_SPP;
     *spp = rd.spp;
     return lr_ref_render_cached(rs, cam, &rd, dir, NULL, NULL, mean, var, hit, e);
 }
 
-/* The second reference (seed LRB_SWEEP_SEED2): from the cache at LRB_SWEEP_SPP samples, else
- * at LRB_SWEEP_SPP2, else rendered at LRB_SWEEP_SPP2 and cached beside the first. */
+/* The second reference (seed LRB_SWEEP_SEED2): from the cache at the most samples committed
+ * (as the first: so that the floor is measured between references of the same count where
+ * both were rendered, not scaled), else at LRB_SWEEP_SPP, else at LRB_SWEEP_SPP2, else
+ * rendered at LRB_SWEEP_SPP2 and cached beside the first. */
 static int second_reference(const lr_ref_scene *rs, const lr_ref_camera *cam, const char *dir,
                             lr_ref_image *mean, lr_ref_image *var, int *spp, bool *hit,
                             lr_err *e)
 {
     lr_ref_render_desc rd = {.width = LRB_SWEEP_W, .height = LRB_SWEEP_H,
                              .seed = LRB_SWEEP_SEED2, .spp = LRB_SWEEP_SPP};
-    bool found = cached(rs, cam, dir, &rd);
+    int most = most_cached(rs, cam, dir, rd);
+    rd.spp = most ? most : LRB_SWEEP_SPP;
+    bool found = most || cached(rs, cam, dir, &rd);
     if (!found) {
         rd.spp = LRB_SWEEP_SPP2;
         found = cached(rs, cam, dir, &rd);
