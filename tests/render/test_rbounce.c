@@ -261,6 +261,17 @@ static void test_closed_box(void **state)
     lr_scene_destroy(s);
 }
 
+/* cube() with a closed box of candle wax of the given size centred at c. */
+static lr_scene *cube_with_wax_box(double h, double rho, lr_vec3 size, lr_vec3 c)
+{
+    char box[512];
+    snprintf(box, sizeof box,
+             "{\"name\":\"box\",\"material\":\"candle_wax\",\"mesh\":{\"type\":\"box\","
+             "\"size\":[%g,%g,%g]},\"transform\":{\"translate\":[%g,%g,%g]}}",
+             size.x, size.y, size.z, c.x, c.y, c.z);
+    return cube(h, rho, lr_v3(10, -20, 15), box);
+}
+
 /* A coaster (a closed 45 x 45 x 0.1 mm box of wax) stands on the closed cube's floor across
  * four 30 mm cells (a quarter, two halves and the whole of one under it); a uniform VPL
  * irradiance X on every open texel and a bright one (1000 X) on the texels under the coaster,
@@ -273,10 +284,7 @@ static void test_covered_cells(void **state)
 {
     (void)state;
     const double rho = 0.6, h = 150, X = 3e-4;
-    static const char coaster[] =
-        "{\"name\":\"coaster\",\"material\":\"candle_wax\",\"mesh\":{\"type\":\"box\","
-        "\"size\":[45,45,0.1]},\"transform\":{\"translate\":[7.5,7.5,-149.95]}}";
-    lr_scene *s = cube(h, rho, lr_v3(10, -20, 15), coaster);
+    lr_scene *s = cube_with_wax_box(h, rho, lr_v3(45, 45, 0.1), lr_v3(7.5, 7.5, -149.95));
     assert_true(lr_scene_object_at(s, 0)->closed);
     lr_rbounce *rb = bounce_of(s);
     const lr_tr *t = lr_rbounce_solver(rb);
@@ -340,10 +348,7 @@ static void test_object_reflects(void **state)
 {
     (void)state;
     const double rho = 0.6, h = 150, X = 3e-4;
-    static const char block[] =
-        "{\"name\":\"block\",\"material\":\"candle_wax\",\"mesh\":{\"type\":\"box\","
-        "\"size\":[60,60,80]},\"transform\":{\"translate\":[20,-10,-110]}}";
-    lr_scene *s = cube(h, rho, lr_v3(10, -20, 15), block);
+    lr_scene *s = cube_with_wax_box(h, rho, lr_v3(60, 60, 80), lr_v3(20, -10, -110));
     lr_rbounce *rb = bounce_of(s);
     const lr_tr *t = lr_rbounce_solver(rb);
     int f0 = lr_rbounce_first_receiver(rb);

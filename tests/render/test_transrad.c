@@ -30,6 +30,7 @@
 #include "render/mesh/shapes.h"
 #include "render/transrad/transrad.h"
 #include "tests/support/near.h"
+#include "tests/support/objects.h"
 
 static lr_scene *load(const char *name)
 {
@@ -72,15 +73,6 @@ static lr_mesh *disk(double r, double z, bool up, int seg)
     return m;
 }
 
-static lr_bvh *bvh_of(const lr_mesh *m)
-{
-    lr_bvh *b;
-    lr_err e = {0};
-    if (lr_bvh_create(m, &b, &e))
-        fail_msg("%s", e.msg);
-    return b;
-}
-
 static lr_mesh *quad(lr_vec3 c, lr_vec3 n, lr_vec3 u, double su, double sv)
 {
     lr_quad_desc q = {.center = c, .normal = n, .u_dir = u, .size_u = su, .size_v = sv};
@@ -106,7 +98,7 @@ static void test_ff_coaxial_disks(void **state)
     (void)state;
     const double r1 = 50, r2 = 80, h = 60;
     lr_mesh *a = disk(r1, 0, true, 512), *b = disk(r2, h, false, 512);
-    lr_bvh *ba = bvh_of(a), *bb = bvh_of(b);
+    lr_bvh *ba = lrt_bvh(a), *bb = lrt_bvh(b);
     lr_tr_surface_desc d[2] = {
         {.kind = LR_TR_DIFFUSE, .mesh = a, .bvh = ba, .patch_mm = 1e4},
         {.kind = LR_TR_DIFFUSE, .mesh = b, .bvh = bb, .patch_mm = 1e4},
@@ -161,7 +153,7 @@ static void test_ff_rectangles(void **state)
         const double a = 100, b = 60, c = 80;
         lr_vec3 n0 = lr_v3(0, 0, 1), n1 = lr_v3(0, 0, -1), u = lr_v3(1, 0, 0);
         lr_mesh *m0 = quad(lr_v3(0, 0, 0), n0, u, a, b), *m1 = quad(lr_v3(0, 0, c), n1, u, a, b);
-        lr_bvh *b0 = bvh_of(m0), *b1 = bvh_of(m1);
+        lr_bvh *b0 = lrt_bvh(m0), *b1 = lrt_bvh(m1);
         lr_tr_surface_desc d[2] = {plane_desc(m0, b0, lr_v3(0, 0, 0), n0, u, a, b),
                                    plane_desc(m1, b1, lr_v3(0, 0, c), n1, u, a, b)};
         lr_tr *t;
@@ -185,7 +177,7 @@ static void test_ff_rectangles(void **state)
         lr_vec3 c0 = lr_v3(w / 2, 0, 0), c1 = lr_v3(0, 0, h / 2);
         lr_vec3 n0 = lr_v3(0, 0, 1), n1 = lr_v3(1, 0, 0), uy = lr_v3(0, 1, 0);
         lr_mesh *m0 = quad(c0, n0, uy, l, w), *m1 = quad(c1, n1, uy, l, h);
-        lr_bvh *b0 = bvh_of(m0), *b1 = bvh_of(m1);
+        lr_bvh *b0 = lrt_bvh(m0), *b1 = lrt_bvh(m1);
         lr_tr_surface_desc d[2] = {plane_desc(m0, b0, c0, n0, uy, l, w),
                                    plane_desc(m1, b1, c1, n1, uy, l, h)};
         lr_tr *t;
@@ -235,7 +227,7 @@ static void test_integrating_sphere(void **state)
         fail_msg("%s", e.msg);
     free(pos);
     free(idx);
-    lr_bvh *b = bvh_of(m);
+    lr_bvh *b = lrt_bvh(m);
     lr_tr_surface_desc d = {.kind = LR_TR_DIFFUSE, .mesh = m, .bvh = b, .albedo = {rho, rho, rho},
                             .patch_mm = 40};
     lr_tr_settings set = {.rays_per_patch = 256, .max_iterations = 300, .tolerance = 1e-7};
@@ -320,7 +312,7 @@ static void test_subsurface_columns_and_gap(void **state)
         fail_msg("%s", e.msg);
     free(pos);
     free(idx);
-    lr_bvh *bv = bvh_of(m);
+    lr_bvh *bv = lrt_bvh(m);
     lr_medium med = {.sigma_a = {0.01, 0.02, 0.03}, .sigma_s_prime = {1, 1, 1}, .eta = 1.3};
     lr_coeffs co;
     if (lr_coeffs_derive(&med, &co, &e))
@@ -409,7 +401,7 @@ static void test_bad_input(void **state)
     assert_int_equal(lr_tr_create(&d, 1, NULL, &t, &e), LR_EINVAL);
     assert_non_null(strstr(e.msg, "mesh"));
     lr_mesh *a = disk(10, 0, true, 16);
-    lr_bvh *b = bvh_of(a);
+    lr_bvh *b = lrt_bvh(a);
     d = (lr_tr_surface_desc){.kind = LR_TR_DIFFUSE, .mesh = a, .bvh = b, .albedo = {1.5, 0, 0}};
     assert_int_equal(lr_tr_create(&d, 1, NULL, &t, &e), LR_EINVAL);
     assert_non_null(strstr(e.msg, "albedo"));

@@ -30,6 +30,7 @@
 #include "render/mesh/shapes.h"
 #include "render/transrad/transrad.h"
 #include "tests/support/near.h"
+#include "tests/support/objects.h"
 
 static lr_mesh *quad_mesh(lr_vec3 c, lr_vec3 n, lr_vec3 u, double su, double sv)
 {
@@ -39,15 +40,6 @@ static lr_mesh *quad_mesh(lr_vec3 c, lr_vec3 n, lr_vec3 u, double su, double sv)
     if (lr_mesh_quad(&q, &m, &e))
         fail_msg("%s", e.msg);
     return m;
-}
-
-static lr_bvh *bvh_of(const lr_mesh *m)
-{
-    lr_bvh *b;
-    lr_err e = {0};
-    if (lr_bvh_create(m, &b, &e))
-        fail_msg("%s", e.msg);
-    return b;
 }
 
 /* A square plane patch (one cell) of side a at c, normal n. */
@@ -66,7 +58,7 @@ static patch patch_make(lr_vec3 c, lr_vec3 n, double a)
     p.u = lr_v3_normalize(lr_v3_cross(ref, p.n));
     p.v = lr_v3_cross(p.n, p.u);
     p.m = quad_mesh(c, p.n, p.u, a, a);
-    p.b = bvh_of(p.m);
+    p.b = lrt_bvh(p.m);
     p.d = (lr_tr_surface_desc){.kind = LR_TR_PLANE, .mesh = p.m, .bvh = p.b, .center = c,
                                .normal = p.n, .u_dir = p.u, .size_u = a, .size_v = a,
                                .cells_u = 1, .cells_v = 1, .albedo = {0, 0, 0}};
@@ -174,7 +166,7 @@ static void test_occluder_halves_and_blocks(void **state)
     /* A sheet 1 mm below the emitter over x in [-60, 0]. */
     lr_mesh *half = quad_mesh(lr_v3(-30, 0, 99), lr_v3(0, 0, -1), lr_v3(1, 0, 0), 60, 120);
     lr_mesh *full = quad_mesh(lr_v3(0, 0, 99), lr_v3(0, 0, -1), lr_v3(1, 0, 0), 120, 120);
-    lr_bvh *bh = bvh_of(half), *bf = bvh_of(full);
+    lr_bvh *bh = lrt_bvh(half), *bf = lrt_bvh(full);
     lr_tr_surface_desc d[2] = {p.d, {.kind = LR_TR_DIFFUSE, .mesh = half, .bvh = bh,
                                      .albedo = {0, 0, 0}, .patch_mm = 1e3}};
     double Eh = solve_E(d, 2, &L);

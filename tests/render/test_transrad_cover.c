@@ -28,6 +28,7 @@
 #include "render/mesh/shapes.h"
 #include "render/transrad/transrad.h"
 #include "tests/support/near.h"
+#include "tests/support/objects.h"
 
 #define FLOOR 120.0
 #define CELL 30.0
@@ -45,15 +46,6 @@ typedef struct rig {
     lr_bvh *bf, *bc, *bk;
     lr_tr *t;
 } rig;
-
-static lr_bvh *bvh_of(const lr_mesh *m)
-{
-    lr_bvh *b;
-    lr_err e = {0};
-    if (lr_bvh_create(m, &b, &e))
-        fail_msg("%s", e.msg);
-    return b;
-}
 
 static lr_mesh *quad(lr_vec3 c, lr_vec3 n, double s)
 {
@@ -75,9 +67,9 @@ static void rig_build(rig *r, bool covers, int rays, int direct)
                       .size = lr_v3(cx1 - cx0, cy1 - cy0, COASTER_H)};
     if (lr_mesh_box(&bd, &r->coaster, &e))
         fail_msg("%s", e.msg);
-    r->bf = bvh_of(r->floor);
-    r->bc = bvh_of(r->ceiling);
-    r->bk = bvh_of(r->coaster);
+    r->bf = lrt_bvh(r->floor);
+    r->bc = lrt_bvh(r->ceiling);
+    r->bk = lrt_bvh(r->coaster);
     lr_tr_surface_desc d[3] = {
         {.kind = LR_TR_DIFFUSE, .mesh = r->coaster, .bvh = r->bk, .patch_mm = 1e5,
          .covers = covers},

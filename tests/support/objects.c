@@ -12,6 +12,15 @@ static void die(const char *what, const lr_err *e)
     abort();
 }
 
+lr_bvh *lrt_bvh(const lr_mesh *m)
+{
+    lr_err e = {0};
+    lr_bvh *b = NULL;
+    if (lr_bvh_create(m, &b, &e))
+        die("bvh", &e);
+    return b;
+}
+
 void lrt_object_make(lr_mesh *m, const lr_medium *medium, lrt_object *out)
 {
     lr_err e = {0};

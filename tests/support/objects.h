@@ -13,6 +13,9 @@ typedef struct lrt_object {
     lr_bvh *bvh;
 } lrt_object;
 
+/* A BVH over m; aborts the test binary on failure. */
+lr_bvh *lrt_bvh(const lr_mesh *m);
+
 /* Takes ownership of m; aborts the test binary on failure. */
 void lrt_object_make(lr_mesh *m, const lr_medium *medium, lrt_object *out);
 void lrt_object_free(lrt_object *o);
