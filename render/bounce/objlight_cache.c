@@ -30,7 +30,8 @@ uint64_t lr_objlight_cache_key(const lr_objlight *ol, const lr_tr *t, int rays)
 {
     lr_ref_hash h;
     lr_ref_hash_init(&h);
-    lr_ref_hash_str(&h, "lamprig objlight rows v1");
+    /* v2: plane hits weighted by the cells' open fractions (render/transrad/cover.c) */
+    lr_ref_hash_str(&h, "lamprig objlight rows v2");
     const uint32_t order = 0x01020304u; /* native size_t and byte order: another key */
     lr_ref_hash_u64(&h, sizeof(size_t));
     lr_ref_hash_bytes(&h, &order, sizeof order);

@@ -25,8 +25,9 @@ bool lr_tr_cast(const lr_tr *t, lr_vec3 o, lr_vec3 d, lr_tr_cast_hit *h)
         h->w[0] = 1.0;
         return true;
     }
-    /* Bilinear between the cells' centres, clamped at the plane's edges (as
-     * lr_tr_plane_to_grid writes the receivers' grid). */
+    /* Bilinear between the cells' centres, clamped at the plane's edges, the weights scaled
+     * by the cells' open fractions (as lr_tr_plane_to_grid writes the receivers' grid: a cell
+     * under a body's foot holds its open part's value over little area, cover.c). */
     lr_vec3 x = lr_v3_add(o, lr_v3_scale(d, dist));
     lr_vec3 r = lr_v3_sub(x, sf->d.center);
     double u = (lr_v3_dot(r, sf->a) / sf->d.size_u + 0.5) * sf->nu - 0.5;
@@ -37,12 +38,18 @@ bool lr_tr_cast(const lr_tr *t, lr_vec3 o, lr_vec3 d, lr_tr_cast_hit *h)
     int u1 = u0 + 1 < sf->nu ? u0 + 1 : u0, v1 = v0 + 1 < sf->nv ? v0 + 1 : v0;
     double fu = u - u0, fv = v - v0;
     int cu[4] = {u0, u1, u0, u1}, cv[4] = {v0, v0, v1, v1};
-    double w[4] = {(1 - fu) * (1 - fv), fu * (1 - fv), (1 - fu) * fv, fu * fv};
+    double w[4] = {(1 - fu) * (1 - fv), fu * (1 - fv), (1 - fu) * fv, fu * fv}, ws = 0;
+    size_t pk[4];
+    for (int k = 0; k < 4; k++) {
+        pk[k] = sf->first + (size_t)cv[k] * (size_t)sf->nu + (size_t)cu[k];
+        w[k] *= t->open ? t->open[pk[k]] : 1.0;
+        ws += w[k];
+    }
     for (int k = 0; k < 4; k++) {
         if (!(w[k] > 0.0))
             continue;
-        h->patch[h->n] = sf->first + (size_t)cv[k] * (size_t)sf->nu + (size_t)cu[k];
-        h->w[h->n++] = w[k];
+        h->patch[h->n] = pk[k];
+        h->w[h->n++] = w[k] / ws;
     }
     return true;
 }

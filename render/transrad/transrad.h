@@ -218,7 +218,8 @@ void lr_tr_escaped_power(const lr_tr *t, int slot, double out[3]);
  * the scene; n 0 for a back face (absorbed: a one-sided receiver from behind, a wall from
  * inside); else the hit surface and n patches with weights summing to 1: the hit's patch on a
  * mesh, on a plane the up to 4 cells around it, bilinear between their centres (clamped at
- * the edges, as the receivers' grid is written). */
+ * the edges) with the weights scaled by the cells' open fractions and renormalised, as the
+ * receivers' grid is written (n 0 where every weight is 0). */
 typedef struct lr_tr_cast_hit {
     int surface, n;
     size_t patch[4];

@@ -12,6 +12,8 @@
  *    within 0.5 % (the coaster's edge shadows a 0.02 mm band); 0 under the coaster;
  *  - without `covers` the same coaster leaves the cells' rows at open x F (the deficit the
  *    receivers' bounce had under a candle's foot), which the flag removes;
+ *  - a ray onto the floor beside it (lr_tr_cast): the cells' bilinear weights scaled by their
+ *    open fractions, the covered cell left out, the rest summing to 1;
  *  - lr_tr_set_albedo: a plane's albedo set after create; out of [0, 1], another surface,
  *    NULL refused. */
 #include <setjmp.h>
@@ -191,6 +193,36 @@ static void test_covered_cells(void **state)
     assert_false(lr_tr_plane_point_covered(r.t, 1, (-20 + FLOOR / 2) / FLOOR, 0.5));
     assert_false(lr_tr_plane_point_covered(r.t, 2, 0.5, 0.5));
     assert_false(lr_tr_plane_point_covered(old.t, 1, (10 + FLOOR / 2) / FLOOR, 0.6));
+    /* A ray onto the floor beside the coaster (lr_tr_cast, the receivers' light on the
+     * objects): the four cells around the hit, bilinear weights scaled by their open fractions
+     * and renormalised; the covered cell (15, 15) gets none. */
+    lr_tr_cast_hit hit;
+    const double hx = 35, hy = 20;
+    assert_true(lr_tr_cast(r.t, lr_v3(hx, hy, 50), lr_v3(0, 0, -1), &hit));
+    assert_int_equal(hit.surface, 1);
+    double want[4], ws = 0, fu = (hx - 15) / CELL, fv = (hy - 15) / CELL;
+    const double cxs[4] = {15, 45, 15, 45}, cys[4] = {15, 15, 45, 45};
+    size_t cell[4];
+    for (int k = 0; k < 4; k++) {
+        int u = (int)((cxs[k] + FLOOR / 2) / CELL), v = (int)((cys[k] + FLOOR / 2) / CELL);
+        cell[k] = f0 + (size_t)v * 4 + (size_t)u;
+        want[k] = ((k & 1) ? fu : 1 - fu) * ((k & 2) ? fv : 1 - fv) *
+                  lr_tr_open_fraction(r.t, cell[k]);
+        ws += want[k];
+    }
+    assert_true(lr_tr_open_fraction(r.t, cell[0]) == 0);
+    assert_int_equal(hit.n, 3);
+    double sum = 0;
+    for (int i = 0; i < hit.n; i++) {
+        int k = 0;
+        while (k < 4 && cell[k] != hit.patch[i])
+            k++;
+        assert_true(k > 0 && k < 4);
+        assert_near(hit.w[i], want[k] / ws, 1e-12);
+        sum += hit.w[i];
+    }
+    assert_near(sum, 1.0, 1e-12);
+
     /* The albedo of a diffuse or plane surface changes after create (F does not depend on
      * it); bad values and surfaces are refused with the field named. */
     const double grey[3] = {0.3, 0.3, 0.3}, bright[3] = {0.3, 1.5, 0.3};
