@@ -30,7 +30,6 @@ struct lr_rbounce {
     double *Evpl;           /* n x 3: the VPL grids' patch means */
     int *cnt;               /* n: scratch, texels per patch */
     double *E;              /* n x 3 scratch */
-    double *open;           /* n: each patch's open fraction (lr_tr_open_fraction) */
     unsigned char *covered[LR_TR_MAX_SURFACES]; /* per receiver, R^2: texel inside a body */
     float *out[LR_TR_MAX_SURFACES][LR_TR_MAX_SLOTS]; /* per receiver, slot: R^2 x 3 */
     lr_objlight *ol;        /* render.receiver_light_on_objects: the objects' E (objlight.h) */
@@ -109,8 +108,7 @@ static void free_solver(lr_rbounce *rb)
     free(rb->Evpl);
     free(rb->E);
     free(rb->cnt);
-    free(rb->open);
-    rb->Evpl = rb->E = rb->open = NULL;
+    rb->Evpl = rb->E = NULL;
     rb->cnt = NULL;
     for (int r = 0; r < LR_TR_MAX_SURFACES; r++) {
         free(rb->covered[r]);
@@ -171,22 +169,20 @@ static int build(lr_rbounce *rb, const lr_scene *s, lr_err *e)
     rb->Evpl = calloc(n3, sizeof *rb->Evpl);
     rb->E = calloc(n3, sizeof *rb->E);
     rb->cnt = calloc(rb->n ? rb->n : 1, sizeof *rb->cnt);
-    rb->open = calloc(rb->n ? rb->n : 1, sizeof *rb->open);
-    if (!rb->Evpl || !rb->E || !rb->cnt || !rb->open)
+    if (!rb->Evpl || !rb->E || !rb->cnt)
         return lr_err_set(e, LR_ENOMEM, "receiver bounce: out of memory (%zu patches)", rb->n);
     rb->n_obj = no;
     rb->n_rcv = nr;
-    for (size_t p = 0; p < rb->n; p++)
-        rb->open[p] = lr_tr_open_fraction(rb->tr, p);
     /* The texels inside a body standing on a receiver: left out of the VPL grid's cell means,
      * which are over the cells' open part like the solver's F and E. */
+    const double *open = lr_tr_open_fractions(rb->tr);
     const int R = LR_RECV_GRID;
-    for (int r = 0; r < nr; r++) {
+    for (int r = 0; r < nr && open; r++) {
         size_t first, count;
         lr_tr_surface_patches(rb->tr, no + r, &first, &count);
         bool any = false;
         for (size_t p = first; p < first + count; p++)
-            any = any || rb->open[p] < 1;
+            any = any || open[p] < 1;
         if (!any)
             continue;
         if (!(rb->covered[r] = calloc((size_t)R * R, 1)))
@@ -346,7 +342,8 @@ static int write_grid(lr_rbounce *rb, int r, int slot, lr_err *e)
     double *X = rb->E; /* the scratch E is free after the solve */
     for (size_t p = 0; p < count; p++)
         lr_tr_indirect(rb->tr, slot, first + p, X + 3 * p);
-    lr_tr_plane_to_grid(X, rb->open + first, nu, nv, *out);
+    const double *open = lr_tr_open_fractions(rb->tr);
+    lr_tr_plane_to_grid(X, open ? open + first : NULL, nu, nv, *out);
     return LR_OK;
 }
 

@@ -110,6 +110,8 @@ int lr_tr_build_cover(lr_tr *t, lr_err *e)
     return LR_OK;
 }
 
+const double *lr_tr_open_fractions(const lr_tr *t) { return t ? t->open : NULL; }
+
 double lr_tr_open_fraction(const lr_tr *t, size_t p)
 {
     return t && t->open && p < t->n ? t->open[p] : 1.0;

@@ -42,27 +42,14 @@ void lr_tr_plane_to_grid(const double *X, const double *open, int nu, int nv, fl
     const int R = LR_RECV_GRID;
     for (int t = 0; t < R; t++)
         for (int s = 0; s < R; s++) {
-            double u = (s + 0.5) / R * nu - 0.5, v = (t + 0.5) / R * nv - 0.5;
-            u = u < 0 ? 0 : u > nu - 1 ? nu - 1 : u;
-            v = v < 0 ? 0 : v > nv - 1 ? nv - 1 : v;
-            int u0 = (int)floor(u), v0 = (int)floor(v);
-            int u1 = u0 + 1 < nu ? u0 + 1 : u0, v1 = v0 + 1 < nv ? v0 + 1 : v0;
-            double fu = u - u0, fv = v - v0;
-            size_t c[4] = {(size_t)v0 * nu + u0, (size_t)v0 * nu + u1, (size_t)v1 * nu + u0,
-                           (size_t)v1 * nu + u1};
-            double w[4] = {(1 - fu) * (1 - fv), fu * (1 - fv), (1 - fu) * fv, fu * fv}, ws = 0;
-            /* Weighted by the cells' open parts: a cell mostly under a body's foot holds its
-             * open part's mean over little area, so it pulls its neighbours' texels in
-             * proportion (a covered texel itself is never seen). */
-            for (int k = 0; k < 4; k++) {
-                w[k] *= open ? open[c[k]] : 1.0;
-                ws += w[k];
-            }
+            size_t c[4];
+            double w[4];
+            lr_tr_plane_cells((s + 0.5) / R, (t + 0.5) / R, nu, nv, open, c, w);
             for (int b = 0; b < 3; b++) {
                 double x = 0;
-                for (int k = 0; k < 4 && ws > 0; k++)
+                for (int k = 0; k < 4; k++)
                     x += w[k] * X[3 * c[k] + (size_t)b];
-                out[3 * ((size_t)t * R + s) + b] = (float)(ws > 0 ? x / ws : 0);
+                out[3 * ((size_t)t * R + s) + b] = (float)x;
             }
         }
 }

@@ -189,6 +189,9 @@ bool lr_tr_plane_grid(const lr_tr *t, int s, int *nu, int *nv);
 /* The fraction of plane cell p outside every covering body (the desc's covers; cover.c):
  * its F, E and solution are means over that part. 1 for any other patch. */
 double lr_tr_open_fraction(const lr_tr *t, size_t p);
+/* All patches' open fractions (n, by patch index), or NULL when no surface covers (every
+ * fraction 1): what lr_tr_plane_cells and lr_tr_plane_to_grid take, from a plane's first. */
+const double *lr_tr_open_fractions(const lr_tr *t);
 /* Whether the point at (fu, fv) of plane surface s (fractions of size_u, size_v from its
  * corner at -size/2, as the receivers' texels) lies inside a covering body. */
 bool lr_tr_plane_point_covered(const lr_tr *t, int s, double fu, double fv);
@@ -227,6 +230,14 @@ typedef struct lr_tr_cast_hit {
     double dist;
 } lr_tr_cast_hit;
 bool lr_tr_cast(const lr_tr *t, lr_vec3 o, lr_vec3 d, lr_tr_cast_hit *h);
+/* The cells of a plane's nu x nv grid around its point at (fu, fv) (fractions of size_u,
+ * size_v from the corner at -size/2): the up to 4 cells (u + nu v) whose centres surround it,
+ * clamped at the edges, bilinear weights scaled by the cells' open fractions (open: one per
+ * cell, lr_tr_open_fraction; NULL: all 1) and renormalised to sum 1 (all 0 where every one
+ * is 0). The receivers' grid (lr_tr_plane_to_grid) and a ray's plane hit (lr_tr_cast) read a
+ * plane's cells through it. */
+void lr_tr_plane_cells(double fu, double fv, int nu, int nv, const double *open, size_t cell[4],
+                       double w[4]);
 /* The ray-origin offset the solver uses off a surface (scale of the scene). */
 double lr_tr_ray_eps(const lr_tr *t);
 

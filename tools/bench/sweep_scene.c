@@ -186,11 +186,11 @@ static bool cached(const lr_ref_scene *rs, const lr_ref_camera *cam, const char 
 }
 
 /* The most samples at which the cache in dir holds d's reference, from LRB_SWEEP_SPP_MAX
- * halving down to above LRB_SWEEP_SPP; 0 when none. */
+ * halving down to LRB_SWEEP_SPP; 0 when none. */
 static int most_cached(const lr_ref_scene *rs, const lr_ref_camera *cam, const char *dir,
                        lr_ref_render_desc d)
 {
-    for (d.spp = LRB_SWEEP_SPP_MAX; d.spp > LRB_SWEEP_SPP; d.spp /= 2)
+    for (d.spp = LRB_SWEEP_SPP_MAX; d.spp >= LRB_SWEEP_SPP; d.spp /= 2)
         if (cached(rs, cam, dir, &d))
             return d.spp;
     return 0;
@@ -220,12 +220,8 @@ static int second_reference(const lr_ref_scene *rs, const lr_ref_camera *cam, co
     lr_ref_render_desc rd = {.width = LRB_SWEEP_W, .height = LRB_SWEEP_H,
                              .seed = LRB_SWEEP_SEED2, .spp = LRB_SWEEP_SPP};
     int most = most_cached(rs, cam, dir, rd);
-    rd.spp = most ? most : LRB_SWEEP_SPP;
+    rd.spp = most ? most : LRB_SWEEP_SPP2;
     bool found = most || cached(rs, cam, dir, &rd);
-    if (!found) {
-        rd.spp = LRB_SWEEP_SPP2;
-        found = cached(rs, cam, dir, &rd);
-    }
     *spp = rd.spp;
     const char *mode = getenv("LRB_SWEEP_REF2");
     if (!found && mode && !strcmp(mode, "cached"))
