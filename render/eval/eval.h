@@ -134,6 +134,15 @@ double lr_eval_ratio_excess(lr_eval_ratio r);
 double lr_eval_median_abs_log(const float *a, const float *b, const unsigned char *mask,
                               size_t n);
 
+/* Two references of the same samples per pixel and independent seeds as one of twice the
+ * samples: mean = (mean + mean2) / 2 and, where both variances are given, var = (var + var2)
+ * / 4 (the variance of the mean of two independent estimates), over 3 n floats, in place.
+ * The median |ln| between two such means is that between two single references over sqrt 2
+ * (the log's standard deviation goes as 1/sqrt(spp); tests/base/test_eval.c checks it on
+ * simulated references). */
+void lr_eval_mean_references(float *mean, float *var, const float *mean2, const float *var2,
+                             size_t n);
+
 /* ---- Pareto front --------------------------------------------------------------------------- */
 
 /* Marks on_front[i] for each point that no other point dominates (another point with

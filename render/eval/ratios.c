@@ -67,3 +67,13 @@ double lr_eval_median_abs_log(const float *a, const float *b, const unsigned cha
     free(v);
     return med;
 }
+
+void lr_eval_mean_references(float *mean, float *var, const float *mean2, const float *var2,
+                             size_t n)
+{
+    for (size_t i = 0; i < 3 * n; i++) {
+        mean[i] = 0.5f * (mean[i] + mean2[i]);
+        if (var && var2)
+            var[i] = 0.25f * (var[i] + var2[i]);
+    }
+}

@@ -166,9 +166,13 @@ void lr_openings_destroy(lr_openings *op)
     free(op);
 }
 
-/* Emitters of object o (index oi): LR_OPENINGS_POINTS points stratified over the area CDF
- * (as render/cpu/cavity.c), each kept on the sides the VPLs do not emit from. */
-static int add_emitters(lr_openings *op, const lr_scene_object *o, int oi, size_t *cap, lr_err *e)
+/* The emitting points of object o (index oi): LR_OPENINGS_POINTS points stratified over the
+ * area CDF (as render/cpu/cavity.c), each kept on the sides the VPLs do not emit from; calls
+ * emit(ctx, x, n, a) for each kept side (a = area / LR_OPENINGS_POINTS), stopping at its first
+ * nonzero return. */
+typedef int (*emit_fn)(void *ctx, lr_vec3 x, lr_vec3 n, double a);
+
+static int walk_emitters(const lr_scene_object *o, int oi, emit_fn emit, void *ctx, lr_err *e)
 {
     size_t nt = lr_mesh_triangle_count(o->mesh);
     if (nt == 0)
@@ -190,7 +194,8 @@ static int add_emitters(lr_openings *op, const lr_scene_object *o, int oi, size_
     const int M = LR_OPENINGS_POINTS;
     double a = area / M, tmin = 1e-4 * o->radius;
     lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(1, 0x0BE4, (uint64_t)oi, 0));
-    for (int i = 0; i < M; i++) {
+    int rc = LR_OK;
+    for (int i = 0; i < M && !rc; i++) {
         double pick = (i + lr_cpu_rng_next(&rng)) / M * area;
         double s = lr_cpu_rng_next(&rng), t = lr_cpu_rng_next(&rng);
         size_t lo = lr_cdf_pick(cdf, nt, pick);
@@ -206,28 +211,62 @@ static int add_emitters(lr_openings *op, const lr_scene_object *o, int oi, size_
          * VPLs (the farthest hit along that ray, lr_cpu_vpl_place) never stand here. */
         bool inner = dc > 0.0 && lr_bvh_occluded(o->bvh, x, lr_v3_scale(cx, 1.0 / dc), tmin,
                                                  4.0 * o->radius + 1.0);
-        for (int side = 0; side < 2; side++) {
+        for (int side = 0; side < 2 && !rc; side++) {
             lr_vec3 ns = side ? lr_v3_scale(n, -1.0) : n;
-            bool emit = o->closed ? side == 0 && inner
+            bool kept = o->closed ? side == 0 && inner
                                   : inner || lr_v3_dot(ns, lr_v3_sub(o->center, x)) > 0.0;
-            if (!emit)
-                continue;
-            if (op->ne == *cap) {
-                size_t nc = *cap ? 2 * *cap : 1024;
-                emitter *g = realloc(op->em, nc * sizeof *g);
-                if (!g) {
-                    free(cdf);
-                    return lr_err_set(e, LR_ENOMEM, "openings: out of memory (%zu emitters)", nc);
-                }
-                op->em = g;
-                *cap = nc;
-            }
-            op->em[op->ne++] = (emitter){.obj = oi, .x = x, .n = ns, .a = a};
-            op->area += a;
+            if (kept)
+                rc = emit(ctx, x, ns, a);
         }
     }
     free(cdf);
+    return rc;
+}
+
+typedef struct append_ctx {
+    lr_openings *op;
+    int oi;
+    size_t *cap;
+    lr_err *e;
+} append_ctx;
+
+static int append_emitter(void *ctx, lr_vec3 x, lr_vec3 n, double a)
+{
+    append_ctx *c = ctx;
+    lr_openings *op = c->op;
+    if (op->ne == *c->cap) {
+        size_t nc = *c->cap ? 2 * *c->cap : 1024;
+        emitter *g = realloc(op->em, nc * sizeof *g);
+        if (!g)
+            return lr_err_set(c->e, LR_ENOMEM, "openings: out of memory (%zu emitters)", nc);
+        op->em = g;
+        *c->cap = nc;
+    }
+    op->em[op->ne++] = (emitter){.obj = c->oi, .x = x, .n = n, .a = a};
+    op->area += a;
     return LR_OK;
+}
+
+static int add_emitters(lr_openings *op, const lr_scene_object *o, int oi, size_t *cap, lr_err *e)
+{
+    append_ctx c = {op, oi, cap, e};
+    return walk_emitters(o, oi, append_emitter, &c, e);
+}
+
+static int sum_area(void *ctx, lr_vec3 x, lr_vec3 n, double a)
+{
+    (void)x, (void)n;
+    *(double *)ctx += a;
+    return LR_OK;
+}
+
+double lr_openings_inner_fraction(const lr_scene_object *o, int index)
+{
+    double emitting = 0.0, area = lr_mesh_area(o->mesh);
+    lr_err e = {0};
+    if (!(area > 0.0) || walk_emitters(o, index, sum_area, &emitting, &e))
+        return 0.0;
+    return emitting / area;
 }
 
 typedef struct kernel_ctx {

@@ -51,6 +51,14 @@
 
 typedef struct lr_openings lr_openings;
 
+/* The share of object o's area (index: its place in the scene, which seeds the points) that
+ * emits here: its inner faces, where the VPLs do not stand (an open object's inner side
+ * counts too), from the emitters' own stratified points; 0 for an empty mesh or when out of
+ * memory. The planner turns render.opening_light on where it is at least
+ * LR_PLAN_INNER_MIN (render/plan/plan.h): the candles' 0, the jar's deep pool 0.16, the
+ * shades' and the votive's inside 0.4-0.5. */
+double lr_openings_inner_fraction(const lr_scene_object *o, int index);
+
 /* Whether scene s asks for it (render.opening_light) and it has work: a plane receiver, a
  * light, and no object using translucent_radiosity and no render.lpv (both carry this light
  * already: render/transrad/tr_scene.h, render/lpv/). */

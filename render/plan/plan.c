@@ -400,6 +400,20 @@ int lr_plan_create(const lr_scene *s, const lr_plan_table *t, const lr_plan_budg
     }
     if (!out->vpl) /* the renderer needs a valid count even with the pass off */
         rs->N_vpl = lr_scene_render(s)->N_vpl;
+    /* The light paths the scene needs with the chosen models (transport.c). */
+    enum lr_sss_model chosen[LR_PLAN_MAX_OBJECTS];
+    for (int i = 0; i < no; i++)
+        if (!lr_sss_model_parse(out->objects[i].row.model, &chosen[i]))
+            chosen[i] = lr_scene_object_at(s, i)->sss_model;
+    int rc = lr_plan_transport_decide(s, chosen, &out->transport, e);
+    if (rc)
+        return rc;
+    if (rs->lpv > 0) /* a chosen row's volume carries the receivers' light (render/lpv) */
+        for (int k = 0; k < LR_PLAN_TRANSPORT_COUNT; k++) {
+            out->transport.needed[k] = out->transport.on[k] = false;
+            snprintf(out->transport.why[k], LR_PLAN_REASON_MAX,
+                     "render.lpv's volumes carry the receivers' light");
+        }
     return LR_OK;
 }
 
@@ -439,7 +453,8 @@ int lr_plan_apply_models(const lr_plan *p, lr_scene *s, unsigned *dirty, lr_err 
         if (rc)
             return lr_err_prefix(e, "applying the plan");
     }
-    return LR_OK;
+    /* The transport goes with the models: it was decided for them. */
+    return lr_plan_transport_apply(&p->transport, s, dirty, e);
 }
 
 /* ---- output ---- */
@@ -515,6 +530,9 @@ size_t lr_plan_format(const lr_plan *p, char *buf, size_t cap)
     if (s->lpv > 0)
         put(&o, ", lpv=%d", s->lpv);
     put(&o, "; after %d frames no pass runs until something changes\n", s->frames);
+    char tline[LR_PLAN_TRANSPORT_COUNT * (LR_PLAN_REASON_MAX + 64) + LR_SCENE_NAME_MAX + 32];
+    lr_plan_transport_format(&p->transport, p->scene, tline, sizeof tline);
+    put(&o, "%s", tline);
     return o.len;
 }
 
@@ -586,7 +604,18 @@ size_t lr_plan_format_json(const lr_plan *p, char *buf, size_t cap)
     }
     const lr_render_settings *s = &p->settings;
     put(&o, "],\"settings\":{\"K\":%d,\"N\":%d,\"N_vpl\":%d,\"map_size\":%d,\"gbuffer_size\":%d,"
-            "\"frames\":%d,\"vpl\":%s}}\n",
+            "\"frames\":%d,\"vpl\":%s},\"transport\":{",
         s->K, s->N, s->N_vpl, s->map_size, s->gbuffer_size, s->frames, p->vpl ? "true" : "false");
+    /* Per path: needed, given (the scene's value stays), on (the plan turns it on), why. */
+    const lr_plan_transport *t = &p->transport;
+    for (int k = 0; k < LR_PLAN_TRANSPORT_COUNT; k++) {
+        put(&o, "%s\"%s\":{\"needed\":%s,\"given\":%s,\"on\":%s,\"why\":", k ? "," : "",
+            lr_plan_transport_key(k), t->needed[k] ? "true" : "false",
+            t->given[k] ? "true" : "false", t->on[k] ? "true" : "false");
+        put_json_string(&o, t->why[k]);
+        put(&o, "}");
+    }
+    put(&o, ",\"inner_fraction\":%.4f,\"vpl_blocked\":%.4f}}\n", t->inner_fraction,
+        t->vpl_blocked);
     return o.len;
 }

@@ -153,6 +153,68 @@ double lr_plan_size_tr(const lr_scene_object *o);
  * vertex beyond a face plane (within tol of 0 when convex; 0 for an open mesh). */
 bool lr_plan_mesh_convex(const lr_mesh *m, bool closed, double tol, double *violation);
 
+#define LR_PLAN_REASONS 10
+#define LR_PLAN_REASON_MAX 320
+
+/* ---- The light transport a scene needs ----------------------------------------------- */
+
+/* Three render settings carry light paths beyond seed 003's (issue 12), each off by default
+ * (each costs time; render/bounce, render/openings, render/README.md "VPL visibility"). The
+ * planner turns one on where the scene's geometry shows the path matters and the scene does
+ * not set it itself (lr_scene_render_given; the file's or --set's value always stays). */
+enum lr_plan_transport_kind {
+    LR_PLAN_RECEIVER_BOUNCE, /* render.receiver_bounce: receivers that face each other or an
+                              * object exchange light */
+    LR_PLAN_OPENING_LIGHT,   /* render.opening_light: an object with inner faces (where its
+                              * VPLs do not stand) sends light out through its openings */
+    LR_PLAN_VPL_VISIBILITY,  /* render.vpl_visibility: the objects block a share of the VPLs'
+                              * light on the receivers (a light in a deep pool: its VPLs on
+                              * the pool would light the wall through the rim) */
+    LR_PLAN_TRANSPORT_COUNT
+};
+
+/* Inner faces at least this share of an object's area (lr_openings_inner_fraction): its
+ * openings' light is worth its pass. The candles' pools give 0, the jar's deep pool 0.16,
+ * the shades and the votive 0.4-0.5. */
+#define LR_PLAN_INNER_MIN 0.01
+/* The objects block at least this share of the VPLs' light on the receivers: VPL
+ * visibility is worth its march. The candles (8 mm pool, flame 3 mm below the rim) 0.03,
+ * the jar (35 mm pool) 0.16, the shades and the votive under 0.01; a convex object alone 0
+ * (a segment leaving a convex body never re-enters it). */
+#define LR_PLAN_BLOCKED_MIN 0.05
+
+typedef struct lr_plan_transport {
+    bool needed[LR_PLAN_TRANSPORT_COUNT]; /* the geometry shows the path matters */
+    bool given[LR_PLAN_TRANSPORT_COUNT];  /* the scene sets it: its value stays */
+    bool on[LR_PLAN_TRANSPORT_COUNT];     /* what applying turns on: needed, not given, off */
+    double inner_fraction; /* the largest lr_openings_inner_fraction of an eligible object */
+    double vpl_blocked;    /* the share of the VPLs' light on the receivers the objects block */
+    char why[LR_PLAN_TRANSPORT_COUNT][LR_PLAN_REASON_MAX];
+} lr_plan_transport;
+
+/* The render key of each kind ("receiver_bounce", ...). */
+const char *lr_plan_transport_key(enum lr_plan_transport_kind k);
+
+/* Decides, from the geometry, which paths scene s needs with each object i rendered by
+ * models[i] (NULL: the scene's own models): none without a point or spot light or a plane
+ * receiver, or with render.lpv (its volumes carry the receivers' light); the bounce and the
+ * openings' light not with translucent radiosity (its F has the receivers); VPL visibility
+ * from LR_PLAN_VPL_SAMPLES VPLs per object (lr_cpu_vpl_place) against 16 x 16 points per
+ * plane receiver, each VPL weighted by the lights' irradiance at it ignoring the body (light
+ * leaves the wax near where it entered), each pair by the VPL kernel's cos cos / d^2.
+ * Deterministic. LR_ENOMEM only. */
+int lr_plan_transport_decide(const lr_scene *s, const enum lr_sss_model *models,
+                             lr_plan_transport *out, lr_err *e);
+/* Sets render.KEY = true for each kind t->on says, ORing dirty flags. */
+int lr_plan_transport_apply(const lr_plan_transport *t, lr_scene *s, unsigned *dirty,
+                            lr_err *e);
+/* "plan: SCENE: transport: receiver_bounce on (why); opening_light kept (the scene sets it);
+ * vpl_visibility not needed (why)\n". Returns the length it needed, without the NUL. */
+size_t lr_plan_transport_format(const lr_plan_transport *t, const char *scene, char *buf,
+                                size_t cap);
+
+#define LR_PLAN_VPL_SAMPLES 128
+
 /* ---- The plan --------------------------------------------------------------------------- */
 
 typedef struct lr_plan_budget {
@@ -164,8 +226,6 @@ typedef struct lr_plan_budget {
     double change_ms;
 } lr_plan_budget;
 
-#define LR_PLAN_REASONS 10
-#define LR_PLAN_REASON_MAX 320
 
 typedef struct lr_plan_choice {
     char object[LR_SCENE_NAME_MAX];
@@ -194,6 +254,9 @@ typedef struct lr_plan {
     lr_render_settings settings;
     bool vpl;
     bool feasible; /* every object's choice meets the budget */
+    /* The light transport the scene needs with the chosen models; lr_plan_apply and
+     * lr_plan_apply_models turn on what it says. */
+    lr_plan_transport transport;
 } lr_plan;
 
 /* Models the planner may choose: bit LR_PLAN_MODEL_BIT(m) for each enum lr_sss_model m

@@ -334,8 +334,9 @@ static int parse_object(ctx *c, lr_jnode obj, int i, obj_rec *o)
 
 /* ---- settings -------------------------------------------------------------------------------- */
 
-static int parse_render(ctx *c, lr_jnode n, lr_render_settings *r)
+static int parse_render(ctx *c, lr_jnode n, lr_scene *s)
 {
+    lr_render_settings *r = &s->render;
     lr_scene_render_defaults(r); /* zero or absent: the default */
     if (n == LR_JNONE)
         return LR_OK;
@@ -344,6 +345,9 @@ static int parse_render(ctx *c, lr_jnode n, lr_render_settings *r)
         return rc;
     if ((rc = lr_fields_read(c->j, n, "render", &lr_scene_render_desc, 0, r, c->e)))
         return rc;
+    for (int i = 0; i < lr_scene_render_desc.n; i++)
+        if (lr_json_get(c->j, n, lr_scene_render_desc.fields[i].key) != LR_JNONE)
+            lr_scene_render_mark_given(s, lr_scene_render_desc.fields[i].key);
     const char *field = NULL;
     lr_err inner = {0};
     if ((rc = lr_scene_check_render(r, &field, &inner)))
@@ -448,7 +452,7 @@ static int parse_document(ctx *c)
         return lr_json_fail(j, root, "camera", c->e, LR_EPARSE, "missing (required)");
     if ((rc = parse_camera(c, cam, &s->camera)))
         return rc;
-    if ((rc = parse_render(c, lr_json_get(j, root, "render"), &s->render)) ||
+    if ((rc = parse_render(c, lr_json_get(j, root, "render"), s)) ||
         (rc = parse_quality(c, lr_json_get(j, root, "quality"), &s->quality)))
         return rc;
     for (int i = 0; i < nr; i++) {

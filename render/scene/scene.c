@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "render/scene/fields.h"
 #include "render/scene/scene_internal.h"
 
 void lr_scene_destroy(lr_scene *s)
@@ -31,6 +32,27 @@ int lr_scene_receiver_count(const lr_scene *s) { return s->nrecv; }
 const lr_camera *lr_scene_camera(const lr_scene *s) { return &s->camera; }
 const lr_render_settings *lr_scene_render(const lr_scene *s) { return &s->render; }
 const lr_quality *lr_scene_quality(const lr_scene *s) { return &s->quality; }
+
+static int render_field_index(const char *name)
+{
+    for (int i = 0; name && i < lr_scene_render_desc.n; i++)
+        if (!strcmp(lr_scene_render_desc.fields[i].key, name))
+            return i;
+    return -1;
+}
+
+void lr_scene_render_mark_given(lr_scene *s, const char *name)
+{
+    int i = render_field_index(name);
+    if (i >= 0 && i < 64)
+        s->render_given |= 1ull << i;
+}
+
+bool lr_scene_render_given(const lr_scene *s, const char *name)
+{
+    int i = render_field_index(name);
+    return i >= 0 && i < 64 && (s->render_given >> i & 1u);
+}
 
 const char *lr_scene_object_model_unmet(const lr_scene_object *o, enum lr_sss_model m)
 {

@@ -281,6 +281,9 @@ const lr_receiver *lr_scene_receiver_at(const lr_scene *s, int i);
 const lr_camera *lr_scene_camera(const lr_scene *s);
 const lr_render_settings *lr_scene_render(const lr_scene *s);
 const lr_quality *lr_scene_quality(const lr_scene *s);
+/* Whether render field `name` ("receiver_bounce") was given, in the file's render block or by
+ * lr_scene_set, rather than left at its default. */
+bool lr_scene_render_given(const lr_scene *s, const char *name);
 /* Index of the object, light or receiver with that name; -1 when none. */
 int lr_scene_find_object(const lr_scene *s, const char *name);
 int lr_scene_find_light(const lr_scene *s, const char *name);

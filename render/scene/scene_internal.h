@@ -68,8 +68,15 @@ struct lr_scene {
     int nrecv;
     lr_camera camera;
     lr_render_settings render;
+    /* Bit i: render field i of lr_scene_render_desc was given (in the file's render block or
+     * by lr_scene_set), not defaulted (lr_scene_render_given: the planner turns on the light
+     * transport a scene needs only where the scene did not say). */
+    unsigned long long render_given;
     lr_quality quality;
 };
+
+/* Marks the render field `name` as given; unknown names are ignored. */
+void lr_scene_render_mark_given(lr_scene *s, const char *name);
 
 /* ---- checks shared by the file and lr_scene_set (check.c) ---------------------------------
  * Each returns LR_OK, or LR_EINVAL with a message (no location) and *field set to the name of

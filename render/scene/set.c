@@ -419,6 +419,7 @@ int lr_scene_set(lr_scene *s, const char *key, const char *value, unsigned *dirt
         if ((rc = lr_scene_check_render(&r, &bad, &inner)))
             return check_failed(&o, k.field, bad, rc, &inner);
         s->render = r;
+        lr_scene_render_mark_given(s, k.field);
         break;
     }
     case K_QUALITY: {

@@ -80,6 +80,10 @@ typedef struct lrb_scene_result {
     double ref_se_object, ref_se_receivers, ref_se_all; /* reference's relative standard error */
     bool ref_hit;
     int ref_spp; /* the reference's samples per pixel (LRB_SWEEP_SPP_MAX) */
+    /* 2 when the second reference has as many samples as the first: the reference is then
+     * their mean (ref_spp each, 2 ref_spp in all) and mal_floor what two such means differ
+     * by (the two's floor / sqrt 2); else 1 (seed 0's alone). */
+    int refs;
     double ref_s;
     long object_px, receiver_px;
     /* Units check (lrb_sweep_units); NaN when it failed. */
@@ -97,8 +101,9 @@ typedef struct lrb_scene_result {
     lrb_fair fair; /* box-filtered: the base row's bias and the figures above */
     double mal_centre; /* median |ln(model / reference)| over object pixels */
     /* The same between the two references (seeds 0 and LRB_SWEEP_SEED2): raw, and scaled to
-     * two references of ref_spp samples each (x sqrt(2 / (1 + spp / spp2))). NaN when
-     * the second reference failed. */
+     * two references of ref_spp samples each (x sqrt(2 / (1 + spp / spp2))), or, when they
+     * are averaged (refs 2), to two such means (raw / sqrt 2). NaN when the second reference
+     * failed. */
     double mal_floor_raw, mal_floor;
     int ref2_spp;
     bool ref2_hit;

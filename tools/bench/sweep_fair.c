@@ -147,7 +147,9 @@ void lrb_sweep_fair_md(FILE *f, const lrb_scene_result *sc, int n)
                "bench before). Bias = relative RMSE with both images' noise taken out; median "
                "|ln| over object pixels of ln(model / reference) on the band sums; floor = the "
                "same between two references of independent seeds (scaled to two of the first one's "
-               "samples: the first is %d spp, more where committed); "
+               "samples: the first is %d spp, more where committed; where both have the most "
+               "samples committed the reference is their mean and the floor what two such means "
+               "differ by, / √2); "
                "receiver power = Σ model / Σ reference over receiver pixels ± the reference's "
                "standard error.\n\n",
             ss, ss, LRB_SWEEP_SPP);
@@ -161,8 +163,8 @@ void lrb_sweep_fair_md(FILE *f, const lrb_scene_result *sc, int n)
         pair(f, s->centre_bias_receivers, s->fair.bias_receivers);
         pair(f, s->mal_centre, s->fair.mal);
         if (isfinite(s->mal_floor))
-            fprintf(f, " %.3f (%d vs %d spp: %.3f) |", s->mal_floor, s->ref_spp, s->ref2_spp,
-                    s->mal_floor_raw);
+            fprintf(f, " %.3f (%d vs %d spp: %.3f%s) |", s->mal_floor, s->ref_spp, s->ref2_spp,
+                    s->mal_floor_raw, s->refs == 2 ? "; their mean is the reference: / √2" : "");
         else
             fprintf(f, " – |");
         if (isfinite(s->fair.receiver_ratio.ratio))

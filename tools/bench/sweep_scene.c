@@ -96,6 +96,16 @@ int lrb_sweep_apply(lr_scene *s, const lrb_setting *st, lr_err *e)
         if ((rc = lr_scene_set(s, key, st->model, NULL, e)))
             return rc;
     }
+    /* A row measures what the plan would render with it: where the scene has a budget (it is
+     * planned), the light transport the plan turns on for these models (render/plan/plan.h,
+     * lr_plan_transport_decide; the file's and LRB_SWEEP_SET's values stay). */
+    lr_plan_budget b;
+    if (lr_plan_budget_from_scene(s, &b)) {
+        lr_plan_transport t;
+        if ((rc = lr_plan_transport_decide(s, NULL, &t, e)) ||
+            (rc = lr_plan_transport_apply(&t, s, NULL, e)))
+            return lr_err_prefix(e, "sweep setting %s", st->label);
+    }
     return LR_OK;
 }
 
@@ -231,6 +241,21 @@ static int second_reference(const lr_ref_scene *rs, const lr_ref_camera *cam, co
     return lr_ref_render_cached(rs, cam, &rd, dir, NULL, NULL, mean, var, hit, e);
 }
 
+/* Two references of the same count (independent seeds) are one reference of twice the
+ * samples: the model is judged against their mean, whose per-pixel variance is a quarter of
+ * the two variances' sum, and the floor becomes what two such means would differ by: the
+ * log's standard deviation, hence the median |ln| of a ratio, goes as 1/sqrt(spp), so the
+ * floor measured between the two is divided by sqrt(2). Where a scene's references differ by
+ * more than its model (the candle's lower body at 4096 spp: per-pixel SE 0.4-1), a single
+ * reference's noise would decide its median. LRB_SWEEP_REF_SINGLE=1 keeps seed 0 alone. */
+static void average_references(lr_ref_image *mean, lr_ref_image *var, const lr_ref_image *mean2,
+                               const lr_ref_image *var2, size_t n, lrb_scene_result *res)
+{
+    lr_eval_mean_references(mean->rgb, var->rgb, mean2->rgb, var2->rgb, n);
+    res->refs = 2;
+    res->mal_floor /= sqrt(2.0);
+}
+
 /* Issue 12's figures on the base setting's converged, box-filtered image C: power ratios per
  * region and band with the reference's standard error, the receivers' power ratio and the
  * median |ln ratio| over object pixels. */
@@ -277,7 +302,8 @@ static void describe_models(const lr_scene *s, const lrb_setting *base, lrb_ship
 
 
 /* LRB_SWEEP_DUMP=dir (diagnosis, issue 12): writes dir/<scene>_<what>.pfm: the base setting's
- * converged fair image ("model"), the reference ("ref", "ref_var"), the second reference
+ * converged fair image ("model"), the reference ("ref", "ref_var": the two references' mean
+ * when they are averaged, refs 2), the second reference
  * ("ref2") and the region labels ("regions": enum lr_eval_region in every band). Best effort:
  * a failed write is reported on stderr and the sweep goes on. */
 static void dump_pfm(const char *scene, const char *what, const float *rgb, int w, int h)
@@ -315,6 +341,7 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
                                        .bias_receivers = NAN, .mal = NAN,
                                        .receiver_ratio = {NAN, NAN}},
                               .mal_centre = NAN, .mal_floor_raw = NAN, .mal_floor = NAN,
+                              .refs = 1,
                               .centre_receiver_ratio = {NAN, NAN}};
     res->shipped.fig = res->fair;
     snprintf(res->name, sizeof res->name, "%s", name);
@@ -361,6 +388,8 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
         res->mal_floor_raw = lr_eval_median_abs_log(mean.rgb, mean2.rgb, m.object, n);
         res->mal_floor = res->mal_floor_raw *
                          sqrt(2.0 / (1.0 + (double)res->ref_spp / res->ref2_spp));
+        if (res->ref2_spp == res->ref_spp && !getenv("LRB_SWEEP_REF_SINGLE"))
+            average_references(&mean, &var, &mean2, &var2, n, res);
     }
     both = malloc(n);
     direct = calloc(n, 1);

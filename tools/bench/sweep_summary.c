@@ -16,11 +16,17 @@ static void scene_block(FILE *f, const lrb_scene_result *sc, const lr_eval_row *
         if (!sc->nrows)
             return;
     }
-    fprintf(f, "Physical reference: %d spp at %d×%d, %s in %.0f s; relative standard error "
+    char spp[96];
+    if (sc->refs == 2)
+        snprintf(spp, sizeof spp, "the mean of two of %d spp (seeds 0 and %d: %d spp in all)",
+                 sc->ref_spp, LRB_SWEEP_SEED2, 2 * sc->ref_spp);
+    else
+        snprintf(spp, sizeof spp, "%d spp", sc->ref_spp);
+    fprintf(f, "Physical reference: %s at %d×%d, %s in %.0f s; relative standard error "
                "%.4f (objects) / %.4f (receivers) / %.4f (both). It is taken out of every error "
                "below in quadrature (E[rmse²] = error² + se²). %ld object and %ld receiver "
                "pixels.\n\n",
-            sc->ref_spp, LRB_SWEEP_W, LRB_SWEEP_H, sc->ref_hit ? "read from the cache" : "rendered",
+            spp, LRB_SWEEP_W, LRB_SWEEP_H, sc->ref_hit ? "read from the cache" : "rendered",
             sc->ref_s, sc->ref_se_object, sc->ref_se_receivers, sc->ref_se_all, sc->object_px,
             sc->receiver_px);
     if (isfinite(sc->units_ratio))
