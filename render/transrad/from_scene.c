@@ -12,9 +12,11 @@ int lr_tr_create_scene(const lr_scene *s, const lr_tr_settings *settings, lr_tr 
                           lr_scene_name(s), no + nr, LR_TR_MAX_SURFACES);
     for (int i = 0; i < no; i++) {
         const lr_scene_object *o = lr_scene_object_at(s, i);
+        /* A closed body covers the receiver cells it stands on (cover.c): their part under
+         * its foot is no surface, as in the receivers' bounce (render/bounce). */
         d[n++] = (lr_tr_surface_desc){.kind = LR_TR_TRANSLUCENT, .mesh = o->mesh, .bvh = o->bvh,
                                       .coeffs = &o->coeffs, .model = o->sss_model,
-                                      .thickness_mm = o->thickness_mm};
+                                      .thickness_mm = o->thickness_mm, .covers = o->closed};
     }
     for (int i = 0; i < nr; i++) {
         const lr_receiver *r = lr_scene_receiver_at(s, i);

@@ -216,7 +216,9 @@ static int receiver_values(lr_tr_scene *ts, const lr_scene *s, int ri, int l, lr
         free(use);
         return LR_OK;
     }
-    lr_tr_plane_to_grid(X, NULL, nu, nv, out);
+    /* Open-weighted: a cell under a closed body's foot holds only its open part's light. */
+    const double *open = lr_tr_open_fractions(t);
+    lr_tr_plane_to_grid(X, open ? open + first : NULL, nu, nv, out);
     free(X);
     free(use);
     ts->rE[ri][l] = out;

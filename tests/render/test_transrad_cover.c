@@ -28,6 +28,7 @@
 #include <string.h>
 
 #include "render/mesh/shapes.h"
+#include "render/scene/scene.h"
 #include "render/transrad/transrad.h"
 #include "tests/support/near.h"
 #include "tests/support/objects.h"
@@ -237,10 +238,72 @@ static void test_covered_cells(void **state)
     rig_free(&old);
 }
 
+/* Translucent radiosity's own scene (lr_tr_create_scene, the lamp shade's and LED shade's
+ * model, and any closed object given it): a closed object covers the table cells under its
+ * foot as the receivers' bounce's do. A 45 x 45 x 10 mm wax box on a 120 mm table of 30 mm
+ * cells over the coaster's footprint: open fractions 0.75, 0.5, 0.5, 0 (10000 stratified
+ * origin points per cell, 0.3 mm apart: the footprint's edges fall on their rows, so within
+ * 0.005); the same box 1 mm above the table covers nothing (1 exactly). */
+static double scene_open(double lift, size_t cell_of[4])
+{
+    char text[2048];
+    snprintf(text, sizeof text,
+             "{\"objects\": [{\"name\": \"block\", \"material\": \"candle_wax\","
+             " \"model\": \"translucent_radiosity\","
+             " \"mesh\": {\"type\": \"box\", \"size\": [45, 45, 10]},"
+             " \"transform\": {\"translate\": [7.5, 7.5, %g]}}],"
+             " \"lights\": [{\"type\": \"point\", \"position\": [7.5, 7.5, 80], \"intensity\": 1}],"
+             " \"camera\": {\"position\": [0, -400, 200], \"target\": [0, 0, 0]},"
+             " \"receivers\": [{\"name\": \"table\", \"type\": \"plane\", \"center\": [0, 0, 0],"
+             " \"normal\": [0, 0, 1], \"size\": [%g, %g], \"albedo\": [0.5, 0.5, 0.5]}]}",
+             5.0 + lift, FLOOR, FLOOR);
+    lr_scene *sc;
+    lr_err e = {0};
+    if (lr_scene_parse(text, strlen(text), "block.json", NULL, &sc, &e))
+        fail_msg("%s", e.msg);
+    lr_tr *t;
+    lr_tr_settings set = {.rays_per_patch = 10000, .receiver_mm = CELL, .seed = 3};
+    if (lr_tr_create_scene(sc, &set, &t, &e))
+        fail_msg("%s", e.msg);
+    size_t f0, nf;
+    lr_tr_surface_patches(t, 1, &f0, &nf);
+    assert_int_equal(nf, 16);
+    double sum = 0;
+    for (size_t p = f0; p < f0 + nf; p++) {
+        lr_vec3 c;
+        lr_tr_patch_geometry(t, p, &c, NULL, NULL);
+        double f = lr_tr_open_fraction(t, p);
+        int k = (c.x > 0) + 2 * (c.y > 0); /* the four cells about the origin */
+        if (fabs(c.x) < CELL && fabs(c.y) < CELL)
+            cell_of[k] = (size_t)(1000 * f + 0.5);
+        else
+            assert_true(f == 1.0);
+        sum += f;
+    }
+    lr_tr_destroy(t);
+    lr_scene_destroy(sc);
+    return sum;
+}
+
+static void test_scene_objects_cover(void **state)
+{
+    (void)state;
+    size_t open[4] = {0}, lifted[4] = {0};
+    double sum = scene_open(0.0, open);
+    print_message("box on the table: open %.3f %.3f %.3f %.3f (0.75 0.5 0.5 0)\n",
+                  open[0] / 1e3, open[1] / 1e3, open[2] / 1e3, open[3] / 1e3);
+    const double want[4] = {0.75, 0.5, 0.5, 0.0};
+    for (int k = 0; k < 4; k++)
+        assert_near(open[k] / 1e3, want[k], 0.005);
+    assert_near(sum, 16 - 2.25, 0.02); /* the footprint is 2.25 cells */
+    assert_near(scene_open(1.0, lifted), 16.0, 0.0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_covered_cells),
+        cmocka_unit_test(test_scene_objects_cover),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
