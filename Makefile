@@ -24,14 +24,18 @@ ifndef LAMPRIG_INNER
 # under the other's linker. Each inner make still builds in parallel (-j reaches it).
 .NOTPARALLEL:
 .PHONY: $(PUBLIC_TARGETS) deps clean
+# A plain `make test` (as CI and the README run it) builds on every CPU: without a -j of the
+# user's, the inner make gets -j(number of CPUs). MAKEFLAGS shows -j only inside a recipe.
+NPROC := $(shell nproc 2>/dev/null || echo 2)
+JOBS = $$(case " $$MAKEFLAGS " in *" -j"*) ;; *) echo -j$(NPROC) ;; esac)
 $(PUBLIC_TARGETS): deps
-	@$(MAKE) --no-print-directory LAMPRIG_INNER=1 $@
+	@$(MAKE) --no-print-directory $(JOBS) LAMPRIG_INNER=1 $@
 deps:
 	@sh tools/deps.sh
 clean:
 	rm -rf build
 %: deps
-	@$(MAKE) --no-print-directory LAMPRIG_INNER=1 $@
+	@$(MAKE) --no-print-directory $(JOBS) LAMPRIG_INNER=1 $@
 else
 
 CC      ?= cc
@@ -148,9 +152,13 @@ UDEVDIR     ?= $(if $(filter /usr,$(PREFIX)),$(PREFIX)/lib/udev/rules.d,/etc/ude
 SYSUSERSDIR ?= $(PREFIX)/lib/sysusers.d
 STATEDIR    ?= /var/lib/lamprig
 INSTALL_BINS := lamprig lamprig-modbus-sim
-# configs/bench/references only serve `make bench`; the planner needs bench/front.csv.
-DATA_FILES  := $(sort $(wildcard configs/materials/*.json configs/scenes/*.json configs/meshes/* \
-                 configs/rig/* configs/controls/* configs/reference/*) configs/bench/front.csv)
+# Every data file the program reads: what git tracks under configs/ (never a user's stray file
+# in the checkout), less configs/bench/references (they serve `make bench` only) and the
+# folders' READMEs. The planner reads bench/front.csv and bench/models.csv (the change costs
+# behind quality.change_ms). Outside a git checkout (a release tarball) the same by wildcard.
+DATA_GIT    := $(shell git ls-files configs 2>/dev/null)
+DATA_FILES  := $(sort $(filter-out configs/bench/references/% %.md, \
+                 $(if $(DATA_GIT),$(wildcard $(DATA_GIT)),$(wildcard configs/*/*))))
 SHADER_FILES := $(sort $(wildcard render/shaders/* render/shaders/*/*))
 SUBST = sed -e 's|@BINDIR@|$(BINDIR)|g' -e 's|@DATADIR@|$(DATADIR)|g' \
             -e 's|@SYSCONFDIR@|$(SYSCONFDIR)|g' -e 's|@STATEDIR@|$(STATEDIR)|g'

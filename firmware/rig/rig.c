@@ -446,7 +446,10 @@ static void handle_event(lr_rig *r, const lr_event *ev, int64_t now)
 
 /* ---- frames ---- */
 
-static void write_png(lr_rig *r, int index)
+/* Files are numbered by the rig's own frame count, never the view's accumulation index: that
+ * restarts at 0 after every change and every scene switch, and its frames would overwrite the
+ * earlier ones. */
+static void write_png(lr_rig *r, uint64_t index)
 {
     int w, h;
     lr_rig_view_size(r->view, &w, &h);
@@ -457,7 +460,7 @@ static void write_png(lr_rig *r, int index)
             for (int k = 0; k < 3; k++)
                 img.rgb[3 * i + k] = lr_srgb_decode(r->rgba[4 * i + k] / 255.0f);
         char path[LR_RIG_PATH_MAX + 32];
-        snprintf(path, sizeof path, "%s/frame_%06d.png", r->out_dir, index);
+        snprintf(path, sizeof path, "%s/frame_%06llu.png", r->out_dir, (unsigned long long)index);
         if (lr_image_write_png(path, &img, NULL, &e) && r->frame_errors++ == 0)
             lr_log_write(&r->log, LR_LOG_ERROR, "frames: %s", e.msg);
     }
@@ -528,7 +531,7 @@ static void frame(lr_rig *r, int64_t now)
     if (!rc && r->out_dir[0]) {
         rc = lr_rig_view_read_rgba8(r->view, r->rgba, &e);
         if (!rc)
-            write_png(r, st.index);
+            write_png(r, r->frames);
     }
     if (rc) {
         /* Logged once per run of failures; the loop keeps going on the controls. */

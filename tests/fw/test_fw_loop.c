@@ -146,7 +146,8 @@ static void test_sim_in_process(void **state)
 
 /* A scene switch (button2) loads the next scene file and writes every control's value into
  * it again: the dimmer's intensity, the material picked by button1 and the translucency
- * scale survive the switch (the votive's file says 0.004 W/sr and scale 1.5). */
+ * scale survive the switch (the votive's file says 0.004 W/sr and scale 1.5); --out-dir keeps
+ * one file per frame across the switch. */
 static void test_scene_switch_keeps_controls(void **state)
 {
     (void)state;
@@ -166,8 +167,10 @@ static void test_scene_switch_keeps_controls(void **state)
              " \"output\": {\"width\": 16, \"height\": 16, \"renderer\": \"preview\"}}\n",
              LR_SOURCE_CONFIGS, LR_SOURCE_CONFIGS, LR_SOURCE_CONFIGS);
     char *cfg = lr_test_write(dir, "rig.json", text, (size_t)-1);
+    char *frames = lr_test_path(dir, "frames");
+    assert_int_equal(mkdir(frames, 0755), 0);
     lr_test_log log = {0};
-    lr_rig_opts o = {.config = cfg, .duration_s = 0.6, .no_signals = true,
+    lr_rig_opts o = {.config = cfg, .duration_s = 0.6, .no_signals = true, .out_dir = frames,
                      .log = {lr_test_log_fn, &log}};
     lr_rig *r;
     lr_err e = {0};
@@ -181,7 +184,25 @@ static void test_scene_switch_keeps_controls(void **state)
     lr_scene_get(lr_rig_scene(r), "objects[0].material.base", buf, sizeof buf, NULL);
     assert_string_equal(buf, "marble");
     assert_int_equal(lr_test_log_count(&log, "scene: "), 1);
+    /* --out-dir numbers frames by the rig's own count: one file per frame drawn, none written
+     * over when the switch restarts the new scene's accumulation at its frame 0. */
+    lr_rig_info info;
+    lr_rig_get_info(r, &info);
+    assert_true(info.frames >= 2);
+    DIR *d = opendir(frames);
+    assert_non_null(d);
+    unsigned long long pngs = 0;
+    struct dirent *de;
+    while ((de = readdir(d)))
+        pngs += strstr(de->d_name, ".png") != NULL;
+    closedir(d);
+    assert_int_equal(pngs, (unsigned long long)info.frames);
+    char last[4096];
+    snprintf(last, sizeof last, "%s/frame_%06llu.png", frames,
+             (unsigned long long)info.frames - 1);
+    assert_int_equal(access(last, F_OK), 0);
     lr_rig_destroy(r);
+    free(frames);
     free(cfg);
     lr_test_rmtree(dir);
 }
