@@ -24,13 +24,30 @@ for p in $PKGS; do
 done
 [ -z "$missing" ] && exit 0
 
-echo "lamprig deps: installing$missing" >&2
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then
-    command -v sudo >/dev/null 2>&1 || { echo "lamprig deps: need root or sudo to install$missing" >&2; exit 1; }
+    if ! command -v sudo >/dev/null 2>&1; then
+        echo "lamprig deps: these Debian packages are missing:$missing" >&2
+        echo "lamprig deps: install them as root (no sudo here): su -c 'sh $(cd "$(dirname "$0")" && pwd)/$(basename "$0")'" >&2
+        exit 1
+    fi
     SUDO=sudo
 fi
 export DEBIAN_FRONTEND=noninteractive
+echo "lamprig deps: missing:$missing" >&2
+echo "lamprig deps: apt-get update ..." >&2
 $SUDO apt-get update -qq >&2
+# What apt will do (the packages with their dependencies, the download), before it does it:
+# a fresh Debian 12 gets several hundred packages and some minutes. -s only simulates;
+# --print-uris lists what would be fetched with its size.
 # shellcheck disable=SC2086
-$SUDO apt-get install -y -qq --no-install-recommends $missing >&2
+plan=$($SUDO apt-get -s install --no-install-recommends $missing 2>/dev/null | sed -n 's/^\(.*newly installed\).*/\1/p' || true)
+# shellcheck disable=SC2086
+mb=$($SUDO apt-get --print-uris -qq install --no-install-recommends $missing 2>/dev/null |
+    awk '{ s += $3 } END { printf "%.1f", s / 1e6 }')
+[ -n "$plan" ] && echo "lamprig deps: $plan, about $mb MB to download" >&2
+echo "lamprig deps: installing (apt's progress below) ..." >&2
+# -q: one line per package fetched and set up, so a long install shows how far it is.
+# shellcheck disable=SC2086
+$SUDO apt-get install -y -q --no-install-recommends -o Dpkg::Use-Pty=0 $missing >&2
+echo "lamprig deps: done" >&2
