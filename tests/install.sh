@@ -4,7 +4,8 @@
 # every file where the unit, the rig config and the binary look for them; systemd-analyze
 # accepts the unit; the udev rules parse and grant each supported device to group lamprig;
 # the installed binary, outside the source tree and unprivileged, finds its data beside
-# itself, renders the default scene and runs the shipped rig config.
+# itself (every tracked data file under configs/), plans the shipped rig's scene as the source
+# tree does, renders the default scene and runs the shipped rig config.
 #
 # Needs no systemd running and changes nothing on the host: the package is never installed
 # (dpkg-deb -x into a temporary root) and no user is created (as root, the binary runs as
@@ -75,6 +76,11 @@ for f in configs/materials/candle_wax.json configs/scenes/candle.json configs/be
     shaders/mesh.vert shaders/lib/optics.glsl; do
     check "data $f beside the binary" test -f "$data/$f"
 done
+if git -C "$src" rev-parse --git-dir >/dev/null 2>&1; then
+    check "every tracked data file under configs/ installed (less bench references, READMEs)" \
+        test "$(git -C "$src" ls-files configs | grep -v -e '^configs/bench/references/' -e '\.md$' | sort)" = \
+        "$(cd "$data" && find configs -type f | sort)"
+fi
 check "every shader of the source tree installed" \
     test "$(cd "$src/render/shaders" && find . -type f | sort)" = "$(cd "$data/shaders" && find . -type f | sort)"
 check "udev rules installed" test -f "$R/lib/udev/rules.d/60-lamprig.rules"
@@ -149,6 +155,23 @@ else
     cat "$T/render.txt"
     fail "installed binary renders candle.json"
 fi
+# The planner's tables (front.csv, models.csv) come from beside the installed binary: its plan
+# of the shipped rig's scene equals the source tree's, as shipped and with another preset (a
+# material change re-plans with the change costs of models.csv).
+sed 's/"candle_wax"/"marble"/' "$data/configs/scenes/candle.json" >"$T/out/candle_marble.json"
+for scene in "$data/configs/scenes/candle.json" "$T/out/candle_marble.json"; do
+    run_installed "$R$exe" plan --scene "$scene" --json >"$T/out/plan_installed.json" \
+        2>"$T/out/plan_installed.err" || true
+    (cd "$src" && env -u LAMPRIG_CONFIGS "$build/bin/lamprig" plan --scene "$scene" --json) \
+        >"$T/plan_source.json" 2>/dev/null || true
+    if [ -s "$T/plan_source.json" ] && cmp -s "$T/out/plan_installed.json" "$T/plan_source.json"; then
+        ok "installed plan of $(basename "$scene") equals the source tree's"
+    else
+        cat "$T/out/plan_installed.err"
+        diff "$T/out/plan_installed.json" "$T/plan_source.json" | cut -c1-300 | head -n 5
+        fail "installed plan of $(basename "$scene") differs from the source tree's"
+    fi
+done
 # The shipped rig config, its /usr paths pointed into the root, stats into a scratch dir.
 sed -e "s|\"/usr/|\"$R/usr/|g" -e "s|\"/var/lib/lamprig/|\"$T/out/|g" "$R$cfg" >"$T/out/rig.json"
 if run_installed "$R$exe" run --config "$T/out/rig.json" --duration 1.5 >"$T/run.txt" 2>&1 &&
