@@ -101,6 +101,18 @@ if command -v systemd-analyze >/dev/null; then
         cat "$T/verify.txt"
         fail "systemd-analyze verify"
     fi
+    # The hardening, scored as systemd scores it (offline: no manager runs here). 7.3 MEDIUM
+    # before it; the bound leaves room for a new directive's weight, not for a lost one.
+    score=$(systemd-analyze security --offline=yes --no-pager "$T/unit/lamprig.service" 2>/dev/null |
+        sed -n 's/.*Overall exposure level for [^:]*: \([0-9.]*\).*/\1/p')
+    if [ -n "$score" ] && awk -v s="$score" 'BEGIN { exit !(s <= 2.5) }'; then
+        ok "systemd-analyze security: exposure $score (at most 2.5)"
+    else
+        systemd-analyze security --offline=yes --no-pager "$T/unit/lamprig.service" 2>&1 | grep -F '✗' | head -n 20
+        fail "systemd-analyze security: exposure '$score' over 2.5"
+    fi
+    check "DevicePolicy=closed with DeviceAllow= for drm, gpiochip, hidraw, usb_device, serial" sh -c \
+        "grep -qx 'DevicePolicy=closed' '$unit' && for c in drm gpiochip hidraw usb_device ttyUSB ttyACM; do grep -qx \"DeviceAllow=char-\$c rw\" '$unit' || exit 1; done"
 else
     fail "systemd-analyze not installed (make deps installs systemd)"
 fi
