@@ -8,6 +8,8 @@
 #include "firmware/version.h"
 #include "render/base/atomic_file.h"
 #include "render/base/paths.h"
+#include "render/gl/shader_cache.h"
+#include "hal/log.h"
 
 /* ---- messages ------------------------------------------------------------------------- */
 
@@ -73,6 +75,22 @@ int lr_cli_need(const lr_cli *c, const char *flag)
 int lr_cli_check(const lr_cli *c, int rc, const lr_err *e)
 {
     return rc ? lr_cli_usage(c->path, "%s", e->msg) : LR_EXIT_OK;
+}
+
+/* ---- before the work -------------------------------------------------------------------- */
+
+/* A full or read-only cache disk must cost the shader cache, not the rig: Mesa's cache dies
+ * with SIGBUS on a full disk (render/gl/shader_cache.h). Disabled for this process before any
+ * GL context exists (Mesa reads the variable at eglInitialize; no other thread runs yet), with
+ * one warning naming the folder. */
+static void guard_shader_cache(void)
+{
+    lr_err e = {0};
+    if (lr_gl_shader_cache_check(&e) == LR_OK)
+        return;
+    setenv("MESA_SHADER_CACHE_DISABLE", "true", 1);
+    lr_log_write(NULL, LR_LOG_WARN, "%s; running without it (shaders compiled at every start)",
+                 e.msg);
 }
 
 /* ---- dispatch ------------------------------------------------------------------------- */
@@ -154,8 +172,10 @@ int lr_cli_command(const lr_command *cmd, const char *parent, int argc, char **a
         if ((cmd->opts[k].flags & LR_ARG_OUTPUT) && c->args.value[k] &&
             lr_atomic_file_check(c->args.value[k], &e))
             st = lr_cli_usage(path, "%s %s", cmd->opts[k].name, e.msg);
-    if (!st)
+    if (!st) {
+        guard_shader_cache();
         st = cmd->run(c);
+    }
     fflush(stdout);
     free(c);
     return st;

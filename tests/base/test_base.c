@@ -6,19 +6,23 @@
 #include <cmocka.h>
 
 #include <dirent.h>
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
+#include <fcntl.h>
 #include <sys/stat.h>
 
 #include "firmware/cli.h"
 #include "render/base/atomic_file.h"
+#include "render/base/dir_check.h"
 #include "render/base/err.h"
 #include "render/base/median.h"
 #include "render/base/paths.h"
+#include "render/gl/shader_cache.h"
 #include "tests/support/fs.h"
 
 static void test_err_prefix(void **state)
@@ -155,6 +159,130 @@ static void test_median_finite(void **state)
     assert_true(isnan(lr_median_finite(NULL, 0)));
 }
 
+/* Fills the file system under dir until a write fails (ENOSPC). */
+static void fill_up(const char *dir)
+{
+    char *path = lr_test_path(dir, "fill");
+    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    assert_true(fd >= 0);
+    static const char block[4096];
+    while (write(fd, block, sizeof block) == (ssize_t)sizeof block)
+        ;
+    close(fd);
+    free(path);
+}
+
+/* A folder that can take writes passes, a missing one is judged by the ancestor it would be
+ * made in, a file where a folder should be and a free-space floor above what the disk has are
+ * refused naming the folder; as root, a read-only and a full tmpfs are refused too (root
+ * ignores permission bits, so only a mount shows them). */
+static void test_dir_check_writable(void **state)
+{
+    (void)state;
+    char *dir = lr_test_tmpdir();
+    lr_err e = {0};
+    assert_int_equal(lr_dir_check_writable(dir, 0, &e), LR_OK);
+    char *deep = lr_test_path(dir, "a/b/c");
+    assert_int_equal(lr_dir_check_writable(deep, 4096, &e), LR_OK);
+    struct stat st;
+    assert_int_equal(stat(deep, &st), -1); /* the check made nothing */
+    char *file = lr_test_write(dir, "plain", "x", (size_t)-1);
+    char *under = lr_test_path(file, "lamprig");
+    assert_int_equal(lr_dir_check_writable(under, 0, &e), LR_EIO);
+    assert_non_null(strstr(e.msg, file));
+    assert_non_null(strstr(e.msg, "not a folder"));
+    assert_int_equal(lr_dir_check_writable(dir, UINT64_MAX, &e), LR_EIO);
+    assert_non_null(strstr(e.msg, dir));
+    assert_non_null(strstr(e.msg, "kB free, under"));
+    /* No probe file is left behind. */
+    DIR *d = opendir(dir);
+    int entries = 0;
+    for (struct dirent *de; (de = readdir(d));)
+        entries += de->d_name[0] != '.';
+    closedir(d);
+    assert_int_equal(entries, 1); /* "plain" */
+
+    char *mnt = lr_test_path(dir, "mnt");
+    assert_int_equal(mkdir(mnt, 0700), 0);
+    if (lr_test_mount_tmpfs(mnt, 1024, 1) != 0) {
+        fprintf(stderr, "skipping the tmpfs cases: mount: %s (needs root)\n", strerror(errno));
+    } else {
+        assert_int_equal(lr_dir_check_writable(mnt, 0, &e), LR_EIO);
+        assert_non_null(strstr(e.msg, "read-only file system"));
+        lr_test_umount(mnt);
+        assert_int_equal(lr_test_mount_tmpfs(mnt, 256, 0), 0);
+        assert_int_equal(lr_dir_check_writable(mnt, 0, &e), LR_OK);
+        fill_up(mnt);
+        /* No floor: the probe write itself finds the disk full. */
+        assert_int_equal(lr_dir_check_writable(mnt, 0, &e), LR_EIO);
+        assert_non_null(strstr(e.msg, mnt));
+        assert_non_null(strstr(e.msg, "No space left"));
+        lr_test_umount(mnt);
+    }
+    free(mnt);
+    free(under);
+    free(file);
+    free(deep);
+    lr_test_rmtree(dir);
+}
+
+/* Mesa 22.3's rules for its shader cache folder, and "disabled" when it is. */
+static void set_env(const char *name, const char *value)
+{
+    if (value)
+        setenv(name, value, 1);
+    else
+        unsetenv(name);
+}
+
+static void test_shader_cache_dir(void **state)
+{
+    (void)state;
+    static const char *names[] = {"MESA_SHADER_CACHE_DISABLE", "MESA_GLSL_CACHE_DISABLE",
+                                  "MESA_SHADER_CACHE_DIR", "MESA_GLSL_CACHE_DIR",
+                                  "XDG_CACHE_HOME", "MESA_DISK_CACHE_SINGLE_FILE",
+                                  "MESA_DISK_CACHE_DATABASE"};
+    char *saved[7];
+    for (int i = 0; i < 7; i++) {
+        saved[i] = getenv(names[i]) ? strdup(getenv(names[i])) : NULL;
+        unsetenv(names[i]);
+    }
+    char buf[512];
+    setenv("XDG_CACHE_HOME", "/x/cache", 1);
+    assert_string_equal(lr_gl_shader_cache_dir(buf, sizeof buf), "/x/cache/mesa_shader_cache");
+    setenv("MESA_GLSL_CACHE_DIR", "/old", 1);
+    assert_string_equal(lr_gl_shader_cache_dir(buf, sizeof buf), "/old/mesa_shader_cache");
+    setenv("MESA_SHADER_CACHE_DIR", "/new", 1);
+    setenv("MESA_DISK_CACHE_SINGLE_FILE", "1", 1);
+    assert_string_equal(lr_gl_shader_cache_dir(buf, sizeof buf), "/new/mesa_shader_cache_sf");
+    setenv("MESA_GLSL_CACHE_DISABLE", "yes", 1);
+    assert_null(lr_gl_shader_cache_dir(buf, sizeof buf));
+    /* The new name, when present, decides alone. */
+    setenv("MESA_SHADER_CACHE_DISABLE", "false", 1);
+    assert_non_null(lr_gl_shader_cache_dir(buf, sizeof buf));
+    setenv("MESA_SHADER_CACHE_DISABLE", "TRUE", 1);
+    assert_null(lr_gl_shader_cache_dir(buf, sizeof buf));
+    lr_err e = {0};
+    assert_int_equal(lr_gl_shader_cache_check(&e), LR_OK); /* disabled: nothing to check */
+    unsetenv("MESA_SHADER_CACHE_DISABLE");
+    unsetenv("MESA_GLSL_CACHE_DISABLE");
+    /* A file where the cache's parent should be: refused, named. */
+    char *dir = lr_test_tmpdir();
+    char *file = lr_test_write(dir, "f", "x", (size_t)-1);
+    setenv("MESA_SHADER_CACHE_DIR", file, 1);
+    assert_int_equal(lr_gl_shader_cache_check(&e), LR_EIO);
+    assert_non_null(strstr(e.msg, "Mesa shader cache"));
+    assert_non_null(strstr(e.msg, file));
+    setenv("MESA_SHADER_CACHE_DIR", dir, 1);
+    assert_int_equal(lr_gl_shader_cache_check(&e), lr_dir_check_writable(dir, LR_GL_SHADER_CACHE_MIN_FREE, NULL));
+    free(file);
+    lr_test_rmtree(dir);
+    for (int i = 0; i < 7; i++) {
+        set_env(names[i], saved[i]);
+        free(saved[i]);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -162,6 +290,8 @@ int main(void)
         cmocka_unit_test(test_atomic_replace_and_failure_keeps_old),
         cmocka_unit_test(test_data_paths),
         cmocka_unit_test(test_median_finite),
+        cmocka_unit_test(test_dir_check_writable),
+        cmocka_unit_test(test_shader_cache_dir),
     };
     return cmocka_run_group_tests_name("base", tests, NULL, NULL);
 }

@@ -101,6 +101,39 @@ static void test_run_out_dir_must_be_a_folder(void **state)
     free(missing);
 }
 
+/* A full cache disk costs the shader cache, not the rig: with XDG_CACHE_HOME on a full tmpfs
+ * Mesa's cache died with SIGBUS before the first frame (exit 135). Now the run finishes (0)
+ * and says once which folder it runs without. Needs root to mount; skipped otherwise. */
+static void test_run_on_a_full_cache_disk(void **state)
+{
+    char *mnt = lr_test_path(dir, "cache");
+    assert_int_equal(mkdir(mnt, 0700), 0);
+    if (lr_test_mount_tmpfs(mnt, 256, 0) != 0) {
+        free(mnt);
+        skip();
+    }
+    char *fill = lr_test_path(mnt, "fill");
+    FILE *f = fopen(fill, "wb");
+    assert_non_null(f);
+    static const char block[4096];
+    while (fwrite(block, 1, sizeof block, f) == sizeof block && fflush(f) == 0)
+        ;
+    fclose(f);
+    int st = run("XDG_CACHE_HOME=%s ./build/bin/lamprig run --config configs/rig/sim.json "
+                 "--headless --duration 0.5", mnt);
+    char *err = slurp("err");
+    lr_test_umount(mnt);
+    if (st != 0)
+        fail_msg("run on a full cache disk: exit %d, stderr '%s'", st, err);
+    const char *w = strstr(err, "Mesa shader cache: ");
+    assert_non_null(w);
+    assert_non_null(strstr(w, mnt));
+    assert_null(strstr(w + 1, "Mesa shader cache: ")); /* once */
+    free(err);
+    free(fill);
+    free(mnt);
+}
+
 static void test_calib_check_skips_rig_configs(void **state)
 {
     /* A valid colour matrix, an invalid one (a required field missing) and the rig configs. */
@@ -145,6 +178,7 @@ int main(void)
         cmocka_unit_test(test_version_is_the_version_file),
         cmocka_unit_test(test_run_out_dir_must_be_a_folder),
         cmocka_unit_test(test_calib_check_skips_rig_configs),
+        cmocka_unit_test(test_run_on_a_full_cache_disk),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
