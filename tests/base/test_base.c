@@ -20,6 +20,7 @@
 #include "render/base/atomic_file.h"
 #include "render/base/dir_check.h"
 #include "render/base/err.h"
+#include "render/base/file.h"
 #include "render/base/median.h"
 #include "render/base/paths.h"
 #include "render/gl/shader_cache.h"
@@ -283,6 +284,57 @@ static void test_shader_cache_dir(void **state)
     }
 }
 
+/* Whole-file reads take regular files only, up to the caller's cap: a FIFO is refused at once
+ * (it blocked the open for ever), a symlink to /dev/zero is refused as a device (it was read
+ * until memory ran out), a file one byte over the cap is refused, one at the cap is read. */
+static void test_file_read_regular_only(void **state)
+{
+    (void)state;
+    char *dir = lr_test_tmpdir();
+    char *fifo = lr_test_path(dir, "fifo.json");
+    assert_int_equal(mkfifo(fifo, 0600), 0);
+    char *zero = lr_test_path(dir, "zero.json");
+    assert_int_equal(symlink("/dev/zero", zero), 0);
+    char *data = NULL;
+    size_t len = 99;
+    lr_err e = {0};
+    alarm(10); /* a regression would block here: fail, do not hang */
+    assert_int_equal(lr_file_read(fifo, LR_FILE_MAX_TEXT, &data, &len, &e), LR_EIO);
+    alarm(0);
+    assert_null(data);
+    assert_int_equal(len, 0);
+    assert_non_null(strstr(e.msg, fifo));
+    assert_non_null(strstr(e.msg, "a FIFO, not a regular file"));
+    assert_int_equal(lr_file_read(zero, LR_FILE_MAX_TEXT, &data, &len, &e), LR_EIO);
+    assert_non_null(strstr(e.msg, zero));
+    assert_non_null(strstr(e.msg, "a character device"));
+    assert_int_equal(lr_file_read(dir, LR_FILE_MAX_TEXT, &data, &len, &e), LR_EIO);
+    assert_non_null(strstr(e.msg, "a directory"));
+    char body[100];
+    memset(body, 'a', sizeof body);
+    char *file = lr_test_write(dir, "f.json", body, sizeof body);
+    assert_int_equal(lr_file_read(file, 99, &data, &len, &e), LR_EIO);
+    assert_non_null(strstr(e.msg, file));
+    assert_non_null(strstr(e.msg, "larger than 99 bytes"));
+    assert_null(data);
+    assert_int_equal(lr_file_read(file, 100, &data, &len, &e), LR_OK);
+    assert_int_equal(len, 100);
+    assert_int_equal(data[100], '\0');
+    assert_memory_equal(data, body, 100);
+    free(data);
+    /* A symlink to a regular file is fine. */
+    char *link = lr_test_path(dir, "link.json");
+    assert_int_equal(symlink(file, link), 0);
+    assert_int_equal(lr_file_read(link, 100, &data, &len, &e), LR_OK);
+    assert_int_equal(len, 100);
+    free(data);
+    free(link);
+    free(file);
+    free(zero);
+    free(fifo);
+    lr_test_rmtree(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -291,6 +343,7 @@ int main(void)
         cmocka_unit_test(test_data_paths),
         cmocka_unit_test(test_median_finite),
         cmocka_unit_test(test_dir_check_writable),
+        cmocka_unit_test(test_file_read_regular_only),
         cmocka_unit_test(test_shader_cache_dir),
     };
     return cmocka_run_group_tests_name("base", tests, NULL, NULL);

@@ -134,6 +134,25 @@ static void test_run_on_a_full_cache_disk(void **state)
     free(mnt);
 }
 
+/* A FIFO given as the scene or the rig config is refused at once, naming it (the open used to
+ * wait for a writer for ever: `timeout` turns that into exit 124). */
+static void test_fifo_input_is_refused(void **state)
+{
+    char *fifo = lr_test_path(dir, "scene.json");
+    assert_int_equal(mkfifo(fifo, 0600), 0);
+    const char *cmd[2] = {"render --scene %s --out x.png", "run --config %s --headless --duration 0.2"};
+    for (int k = 0; k < 2; k++) {
+        char line[512];
+        snprintf(line, sizeof line, cmd[k], fifo);
+        int st = run("timeout 20 ./build/bin/lamprig %s", line);
+        char *err = slurp("err");
+        if (st != 1 || !strstr(err, fifo) || !strstr(err, "a FIFO, not a regular file"))
+            fail_msg("%s: exit %d, stderr '%s' (expected 1 naming the FIFO)", line, st, err);
+        free(err);
+    }
+    free(fifo);
+}
+
 static void test_calib_check_skips_rig_configs(void **state)
 {
     /* A valid colour matrix, an invalid one (a required field missing) and the rig configs. */
@@ -179,6 +198,7 @@ int main(void)
         cmocka_unit_test(test_run_out_dir_must_be_a_folder),
         cmocka_unit_test(test_calib_check_skips_rig_configs),
         cmocka_unit_test(test_run_on_a_full_cache_disk),
+        cmocka_unit_test(test_fifo_input_is_refused),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
