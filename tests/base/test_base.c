@@ -23,6 +23,7 @@
 #include "render/base/file.h"
 #include "render/base/median.h"
 #include "render/base/paths.h"
+#include "render/base/umask.h"
 #include "render/gl/shader_cache.h"
 #include "tests/support/fs.h"
 
@@ -335,6 +336,44 @@ static void test_file_read_regular_only(void **state)
     lr_test_rmtree(dir);
 }
 
+static unsigned mode_of(const char *path)
+{
+    struct stat st;
+    assert_int_equal(stat(path, &st), 0);
+    return (unsigned)(st.st_mode & 07777);
+}
+
+/* Written files get the mode asked for less the umask, as open(2) gives (it was 0644 whatever
+ * the umask); the umask is read without changing it (lr_umask_get). Private files (calibrations,
+ * the rig's state) are 0640 at most. */
+static void test_atomic_file_mode_follows_umask(void **state)
+{
+    (void)state;
+    char *dir = lr_test_tmpdir();
+    char *path = lr_test_path(dir, "f.bin");
+    lr_err e = {0};
+    static const struct {
+        mode_t mask;
+        unsigned data, priv;
+    } cases[] = {{022, 0644, 0640}, {027, 0640, 0640}, {077, 0600, 0600}, {002, 0664, 0640}};
+    mode_t old = umask(022);
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        umask(cases[i].mask);
+        assert_int_equal(lr_umask_get(), cases[i].mask);
+        assert_int_equal(lr_atomic_write(path, "x", 1, &e), LR_OK);
+        if (mode_of(path) != cases[i].data)
+            fail_msg("umask %03o: data file %03o, expected %03o", (unsigned)cases[i].mask,
+                     mode_of(path), cases[i].data);
+        assert_int_equal(lr_atomic_write_mode(path, "y", 1, LR_FILE_MODE_PRIVATE, &e), LR_OK);
+        if (mode_of(path) != cases[i].priv)
+            fail_msg("umask %03o: private file %03o, expected %03o", (unsigned)cases[i].mask,
+                     mode_of(path), cases[i].priv);
+    }
+    umask(old);
+    free(path);
+    lr_test_rmtree(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -343,6 +382,7 @@ int main(void)
         cmocka_unit_test(test_data_paths),
         cmocka_unit_test(test_median_finite),
         cmocka_unit_test(test_dir_check_writable),
+        cmocka_unit_test(test_atomic_file_mode_follows_umask),
         cmocka_unit_test(test_file_read_regular_only),
         cmocka_unit_test(test_shader_cache_dir),
     };
