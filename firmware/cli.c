@@ -4,11 +4,15 @@
 #include <stdlib.h>
 #include <stdbool.h>
 #include <string.h>
+#include <time.h>
 
 #include "firmware/version.h"
 #include "render/base/atomic_file.h"
 #include "render/base/paths.h"
+#include "render/base/cache_dir.h"
+#include "render/base/dir_check.h"
 #include "render/gl/shader_cache.h"
+#include "render/transrad/transrad.h"
 #include "hal/log.h"
 
 /* ---- messages ------------------------------------------------------------------------- */
@@ -93,6 +97,38 @@ static void guard_shader_cache(void)
                  e.msg);
 }
 
+/* Free space our cache folder should have: the sim rig's precomputations take 12 MB. */
+#define CACHE_MIN_FREE (16u << 20)
+
+/* The precomputation caches ($XDG_CACHE_HOME/lamprig, render/transrad/cache.c): a folder that
+ * cannot take writes costs every start a rebuild of seconds, said here once rather than never
+ * (each store fails quietly: best effort). Otherwise stale temps of a killed writer are swept
+ * and the folder is held to its cap (render/base/cache_dir.h). */
+static void tidy_caches(void)
+{
+    char dir[1024];
+    if (!lr_tr_cache_default_dir(dir, sizeof dir))
+        return;
+    lr_err e = {0};
+    if (lr_dir_check_writable(dir, CACHE_MIN_FREE, &e)) {
+        lr_log_write(NULL, LR_LOG_WARN, "cache folder: %s; precomputations (translucent "
+                     "radiosity, receiver light) are rebuilt at every start", e.msg);
+        return;
+    }
+    uint64_t cap;
+    if (lr_cache_max_bytes(&cap, &e))
+        lr_log_write(NULL, LR_LOG_WARN, "%s; using %llu MiB", e.msg,
+                     (unsigned long long)(cap >> 20));
+    lr_cache_tidy t;
+    if (lr_cache_dir_tidy(dir, cap, time(NULL), &t, &e))
+        lr_log_write(NULL, LR_LOG_WARN, "cache folder: %s", e.msg);
+    else if (t.temps_removed || t.files_removed)
+        lr_log_write(NULL, LR_LOG_INFO, "cache folder %s: removed %d stale temporary files and "
+                     "%d cache files (%llu -> %llu MiB, cap %llu MiB)", dir, t.temps_removed,
+                     t.files_removed, (unsigned long long)(t.bytes_before >> 20),
+                     (unsigned long long)(t.bytes_after >> 20), (unsigned long long)(cap >> 20));
+}
+
 /* ---- dispatch ------------------------------------------------------------------------- */
 
 static int is_help(const char *a) { return !strcmp(a, "--help") || !strcmp(a, "-h"); }
@@ -174,6 +210,7 @@ int lr_cli_command(const lr_command *cmd, const char *parent, int argc, char **a
             st = lr_cli_usage(path, "%s %s", cmd->opts[k].name, e.msg);
     if (!st) {
         guard_shader_cache();
+        tidy_caches();
         st = cmd->run(c);
     }
     fflush(stdout);

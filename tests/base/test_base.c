@@ -15,9 +15,11 @@
 
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/time.h>
 
 #include "firmware/cli.h"
 #include "render/base/atomic_file.h"
+#include "render/base/cache_dir.h"
 #include "render/base/dir_check.h"
 #include "render/base/err.h"
 #include "render/base/file.h"
@@ -374,6 +376,86 @@ static void test_atomic_file_mode_follows_umask(void **state)
     lr_test_rmtree(dir);
 }
 
+/* Sets a file's access and modification times to now - age_s. */
+static void age(const char *dir, const char *name, time_t now, long age_s, size_t bytes)
+{
+    char *path = lr_test_path(dir, name);
+    char *body = calloc(1, bytes + 1);
+    memset(body, 'c', bytes);
+    lr_test_put(path, body, bytes);
+    struct timeval tv[2] = {{now - age_s, 0}, {now - age_s, 0}};
+    assert_int_equal(utimes(path, tv), 0);
+    free(body);
+    free(path);
+}
+
+static int exists(const char *dir, const char *name)
+{
+    char *path = lr_test_path(dir, name);
+    struct stat st;
+    int ok = stat(path, &st) == 0;
+    free(path);
+    return ok;
+}
+
+/* Stale temps of our exact pattern are swept (a kill between mkstemp and rename left them for
+ * ever), fresh ones and other people's files are kept; over the cap the least recently used
+ * cache files go first until the rest fit. */
+static void test_cache_dir_tidy(void **state)
+{
+    (void)state;
+    int temp;
+    assert_true(lr_cache_dir_ours("transrad-0123456789abcdef.bin", &temp) && !temp);
+    assert_true(lr_cache_dir_ours("objlight-0123456789abcdef.bin.tmpAb3xYz", &temp) && temp);
+    assert_false(lr_cache_dir_ours("transrad-0123456789ABCDEF.bin", &temp));
+    assert_false(lr_cache_dir_ours("transrad-0123456789abcde.bin", &temp));
+    assert_false(lr_cache_dir_ours("transrad-0123456789abcdef.bin.tmpAb3xY", &temp));
+    assert_false(lr_cache_dir_ours("transrad-0123456789abcdef.bin.tmpAb3xYzz", &temp));
+    assert_false(lr_cache_dir_ours("notes.txt.tmpAb3xYz", &temp));
+    assert_false(lr_cache_dir_ours("mesa_shader_cache", &temp));
+
+    char *dir = lr_test_tmpdir();
+    time_t now = time(NULL);
+    const char *a = "transrad-000000000000000a.bin", *b = "objlight-000000000000000b.bin",
+               *c = "transrad-000000000000000c.bin";
+    age(dir, a, now, 3000, 4000); /* least recently used */
+    age(dir, b, now, 2000, 3000);
+    age(dir, c, now, 1000, 2000);
+    age(dir, "transrad-000000000000000a.bin.tmpQw3rTy", now, 120, 100); /* stale */
+    age(dir, "transrad-000000000000000c.bin.tmpFr35hh", now, 5, 100);   /* a writer's */
+    age(dir, "keep.bin.tmpQw3rTy", now, 5000, 100);                     /* not ours */
+    lr_cache_tidy t;
+    lr_err e = {0};
+    assert_int_equal(lr_cache_dir_tidy(dir, 9000, now, &t, &e), LR_OK);
+    assert_int_equal(t.temps_removed, 1);
+    assert_int_equal(t.files_removed, 0);
+    assert_int_equal(t.bytes_before, 9000);
+    assert_false(exists(dir, "transrad-000000000000000a.bin.tmpQw3rTy"));
+    assert_true(exists(dir, "transrad-000000000000000c.bin.tmpFr35hh"));
+    assert_true(exists(dir, "keep.bin.tmpQw3rTy"));
+    /* Cap 4999: a (4000) goes first (5000 left, still over), then b (3000): 2000 left. */
+    assert_int_equal(lr_cache_dir_tidy(dir, 4999, now, &t, &e), LR_OK);
+    assert_int_equal(t.files_removed, 2);
+    assert_int_equal(t.bytes_after, 2000);
+    assert_false(exists(dir, a));
+    assert_false(exists(dir, b));
+    assert_true(exists(dir, c));
+    /* A missing folder: nothing to do. */
+    char *none = lr_test_path(dir, "none");
+    assert_int_equal(lr_cache_dir_tidy(none, 0, now, &t, &e), LR_OK);
+    free(none);
+    uint64_t cap;
+    setenv("LAMPRIG_CACHE_MAX_MB", "12", 1);
+    assert_int_equal(lr_cache_max_bytes(&cap, &e), LR_OK);
+    assert_true(cap == (uint64_t)12 << 20);
+    setenv("LAMPRIG_CACHE_MAX_MB", "-3", 1);
+    assert_int_equal(lr_cache_max_bytes(&cap, &e), LR_EINVAL);
+    assert_non_null(strstr(e.msg, "LAMPRIG_CACHE_MAX_MB"));
+    assert_true(cap == LR_CACHE_MAX_BYTES_DEFAULT);
+    unsetenv("LAMPRIG_CACHE_MAX_MB");
+    lr_test_rmtree(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -382,6 +464,7 @@ int main(void)
         cmocka_unit_test(test_data_paths),
         cmocka_unit_test(test_median_finite),
         cmocka_unit_test(test_dir_check_writable),
+        cmocka_unit_test(test_cache_dir_tidy),
         cmocka_unit_test(test_atomic_file_mode_follows_umask),
         cmocka_unit_test(test_file_read_regular_only),
         cmocka_unit_test(test_shader_cache_dir),

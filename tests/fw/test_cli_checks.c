@@ -14,6 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/time.h>
+#include <time.h>
 #include <sys/wait.h>
 
 #include "calib/colormatrix.h"
@@ -129,6 +131,11 @@ static void test_run_on_a_full_cache_disk(void **state)
     assert_non_null(w);
     assert_non_null(strstr(w, mnt));
     assert_null(strstr(w + 1, "Mesa shader cache: ")); /* once */
+    /* Our own caches cannot be stored either: said once, not never. */
+    const char *c = strstr(err, "cache folder: ");
+    assert_non_null(c);
+    assert_non_null(strstr(c, mnt));
+    assert_null(strstr(c + 1, "cache folder: "));
     free(err);
     free(fill);
     free(mnt);
@@ -151,6 +158,30 @@ static void test_fifo_input_is_refused(void **state)
         free(err);
     }
     free(fifo);
+}
+
+/* A command's start sweeps the cache folder: a temp of ours two minutes old (a writer killed
+ * between mkstemp and rename) is removed, a fresh one and a file not of our naming stay. */
+static void test_start_sweeps_stale_cache_temps(void **state)
+{
+    char *cache = lr_test_path(dir, "xdg");
+    char *stale = lr_test_write(dir, "xdg/lamprig/transrad-00000000000000aa.bin.tmpAb12Zx", "x", 1);
+    char *fresh = lr_test_write(dir, "xdg/lamprig/transrad-00000000000000bb.bin.tmpCd34Wv", "x", 1);
+    char *other = lr_test_write(dir, "xdg/lamprig/mine.txt.tmpAb12Zx", "x", 1);
+    struct timeval tv[2] = {{time(NULL) - 120, 0}, {time(NULL) - 120, 0}};
+    assert_int_equal(utimes(stale, tv), 0);
+    assert_int_equal(utimes(other, tv), 0);
+    int st = run("XDG_CACHE_HOME=%s ./build/bin/lamprig render --scene %s/none.json --out x.png",
+                 cache, dir);
+    assert_int_equal(st, 1); /* no such scene: the sweep ran before the work */
+    struct stat sb;
+    assert_int_equal(stat(stale, &sb), -1);
+    assert_int_equal(stat(fresh, &sb), 0);
+    assert_int_equal(stat(other, &sb), 0);
+    free(stale);
+    free(fresh);
+    free(other);
+    free(cache);
 }
 
 static void test_calib_check_skips_rig_configs(void **state)
@@ -199,6 +230,7 @@ int main(void)
         cmocka_unit_test(test_calib_check_skips_rig_configs),
         cmocka_unit_test(test_run_on_a_full_cache_disk),
         cmocka_unit_test(test_fifo_input_is_refused),
+        cmocka_unit_test(test_start_sweeps_stale_cache_temps),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
