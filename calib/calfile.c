@@ -146,7 +146,8 @@ int lr_calfile_save(const char *path, const char *kind, lr_calfile_fill_fn fill,
         free(text);
         return lr_err_prefix(e, "refusing to write %s (the previous file is kept)", path);
     }
-    rc = lr_atomic_write(path, text, len, e);
+    /* A calibration is the rig's own state: the service's group reads it, others not. */
+    rc = lr_atomic_write_mode(path, text, len, LR_FILE_MODE_PRIVATE, e);
     free(text);
     return rc;
 }

@@ -4,10 +4,16 @@
 #include <stdlib.h>
 #include <stdbool.h>
 #include <string.h>
+#include <time.h>
 
 #include "firmware/version.h"
 #include "render/base/atomic_file.h"
 #include "render/base/paths.h"
+#include "render/base/cache_dir.h"
+#include "render/base/dir_check.h"
+#include "render/gl/shader_cache.h"
+#include "render/transrad/transrad.h"
+#include "hal/log.h"
 
 /* ---- messages ------------------------------------------------------------------------- */
 
@@ -73,6 +79,54 @@ int lr_cli_need(const lr_cli *c, const char *flag)
 int lr_cli_check(const lr_cli *c, int rc, const lr_err *e)
 {
     return rc ? lr_cli_usage(c->path, "%s", e->msg) : LR_EXIT_OK;
+}
+
+/* ---- before the work -------------------------------------------------------------------- */
+
+/* A full or read-only cache disk must cost the shader cache, not the rig: Mesa's cache dies
+ * with SIGBUS on a full disk (render/gl/shader_cache.h). Disabled for this process before any
+ * GL context exists (Mesa reads the variable at eglInitialize; no other thread runs yet), with
+ * one warning naming the folder. */
+static void guard_shader_cache(void)
+{
+    lr_err e = {0};
+    if (lr_gl_shader_cache_check(&e) == LR_OK)
+        return;
+    setenv("MESA_SHADER_CACHE_DISABLE", "true", 1);
+    lr_log_write(NULL, LR_LOG_WARN, "%s; running without it (shaders compiled at every start)",
+                 e.msg);
+}
+
+/* Free space our cache folder should have: the sim rig's precomputations take 12 MB. */
+#define CACHE_MIN_FREE (16u << 20)
+
+/* The precomputation caches ($XDG_CACHE_HOME/lamprig, render/transrad/cache.c): a folder that
+ * cannot take writes costs every start a rebuild of seconds, said here once rather than never
+ * (each store fails quietly: best effort). Otherwise stale temps of a killed writer are swept
+ * and the folder is held to its cap (render/base/cache_dir.h). */
+static void tidy_caches(void)
+{
+    char dir[1024];
+    if (!lr_tr_cache_default_dir(dir, sizeof dir))
+        return;
+    lr_err e = {0};
+    if (lr_dir_check_writable(dir, CACHE_MIN_FREE, &e)) {
+        lr_log_write(NULL, LR_LOG_WARN, "cache folder: %s; precomputations (translucent "
+                     "radiosity, receiver light) are rebuilt at every start", e.msg);
+        return;
+    }
+    uint64_t cap;
+    if (lr_cache_max_bytes(&cap, &e))
+        lr_log_write(NULL, LR_LOG_WARN, "%s; using %llu MiB", e.msg,
+                     (unsigned long long)(cap >> 20));
+    lr_cache_tidy t;
+    if (lr_cache_dir_tidy(dir, cap, time(NULL), &t, &e))
+        lr_log_write(NULL, LR_LOG_WARN, "cache folder: %s", e.msg);
+    else if (t.temps_removed || t.files_removed)
+        lr_log_write(NULL, LR_LOG_INFO, "cache folder %s: removed %d stale temporary files and "
+                     "%d cache files (%llu -> %llu MiB, cap %llu MiB)", dir, t.temps_removed,
+                     t.files_removed, (unsigned long long)(t.bytes_before >> 20),
+                     (unsigned long long)(t.bytes_after >> 20), (unsigned long long)(cap >> 20));
 }
 
 /* ---- dispatch ------------------------------------------------------------------------- */
@@ -154,8 +208,11 @@ int lr_cli_command(const lr_command *cmd, const char *parent, int argc, char **a
         if ((cmd->opts[k].flags & LR_ARG_OUTPUT) && c->args.value[k] &&
             lr_atomic_file_check(c->args.value[k], &e))
             st = lr_cli_usage(path, "%s %s", cmd->opts[k].name, e.msg);
-    if (!st)
+    if (!st) {
+        guard_shader_cache();
+        tidy_caches();
         st = cmd->run(c);
+    }
     fflush(stdout);
     free(c);
     return st;

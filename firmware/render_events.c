@@ -86,7 +86,7 @@ int lr_render_events_load(const char *path, lr_render_events *out, lr_err *e)
 {
     char *text = NULL;
     size_t len = 0;
-    int rc = lr_file_read(path, &text, &len, e);
+    int rc = lr_file_read(path, LR_FILE_MAX_TEXT, &text, &len, e);
     if (rc)
         return rc;
     if (memchr(text, 0, len)) {

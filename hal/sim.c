@@ -6,8 +6,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "hal/dev_impl.h"
+#include "render/base/file.h"
 
 const lr_opt lr_sim_opts[] = {
     [LR_SIM_OPT_SCRIPT] = {"script", LR_OPT_STRING, .help = "script file (hal/README.md)"},
@@ -187,9 +189,15 @@ int lr_sim_script_parse(const char *text, const char *filename, lr_sim_script **
 int lr_sim_script_load(const char *path, lr_sim_script **out, lr_err *e)
 {
     *out = NULL;
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return lr_err_set(e, LR_EIO, "%s: cannot open: %s", path, strerror(errno));
+    /* A regular file only: a FIFO would block the open for ever, a device read for ever. */
+    int fd = lr_file_open_regular(path, e);
+    if (fd < 0)
+        return -fd;
+    FILE *f = fdopen(fd, "rb");
+    if (!f) {
+        close(fd);
+        return lr_err_set(e, LR_ENOMEM, "%s: out of memory", path);
+    }
     size_t cap = 4096, len = 0;
     char *buf = malloc(cap);
     int rc = LR_OK;

@@ -159,7 +159,8 @@ int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *conf
                        int64_t now_ns, unsigned garbage, lr_err *e)
 {
     lr_atomic_file *af;
-    int rc = lr_atomic_file_open(path, &af, e);
+    /* The rig's state: the service's group reads it, others not. */
+    int rc = lr_atomic_file_open_mode(path, LR_FILE_MODE_PRIVATE, &af, e);
     if (rc)
         return rc;
     lr_jw *w = lr_jw_create(lr_atomic_file_stream(af));

@@ -8,6 +8,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "render/base/umask.h"
+
 struct lr_atomic_file {
     FILE *stream;
     char *path;
@@ -15,6 +17,11 @@ struct lr_atomic_file {
 };
 
 int lr_atomic_file_open(const char *path, lr_atomic_file **out, lr_err *e)
+{
+    return lr_atomic_file_open_mode(path, LR_FILE_MODE_DATA, out, e);
+}
+
+int lr_atomic_file_open_mode(const char *path, mode_t mode, lr_atomic_file **out, lr_err *e)
 {
     *out = NULL;
     lr_atomic_file *f = calloc(1, sizeof *f);
@@ -34,8 +41,18 @@ int lr_atomic_file_open(const char *path, lr_atomic_file **out, lr_err *e)
         free(f);
         return lr_err_set(e, LR_EIO, "%s: cannot create a temporary file beside it: %s", path, strerror(err));
     }
-    /* mkstemp makes 0600; saved files are ordinary data files. */
-    (void)fchmod(fd, 0644);
+    /* mkstemp makes 0600 whatever the umask; the file gets the mode open(2) would have given
+     * it (a service's UMask= and a user's umask decide who may read its output). */
+    if (fchmod(fd, mode & ~lr_umask_get() & 0777) != 0) {
+        int err = errno;
+        close(fd);
+        unlink(f->tmp);
+        free(f->tmp);
+        free(f->path);
+        free(f);
+        return lr_err_set(e, LR_EIO, "%s: cannot set the mode of its temporary file: %s", path,
+                          strerror(err));
+    }
     f->stream = fdopen(fd, "wb");
     if (!f->stream) {
         close(fd);
@@ -116,8 +133,13 @@ int lr_atomic_file_check(const char *path, lr_err *e)
 
 int lr_atomic_write(const char *path, const void *data, size_t len, lr_err *e)
 {
+    return lr_atomic_write_mode(path, data, len, LR_FILE_MODE_DATA, e);
+}
+
+int lr_atomic_write_mode(const char *path, const void *data, size_t len, mode_t mode, lr_err *e)
+{
     lr_atomic_file *f;
-    int rc = lr_atomic_file_open(path, &f, e);
+    int rc = lr_atomic_file_open_mode(path, mode, &f, e);
     if (rc)
         return rc;
     if (len && fwrite(data, 1, len, f->stream) != len) {

@@ -70,7 +70,7 @@ int lr_json_load(const char *path, lr_json **out, lr_err *e)
     *out = NULL;
     char *buf = NULL;
     size_t len = 0;
-    int rc = lr_file_read(path, &buf, &len, e);
+    int rc = lr_file_read(path, LR_FILE_MAX_TEXT, &buf, &len, e);
     if (rc)
         return rc;
     rc = lr_json_parse(buf, len, path, out, e);

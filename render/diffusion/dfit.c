@@ -45,7 +45,7 @@ static int parse(const char *path, caps *c, lr_err *e)
 {
     char *text;
     size_t len;
-    int rc = lr_file_read(path, &text, &len, e);
+    int rc = lr_file_read(path, LR_FILE_MAX_TEXT, &text, &len, e);
     if (rc)
         return rc;
     memset(c, 0, sizeof *c);

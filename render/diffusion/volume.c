@@ -220,7 +220,7 @@ int lr_dvolume_load(const char *path, lr_dvolume **out, lr_err *e)
     *out = NULL;
     char *text;
     size_t len;
-    int rc = lr_file_read(path, &text, &len, e);
+    int rc = lr_file_read(path, LR_FILE_MAX_DATA, &text, &len, e);
     if (rc)
         return rc;
     if (strlen(text) != len) {

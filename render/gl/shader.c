@@ -171,7 +171,7 @@ static int load_file(lr_shader_source *s, const char *path, const char *from, in
     char *data;
     size_t len;
     char real[PATH_MAX];
-    int rc = lr_file_read(path, &data, &len, e);
+    int rc = lr_file_read(path, LR_FILE_MAX_TEXT, &data, &len, e);
     if (rc)
         return from ? lr_err_prefix(e, "%s:%d: include", from, from_line) : rc;
     if (!realpath(path, real))

@@ -74,7 +74,7 @@ int lr_image_read_pfm(const char *path, lr_image *out, lr_err *e)
     out->rgb = NULL;
     char *text = NULL;
     size_t n = 0;
-    int rc = lr_file_read(path, &text, &n, e);
+    int rc = lr_file_read(path, LR_FILE_MAX_DATA, &text, &n, e);
     const unsigned char *d = (const unsigned char *)text;
     if (rc)
         return rc;

@@ -7,8 +7,10 @@
 #include <png.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "render/base/atomic_file.h"
+#include "render/base/file.h"
 
 int lr_image_write_png(const char *path, const lr_image *img, const lr_tonemap *tm, lr_err *e)
 {
@@ -84,9 +86,15 @@ int lr_image_read_png(const char *path, lr_image *out, lr_err *e)
     out->width = out->height = 0;
     out->rgb = NULL;
     /* Opened here so a missing file is an I/O error in errno's words, not a PNG error. */
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return lr_err_set(e, LR_EIO, "%s: cannot open: %s", path, strerror(errno));
+    /* A regular file only: a FIFO would block the open for ever, a device read for ever. */
+    int fd = lr_file_open_regular(path, e);
+    if (fd < 0)
+        return -fd;
+    FILE *f = fdopen(fd, "rb");
+    if (!f) {
+        close(fd);
+        return lr_err_set(e, LR_ENOMEM, "%s: out of memory", path);
+    }
     png_image pi;
     memset(&pi, 0, sizeof pi);
     pi.version = PNG_IMAGE_VERSION;

@@ -2,16 +2,24 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "render/mesh/mesh_internal.h"
+#include "render/base/file.h"
 
 int lr_mesh_read_file(const char *path, char **buf, size_t *len, lr_err *e)
 {
     *buf = NULL;
     *len = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return lr_err_set(e, LR_EIO, "%s: cannot open: %s", path, strerror(errno));
+    /* A regular file only: a FIFO would block the open for ever, a device read for ever. */
+    int fd = lr_file_open_regular(path, e);
+    if (fd < 0)
+        return -fd;
+    FILE *f = fdopen(fd, "rb");
+    if (!f) {
+        close(fd);
+        return lr_err_set(e, LR_ENOMEM, "%s: out of memory", path);
+    }
     char *b = NULL;
     size_t n = 0, cap = 0;
     for (;;) {

@@ -21,7 +21,8 @@
 #include "render/passes/material_pack.h"
 #include "render/scene/scene.h"
 
-#define LR_MAX_K 32
+/* The scene loader refuses more (render.K). */
+#define LR_MAX_K LR_SCENE_MAX_K
 #define LR_MAX_RECEIVERS 16
 #define LR_MAX_VPL 4096
 /* Lights with their own G-buffer and radiosity maps (render/shaders/lib/lights.glsl unrolls

@@ -375,7 +375,7 @@ static int merge_changes_file(lr_plan_table *t, const char *path, lr_err *e)
         return LR_OK;
     char *data;
     size_t len;
-    int rc = lr_file_read(path, &data, &len, e);
+    int rc = lr_file_read(path, LR_FILE_MAX_TEXT, &data, &len, e);
     if (rc)
         return rc;
     rc = lr_plan_table_merge_changes(t, data, len, path, e);
@@ -388,7 +388,7 @@ int lr_plan_table_load(const char *path, lr_plan_table **out, lr_err *e)
     char *data;
     size_t len;
     *out = NULL;
-    int rc = lr_file_read(path, &data, &len, e);
+    int rc = lr_file_read(path, LR_FILE_MAX_TEXT, &data, &len, e);
     if (rc)
         return rc;
     rc = lr_plan_table_parse(data, len, path, out, e);

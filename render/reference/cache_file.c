@@ -54,7 +54,7 @@ bool lr_cache_file_read(const char *path, const char magic[8], uint64_t *words, 
     char *d = NULL;
     size_t len = 0;
     lr_err e = {0};
-    if (lr_file_read(path, &d, &len, &e))
+    if (lr_file_read(path, LR_FILE_MAX_CACHE, &d, &len, &e))
         return false;
     size_t head = head_bytes(nwords);
     uint64_t hash;

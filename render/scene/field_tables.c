@@ -303,10 +303,11 @@ const lr_record_desc lr_scene_transform_desc = {"objects[i].transform", "a trans
 #define Z LR_FF_ZERO_DEFAULT
 
 /* Seed 003 renders with 31 maps of 512^2 on a desktop GPU; a Raspberry-Pi-class GPU gets half
- * the maps at a quarter of the texels by default. 256 layers: GL_MAX_ARRAY_TEXTURE_LAYERS is at
- * least 256 on GLES 3.x; 8192: the largest texture an SBC GPU offers. */
+ * the maps at a quarter of the texels by default. K: the radiosity pass's arrays
+ * (LR_SCENE_MAX_K), well under the 256 layers GL_MAX_ARRAY_TEXTURE_LAYERS is on GLES 3.x;
+ * 8192: the largest texture an SBC GPU offers. */
 static const lr_field render_fields[] = {
-    {"K", LR_FT_INT, 0, RS(K), 1, 256, Z, .dflt = {16}, .dirty = SET,
+    {"K", LR_FT_INT, 0, RS(K), 1, LR_SCENE_MAX_K, Z, .dflt = {16}, .dirty = SET,
      .help = "scattered-radiosity maps"},
     {"N", LR_FT_INT, 0, RS(N), 1, 65536, Z, .dflt = {16}, .dirty = SET,
      .help = "samples per texel, band and frame"},

@@ -52,6 +52,10 @@ typedef struct lr_scene lr_scene;
 /* Lights per scene: the GPU transport keeps a G-buffer and radiosity maps per light
  * (render/passes/PIPELINE.md), so their number is bounded; more is a load-time error. */
 #define LR_SCENE_MAX_LIGHTS 4
+/* Scattered-radiosity maps (render.K): the radiosity pass keeps a view and texture matrix per
+ * map in fixed arrays, and the shaders unroll that many (render/passes/radiosity.h,
+ * LR_MAX_K); more is a load-time error. */
+#define LR_SCENE_MAX_K 32
 
 /* ---- Objects ------------------------------------------------------------------------------ */
 

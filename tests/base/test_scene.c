@@ -650,6 +650,9 @@ static void test_set_dirty_flags(void **state)
     assert_int_equal(lr_dirty_passes(LR_DIRTY_DISPLAY), LR_PASS_BLEND);
     set_ok(s, "render.K", "32", LR_DIRTY_SETTINGS);
     assert_int_equal(lr_scene_render(s)->K, 32);
+    /* The renderer's limit (LR_SCENE_MAX_K, the radiosity pass's arrays) is the field's: 33
+     * is refused here, not by the renderer after loading. */
+    set_bad(s, "render.K", "33", "must be between 1 and 32, got 33");
     set_ok(s, "render.K", "0", LR_DIRTY_SETTINGS); /* 0: the default, as in the file */
     assert_int_equal(lr_scene_render(s)->K, 16);
     set_ok(s, "quality.max_error", "0.02", LR_DIRTY_SETTINGS);
@@ -724,7 +727,7 @@ static void test_set_rejects_bad_values(void **state)
     set_bad(s, "camera.target", "0,-450,230", "must differ from position");
     set_bad(s, "camera.up", "0,0,0", "must be a non-zero vector");
     set_bad(s, "camera.fov_deg", "180", "must be in (0, 180) degrees");
-    set_bad(s, "render.K", "1000", "must be between 1 and 256, got 1000");
+    set_bad(s, "render.K", "1000", "must be between 1 and 32, got 1000");
     set_bad(s, "render.K", "2.5", "expected an integer");
     set_bad(s, "render.exposure", "-1", "must be > 0");
     set_bad(s, "receivers[wall].albedo", "1.2,0.5,0.5", "each band must be in [0, 1]");

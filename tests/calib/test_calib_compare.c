@@ -500,7 +500,7 @@ static void test_cli(void **state)
     assert_int_equal(run_compare(ok, 23), 0);
     char *text;
     size_t len;
-    assert_int_equal(lr_file_read(report, &text, &len, &e), LR_OK);
+    assert_int_equal(lr_file_read(report, LR_FILE_MAX_TEXT, &text, &len, &e), LR_OK);
     assert_non_null(strstr(text, "\"kind\": \"comparison\""));
     assert_non_null(strstr(text, "\"rel_rmse\""));
     assert_non_null(strstr(text, "\"render_s\""));
@@ -548,7 +548,7 @@ static void test_cli(void **state)
         for (int i = 0; i < 3; i++) {
             lr_json *j;
             lr_err je = {0};
-            assert_int_equal(lr_file_read(reps[i], &text, &len, &e), LR_OK);
+            assert_int_equal(lr_file_read(reps[i], LR_FILE_MAX_TEXT, &text, &len, &e), LR_OK);
             assert_int_equal(lr_json_parse(text, len, reps[i], &j, &je), LR_OK);
             lr_jnode all = lr_json_get(j, lr_json_get(j, lr_json_root(j), "regions"), "all");
             assert_int_equal(lr_json_get_number(j, all, "rel_rmse", true, &rel[i], &je), LR_OK);

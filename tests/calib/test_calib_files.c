@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "calib/camcal.h"
@@ -148,7 +149,14 @@ static void test_camera_file(void **state)
     lr_camcal c, back;
     camera_fixture(&c);
     const char *good = path_in("camera.json");
+    mode_t old_mask = umask(022);
     assert_int_equal(lr_camcal_save(good, &c, &err), LR_OK);
+    umask(old_mask);
+    /* A calibration is the rig's state: group-readable, not world-readable (LR_FILE_MODE_PRIVATE
+     * less the umask 022; it was 0644). */
+    struct stat st;
+    assert_int_equal(stat(good, &st), 0);
+    assert_int_equal(st.st_mode & 0777, 0640);
     assert_int_equal(lr_camcal_load(good, &back, &err), LR_OK);
     assert_true(back.k.fx == c.k.fx && back.k.dist[3] == c.k.dist[3]);
     assert_string_equal(back.views[0].image, "a \"quoted\" name.jpg");

@@ -14,6 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/time.h>
+#include <time.h>
 #include <sys/wait.h>
 
 #include "calib/colormatrix.h"
@@ -101,6 +103,87 @@ static void test_run_out_dir_must_be_a_folder(void **state)
     free(missing);
 }
 
+/* A full cache disk costs the shader cache, not the rig: with XDG_CACHE_HOME on a full tmpfs
+ * Mesa's cache died with SIGBUS before the first frame (exit 135). Now the run finishes (0)
+ * and says once which folder it runs without. Needs root to mount; skipped otherwise. */
+static void test_run_on_a_full_cache_disk(void **state)
+{
+    char *mnt = lr_test_path(dir, "cache");
+    assert_int_equal(mkdir(mnt, 0700), 0);
+    if (lr_test_mount_tmpfs(mnt, 256, 0) != 0) {
+        free(mnt);
+        skip();
+    }
+    char *fill = lr_test_path(mnt, "fill");
+    FILE *f = fopen(fill, "wb");
+    assert_non_null(f);
+    static const char block[4096];
+    while (fwrite(block, 1, sizeof block, f) == sizeof block && fflush(f) == 0)
+        ;
+    fclose(f);
+    int st = run("XDG_CACHE_HOME=%s ./build/bin/lamprig run --config configs/rig/sim.json "
+                 "--headless --duration 0.5", mnt);
+    char *err = slurp("err");
+    lr_test_umount(mnt);
+    if (st != 0)
+        fail_msg("run on a full cache disk: exit %d, stderr '%s'", st, err);
+    const char *w = strstr(err, "Mesa shader cache: ");
+    assert_non_null(w);
+    assert_non_null(strstr(w, mnt));
+    assert_null(strstr(w + 1, "Mesa shader cache: ")); /* once */
+    /* Our own caches cannot be stored either: said once, not never. */
+    const char *c = strstr(err, "cache folder: ");
+    assert_non_null(c);
+    assert_non_null(strstr(c, mnt));
+    assert_null(strstr(c + 1, "cache folder: "));
+    free(err);
+    free(fill);
+    free(mnt);
+}
+
+/* A FIFO given as the scene or the rig config is refused at once, naming it (the open used to
+ * wait for a writer for ever: `timeout` turns that into exit 124). */
+static void test_fifo_input_is_refused(void **state)
+{
+    char *fifo = lr_test_path(dir, "scene.json");
+    assert_int_equal(mkfifo(fifo, 0600), 0);
+    const char *cmd[2] = {"render --scene %s --out x.png", "run --config %s --headless --duration 0.2"};
+    for (int k = 0; k < 2; k++) {
+        char line[512];
+        snprintf(line, sizeof line, cmd[k], fifo);
+        int st = run("timeout 20 ./build/bin/lamprig %s", line);
+        char *err = slurp("err");
+        if (st != 1 || !strstr(err, fifo) || !strstr(err, "a FIFO, not a regular file"))
+            fail_msg("%s: exit %d, stderr '%s' (expected 1 naming the FIFO)", line, st, err);
+        free(err);
+    }
+    free(fifo);
+}
+
+/* A command's start sweeps the cache folder: a temp of ours two minutes old (a writer killed
+ * between mkstemp and rename) is removed, a fresh one and a file not of our naming stay. */
+static void test_start_sweeps_stale_cache_temps(void **state)
+{
+    char *cache = lr_test_path(dir, "xdg");
+    char *stale = lr_test_write(dir, "xdg/lamprig/transrad-00000000000000aa.bin.tmpAb12Zx", "x", 1);
+    char *fresh = lr_test_write(dir, "xdg/lamprig/transrad-00000000000000bb.bin.tmpCd34Wv", "x", 1);
+    char *other = lr_test_write(dir, "xdg/lamprig/mine.txt.tmpAb12Zx", "x", 1);
+    struct timeval tv[2] = {{time(NULL) - 120, 0}, {time(NULL) - 120, 0}};
+    assert_int_equal(utimes(stale, tv), 0);
+    assert_int_equal(utimes(other, tv), 0);
+    int st = run("XDG_CACHE_HOME=%s ./build/bin/lamprig render --scene %s/none.json --out x.png",
+                 cache, dir);
+    assert_int_equal(st, 1); /* no such scene: the sweep ran before the work */
+    struct stat sb;
+    assert_int_equal(stat(stale, &sb), -1);
+    assert_int_equal(stat(fresh, &sb), 0);
+    assert_int_equal(stat(other, &sb), 0);
+    free(stale);
+    free(fresh);
+    free(other);
+    free(cache);
+}
+
 static void test_calib_check_skips_rig_configs(void **state)
 {
     /* A valid colour matrix, an invalid one (a required field missing) and the rig configs. */
@@ -145,6 +228,9 @@ int main(void)
         cmocka_unit_test(test_version_is_the_version_file),
         cmocka_unit_test(test_run_out_dir_must_be_a_folder),
         cmocka_unit_test(test_calib_check_skips_rig_configs),
+        cmocka_unit_test(test_run_on_a_full_cache_disk),
+        cmocka_unit_test(test_fifo_input_is_refused),
+        cmocka_unit_test(test_start_sweeps_stale_cache_temps),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

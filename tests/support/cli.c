@@ -33,7 +33,7 @@ char *lr_test_slurp(const char *dir, const char *name)
     char *t = NULL;
     size_t n;
     lr_err e = {0};
-    if (lr_file_read(path, &t, &n, &e))
+    if (lr_file_read(path, LR_FILE_MAX_TEXT, &t, &n, &e))
         fail_msg("%s", e.msg);
     return t;
 }

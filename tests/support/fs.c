@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mount.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -83,3 +84,12 @@ unsigned char *lr_test_read(const char *path, size_t *len)
     *len = (size_t)n;
     return buf;
 }
+
+int lr_test_mount_tmpfs(const char *dir, unsigned kib, int read_only)
+{
+    char opts[64];
+    snprintf(opts, sizeof opts, "size=%uk", kib);
+    return mount("tmpfs", dir, "tmpfs", read_only ? MS_RDONLY : 0, opts);
+}
+
+void lr_test_umount(const char *dir) { (void)umount2(dir, MNT_DETACH); }
