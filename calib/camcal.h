@@ -24,7 +24,7 @@
 
 #include "calib/board.h"
 #include "calib/intrinsics.h"
-#include "calib/progress.h"
+#include "render/base/progress.h"
 
 #define LR_CAMCAL_KIND "camera_intrinsics"
 #define LR_SUBPIX_AUTO (-1)

@@ -11,7 +11,7 @@
 #define LR_CALIB_CAPTURE_H
 
 #include "calib/graycode.h"
-#include "calib/progress.h"
+#include "render/base/progress.h"
 
 /* A frame sequence for a pw x ph projector, shown frame by frame (lr_gc_run_sequence and
  * lr_projresp_run_sequence have this shape). */

@@ -23,7 +23,7 @@ extern "C" {
 #endif
 
 #include "calib/image.h"
-#include "calib/progress.h"
+#include "render/base/progress.h"
 #include "render/base/err.h"
 
 /* ---- images ------------------------------------------------------------------------- */

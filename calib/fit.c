@@ -157,10 +157,34 @@ static void from_log(const double *x, double *sa, double *ss)
     *ss = exp(x[1]);
 }
 
+/* The model's own relative noise at (sa, ss), all bands: two half-sample renders with
+ * independent seeds differ by m1 - m2, whose variance is twice a half render's, i.e. four
+ * times the full-sample render's; so sum ((m1 - m2) / 2)^2 / sum t^2 is the full render's
+ * relative mean squared noise, the floor the residual cannot go below. */
+static int noise_at(ctx *c, const double sa[3], const double ss[3], double *out, lr_err *e)
+{
+    lr_image m1 = {0}, m2 = {0};
+    int rc = model_half(c, sa, ss, &m1, 1, e);
+    if (!rc)
+        rc = model_half(c, sa, ss, &m2, 2, e);
+    if (!rc) {
+        double se = 0;
+        for (size_t p = 0; p < (size_t)c->w * c->h; p++)
+            for (int b = 0; b < 3 && c->mask[p]; b++) {
+                double dlt = 0.5 * ((double)m1.rgb[3 * p + b] - m2.rgb[3 * p + b]);
+                se += dlt * dlt;
+            }
+        *out = sqrt(se / (c->tt[0] + c->tt[1] + c->tt[2]));
+    }
+    lr_image_free(&m1);
+    lr_image_free(&m2);
+    return rc;
+}
+
 /* Gauss-Newton standard errors of the log parameters per band, central differences of
  * +-h in log space (all bands moved together: they do not interact). */
 static int uncertainty(ctx *c, const double sa[3], const double ss[3], const lr_image *at,
-                       bool shared, double se[3][2], lr_err *e)
+                       bool shared, double se[3][2], double cond[3], lr_err *e)
 {
     const double h = 0.05;
     lr_image plus[2], minus[2];
@@ -177,6 +201,7 @@ static int uncertainty(ctx *c, const double sa[3], const double ss[3], const lr_
         }
         if ((rc = model(c, a1, s1, &plus[k], e)) == LR_OK)
             rc = model(c, a2, s2, &minus[k], e);
+        lr_progress_report(c->d->progress, "uncertainty", 2 * k + 4, 6);
     }
     if (!rc) {
         /* per band (or pooled over bands when the parameters are shared) */
@@ -200,6 +225,11 @@ static int uncertainty(ctx *c, const double sa[3], const double ss[3], const lr_
         }
         for (int g = 0; g < 3; g++) {
             double det = JJ[g][0] * JJ[g][2] - JJ[g][1] * JJ[g][1];
+            /* eigenvalues of the symmetric 2 x 2 J^T J: their ratio says how much flatter the
+             * residual is along one parameter combination than along the other */
+            double tr = JJ[g][0] + JJ[g][2], disc = sqrt(fmax(0.0, tr * tr / 4 - det));
+            double lmax = tr / 2 + disc, lmin = tr / 2 - disc;
+            cond[g] = shared && g ? 0 : lmin > 0 ? lmax / lmin : INFINITY;
             if (m[g] <= 2 || !(det > 0)) {
                 se[g][0] = se[g][1] = shared && g ? 0 : INFINITY;
                 continue;
@@ -232,6 +262,7 @@ int lr_fit_run(const lr_fit_desc *d, lr_fit_result *r, lr_err *e)
     if (!c.mask)
         return lr_err_set(e, LR_ENOMEM, "fit: out of memory");
     long n = lr_fit_object_mask(d->scene, d->object, c.w, c.h, c.mask);
+    r->object_pixels = n;
     double mean[3] = {0};
     for (size_t p = 0; p < (size_t)c.w * c.h; p++) {
         if (!c.mask[p])
@@ -312,6 +343,10 @@ int lr_fit_run(const lr_fit_desc *d, lr_fit_result *r, lr_err *e)
         r->start_rel_rmse = lr_fit_rel_rmse(&img, d->target, c.mask, NULL);
         lr_image_free(&img);
     }
+    /* a run stops once max_evals are spent, but the simplex step under way may take two more
+     * (reflection, contraction, the first point of a shrink) */
+    int evaluation = 0, eval_bound = max_evals + 2;
+    lr_progress_report(d->progress, "evaluations", 0, eval_bound);
     for (;;) {
         double x[3][2], sa[3], ss[3];
         bool active[3] = {false, false, false}, any = false;
@@ -359,7 +394,10 @@ int lr_fit_run(const lr_fit_desc *d, lr_fit_result *r, lr_err *e)
         for (int k = 0; k < runs; k++)
             if (active[k])
                 lr_nm_tell(&nm[k], f[k]);
+        lr_progress_report(d->progress, "evaluations", ++evaluation, eval_bound);
     }
+    /* the optimiser stopped (converged, usually before max_evals): the stage ends here */
+    lr_progress_report(d->progress, "evaluations", evaluation, evaluation);
     for (int k = 0; k < runs; k++) {
         double x[2];
         double f2 = lr_nm_best(&nm[k], x); /* the optimiser minimised L^2 (signed) */
@@ -384,11 +422,15 @@ int lr_fit_run(const lr_fit_desc *d, lr_fit_result *r, lr_err *e)
                         SIGMA_MIN, SIGMA_MAX);
         goto done;
     }
+    lr_progress_report(d->progress, "uncertainty", 0, 6);
     if ((rc = model(&c, r->sigma_a, r->sigma_s_prime, &best_img, e)))
         goto done;
     r->rel_rmse_all = lr_fit_rel_rmse(&best_img, d->target, c.mask, r->rel_rmse);
+    if ((rc = noise_at(&c, r->sigma_a, r->sigma_s_prime, &r->noise_rel, e)))
+        goto done;
+    lr_progress_report(d->progress, "uncertainty", 2, 6);
     if ((rc = uncertainty(&c, r->sigma_a, r->sigma_s_prime, &best_img, d->mode == LR_FIT_SCALE,
-                          r->stderr_log, e)))
+                          r->stderr_log, r->cond, e)))
         goto done;
     /* leave the scene at the result */
     rc = set_material(d->scene, d->object, r->sigma_a, r->sigma_s_prime, e);

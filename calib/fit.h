@@ -28,7 +28,10 @@
  * Uncertainty: at the result, the Jacobian of the model with respect to the log parameters
  * by central differences (4 renders, all bands at once) gives the Gauss-Newton covariance
  *     Cov = s^2 (J^T J)^-1,  s^2 = sum r_i^2 / (m - 2)
- * per band; its square roots are the standard errors reported and used by the test.
+ * per band; its square roots are the standard errors reported and used by the test, and
+ * J^T J's eigenvalue ratio the condition number. Two half-sample renders at the result give
+ * the model's own noise (noise_rel). calib/fit_checks.h judges from these whether the data
+ * determined the parameters.
  */
 #ifndef LR_CALIB_FIT_H
 #define LR_CALIB_FIT_H
@@ -36,6 +39,7 @@
 #include <stdbool.h>
 
 #include "render/base/err.h"
+#include "render/base/progress.h"
 #include "render/image/image.h"
 #include "render/scene/scene.h"
 
@@ -60,6 +64,9 @@ typedef struct lr_fit_desc {
     int max_evals;           /* per run; 0: 200 */
     int restarts;            /* 0: 2; < 0: none */
     int min_pixels;          /* fewer object pixels is an error; 0: 16 */
+    const lr_progress *progress; /* may be NULL: "evaluations" (of at most max_evals + 2;
+                                  * the optimiser usually stops earlier), "uncertainty" (the
+                                  * noise and Jacobian renders, 6) */
 } lr_fit_desc;
 
 typedef struct lr_fit_result {
@@ -73,7 +80,12 @@ typedef struct lr_fit_result {
                                             * (SCALE: of log s_a, log s_s, in row 0) */
     int iterations[3], evals[3];           /* per run (SCALE: index 0) */
     int renders;                           /* model renders in all */
-    long mask_pixels;
+    long object_pixels;                    /* the object's pixels in the view */
+    long mask_pixels;                      /* of them used: a finite (unclipped) target */
+    double noise_rel;                      /* the model's own relative RMS noise at the
+                                            * result (two half-sample renders), all bands */
+    double cond[3];                        /* condition number of J^T J per band (SCALE:
+                                            * row 0), J in log parameters; inf: singular */
     double seconds;                        /* wall time of the fit, uncertainty included */
 } lr_fit_result;
 

@@ -25,7 +25,7 @@
 
 #include "calib/cv_shim.h"
 #include "calib/image.h"
-#include "calib/progress.h"
+#include "render/base/progress.h"
 
 #define LR_GC_SEQUENCE_KIND "graycode_sequence"
 #define LR_GC_DEFAULT_CONTRAST 5

@@ -21,7 +21,7 @@
 #include "calib/board.h"
 #include "calib/graycode.h"
 #include "calib/intrinsics.h"
-#include "calib/progress.h"
+#include "render/base/progress.h"
 
 #define LR_PROCAM_KIND "projector_camera"
 

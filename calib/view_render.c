@@ -27,11 +27,17 @@ static int render_gpu(const lr_view_render_desc *d, int w, int h, lr_image *pin,
                                                     .height = h, .seed = d->seed},
                                 &r, e);
     double t0 = now_s();
+    /* until converged: render.frames accumulated (lr_renderer_needs_frame) */
+    int total = d->frames ? d->frames : lr_scene_render(d->scene)->frames;
+    if (!rc)
+        lr_progress_report(d->progress, "render frame", 0, total);
     for (int i = 0; !rc; i++) {
         if (d->frames ? i >= d->frames : !lr_renderer_needs_frame(r))
             break;
         lr_frame_stats st;
         rc = lr_renderer_frame(r, &st, e);
+        if (!rc)
+            lr_progress_report(d->progress, "render frame", i + 1, total);
     }
     if (!rc && !(rgb = malloc((size_t)w * h * 3 * sizeof *rgb)))
         rc = lr_err_set(e, LR_ENOMEM, "out of memory");
@@ -63,7 +69,7 @@ int lr_view_render(const lr_view_render_desc *d, lr_image *out, double *seconds,
     if (d->cpu) {
         lr_cpu_render_desc cd = {.scene = d->scene, .width = w, .height = h,
                                  .mode = LR_CPU_PASS, .frames = d->frames, .seed = d->seed,
-                                 .threads = d->threads};
+                                 .threads = d->threads, .progress = d->progress};
         lr_cpu_render_stats st = {0};
         rc = lr_cpu_render(&cd, &pin, NULL, &st, e);
         secs = st.seconds;

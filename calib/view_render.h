@@ -13,6 +13,7 @@
 #include <stdbool.h>
 
 #include "calib/camview.h"
+#include "render/base/progress.h"
 #include "render/image/image.h"
 #include "render/scene/scene.h"
 
@@ -23,6 +24,8 @@ typedef struct lr_view_render_desc {
     int frames;               /* progressive frames; 0: render.frames (until converged) */
     unsigned seed;            /* 0: 1 */
     int threads;              /* CPU: 0 = all */
+    const lr_progress *progress; /* may be NULL: "render frame" i of N (GPU; N the frames or
+                                  * render.frames), the CPU twin's stages (render/cpu/frame.h) */
 } lr_view_render_desc;
 
 /* *seconds (may be NULL): wall time of the render itself (context and remap excluded). */

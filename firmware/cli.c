@@ -310,3 +310,16 @@ int lr_cli_main(int argc, char **argv)
         return lr_cli_usage(NULL, "unknown command '%s'", name);
     return lr_cli_command(c, NULL, argc - 1, argv + 1);
 }
+
+lr_progress_meter *lr_cli_progress(const lr_cli *c)
+{
+    char prefix[300];
+    snprintf(prefix, sizeof prefix, "lamprig %s", c->path);
+    bool quiet = lr_args_spec(&c->args, "--quiet") && lr_args_has(&c->args, "--quiet");
+    lr_progress_meter *m = NULL;
+    lr_progress_meter_create(&(lr_progress_meter_desc){.prefix = prefix,
+                                                        .style = quiet ? LR_PROGRESS_QUIET
+                                                                       : LR_PROGRESS_AUTO},
+                             &m, NULL);
+    return m;
+}

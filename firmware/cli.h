@@ -10,6 +10,7 @@
 #include <stdio.h>
 
 #include "firmware/args.h"
+#include "render/base/progress.h"
 
 /* Exit statuses shared by every subcommand. */
 enum { LR_EXIT_OK = 0, LR_EXIT_FAIL = 1, LR_EXIT_USAGE = 2 };
@@ -62,6 +63,15 @@ int lr_cli_need(const lr_cli *c, const char *flag);
 /* lr_cli_usage with e's message when rc is set; LR_EXIT_OK otherwise (typed getters:
  * `if ((st = lr_cli_check(c, lr_args_int(&c->args, "--n", &n, &e), &e))) return st;`). */
 int lr_cli_check(const lr_cli *c, int rc, const lr_err *e);
+
+/* The option every command that can run long takes: its progress lines off. */
+#define LR_CLI_QUIET_OPT                                                                        \
+    {.name = "--quiet", .help = "no progress lines on stderr (results and errors stay)"}
+/* The command's progress printer (render/base/progress.h): lines on stderr prefixed
+ * `lamprig PATH`, rewritten in place on a terminal, silent with --quiet (when the command's
+ * table has LR_CLI_QUIET_OPT). NULL when out of memory: the work then runs unreported. Free
+ * with lr_progress_meter_destroy. */
+lr_progress_meter *lr_cli_progress(const lr_cli *c);
 
 /* The generated help of cmd at path ("calib projector") into f (firmware/help.c). */
 void lr_help_print(FILE *f, const lr_command *cmd, const char *path);

@@ -52,13 +52,13 @@ static int run(const lr_cli *c)
         free(cal);
         return lr_cli_fail(c->path, "%s", e.msg);
     }
-    lr_calib_progress ps;
+    lr_progress_meter *pm = lr_cli_progress(c);
     lr_gc_map *m = NULL;
     lr_image white = {0}, black = {0};
     lr_albedo a = {0};
     char path[4096];
     int status = LR_EXIT_OK;
-    if (lr_gc_decode_dir(dir, pw, ph, &params, lr_calib_progress_init(&ps), &m, &e)) {
+    if (lr_gc_decode_dir(dir, pw, ph, &params, lr_progress_meter_sink(pm), &m, &e)) {
         status = lr_cli_fail(c->path, "%s", e.msg);
         goto done;
     }
@@ -83,6 +83,7 @@ done:
     lr_image_free(&white);
     lr_image_free(&black);
     lr_gc_map_destroy(m);
+    lr_progress_meter_destroy(pm);
     lr_rig_calib_free(cal);
     free(cal);
     return status;
@@ -99,6 +100,7 @@ static const lr_argspec opts[] = {
     LR_CALIB_DECODE_OPTS,
     {.name = "--fill", .type = LR_ARG_INT, .min = 0, .max = 64,
      .help = "passes filling unmeasured pixels from their neighbours (default 2)"},
+    LR_CLI_QUIET_OPT,
     {0},
 };
 

@@ -19,6 +19,7 @@ static const lr_argspec opts[] = {
      .help = "a view is an outlier above F times the median error (default 3)"},
     {.name = "--min-views", .type = LR_ARG_INT, .min = 1, .max = 10000,
      .help = "fewest views the fit accepts (default 3)"},
+    LR_CLI_QUIET_OPT,
     {0},
 };
 
@@ -46,12 +47,13 @@ static int run(const lr_cli *c)
     glob_t g;
     if ((rc = lr_calib_glob(c, images, &g)))
         return rc;
-    lr_calib_progress ps;
+    lr_progress_meter *pm = lr_cli_progress(c);
     d.images = (const char *const *)g.gl_pathv;
     d.nimages = (int)g.gl_pathc;
-    d.progress = lr_calib_progress_init(&ps);
+    d.progress = lr_progress_meter_sink(pm);
     lr_camcal cal;
     rc = lr_camcal_run(&d, &cal, &e);
+    lr_progress_meter_destroy(pm);
     globfree(&g);
     /* One line per image left out, also when too few remain: they say why. */
     for (int i = 0; i < cal.nrejected; i++)

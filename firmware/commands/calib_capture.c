@@ -45,10 +45,12 @@ static int capture(const lr_cli *c, bool graycode)
                                   lr_args_int(a, "--settle-ms", &d.settle_ms, &e),
                            &e)))
         return rc;
-    lr_calib_progress ps;
-    d.progress = lr_calib_progress_init(&ps);
-    if (lr_capture_run(&d, graycode ? lr_gc_run_sequence : lr_projresp_run_sequence, pw, ph, out,
-                       &e))
+    lr_progress_meter *pm = lr_cli_progress(c);
+    d.progress = lr_progress_meter_sink(pm);
+    rc = lr_capture_run(&d, graycode ? lr_gc_run_sequence : lr_projresp_run_sequence, pw, ph, out,
+                        &e);
+    lr_progress_meter_destroy(pm);
+    if (rc)
         return lr_cli_fail(c->path, "%s", e.msg);
     printf("captured -> %s/\n", out);
     return LR_EXIT_OK;
@@ -72,6 +74,7 @@ static const lr_argspec opts[] = {
      .help = "the camera mode (default: the driver's)"},
     {.name = "--settle-ms", .type = LR_ARG_INT, .min = 1, .max = 60000,
      .help = "wait after each frame is shown (default 150)"},
+    LR_CLI_QUIET_OPT,
     {0},
 };
 

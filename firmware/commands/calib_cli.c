@@ -55,25 +55,3 @@ int lr_calib_glob(const lr_cli *c, const char *pattern, glob_t *g)
     }
     return LR_EXIT_OK;
 }
-
-static void print_progress(void *ctx, const char *stage, int done, int total)
-{
-    lr_calib_progress *p = ctx;
-    int decile = total > 0 ? (int)((long)done * 10 / total) : 10;
-    if (strncmp(p->stage, stage, sizeof p->stage - 1) != 0) {
-        snprintf(p->stage, sizeof p->stage, "%s", stage);
-        p->last_decile = -1;
-    }
-    if (decile == p->last_decile)
-        return;
-    p->last_decile = decile;
-    fprintf(stderr, "  %s: %d/%d\n", stage, done, total);
-}
-
-lr_progress *lr_calib_progress_init(lr_calib_progress *p)
-{
-    p->stage[0] = '\0';
-    p->last_decile = -1;
-    p->progress = (lr_progress){print_progress, p};
-    return &p->progress;
-}

@@ -1,7 +1,7 @@
 /* lamprig calib — what the calib subcommands share: their command objects (one file each,
  * firmware/commands/calib_*.c, gathered by calib.c), the option-table entries several of them
- * take (board, projector size, decoding thresholds) and the helpers reading them, the progress
- * printer and the glob expansion. Every result is computed in full before its file is written,
+ * take (board, projector size, decoding thresholds) and the helpers reading them and the
+ * glob expansion (progress: lr_cli_progress, firmware/cli.h). Every result is computed in full before its file is written,
  * and written atomically after validation, so a failed run leaves the previous calibration
  * untouched (exit status 1, one-line reason on stderr). */
 #ifndef LR_CALIB_CLI_H
@@ -10,7 +10,7 @@
 #include <glob.h>
 
 #include "calib/board.h"
-#include "calib/progress.h"
+#include "render/base/progress.h"
 #include "firmware/cli.h"
 
 extern const lr_command lr_calib_camera;
@@ -55,13 +55,5 @@ int lr_calib_board(const lr_cli *c, lr_board *b);
 int lr_calib_subpix(const lr_cli *c, int *out);
 /* Sorted glob matches; LR_EXIT_FAIL (message printed) when nothing matches. */
 int lr_calib_glob(const lr_cli *c, const char *pattern, glob_t *g);
-
-/* One line per stage and per tenth of it on stderr: readable in a log, alive on a terminal. */
-typedef struct lr_calib_progress {
-    char stage[256];
-    int last_decile;
-    lr_progress progress; /* what the calib/ functions take */
-} lr_calib_progress;
-lr_progress *lr_calib_progress_init(lr_calib_progress *p);
 
 #endif

@@ -18,8 +18,10 @@ static int run_patterns(const lr_cli *c)
     lr_err e = {0};
     if ((st = lr_cli_check(c, lr_args_size(&c->args, "--proj", &pw, &ph, &e), &e)))
         return st;
-    lr_calib_progress ps;
-    if (lr_gc_write_patterns(out, pw, ph, lr_calib_progress_init(&ps), &e))
+    lr_progress_meter *pm = lr_cli_progress(c);
+    st = lr_gc_write_patterns(out, pw, ph, lr_progress_meter_sink(pm), &e);
+    lr_progress_meter_destroy(pm);
+    if (st)
         return lr_cli_fail(c->path, "%s", e.msg);
     int n = 0;
     lr_gc_frame_count(pw, ph, &n, &e);
@@ -31,6 +33,7 @@ static const lr_argspec patterns_opts[] = {
     LR_CALIB_PROJ_OPT(LR_ARG_REQUIRED, "the projector's resolution"),
     {.name = "--out", .type = LR_ARG_PATH, .metavar = "DIR", .flags = LR_ARG_REQUIRED,
      .help = "the folder the frames are written to"},
+    LR_CLI_QUIET_OPT,
     {0},
 };
 
@@ -56,9 +59,11 @@ static int run_decode(const lr_cli *c)
                                   lr_args_int(a, "--shadow", &params.shadow, &e),
                            &e)))
         return st;
-    lr_calib_progress ps;
+    lr_progress_meter *pm = lr_cli_progress(c);
     lr_gc_map *m;
-    if (lr_gc_decode_dir(dir, pw, ph, &params, lr_calib_progress_init(&ps), &m, &e))
+    st = lr_gc_decode_dir(dir, pw, ph, &params, lr_progress_meter_sink(pm), &m, &e);
+    lr_progress_meter_destroy(pm);
+    if (st)
         return lr_cli_fail(c->path, "%s", e.msg);
     long total = (long)lr_gc_map_width(m) * lr_gc_map_height(m);
     printf("%s: %dx%d camera pixels:", dir, lr_gc_map_width(m), lr_gc_map_height(m));
@@ -85,6 +90,7 @@ static const lr_argspec decode_opts[] = {
     LR_CALIB_DECODE_OPTS,
     {.name = "--map", .type = LR_ARG_PATH, .metavar = "OUT.png",
      .help = "the decoded map (R = projector x, G = y, B = status)"},
+    LR_CLI_QUIET_OPT,
     {0},
 };
 
@@ -120,10 +126,11 @@ static int run_calibrate(const lr_cli *c)
         d.camera = &cam.k;
         d.camera_rms = cam.rms;
     }
-    lr_calib_progress ps;
-    d.progress = lr_calib_progress_init(&ps);
+    lr_progress_meter *pm = lr_cli_progress(c);
+    d.progress = lr_progress_meter_sink(pm);
     lr_procam p;
     rc = lr_procam_run(&d, &p, &e);
+    lr_progress_meter_destroy(pm);
     if (camera)
         lr_camcal_free(&cam);
     if (rc)
@@ -158,6 +165,7 @@ static const lr_argspec calibrate_opts[] = {
     {.name = "--window", .type = LR_ARG_INT, .min = 2, .max = 500,
      .help = "half-size of the local homography window, px (default 23)"},
     LR_CALIB_SUBPIX_OPT,
+    LR_CLI_QUIET_OPT,
     {0},
 };
 

@@ -54,6 +54,7 @@ static const lr_argspec opts[] = {
              "it; cos4 uses the calibrated focal length and principal point)"},
     {.name = "--set", .type = LR_ARG_STRING, .metavar = "key=value", .repeat = MAX_SETS,
      .help = "change a scene parameter first (repeatable), as in lamprig render"},
+    LR_CLI_QUIET_OPT,
     {0},
 };
 
@@ -73,7 +74,8 @@ const lr_command lr_compare_command = {
         "--heatmap writes the per-pixel CIEDE2000 (scale 0..--heatmap-max, default 10).\n"
         "--cpu renders with the CPU twin instead of the GPU renderer. --vignette divides the\n"
         "capture by a vignetting model (as lamprig-capsim applies it; cos4 uses the calibrated\n"
-        "focal length and principal point).",
+        "focal length and principal point). Progress (render frames) goes to stderr; --quiet\n"
+        "turns it off.",
     .opts = opts,
     .notes = "Exit status: 0 success, 1 failure (nothing written), 2 bad arguments.",
     .run = run_compare,
@@ -271,8 +273,12 @@ static int run_compare(const lr_cli *c)
         lr_camview_labels(view, scene, labels, &e))
         goto fail;
     double render_s = 0;
-    lr_view_render_desc vd = {.scene = scene, .view = view, .cpu = cpu, .frames = frames};
-    if (lr_view_render(&vd, &ren, &render_s, &e))
+    lr_progress_meter *pm = lr_cli_progress(c);
+    lr_view_render_desc vd = {.scene = scene, .view = view, .cpu = cpu, .frames = frames,
+                              .progress = lr_progress_meter_sink(pm)};
+    int rrc = lr_view_render(&vd, &ren, &render_s, &e);
+    lr_progress_meter_destroy(pm);
+    if (rrc)
         goto fail;
     lr_compare_result res;
     lr_compare_desc cd = {.render = &ren, .capture = &cap, .labels = labels, .exclude = exclude};

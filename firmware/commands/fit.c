@@ -7,6 +7,7 @@
 
 #include "calib/fit.h"
 #include "calib/fit_captures.h"
+#include "calib/fit_checks.h"
 #include "calib/rig.h"
 #include "firmware/commands/commands.h"
 #include "render/base/atomic_file.h"
@@ -17,6 +18,9 @@
 #include "render/renderer.h"
 
 static int run_fit(const lr_cli *c);
+
+/* The data do not determine the material (calib/fit_checks.h): nothing written. */
+enum { FIT_EXIT_WEAK = 3 };
 
 static const lr_argspec opts[] = {
     {.name = "--diffusion", .type = LR_ARG_PATH, .metavar = "CAPTURES", .flags = LR_ARG_ALONE,
@@ -65,6 +69,12 @@ static const lr_argspec opts[] = {
     {.name = "--name", .type = LR_ARG_STRING, .metavar = "NAME",
      .help = "the preset's name (default: the --out file's base name)"},
     {.name = "--no-gpu-check", .help = "skip the confirmation render on the GPU"},
+    {.name = "--accept-weak",
+     .help = "write the material even when the data do not determine it (too few\n"
+             "unclipped pixels, most of the object clipped, a flat residual, a\n"
+             "parameter at its bound, a residual over twice the noise): warned,\n"
+             "not refused"},
+    LR_CLI_QUIET_OPT,
     {0},
 };
 
@@ -81,7 +91,11 @@ const lr_command lr_fit_command = {
         "render. Prints parameters, residual (relative RMSE), iterations and time; writes the\n"
         "material preset (configs/materials format) atomically.",
     .opts = opts,
-    .notes = "Exit status: 0 success, 1 failure (the output is left as it was), 2 bad arguments.",
+    .notes = "Progress (evaluations, uncertainty, GPU check frames) goes to stderr; --quiet turns it\n"
+             "off. Exit status: 0 success, 1 failure (the output is left as it was), 2 bad\n"
+             "arguments, 3 a weak fit refused: the captures do not determine the material (the\n"
+             "check and its figures are named, with the exposure-stack command that recovers\n"
+             "clipped pixels; nothing written; --accept-weak writes it anyway).",
     .run = run_fit,
 };
 
@@ -128,8 +142,8 @@ static int write_material(const char *path, const char *name, const char *source
 
 /* One GPU render of the fitted scene at the fit's size, converged; its relative RMSE against
  * the captures over the object's pixels. */
-static int gpu_check(lr_scene *scene, int object, const lr_image *target, double *rel,
-                     double *ms, lr_err *e)
+static int gpu_check(lr_scene *scene, int object, const lr_image *target,
+                     const lr_progress *progress, double *rel, double *ms, lr_err *e)
 {
     lr_gl *gl = NULL;
     lr_renderer *r = NULL;
@@ -143,11 +157,14 @@ static int gpu_check(lr_scene *scene, int object, const lr_image *target, double
                                  &r, e)))
         goto done;
     *ms = 0;
+    int frames = lr_scene_render(scene)->frames;
+    lr_progress_report(progress, "GPU check frame", 0, frames);
     for (int i = 0; i < 100000 && lr_renderer_needs_frame(r); i++) {
         lr_frame_stats st;
         if ((rc = lr_renderer_frame(r, &st, e)))
             goto done;
         *ms += st.total_ms;
+        lr_progress_report(progress, "GPU check frame", i + 1, frames);
     }
     rgb = malloc(sizeof(float) * 3 * (size_t)w * h);
     mask = malloc((size_t)w * h);
@@ -195,6 +212,66 @@ static int run_fit_diffusion(const lr_cli *c)
                r.misfit[ch]);
     printf("wrote %s (%d regions)\n", out, r.regions);
     return LR_EXIT_OK;
+}
+
+/* What the refusal names: the command run, to say the one that would work. */
+typedef struct weak_ctx {
+    const lr_cli *c;
+    const char *scene, *calib, *captures;
+    int ncaptures;
+    double time; /* the (first) capture's exposure time, s */
+    const char *out;
+    int w, h;
+    long clipped;
+} weak_ctx;
+
+/* The refusal: the checks that failed with their figures, then what to do -- an exposure
+ * stack when pixels are clipped (lr_fit_load_captures merges it, so the clipped ones come
+ * back), a larger --size when the object is small in the view. FIT_EXIT_WEAK. */
+static int weak_refuse(const weak_ctx *k, const char *why)
+{
+    fprintf(stderr, "lamprig fit: weak fit refused, nothing written (exit 3): the captures do "
+                    "not determine the material. %s\n", why);
+    char cal[1024] = "";
+    if (k->calib)
+        snprintf(cal, sizeof cal, " --calib %s", k->calib);
+    if (k->clipped > 0) {
+        /* the first capture's name without its extension, for the shots added */
+        char base[1024];
+        snprintf(base, sizeof base, "%.*s", (int)strcspn(k->captures, ","), k->captures);
+        char *dot = strrchr(base, '.');
+        if (dot && !strchr(dot, '/'))
+            *dot = 0;
+        double t = k->time;
+        fprintf(stderr,
+                "  An exposure stack brings the clipped pixels back: add shots at 1/4 and 1/16 "
+                "of the exposure time (%g s; shorter still while the shortest clips) and fit "
+                "them together:\n",
+                t);
+        if (k->ncaptures == 1 && k->calib)
+            fprintf(stderr,
+                    "    lamprig-capsim --scene %s --calib %s --exposure %g --out %s_4.png "
+                    "(simulated; on the rig, the same view at %g s)\n"
+                    "    lamprig-capsim --scene %s --calib %s --exposure %g --out %s_16.png\n",
+                    k->scene, k->calib, t / 4, base, t / 4, k->scene, k->calib, t / 16, base);
+        if (k->ncaptures == 1)
+            fprintf(stderr,
+                    "    lamprig fit --scene %s%s --captures %s,%s_4.png,%s_16.png --times "
+                    "%g,%g,%g --out %s --size %dx%d\n",
+                    k->scene, cal, k->captures, base, base, t, t / 4, t / 16, k->out, k->w,
+                    k->h);
+        else /* a stack that still clips: shorter shots on top of it */
+            fprintf(stderr,
+                    "    lamprig fit --scene %s%s --captures %s,%s_4.png,%s_16.png --times "
+                    "<yours>,%g,%g --out %s --size %dx%d\n",
+                    k->scene, cal, k->captures, base, base, t / 4, t / 16, k->out, k->w, k->h);
+    } else {
+        fprintf(stderr, "  The object is small in the view: a larger --size (now %dx%d) gives "
+                        "it more pixels.\n",
+                k->w, k->h);
+    }
+    fprintf(stderr, "  --accept-weak writes the material anyway.\n");
+    return FIT_EXIT_WEAK;
 }
 
 static int run_fit(const lr_cli *c)
@@ -245,10 +322,12 @@ static int run_fit(const lr_cli *c)
 
     int status = LR_EXIT_FAIL;
     lr_scene *scene = NULL;
+    lr_progress_meter *pm = lr_cli_progress(c);
     lr_rig_calib *cal = calloc(1, sizeof *cal);
     lr_image target = {0};
     if (!cal) {
         free(list);
+        lr_progress_meter_destroy(pm);
         return LR_EXIT_FAIL;
     }
     if (lr_scene_load(scene_path, NULL, &scene, &e)) {
@@ -304,10 +383,21 @@ static int run_fit(const lr_cli *c)
         printf("lamprig fit: %ld of the object's %ld pixels left out: they touch capture "
                "pixels clipped (some channel >= 250, or black) in every capture\n",
                clipped, inside);
+    /* Refused before the work when the data cannot carry it (the checks that need no fit). */
+    char why[1536];
+    bool accept = lr_args_has(a, "--accept-weak");
+    unsigned weak = lr_fit_check_data(d.mode, inside, inside - clipped, why, sizeof why);
+    weak_ctx wk = {c, scene_path, cdir, caps, n, ntimes ? times[0] : 1.0, out, w, h, clipped};
+    if (weak && !accept) {
+        status = weak_refuse(&wk, why);
+        goto done;
+    }
     d.scene = scene;
     d.target = &target;
+    d.progress = lr_progress_meter_sink(pm);
     lr_fit_result r;
-    if (lr_fit_run(&d, &r, &e)) {
+    int frc = lr_fit_run(&d, &r, &e);
+    if (frc) {
         status = lr_cli_fail(c->path, "%s", e.msg);
         goto done;
     }
@@ -335,13 +425,22 @@ static int run_fit(const lr_cli *c)
     if (!lr_args_has(a, "--no-gpu-check")) {
         double rel = 0, ms = 0;
         lr_err ge = {0};
-        if (gpu_check(scene, d.object, &target, &rel, &ms, &ge))
+        if (gpu_check(scene, d.object, &target, lr_progress_meter_sink(pm), &rel, &ms, &ge))
             printf("  GPU check: not run (%s)\n", ge.msg);
         else
             printf("  GPU check: relative RMSE %.4f against the captures (CPU reference %.4f), "
                    "%.0f ms\n",
                    rel, r.rel_rmse_all, ms);
     }
+    weak = lr_fit_check_result(d.mode, &r, why, sizeof why);
+    char weak_names[96] = "";
+    lr_fit_check_names(weak, weak_names, sizeof weak_names);
+    if (weak && !accept) {
+        status = weak_refuse(&wk, why);
+        goto done;
+    }
+    if (weak)
+        fprintf(stderr, "lamprig fit: warning: weak fit written (--accept-weak): %s\n", why);
     char name[LR_MATERIAL_NAME_MAX];
     const char *nm = lr_args_get(a, "--name");
     if (!nm) {
@@ -352,13 +451,14 @@ static int run_fit(const lr_cli *c)
                  base);
         nm = name;
     }
-    char source[512];
+    char source[1024];
     snprintf(source, sizeof source,
              "lamprig fit: %s, object '%s', %d capture(s) from %s read with %s, %s, relative "
-             "RMSE %.4f over %ld pixels at %d x %d",
+             "RMSE %.4f over %ld pixels at %d x %d%s%s",
              scene_path, o->name, n, paths[0], resp,
              d.mode == LR_FIT_SCALE ? "two scales on a preset" : "sigma per band",
-             r.rel_rmse_all, r.mask_pixels, w, h);
+             r.rel_rmse_all, r.mask_pixels, w, h, weak ? "; WEAK, accepted: " : "",
+             weak_names);
     if (write_material(out, nm, source, &o->material.medium, &e)) {
         status = lr_cli_fail(c->path, "%s", e.msg);
         goto done;
@@ -366,6 +466,7 @@ static int run_fit(const lr_cli *c)
     printf("  wrote %s\n", out);
     status = LR_EXIT_OK;
 done:
+    lr_progress_meter_destroy(pm);
     lr_image_free(&target);
     lr_rig_calib_free(cal);
     free(cal);

@@ -65,6 +65,7 @@ static const lr_argspec opts[] = {
              "re-renders) as markdown, and exit"},
     {.name = "--table", .type = LR_ARG_PATH, .metavar = "CSV",
      .help = "the planner's measured table (default: see `lamprig help plan`)"},
+    LR_CLI_QUIET_OPT,
     {0},
 };
 
@@ -268,6 +269,7 @@ static int run_render(const lr_cli *c)
     lr_scene *scene = NULL;
     lr_gl *gl = NULL;
     lr_renderer *r = NULL;
+    lr_progress_meter *pm = NULL;
     lr_render_events ev = {0};
     stats_log log = {0};
     lr_image img = {0};
@@ -313,6 +315,11 @@ static int run_render(const lr_cli *c)
         goto done;
     }
     int next_ev = 0;
+    /* without --frames: render.frames to converge (events may restart it: then more) */
+    int nframes = frames ? frames : lr_scene_render(scene)->frames;
+    pm = lr_cli_progress(c);
+    const lr_progress *pg = lr_progress_meter_sink(pm);
+    lr_progress_report(pg, "frame", 0, nframes);
     for (int i = 0;; i++) {
         if (frames ? i >= frames : (!lr_renderer_needs_frame(r) && next_ev >= ev.count))
             break;
@@ -339,7 +346,11 @@ static int run_render(const lr_cli *c)
             status = LR_EXIT_FAIL;
             goto done;
         }
+        /* past render.frames (an event restarted the accumulation): the count alone */
+        lr_progress_report(pg, "frame", i + 1, i + 1 <= nframes ? nframes : 0);
     }
+    lr_progress_meter_destroy(pm);
+    pm = NULL;
     for (; next_ev < ev.count; next_ev++)
         fprintf(stderr, "lamprig render: %s:%d: event for frame %d not applied (--frames %d)\n",
                 ev.path, ev.ev[next_ev].line, ev.ev[next_ev].frame, frames);
@@ -377,6 +388,7 @@ static int run_render(const lr_cli *c)
             printf("wrote %s\n", stats_path);
     }
 done:
+    lr_progress_meter_destroy(pm);
     lr_image_free(&img);
     free(log.v);
     lr_render_events_free(&ev);

@@ -398,6 +398,38 @@ static bool trace(const lr_scene *s, lr_vec3 org, lr_vec3 dir, int *kind, int *i
     return true;
 }
 
+static void pixel_item(void *p, long item);
+
+typedef struct pixel_span {
+    rctx *r;
+    long base;
+} pixel_span;
+
+static void span_item(void *p, long item)
+{
+    pixel_span *s = p;
+    pixel_item(s->r, s->base + item);
+}
+
+/* Every pixel; with a progress listener in sixteen spans, reported as each ends (the items
+ * are independent, so the split changes nothing but the reports). */
+static void render_pixels(rctx *r)
+{
+    const lr_progress *pg = r->d->progress;
+    long n = (long)r->W * r->H;
+    if (!pg || !pg->fn) {
+        lr_cpu_parallel_for(n, r->d->threads, pixel_item, r);
+        return;
+    }
+    enum { SPANS = 16 };
+    lr_progress_report(pg, "cpu pixels", 0, SPANS);
+    for (int k = 0; k < SPANS; k++) {
+        pixel_span s = {r, n * k / SPANS};
+        lr_cpu_parallel_for(n * (k + 1) / SPANS - s.base, r->d->threads, span_item, &s);
+        lr_progress_report(pg, "cpu pixels", k + 1, SPANS);
+    }
+}
+
 static void pixel_item(void *p, long item)
 {
     rctx *r = p;
@@ -633,6 +665,7 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
     if (!ref) {
         for (int o = 0; o < r.nobj; o++)
             for (int l = 0; l < r.nlight; l++) {
+                lr_progress_report(d->progress, "cpu maps", o * r.nlight + l, r.nobj * r.nlight);
                 lr_cpu_maps_desc md = {.object = lr_scene_object_at(s, o),
                                        .light = lr_scene_light_at(s, l),
                                        .K = d->K ? d->K : rs->K,
@@ -733,7 +766,9 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
     if (!ref && lr_scene_render(s)->lpv > 0 && r.nrecv > 0 &&
         (rc = lpv_grids(&r, lr_scene_render(s)->lpv, e)))
         goto fail;
-    lr_cpu_parallel_for((long)r.W * r.H, d->threads, pixel_item, &r);
+    if (!ref)
+        lr_progress_report(d->progress, "cpu maps", r.nobj * r.nlight, r.nobj * r.nlight);
+    render_pixels(&r);
     long objpx = 0, fbpx = 0;
     for (long i = 0; i < (long)r.W * r.H; i++) {
         objpx += r.object_px[i];

@@ -23,6 +23,7 @@
 #include <stdbool.h>
 
 #include "render/base/err.h"
+#include "render/base/progress.h"
 #include "render/cpu/radiosity.h"
 #include "render/image/image.h"
 #include "render/scene/scene.h"
@@ -38,6 +39,8 @@ typedef struct lr_cpu_render_desc {
     bool no_vpl;                /* receivers get direct light only */
     unsigned seed;              /* 0: 1 */
     int threads;                /* 0: all CPUs */
+    const lr_progress *progress; /* may be NULL: "cpu maps" per object and light (PASS),
+                                  * "cpu pixels" in sixteenths of the image */
 } lr_cpu_render_desc;
 
 typedef struct lr_cpu_render_stats {

@@ -1,4 +1,5 @@
-/* Base utilities: error messages and atomic file replacement. */
+/* Base utilities: error messages, atomic file replacement, data paths, the median and the
+ * progress printer. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -27,6 +28,7 @@
 #include "render/base/paths.h"
 #include "render/base/umask.h"
 #include "render/gl/shader_cache.h"
+#include "render/base/progress.h"
 #include "tests/support/fs.h"
 
 static void test_err_prefix(void **state)
@@ -456,6 +458,105 @@ static void test_cache_dir_tidy(void **state)
     lr_test_rmtree(dir);
 }
 
+/* ---- progress (render/base/progress.h) ---------------------------------------------------- */
+
+static double fake_clock(void *ctx)
+{
+    return *(const double *)ctx;
+}
+
+/* A meter writing into a memory stream at a clock the test sets. */
+typedef struct meter_case {
+    double t;
+    char *buf;
+    size_t len;
+    FILE *f;
+    lr_progress_meter *m;
+} meter_case;
+
+static void meter_open(meter_case *c, lr_progress_style style)
+{
+    memset(c, 0, sizeof *c);
+    assert_non_null(c->f = open_memstream(&c->buf, &c->len));
+    lr_progress_meter_desc d = {.prefix = "lamprig x", .style = style, .out = c->f,
+                                .clock = fake_clock, .clock_ctx = &c->t};
+    assert_int_equal(lr_progress_meter_create(&d, &c->m, NULL), LR_OK);
+}
+
+static void meter_close(meter_case *c)
+{
+    lr_progress_meter_destroy(c->m);
+    fclose(c->f);
+}
+
+/* Plain lines: the first report at once, then at most one a second, plus the line that closes
+ * a stage already shown; stage, n/N, percentage, elapsed and the straight-line estimate of the
+ * time left (10 s for 25 of 100 -> 30 s left). */
+static void test_progress_lines(void **state)
+{
+    (void)state;
+    meter_case c;
+    meter_open(&c, LR_PROGRESS_LINES);
+    const lr_progress *p = lr_progress_meter_sink(c.m);
+    for (int i = 0; i <= 100; i++) { /* 100 steps over 40 s: 0.4 s each */
+        c.t = 0.4 * i;
+        lr_progress_report(p, "render frame", i, 100);
+    }
+    /* a stage done within the interval after the last line: never shown */
+    lr_progress_report(p, "quick", 0, 2);
+    lr_progress_report(p, "quick", 2, 2);
+    int lines = lr_progress_meter_lines(c.m);
+    meter_close(&c);
+    /* lines at t = 0, 1.2, 2.4, ... (every third step, 1.2 s >= 1 s apart): 0, 3, ..., 99,
+     * then 100 closing the stage */
+    assert_int_equal(lines, 35);
+    assert_non_null(strstr(c.buf, "lamprig x: render frame 0/100 (0 %), 0 s elapsed\n"));
+    assert_non_null(strstr(c.buf, "lamprig x: render frame 3/100 (3 %), 1 s elapsed, ~39 s left\n"));
+    /* at step 75, 30 s: 30 x 25 / 75 = 10 s left */
+    assert_non_null(strstr(c.buf, "render frame 75/100 (75 %), 30 s elapsed, ~10 s left\n"));
+    assert_non_null(strstr(c.buf, "render frame 100/100 (100 %), 40 s elapsed\n"));
+    assert_null(strstr(c.buf, "quick"));
+    assert_null(strchr(c.buf, '\r'));
+    free(c.buf);
+}
+
+/* A terminal: one line rewritten in place (\r ... ESC[K), ended by a newline when the stage
+ * ends or the meter is destroyed; quiet: nothing at all. */
+static void test_progress_tty_and_quiet(void **state)
+{
+    (void)state;
+    meter_case c;
+    meter_open(&c, LR_PROGRESS_TTY);
+    const lr_progress *p = lr_progress_meter_sink(c.m);
+    lr_progress_report(p, "decode", 0, 4);
+    c.t = 0.3;
+    lr_progress_report(p, "decode", 1, 4);
+    c.t = 0.4; /* 0.1 s after the last update: skipped */
+    lr_progress_report(p, "decode", 2, 4);
+    c.t = 0.7;
+    lr_progress_report(p, "decode", 4, 4);
+    c.t = 1.0;
+    lr_progress_report(p, "evaluations", 5, 0); /* total unknown */
+    meter_close(&c);
+    assert_string_equal(c.buf, "\rlamprig x: decode 0/4 (0 %), 0 s elapsed\033[K"
+                               "\rlamprig x: decode 1/4 (25 %), 0 s elapsed, ~1 s left\033[K"
+                               "\rlamprig x: decode 4/4 (100 %), 1 s elapsed\033[K\n"
+                               "\rlamprig x: evaluations 5, 0 s elapsed\033[K\n");
+    free(c.buf);
+    meter_open(&c, LR_PROGRESS_QUIET);
+    p = lr_progress_meter_sink(c.m);
+    for (int i = 0; i < 5; i++) {
+        c.t = 10.0 * i;
+        lr_progress_report(p, "render frame", i, 4);
+    }
+    assert_int_equal(lr_progress_meter_lines(c.m), 0);
+    meter_close(&c);
+    assert_int_equal(c.len, 0);
+    free(c.buf);
+    /* nobody listening */
+    lr_progress_report(lr_progress_meter_sink(NULL), "x", 1, 2);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -468,6 +569,8 @@ int main(void)
         cmocka_unit_test(test_atomic_file_mode_follows_umask),
         cmocka_unit_test(test_file_read_regular_only),
         cmocka_unit_test(test_shader_cache_dir),
+        cmocka_unit_test(test_progress_lines),
+        cmocka_unit_test(test_progress_tty_and_quiet),
     };
     return cmocka_run_group_tests_name("base", tests, NULL, NULL);
 }

@@ -29,6 +29,7 @@
 #include "render/base/json.h"
 #include "render/scene/scene.h"
 #include "tests/support/calib_sim.h"
+#include "tests/support/cli.h"
 #include "tests/support/gl.h"
 #include "tests/support/near.h"
 
@@ -498,6 +499,35 @@ static void test_cli(void **state)
                         "--set", "render.K=4", "--set", "render.N=4", "--set",
                         "render.map_size=64", "--set", "render.N_vpl=16"};
     assert_int_equal(run_compare(ok, 23), 0);
+    /* lamprig-capsim (release build) through the same rig: its render reports progress on
+     * stderr (the CPU twin's stages, counts rising to total of total), --quiet silences it
+     * (issue 33 item 13: an 844 s capture said nothing). */
+    for (int quiet = 0; quiet < 2; quiet++) {
+        int cst = lr_test_run_cli(dir,
+                                  "build/bin/lamprig-capsim --scene %s/scenes/candle.json "
+                                  "--calib %s --out %s/sim.png --cpu --frames 2 --set render.K=4 "
+                                  "--set render.N=4 --set render.map_size=64 --set "
+                                  "render.N_vpl=16 %s",
+                                  LR_SOURCE_CONFIGS, rigdir, dir, quiet ? "--quiet" : "");
+        char *err = lr_test_slurp(dir, "err");
+        if (cst != 0)
+            fail_msg("lamprig-capsim: exit %d: %s", cst, err);
+        if (quiet) {
+            assert_int_equal(strlen(err), 0);
+        } else {
+            printf("%s", err);
+            int n = 0, last = -1, done = 0, total = 0;
+            for (const char *p = err; (p = strstr(p, "lamprig-capsim: cpu maps ")); p++, n++) {
+                assert_int_equal(sscanf(p, "lamprig-capsim: cpu maps %d/%d", &done, &total), 2);
+                assert_true(done > last);
+                last = done;
+            }
+            assert_true(n >= 2); /* the first report and the one closing the stage */
+            assert_int_equal(done, total);
+            assert_int_equal(total, 1); /* one object, one light */
+        }
+        free(err);
+    }
     char *text;
     size_t len;
     assert_int_equal(lr_file_read(report, LR_FILE_MAX_TEXT, &text, &len, &e), LR_OK);

@@ -21,9 +21,11 @@
 #include "calib/capture_sim.h"
 #include "calib/fit.h"
 #include "calib/fit_captures.h"
+#include "calib/fit_checks.h"
 #include "calib/nelder_mead.h"
 #include "calib/rig.h"
 #include "render/cpu/frame.h"
+#include "tests/support/cli.h"
 #include "tests/support/fs.h"
 #include "tests/support/near.h"
 
@@ -183,6 +185,14 @@ static void test_fit_recovers_sigma(void **state)
     assert_int_equal(lr_cpu_render(&rd, &at_truth, NULL, NULL, NULL), 0);
     double floor_rel = lr_fit_rel_rmse(&at_truth, &target, NULL, NULL);
     print_message("noise floor (model at the truth) %.4f\n", floor_rel);
+    /* A good capture passes every check of calib/fit_checks.h. */
+    char why[1024];
+    unsigned weak = lr_fit_check_result(LR_FIT_SIGMA, &r, why, sizeof why);
+    print_message("checks: %u %s; model noise %.4f, cond %.3g %.3g %.3g\n", weak, why,
+                  r.noise_rel, r.cond[0], r.cond[1], r.cond[2]);
+    assert_int_equal(weak, 0);
+    assert_int_equal(r.object_pixels, W * H);
+    assert_int_equal(r.mask_pixels, W * H);
     lr_image_free(&at_truth);
     /* converged: from a start whose error is over three times the floor down to within 30 %
      * of the floor (the fit's objective is two other draws of the model's noise, seeds 1 and
@@ -315,6 +325,138 @@ static void test_fit_captures(void **state)
     rmdir(dir);
 }
 
+/* ---- the CLI (release build/bin/lamprig): progress and weak fits (issue 33) ------------- */
+
+/* dir/slab.json (the slab scene), dir/good.png (brightest pixel at 60 % of saturation) and
+ * dir/clipped.png (at 100x saturation: the spot and most of its halo clipped), both at *gain. */
+static void write_cli_case(const char *dir, double *gain)
+{
+    char path[1024];
+    lr_err e = {0};
+    snprintf(path, sizeof path, "%s/slab.json", dir);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(SLAB, f);
+    fclose(f);
+    lr_scene *s = load_slab(NULL);
+    set_sigma(s, TRUE_SA, TRUE_SS);
+    lr_image L;
+    lr_cpu_render_desc rd = {.scene = s, .width = W, .height = H, .mode = LR_CPU_REFERENCE,
+                             .samples = 256, .no_vpl = true, .seed = 99, .threads = 2};
+    if (lr_cpu_render(&rd, &L, NULL, NULL, &e))
+        fail_msg("render: %s", e.msg);
+    double lmax = 0;
+    for (int i = 0; i < W * H * 3; i++)
+        lmax = fmax(lmax, L.rgb[i]);
+    lr_sensor sen = {.exposure_s = 1, .full_well_e = 20000, .read_noise_e = 5, .seed = 1234};
+    *gain = 0.6 * lr_sensor_saturation(&sen, 0) / lmax;
+    for (int k = 0; k < 2; k++) {
+        sen.gain = *gain * (k ? 100 / 0.6 : 1);
+        lr_img cap;
+        if (lr_sensor_capture(&sen, &L, &cap, &e))
+            fail_msg("capture: %s", e.msg);
+        snprintf(path, sizeof path, "%s/%s.png", dir, k ? "clipped" : "good");
+        assert_int_equal(lr_img_write(path, &cap, &e), LR_OK);
+        lr_img_free(&cap);
+    }
+    lr_image_free(&L);
+    lr_scene_destroy(s);
+}
+
+/* The "evaluations" progress lines of stderr: at least two (the first report is shown at
+ * once, and a stage shown is closed at total of total), counts strictly increasing from 0
+ * to a last line at N/N, N > 0. Returns how many. */
+static int check_progress(const char *err)
+{
+    int n = 0, last = -1, done = 0, total = 0;
+    for (const char *p = err; (p = strstr(p, "lamprig fit: evaluations ")); p++) {
+        assert_int_equal(sscanf(p, "lamprig fit: evaluations %d/%d", &done, &total), 2);
+        assert_true(done > last);
+        if (n == 0)
+            assert_int_equal(done, 0);
+        last = done;
+        n++;
+    }
+    assert_true(n >= 2);
+    assert_int_equal(done, total);
+    assert_true(done > 0 && done <= 22); /* --max-evals 20, + 2 for the step under way */
+    return n;
+}
+
+/* Long commands report progress on stderr, rate-limited, and --quiet silences it
+ * (issue 33 item 13). A cheap fit: 16 x 16, 16 samples, at most 20 evaluations. */
+static void test_fit_cli_progress(void **state)
+{
+    (void)state;
+    char *dir = lr_test_tmpdir();
+    double gain;
+    write_cli_case(dir, &gain);
+    const char *fmt = "build/bin/lamprig fit --scene %s/slab.json --captures %s/good.png "
+                      "--capture-scale %.17g --size 16x16 --samples 16 --max-evals 20 "
+                      "--threads 2 --no-gpu-check --out %s/m.json %s";
+    int st = lr_test_run_cli(dir, fmt, dir, dir, gain, dir, "");
+    char *err = lr_test_slurp(dir, "err"), *out = lr_test_slurp(dir, "out");
+    print_message("%s%s", out, err);
+    assert_int_equal(st, 0);
+    int lines = check_progress(err);
+    /* rate-limited: at most one line a second plus the closing one, never one per step */
+    assert_true(lines < 20);
+    free(err);
+    free(out);
+    st = lr_test_run_cli(dir, fmt, dir, dir, gain, dir, "--quiet");
+    err = lr_test_slurp(dir, "err");
+    assert_int_equal(st, 0);
+    assert_null(strstr(err, "lamprig fit: evaluations"));
+    assert_null(strstr(err, "uncertainty"));
+    free(err);
+    lr_test_rmtree(dir);
+}
+
+/* A capture that clips most of the object is refused, before the fit, with the check, its
+ * figures and the exposure-stack command (exit 3, nothing written); --accept-weak writes it
+ * with a warning (issue 33 item 14: such a fit used to return sigma_s' 6x off, silently). */
+static void test_fit_cli_weak(void **state)
+{
+    (void)state;
+    char *dir = lr_test_tmpdir();
+    double gain;
+    write_cli_case(dir, &gain);
+    const char *fmt = "build/bin/lamprig fit --scene %s/slab.json --captures %s/clipped.png "
+                      "--capture-scale %.17g --size 16x16 --samples 8 --max-evals 6 "
+                      "--threads 2 --no-gpu-check --quiet --out %s/m.json %s";
+    int st = lr_test_run_cli(dir, fmt, dir, dir, gain, dir, "");
+    char *err = lr_test_slurp(dir, "err"), *out = lr_test_slurp(dir, "out");
+    print_message("%s%s", out, err);
+    assert_int_equal(st, 3);
+    assert_non_null(strstr(err, "weak fit refused, nothing written (exit 3)"));
+    /* the clipped count the command printed is the one the check names */
+    long clipped = 0, inside = 0;
+    for (const char *p = out; (p = strstr(p, "lamprig fit: ")); p++)
+        if (sscanf(p, "lamprig fit: %ld of the object's %ld pixels left out", &clipped,
+                   &inside) == 2)
+            break;
+    assert_int_equal(inside, W * H);
+    assert_true(2 * clipped > inside);
+    char want[160];
+    snprintf(want, sizeof want, "clipped: %ld of the object's %ld pixels are clipped", clipped,
+             inside);
+    assert_non_null(strstr(err, want));
+    assert_non_null(strstr(err, "--times 1,0.25,0.0625"));
+    assert_non_null(strstr(err, "clipped_4.png"));
+    char mpath[1024];
+    snprintf(mpath, sizeof mpath, "%s/m.json", dir);
+    assert_int_equal(access(mpath, F_OK), -1);
+    free(err);
+    free(out);
+    st = lr_test_run_cli(dir, fmt, dir, dir, gain, dir, "--accept-weak");
+    err = lr_test_slurp(dir, "err");
+    assert_int_equal(st, 0);
+    assert_non_null(strstr(err, "warning: weak fit written (--accept-weak)"));
+    assert_int_equal(access(mpath, F_OK), 0);
+    free(err);
+    lr_test_rmtree(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -322,6 +464,8 @@ int main(void)
         cmocka_unit_test(test_fit_recovers_sigma),
         cmocka_unit_test(test_fit_no_object),
         cmocka_unit_test(test_fit_captures),
+        cmocka_unit_test(test_fit_cli_progress),
+        cmocka_unit_test(test_fit_cli_weak),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -9,12 +9,14 @@
  *   lamprig-capsim --scene FILE --calib DIR --out IMG.png [--exposure S] [--gain G]
  *                  [--noise FULL_WELL,READ | none] [--seed N] [--bits 8|16]
  *                  [--vignette none|cos4|poly:V1,V2,V3] [--gamma G] [--cpu] [--frames N]
- *                  [--hdr RADIANCE.pfm] [--set key=value ...]
+ *                  [--hdr RADIANCE.pfm] [--set key=value ...] [--quiet]
  *
  * --gain defaults to the scene's render.exposure (the capture is then about as bright as
  * the renderer's own PNG at --exposure 1); --noise defaults to 10000 e- full well and 4 e-
  * read noise. --seed drives the sensor noise only; the render uses the renderers' default
- * sample seed, as `lamprig compare` does. Exit status 0, 1 (failure, message on stderr),
+ * sample seed, as `lamprig compare` does. The render's progress goes to stderr
+ * (render/base/progress.h: frames of the GPU render, the CPU twin's stages), --quiet turns it
+ * off. Exit status 0, 1 (failure, message on stderr),
  * 2 (bad arguments). */
 #include <math.h>
 #include <stdio.h>
@@ -39,7 +41,7 @@ static int usage(const char *msg, const char *arg)
             "usage: lamprig-capsim --scene FILE --calib DIR --out IMG.png [--exposure S] "
             "[--gain G] [--noise FULL_WELL,READ|none] [--seed N] [--bits 8|16] "
             "[--vignette none|cos4|poly:V1,V2,V3] [--gamma G] [--cpu] [--frames N] "
-            "[--hdr RADIANCE.pfm] [--set key=value ...]\n");
+            "[--hdr RADIANCE.pfm] [--set key=value ...] [--quiet]\n");
     return 2;
 }
 
@@ -59,12 +61,16 @@ int main(int argc, char **argv)
     const char *sets[MAX_SETS];
     int nsets = 0;
     lr_sensor s = {.full_well_e = 10000, .read_noise_e = 4, .seed = 1};
-    bool cpu = false, gain_given = false;
+    bool cpu = false, gain_given = false, quiet = false;
     double frames = 0, seed = 1, gamma = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--cpu")) {
             cpu = true;
+            continue;
+        }
+        if (!strcmp(a, "--quiet")) {
+            quiet = true;
             continue;
         }
         if (!strcmp(a, "--help") || !strcmp(a, "-h"))
@@ -128,6 +134,7 @@ int main(int argc, char **argv)
     lr_scene *scene = NULL;
     lr_rig_calib *rig = calloc(1, sizeof *rig);
     lr_camview *view = NULL;
+    lr_progress_meter *pm = NULL;
     lr_image rad = {0};
     lr_img cap = {0};
     int status = 1;
@@ -171,8 +178,17 @@ int main(int argc, char **argv)
     /* The renderers' default sample seed, as `lamprig compare` uses: a capture and a
      * comparison at the same --frames see the same Monte Carlo samples, so what differs is
      * the sensor alone (--seed drives its noise). */
-    lr_view_render_desc vd = {.scene = scene, .view = view, .cpu = cpu, .frames = (int)frames};
-    if (lr_view_render(&vd, &rad, &secs, &e) || (hdr && lr_image_write_pfm(hdr, &rad, &e)) ||
+    if (lr_progress_meter_create(&(lr_progress_meter_desc){.prefix = "lamprig-capsim",
+                                                            .style = quiet ? LR_PROGRESS_QUIET
+                                                                           : LR_PROGRESS_AUTO},
+                                 &pm, &e))
+        goto fail;
+    lr_view_render_desc vd = {.scene = scene, .view = view, .cpu = cpu, .frames = (int)frames,
+                              .progress = lr_progress_meter_sink(pm)};
+    int rrc = lr_view_render(&vd, &rad, &secs, &e);
+    lr_progress_meter_destroy(pm);
+    pm = NULL;
+    if (rrc || (hdr && lr_image_write_pfm(hdr, &rad, &e)) ||
         lr_sensor_capture(&s, &rad, &cap, &e) || lr_img_write(out, &cap, &e))
         goto fail;
     char rname[256];
@@ -185,6 +201,7 @@ int main(int argc, char **argv)
 fail:
     fprintf(stderr, "lamprig-capsim: %s\n", e.msg);
 done:
+    lr_progress_meter_destroy(pm);
     lr_img_free(&cap);
     lr_image_free(&rad);
     lr_camview_destroy(view);

@@ -2,7 +2,7 @@
  *
  *   lamprig-reference render --scene FILE [--out F.pfm] [--variance F.pfm] [--cache]
  *                            [--cache-dir DIR] [--width N] [--height N] [--spp N]
- *                            [--pass N] [--threads N] [--seed N] [--progress]
+ *                            [--pass N] [--threads N] [--seed N] [--quiet]
  *   lamprig-reference validate [--photons N] [--threads N] [--seed N]
  *
  * Exit status 0 on success, 1 on a runtime failure, 2 on bad arguments (one line on stderr).
@@ -15,6 +15,7 @@
 
 #include "firmware/args.h"
 #include "render/base/json.h"
+#include "render/base/progress.h"
 #include "render/reference/reference.h"
 #include "render/scene/scene.h"
 
@@ -33,7 +34,8 @@ static const char usage[] =
     "  --width N, --height N, --spp N, --seed N   override the scene file's render block\n"
     "  --pass N           samples per pixel per progressive pass (default 4)\n"
     "  --threads N        worker threads (default: all CPUs; the image does not depend on it)\n"
-    "  --progress         progress line on stderr even when it is not a terminal\n"
+    "  --quiet            no progress lines on stderr (a line rewritten in place on a\n"
+    "                     terminal, one a second otherwise; --progress: the default)\n"
     "\n"
     "validate: the published slab benchmarks and the sphere energy balance, by counting\n"
     "photons on the renderer's transport code (default 4000000 photons each).\n";
@@ -63,26 +65,10 @@ static int int_flag(const lr_args *a, const char *flag, long lo, long hi, long *
     return 0;
 }
 
-typedef struct progress {
-    bool show;
-    double t0;
-} progress;
-
+/* The passes' progress through the one printer (render/base/progress.h). */
 static void show_progress(const lr_ref_render *r, void *user)
 {
-    progress *p = user;
-    if (!p->show)
-        return;
-    int done = lr_ref_render_spp_done(r), total = lr_ref_render_spp_total(r);
-    double el = now() - p->t0;
-    double rate = el > 0.0 ? (double)lr_ref_render_stats(r)->paths / el : 0.0;
-    double left = done > 0 ? el * (double)(total - done) / done : 0.0;
-    /* One line, rewritten in place (\r, then clear to the end of the line). */
-    fprintf(stderr, "\rreference: %d/%d spp  %.2f Mpaths/s  %.0f s elapsed, %.0f s left\033[K",
-            done, total, rate * 1e-6, el, left);
-    if (done == total)
-        fputc('\n', stderr);
-    fflush(stderr);
+    lr_progress_report(user, "spp", lr_ref_render_spp_done(r), lr_ref_render_spp_total(r));
 }
 
 /* A project scene (render/scene) has receivers or objects with a "mesh"; a reference scene
@@ -115,6 +101,7 @@ static int cmd_render(int argc, char **argv)
         {.name = "--threads", .type = LR_ARG_STRING},
         {.name = "--seed", .type = LR_ARG_STRING},
         {.name = "--progress"},
+        {.name = "--quiet"},
         {0},
     };
     lr_args a;
@@ -169,32 +156,45 @@ static int cmd_render(int argc, char **argv)
         snprintf(varbuf, sizeof varbuf, "%.*s.var.pfm", (int)n, out);
         var = varbuf;
     }
-    progress pr = {.show = isatty(2) || lr_args_has(&a, "--progress"), .t0 = now()};
+    double t0 = now();
+    lr_progress_meter *pm = NULL;
+    if (lr_progress_meter_create(
+            &(lr_progress_meter_desc){.prefix = "lamprig-reference",
+                                      .style = lr_args_has(&a, "--quiet") ? LR_PROGRESS_QUIET
+                                                                          : LR_PROGRESS_AUTO},
+            &pm, &e)) {
+        fprintf(stderr, "lamprig-reference: %s\n", e.msg);
+        lr_ref_scene_destroy(s);
+        lr_scene_destroy(project);
+        return 1;
+    }
+    void *pr = (void *)lr_progress_meter_sink(pm);
     lr_ref_image mean = {0}, vimg = {0};
     lr_ref_stats stats = {0};
     int status = 0;
     bool hit = false;
     const char *cache_dir = lr_args_get(&a, "--cache-dir");
     if (cache_dir || lr_args_has(&a, "--cache")) {
-        if (lr_ref_render_cached(s, &cam, &d, cache_dir, show_progress, &pr, &mean, &vimg, &hit,
+        if (lr_ref_render_cached(s, &cam, &d, cache_dir, show_progress, pr, &mean, &vimg, &hit,
                                  &e))
             status = 1;
     } else {
         lr_ref_render *r = NULL;
         if (lr_ref_render_create(s, &cam, &d, &r, &e) ||
-            lr_ref_render_run(r, show_progress, &pr, &e) || lr_ref_render_mean(r, &mean, &e) ||
+            lr_ref_render_run(r, show_progress, pr, &e) || lr_ref_render_mean(r, &mean, &e) ||
             lr_ref_render_variance(r, &vimg, &e))
             status = 1;
         if (r)
             stats = *lr_ref_render_stats(r);
         lr_ref_render_destroy(r);
     }
+    lr_progress_meter_destroy(pm);
     if (!status && (lr_image_write_pfm(out, &mean, &e) || lr_image_write_pfm(var, &vimg, &e)))
         status = 1;
     if (status) {
         fprintf(stderr, "lamprig-reference: %s\n", e.msg);
     } else {
-        double el = now() - pr.t0;
+        double el = now() - t0;
         char key[17];
         lr_ref_cache_key(s, &cam, &d, key);
         printf("reference %s: %dx%d, key %s%s\n", scene, mean.width, mean.height, key,
