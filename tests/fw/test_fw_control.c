@@ -378,7 +378,8 @@ static void expect_map_error(const char *controls, const char *msg)
     lr_scene *scene;
     lr_control_map *map = NULL;
     lr_err e = {0};
-    if (lr_rig_config_parse(text, "test-rig.json", &cfg, &e) || lr_scene_load(SCENE, NULL, &scene, &e))
+    if (lr_rig_config_parse(text, "test-rig.json", &cfg, &e) ||
+        lr_scene_load(SCENE, NULL, &scene, &e))
         fail_msg("%s", e.msg);
     assert_int_not_equal(lr_control_map_create(cfg, scene, true, 0, &map, &e), LR_OK);
     if (!strstr(e.msg, msg))
@@ -480,7 +481,8 @@ static void test_shipped_cycles_are_visible(void **state)
         assert_true(dimmer >= 0);
         lr_scene *scene;
         lr_control_map *map;
-        if (lr_scene_load(cfg->scene, NULL, &scene, &e) || lr_rig_config_apply_sets(cfg, scene, &e) ||
+        if (lr_scene_load(cfg->scene, NULL, &scene, &e) ||
+            lr_rig_config_apply_sets(cfg, scene, &e) ||
             lr_control_map_create(cfg, scene, true, 0, &map, &e))
             fail_msg("%s: %s", rigs.gl_pathv[ri], e.msg);
         lr_event full = ev("", cfg->bindings[dimmer].control, LR_EV_ABSOLUTE, 1.0, 0);

@@ -534,7 +534,7 @@ static void tcp_late_answers_are_dropped(void **state)
     lr_dev *d = lr_modbus_dev(m);
     assert_true(lr_test_run(&d, 1, 20000, late_done, &c));
     assert_int_equal(c.wrong, 0);
-    assert_int_equal(lr_test_rogue_reg(r, 5), 26);
+    assert_int_equal(lr_test_rogue_driver(r, 5), 26);
     lr_modbus_counters k;
     lr_modbus_get_counters(m, &k);
     assert_true(k.stale >= 20);

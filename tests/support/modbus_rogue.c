@@ -25,7 +25,7 @@ struct lr_test_rogue {
     int stop[2];
     pthread_t th;
     pthread_mutex_t mu;
-    int regs[NREG];
+    int regs[2][NREG]; /* [0]: every unit but 2 (the panel); [1]: unit 2 (the lamp driver) */
     int accepted, requests;
     /* thread only */
     int client;
@@ -70,6 +70,7 @@ static void tx(lr_test_rogue *r, const uint8_t *b, int n)
 static int answer(lr_test_rogue *r, const uint8_t *q, uint8_t *a)
 {
     int fc = q[7], addr = q[8] << 8 | q[9], qty = q[10] << 8 | q[11];
+    int *regs = r->regs[q[6] == 2];
     memcpy(a, q, 7);
     a[7] = (uint8_t)fc;
     int pl;
@@ -82,12 +83,12 @@ static int answer(lr_test_rogue *r, const uint8_t *q, uint8_t *a)
         } else {
             a[8] = (uint8_t)(2 * qty);
             for (int i = 0; i < qty; i++)
-                put16(a + 9 + 2 * i, r->regs[addr + i]);
+                put16(a + 9 + 2 * i, regs[addr + i]);
             pl = 2 + 2 * qty;
         }
     } else if (fc == 6 || fc == 16) {
         if (addr < NREG)
-            r->regs[addr] = fc == 6 ? qty : (q[13] << 8 | q[14]);
+            regs[addr] = fc == 6 ? qty : (q[13] << 8 | q[14]);
         memcpy(a + 8, q + 8, 4); /* address and value / quantity */
         pl = 5;
     } else {
@@ -256,14 +257,14 @@ int lr_test_rogue_port(const lr_test_rogue *r) { return r->port; }
 void lr_test_rogue_set_reg(lr_test_rogue *r, int reg, int value)
 {
     pthread_mutex_lock(&r->mu);
-    r->regs[reg] = value;
+    r->regs[0][reg] = value;
     pthread_mutex_unlock(&r->mu);
 }
 
-int lr_test_rogue_reg(lr_test_rogue *r, int reg)
+int lr_test_rogue_driver(lr_test_rogue *r, int reg)
 {
     pthread_mutex_lock(&r->mu);
-    int v = r->regs[reg];
+    int v = r->regs[1][reg];
     pthread_mutex_unlock(&r->mu);
     return v;
 }

@@ -1,7 +1,7 @@
 /* lamprig tests — a misbehaving Modbus/TCP peer in a thread on 127.0.0.1 (a free port), for the
  * defects a well-behaved libmodbus server (modbus_server.h) cannot show. One client at a time
- * (a new connection replaces the old one). Registers: holding register r of any unit reads
- * lr_test_rogue_set_reg's value (default 0); writes are echoed and stored.
+ * (a new connection replaces the old one). Registers: unit 2 is the lamp driver, every other
+ * unit the panel; 16 holding registers each (default 0); writes are echoed and stored.
  *
  *  DRIP    every read is answered with a header declaring 250 data bytes, then one byte every
  *          drip_ms (the rest of the requests are read and ignored while a drip runs)
@@ -26,8 +26,10 @@ typedef struct lr_test_rogue lr_test_rogue;
 /* Aborts the test when the socket or thread cannot be set up. drip_ms: DRIP only. */
 lr_test_rogue *lr_test_rogue_start(lr_test_rogue_mode mode, int drip_ms);
 int lr_test_rogue_port(const lr_test_rogue *r);
+/* The panel's register. */
 void lr_test_rogue_set_reg(lr_test_rogue *r, int reg, int value);
-int lr_test_rogue_reg(lr_test_rogue *r, int reg);
+/* The lamp driver's register (unit 2). */
+int lr_test_rogue_driver(lr_test_rogue *r, int reg);
 /* Connections accepted so far. */
 int lr_test_rogue_accepted(lr_test_rogue *r);
 /* Requests received so far. */
