@@ -85,7 +85,8 @@ static void opened(lr_dev *d)
                  attempts, attempts == 1 ? "" : "s");
     else
         snprintf(line, sizeof line, "%s: %sopen", d->prefix, what);
-    lr_backoff_reset(&d->backoff);
+    if (!d->ops->open_needs_proof)
+        lr_backoff_reset(&d->backoff);
     d->retry_at = LR_NO_DEADLINE;
     lr_dev_fds_changed(d);
     set_state(d, LR_DEV_OPEN, LR_LOG_INFO, line);
@@ -115,6 +116,12 @@ void lr_dev_lost(lr_dev *d, int code, int64_t now_ns, const char *fmt, ...)
     d->ops->close(d);
     lr_dev_fds_changed(d);
     failed(d, code, now_ns, msg);
+}
+
+void lr_dev_proven(lr_dev *d)
+{
+    if (d->state == LR_DEV_OPEN)
+        lr_backoff_reset(&d->backoff);
 }
 
 void lr_dev_done(lr_dev *d, const char *fmt, ...)

@@ -7,9 +7,9 @@
  *     poll(all fds, timeout = min over devices of (t - now), or -1 when every t is LR_NO_DEADLINE)
  *     lr_dev_dispatch(d, now) for every device whose fd is ready or whose deadline has passed
  *
- * dispatch never blocks for long: descriptors are non-blocking, reads drain what is ready, and
- * the one blocking library (libmodbus) is only called when its socket is readable and with short
- * timeouts (see hal/modbus.h). Calling dispatch when nothing is ready is harmless, so an epoll
+ * dispatch never blocks for long: descriptors are non-blocking and reads take only what is
+ * ready (libmodbus only connects; the Modbus frames are read without waiting, see
+ * hal/modbus.h). Calling dispatch when nothing is ready is harmless, so an epoll
  * loop may simply dispatch every device it was woken for. No threads are created by hal/
  * (hidapi's libusb back end runs its own reader thread internally; see hal/hid.h).
  *
@@ -90,7 +90,9 @@ const char *lr_dev_kind(const lr_dev *d);      /* "gpio", "hid", "usb", "modbus"
  * directory; retrying with backoff". Owned by the device, valid until the next dispatch. */
 const char *lr_dev_status(const lr_dev *d);
 unsigned lr_dev_fd_generation(const lr_dev *d);
-/* Consecutive failed (re)open attempts since the device was last open. */
+/* Consecutive failed (re)open attempts since the device last worked: since it was last open,
+ * or for a device whose open proves nothing (Modbus over TCP: a peer that accepts and closes
+ * at once), since its last good answer; a loss after an unproven open counts as a failure. */
 unsigned lr_dev_failures(const lr_dev *d);
 
 /* Destroys the back end behind d (same as lr_gpio_destroy(...) etc.); NULL is a no-op. */

@@ -23,6 +23,11 @@ typedef struct lr_dev_ops {
     int64_t (*next_deadline)(lr_dev *d);
     /* Frees the back end (after close). */
     void (*destroy)(lr_dev *d);
+    /* true: a successful open is not yet a success for the reopen backoff; the back end calls
+     * lr_dev_proven() once the device really worked (Modbus: a good answer). Otherwise a peer
+     * that accepts a connection and closes it at once would be reopened every retry_min_ms
+     * for ever, since each connect would reset the backoff. */
+    bool open_needs_proof;
 } lr_dev_ops;
 
 struct lr_dev {
@@ -50,6 +55,9 @@ int lr_dev_start(lr_dev *d, bool required, int64_t now_ns, lr_err *e);
 /* Back end saw its device go away or fail: closes it, logs once, schedules the reopen. */
 void lr_dev_lost(lr_dev *d, int code, int64_t now_ns, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
+/* The device worked (see lr_dev_ops.open_needs_proof): the next failure waits retry_min_ms
+ * again. Cheap; call it on every good exchange. */
+void lr_dev_proven(lr_dev *d);
 /* Marks the device finished (sim script played out). */
 void lr_dev_done(lr_dev *d, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* Emits one event from this device (source = device name unless given). */

@@ -36,3 +36,31 @@ void lr_log_write(const lr_log *log, lr_log_level level, const char *fmt, ...)
      * still says why a device is missing. */
     fprintf(stderr, "lamprig: %s: %s\n", lr_log_level_name(level), line);
 }
+
+void lr_log_limit_init(lr_log_limit *l, int burst, int64_t window_ns)
+{
+    l->window_ns = window_ns;
+    l->burst = burst < 1 ? 1 : burst;
+    l->window_start = INT64_MIN;
+    l->used = 0;
+    l->dropped = 0;
+}
+
+bool lr_log_limit_take(lr_log_limit *l, int64_t now_ns, unsigned *dropped)
+{
+    if (l->window_ns > 0) {
+        if (l->window_start == INT64_MIN || now_ns - l->window_start >= l->window_ns) {
+            l->window_start = now_ns;
+            l->used = 0;
+        }
+        if (l->used >= l->burst) {
+            l->dropped++;
+            return false;
+        }
+        l->used++;
+    }
+    if (dropped)
+        *dropped = l->dropped;
+    l->dropped = 0;
+    return true;
+}

@@ -23,9 +23,9 @@ const lr_opt lr_modbus_opts[] = {
     [LR_MODBUS_OPT_POLL_MS] = {"poll_ms", LR_OPT_INT, 1, 60000, 50,
                                .help = "input polling period"},
     [LR_MODBUS_OPT_TIMEOUT_MS] = {"timeout_ms", LR_OPT_INT, 1, 10000, 100,
-                                  .help = "response (and TCP connect) timeout"},
+                                  .help = "bound of a whole answer (and of the TCP connect)"},
     [LR_MODBUS_OPT_BYTE_TIMEOUT_MS] = {"byte_timeout_ms", LR_OPT_INT, 1, 10000, 50,
-                                       .help = "gap allowed inside a frame"},
+                                       .help = "RTU: gap that ends a frame"},
     [LR_MODBUS_OPT_MAX_TIMEOUTS] = {"max_timeouts", LR_OPT_INT, 1, 1000, 3,
                                     .help = "consecutive timeouts that drop the link"},
     [LR_MODBUS_OPT_INPUTS] = {"inputs", LR_OPT_LIST, .help = "panel registers (below)"},
@@ -98,31 +98,47 @@ typedef struct output {
 enum { IDLE, WAIT };
 enum { REQ_READ, REQ_WRITE };
 
+/* Kinds of log line a peer can cause; each is rate-limited on its own (LOG_BURST lines per
+ * LOG_WINDOW_NS per device), since a peer answering at random varies the text of every line. */
+enum { K_TIMEOUT, K_CRC, K_EXCEPTION, K_BAD, K_STALE, K_RECOVERY, N_KINDS };
+#define LOG_BURST 4
+#define LOG_WINDOW_NS (10 * 1000 * MS)
+
+/* Two of the longest frames: a partial one behind a complete one. */
+#define RX_MAX (2 * MODBUS_MAX_ADU_LENGTH)
+
 struct lr_modbus {
     lr_dev base;
     lr_modbus_url url;
     char url_text[LR_MODBUS_HOST_MAX + 64];
-    modbus_t *ctx;
+    modbus_t *ctx; /* connect, serial setup, close and tcflush only: the frames are ours */
     int fd;
     input in[MAX_INPUTS];
     int n_in;
     output out;
     int64_t poll_ns, timeout_ns;
-    int byte_timeout_ms;
+    int64_t byte_timeout_ns;
     int max_timeouts;
     int64_t gap_ns; /* RTU: silence owed to the bus between frames (3.5 characters) */
+    /* received bytes not yet framed */
+    uint8_t rx[RX_MAX];
+    int rx_len;
+    int64_t rx_last_ns; /* when the last byte came */
     /* the transaction in flight */
     int phase;
     int req;       /* REQ_READ / REQ_WRITE */
     int req_input; /* for REQ_READ */
     int req_raw;   /* for REQ_WRITE */
     int req_unit, req_func, req_addr;
-    int64_t deadline;
+    int req_tid;   /* TCP: the MBAP transaction id sent */
+    uint16_t next_tid;
+    int64_t deadline; /* of the whole transaction: send + timeout_ms, however the bytes drip */
     int64_t earliest_send;
     /* polling */
     int next_input;
     int64_t next_cycle;
     int consecutive_timeouts;
+    lr_log_limit limit[N_KINDS];
     lr_modbus_counters c;
 };
 
@@ -131,10 +147,31 @@ static channel *req_channel(lr_modbus *m)
     return m->req == REQ_WRITE ? &m->out.ch : &m->in[m->req_input].ch;
 }
 
-/* Logs a channel problem once, until the channel works again or fails differently. */
-static void ch_fail(lr_modbus *m, channel *ch, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-static void ch_fail(lr_modbus *m, channel *ch, const char *fmt, ...)
+/* One line of kind `kind`, unless that kind is over its rate; the next line let through
+ * says how many were dropped. */
+static void note(lr_modbus *m, int kind, lr_log_level level, int64_t now_ns, const char *fmt, ...)
+    __attribute__((format(printf, 5, 6)));
+static void note(lr_modbus *m, int kind, lr_log_level level, int64_t now_ns, const char *fmt, ...)
+{
+    unsigned dropped;
+    if (!lr_log_limit_take(&m->limit[kind], now_ns, &dropped))
+        return;
+    char msg[LR_ERR_MSG_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    if (dropped)
+        lr_dev_log(&m->base, level, "%s (%u similar lines dropped)", msg, dropped);
+    else
+        lr_dev_log(&m->base, level, "%s", msg);
+}
+
+/* Logs a channel problem once, until the channel works again or fails differently; and a
+ * peer varying its answers still gets at most LOG_BURST lines of each kind per window. */
+static void ch_fail(lr_modbus *m, channel *ch, int kind, int64_t now_ns, const char *fmt, ...)
+    __attribute__((format(printf, 5, 6)));
+static void ch_fail(lr_modbus *m, channel *ch, int kind, int64_t now_ns, const char *fmt, ...)
 {
     char msg[sizeof ch->last];
     va_list ap;
@@ -145,17 +182,17 @@ static void ch_fail(lr_modbus *m, channel *ch, const char *fmt, ...)
         return;
     ch->failing = true;
     memcpy(ch->last, msg, sizeof msg);
-    lr_dev_log(&m->base, LR_LOG_WARN, "%s: %s: %s (counted; repeats not logged)",
-               m->url_text, ch->what, msg);
+    note(m, kind, LR_LOG_WARN, now_ns, "%s: %s: %s (counted; repeats not logged)", m->url_text,
+         ch->what, msg);
 }
 
-static void ch_ok(lr_modbus *m, channel *ch)
+static void ch_ok(lr_modbus *m, channel *ch, int64_t now_ns)
 {
     if (!ch->failing)
         return;
     ch->failing = false;
     ch->last[0] = '\0';
-    lr_dev_log(&m->base, LR_LOG_INFO, "%s: %s: answering again", m->url_text, ch->what);
+    note(m, K_RECOVERY, LR_LOG_INFO, now_ns, "%s: %s: answering again", m->url_text, ch->what);
 }
 
 static const char *exception_name(int code)
@@ -180,6 +217,19 @@ static bool errno_means_missing(int err)
            err == EHOSTUNREACH || err == ENETUNREACH || err == EHOSTDOWN;
 }
 
+/* Modbus over serial line v1.02, 6.2.2: CRC-16 (polynomial 0xA001 reflected, init 0xFFFF),
+ * sent low byte first. */
+static uint16_t crc16(const uint8_t *b, int n)
+{
+    uint16_t crc = 0xffff;
+    for (int i = 0; i < n; i++) {
+        crc ^= b[i];
+        for (int k = 0; k < 8; k++)
+            crc = crc & 1 ? (uint16_t)((crc >> 1) ^ 0xa001) : (uint16_t)(crc >> 1);
+    }
+    return crc;
+}
+
 static void mb_close(lr_dev *d)
 {
     lr_modbus *m = (lr_modbus *)d;
@@ -190,6 +240,7 @@ static void mb_close(lr_dev *d)
     m->ctx = NULL;
     m->fd = -1;
     m->phase = IDLE;
+    m->rx_len = 0;
 }
 
 static int mb_open(lr_dev *d, int64_t now_ns, lr_err *e)
@@ -207,11 +258,10 @@ static int mb_open(lr_dev *d, int64_t now_ns, lr_err *e)
     if (!m->ctx)
         return lr_err_set(e, LR_EINVAL, "%s: cannot set up libmodbus: %s", m->url_text,
                           modbus_strerror(errno));
+    /* The response timeout bounds modbus_connect on TCP; no other libmodbus call waits. */
     uint32_t to_us = (uint32_t)(m->timeout_ns / 1000);
-    uint32_t bt_us = (uint32_t)m->byte_timeout_ms * 1000u;
     modbus_set_error_recovery(m->ctx, MODBUS_ERROR_RECOVERY_NONE);
     modbus_set_response_timeout(m->ctx, to_us / 1000000u, to_us % 1000000u);
-    modbus_set_byte_timeout(m->ctx, bt_us / 1000000u, bt_us % 1000000u);
     if (modbus_connect(m->ctx) == -1) {
         int err = errno;
         int code = errno_means_missing(err) ? LR_ENODEV : LR_EIO;
@@ -235,6 +285,7 @@ static int mb_open(lr_dev *d, int64_t now_ns, lr_err *e)
     if (u->transport == LR_MODBUS_RTU)
         modbus_flush(m->ctx); /* bytes left from before we opened the port */
     m->phase = IDLE;
+    m->rx_len = 0;
     m->next_input = 0;
     m->next_cycle = now_ns;
     m->earliest_send = now_ns;
@@ -249,18 +300,41 @@ static int mb_open(lr_dev *d, int64_t now_ns, lr_err *e)
     return LR_OK;
 }
 
-static bool send_request(lr_modbus *m, int64_t now_ns, uint8_t *raw, int len)
+/* Sends unit + PDU (raw[0..len)) as one ADU: MBAP header on TCP (with a fresh transaction id),
+ * CRC on RTU. Small frames on a non-blocking socket or tty: a short write is an I/O error. */
+static bool send_request(lr_modbus *m, int64_t now_ns, const uint8_t *raw, int len)
 {
-    if (m->url.transport == LR_MODBUS_RTU)
-        modbus_set_slave(m->ctx, raw[0]); /* libmodbus drops RTU answers from other units */
+    uint8_t adu[7 + 16];
+    int n;
     m->req_unit = raw[0];
     m->req_func = raw[1];
     m->req_addr = raw[2] << 8 | raw[3];
-    if (modbus_send_raw_request(m->ctx, raw, len) == -1) {
-        int err = errno;
+    ssize_t w;
+    if (m->url.transport == LR_MODBUS_TCP) {
+        uint16_t tid = m->next_tid++;
+        m->req_tid = tid;
+        adu[0] = (uint8_t)(tid >> 8);
+        adu[1] = (uint8_t)tid;
+        adu[2] = adu[3] = 0; /* protocol: Modbus */
+        adu[4] = (uint8_t)(len >> 8);
+        adu[5] = (uint8_t)len;
+        memcpy(adu + 6, raw, (size_t)len);
+        n = 6 + len;
+        w = send(m->fd, adu, (size_t)n, MSG_NOSIGNAL);
+    } else {
+        memcpy(adu, raw, (size_t)len);
+        uint16_t crc = crc16(raw, len);
+        adu[len] = (uint8_t)crc;
+        adu[len + 1] = (uint8_t)(crc >> 8);
+        n = len + 2;
+        w = write(m->fd, adu, (size_t)n);
+    }
+    if (w != n) {
+        int err = w < 0 ? errno : EAGAIN;
         m->c.io_errors++;
         lr_dev_lost(&m->base, LR_EIO, now_ns, "%s: send failed: %s", m->url_text,
-                    modbus_strerror(err));
+                    err == EPIPE || err == ECONNRESET ? "connection closed by the server"
+                                                      : strerror(err));
         return false;
     }
     m->c.requests++;
@@ -338,89 +412,113 @@ static void start_next(lr_modbus *m, int64_t now_ns)
     send_read(m, i, now_ns);
 }
 
-static void handle_timeout(lr_modbus *m, int64_t now_ns)
+/* RTU frames have no length field and no transaction id: after a broken or missing answer
+ * the bytes on the line are dropped (a late answer must not be taken for the next one). TCP
+ * keeps its bytes: the MBAP length keeps the stream framed, and the transaction id tells a
+ * late answer from the current one. */
+static void rtu_resync(lr_modbus *m)
+{
+    if (m->url.transport != LR_MODBUS_RTU)
+        return;
+    modbus_flush(m->ctx);
+    m->rx_len = 0;
+}
+
+/* The transaction ends: the bus silence counts from now, the end of the answer. */
+static void end_transaction(lr_modbus *m, int64_t now_ns)
 {
     m->phase = IDLE;
+    m->earliest_send = m->gap_ns ? lr_now_ns() + m->gap_ns : now_ns;
+}
+
+static void handle_timeout(lr_modbus *m, int64_t now_ns)
+{
+    end_transaction(m, now_ns);
     m->c.timeouts++;
     m->consecutive_timeouts++;
-    ch_fail(m, req_channel(m), "no answer within %lld ms", (long long)(m->timeout_ns / MS));
+    if (m->rx_len > 0)
+        ch_fail(m, req_channel(m), K_TIMEOUT, now_ns,
+                "answer incomplete after %lld ms (%d bytes so far)",
+                (long long)(m->timeout_ns / MS), m->rx_len);
+    else
+        ch_fail(m, req_channel(m), K_TIMEOUT, now_ns, "no answer within %lld ms",
+                (long long)(m->timeout_ns / MS));
     if (m->consecutive_timeouts >= m->max_timeouts) {
         lr_dev_lost(&m->base, LR_ETIMEOUT, now_ns, "%s: no answer to %d requests in a row",
                     m->url_text, m->consecutive_timeouts);
         return;
     }
-    /* A late answer must not be taken for the next one. */
-    modbus_flush(m->ctx);
+    rtu_resync(m);
 }
 
-static void handle_response(lr_modbus *m, int64_t now_ns)
+/* Length of the frame at the start of b[0..n): > 0 complete, 0 incomplete, -1 unframeable
+ * (TCP: a header that is not Modbus; RTU: a function whose answer length is unknown). */
+static int frame_length(const lr_modbus *m, const uint8_t *b, int n)
 {
-    uint8_t rsp[MODBUS_MAX_ADU_LENGTH];
-    int n = modbus_receive_confirmation(m->ctx, rsp);
-    m->phase = IDLE;
-    /* The bus silence counts from the end of the answer, which is now, not dispatch start. */
-    m->earliest_send = m->gap_ns ? lr_now_ns() + m->gap_ns : now_ns;
+    int len;
+    if (m->url.transport == LR_MODBUS_TCP) {
+        if (n < 7)
+            return 0;
+        int proto = b[2] << 8 | b[3], mlen = b[4] << 8 | b[5];
+        if (proto != 0 || mlen < 2 || mlen > MODBUS_TCP_MAX_ADU_LENGTH - 6)
+            return -1;
+        len = 6 + mlen;
+    } else {
+        if (n < 2)
+            return 0;
+        int fc = b[1];
+        if (fc & 0x80)
+            len = 5;
+        else if (fc == MODBUS_FC_READ_HOLDING_REGISTERS || fc == MODBUS_FC_READ_INPUT_REGISTERS)
+            len = n < 3 ? 0 : 5 + b[2];
+        else if (fc == MODBUS_FC_WRITE_SINGLE_REGISTER || fc == MODBUS_FC_WRITE_MULTIPLE_REGISTERS)
+            len = 8;
+        else
+            return -1;
+        if (len == 0)
+            return 0;
+    }
+    return n >= len ? len : 0;
+}
+
+/* The answer's PDU (function code first) to the request in flight. */
+static void handle_answer(lr_modbus *m, int unit, const uint8_t *p, int pl, int64_t now_ns)
+{
+    end_transaction(m, now_ns);
     channel *ch = req_channel(m);
-    if (n < 0) {
-        int err = errno;
-        if (err == EMBBADCRC) {
-            m->c.crc_errors++;
-            ch_fail(m, ch, "answer with a bad CRC");
-            modbus_flush(m->ctx);
-        } else if (err == ETIMEDOUT) {
-            /* The frame started but stopped before its end. */
-            handle_timeout(m, now_ns);
-        } else if (err == EMBBADDATA) {
-            m->c.bad_responses++;
-            ch_fail(m, ch, "malformed answer");
-            modbus_flush(m->ctx);
-        } else {
-            m->c.io_errors++;
-            lr_dev_lost(&m->base, LR_EIO, now_ns, "%s: %s", m->url_text,
-                        err == ECONNRESET ? "connection closed by the server"
-                                          : modbus_strerror(err));
-        }
-        return;
-    }
-    int h = modbus_get_header_length(m->ctx);
-    if (n == 0 || n < h + 2) {
-        /* RTU: libmodbus returns 0 for a frame from another unit. */
-        m->c.bad_responses++;
-        ch_fail(m, ch, "answer from another unit or truncated");
-        return;
-    }
     m->consecutive_timeouts = 0;
-    int unit = rsp[h - 1], func = rsp[h];
+    int func = p[0];
     if (unit != m->req_unit) {
         m->c.bad_responses++;
-        ch_fail(m, ch, "answer from unit %d", unit);
+        ch_fail(m, ch, K_BAD, now_ns, "answer from unit %d", unit);
         return;
     }
-    if (func == (m->req_func | 0x80)) {
-        int code = rsp[h + 1];
+    if (func == (m->req_func | 0x80) && pl == 2) {
+        int code = p[1];
         m->c.exceptions++;
         m->c.last_exception = (uint64_t)code;
-        ch_fail(m, ch, "exception %d (%s)", code, exception_name(code));
+        ch_fail(m, ch, K_EXCEPTION, now_ns, "exception %d (%s)", code, exception_name(code));
         if (m->req == REQ_WRITE)
             m->out.rejected = m->req_raw;
         return;
     }
     if (func != m->req_func) {
         m->c.bad_responses++;
-        ch_fail(m, ch, "answer to function %d, asked %d", func, m->req_func);
-        modbus_flush(m->ctx);
+        ch_fail(m, ch, K_BAD, now_ns, "answer to function %d, asked %d", func, m->req_func);
         return;
     }
     if (m->req == REQ_READ) {
-        if (n < h + 4 || rsp[h + 1] != 2) {
+        if (pl != 4 || p[1] != 2) {
             m->c.bad_responses++;
-            ch_fail(m, ch, "read answer with %d data bytes, expected 2", rsp[h + 1]);
+            ch_fail(m, ch, K_BAD, now_ns, "read answer with %d data bytes, expected 2",
+                    pl >= 2 ? p[1] : 0);
             return;
         }
         input *in = &m->in[m->req_input];
-        int raw = rsp[h + 2] << 8 | rsp[h + 3];
+        int raw = p[2] << 8 | p[3];
         m->c.responses++;
-        ch_ok(m, ch);
+        lr_dev_proven(&m->base);
+        ch_ok(m, ch, now_ns);
         if (!in->have || raw != in->last_raw) {
             in->have = true;
             in->last_raw = raw;
@@ -431,18 +529,116 @@ static void handle_response(lr_modbus *m, int64_t now_ns)
         return;
     }
     /* Write echo: FC 6 echoes address and value, FC 16 address and quantity. */
-    int echo_addr = n >= h + 5 ? (rsp[h + 1] << 8 | rsp[h + 2]) : -1;
-    int echo_val = n >= h + 5 ? (rsp[h + 3] << 8 | rsp[h + 4]) : -1;
+    int echo_addr = pl == 5 ? (p[1] << 8 | p[2]) : -1;
+    int echo_val = pl == 5 ? (p[3] << 8 | p[4]) : -1;
     int expect_val = m->out.multiple ? 1 : m->req_raw;
     if (echo_addr != m->req_addr || echo_val != expect_val) {
         m->c.bad_responses++;
-        ch_fail(m, ch, "write echo does not match the request");
+        ch_fail(m, ch, K_BAD, now_ns, "write echo does not match the request");
         return;
     }
     m->c.responses++;
     m->c.writes++;
     m->out.acked = m->req_raw;
-    ch_ok(m, ch);
+    lr_dev_proven(&m->base);
+    ch_ok(m, ch, now_ns);
+}
+
+/* One complete frame f[0..n). */
+static void handle_frame(lr_modbus *m, const uint8_t *f, int n, int64_t now_ns)
+{
+    if (m->url.transport == LR_MODBUS_TCP) {
+        int tid = f[0] << 8 | f[1];
+        if (m->phase != WAIT || tid != m->req_tid) {
+            /* An answer to an earlier request (one that timed out): never the current one. */
+            m->c.stale++;
+            if (m->phase == WAIT)
+                note(m, K_STALE, LR_LOG_WARN, now_ns,
+                     "%s: stale answer dropped (transaction %d, waiting for %d; counted)",
+                     m->url_text, tid, m->req_tid);
+            else
+                note(m, K_STALE, LR_LOG_WARN, now_ns,
+                     "%s: stale answer dropped (transaction %d, nothing asked; counted)",
+                     m->url_text, tid);
+            return;
+        }
+        handle_answer(m, f[6], f + 7, n - 7, now_ns);
+        return;
+    }
+    if (m->phase != WAIT) {
+        m->c.bad_responses++; /* stray bytes on the bus */
+        rtu_resync(m);
+        return;
+    }
+    uint16_t crc = crc16(f, n - 2);
+    if (f[n - 2] != (uint8_t)crc || f[n - 1] != (uint8_t)(crc >> 8)) {
+        end_transaction(m, now_ns);
+        m->c.crc_errors++;
+        ch_fail(m, req_channel(m), K_CRC, now_ns, "answer with a bad CRC");
+        rtu_resync(m);
+        return;
+    }
+    handle_answer(m, f[0], f + 1, n - 3, now_ns);
+}
+
+/* Frames what rx holds; false when the device was dropped. */
+static bool parse_rx(lr_modbus *m, int64_t now_ns)
+{
+    int off = 0;
+    while (off < m->rx_len) {
+        int n = frame_length(m, m->rx + off, m->rx_len - off);
+        if (n == 0)
+            break;
+        if (n < 0) {
+            m->c.bad_responses++;
+            if (m->url.transport == LR_MODBUS_TCP) {
+                /* Without a valid MBAP header the stream cannot be framed again. */
+                m->c.io_errors++;
+                lr_dev_lost(&m->base, LR_EPROTO, now_ns,
+                            "%s: not a Modbus/TCP answer (bad MBAP header); reconnecting",
+                            m->url_text);
+                return false;
+            }
+            if (m->phase == WAIT) {
+                end_transaction(m, now_ns);
+                ch_fail(m, req_channel(m), K_BAD, now_ns, "malformed answer");
+            }
+            rtu_resync(m);
+            return true;
+        }
+        handle_frame(m, m->rx + off, n, now_ns);
+        if (m->base.state != LR_DEV_OPEN)
+            return false;
+        if (m->rx_len == 0)
+            return true; /* resynchronized: the rest was dropped */
+        off += n;
+    }
+    memmove(m->rx, m->rx + off, (size_t)(m->rx_len - off));
+    m->rx_len -= off;
+    return true;
+}
+
+/* Reads what is there without waiting; *got: bytes read. 0: fine; 1: end of stream (TCP);
+ * -1: error (errno). */
+static int rx_fill(lr_modbus *m, int64_t now_ns, int *got)
+{
+    *got = 0;
+    for (;;) {
+        if (m->rx_len == RX_MAX)
+            return 0; /* parse_rx makes room: a complete frame is always shorter */
+        ssize_t n = read(m->fd, m->rx + m->rx_len, (size_t)(RX_MAX - m->rx_len));
+        if (n > 0) {
+            m->rx_len += (int)n;
+            *got += (int)n;
+            m->rx_last_ns = now_ns;
+            continue;
+        }
+        if (n == 0) /* TCP: closed. A tty with VMIN = VTIME = 0 (libmodbus): nothing there. */
+            return m->url.transport == LR_MODBUS_TCP ? 1 : 0;
+        if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)
+            return 0;
+        return -1;
+    }
 }
 
 static void mb_dispatch(lr_dev *d, int64_t now_ns)
@@ -451,25 +647,36 @@ static void mb_dispatch(lr_dev *d, int64_t now_ns)
     struct pollfd p = {.fd = m->fd, .events = POLLIN};
     if (poll(&p, 1, 0) < 0)
         p.revents = 0;
-    if (m->phase == WAIT) {
-        if (p.revents & (POLLIN | POLLHUP | POLLERR))
-            handle_response(m, now_ns);
-        else if (now_ns >= m->deadline)
-            handle_timeout(m, now_ns);
-    } else if (p.revents & (POLLHUP | POLLERR)) {
-        m->c.io_errors++;
-        lr_dev_lost(d, LR_EIO, now_ns, "%s: connection lost", m->url_text);
-    } else if (p.revents & POLLIN) {
-        /* Nothing was asked: end of connection, or stray bytes on the bus. */
-        char c;
-        if (m->url.transport == LR_MODBUS_TCP && recv(m->fd, &c, 1, MSG_PEEK | MSG_DONTWAIT) == 0) {
+    if (p.revents & (POLLIN | POLLHUP | POLLERR)) {
+        /* Bounded work: at most RX_MAX bytes per call, however fast the peer sends. */
+        int got;
+        int r = rx_fill(m, now_ns, &got);
+        int err = errno;
+        if (!parse_rx(m, now_ns))
+            return; /* answers that came before the end are taken first */
+        if (r != 0 || (got == 0 && (p.revents & (POLLHUP | POLLERR)))) {
             m->c.io_errors++;
-            lr_dev_lost(d, LR_EIO, now_ns, "%s: connection closed by the server", m->url_text);
-        } else {
-            m->c.bad_responses++;
-            modbus_flush(m->ctx);
+            lr_dev_lost(d, LR_EIO, now_ns, "%s: %s", m->url_text,
+                        r == 1 || (r < 0 && err == ECONNRESET) ? "connection closed by the server"
+                        : r < 0                                ? strerror(err)
+                                                               : "connection lost");
+            return;
         }
     }
+    /* RTU: a gap longer than byte_timeout_ms inside a frame ends it. */
+    if (m->url.transport == LR_MODBUS_RTU && m->rx_len > 0 &&
+        now_ns - m->rx_last_ns >= m->byte_timeout_ns) {
+        if (m->phase == WAIT) {
+            handle_timeout(m, now_ns);
+        } else {
+            m->c.bad_responses++;
+            rtu_resync(m);
+        }
+    }
+    if (d->state != LR_DEV_OPEN)
+        return;
+    if (m->phase == WAIT && now_ns >= m->deadline)
+        handle_timeout(m, now_ns);
     if (d->state == LR_DEV_OPEN)
         start_next(m, now_ns);
 }
@@ -485,13 +692,19 @@ static int mb_pollfds(lr_dev *d, struct pollfd *fds, int max)
 static int64_t mb_next_deadline(lr_dev *d)
 {
     lr_modbus *m = (lr_modbus *)d;
+    int64_t t;
     if (m->phase == WAIT)
-        return m->deadline;
-    if (write_pending(m) || (m->n_in && m->next_input != 0))
-        return m->earliest_send;
-    if (m->n_in == 0)
-        return LR_NO_DEADLINE;
-    return m->next_cycle > m->earliest_send ? m->next_cycle : m->earliest_send;
+        t = m->deadline;
+    else if (write_pending(m) || (m->n_in && m->next_input != 0))
+        t = m->earliest_send;
+    else if (m->n_in == 0)
+        t = LR_NO_DEADLINE;
+    else
+        t = m->next_cycle > m->earliest_send ? m->next_cycle : m->earliest_send;
+    if (m->url.transport == LR_MODBUS_RTU && m->rx_len > 0 &&
+        m->rx_last_ns + m->byte_timeout_ns < t)
+        t = m->rx_last_ns + m->byte_timeout_ns;
+    return t;
 }
 
 static void mb_destroy(lr_dev *d) { free(d); }
@@ -504,6 +717,7 @@ static const lr_dev_ops MODBUS_OPS = {
     .dispatch = mb_dispatch,
     .next_deadline = mb_next_deadline,
     .destroy = mb_destroy,
+    .open_needs_proof = true, /* a TCP peer may accept and close at once */
 };
 
 /* Validates unit, register/base and raw range of one channel; fills unit/addr. */
@@ -600,8 +814,8 @@ static int configure(lr_modbus *m, const lr_modbus_desc *desc, lr_err *e)
                           desc->max_timeouts);
     m->poll_ns = lr_opt_or_default(&op[LR_MODBUS_OPT_POLL_MS], desc->poll_ms) * MS;
     m->timeout_ns = lr_opt_or_default(&op[LR_MODBUS_OPT_TIMEOUT_MS], desc->timeout_ms) * MS;
-    m->byte_timeout_ms = (int)lr_opt_or_default(&op[LR_MODBUS_OPT_BYTE_TIMEOUT_MS],
-                                                desc->byte_timeout_ms);
+    m->byte_timeout_ns = lr_opt_or_default(&op[LR_MODBUS_OPT_BYTE_TIMEOUT_MS],
+                                           desc->byte_timeout_ms) * MS;
     m->max_timeouts = (int)lr_opt_or_default(&op[LR_MODBUS_OPT_MAX_TIMEOUTS],
                                              desc->max_timeouts);
     if (m->url.transport == LR_MODBUS_RTU) {
@@ -620,6 +834,8 @@ int lr_modbus_create(const lr_modbus_desc *desc, lr_modbus **out, lr_err *e)
     if (!m)
         return lr_err_set(e, LR_ENOMEM, "modbus: out of memory");
     m->fd = -1;
+    for (int k = 0; k < N_KINDS; k++)
+        lr_log_limit_init(&m->limit[k], LOG_BURST, LOG_WINDOW_NS);
     int rc = lr_dev_init(&m->base, &MODBUS_OPS, &desc->dev, e);
     if (rc == LR_OK)
         rc = configure(m, desc, e);

@@ -16,19 +16,32 @@
  * applied here: the firmware applies it in one place; this layer only scales. Only the latest
  * level is kept: a burst of knob events becomes one write when the link is busy.
  *
- * Loop design: libmodbus calls block, so they are only made when they cannot block for long.
- * A request is sent with modbus_send_raw_request (a write to a non-blocking socket or tty);
- * the answer is read with modbus_receive_confirmation only once the main loop saw the fd
- * readable (then it returns as soon as the frame is in: a few ms on RTU at 19200 baud, bounded
- * by byte_timeout). A missing answer is a deadline (timeout_ms) in lr_dev_next_deadline, not a
- * blocked call. modbus_connect on TCP is a non-blocking connect bounded by timeout_ms; on RTU
- * an open(2) of the tty. DNS: give an address, or a name /etc/hosts resolves, since
- * getaddrinfo may block.
+ * Loop design: no call waits for the peer. libmodbus only connects (TCP: a non-blocking
+ * connect bounded by timeout_ms; RTU: open(2) and termios of the tty) and closes; the frames
+ * are built and parsed here (modbus_receive_confirmation bounds each byte, not the frame: a
+ * peer dripping a long answer one byte per byte_timeout would block it for seconds). A request
+ * is one write to the non-blocking socket or tty; dispatch reads whatever bytes are there
+ * (at most two frames' worth per call) into a buffer and frames them: TCP by the MBAP length,
+ * RTU by the function's answer length. The whole transaction has one deadline, timeout_ms
+ * after the request, however the bytes arrive: so a dispatch returns in microseconds and no
+ * peer holds the loop, or the other devices, longer than that. RTU also ends a frame at a gap
+ * of byte_timeout_ms. DNS: give an address, or a name /etc/hosts resolves, since getaddrinfo
+ * may block.
  *
- * Errors are counted (lr_modbus_get_counters), logged once per change of condition, never
- * fatal: exception responses (illegal address ...) and garbage (bad CRC, wrong function or
- * length) keep the link; max_timeouts consecutive timeouts, a closed connection or an I/O error
- * drop it, and it is reopened with exponential backoff (lr_dev_desc.retry_min_ms/max_ms).
+ * Matching: a TCP answer is taken for the request in flight only when its MBAP transaction id
+ * is the request's; others are late answers to earlier requests (after a timeout) and are
+ * dropped and counted (`stale`), the wait going on. Unit, function, byte count / echo are
+ * checked too (`bad_responses`). RTU has no transaction id: after a timeout or a broken frame
+ * the line is flushed, so a late answer cannot be taken for the next one.
+ *
+ * Errors are counted (lr_modbus_get_counters), logged once per change of condition per channel
+ * and at most 4 lines of a kind (timeouts, CRC, exceptions, malformed, stale, recoveries) per
+ * 10 s per device, never fatal: exception responses (illegal address ...) and garbage (bad CRC,
+ * wrong function or length) keep the link; max_timeouts consecutive timeouts, a closed
+ * connection, an I/O error or a TCP stream that is not Modbus drop it, and it is reopened with
+ * exponential backoff (lr_dev_desc.retry_min_ms/max_ms). The backoff restarts from
+ * retry_min_ms on a good answer, not on a connect: a peer that accepts and closes at once is
+ * retried ever later, up to retry_max_ms.
  */
 #ifndef LR_HAL_MODBUS_H
 #define LR_HAL_MODBUS_H
@@ -102,8 +115,8 @@ typedef struct lr_modbus_desc {
     lr_modbus_output output;
     /* Defaults and ranges of these: lr_modbus_opts below (0: the default). */
     int poll_ms;             /* input polling period */
-    int timeout_ms;          /* response (and TCP connect) timeout */
-    int byte_timeout_ms;     /* gap allowed inside a frame once it started */
+    int timeout_ms;          /* bounds a whole answer from its request (and connect) */
+    int byte_timeout_ms;     /* RTU: a gap this long inside a frame ends it */
     int max_timeouts;        /* consecutive timeouts that drop the link */
 } lr_modbus_desc;
 
@@ -147,6 +160,7 @@ typedef struct lr_modbus_counters {
     uint64_t exceptions;     /* exception responses (illegal address, device busy ...) */
     uint64_t last_exception; /* code of the latest one (2 = illegal data address) */
     uint64_t bad_responses;  /* wrong function, length, echo or unit */
+    uint64_t stale;          /* TCP answers to an earlier request (transaction id), dropped */
     uint64_t io_errors;      /* send/receive failures that dropped the link */
     uint64_t connects;       /* successful (re)connects */
     uint64_t writes;         /* level writes acknowledged by the driver */

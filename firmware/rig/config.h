@@ -40,7 +40,9 @@
  *
  * BINDING (one control → one scene parameter; firmware/rig/control_map.h):
  *   "control": "SOURCE/CONTROL" | "CONTROL" (any source)      required
- *   "param":   scene parameter name (lr_scene_set) or "scene"  required
+ *   "param":   scene parameter name (lr_scene_set) or "scene"  required; "light.level" /
+ *              "lights[i].level": that light's own intensity (radiance) times the value
+ *              (control_map.h)
  *   "name":    for logs and stats (default: the control)
  *   level bindings (a number or a colour following a position 0..1):
  *     "range": [MIN, MAX] (default [0, 1]) | "colors": [[r,g,b], [r,g,b]] (interpolated),

@@ -28,6 +28,13 @@ typedef struct group {
     const char *param;
     bool vector;                /* written as "r,g,b" */
     char last[128];             /* text last written; "" = rewrite */
+    /* A light's "level" (param "light.level", "lights[i].level"): the value multiplies that
+     * light's own strength in the scene as loaded, so one dimmer means the same in every scene
+     * of a cycle (a tealight of 0.004 W/sr and a shade's bulb of 0.25 W/sr alike). */
+    bool relative;
+    bool need_base;             /* the scene was (re)loaded: read its own strength again */
+    char target[160];           /* the light's "intensity" or "radiance" key */
+    double base[3];
 } group;
 
 struct lr_control_map {
@@ -41,6 +48,49 @@ struct lr_control_map {
     bool has_scene_request;
     unsigned garbage;
 };
+
+/* Length of the light key before ".level" ("light", "lights[bulb]"), or 0 when param is not a
+ * light's level. */
+static size_t level_prefix(const char *param)
+{
+    size_t n = strlen(param);
+    if (n <= 6 || strcmp(param + n - 6, ".level") != 0)
+        return 0;
+    if (n == 11 && strncmp(param, "light", 5) == 0)
+        return 5;
+    if (strncmp(param, "lights[", 7) == 0 && param[n - 7] == ']')
+        return n - 6;
+    return 0;
+}
+
+/* Finds the relative group's light strength in `scene`: its intensity (point, spot) or its
+ * radiance (directional, area), as the scene has it now. */
+static int resolve_level(group *g, const lr_scene *scene, lr_err *e)
+{
+    size_t pre = level_prefix(g->param);
+    char cur[256];
+    lr_err le = {0};
+    static const char *const fields[] = {"intensity", "radiance"};
+    for (int k = 0; k < 2; k++) {
+        snprintf(g->target, sizeof g->target, "%.*s.%s", (int)pre, g->param, fields[k]);
+        lr_err fe = {0};
+        if (lr_scene_get(scene, g->target, cur, sizeof cur, &fe) == LR_OK) {
+            int n = sscanf(cur, "%lf,%lf,%lf", &g->base[0], &g->base[1], &g->base[2]);
+            if (n == 1)
+                g->base[1] = g->base[2] = g->base[0];
+            else if (n != 3)
+                return lr_err_set(e, LR_EINVAL, "%s = '%s' is not a number", g->target, cur);
+            g->vector = n == 3;
+            g->need_base = false;
+            return LR_OK;
+        }
+        if (k == 0)
+            le = fe;
+    }
+    return lr_err_set(e, le.code ? le.code : LR_EINVAL,
+                      "'%s' is a light's level relative to its own intensity or radiance: %s",
+                      g->param, le.msg);
+}
 
 /* The one place a curve is applied: control position → level. */
 static double level_of(const lr_rig_binding *b, double x)
@@ -89,12 +139,20 @@ static int check_values(const lr_rig_config *cfg, lr_control_map *m, lr_err *e)
     for (int i = 0; i < m->n && !rc; i++) {
         const lr_rig_binding *b = &cfg->bindings[i];
         if (b->kind == LR_BIND_LEVEL) {
+            group g = m->groups[m->st[i].group];
+            if (g.relative && resolve_level(&g, scratch, &le)) {
+                rc = param_fail(cfg, i, b->line_param, "param", e, le.msg);
+                break;
+            }
             for (int end = 0; end < 2 && !rc; end++) {
                 double v[3];
                 value_of(b, end, v);
+                if (g.relative)
+                    for (int k = 0; k < 3; k++)
+                        v[k] *= g.base[k];
                 char text[128];
-                format_value(v, m->groups[m->st[i].group].vector, text, sizeof text);
-                if (lr_scene_set(scratch, b->param, text, NULL, &le)) {
+                format_value(v, g.vector, text, sizeof text);
+                if (lr_scene_set(scratch, g.relative ? g.target : b->param, text, NULL, &le)) {
                     char msg[LR_ERR_MSG_MAX];
                     snprintf(msg, sizeof msg, "the scene rejects %s = %s: %.300s",
                              end ? "the upper end" : "the lower end", text, le.msg);
@@ -105,10 +163,17 @@ static int check_values(const lr_rig_config *cfg, lr_control_map *m, lr_err *e)
         } else if (strcmp(b->param, "scene") == 0) {
             for (int k = 0; k < b->n_values && !rc; k++) {
                 lr_scene *other = NULL;
+                char f[32];
+                snprintf(f, sizeof f, "values[%d]", k);
                 if (lr_scene_load(b->values[k], NULL, &other, &le)) {
-                    char f[32];
-                    snprintf(f, sizeof f, "values[%d]", k);
                     rc = param_fail(cfg, i, b->line_values[k], f, e, le.msg);
+                } else {
+                    /* Every scene of the cycle needs the light a level binding follows. */
+                    for (int g = 0; g < m->n_groups && !rc; g++) {
+                        group tmp = m->groups[g];
+                        if (tmp.relative && resolve_level(&tmp, other, &le))
+                            rc = param_fail(cfg, i, b->line_values[k], f, e, le.msg);
+                    }
                 }
                 lr_scene_destroy(other);
             }
@@ -148,7 +213,18 @@ int lr_control_map_create(const lr_rig_config *cfg, lr_scene *scene, bool check,
         }
         char cur[256];
         lr_err le = {0};
-        if (lr_scene_get(scene, b->param, cur, sizeof cur, &le)) {
+        bool relative = level_prefix(b->param) > 0;
+        if (relative && b->kind == LR_BIND_CYCLE) {
+            rc = param_fail(cfg, i, b->line_param, "param", e,
+                            "a light's level follows a position: give 'range', not 'values'");
+            break;
+        }
+        if (relative && b->is_color) {
+            rc = param_fail(cfg, i, b->line_range, "colors", e,
+                            "a light's level is a number: give 'range', not 'colors'");
+            break;
+        }
+        if (!relative && lr_scene_get(scene, b->param, cur, sizeof cur, &le)) {
             rc = param_fail(cfg, i, b->line_param, "param", e, le.msg);
             break;
         }
@@ -172,7 +248,15 @@ int lr_control_map_create(const lr_rig_config *cfg, lr_scene *scene, bool check,
             m->groups[s->group].param = b->param;
         }
         group *g = &m->groups[s->group];
-        g->vector |= b->is_color || strchr(cur, ',') != NULL;
+        if (relative) {
+            g->relative = true;
+            if ((rc = resolve_level(g, scene, &le))) {
+                rc = param_fail(cfg, i, b->line_param, "param", e, le.msg);
+                break;
+            }
+        } else {
+            g->vector |= b->is_color || strchr(cur, ',') != NULL;
+        }
         lr_accel_init(&s->accel, b->accel_gain, b->accel_rate0, b->accel_max);
     }
     /* Starting positions: `initial`, else the position that reproduces the scene's value
@@ -189,8 +273,8 @@ int lr_control_map_create(const lr_rig_config *cfg, lr_scene *scene, bool check,
         if (b->has_initial) {
             x = b->initial;
         } else if (!b->is_color) {
-            double target = 1.0;
-            if (members == 1) {
+            double target = 1.0; /* shared, or a light's level: the scene's own value */
+            if (members == 1 && !m->groups[s->group].relative) {
                 char cur[256];
                 lr_scene_get(scene, b->param, cur, sizeof cur, NULL);
                 target = strtod(cur, NULL);
@@ -325,6 +409,12 @@ int lr_control_map_update(lr_control_map *m, lr_scene *scene, int64_t now_ns, un
     }
     for (int g = 0; g < m->n_groups; g++) {
         group *gr = &m->groups[g];
+        lr_err le = {0};
+        if (gr->relative && gr->need_base && resolve_level(gr, scene, &le)) {
+            if (!rc)
+                rc = lr_err_set(e, le.code, "parameter '%s': %s", gr->param, le.msg);
+            continue;
+        }
         double v[3] = {1, 1, 1};
         for (int i = 0; i < m->n; i++) {
             bstate *s = &m->st[i];
@@ -335,14 +425,17 @@ int lr_control_map_update(lr_control_map *m, lr_scene *scene, int64_t now_ns, un
             for (int k = 0; k < 3; k++)
                 v[k] *= bv[k];
         }
+        if (gr->relative)
+            for (int k = 0; k < 3; k++)
+                v[k] *= gr->base[k];
         char text[128];
         format_value(v, gr->vector, text, sizeof text);
         if (!material_replaced && strcmp(text, gr->last) == 0)
             continue;
-        lr_err le = {0};
-        if (lr_scene_set(scene, gr->param, text, dirty, &le)) {
+        const char *key = gr->relative ? gr->target : gr->param;
+        if (lr_scene_set(scene, key, text, dirty, &le)) {
             if (!rc)
-                rc = lr_err_set(e, le.code, "parameter '%s' = %s: %s", gr->param, text, le.msg);
+                rc = lr_err_set(e, le.code, "parameter '%s' = %s: %s", key, text, le.msg);
             gr->last[0] = '\0';
         } else {
             snprintf(gr->last, sizeof gr->last, "%s", text);
@@ -353,8 +446,10 @@ int lr_control_map_update(lr_control_map *m, lr_scene *scene, int64_t now_ns, un
 
 void lr_control_map_scene_replaced(lr_control_map *m)
 {
-    for (int g = 0; g < m->n_groups; g++)
+    for (int g = 0; g < m->n_groups; g++) {
         m->groups[g].last[0] = '\0';
+        m->groups[g].need_base = m->groups[g].relative;
+    }
     for (int i = 0; i < m->n; i++)
         if (m->st[i].b->kind == LR_BIND_CYCLE && m->st[i].cycle_applied &&
             strcmp(m->st[i].b->param, "scene") != 0)

@@ -8,6 +8,10 @@
  * fade_s to its new target, and the faded level is what both the scene and the lamp driver get:
  * the parameter becomes min + (max - min) * y (or the colour c0 + (c1 - c0) * y) and, for the
  * binding marked "lamp", y itself goes to lr_modbus_write_level.
+ * A light's level ("light.level", "lights[i].level") is relative: the parameter written is the
+ * light's intensity (radiance for directional and area lights) = the scene's own value, read
+ * when the scene is loaded or replaced, times min + (max - min) * y; so one dimmer means the
+ * same in every scene a "scene" binding switches to.
  * Several level bindings on one parameter multiply (a translucency-scale knob and a shade
  * colour both on objects[0].material.scale give scale * colour).
  *

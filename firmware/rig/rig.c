@@ -43,6 +43,7 @@ typedef struct rigset {
     lr_control_map *map;
     lr_dev *devs[LR_RIG_MAX_DEVICES];
     lr_modbus *lamp[LR_RIG_MAX_DEVICES]; /* modbus devices with a lamp driver */
+    lr_modbus *modbus[LR_RIG_MAX_DEVICES]; /* per devs[i]: its modbus link, or NULL */
     int n_devs, n_lamps;
     bool has_hid;
     bool no_vpl; /* the planner found no receiver that sees any object */
@@ -155,6 +156,7 @@ static int create_device(lr_rig *r, rigset *s, const lr_rig_device *d, lr_err *e
         lr_modbus *m;
         if (!(rc = lr_modbus_create(&md, &m, e))) {
             out = lr_modbus_dev(m);
+            s->modbus[s->n_devs] = m;
             if (d->has_lamp)
                 s->lamp[s->n_lamps++] = m;
         }
@@ -587,8 +589,19 @@ static void write_stats(lr_rig *r, int64_t now)
     if (!r->stats_path[0])
         return;
     lr_err e = {0};
+    lr_rig_stats_dev devs[LR_RIG_MAX_DEVICES];
+    lr_modbus_counters mc[LR_RIG_MAX_DEVICES];
+    for (int i = 0; i < r->set.n_devs; i++) {
+        lr_dev *d = r->set.devs[i];
+        devs[i] = (lr_rig_stats_dev){lr_dev_name(d), lr_dev_kind(d),
+                                     lr_dev_state_name(lr_dev_get_state(d)), NULL};
+        if (r->set.modbus[i]) {
+            lr_modbus_get_counters(r->set.modbus[i], &mc[i]);
+            devs[i].modbus = &mc[i];
+        }
+    }
     if (lr_rig_stats_write(r->stats, r->stats_path, r->config_path, now,
-                           lr_control_map_garbage(r->set.map), &e))
+                           lr_control_map_garbage(r->set.map), devs, r->set.n_devs, &e))
         lr_log_write(&r->log, LR_LOG_ERROR, "stats: %s", e.msg);
 }
 

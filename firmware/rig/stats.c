@@ -155,8 +155,39 @@ double lr_rig_stats_latency_ms(const lr_rig_stats *s, double q)
     return v;
 }
 
+static void write_devices(lr_jw *w, const lr_rig_stats_dev *devs, int n)
+{
+    lr_jw_array(w, "devices");
+    for (int i = 0; i < n; i++) {
+        const lr_rig_stats_dev *d = &devs[i];
+        lr_jw_object(w, NULL);
+        lr_jw_string(w, "name", d->name);
+        lr_jw_string(w, "kind", d->kind);
+        lr_jw_string(w, "state", d->state);
+        if (d->modbus) {
+            const lr_modbus_counters *c = d->modbus;
+            lr_jw_object(w, "modbus");
+            lr_jw_int(w, "requests", (long)c->requests);
+            lr_jw_int(w, "responses", (long)c->responses);
+            lr_jw_int(w, "timeouts", (long)c->timeouts);
+            lr_jw_int(w, "stale", (long)c->stale);
+            lr_jw_int(w, "bad_responses", (long)c->bad_responses);
+            lr_jw_int(w, "crc_errors", (long)c->crc_errors);
+            lr_jw_int(w, "exceptions", (long)c->exceptions);
+            lr_jw_int(w, "last_exception", (long)c->last_exception);
+            lr_jw_int(w, "io_errors", (long)c->io_errors);
+            lr_jw_int(w, "connects", (long)c->connects);
+            lr_jw_int(w, "writes", (long)c->writes);
+            lr_jw_object_end(w);
+        }
+        lr_jw_object_end(w);
+    }
+    lr_jw_array_end(w);
+}
+
 int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *config,
-                       int64_t now_ns, unsigned garbage, lr_err *e)
+                       int64_t now_ns, unsigned garbage, const lr_rig_stats_dev *devs,
+                       int n_devs, lr_err *e)
 {
     lr_atomic_file *af;
     /* The rig's state: the service's group reads it, others not. */
@@ -179,6 +210,7 @@ int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *conf
     lr_jw_int(w, "events_pending", s->n_pending);
     lr_jw_int(w, "events_unmatched", (long)s->unmatched);
     lr_jw_int(w, "garbage", (long)garbage);
+    write_devices(w, devs, n_devs);
     if (s->ar_frames) {
         lr_jw_object(w, "ar");
         lr_jw_int(w, "frames", (long)s->ar_frames);

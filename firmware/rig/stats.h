@@ -5,6 +5,8 @@
  * {
  *   "config": "configs/rig/sim.json", "duration_s": 12.5,
  *   "frames": 321, "events": 40, "events_unmatched": 3, "garbage": 0,
+ *   "devices": [{"name": "panel", "kind": "modbus", "state": "open",
+ *                "modbus": {"requests": 812, "responses": 806, "timeouts": 2, "stale": 4, ...}}],
  *   "latency_ms": {"n": 40, "min": 0.8, "median": 2.1, "p99": 7.9, "max": 8.3, "mean": 2.4},
  *   "event_log": [{"source": "sim", "control": "dimmer", "kind": "absolute", "value": 0.5,
  *                  "t_s": 1.25, "frame": 38, "latency_ms": 2.1}, ...],     (last 4096)
@@ -19,6 +21,7 @@
 #include <stdint.h>
 
 #include "hal/event.h"
+#include "hal/modbus.h"
 #include "render/base/err.h"
 #include "render/renderer.h"
 
@@ -45,9 +48,17 @@ uint64_t lr_rig_stats_events(const lr_rig_stats *s); /* with a latency */
 /* Latency quantile q in [0, 1] over every event so far, ms; NaN when none. */
 double lr_rig_stats_latency_ms(const lr_rig_stats *s, double q);
 
+/* One device as the stats file shows it ("devices"): its state and, for a Modbus link, every
+ * counter of lr_modbus_counters (stale answers, timeouts, ...). */
+typedef struct lr_rig_stats_dev {
+    const char *name, *kind, *state;
+    const lr_modbus_counters *modbus; /* NULL: not a Modbus device */
+} lr_rig_stats_dev;
+
 /* Writes the JSON above to path atomically. config may be NULL; garbage counts events with
- * non-finite values. */
+ * non-finite values; devs[0..n_devs) the devices. */
 int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *config,
-                       int64_t now_ns, unsigned garbage, lr_err *e);
+                       int64_t now_ns, unsigned garbage, const lr_rig_stats_dev *devs,
+                       int n_devs, lr_err *e);
 
 #endif

@@ -12,10 +12,16 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <glob.h>
+#include <limits.h>
+
 #include "firmware/control/accel.h"
 #include "firmware/control/curve.h"
 #include "firmware/rig/config.h"
 #include "firmware/rig/control_map.h"
+#include "render/cpu/frame.h"
+#include "render/image/image.h"
+#include "render/passes/passes.h"
 #include "render/scene/scene.h"
 #include "tests/support/near.h"
 
@@ -317,6 +323,220 @@ static void test_scene_request(void **state)
     fx_free(&f);
 }
 
+/* A light's level (param "light.level") multiplies the light's own intensity in the scene as
+ * loaded: the same dimmer position is the same fraction of each scene's light. The candle's
+ * flame is 0.005 W/sr, the lamp shade's bulb 0.25 W/sr; range [0, 2] with the square curve:
+ * the scene's own light at y = 0.5 (x = sqrt 0.5), twice it at full. */
+static void test_light_level_follows_each_scene(void **state)
+{
+    (void)state;
+    fx f;
+    fx_make(&f, "[{\"control\": \"dimmer\", \"param\": \"light.level\", \"range\": [0, 2], "
+                "\"curve\": \"square\", \"lamp\": true}]");
+    assert_near(lr_control_map_position(f.map, 0), sqrt(0.5), 1e-12);
+    update(&f, 0);
+    assert_near(get(&f, "light.intensity"), 0.005, 1e-12);
+    lr_event e1 = ev("sim", "dimmer", LR_EV_ABSOLUTE, 1.0, 0);
+    assert_int_equal(lr_control_map_event(f.map, &e1, 0), 0);
+    update(&f, 0);
+    assert_near(get(&f, "light.intensity"), 0.01, 1e-12);
+
+    /* The scene switch: a fresh lamp shade scene; its own bulb, not the candle's number. */
+    lr_scene_destroy(f.scene);
+    lr_err e = {0};
+    if (lr_scene_load(LR_SOURCE_CONFIGS "/scenes/lampshade.json", NULL, &f.scene, &e))
+        fail_msg("%s", e.msg);
+    lr_control_map_scene_replaced(f.map);
+    update(&f, 0);
+    assert_near(get(&f, "light.intensity"), 0.5, 1e-12);
+    lr_event e2 = ev("sim", "dimmer", LR_EV_ABSOLUTE, 0.5, 0);
+    lr_control_map_event(f.map, &e2, 0);
+    unsigned dirty = update(&f, 0);
+    assert_true(dirty != 0);
+    assert_near(get(&f, "light.intensity"), 0.25 * 2 * 0.25, 1e-12); /* y = 0.5^2 */
+    double lamp;
+    assert_true(lr_control_map_lamp_level(f.map, 0, &lamp));
+    assert_near(lamp, 0.25, 1e-12);
+    /* Back to a candle: 0.25 of twice 0.005. */
+    lr_scene_destroy(f.scene);
+    if (lr_scene_load(SCENE, NULL, &f.scene, &e))
+        fail_msg("%s", e.msg);
+    lr_control_map_scene_replaced(f.map);
+    update(&f, 0);
+    assert_near(get(&f, "light.intensity"), 0.0025, 1e-12);
+    fx_free(&f);
+}
+
+static void expect_map_error(const char *controls, const char *msg)
+{
+    char text[4096];
+    snprintf(text, sizeof text,
+             "{\"scene\": \"%s\", \"devices\": [{\"type\": \"sim\", \"text\": \"0 x press\"}], "
+             "\"controls\": %s}",
+             SCENE, controls);
+    lr_rig_config *cfg;
+    lr_scene *scene;
+    lr_control_map *map = NULL;
+    lr_err e = {0};
+    if (lr_rig_config_parse(text, "test-rig.json", &cfg, &e) ||
+        lr_scene_load(SCENE, NULL, &scene, &e))
+        fail_msg("%s", e.msg);
+    assert_int_not_equal(lr_control_map_create(cfg, scene, true, 0, &map, &e), LR_OK);
+    if (!strstr(e.msg, msg))
+        fail_msg("'%s' does not say '%s'", e.msg, msg);
+    lr_scene_destroy(scene);
+    lr_rig_config_destroy(cfg);
+}
+
+static void test_light_level_errors(void **state)
+{
+    (void)state;
+    expect_map_error("[{\"control\": \"b\", \"param\": \"light.level\", \"values\": [\"1\"]}]",
+                     "test-rig.json:1: field 'controls[0].param': a light's level follows a "
+                     "position: give 'range', not 'values'");
+    expect_map_error("[{\"control\": \"b\", \"param\": \"light.level\", "
+                     "\"colors\": [[1, 1, 1], [0, 0, 0]]}]",
+                     "field 'controls[0].colors': a light's level is a number");
+    expect_map_error("[{\"control\": \"b\", \"param\": \"lights[nope].level\"}]",
+                     "field 'controls[0].param': 'lights[nope].level' is a light's level relative "
+                     "to its own intensity or radiance: lights[nope].intensity: no lights named "
+                     "'nope'");
+    /* The upper end is checked against the scene's limits like any range. */
+    expect_map_error("[{\"control\": \"b\", \"param\": \"light.level\", \"range\": [-1, 1]}]",
+                     "field 'controls[0].range': the scene rejects the lower end = -0.005");
+}
+
+static bool same_file(const char *a, const char *b)
+{
+    char ra[PATH_MAX], rb[PATH_MAX];
+    return realpath(a, ra) && realpath(b, rb) && strcmp(ra, rb) == 0;
+}
+
+/* The dimmer's bindings of a config: level bindings on a light's strength. */
+static bool is_dimmer(const lr_rig_binding *b)
+{
+    size_t n = strlen(b->param);
+    return b->kind == LR_BIND_LEVEL && strncmp(b->param, "light", 5) == 0 &&
+           ((n > 6 && strcmp(b->param + n - 6, ".level") == 0) ||
+            (n > 10 && strcmp(b->param + n - 10, ".intensity") == 0) ||
+            (n > 9 && strcmp(b->param + n - 9, ".radiance") == 0));
+}
+
+static double light_strength(const lr_scene *s)
+{
+    char buf[128];
+    if (lr_scene_get(s, "light.intensity", buf, sizeof buf, NULL) &&
+        lr_scene_get(s, "light.radiance", buf, sizeof buf, NULL))
+        fail_msg("%s: no light strength", lr_scene_path(s));
+    return strtod(buf, NULL);
+}
+
+/* Mean display value (0..1, ACES at the scene's exposure) of the CPU twin's image of s with
+ * its radiance times k: a 32 x 24 pass, one frame, direct light only (cheap). */
+static double mean_display(const lr_image *img, double exposure, double k)
+{
+    lr_tonemap tm = {LR_RENDER_TONEMAP, (float)exposure};
+    double sum = 0;
+    size_t n = (size_t)img->width * (size_t)img->height * 3;
+    for (size_t i = 0; i < n; i++)
+        sum += lr_tonemap_apply(&tm, (float)(img->rgb[i] * k));
+    return sum / (double)n;
+}
+
+/* Every scene of every shipped config's cycle (the rig configs in configs/rig, with the
+ * control-map files in configs/controls they use), loaded as the rig loads it on a scene
+ * switch, with the dimmer at its full level, shows a visible image: its mean display value at
+ * least half of what the scene's own light gives at the scene's own exposure (the renderer is
+ * linear in the light, so one render gives both; the scene's own is at least 1/255). The old
+ * candle map's light.intensity 0..0.01 W/sr gave the lamp shade (0.25 W/sr, exposure 2e5)
+ * 0.04 of its own light at full: 0.1/255 against 8.6/255. Every configs/controls file is
+ * reached by some rig config. */
+static void test_shipped_cycles_are_visible(void **state)
+{
+    (void)state;
+    glob_t rigs, maps;
+    assert_int_equal(glob(LR_SOURCE_CONFIGS "/rig/*.json", 0, NULL, &rigs), 0);
+    assert_int_equal(glob(LR_SOURCE_CONFIGS "/controls/*.json", 0, NULL, &maps), 0);
+    bool reached[64] = {false};
+    assert_true(maps.gl_pathc <= 64);
+    int checked = 0;
+    for (size_t ri = 0; ri < rigs.gl_pathc; ri++) {
+        lr_rig_config *cfg;
+        lr_err e = {0};
+        if (lr_rig_config_load(rigs.gl_pathv[ri], &cfg, &e))
+            fail_msg("%s", e.msg);
+        const char *scenes[LR_RIG_MAX_VALUES + 1] = {cfg->scene};
+        int n_scenes = 1, dimmer = -1;
+        for (int i = 0; i < cfg->n_bindings; i++) {
+            const lr_rig_binding *b = &cfg->bindings[i];
+            for (size_t k = 0; k < maps.gl_pathc; k++)
+                reached[k] |= same_file(b->file, maps.gl_pathv[k]);
+            if (strcmp(b->param, "scene") == 0)
+                for (int k = 0; k < b->n_values; k++)
+                    if (!same_file(b->values[k], cfg->scene))
+                        scenes[n_scenes++] = b->values[k];
+            if (is_dimmer(b))
+                dimmer = i;
+        }
+        assert_true(dimmer >= 0);
+        lr_scene *scene;
+        lr_control_map *map;
+        if (lr_scene_load(cfg->scene, NULL, &scene, &e) ||
+            lr_rig_config_apply_sets(cfg, scene, &e) ||
+            lr_control_map_create(cfg, scene, true, 0, &map, &e))
+            fail_msg("%s: %s", rigs.gl_pathv[ri], e.msg);
+        lr_event full = ev("", cfg->bindings[dimmer].control, LR_EV_ABSOLUTE, 1.0, 0);
+        if (cfg->bindings[dimmer].source[0])
+            snprintf(full.source, sizeof full.source, "%s", cfg->bindings[dimmer].source);
+        lr_control_map_event(map, &full, 0);
+        for (int si = 0; si < n_scenes; si++) {
+            if (si > 0) { /* the rig's scene switch: load, the config's sets, the map again */
+                lr_scene_destroy(scene);
+                if (lr_scene_load(scenes[si], NULL, &scene, &e) ||
+                    lr_rig_config_apply_sets(cfg, scene, &e))
+                    fail_msg("%s", e.msg);
+                lr_control_map_scene_replaced(map);
+            }
+            lr_scene *own = NULL;
+            if (lr_scene_load(scenes[si], NULL, &own, &e))
+                fail_msg("%s", e.msg);
+            double own_strength = light_strength(own);
+            lr_scene_destroy(own);
+            unsigned dirty = 0;
+            if (lr_control_map_update(map, scene, 60 * 1000 * MS, &dirty, &e)) /* fades done */
+                fail_msg("%s", e.msg);
+            double at_full = light_strength(scene);
+            assert_true(at_full > 0);
+            lr_cpu_render_desc d = {.scene = scene, .width = 32, .height = 24,
+                                    .mode = LR_CPU_PASS, .frames = 1, .K = 4, .map_size = 32,
+                                    .N = 4, .vpl_count = 8, .no_vpl = true, .threads = 1};
+            lr_image img;
+            lr_cpu_render_stats st;
+            if (lr_cpu_render(&d, &img, NULL, &st, &e))
+                fail_msg("%s", e.msg);
+            double exposure = lr_scene_render(scene)->exposure;
+            double mean = mean_display(&img, exposure, 1.0);
+            double mean_own = mean_display(&img, exposure, own_strength / at_full);
+            printf("%s: %s: light %.4g at full (own %.4g), mean %.1f/255 (own light %.1f/255), "
+                   "%.2f s\n", strrchr(rigs.gl_pathv[ri], '/') + 1, strrchr(scenes[si], '/') + 1,
+                   at_full, own_strength, 255 * mean, 255 * mean_own, st.seconds);
+            assert_true(mean_own >= 1.0 / 255);
+            assert_true(mean >= 0.5 * mean_own);
+            lr_image_free(&img);
+            checked++;
+        }
+        lr_control_map_destroy(map);
+        lr_scene_destroy(scene);
+        lr_rig_config_destroy(cfg);
+    }
+    for (size_t k = 0; k < maps.gl_pathc; k++)
+        if (!reached[k])
+            fail_msg("%s: no rig config uses this control map", maps.gl_pathv[k]);
+    assert_true(checked >= 4);
+    globfree(&rigs);
+    globfree(&maps);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -327,6 +547,9 @@ int main(void)
         cmocka_unit_test(test_colour_times_scale),
         cmocka_unit_test(test_garbage_ignored),
         cmocka_unit_test(test_scene_request),
+        cmocka_unit_test(test_light_level_follows_each_scene),
+        cmocka_unit_test(test_light_level_errors),
+        cmocka_unit_test(test_shipped_cycles_are_visible),
     };
     if (getenv("LR_TEST_FILTER")) /* e.g. LR_TEST_FILTER='test_soak*' to run one test */
         cmocka_set_test_filter(getenv("LR_TEST_FILTER"));

@@ -17,11 +17,13 @@
 
 #include "firmware/rig/rig.h"
 #include "hal/dev.h"
+#include "render/base/json.h"
 #include "render/image/image.h"
 #include "render/scene/scene.h"
 #include "tests/support/fs.h"
 #include "tests/support/gl.h"
 #include "tests/support/hal_test.h"
+#include "tests/support/modbus_rogue.h"
 #include "tests/support/modbus_server.h"
 #include "tests/support/near.h"
 
@@ -389,6 +391,60 @@ static void test_missing_at_start(void **state)
     lr_test_rmtree(dir);
 }
 
+/* A peer answering every request late first (tests/support/modbus_rogue.c LATE): the rig's
+ * stats file shows the link's counters, the stale answers among them, and the dimmer follows
+ * the panel's register 0 (300 of 1000), never the late answer (the driver register, read back
+ * as 77 = round(0.3 * 255)). */
+static void test_stale_answers_in_stats(void **state)
+{
+    (void)state;
+    lr_test_rogue *g = lr_test_rogue_start(LR_ROGUE_LATE, 0);
+    lr_test_rogue_set_reg(g, 0, 300);
+    char *dir = lr_test_tmpdir();
+    write_config(dir, lr_test_rogue_port(g), "linear", 0, 0);
+    char *cfg = lr_test_path(dir, "rig.json");
+    char *stats = lr_test_path(dir, "stats.json");
+    lr_test_log log = {0};
+    lr_rig_opts o = {.config = cfg, .stats_path = stats, .no_signals = true,
+                     .log = {lr_test_log_fn, &log}};
+    lr_rig *r;
+    lr_err e = {0};
+    if (lr_rig_create(&o, &r, &e))
+        fail_msg("%s", e.msg);
+    int64_t end = lr_now_ns() + GUARD_MS * MS;
+    while (lr_now_ns() < end &&
+           (lr_test_rogue_requests(g) < 30 || lr_test_rogue_driver(g, 0) != 77))
+        assert_int_equal(lr_rig_run_until(r, lr_now_ns() + 10 * MS, &e), LR_OK);
+    assert_true(lr_test_rogue_requests(g) >= 30);
+    assert_int_equal(lr_test_rogue_driver(g, 0), 77);
+    assert_near(intensity(r), 0.003, 1e-12);
+    lr_rig_destroy(r); /* writes the stats */
+    lr_json *j;
+    if (lr_json_load(stats, &j, &e))
+        fail_msg("%s", e.msg);
+    lr_jnode devs = lr_json_get(j, lr_json_root(j), "devices");
+    assert_int_equal(lr_json_count(j, devs), 1);
+    lr_jnode d = lr_json_at(j, devs, 0);
+    char buf[64];
+    assert_int_equal(lr_json_string(j, lr_json_get(j, d, "kind"), "kind", buf, sizeof buf, &e),
+                     LR_OK);
+    assert_string_equal(buf, "modbus");
+    lr_jnode mb = lr_json_get(j, d, "modbus");
+    long stale = 0, responses = 0, bad = 0;
+    assert_int_equal(lr_json_get_int(j, mb, "stale", true, &stale, &e), LR_OK);
+    assert_int_equal(lr_json_get_int(j, mb, "responses", true, &responses, &e), LR_OK);
+    assert_int_equal(lr_json_get_int(j, mb, "bad_responses", true, &bad, &e), LR_OK);
+    /* Every answer after the first came behind a late one (the last may still be on its way). */
+    assert_true(stale >= 20);
+    assert_true(stale + 2 >= responses);
+    assert_int_equal(bad, 0);
+    lr_json_destroy(j);
+    lr_test_rogue_free(g);
+    free(cfg);
+    free(stats);
+    lr_test_rmtree(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -396,6 +452,7 @@ int main(void)
         cmocka_unit_test(test_shipped_modbus_demo),
         cmocka_unit_test(test_missing_at_start),
         cmocka_unit_test(test_rtu_over_pty),
+        cmocka_unit_test(test_stale_answers_in_stats),
     };
     if (getenv("LR_TEST_FILTER")) /* e.g. LR_TEST_FILTER='test_soak*' to run one test */
         cmocka_set_test_filter(getenv("LR_TEST_FILTER"));

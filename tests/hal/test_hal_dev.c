@@ -89,6 +89,29 @@ static void log_hook(void **state)
     lr_log_write(&silent, LR_LOG_ERROR, "dropped");
 }
 
+/* At most burst lines per window; the first line of a new window reports the dropped ones. */
+static void log_rate_limit(void **state)
+{
+    (void)state;
+    lr_log_limit l;
+    unsigned dropped = 99;
+    lr_log_limit_init(&l, 2, 1000 * MS);
+    assert_true(lr_log_limit_take(&l, 5000 * MS, &dropped));
+    assert_int_equal(dropped, 0);
+    assert_true(lr_log_limit_take(&l, 5001 * MS, &dropped));
+    for (int i = 0; i < 5; i++)
+        assert_false(lr_log_limit_take(&l, (5002 + 100 * i) * MS, &dropped));
+    assert_false(lr_log_limit_take(&l, 5999 * MS, &dropped));
+    assert_true(lr_log_limit_take(&l, 6000 * MS, &dropped));
+    assert_int_equal(dropped, 6);
+    assert_true(lr_log_limit_take(&l, 6001 * MS, &dropped));
+    assert_int_equal(dropped, 0);
+    /* No window: no limit. */
+    lr_log_limit_init(&l, 1, 0);
+    for (int i = 0; i < 10; i++)
+        assert_true(lr_log_limit_take(&l, 0, NULL));
+}
+
 static void device_interface(void **state)
 {
     (void)state;
@@ -136,6 +159,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(backoff_schedule),
+        cmocka_unit_test(log_rate_limit),
         cmocka_unit_test(ring_fifo_and_overflow),
         cmocka_unit_test(event_names),
         cmocka_unit_test(log_hook),

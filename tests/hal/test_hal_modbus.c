@@ -21,6 +21,7 @@
 
 #include "hal/modbus.h"
 #include "tests/support/hal_test.h"
+#include "tests/support/modbus_rogue.h"
 #include "tests/support/modbus_server.h"
 
 /* ---- URL parsing ---- */
@@ -275,6 +276,8 @@ static void tcp_panel_driver_and_reconnect(void **state)
     lr_modbus_get_counters(m, &k);
     assert_int_equal(k.connects, 2);
     assert_int_equal(lr_test_log_count(&log, ": open (after 4 failed attempts)"), 1);
+    /* The good answers reset the backoff (a connect alone does not: see the CLOSE peer). */
+    assert_int_equal(lr_dev_failures(d), 0);
 
     lr_modbus_destroy(m);
     lr_test_mb_server_free(s);
@@ -412,6 +415,208 @@ static void config_errors(void **state)
     lr_event_ring_destroy(ring);
 }
 
+/* ---- misbehaving TCP peers (tests/support/modbus_rogue.c) ---- */
+
+#define MS_NS 1000000LL
+
+static lr_modbus *rogue_master(lr_test_rogue *r, lr_event_ring *ring, lr_test_log *log,
+                               const lr_modbus_input *in, int n_in, int poll_ms, char *url,
+                               size_t url_cap)
+{
+    snprintf(url, url_cap, "tcp://127.0.0.1:%d", lr_test_rogue_port(r));
+    lr_modbus_desc desc = {
+        .dev = {.sink = lr_event_ring_sink(ring), .log = {lr_test_log_fn, log},
+                .retry_min_ms = 10, .retry_max_ms = 10000},
+        .url = url, .inputs = in, .n_inputs = n_in,
+        .output = {.enabled = true, .unit = 2, .reg = 5, .raw_max = 255},
+        .poll_ms = poll_ms, .timeout_ms = 100, .byte_timeout_ms = 50, .max_timeouts = 3,
+    };
+    lr_modbus *m = NULL;
+    lr_err e = {0};
+    assert_int_equal(lr_modbus_create(&desc, &m, &e), LR_OK);
+    return m;
+}
+
+/* An FC 3 answer declaring 250 data bytes, one byte every 45 ms (each within byte_timeout_ms
+ * 50): 11.7 s for the frame. No dispatch may wait for it: each returns in well under one
+ * byte's gap, and the transaction ends at its deadline (timeout_ms 100 after the request) with
+ * a timeout naming the peer and the channel. Three in a row drop the link. */
+static void tcp_drip_peer_cannot_hold_the_loop(void **state)
+{
+    (void)state;
+    lr_test_rogue *r = lr_test_rogue_start(LR_ROGUE_DRIP, 45);
+    lr_event_ring *ring;
+    assert_int_equal(lr_event_ring_create(0, &ring, NULL), LR_OK);
+    lr_test_log log = {0};
+    char url[64];
+    lr_modbus *m = rogue_master(r, ring, &log, &PANEL, 1, 10, url, sizeof url);
+    lr_dev *d = lr_modbus_dev(m);
+    int64_t t0 = lr_now_ns(), worst = 0, first_timeout = -1;
+    lr_modbus_counters k;
+    while (lr_now_ns() - t0 < 600 * MS_NS) {
+        struct pollfd p;
+        int n = lr_dev_pollfds(d, &p, 1);
+        int64_t now = lr_now_ns(), t = lr_dev_next_deadline(d);
+        int wait_ms = t <= now ? 0 : t - now > 10 * MS_NS ? 10 : (int)((t - now) / MS_NS) + 1;
+        poll(&p, (nfds_t)n, wait_ms);
+        int64_t a = lr_now_ns();
+        lr_dev_dispatch(d, a);
+        int64_t b = lr_now_ns();
+        worst = b - a > worst ? b - a : worst;
+        lr_modbus_get_counters(m, &k);
+        if (k.timeouts && first_timeout < 0)
+            first_timeout = b - t0;
+    }
+    lr_modbus_get_counters(m, &k);
+    /* 45 ms: one byte's gap; the old receive blocked for the whole 11.7 s frame. */
+    assert_true(worst < 45 * MS_NS);
+    /* The first request goes out at create (t0 is just after): its deadline is 100 ms on. */
+    assert_true(first_timeout >= 0);
+    assert_true(first_timeout <= (100 + 150) * MS_NS);
+    /* 600 ms of 100 ms transactions: the link dropped after three and came back. */
+    assert_true(k.timeouts >= 3);
+    assert_true(k.connects >= 2);
+    assert_int_equal(k.responses, 0);
+    assert_int_equal(lr_event_ring_count(ring), 0);
+    char want[160];
+    snprintf(want, sizeof want, "%s: input 'dimmer' (unit 1, holding register 0): answer "
+                                "incomplete after 100 ms", url);
+    assert_true(lr_test_log_count(&log, want) >= 1);
+    lr_modbus_destroy(m);
+    lr_test_rogue_free(r);
+    lr_event_ring_destroy(ring);
+}
+
+typedef struct late_cond {
+    lr_modbus *m;
+    lr_event_ring *ring;
+    lr_test_rogue *r;
+    int dimmer, fader; /* events seen */
+    int wrong;         /* events with the other register's value */
+} late_cond;
+
+static bool late_done(void *u)
+{
+    late_cond *c = u;
+    lr_event ev;
+    while (lr_event_ring_pop(c->ring, &ev)) {
+        bool dimmer = strcmp(ev.control, "dimmer") == 0;
+        c->dimmer += dimmer;
+        c->fader += !dimmer;
+        if (fabs(ev.value - (dimmer ? 0.1 : 0.9)) > 1e-12)
+            c->wrong++;
+    }
+    lr_modbus_counters k;
+    lr_modbus_get_counters(c->m, &k);
+    return c->wrong > 0 ||
+           (k.stale >= 20 && lr_modbus_output_synced(c->m) && c->dimmer && c->fader);
+}
+
+/* A peer answering every request twice, the previous request's answer first (with its
+ * transaction id). Register 0 (the dimmer) reads 100 of 1000, register 1 (a fader) 900: taken
+ * for the current request, the late answer would make the dimmer 0.9 and the fader 0.1. The
+ * master drops it by its transaction id, counts it, and takes the right one. */
+static void tcp_late_answers_are_dropped(void **state)
+{
+    (void)state;
+    lr_test_rogue *r = lr_test_rogue_start(LR_ROGUE_LATE, 0);
+    lr_test_rogue_set_reg(r, 0, 100);
+    lr_test_rogue_set_reg(r, 1, 900);
+    lr_event_ring *ring;
+    assert_int_equal(lr_event_ring_create(0, &ring, NULL), LR_OK);
+    lr_test_log log = {0};
+    char url[64];
+    lr_modbus_input in[2] = {PANEL, {.control = "fader", .unit = 1, .reg = 1, .raw_max = 1000}};
+    lr_modbus *m = rogue_master(r, ring, &log, in, 2, 2, url, sizeof url);
+    /* 0.1 of 0..255 is 25.5: raw 26 (the late answer to a read would be 230 = 0.9 * 255). */
+    assert_int_equal(lr_modbus_write_level(m, 0.1), LR_OK);
+    late_cond c = {.m = m, .ring = ring, .r = r};
+    lr_dev *d = lr_modbus_dev(m);
+    assert_true(lr_test_run(&d, 1, 20000, late_done, &c));
+    assert_int_equal(c.wrong, 0);
+    assert_int_equal(lr_test_rogue_driver(r, 5), 26);
+    lr_modbus_counters k;
+    lr_modbus_get_counters(m, &k);
+    assert_true(k.stale >= 20);
+    /* Every answer but the first came after a late one: as many stale as answers, minus 1. */
+    assert_true(k.stale + 1 >= k.responses);
+    assert_int_equal(k.bad_responses + k.timeouts + k.io_errors, 0);
+    assert_int_equal(k.connects, 1);
+    /* Logged, but not once per stale answer. */
+    assert_true(lr_test_log_count(&log, "stale answer dropped") >= 1);
+    assert_true(lr_test_log_count(&log, "stale answer dropped") <= 4);
+    lr_modbus_destroy(m);
+    lr_test_rogue_free(r);
+    lr_event_ring_destroy(ring);
+}
+
+static bool rogue_requests(void *u)
+{
+    cond *c = u;
+    return lr_test_rogue_requests((lr_test_rogue *)c->s) >= c->n;
+}
+
+/* A peer cycling through a wrong unit, a wrong function and an exception, each with a
+ * different number every time, and a good answer: 400 requests. Deduplication by text alone
+ * logged a line per bad answer (and one per recovery); per kind and device the master now
+ * logs at most 4 lines per 10 s: at most 6 kinds x 4 plus the open line. */
+static void tcp_random_answers_do_not_flood_the_log(void **state)
+{
+    (void)state;
+    lr_test_rogue *r = lr_test_rogue_start(LR_ROGUE_RANDOM, 0);
+    lr_test_rogue_set_reg(r, 0, 250);
+    lr_event_ring *ring;
+    assert_int_equal(lr_event_ring_create(0, &ring, NULL), LR_OK);
+    lr_test_log log = {0};
+    char url[64];
+    lr_modbus *m = rogue_master(r, ring, &log, &PANEL, 1, 1, url, sizeof url);
+    cond c = {.m = m, .ring = ring, .s = (lr_test_mb_server *)r, .n = 400};
+    assert_true(run(m, rogue_requests, &c));
+    lr_modbus_counters k;
+    lr_modbus_get_counters(m, &k);
+    assert_true(k.bad_responses >= 150);
+    assert_true(k.exceptions >= 75);
+    assert_true(k.responses >= 75);
+    assert_int_equal(k.connects, 1);
+    assert_true(log.n <= 6 * 4 + 1);
+    assert_true(lr_test_log_count(&log, "answer from unit") >= 1);
+    assert_true(lr_test_log_count(&log, "answer from unit") <= 4);
+    /* The good answers still arrive: 250 of 1000, reported once. */
+    assert_int_equal(lr_event_ring_count(ring), 1);
+    assert_float_equal(last(ring).value, 0.25, 1e-12);
+    lr_modbus_destroy(m);
+    lr_test_rogue_free(r);
+    lr_event_ring_destroy(ring);
+}
+
+/* A peer that accepts the connection and closes it at once, for 1 s. The backoff restarts on
+ * a good answer, not on a connect: retries come 10, 20, 40 ... ms apart, so after n losses
+ * 10 (2^n - 1) ms have passed: at most 7 reconnects after the first connect within 1 s (the
+ * old reset on connect reconnected every ~10 ms, about 90 times). */
+static void tcp_accept_and_close_backs_off(void **state)
+{
+    (void)state;
+    lr_test_rogue *r = lr_test_rogue_start(LR_ROGUE_CLOSE, 0);
+    lr_event_ring *ring;
+    assert_int_equal(lr_event_ring_create(0, &ring, NULL), LR_OK);
+    lr_test_log log = {0};
+    char url[64];
+    lr_modbus *m = rogue_master(r, ring, &log, &PANEL, 1, 10, url, sizeof url);
+    lr_dev *d = lr_modbus_dev(m);
+    lr_test_run(&d, 1, 1000, NULL, NULL);
+    lr_modbus_counters k;
+    lr_modbus_get_counters(m, &k);
+    assert_true(k.connects >= 3);
+    assert_true(k.connects <= 8);
+    assert_true(lr_test_rogue_accepted(r) <= 8);
+    /* Every loss counts: the failures grow with the connects. */
+    assert_true((int)lr_dev_failures(d) >= (int)k.connects - 1);
+    assert_true(lr_test_log_count(&log, "connection closed by the server") >= 1);
+    lr_modbus_destroy(m);
+    lr_test_rogue_free(r);
+    lr_event_ring_destroy(ring);
+}
+
 /* ---- RTU over a pseudo-terminal pair ---- */
 
 static void rtu_over_pty(void **state)
@@ -491,6 +696,10 @@ int main(void)
         cmocka_unit_test(tcp_exceptions_are_counted_not_fatal),
         cmocka_unit_test(tcp_timeouts_drop_and_restore_the_link),
         cmocka_unit_test(config_errors),
+        cmocka_unit_test(tcp_drip_peer_cannot_hold_the_loop),
+        cmocka_unit_test(tcp_late_answers_are_dropped),
+        cmocka_unit_test(tcp_random_answers_do_not_flood_the_log),
+        cmocka_unit_test(tcp_accept_and_close_backs_off),
         cmocka_unit_test(rtu_over_pty),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
