@@ -46,15 +46,18 @@ int lr_plan_scene_replanner(const lr_scene *scene, const lr_plan_scene_result *r
     return rc ? rc : lr_replan_create(scene, t, &res->plan, NULL, out, e);
 }
 
-char *lr_plan_scene_text(const lr_plan_scene_result *res)
+char *lr_plan_scene_text(const lr_plan_scene_result *res, bool verbose)
 {
-    size_t need = lr_plan_format(&res->plan, NULL, 0);
-    size_t head = strlen(res->table) + 64;
+    size_t (*format)(const lr_plan *, char *, size_t) =
+        verbose ? lr_plan_format : lr_plan_format_brief;
+    size_t need = format(&res->plan, NULL, 0);
+    size_t head = verbose ? strlen(res->table) + 64 : 1;
     char *buf = malloc(head + need + 1);
     if (!buf)
         return NULL;
-    int n = snprintf(buf, head, "plan: table %s (%s)\n", res->table,
-                     res->table_why ? res->table_why : "given");
-    lr_plan_format(&res->plan, buf + n, need + 1);
+    int n = verbose ? snprintf(buf, head, "plan: table %s (%s)\n", res->table,
+                               res->table_why ? res->table_why : "given")
+                    : 0;
+    format(&res->plan, buf + n, need + 1);
     return buf;
 }

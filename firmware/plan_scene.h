@@ -34,8 +34,8 @@ int lr_plan_scene(lr_scene *scene, const char *table, bool models_only,
 int lr_plan_scene_replanner(const lr_scene *scene, const lr_plan_scene_result *res,
                             lr_replan **out, lr_err *e);
 
-/* The plan's lines (lr_plan_format) preceded by "plan: table PATH (WHY)". Returns a malloc'd
- * string, NULL when out of memory. */
-char *lr_plan_scene_text(const lr_plan_scene_result *res);
+/* verbose: the plan's lines (lr_plan_format) preceded by "plan: table PATH (WHY)"; else its
+ * one sentence (lr_plan_format_brief). Returns a malloc'd string, NULL when out of memory. */
+char *lr_plan_scene_text(const lr_plan_scene_result *res, bool verbose);
 
 #endif

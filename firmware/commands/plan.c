@@ -14,9 +14,10 @@ static const lr_argspec opts[] = {
     {.name = "--scene", .type = LR_ARG_PATH, .flags = LR_ARG_REQUIRED,
      .help = "the scene (configs/scenes/*.json); its \"quality\" block is the budget"},
     {.name = "--max-error", .type = LR_ARG_NUMBER, .metavar = "E", .flags = LR_ARG_ABOVE_MIN,
-     .help = "relative RMSE budget (replaces the scene's quality block with --frame-ms)"},
+     .help = "error budget (alone or with --frame-ms, replaces the scene's max_error\n"
+             "and frame_ms)"},
     {.name = "--frame-ms", .type = LR_ARG_NUMBER, .metavar = "T", .flags = LR_ARG_ABOVE_MIN,
-     .help = "milliseconds per accumulation frame"},
+     .help = "milliseconds per accumulation frame (the same)"},
     {.name = "--change-ms", .type = LR_ARG_NUMBER, .metavar = "T", .flags = LR_ARG_ABOVE_MIN,
      .help = "longest wait after a material change: models measured slower\n"
              "(configs/bench/models.csv) are left out (default: the scene's\n"
@@ -24,7 +25,10 @@ static const lr_argspec opts[] = {
     {.name = "--table", .type = LR_ARG_PATH, .metavar = "CSV",
      .help = "the measured table (default: build/bench/results.csv when at least as\n"
              "new as configs/bench/front.csv, else that one)"},
-    {.name = "--json", .help = "one JSON object instead of text"},
+    {.name = "--json", .help = "one JSON object instead of text (every detail)"},
+    {.name = "--verbose",
+     .help = "the table used, a line per object with its settings, predicted error parts\n"
+             "and reasons, the budget line and the light transport (default: one sentence)"},
     {.name = "--models", .type = LR_ARG_STRING,
      .metavar = "MODEL,...|all",
      .help = "models to choose from, comma-separated objects[].model names\n"
@@ -38,11 +42,13 @@ const lr_command lr_plan_command = {
     .summary = "choose per object the cheapest measured settings that meet the scene's quality "
                "budget",
     .about =
-        "Prints, per object of the scene, the cheapest measured model and settings (K, N, N_vpl,\n"
-        "map and G-buffer sizes, frames, VPLs on or off) that meet the budget, the predicted error\n"
-        "(relative RMSE against the physical reference) and time, and the reasons: the measured\n"
-        "scene the rows come from, whether any receiver sees the object (else no VPL pass), how\n"
-        "many maps cover its surface (convex objects need fewer), infeasible budgets.",
+        "Prints in one sentence the model and maps chosen, the predicted error and frame time,\n"
+        "and whether the budget holds. --verbose prints, per object of the scene, the cheapest\n"
+        "measured model and settings (K, N, N_vpl, map and G-buffer sizes, frames, VPLs on or off)\n"
+        "that meet the budget, the predicted error (against the physical reference) and time, and\n"
+        "the reasons: the measured scene the rows come from, whether any receiver sees the object\n"
+        "(else no VPL pass), how many maps cover its surface (convex objects need fewer),\n"
+        "infeasible budgets.",
     .opts = opts,
     .notes =
         "Exit status: 0 planned (an infeasible budget is planned to the closest setting and said\n"
@@ -81,12 +87,12 @@ static int run_plan(const lr_cli *c)
     const lr_args *a = &c->args;
     lr_err e = {0};
     const char *scene_path = lr_args_get(a, "--scene");
-    lr_plan_budget b = {0};
+    lr_plan_budget given = {0}, b;
     unsigned models;
     int st;
-    if ((st = lr_cli_check(c, lr_args_double(a, "--max-error", &b.max_error, &e) ||
-                                  lr_args_double(a, "--frame-ms", &b.frame_ms, &e) ||
-                                  lr_args_double(a, "--change-ms", &b.change_ms, &e),
+    if ((st = lr_cli_check(c, lr_args_double(a, "--max-error", &given.max_error, &e) ||
+                                  lr_args_double(a, "--frame-ms", &given.frame_ms, &e) ||
+                                  lr_args_double(a, "--change-ms", &given.change_ms, &e),
                            &e)) ||
         (st = models_arg(c, lr_args_get(a, "--models"), &models)))
         return st;
@@ -97,13 +103,11 @@ static int run_plan(const lr_cli *c)
             return lr_cli_fail(c->path, "%s", e.msg);
         return lr_cli_usage(c->path, "%s", e.msg);
     }
-    if (!(b.max_error > 0) && !(b.frame_ms > 0) && !lr_plan_budget_from_scene(scene, &b)) {
+    if (!lr_plan_budget_resolve(scene, &given, &b)) {
         lr_scene_destroy(scene);
         return lr_cli_usage(c->path, "the scene has no quality budget (quality.max_error or "
                            "quality.frame_ms): give --max-error or --frame-ms");
     }
-    if (!(b.change_ms > 0))
-        b.change_ms = lr_scene_quality(scene)->change_ms;
     char table[1024];
     const char *why = "given";
     const char *tp = lr_args_get(a, "--table");
@@ -121,15 +125,14 @@ static int run_plan(const lr_cli *c)
         goto fail;
     if (lr_plan_create(scene, t, &b, &(lr_plan_options){.models = models}, plan, &e))
         goto fail;
-    bool json = lr_args_has(a, "--json");
-    size_t need = json ? lr_plan_format_json(plan, NULL, 0) : lr_plan_format(plan, NULL, 0);
+    bool json = lr_args_has(a, "--json"), verbose = lr_args_has(a, "--verbose");
+    size_t (*format)(const lr_plan *, char *, size_t) =
+        json ? lr_plan_format_json : verbose ? lr_plan_format : lr_plan_format_brief;
+    size_t need = format(plan, NULL, 0);
     if (!(text = malloc(need + 1)))
         goto done;
-    if (json)
-        lr_plan_format_json(plan, text, need + 1);
-    else
-        lr_plan_format(plan, text, need + 1);
-    if (!json)
+    format(plan, text, need + 1);
+    if (verbose && !json)
         printf("plan: table %s (%s)\n", table, why);
     fputs(text, stdout);
     st = LR_EXIT_OK;

@@ -13,6 +13,7 @@
 #include "render/gl/gl.h"
 #include "render/image/image.h"
 #include "render/optics/optics.h"
+#include "render/plan/limits.h"
 #include "render/renderer.h"
 #include "render/renderer_debug.h"
 #include "render/scene/scene.h"
@@ -66,6 +67,8 @@ static const lr_argspec opts[] = {
     {.name = "--table", .type = LR_ARG_PATH, .metavar = "CSV",
      .help = "the planner's measured table (default: see `lamprig help plan`)"},
     LR_CLI_QUIET_OPT,
+    {.name = "--verbose",
+     .help = "the plan's every line (as `lamprig plan --verbose`) instead of its sentence"},
     {0},
 };
 
@@ -185,7 +188,7 @@ static int write_stats(const char *path, const lr_scene *scene, lr_renderer *r,
  * (with --plan-models its models alone) and prints its lines. A missing or unusable table
  * is not fatal: the scene's own settings render, and a "plan: skipped: WHY" line says so. */
 static int plan(const char *path, lr_scene *scene, const char *table, bool models_only,
-                bool *no_vpl, bool *planned)
+                bool verbose, bool *no_vpl, bool *planned)
 {
     lr_plan_scene_result *res = calloc(1, sizeof *res);
     if (!res)
@@ -195,7 +198,7 @@ static int plan(const char *path, lr_scene *scene, const char *table, bool model
         /* Informational like the plan itself (stdout): the render goes on. */
         printf("plan: skipped: %s; rendering with the scene's settings\n", e.msg);
     } else if (res->planned) {
-        char *text = lr_plan_scene_text(res);
+        char *text = lr_plan_scene_text(res, verbose);
         if (text)
             fputs(text, stdout);
         free(text);
@@ -296,7 +299,8 @@ static int run_render(const lr_cli *c)
         status = lr_cli_usage(c->path, "--no-plan and --plan-models: choose one");
         goto done;
     }
-    if (!no_plan && (status = plan(c->path, scene, table, plan_models, &no_vpl, &planned)))
+    if (!no_plan && (status = plan(c->path, scene, table, plan_models, lr_args_has(a, "--verbose"),
+                                      &no_vpl, &planned)))
         goto done;
     for (int i = 0; planned && i < nsets; i++) {
         if (lr_scene_set_assignment(scene, sets[i], NULL, &e)) {
@@ -305,6 +309,13 @@ static int run_render(const lr_cli *c)
         }
         if (!strncmp(sets[i], "render.", 7))
             printf("plan: --set %s overrides the plan\n", sets[i]);
+    }
+    /* A model forced outside its validity limit for the material (the file's or --set's
+     * objects[i].model, which the plan does not replace) is bad input, refused before the
+     * renderer spends its solver's iterations on it. */
+    if (lr_plan_check_models(scene, &e)) {
+        status = lr_cli_usage(c->path, "%s", e.msg);
+        goto done;
     }
     if (lr_gl_create(NULL, &gl, &e) ||
         lr_renderer_create(&(lr_renderer_desc){.gl = gl, .scene = scene, .width = width,

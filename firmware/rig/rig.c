@@ -30,6 +30,7 @@
 #include "render/base/out_dir.h"
 #include "render/gl/gl.h"
 #include "render/image/image.h"
+#include "render/plan/limits.h"
 #include "render/scene/scene.h"
 #include "firmware/plan_scene.h"
 
@@ -246,7 +247,7 @@ static int plan_scene(lr_rig *r, const lr_rig_config *cfg, lr_scene *scene, bool
     if (lr_plan_scene(scene, r->opts.plan_table, false, res, &pe)) {
         lr_log_write(&r->log, LR_LOG_WARN, "plan: %s; running with the scene's settings", pe.msg);
     } else if (res->planned) {
-        char *text = lr_plan_scene_text(res);
+        char *text = lr_plan_scene_text(res, true); /* the log keeps every reason */
         log_lines(r, text);
         free(text);
         *no_vpl = !res->vpl;
@@ -321,6 +322,8 @@ static int set_build(lr_rig *r, rigset *s, bool with_devices, lr_err *e)
         rc = lr_rig_config_apply_sets(s->cfg, s->scene, e);
     if (!rc)
         rc = plan_scene(r, s->cfg, s->scene, &s->no_vpl, &s->replan, e);
+    if (!rc) /* a model forced outside its validity limit (render/plan/limits.h) */
+        rc = lr_plan_check_models(s->scene, e);
     if (!rc)
         rc = lr_control_map_create(s->cfg, s->scene, true, lr_now_ns(), &s->map, e);
     if (!rc && s->cfg->calib[0])
@@ -404,7 +407,8 @@ static void switch_scene(lr_rig *r, const char *path)
     lr_replan *rp = NULL;
     if (lr_scene_load(path, &warn, &scene, &e) ||
         lr_rig_config_apply_sets(r->set.cfg, scene, &e) ||
-        plan_scene(r, r->set.cfg, scene, &no_vpl, &rp, &e)) {
+        plan_scene(r, r->set.cfg, scene, &no_vpl, &rp, &e) ||
+        lr_plan_check_models(scene, &e)) {
         lr_log_write(&r->log, LR_LOG_ERROR, "scene switch: %s; keeping %s", e.msg,
                      lr_scene_path(r->set.scene));
         lr_scene_destroy(scene);

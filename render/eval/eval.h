@@ -166,6 +166,14 @@ typedef struct lr_eval_row {
                                * frame_ms) */
     double bias_object, bias_receivers;   /* converged model vs physical reference */
     double noise_object, noise_receivers; /* `frames` frames vs converged model */
+    /* The noise floor under each debiased error above: rel_rmse* have the reference's noise
+     * taken out in quadrature (sqrt(rmse^2 - se^2)), the bias also the converged image's own,
+     * and an error under that noise comes out 0, which says only that it is at most the
+     * noise. The bench sets each to the noise taken out (sqrt(se^2 [+ its own^2])); the CSV
+     * writes an error of 0 with a floor > 0 as "<FLOOR" (lr_eval_csv_print), never as 0.
+     * 0 (a zero-initialised row): none known. */
+    double floor_rel_rmse, floor_rel_rmse_object, floor_rel_rmse_receivers;
+    double floor_bias_object, floor_bias_receivers;
     int width, height; /* where the errors are measured (the reference's size) */
     /* The pixel filter (issue 12): 1 = pixel centres; s >= 2 = rendered at s*width x
      * s*height and box-filtered, as the reference's pixels are (the times are then those of

@@ -22,6 +22,16 @@ static void num(FILE *f, double v, const char *fmt)
     }
 }
 
+/* A debiased error: "<FLOOR" where it came out 0 under a noise floor (at most the floor:
+ * the planner reads it so, render/plan/table.c), else as num. */
+static void err_num(FILE *f, double v, double floor)
+{
+    if (v == 0.0 && isfinite(floor) && floor > 0.0)
+        fprintf(f, ",<%.5f", floor);
+    else
+        num(f, v, "%.5f");
+}
+
 void lr_eval_csv_print(FILE *f, const lr_eval_row *rows, int n)
 {
     bool lpv = false, seen = false;
@@ -40,15 +50,15 @@ void lr_eval_csv_print(FILE *f, const lr_eval_row *rows, int n)
         /* Scene and model names are identifiers (no commas or quotes); params has none. */
         fprintf(f, "%s,%s,%s", r->scene, r->model, params);
         num(f, r->frame_ms, "%.3f");
-        num(f, r->rel_rmse, "%.5f");
-        num(f, r->rel_rmse_object, "%.5f");
-        num(f, r->rel_rmse_receivers, "%.5f");
+        err_num(f, r->rel_rmse, r->floor_rel_rmse);
+        err_num(f, r->rel_rmse_object, r->floor_rel_rmse_object);
+        err_num(f, r->rel_rmse_receivers, r->floor_rel_rmse_receivers);
         fprintf(f, ",%d,%d,%d,%d,%d,%d,%s", r->K, r->N, r->N_vpl, r->map_size, r->gbuffer_size,
                 r->frames, r->vpl ? "on" : "off");
         for (int p = 0; p < LR_EVAL_CSV_PASSES; p++)
             num(f, r->ms[p], "%.3f");
-        num(f, r->bias_object, "%.5f");
-        num(f, r->bias_receivers, "%.5f");
+        err_num(f, r->bias_object, r->floor_bias_object);
+        err_num(f, r->bias_receivers, r->floor_bias_receivers);
         num(f, r->noise_object, "%.5f");
         num(f, r->noise_receivers, "%.5f");
         fprintf(f, ",%d,%d,%d", r->width, r->height, r->supersample);

@@ -15,8 +15,9 @@ const char *lr_plan_model_limit(const lr_scene_object *o, enum lr_sss_model m, c
         double s = fmax(c->sigma_tr[0], fmax(c->sigma_tr[1], c->sigma_tr[2]));
         if (!(s * h <= LR_PLAN_GRID_MAX_SIGMA_H)) {
             snprintf(buf, cap, "the grid spacing %.2g mm is %.2g diffusion lengths of the "
-                     "material (at most %g: the stencil's decay rate is then %.0f %% low)",
-                     h, s * h, LR_PLAN_GRID_MAX_SIGMA_H,
+                     "material (sigma_tr %.3g /mm in its largest band; at most %g: the "
+                     "stencil's decay rate is then %.0f %% low)",
+                     h, s * h, s, LR_PLAN_GRID_MAX_SIGMA_H,
                      100.0 * (1.0 - acosh(1.0 + 0.5 * s * h * s * h) / (s * h)));
             return buf;
         }
@@ -38,4 +39,18 @@ const char *lr_plan_model_limit(const lr_scene_object *o, enum lr_sss_model m, c
         }
     }
     return NULL;
+}
+
+int lr_plan_check_models(const lr_scene *s, lr_err *e)
+{
+    for (int i = 0; i < lr_scene_object_count(s); i++) {
+        const lr_scene_object *o = lr_scene_object_at(s, i);
+        char why[320];
+        if (lr_plan_model_limit(o, o->sss_model, why, sizeof why))
+            return lr_err_set(e, LR_EINVAL, "objects[%d].model: %s is outside its validity "
+                              "limit for '%s' in %s: %s", i, lr_sss_model_name(o->sss_model),
+                              o->name, o->material.name[0] ? o->material.name : "its material",
+                              why);
+    }
+    return LR_OK;
 }

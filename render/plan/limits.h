@@ -27,6 +27,7 @@
 
 #include <stddef.h>
 
+#include "render/base/err.h"
 #include "render/scene/scene.h"
 
 #define LR_PLAN_GRID_MAX_SIGMA_H 1.0
@@ -35,5 +36,13 @@
  * buf, which is returned), or NULL when it is within them. */
 const char *lr_plan_model_limit(const lr_scene_object *o, enum lr_sss_model m, char *buf,
                                 size_t cap);
+
+/* Refuses a scene an object of which is to render with a model outside these limits for its
+ * material (objects[i].model forced by the scene file, `--set` or a control, where the planner
+ * would have left the model out: the grid on porcelain otherwise fails after its solver's
+ * every iteration): LR_EINVAL "objects[I].model: MODEL is outside its validity limit for
+ * 'NAME' in MATERIAL: WHY" (WHY as lr_plan_model_limit). The rule is lr_plan_model_limit's,
+ * the planner's own. */
+int lr_plan_check_models(const lr_scene *s, lr_err *e);
 
 #endif

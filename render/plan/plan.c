@@ -56,6 +56,21 @@ bool lr_plan_budget_from_scene(const lr_scene *s, lr_plan_budget *out)
     return q->max_error > 0 || q->frame_ms > 0;
 }
 
+bool lr_plan_budget_resolve(const lr_scene *s, const lr_plan_budget *given, lr_plan_budget *out)
+{
+    lr_plan_budget_from_scene(s, out);
+    /* An error or frame budget given is the budget's kind: it replaces the scene's pair (a
+     * frame-only budget is frame-only), while change_ms, no budget by itself, is kept unless
+     * given. */
+    if (given->max_error > 0 || given->frame_ms > 0) {
+        out->max_error = given->max_error > 0 ? given->max_error : 0.0;
+        out->frame_ms = given->frame_ms > 0 ? given->frame_ms : 0.0;
+    }
+    if (given->change_ms > 0)
+        out->change_ms = given->change_ms;
+    return out->max_error > 0 || out->frame_ms > 0;
+}
+
 /* The scene file's base name without extension: what the bench writes in `scene`. */
 void lr_plan_scene_key(const lr_scene *s, char *buf, size_t cap)
 {
@@ -243,7 +258,7 @@ int lr_plan_choose(const lr_scene *s, int index, const lr_plan_table *t, const l
     bool need_vpl = a->receivers_seeing != 0;
     /* Candidates: the measured scene's rows with a model the renderer runs and at least
      * K_cover maps (the bench measures one view; coverage must hold for every view). */
-    int n = lr_plan_table_count(t), ncand = 0, nscene = 0, kmax = 0;
+    int n = lr_plan_table_count(t), ncand = 0, nscene = 0, kmax = 0, ndark = 0;
     unsigned said = 0;
     cand *cs = malloc((size_t)(n > 0 ? n : 1) * sizeof *cs);
     if (!cs)
@@ -287,6 +302,13 @@ retry:
                 (lr_sss_model_parse(r->model, &rm) && (change_slow & LR_PLAN_MODEL_BIT(rm))) ||
                 !model_ok(r->model, models, o, c, &said))
                 continue;
+            /* A row that leaves a region of the measured view dark (band_excess inf: the wall
+             * of a row without VPLs) predicts no error at all: while a receiver sees the
+             * object, its light would be missing there, so the row never wins. */
+            if (need_vpl && !isfinite(lr_plan_row_error(r))) {
+                ndark += !pass;
+                continue;
+            }
             if (!pass) {
                 nscene++;
                 if (r->K > kmax)
@@ -304,6 +326,10 @@ retry:
                 x.conv += r->ms_lpv;
             cs[ncand++] = x;
         }
+        if (!pass && ndark)
+            reason(c, "%d row%s left out: %s a region dark (no finite error), and a receiver "
+                      "sees %s", ndark, ndark == 1 ? "" : "s", ndark == 1 ? "it leaves" :
+                      "they leave", o->name);
         if (!ncand && nscene && !pass)
             reason(c, "no measured row has K >= %d: using the most maps measured (K = %d)",
                    a->K_cover, kmax);
@@ -313,21 +339,26 @@ retry:
     if (!ncand && change_slow) {
         reason(c, "no other model has usable rows: the slow material changes kept");
         change_slow = 0;
-        nscene = kmax = 0;
+        nscene = kmax = ndark = 0;
         goto retry;
     }
     if (!ncand) {
         free(cs);
         return lr_err_set(e, LR_EINVAL, "planner: %s: no row of scene '%s' in %s with a model "
-                          "allowed (--models) that the object can take",
-                          o->name, c->table_scene, lr_plan_table_name(t));
+                          "allowed (--models) that the object can take%s",
+                          o->name, c->table_scene, lr_plan_table_name(t),
+                          ndark ? " and that lights every region in sight (the others leave "
+                                  "one dark: no finite error)" : "");
     }
 
     const cand *best = NULL;
     int nfeas = 0;
     for (int i = 0; i < ncand; i++) {
         const cand *x = &cs[i];
-        bool ok = (b->max_error <= 0 || x->err <= b->max_error) &&
+        /* A budget holds only with a finite predicted error: a frame-only budget says
+         * nothing of the error, but a row whose error is unknown (a region dark, no receiver
+         * in sight) meets nothing. */
+        bool ok = isfinite(x->err) && (b->max_error <= 0 || x->err <= b->max_error) &&
                   (b->frame_ms <= 0 || x->fms <= b->frame_ms);
         if (!ok)
             continue;
@@ -486,20 +517,30 @@ static void put_budget(out *o, const lr_plan_budget *b)
         put(o, "<= %g ms/frame", b->frame_ms);
 }
 
+/* Whether the predicted error (the largest part) is the RMSE part's noise floor: the row's
+ * error is at most that. */
+static bool error_at_most(const lr_plan_error_parts *p)
+{
+    return p->rmse_at_most && !(p->median > p->rmse) && !(p->band > p->rmse);
+}
+
 static void put_choice(out *o, const lr_plan_choice *c)
 {
     const lr_plan_row *r = &c->row;
-    put(o, "plan: %s: %s K=%d N=%d N_vpl=%d map=%d gbuffer=%d frames=%d vpl=%s, error %.3g, "
+    lr_plan_error_parts ep = lr_plan_row_error_parts(r);
+    put(o, "plan: %s: %s K=%d N=%d N_vpl=%d map=%d gbuffer=%d frames=%d vpl=%s, error %s%.3g, "
            "%.0f ms/frame, converged in %.1f s%s",
         c->object, r->model, r->K, r->N, c->vpl ? r->N_vpl : 0, r->map_size, r->gbuffer_size,
-        r->frames, c->vpl ? "on" : "off", c->predicted_error, c->predicted_frame_ms,
-        c->predicted_converge_ms / 1000.0, c->feasible ? "" : " [INFEASIBLE]");
+        r->frames, c->vpl ? "on" : "off", error_at_most(&ep) ? "at most " : "",
+        c->predicted_error, c->predicted_frame_ms, c->predicted_converge_ms / 1000.0,
+        c->feasible ? "" : " [INFEASIBLE]");
     if (r->lpv > 0)
         put(o, ", light-propagation volume %d^3", r->lpv);
-    lr_plan_error_parts ep = lr_plan_row_error_parts(r);
     if (isfinite(ep.median) || isfinite(ep.band))
-        put(o, " (error: RMSE %.3g, median |ln| over the references' floor %.3g, worst band "
-               "%.3g)", ep.rmse, ep.median, ep.band);
+        put(o, " (error: RMSE %s%.3g, median |ln| over the references' floor %.3g, worst band "
+               "%.3g)", ep.rmse_at_most ? "at most " : "", ep.rmse, ep.median, ep.band);
+    else if (ep.rmse_at_most)
+        put(o, " (error: RMSE at most %.3g, under the reference's noise)", ep.rmse);
     for (int k = 0; k < c->nreasons; k++)
         put(o, "%s%s", k ? "; " : " (", c->reasons[k]);
     put(o, "%s\n", c->nreasons ? ")" : "");
@@ -533,6 +574,56 @@ size_t lr_plan_format(const lr_plan *p, char *buf, size_t cap)
     char tline[LR_PLAN_TRANSPORT_COUNT * (LR_PLAN_REASON_MAX + 64) + LR_SCENE_NAME_MAX + 32];
     lr_plan_transport_format(&p->transport, p->scene, tline, sizeof tline);
     put(&o, "%s", tline);
+    return o.len;
+}
+
+/* The budget as a reader says it: "error <= 0.05, <= 100 ms a frame". */
+static void put_budget_words(out *o, const lr_plan_budget *b)
+{
+    if (b->max_error > 0)
+        put(o, "error <= %g%s", b->max_error, b->frame_ms > 0 ? ", " : "");
+    if (b->frame_ms > 0)
+        put(o, "<= %g ms a frame", b->frame_ms);
+}
+
+size_t lr_plan_format_brief(const lr_plan *p, char *buf, size_t cap)
+{
+    out o = {buf, cap, 0};
+    if (cap)
+        buf[0] = '\0';
+    /* The scene's figures are its worst object's: one settings block renders them all. */
+    double err = 0.0, fms = 0.0, over = 0.0;
+    bool at_most = false; /* the worst error is a noise floor (error_at_most) */
+    put(&o, "plan: %s: ", p->scene);
+    for (int i = 0; i < p->nobjects; i++) {
+        const lr_plan_choice *c = &p->objects[i];
+        put(&o, "%s%s K %d", i ? ", " : "", c->row.model, c->row.K);
+        if (p->nobjects > 1)
+            put(&o, " for %s", c->object);
+        if (!i || !(c->predicted_error <= err)) {
+            lr_plan_error_parts ep = lr_plan_row_error_parts(&c->row);
+            at_most = error_at_most(&ep);
+        }
+        err = isfinite(c->predicted_error) && isfinite(err) ? fmax(err, c->predicted_error)
+                                                            : INFINITY;
+        fms = fmax(fms, c->predicted_frame_ms);
+        over = fmax(over, shortfall(&(cand){.err = c->predicted_error,
+                                            .fms = c->predicted_frame_ms},
+                                    &p->budget));
+    }
+    if (isfinite(err))
+        put(&o, ", predicted error %s%.3g", at_most ? "at most " : "", err);
+    else
+        put(&o, ", no finite predicted error (a region left dark)");
+    put(&o, ", %.0f ms a frame on this table; the budget (", fms);
+    put_budget_words(&o, &p->budget);
+    if (p->feasible)
+        put(&o, ") holds\n");
+    else
+        put(&o, isfinite(over) && over > 1.0
+                    ? ") is not reachable here, the closest row shown (%.2gx over; --verbose: why)\n"
+                    : ") is not reachable here, the closest row shown (--verbose: why)\n",
+            over);
     return o.len;
 }
 
@@ -591,6 +682,9 @@ size_t lr_plan_format_json(const lr_plan *p, char *buf, size_t cap)
         for (size_t k = 0; k < sizeof parts / sizeof parts[0]; k++)
             if (isfinite(parts[k].v))
                 put(&o, "\"%s\":%.6g,", parts[k].key, parts[k].v);
+        /* The RMSE part is a noise floor: the error is at most it (not measured as 0). */
+        if (ep.rmse_at_most)
+            put(&o, "\"predicted_rmse_at_most\":true,");
         put(&o, "\"convex\":%s,\"shell\":%s,\"enclosed\":%s,\"K_cover\":%d,\"coverage\":%.4f,"
                 "\"receivers_seeing\":%d,\"reasons\":[",
             a->features.convex ? "true" : "false", a->features.shell ? "true" : "false",

@@ -63,7 +63,19 @@ typedef struct lr_plan_row {
      * references (the floor), and the worst region-band power ratio beyond its 2 se
      * (lr_eval_ratio_excess). */
     double median_ln_object, median_ln_floor, band_excess;
+    /* LR_PLAN_UNDER_* bits: the columns whose cell read "<FLOOR" (the bench's debiased error
+     * came out under the reference's noise, tools/bench): the field holds that floor, an
+     * upper bound on the error ("at most the floor", never 0). */
+    unsigned under_floor;
 } lr_plan_row;
+
+enum {
+    LR_PLAN_UNDER_REL_RMSE = 1u << 0,
+    LR_PLAN_UNDER_REL_RMSE_OBJECT = 1u << 1,
+    LR_PLAN_UNDER_REL_RMSE_RECEIVERS = 1u << 2,
+    LR_PLAN_UNDER_BIAS_OBJECT = 1u << 3,
+    LR_PLAN_UNDER_BIAS_RECEIVERS = 1u << 4,
+};
 
 typedef struct lr_plan_table lr_plan_table;
 
@@ -72,9 +84,13 @@ typedef struct lr_plan_table lr_plan_table;
  *   rel_rmse for rows without the split;
  * - median: the typical object pixel's |ln ratio| beyond the references' own,
  *   max(0, median_ln_object - median_ln_floor) (the whole median without a floor);
- * - band: band_excess, the worst region-band's power off by more than the reference's 2 se. */
+ * - band: band_excess, the worst region-band's power off by more than the reference's 2 se.
+ * A bias under the reference's noise ("<FLOOR" in the table) counts as its floor: the error
+ * it predicts is then at most that (rmse_at_most), and never 0. */
 typedef struct lr_plan_error_parts {
     double rmse, median, band;
+    /* The rmse part is a noise floor (lr_plan_row.under_floor): the error is at most it. */
+    bool rmse_at_most;
 } lr_plan_error_parts;
 lr_plan_error_parts lr_plan_row_error_parts(const lr_plan_row *r);
 
@@ -292,6 +308,12 @@ int lr_plan_create(const lr_scene *s, const lr_plan_table *t, const lr_plan_budg
 
 /* The budget of a scene's "quality" block; false when it sets none. */
 bool lr_plan_budget_from_scene(const lr_scene *s, lr_plan_budget *out);
+/* The budget of a command line (`lamprig plan --max-error/--frame-ms/--change-ms`: fields
+ * > 0 given, 0 not) over the scene's: a max_error or frame_ms given replaces the scene's
+ * pair of them (the budget's kind is the one given), change_ms given replaces the scene's,
+ * and what is not given is the scene's. False when the result has neither max_error nor
+ * frame_ms. */
+bool lr_plan_budget_resolve(const lr_scene *s, const lr_plan_budget *given, lr_plan_budget *out);
 
 /* Applies plan->settings to the scene through lr_scene_set (render.K, N, N_vpl, map_size,
  * gbuffer_size, frames, lpv) and each object's chosen model (objects[i].model), ORing dirty
@@ -307,6 +329,12 @@ int lr_plan_apply_models(const lr_plan *p, lr_scene *s, unsigned *dirty, lr_err 
  * after the planned frames until something changes); written to buf (truncated to cap,
  * which may be 0). Returns the length it needed, without the NUL. */
 size_t lr_plan_format(const lr_plan *p, char *buf, size_t cap);
+/* The plan in one sentence, what `lamprig plan` and `lamprig render` print without
+ * --verbose: "plan: SCENE: MODEL K k[ for OBJECT, ...], predicted error E, T ms a frame on
+ * this table; the budget (error <= E, <= T ms a frame) holds" or "... is not reachable here,
+ * the closest row shown (1.4x over; --verbose: why)". Error and frame time are the worst
+ * object's. Returns the length it needed, without the NUL. */
+size_t lr_plan_format_brief(const lr_plan *p, char *buf, size_t cap);
 /* One object's line of lr_plan_format. */
 size_t lr_plan_format_choice(const lr_plan_choice *c, char *buf, size_t cap);
 /* The same as one JSON object. */

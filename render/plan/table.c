@@ -33,19 +33,26 @@ static const struct {
     const char *name;
     bool required;
     bool inf_ok; /* "inf" is a value: band_excess of a row that leaves a region dark */
+    /* "<FLOOR" is a value: a debiased error under the reference's noise (the bench writes the
+     * floor, lr_eval_row's floor_*): the field gets the floor, lr_plan_row.under_floor this
+     * bit. */
+    unsigned floor_bit;
 } cols[C_COUNT] = {
     [C_SCENE] = {"scene", true},          [C_MODEL] = {"model", true},
     [C_PARAMS] = {"params", false},       [C_FRAME_MS] = {"frame_ms", true},
-    [C_RMSE] = {"rel_rmse", true},        [C_RMSE_OBJ] = {"rel_rmse_object", false},
-    [C_RMSE_REC] = {"rel_rmse_receivers", false},
+    [C_RMSE] = {"rel_rmse", true, false, LR_PLAN_UNDER_REL_RMSE},
+    [C_RMSE_OBJ] = {"rel_rmse_object", false, false, LR_PLAN_UNDER_REL_RMSE_OBJECT},
+    [C_RMSE_REC] = {"rel_rmse_receivers", false, false, LR_PLAN_UNDER_REL_RMSE_RECEIVERS},
     [C_K] = {"K", true},                  [C_N] = {"N", true},
     [C_NVPL] = {"N_vpl", true},           [C_MAP] = {"map_size", true},
     [C_GBUF] = {"gbuffer_size", true},    [C_FRAMES] = {"frames", true},
     [C_VPL] = {"vpl", true},              [C_MS_G] = {"ms_gbuffer", false},
     [C_MS_R] = {"ms_radiosity", false},   [C_MS_V] = {"ms_vpl", false},
     [C_MS_C] = {"ms_compose", false},     [C_W] = {"width", false},
-    [C_H] = {"height", false},            [C_BIAS_O] = {"bias_object", false},
-    [C_BIAS_R] = {"bias_receivers", false}, [C_NOISE_O] = {"noise_object", false},
+    [C_H] = {"height", false},
+    [C_BIAS_O] = {"bias_object", false, false, LR_PLAN_UNDER_BIAS_OBJECT},
+    [C_BIAS_R] = {"bias_receivers", false, false, LR_PLAN_UNDER_BIAS_RECEIVERS},
+    [C_NOISE_O] = {"noise_object", false},
     [C_NOISE_R] = {"noise_receivers", false}, [C_SS] = {"supersample", false},
     [C_LPV] = {"lpv", false},             [C_MS_LPV] = {"ms_lpv", false},
     [C_MAL] = {"median_ln_object", false}, [C_MAL_FLOOR] = {"median_ln_floor", false},
@@ -153,8 +160,13 @@ static int parse_row(const char *name, int line, char **f, const int *at, lr_pla
 #define NUM(c, field) \
     if (cols[c].inf_ok && at[c] >= 0 && !strcmp(f[at[c]], "inf")) \
         r->field = INFINITY; \
-    else if ((rc = cell_number(name, line, cols[c].name, at[c] >= 0 ? f[at[c]] : "", \
-                               cols[c].required, &r->field, e))) \
+    else if (cols[c].floor_bit && at[c] >= 0 && f[at[c]][0] == '<') { \
+        if (cell_number(name, line, cols[c].name, f[at[c]] + 1, true, &r->field, e)) \
+            return cell_err(name, line, cols[c].name, e, "expected '<' and a finite number " \
+                            ">= 0 (an error under its noise floor)", f[at[c]]); \
+        r->under_floor |= cols[c].floor_bit; \
+    } else if ((rc = cell_number(name, line, cols[c].name, at[c] >= 0 ? f[at[c]] : "", \
+                                 cols[c].required, &r->field, e))) \
         return rc
 #define INT(c, field, min) \
     if ((rc = cell_int(name, line, cols[c].name, at[c] >= 0 ? f[at[c]] : "", cols[c].required, \
@@ -478,22 +490,30 @@ static double region_error(double bias, double noise)
     return isfinite(bias) && isfinite(noise) ? sqrt(bias * bias + noise * noise) : NAN;
 }
 
-static double rmse_part(const lr_plan_row *r)
+/* A bias under the reference's noise reads its floor (an upper bound): *at_most says so for
+ * the region whose error is returned. */
+static double rmse_part(const lr_plan_row *r, bool *at_most)
 {
     double o = region_error(r->bias_object, r->noise_object);
     double v = region_error(r->bias_receivers, r->noise_receivers);
-    if (isnan(o) && isnan(v))
+    bool ob = r->under_floor & LR_PLAN_UNDER_BIAS_OBJECT,
+         vb = r->under_floor & LR_PLAN_UNDER_BIAS_RECEIVERS;
+    if (isnan(o) && isnan(v)) {
+        *at_most = r->under_floor & LR_PLAN_UNDER_REL_RMSE;
         return r->rel_rmse;
-    if (isnan(o))
-        return v;
-    if (isnan(v))
+    }
+    if (isnan(v) || (!isnan(o) && o > v) || (!isnan(o) && o == v && !ob)) {
+        *at_most = ob;
         return o;
-    return o > v ? o : v;
+    }
+    *at_most = vb;
+    return v;
 }
 
 lr_plan_error_parts lr_plan_row_error_parts(const lr_plan_row *r)
 {
-    lr_plan_error_parts p = {rmse_part(r), NAN, r->band_excess};
+    lr_plan_error_parts p = {.median = NAN, .band = r->band_excess};
+    p.rmse = rmse_part(r, &p.rmse_at_most);
     /* Two references differ by the floor where both are noisy (the candle's dim sides: 0.44);
      * only what the model adds to it is the model's. */
     if (isfinite(r->median_ln_object))

@@ -125,6 +125,19 @@ static void test_csv(void **state)
     assert_non_null(fgets(line, sizeof line, f));
     assert_non_null(strstr(line, ",64,48,1,16,0.000,nan,nan,0.50000\n"));
     fclose(f);
+    /* An error debiased to 0 under its noise floor is written "<FLOOR" (at most the floor:
+     * the planner's table.c reads it so), never 0; an error of 0 without a floor stays 0. */
+    r[0].rel_rmse = 0.0, r[0].floor_rel_rmse = 0.07634;
+    r[0].bias_object = 0.0, r[0].floor_bias_object = 0.11061;
+    r[0].bias_receivers = 0.0, r[0].floor_bias_receivers = 0.0;
+    r[0].rel_rmse_object = 0.2, r[0].floor_rel_rmse_object = 0.05; /* above its floor */
+    assert_int_equal(lr_eval_csv_write(path, r, 2, &e), LR_OK);
+    assert_non_null(f = fopen(path, "r"));
+    assert_non_null(fgets(line, sizeof line, f));
+    assert_non_null(fgets(line, sizeof line, f));
+    assert_non_null(strstr(line, "vpl=on,12.500,<0.07634,0.20000,0.05000,16,"));
+    assert_non_null(strstr(line, ",4.000,<0.11061,0.00000,0.15000,"));
+    fclose(f);
     unlink(path);
     rmdir(dir);
     /* An unwritable place: an error naming it, no crash. */

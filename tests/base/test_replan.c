@@ -81,6 +81,21 @@ static void test_limits(void **state)
     assert_non_null(strstr(why, want));
     assert_null(lr_plan_model_limit(o, LR_SSS_DIRECTIONAL_DIPOLE, buf, sizeof buf));
     assert_near(1.0 - acosh(1.5), 0.0376, 1e-4); /* the header's 3.8 % at x = 1 */
+    /* A scene forcing the grid there is refused with the same rule, naming the field, the
+     * model, the material, its sigma_tr and the limit; the dipole it may keep. */
+    lr_err e = {0};
+    assert_int_equal(lr_plan_check_models(s, &e), LR_OK); /* the candle file's own model */
+    set(s, "objects[0].model", "diffusion_grid", NULL);
+    assert_int_equal(lr_plan_check_models(s, &e), LR_EINVAL);
+    char sig[64];
+    snprintf(sig, sizeof sig, "(sigma_tr %.3g /mm in its largest band; at most 1:",
+             fmax(o->coeffs.sigma_tr[0], fmax(o->coeffs.sigma_tr[1], o->coeffs.sigma_tr[2])));
+    if (!strstr(e.msg, "objects[0].model: diffusion_grid is outside its validity limit for "
+                       "'pillar' in porcelain: the grid spacing") || !strstr(e.msg, sig) ||
+        !strstr(e.msg, want))
+        fail_msg("%s", e.msg);
+    set(s, "objects[0].material", "candle_wax", NULL);
+    assert_int_equal(lr_plan_check_models(s, &e), LR_OK);
     lr_scene_destroy(s);
 
     lr_scene *shade = load("lampshade"); /* porcelain, 1.5 mm wall: mfp 0.17 to 0.18 mm */

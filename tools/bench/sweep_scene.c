@@ -134,6 +134,14 @@ static double debias(double rmse, double se)
     return v > 0.0 ? sqrt(v) : 0.0;
 }
 
+/* The noise debias takes out of an error: the floor an error of 0 is under (lr_eval_row's
+ * floor_* columns, written "<FLOOR"). se2 may be NaN (none). */
+static double noise_floor(double se, double se2)
+{
+    double v = (isfinite(se) ? se * se : 0.0) + (isfinite(se2) ? se2 * se2 : 0.0);
+    return sqrt(v);
+}
+
 int lrb_sweep_supersample(void)
 {
     const char *v = getenv("LRB_SWEEP_SUPERSAMPLE");
@@ -170,19 +178,24 @@ static int run_series(lr_gl *gl, lr_scene *s, const lrb_setting *st, int ss, lr_
 
 /* Bias of a series's converged image C against the physical reference: the reference's noise
  * (se) and C's own (its last checkpoint's noise about C, sigma^2 / F, scaled to sigma^2 / C)
- * taken out in quadrature. */
+ * taken out in quadrature; floor (may be NULL): the two noises together, objects then
+ * receivers, under which a bias of 0 lies. */
 static void series_bias(const lr_eval_series *ser, const lrb_setting *st, const float *ref,
                         const lr_eval_masks *m, const lrb_scene_result *res, double *bo,
-                        double *br)
+                        double *br, double floor[2])
 {
     const size_t n = (size_t)LRB_SWEEP_W * LRB_SWEEP_H;
     const float *C = ser->converged, *I = ser->image[st->ncheck - 1];
     const double Cf = st->converge_frames, Fl = st->checkpoints[st->ncheck - 1];
     const double k = sqrt(Fl / Cf) / sqrt(1.0 - Fl / Cf);
-    *bo = debias(debias(lr_eval_rel_rmse(C, ref, m->object, n), res->ref_se_object),
-                 lr_eval_rel_rmse(I, C, m->object, n) * k);
-    *br = debias(debias(lr_eval_rel_rmse(C, ref, m->receivers, n), res->ref_se_receivers),
-                 lr_eval_rel_rmse(I, C, m->receivers, n) * k);
+    const double own_o = lr_eval_rel_rmse(I, C, m->object, n) * k;
+    const double own_r = lr_eval_rel_rmse(I, C, m->receivers, n) * k;
+    *bo = debias(debias(lr_eval_rel_rmse(C, ref, m->object, n), res->ref_se_object), own_o);
+    *br = debias(debias(lr_eval_rel_rmse(C, ref, m->receivers, n), res->ref_se_receivers), own_r);
+    if (floor) {
+        floor[0] = noise_floor(res->ref_se_object, own_o);
+        floor[1] = noise_floor(res->ref_se_receivers, own_r);
+    }
 }
 
 /* Whether the cache in dir holds the reference d describes. */
@@ -429,8 +442,8 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
         const double Cf = st->converge_frames;
         /* Bias: converged model vs physical, without the reference's and the converged
          * image's own noise. */
-        double bias_obj, bias_rec;
-        series_bias(&ser, st, mean.rgb, &m, res, &bias_obj, &bias_rec);
+        double bias_obj, bias_rec, bias_floor[2];
+        series_bias(&ser, st, mean.rgb, &m, res, &bias_obj, &bias_rec, bias_floor);
         /* What a person sees on this setting's converged image (the rows' last columns). */
         lrb_fair seen = {0};
         fair_figures(C, &mean, &var, &rg, &m, mask, res->region_px, &seen);
@@ -463,6 +476,11 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
                 .bias_object = bias_obj, .bias_receivers = bias_rec,
                 .noise_object = lr_eval_rel_rmse(I, C, m.object, n) * fix,
                 .noise_receivers = lr_eval_rel_rmse(I, C, m.receivers, n) * fix,
+                /* Under its floor, an error reads "<FLOOR" in the table, not 0. */
+                .floor_rel_rmse = noise_floor(res->ref_se_all, NAN),
+                .floor_rel_rmse_object = noise_floor(res->ref_se_object, NAN),
+                .floor_rel_rmse_receivers = noise_floor(res->ref_se_receivers, NAN),
+                .floor_bias_object = bias_floor[0], .floor_bias_receivers = bias_floor[1],
                 .width = w, .height = h, .supersample = ss,
                 .median_ln_object = seen.mal, .median_ln_floor = res->mal_floor,
                 .band_excess = lrb_band_excess(seen.region_ratio),
@@ -514,7 +532,7 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
         } else {
             long px[LR_EVAL_REGION_COUNT];
             series_bias(&ser, &sh, mean.rgb, &m, res, &f->fig.bias_object,
-                        &f->fig.bias_receivers);
+                        &f->fig.bias_receivers, NULL);
             fair_figures(ser.converged, &mean, &var, &rg, &m, mask, px, &f->fig);
             f->fig.frame_ms = ser.frame_ms;
         }
@@ -541,7 +559,7 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
         const float *C = ss == 1 ? NULL : ser.converged;
         if (C) {
             series_bias(&ser, &set[0], mean.rgb, &m, res, &res->centre_bias_object,
-                        &res->centre_bias_receivers);
+                        &res->centre_bias_receivers, NULL);
             res->mal_centre = lr_eval_median_abs_log(C, mean.rgb, m.object, n);
             res->centre_receiver_ratio =
                 lr_eval_power_ratio(C, mean.rgb, var.rgb, m.receivers, n, -1);
@@ -564,7 +582,7 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
         int j = res->nss++;
         res->ss[j] = f;
         series_bias(&ser, &set[0], mean.rgb, &m, res, &res->ss_bias_object[j],
-                    &res->ss_bias_receivers[j]);
+                    &res->ss_bias_receivers[j], NULL);
         res->ss_mal[j] = lr_eval_median_abs_log(ser.converged, mean.rgb, m.object, n);
         fprintf(stderr, "bench sweep: %s supersampled %dx%d: bias %.4f / %.4f, median |ln| %.4f\n",
                 name, f, f, res->ss_bias_object[j], res->ss_bias_receivers[j], res->ss_mal[j]);
