@@ -279,8 +279,9 @@ static void test_sphere_and_votive_scenes(void **state)
     (void)state;
     /* The light sits inside solid material: the loader says so (issue 3: never a silent 0). */
     lr_scene *s = load_warns("configs/scenes/sphere.json",
-                             "sphere.json:16: lights[0] 'core' is inside the material of "
-                             "objects[0] 'ball'");
+                             "sphere.json:16: lights[0] 'core' at (0, 0, 0) is inside the "
+                             "material of objects[0] 'ball' (white_no_absorption): it "
+                             "lights nothing the renderer draws");
     assert_false(lr_scene_object_at(s, 0)->sd_raw); /* energy-normalised S_d by default */
     const lr_scene_object *o = lr_scene_object_at(s, 0);
     /* Non-absorbing: sigma_a = 0, so sigma_tr = 0 (albedo 1). */
