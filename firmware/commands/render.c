@@ -126,7 +126,7 @@ typedef struct stop_info {
     int requested;    /* --frames, 0: none */
     int skipped_from; /* --frames: the first frame (from 0) not drawn, -1: none */
     bool last_drawn;  /* with skipped_from: frame requested - 1 was drawn (a flickering light) */
-    char why[LR_ERR_MSG_MAX]; /* "" when nothing stopped early */
+    char why[1024]; /* "" when nothing stopped early */
 } stop_info;
 
 static void stop_explain(stop_info *s, const lr_scene *scene, const stats_log *log)
@@ -137,10 +137,10 @@ static void stop_explain(stop_info *s, const lr_scene *scene, const stats_log *l
     const lr_frame_stats *last = &log->v[log->n - 1];
     int target = lr_scene_render(scene)->frames;
     bool early = last->converged && last->deterministic && last->samples < target;
-    char conv[256];
+    char conv[512];
     if (early) {
         /* The objects' models: each B solved or evaluated, none sampled (renderer.h). */
-        char models[160] = "";
+        char models[128] = "";
         size_t used = 0;
         for (int i = 0; i < lr_scene_object_count(scene) && used < sizeof models; i++) {
             const lr_scene_object *o = lr_scene_object_at(scene, i);
