@@ -55,6 +55,25 @@ int lr_cli_fail(const char *path, const char *fmt, ...)
     return LR_EXIT_FAIL;
 }
 
+static void cli_warn(void *path, const char *msg)
+{
+    const char *p = path;
+    char line[LR_ERR_MSG_MAX];
+    snprintf(line, sizeof line, "%s", msg);
+    for (char *c = line; *c; c++) /* one line, as every message of the CLI */
+        if ((unsigned char)*c < 0x20 || *c == 0x7f)
+            *c = '?';
+    if (p)
+        fprintf(stderr, "lamprig %.*s: warning: %s\n", top_len(p), p, line);
+    else
+        fprintf(stderr, "lamprig: warning: %s\n", line);
+}
+
+lr_warn_sink lr_cli_warn_sink(const char *path)
+{
+    return (lr_warn_sink){cli_warn, (void *)path};
+}
+
 /* A top-level command is named by the prefix already: "--scene FILE is required"; a
  * subcommand says which one needs it: "dirpole needs --xo x,y,z". */
 static int missing(const char *path, const lr_argspec *s)

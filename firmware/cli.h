@@ -11,6 +11,7 @@
 
 #include "firmware/args.h"
 #include "render/base/progress.h"
+#include "render/base/warn.h"
 
 /* Exit statuses shared by every subcommand. */
 enum { LR_EXIT_OK = 0, LR_EXIT_FAIL = 1, LR_EXIT_USAGE = 2 };
@@ -57,6 +58,10 @@ int lr_cli_command(const lr_command *cmd, const char *parent, int argc, char **a
 int lr_cli_usage(const char *path, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* A failure after the arguments were accepted: `lamprig CMD: MESSAGE`, LR_EXIT_FAIL. */
 int lr_cli_fail(const char *path, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* The sink a command passes to lr_scene_load (and the other loaders that warn): each
+ * warning as one line `lamprig CMD: warning: MESSAGE` on stderr (CMD the top-level command of
+ * path, which must outlive the sink: the lr_cli's path does). */
+lr_warn_sink lr_cli_warn_sink(const char *path);
 /* Usage error for an option the command needs but did not get (the message of a missing
  * LR_ARG_REQUIRED option): LR_EXIT_OK when flag was given. */
 int lr_cli_need(const lr_cli *c, const char *flag);

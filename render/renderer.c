@@ -510,10 +510,25 @@ void lr_renderer_invalidate(lr_renderer *r, unsigned dirty)
     r->dirty |= dirty;
 }
 
-/* Frames to accumulate: render.frames, capped for half-float maps (LR_HALF_MAX_FRAMES). */
+/* Whether the accumulated maps are deterministic: made (since their last restart) without a
+ * per-frame sample. The frame-seeded estimator (lr_radiosity.sampled) and an area light's
+ * point p_f (render/area/frames.h: the G-buffer, the maps and the receivers' direct grid
+ * move with it) are the only inputs that change from one accumulation frame to the next;
+ * the VPLs (fixed directions), the receivers' grids, the bounce, the openings' light and
+ * composition are functions of the maps. */
+static bool maps_deterministic(const lr_renderer *r)
+{
+    return r->rad.F > 0 && !r->rad.sampled && !lr_area_direct_needed(r->scene);
+}
+
+/* Frames to accumulate: render.frames, capped for half-float maps (LR_HALF_MAX_FRAMES); 1
+ * for deterministic maps, whose every further frame would redraw the same values (issue 33:
+ * the grid, translucent radiosity and SH redrew one image render.frames times). */
 static int frames_target(const lr_renderer *r)
 {
     int f = lr_scene_render(r->scene)->frames;
+    if (maps_deterministic(r))
+        return 1;
     return r->map_format == LR_TEX_RGBA16F && f > LR_HALF_MAX_FRAMES ? LR_HALF_MAX_FRAMES : f;
 }
 
@@ -611,10 +626,13 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
                 st.total_ms += st.ms[i];
             }
     r->dirty = 0;
+    /* A restart this frame may have found the maps deterministic: the target after it. */
+    r->rs.frames = frames_target(r);
     st.index = r->frame_index++;
     st.passes = passes;
     st.samples = r->rad.F;
     st.converged = r->rad.F >= r->rs.frames;
+    st.deterministic = maps_deterministic(r);
     st.time_s = r->clock_set ? r->time_s : 0.0;
     if (stats)
         *stats = st;

@@ -15,7 +15,10 @@
  * the VPLs or the receivers); a material change the radiosity maps, VPLs, grids, composition
  * and blend; light or geometry changes everything. With nothing dirty, frames keep accumulating radiosity samples until
  * `render.frames` have been accumulated, then lr_renderer_needs_frame() turns false and the
- * caller only re-presents.
+ * caller only re-presents. Where nothing is sampled per frame (every object's B solved or
+ * evaluated: translucent_radiosity, diffusion_grid, sh_translucency; no area light) the first
+ * accumulation frame is the converged one, and lr_renderer_needs_frame() turns false after
+ * it whatever render.frames says (lr_frame_stats.deterministic).
  */
 #ifndef LR_RENDERER_H
 #define LR_RENDERER_H
@@ -50,7 +53,11 @@ typedef struct lr_frame_stats {
     double ms[LR_PASS_COUNT];    /* per pass, GPU time when timer queries exist, else CPU+finish */
     double total_ms;
     int samples;                 /* radiosity frames accumulated in the maps after this frame */
-    bool converged;              /* samples reached render.frames */
+    bool converged;              /* samples reached render.frames, or 1 where deterministic */
+    /* The maps' every frame is the same (no object's B is sampled per frame, no area light
+     * is sampled per frame): they converged after their first frame, and further frames
+     * cannot change the image (render/README.md, "When accumulation stops"). */
+    bool deterministic;
     double time_s;               /* the clock the frame was composed at (0 without one) */
 } lr_frame_stats;
 

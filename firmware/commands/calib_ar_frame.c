@@ -34,7 +34,8 @@ static int run(const lr_cli *c)
     int status = LR_EXIT_FAIL;
     if (!cal)
         return lr_cli_fail(c->path, "out of memory");
-    if (lr_scene_load(scene_path, NULL, &scene, &e) || lr_rig_calib_load(cdir, cal, &e)) {
+    lr_warn_sink warn = lr_cli_warn_sink(c->path);
+    if (lr_scene_load(scene_path, &warn, &scene, &e) || lr_rig_calib_load(cdir, cal, &e)) {
         lr_cli_fail(c->path, "%s", e.msg);
         goto done;
     }

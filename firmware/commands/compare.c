@@ -226,7 +226,8 @@ static int run_compare(const lr_cli *c)
                    rig->has_pose ? "" : "; pose.json is missing");
         goto fail;
     }
-    if (lr_scene_load(scene_path, NULL, &scene, &e))
+    lr_warn_sink warn = lr_cli_warn_sink(c->path);
+    if (lr_scene_load(scene_path, &warn, &scene, &e))
         goto fail;
     for (int i = 0; i < nsets; i++)
         if (lr_scene_set_assignment(scene, sets[i], NULL, &e)) {

@@ -330,7 +330,8 @@ static int run_fit(const lr_cli *c)
         lr_progress_meter_destroy(pm);
         return LR_EXIT_FAIL;
     }
-    if (lr_scene_load(scene_path, NULL, &scene, &e)) {
+    lr_warn_sink warn = lr_cli_warn_sink(c->path);
+    if (lr_scene_load(scene_path, &warn, &scene, &e)) {
         status = e.code == LR_EIO ? lr_cli_fail(c->path, "%s", e.msg)
                                   : lr_cli_usage(c->path, "%s", e.msg);
         goto done;

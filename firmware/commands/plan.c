@@ -98,7 +98,8 @@ static int run_plan(const lr_cli *c)
         return st;
 
     lr_scene *scene = NULL;
-    if (lr_scene_load(scene_path, NULL, &scene, &e)) {
+    lr_warn_sink warn = lr_cli_warn_sink(c->path);
+    if (lr_scene_load(scene_path, &warn, &scene, &e)) {
         if (e.code == LR_EIO)
             return lr_cli_fail(c->path, "%s", e.msg);
         return lr_cli_usage(c->path, "%s", e.msg);

@@ -61,6 +61,10 @@ static const lr_argspec opts[] = {
     {.name = "--plan-models",
      .help = "take the plan's model per object but keep the scene's render settings\n"
              "(K, N, N_vpl, maps, frames, lpv) and its VPL pass"},
+    {.name = "--allow-dark",
+     .help = "render even when no light lights anything the renderer draws (every\n"
+             "light inside a closed object's material, or of zero power): the image\n"
+             "is black; without it such a scene is refused (exit status 2)"},
     {.name = "--help-scene", .flags = LR_ARG_ALONE,
      .help = "print every scene field (type, range, default, what a change\n"
              "re-renders) as markdown, and exit"},
@@ -87,7 +91,13 @@ const lr_command lr_render_command = {
         "\n"
         "Files are written atomically. Output paths (--out, --hdr, --stats) are checked before\n"
         "anything renders: a directory or a missing folder is a bad argument.\n"
-        "Exit status: 0 done; 1 rendering or I/O failed; 2 bad arguments (one line on stderr).\n"
+        "The loader's warnings (a mesh repaired, a light that lights nothing) go to stderr.\n"
+        "A scene in which no light lights anything the renderer draws (every light inside a\n"
+        "closed object's material, or of zero power) is refused before rendering: its image\n"
+        "would be black; --allow-dark renders it anyway.\n"
+        "\n"
+        "Exit status: 0 done; 1 rendering or I/O failed; 2 bad arguments or a scene that\n"
+        "lights nothing (one line on stderr).\n"
         "\n"
         "Example:\n"
         "  lamprig render --scene configs/scenes/candle.json --out candle.png --stats s.json",
@@ -113,8 +123,59 @@ static int log_push(stats_log *l, const lr_frame_stats *s)
     return 0;
 }
 
+/* Why the render drew fewer frames than asked or than render.frames (issue 33): the maps
+ * converged early (deterministic ones after their first frame), and with --frames the
+ * frames that could not change the image were not drawn. */
+typedef struct stop_info {
+    int requested;    /* --frames, 0: none */
+    int skipped_from; /* --frames: the first frame (from 0) not drawn, -1: none */
+    bool last_drawn;  /* with skipped_from: frame requested - 1 was drawn (a flickering light) */
+    char why[1024]; /* "" when nothing stopped early */
+} stop_info;
+
+static void stop_explain(stop_info *s, const lr_scene *scene, const stats_log *log)
+{
+    s->why[0] = '\0';
+    if (!log->n)
+        return;
+    const lr_frame_stats *last = &log->v[log->n - 1];
+    int target = lr_scene_render(scene)->frames;
+    bool early = last->converged && last->deterministic && last->samples < target;
+    char conv[512];
+    if (early) {
+        /* The objects' models: each B solved or evaluated, none sampled (renderer.h). */
+        char models[128] = "";
+        size_t used = 0;
+        for (int i = 0; i < lr_scene_object_count(scene) && used < sizeof models; i++) {
+            const lr_scene_object *o = lr_scene_object_at(scene, i);
+            int w = snprintf(models + used, sizeof models - used, "%s%s %s", i ? ", " : "",
+                             o->name, lr_sss_model_name(o->sss_model));
+            used += w > 0 ? (size_t)w : 0;
+        }
+        snprintf(conv, sizeof conv, "converged after %d frame%s: deterministic (%s: nothing "
+                 "sampled per frame, so render.frames = %d would redraw the same maps)",
+                 last->samples, last->samples == 1 ? "" : "s", models, target);
+    } else {
+        snprintf(conv, sizeof conv, "converged after %d frames (render.frames)", last->samples);
+    }
+    if (s->skipped_from < 0) {
+        if (early)
+            snprintf(s->why, sizeof s->why, "%s", conv);
+        return;
+    }
+    /* Frames counted from 1 here, as --frames counts them. */
+    if (s->last_drawn)
+        snprintf(s->why, sizeof s->why, "%s; frames %d-%d of %d not drawn (they could not "
+                 "change the image), frame %d composed at its clock (t = %g s)", conv,
+                 s->skipped_from + 1, s->requested - 1, s->requested, s->requested,
+                 last->time_s);
+    else
+        snprintf(s->why, sizeof s->why, "%s; frames %d-%d of %d not drawn (they could not "
+                 "change the image)", conv, s->skipped_from + 1, s->requested, s->requested);
+}
+
 static int write_stats(const char *path, const lr_scene *scene, lr_renderer *r,
-                       const stats_log *log, lr_err *e)
+                       const stats_log *log, const stop_info *stop, lr_err *e)
 {
     /* Object pixels of the final image that no radiosity map sees (PIPELINE.md, pass 3). */
     int uncovered = -1;
@@ -154,6 +215,15 @@ static int write_stats(const char *path, const lr_scene *scene, lr_renderer *r,
         lr_jw_string(jw, o->name, lr_sss_model_name(o->sss_model));
     }
     lr_jw_object_end(jw);
+    if (stop->requested)
+        lr_jw_int(jw, "frames_requested", stop->requested);
+    else
+        lr_jw_null(jw, "frames_requested");
+    lr_jw_int(jw, "frames_drawn", log->n);
+    if (stop->why[0])
+        lr_jw_string(jw, "stopped_early", stop->why);
+    else
+        lr_jw_null(jw, "stopped_early");
     lr_jw_array(jw, "frames");
     for (int i = 0; i < log->n; i++) {
         const lr_frame_stats *s = &log->v[i];
@@ -172,6 +242,7 @@ static int write_stats(const char *path, const lr_scene *scene, lr_renderer *r,
         lr_jw_number_or_null(jw, "total_ms", s->total_ms);
         lr_jw_int(jw, "samples", s->samples);
         lr_jw_bool(jw, "converged", s->converged);
+        lr_jw_bool(jw, "deterministic", s->deterministic);
         lr_jw_number_or_null(jw, "time_s", s->time_s);
         lr_jw_object_end(jw);
     }
@@ -275,8 +346,10 @@ static int run_render(const lr_cli *c)
     lr_progress_meter *pm = NULL;
     lr_render_events ev = {0};
     stats_log log = {0};
+    stop_info stop = {.skipped_from = -1};
     lr_image img = {0};
-    if (lr_scene_load(scene_path, NULL, &scene, &e)) {
+    lr_warn_sink warn = lr_cli_warn_sink(c->path);
+    if (lr_scene_load(scene_path, &warn, &scene, &e)) {
         /* A scene that cannot be read or is invalid is bad input. */
         status = e.code == LR_EIO ? lr_cli_fail(c->path, "%s", e.msg)
                                   : lr_cli_usage(c->path, "%s", e.msg);
@@ -317,6 +390,22 @@ static int run_render(const lr_cli *c)
         status = lr_cli_usage(c->path, "%s", e.msg);
         goto done;
     }
+    /* A scene no light of which lights anything renders all zeros, whatever the model: say so
+     * before any pass runs (the loader has named each such light already), and refuse it
+     * unless asked (render/scene/dark.c; issue 33). Checked after --set and the plan. */
+    {
+        char why[LR_ERR_MSG_MAX];
+        if (lr_scene_dark(scene, why, sizeof why)) {
+            if (!lr_args_has(a, "--allow-dark")) {
+                status = lr_cli_usage(c->path, "%s: no light lights anything the renderer draws "
+                                      "(%s), so the image would be black; --allow-dark "
+                                      "renders it anyway", lr_scene_name(scene), why);
+                goto done;
+            }
+            lr_warn(&warn, "%s: no light lights anything the renderer draws (%s): the image is "
+                    "black (--allow-dark)", lr_scene_name(scene), why);
+        }
+    }
     if (lr_gl_create(NULL, &gl, &e) ||
         lr_renderer_create(&(lr_renderer_desc){.gl = gl, .scene = scene, .width = width,
                                                .height = height, .no_vpl = no_vpl,
@@ -336,6 +425,20 @@ static int run_render(const lr_cli *c)
             break;
         if (!frames && i >= 1000000)
             break;
+        /* --frames N: once the maps converged and every event is applied, frames i .. N - 2
+         * cannot change the image (their clock only moves the flicker, which the last frame
+         * sets): jump to frame N - 1, composed at its clock, which draws the blend alone for
+         * a flickering light and nothing for a steady one (issue 33: deterministic models
+         * converge in one frame). */
+        if (frames && i > 0 && i < frames - 1 && !lr_renderer_needs_frame(r) &&
+            next_ev >= ev.count) {
+            stop.skipped_from = i;
+            i = frames - 1;
+            lr_renderer_set_time(r, i / fps);
+            if (!lr_renderer_needs_frame(r))
+                break;
+            stop.last_drawn = true;
+        }
         while (next_ev < ev.count && ev.ev[next_ev].frame <= i) {
             const lr_render_event *x = &ev.ev[next_ev++];
             unsigned dirty = 0;
@@ -381,7 +484,11 @@ static int run_render(const lr_cli *c)
             goto done;
         }
     }
-    if (stats_path && write_stats(stats_path, scene, r, &log, &e)) {
+    stop.requested = frames;
+    stop_explain(&stop, scene, &log);
+    if (stop.why[0])
+        fprintf(stderr, "lamprig render: %s\n", stop.why);
+    if (stats_path && write_stats(stats_path, scene, r, &log, &stop, &e)) {
         status = lr_cli_fail(c->path, "%s", e.msg);
         goto done;
     }

@@ -16,3 +16,8 @@ void lr_warn(const lr_warn_sink *sink, const char *fmt, ...)
     va_end(ap);
     sink->fn(sink->user, msg);
 }
+
+void lr_warn_stderr(void *program, const char *msg)
+{
+    fprintf(stderr, "%s: warning: %s\n", program ? (const char *)program : "lamprig", msg);
+}

@@ -17,4 +17,9 @@ typedef struct lr_warn_sink {
  * NULL. */
 void lr_warn(const lr_warn_sink *sink, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
+/* A sink function for programs (library code never passes it itself): writes
+ * "PROGRAM: warning: MSG" and a newline to stderr, PROGRAM the user pointer (a string that
+ * outlives the sink, e.g. "lamprig-bench"). {lr_warn_stderr, "lamprig-cpuref"} is a sink. */
+void lr_warn_stderr(void *program, const char *msg);
+
 #endif

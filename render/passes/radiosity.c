@@ -248,6 +248,16 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
             rc = lr_radiosity_sh_project(rad, c, gb, e);
         if (rc)
             return rc;
+        /* radiosity.frag's branches: per-vertex B (u_tr_on) and the models without a profile
+         * (the grid's field, SH) are drawn without a sample; every other object is sampled
+         * afresh at each frame (u_frame). */
+        rad->sampled = false;
+        for (int i = 0; i < c->objs->n_objects; i++) {
+            bool per_vertex = i < LR_MAX_OBJECTS && rad->trB[i];
+            enum lr_sss_model m = lr_scene_object_at(c->scene, i)->sss_model;
+            if (!per_vertex && !lr_sss_model_props_of(m)->no_profile)
+                rad->sampled = true;
+        }
     }
     int F = rad->F + 1;
     int K = rad->K;

@@ -26,6 +26,11 @@ typedef struct lr_radiosity {
     lr_fb *fb[LR_MAX_LIGHTS * LR_MAX_K]; /* [l K + k] */
     float scale[LR_MAX_LIGHTS]; /* light l's maps store B * scale[l] */
     int F; /* frames accumulated */
+    /* Whether a frame's estimate differs from the last one's: some object's B is sampled by
+     * the estimator (seeded by the frame) rather than solved or evaluated (translucent
+     * radiosity's per-vertex B, the diffusion grid's field, SH: the same every frame). Set
+     * at each restart; false: the running mean is its first frame, to float rounding. */
+    bool sampled;
     /* Translucent radiosity (seed 000): the solver, rebuilt when geometry or materials
      * change, re-solved per light at each restart; per object a texture of its vertices' B,
      * rows tr_rows[i] per light (NULL for an object with another model). */

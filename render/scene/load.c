@@ -480,18 +480,24 @@ static int parse_document(ctx *c)
     }
     if ((rc = unique_names(c, objs, "objects", obj_name, no)))
         return rc;
-    /* A light inside solid material: every ray from it meets the surface from behind, which
-     * the surface-incidence BSSRDF (PIPELINE.md) counts as no light, so that object stays dark
-     * for this light. Say so rather than render 0 silently (issue 3). */
+    /* A light that lights nothing the renderer draws (render/scene/dark.c): inside solid
+     * material every ray from it meets the surface from behind, which the surface-incidence
+     * BSSRDF (PIPELINE.md) counts as no light; zero power is no light. Say so rather than
+     * render 0 silently (issues 3 and 33). */
     for (int i = 0; i < nl; i++) {
-        int k = -1;
-        if (lr_scene_light_enclosure(s, i, &k) == LR_ENCLOSURE_SOLID && k >= 0)
+        char why[LR_ERR_MSG_MAX];
+        if (!lr_scene_light_dark(s, i, why, sizeof why))
+            continue;
+        int line = lr_json_line(j, lr_json_at(j, lights, i));
+        if (lr_scene_light_enclosure(s, i, NULL) == LR_ENCLOSURE_SOLID)
             lr_warn(&s->warn,
-                    "%s:%d: lights[%d] '%s' is inside the material of objects[%d] '%s': the "
-                    "model has no term for a source embedded in the medium, so that object "
-                    "gets no light from it (put the light in a cavity: a hollow object)",
-                    s->path, lr_json_line(j, lr_json_at(j, lights, i)), i, s->light[i].name, k,
-                    s->obj[k].pub.name);
+                    "%s:%d: %s: it lights nothing the renderer draws (the model has no term "
+                    "for a source embedded in the medium; put the light in a cavity: a hollow "
+                    "object)",
+                    s->path, line, why);
+        else
+            lr_warn(&s->warn, "%s:%d: %s: it lights nothing the renderer draws", s->path, line,
+                    why);
     }
     return LR_OK;
 }

@@ -300,6 +300,17 @@ void lr_scene_bounds(const lr_scene *s, lr_vec3 *center, double *radius);
  * index of the (first) enclosing object, or -1. */
 enum lr_enclosure lr_scene_light_enclosure(const lr_scene *s, int light, int *object);
 
+/* Whether light `light` lights nothing the renderer draws (render/scene/dark.c): it is inside
+ * a closed object's material (LR_ENCLOSURE_SOLID: the models have no term for a source in the
+ * medium, and the object hides it from everything else) or has zero power (intensity x colour
+ * 0 in every band). why (may be NULL) gets one phrase naming the light and the cause, e.g.
+ * "lights[0] 'core' at (0, 0, 0) is inside the material of objects[0] 'ball' (marble)";
+ * empty when the light may light something. */
+bool lr_scene_light_dark(const lr_scene *s, int light, char *why, size_t cap);
+/* Whether every light of the scene lights nothing, so that every image of it is black; why
+ * gets their phrases joined by "; " (truncated to cap). */
+bool lr_scene_dark(const lr_scene *s, char *why, size_t cap);
+
 /* ---- Changes ------------------------------------------------------------------------------- */
 
 /* Sets one parameter by its scene-file name (see the top of this file) from its text value,

@@ -279,8 +279,9 @@ static void test_sphere_and_votive_scenes(void **state)
     (void)state;
     /* The light sits inside solid material: the loader says so (issue 3: never a silent 0). */
     lr_scene *s = load_warns("configs/scenes/sphere.json",
-                             "sphere.json:16: lights[0] 'core' is inside the material of "
-                             "objects[0] 'ball'");
+                             "sphere.json:16: lights[0] 'core' at (0, 0, 0) is inside the "
+                             "material of objects[0] 'ball' (white_no_absorption): it "
+                             "lights nothing the renderer draws");
     assert_false(lr_scene_object_at(s, 0)->sd_raw); /* energy-normalised S_d by default */
     const lr_scene_object *o = lr_scene_object_at(s, 0);
     /* Non-absorbing: sigma_a = 0, so sigma_tr = 0 (albedo 1). */
@@ -971,9 +972,63 @@ static void test_readme_field_reference(void **state)
     lr_test_doc_block("configs/scenes/README.md", "scene-fields", lr_scene_fields_markdown);
 }
 
+/* Issue 33: lights that light nothing the renderer draws. A box of wax (closed) holds light 0
+ * inside its material; light 1 has zero power; light 2, outside, lights the box. The loader
+ * warns for 0 and 1, naming each; the scene is dark only while light 2 is off too, and a
+ * change (lr_scene_set) is seen at once. */
+static void test_dark_lights(void **state)
+{
+    (void)state;
+    const char *text =
+        "{\"objects\": [{\"name\": \"block\", \"material\": \"candle_wax\",\n"
+        "  \"mesh\": {\"type\": \"box\", \"size\": [40, 40, 40]}}],\n"
+        " \"lights\": [\n"
+        "  {\"type\": \"point\", \"name\": \"in\", \"position\": [1, 2, 3], \"intensity\": 1},\n"
+        "  {\"type\": \"point\", \"name\": \"off\", \"position\": [0, 0, 100], "
+        "\"intensity\": 0},\n"
+        "  {\"type\": \"spot\", \"name\": \"side\", \"position\": [0, -200, 0], "
+        "\"direction\": [0, 1, 0], \"intensity\": 1, \"color\": [0, 0, 0]}],\n"
+        " \"camera\": {\"position\": [0, -300, 0], \"target\": [0, 0, 0], \"up\": [0, 0, 1]}}\n";
+    char name[128];
+    snprintf(name, sizeof name, "%s/dark.json", tmpdir);
+    warnings w = {0};
+    lr_warn_sink sink = {collect, &w};
+    lr_scene *s = NULL;
+    lr_err e = {0};
+    if (lr_scene_parse(text, strlen(text), name, &sink, &s, &e))
+        fail_msg("%s", e.msg);
+    assert_int_equal(w.n, 3);
+    assert_non_null(strstr(w.msg[0], "dark.json:4: lights[0] 'in' at (1, 2, 3) is inside the "
+                                     "material of objects[0] 'block' (candle_wax): it lights "
+                                     "nothing the renderer draws"));
+    assert_non_null(strstr(w.msg[1], "dark.json:5: lights[1] 'off' has zero power (intensity 0, "
+                                     "color 1, 1, 1): it lights nothing"));
+    assert_non_null(strstr(w.msg[2], "lights[2] 'side' has zero power (intensity 1, color 0, 0, 0)"));
+    char why[LR_ERR_MSG_MAX];
+    assert_true(lr_scene_dark(s, why, sizeof why));
+    assert_non_null(strstr(why, "lights[0] 'in' at (1, 2, 3) is inside the material"));
+    assert_non_null(strstr(why, "; lights[1] 'off' has zero power"));
+    assert_non_null(strstr(why, "; lights[2] 'side' has zero power"));
+    /* The spot gets a colour: it lights the box from outside. */
+    if (lr_scene_set(s, "lights[2].color", "1,1,1", NULL, &e))
+        fail_msg("%s", e.msg);
+    assert_false(lr_scene_light_dark(s, 2, why, sizeof why));
+    assert_string_equal(why, "");
+    assert_false(lr_scene_dark(s, why, sizeof why));
+    /* Moved into the box, it lights nothing again (the loader's warnings are not re-run: the
+     * check is the callers', after their changes). */
+    if (lr_scene_set(s, "lights[2].position", "0,0,-10", NULL, &e))
+        fail_msg("%s", e.msg);
+    assert_true(lr_scene_light_dark(s, 2, why, sizeof why));
+    assert_non_null(strstr(why, "lights[2] 'side' at (0, 0, -10) is inside the material"));
+    assert_true(lr_scene_dark(s, NULL, 0));
+    lr_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_dark_lights),
         cmocka_unit_test(test_candle_scene),
         cmocka_unit_test(test_jar_candle_scene),
         cmocka_unit_test(test_lampshade_scene),

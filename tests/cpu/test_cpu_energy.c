@@ -192,7 +192,7 @@ static void test_sphere_scene_light_in_medium(void **state)
     /* Never silently dark: the loader names the light, the object and the file:line. */
     print_message("warning: %s\n", warned);
     assert_non_null(strstr(warned, "sphere.json:"));
-    assert_non_null(strstr(warned, "lights[0] 'core' is inside the material of objects[0] 'ball'"));
+    assert_non_null(strstr(warned, "lights[0] 'core' at (0, 0, 0) is inside the material of objects[0] 'ball'"));
     int obj = -1;
     assert_int_equal(lr_scene_light_enclosure(s, 0, &obj), LR_ENCLOSURE_SOLID);
     const lr_scene_object *o = lr_scene_object_at(s, 0);

@@ -8,6 +8,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,6 +18,7 @@
 #include "render/base/file.h"
 #include "render/base/json.h"
 #include "render/image/image.h"
+#include "render/scene/scene.h"
 #include "tests/support/cli.h"
 #include "tests/support/fs.h"
 #include "tests/support/near.h"
@@ -120,7 +122,10 @@ static void test_render_writes_images_and_stats(void **state)
     FILE *f = fopen(ev, "w");
     fputs("# dimmer halfway down after convergence\n2 light.intensity 0.0025\n", f);
     fclose(f);
+    /* The directional dipole, which accumulates: the plan's diffusion_grid converges after
+     * its first frame (test_deterministic_stops_early). */
     int st = run("./build/bin/lamprig render --scene configs/scenes/candle.json " SMALL
+                 " --set objects[0].model=directional_dipole"
                  " --frames 4 --events %s --out %s/c.png --hdr %s/c.pfm --stats %s/s.json",
                  ev, dir, dir, dir);
     char *err = slurp("err");
@@ -152,6 +157,7 @@ static void test_render_writes_images_and_stats(void **state)
     lr_json_destroy(j);
     /* A steady flame (flicker.amplitude 0) at 10 fps: frame 3 has nothing left to do. */
     st = run("./build/bin/lamprig render --scene configs/scenes/candle.json " SMALL
+             " --set objects[0].model=directional_dipole"
              " --frames 4 --fps 10 --set lights[0].flicker.amplitude=0 --events %s --stats %s/s.json",
              ev, dir);
     if (st != 0)
@@ -259,9 +265,185 @@ static void test_output_paths_checked_first(void **state)
     }
 }
 
+/* Expects exit status 2, no summary line on stdout, and every needle on stderr. */
+static void expect_refused(const char *args, const char *const *needles, int n)
+{
+    int st = run("./build/bin/lamprig render %s", args);
+    char *err = slurp("err"), *out = slurp("out");
+    if (st != 2)
+        fail_msg("'%s': exit %d (expected 2), stderr '%s'", args, st, err);
+    for (int i = 0; i < n; i++)
+        if (!strstr(err, needles[i]))
+            fail_msg("'%s': stderr '%s' lacks '%s'", args, err, needles[i]);
+    if (strstr(out, "lamprig render:"))
+        fail_msg("'%s': rendered before refusing: '%s'", args, out);
+    free(err);
+    free(out);
+}
+
+/* Issue 33, "silent black renders": a scene no light of which lights anything renders all
+ * zeros (exactly: test_cpu_energy's Phi = 0), so the loader's warnings reach stderr (they were
+ * dropped: render passed no sink) and render refuses the scene before any pass runs (exit 2)
+ * unless --allow-dark. configs/scenes/sphere.json keeps its light inside the material on
+ * purpose (the energy test's counter-example, configs/scenes/README.md). */
+static void test_dark_scene_refused(void **state)
+{
+    const char *sphere[] = {
+        /* the loader's warning, naming the file:line, the light, where it is, the object */
+        "lamprig render: warning: configs/scenes/sphere.json:16: lights[0] 'core' at (0, 0, 0) "
+        "is inside the material of objects[0] 'ball' (white_no_absorption): it lights nothing "
+        "the renderer draws",
+        /* the refusal */
+        "lamprig render: sphere: no light lights anything the renderer draws", "--allow-dark"};
+    expect_refused("--scene configs/scenes/sphere.json " SMALL " --frames 1", sphere, 3);
+    /* A --set that darkens the scene: the check runs after --set (and the plan). */
+    const char *zero[] = {"lights[0] 'flame' has zero power (intensity 0, color 1, 0.55, 0.2)",
+                          "no light lights anything"};
+    expect_refused("--scene configs/scenes/candle.json --no-plan " SMALL
+                   " --set lights[0].intensity=0 --frames 1", zero, 2);
+    const char *wax[] = {"lights[0] 'flame' at (0, 0, 60) is inside the material of objects[0] "
+                         "'pillar' (candle_wax)"};
+    expect_refused("--scene configs/scenes/candle.json --no-plan " SMALL
+                   " --set lights[0].position=0,0,60 --frames 1", wax, 1);
+    /* --allow-dark renders it: black to the last bit, the table and wall included (the wax
+     * hides the flame from them too), with the warning. */
+    int st = run("./build/bin/lamprig render --scene configs/scenes/candle.json --no-plan " SMALL
+                 " --set lights[0].position=0,0,60 --frames 1 --allow-dark --hdr %s/d.pfm", dir);
+    char *err = slurp("err");
+    if (st != 0)
+        fail_msg("--allow-dark: exit %d: %s", st, err);
+    assert_non_null(strstr(err, "warning: candle: no light lights anything"));
+    free(err);
+    assert_true(radiance_sum("d.pfm") == 0.0);
+    /* The shipped candle lights something: no such warning. */
+    st = run("./build/bin/lamprig render --scene configs/scenes/candle.json --no-plan " SMALL
+             " --frames 1 --hdr %s/l.pfm", dir);
+    err = slurp("err");
+    if (st != 0 || strstr(err, "lights nothing") || strstr(err, "no light lights"))
+        fail_msg("candle: exit %d, stderr '%s'", st, err);
+    free(err);
+    assert_true(radiance_sum("l.pfm") > 0.0);
+    /* Every command that loads a scene prints the loader's warnings: plan too (which then
+     * refuses the scene for want of a budget). */
+    st = run("./build/bin/lamprig plan --scene configs/scenes/sphere.json");
+    err = slurp("err");
+    if (st != 2 || !strstr(err, "lamprig plan: warning: configs/scenes/sphere.json:16: "
+                                 "lights[0] 'core'"))
+        fail_msg("plan: exit %d, stderr '%s'", st, err);
+    free(err);
+}
+
+/* The image of a 32x24 PFM in dir (the caller frees img->rgb). */
+static void read_pfm(const char *file, lr_image *img)
+{
+    char path[512];
+    lr_err e = {0};
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    if (lr_image_read_pfm(path, img, &e))
+        fail_msg("%s", e.msg);
+    assert_int_equal(img->width * img->height, 32 * 24);
+}
+
+/* Issue 33, "deterministic models redraw identical frames": sh_translucency (like
+ * diffusion_grid and translucent_radiosity) draws the same maps every frame, so the renderer
+ * stops accumulating after the first one whatever render.frames says, and render --frames N
+ * draws no frame that cannot change the image. A stochastic model (the directional dipole,
+ * sampled afresh each frame) still draws every frame. The candle's light paths that cost CPU
+ * time (bounce, VPL visibility) are off: they do not decide when the maps converge. */
+#define FAST SMALL " --no-plan --set render.frames=8 --set render.receiver_bounce=false " \
+                   "--set render.vpl_visibility=false "
+static void test_deterministic_stops_early(void **state)
+{
+    lr_err e = {0};
+    /* A steady flame: one frame drawn of the 8 asked for. */
+    int st = run("./build/bin/lamprig render --scene configs/scenes/candle.json " FAST
+                 "--set objects[0].model=sh_translucency --set lights[0].flicker.amplitude=0 "
+                 "--frames 8 --hdr %s/steady.pfm --stats %s/s.json", dir, dir);
+    char *err = slurp("err");
+    if (st != 0)
+        fail_msg("exit %d: %s", st, err);
+    assert_non_null(strstr(err, "lamprig render: converged after 1 frame: deterministic "
+                                "(pillar sh_translucency"));
+    assert_non_null(strstr(err, "frames 2-8 of 8 not drawn"));
+    free(err);
+    lr_json *j = load_stats();
+    long n = -1;
+    assert_int_equal(lr_json_get_int(j, lr_json_root(j), "frames_requested", true, &n, &e), 0);
+    assert_int_equal(n, 8);
+    assert_int_equal(lr_json_get_int(j, lr_json_root(j), "frames_drawn", true, &n, &e), 0);
+    assert_int_equal(n, 1);
+    assert_int_equal(lr_json_count(j, lr_json_get(j, lr_json_root(j), "frames")), 1);
+    char why[LR_ERR_MSG_MAX];
+    assert_int_equal(lr_json_get_string(j, lr_json_root(j), "stopped_early", true, why,
+                                        sizeof why, &e), 0);
+    assert_non_null(strstr(why, "converged after 1 frame: deterministic"));
+    expect_frame(j, 0, "gbuffer,radiosity,vpl,compose,blend,irradiance", 1, true, 0.0);
+    bool det = false;
+    lr_jnode f0 = lr_json_at(j, lr_json_get(j, lr_json_root(j), "frames"), 0);
+    assert_int_equal(lr_json_get_bool(j, f0, "deterministic", true, &det, &e), 0);
+    assert_true(det);
+    lr_json_destroy(j);
+
+    /* The flickering flame: frame 8 is composed at its clock 7/30 s, the blend alone, so the
+     * image is the steady one times the flame's flicker factor then (transport is linear in
+     * the intensity), as 8 drawn frames gave it. */
+    st = run("./build/bin/lamprig render --scene configs/scenes/candle.json " FAST
+             "--set objects[0].model=sh_translucency --frames 8 --hdr %s/flicker.pfm "
+             "--stats %s/s.json", dir, dir);
+    if (st != 0)
+        fail_msg("exit %d (flicker)", st);
+    j = load_stats();
+    assert_int_equal(lr_json_get_int(j, lr_json_root(j), "frames_drawn", true, &n, &e), 0);
+    assert_int_equal(n, 2);
+    expect_frame(j, 1, "blend", 1, true, 7.0 / 30.0);
+    lr_json_destroy(j);
+    lr_scene *scene = NULL;
+    if (lr_scene_load("configs/scenes/candle.json", NULL, &scene, &e))
+        fail_msg("%s", e.msg);
+    double f = 0.0;
+    lr_light_flicker_at(lr_scene_light_at(scene, 0), 7.0 / 30.0, &f, NULL);
+    lr_scene_destroy(scene);
+    assert_true(fabs(f - 1.0) > 1e-3); /* the clock matters */
+    lr_image a = {0}, b = {0};
+    read_pfm("steady.pfm", &a);
+    read_pfm("flicker.pfm", &b);
+    double peak = 0.0, worst = 0.0;
+    for (int i = 0; i < 32 * 24 * 3; i++)
+        peak = fmax(peak, a.rgb[i]);
+    assert_true(peak > 0.0);
+    for (int i = 0; i < 32 * 24 * 3; i++)
+        worst = fmax(worst, fabs(b.rgb[i] - f * a.rgb[i]) / peak);
+    /* float32 products: a few ulp of the peak */
+    if (worst > 1e-6)
+        fail_msg("flicker image != %g x steady image: worst %g of the peak", f, worst);
+    lr_image_free(&a);
+    lr_image_free(&b);
+
+    /* The directional dipole samples each frame afresh: all 3 frames drawn, accumulating. */
+    st = run("./build/bin/lamprig render --scene configs/scenes/candle.json " FAST
+             "--set objects[0].model=directional_dipole --set lights[0].flicker.amplitude=0 "
+             "--frames 3 --stats %s/s.json", dir);
+    err = slurp("err");
+    if (st != 0 || strstr(err, "converged"))
+        fail_msg("dipole: exit %d, stderr '%s'", st, err);
+    free(err);
+    j = load_stats();
+    assert_int_equal(lr_json_get_int(j, lr_json_root(j), "frames_drawn", true, &n, &e), 0);
+    assert_int_equal(n, 3);
+    for (int i = 0; i < 3; i++)
+        expect_frame(j, i, i ? "radiosity,vpl,compose,blend,irradiance"
+                             : "gbuffer,radiosity,vpl,compose,blend,irradiance",
+                     i + 1, false, i / 30.0);
+    assert_int_equal(lr_json_type(j, lr_json_get(j, lr_json_root(j), "stopped_early")),
+                     LR_JSON_NULL);
+    lr_json_destroy(j);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_dark_scene_refused),
+        cmocka_unit_test(test_deterministic_stops_early),
         cmocka_unit_test(test_render_jar_candle),
         cmocka_unit_test(test_render_writes_images_and_stats),
         cmocka_unit_test(test_bad_arguments),

@@ -49,7 +49,7 @@ static int path_open(lr_gl *gl, const char *name, int p, int w, int h, path_stat
     char path[1024];
     snprintf(path, sizeof path, "%s/scenes/%s.json", lr_configs_dir(), name);
     lr_err e = {0};
-    if (lr_scene_load(path, NULL, &ps->s, &e)) {
+    if (lr_scene_load(path, &(const lr_warn_sink){lr_warn_stderr, "lamprig-bench"}, &ps->s, &e)) {
         fprintf(stderr, "bench camera: %s\n", e.msg);
         return 1;
     }

@@ -38,7 +38,7 @@ static lr_scene *load(const char *name)
     snprintf(path, sizeof path, "%s/scenes/%s.json", lr_configs_dir(), name);
     lr_scene *s = NULL;
     lr_err e = {0};
-    if (lr_scene_load(path, NULL, &s, &e))
+    if (lr_scene_load(path, &(const lr_warn_sink){lr_warn_stderr, "lamprig-bench"}, &s, &e))
         fprintf(stderr, "bench cpu: %s\n", e.msg);
     return s;
 }

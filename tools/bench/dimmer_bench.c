@@ -65,7 +65,7 @@ static int row(lr_gl *gl, const char *name, int w, int h, int reps, FILE *out)
     }
     double *dim = t, *flo = t + reps, *ratio = t + 2 * reps;
     double *cdim = t + 3 * reps, *cflo = t + 4 * reps, *cratio = t + 5 * reps;
-    if (lr_scene_load(path, NULL, &s, &e)) {
+    if (lr_scene_load(path, &(const lr_warn_sink){lr_warn_stderr, "lamprig-bench"}, &s, &e)) {
         fprintf(stderr, "bench dimmer: %s\n", e.msg);
         goto done;
     }

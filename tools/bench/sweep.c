@@ -150,6 +150,7 @@ static int run_opts(FILE *out, const lrb_options *opt)
         lr_renderer *r = NULL;
         char path[1024];
         snprintf(path, sizeof path, "%s/scenes/%s.json", lr_configs_dir(), names[0]);
+        /* A probe for the renderer string; the scene's sweep prints its warnings. */
         if (!lr_scene_load(path, NULL, &s, &e) &&
             !lr_renderer_create(&(lr_renderer_desc){.gl = gl, .scene = s, .width = 16, .height = 16},
                                 &r, &e))

@@ -373,7 +373,7 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
     const int ss = res->supersample;
     int rc;
     double t0 = lrb_now();
-    if ((rc = lr_scene_load(path, NULL, &s, &e)))
+    if ((rc = lr_scene_load(path, &(const lr_warn_sink){lr_warn_stderr, "lamprig-bench"}, &s, &e)))
         goto done;
     lr_ref_camera cam;
     if ((rc = lr_ref_scene_from_scene(s, &rs, &cam, &e)))
@@ -518,6 +518,7 @@ int lrb_sweep_scene(lr_gl *gl, const char *name, lr_eval_row *rows, int *nrows, 
         lrb_shipped *f = &res->shipped;
         lr_scene *s2 = NULL;
         lr_eval_series ser = {0};
+        /* The same file again: its warnings were printed at the first load. */
         if ((rc = lr_scene_load(path, NULL, &s2, &e)) || (rc = lrb_sweep_apply(s2, &sh, &e))) {
             lr_scene_destroy(s2);
             goto done;

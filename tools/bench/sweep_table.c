@@ -40,7 +40,7 @@ int lrb_sweep_time_640(lr_gl *gl, const char *name, lrb_timing_640 *out)
     lr_err e = {0};
     lr_scene *s = NULL;
     lr_renderer *r = NULL;
-    int rc = lr_scene_load(path, NULL, &s, &e);
+    int rc = lr_scene_load(path, &(const lr_warn_sink){lr_warn_stderr, "lamprig-bench"}, &s, &e);
     char v[32];
     /* Accumulation converges after the last accumulation frame, so the dimmer frames run
      * compose alone. */

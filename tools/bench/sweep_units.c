@@ -34,7 +34,7 @@ int lrb_sweep_units(lr_gl *gl, const char *name, double *ratio, double *se, long
     lr_ref_image mean = {0}, var = {0};
     lr_eval_masks m = {0};
     float *gpu = NULL;
-    int rc = lr_scene_load(path, NULL, &s, &e);
+    int rc = lr_scene_load(path, &(const lr_warn_sink){lr_warn_stderr, "lamprig-bench"}, &s, &e);
     if (!rc) {
         const lr_camera *c = lr_scene_camera(s);
         lr_vec3 far = lr_v3_sub(c->position, lr_v3_scale(lr_v3_sub(c->target, c->position), 10.0));

@@ -142,7 +142,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "lamprig-capsim: out of memory\n");
         return 1;
     }
-    if (lr_rig_calib_load(calib, rig, &e) || lr_scene_load(scene_path, NULL, &scene, &e))
+    if (lr_rig_calib_load(calib, rig, &e) || lr_scene_load(scene_path, &(const lr_warn_sink){lr_warn_stderr, "lamprig-capsim"}, &scene, &e))
         goto fail;
     if (!rig->has_camera || !rig->has_pose) {
         lr_err_set(&e, LR_EINVAL, "%s: needs camera.json (intrinsics) and pose.json (lamprig "

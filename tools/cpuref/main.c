@@ -104,7 +104,7 @@ int main(int argc, char **argv)
     d.seed = (unsigned)seed;
     lr_err e = {0};
     lr_scene *s;
-    if (lr_scene_load(scene_path, NULL, &s, &e)) {
+    if (lr_scene_load(scene_path, &(const lr_warn_sink){lr_warn_stderr, "lamprig-cpuref"}, &s, &e)) {
         fprintf(stderr, "lamprig-cpuref: %s\n", e.msg);
         return 1;
     }

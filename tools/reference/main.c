@@ -125,7 +125,7 @@ static int cmd_render(int argc, char **argv)
     lr_ref_render_desc d = {0};
     lr_ref_scene *s = NULL;
     lr_scene *project = NULL;
-    if (is_project_scene(scene) ? lr_scene_load(scene, NULL, &project, &e) ||
+    if (is_project_scene(scene) ? lr_scene_load(scene, &(const lr_warn_sink){lr_warn_stderr, "lamprig-reference"}, &project, &e) ||
                                       lr_ref_scene_from_scene(project, &s, &cam, &e)
                                 : lr_ref_scene_load(scene, &s, &cam, &d, &e)) {
         fprintf(stderr, "lamprig-reference: %s\n", e.msg);

@@ -41,7 +41,7 @@ int main(int argc, char **argv)
     }
     lr_err e = {0};
     lr_scene *s;
-    if (lr_scene_load(argv[1], NULL, &s, &e)) {
+    if (lr_scene_load(argv[1], &(const lr_warn_sink){lr_warn_stderr, "lamprig-transrad"}, &s, &e)) {
         fprintf(stderr, "lamprig-transrad: %s\n", e.msg);
         return 1;
     }
