@@ -1,0 +1,43 @@
+/* lamprig — a point light's irradiance integrated over a surface patch rather than sampled at
+ * a point.
+ *
+ * A unit-intensity point light at p gives a surface point x with normal n the irradiance
+ * E(x) = n . (p - x) / |p - x|^3 (cos theta / d^2), which diverges as p nears the surface. What
+ * a discretisation needs is the power the patch a sample stands for receives, and that is
+ * bounded: over a planar patch P with p on its front side,
+ *
+ *     int_P n . (p - x) / |p - x|^3 dA = Omega_P <= 2 pi,
+ *
+ * the solid angle P subtends at p (the integrand is the solid-angle measure). So the mean
+ * irradiance over the patch is Omega_P / A_P: for d >> sqrt(A_P) it tends to the point sample
+ * cos / d^2 (relative difference O(A_P / d^2)), and as d -> 0 it stays at most 2 pi / A_P.
+ * Solid angles of triangles by Van Oosterom & Strackee (1983):
+ *
+ *     tan(Omega / 2) = a . (b x c) / (|a||b||c| + (a.b)|c| + (a.c)|b| + (b.c)|a|),
+ *
+ * a, b, c the corners relative to p (exact; atan2 keeps the branch for Omega up to 2 pi).
+ * Users: the diffusion grid's boundary source (render/diffusion/dscene.c). */
+#ifndef LR_NEAR_LIGHT_H
+#define LR_NEAR_LIGHT_H
+
+#include "render/base/vec3.h"
+
+/* Signed solid angle of triangle (a, b, c) seen from p: positive when p lies on the side
+ * (b - a) x (c - a) points to, in [-2 pi, 2 pi]; 0 when p is in the triangle's plane. */
+double lr_solid_angle_triangle(lr_vec3 p, lr_vec3 a, lr_vec3 b, lr_vec3 c);
+
+/* Signed solid angle, seen from p, of the square of side `side` centred at c in the plane of
+ * unit normal n (positive on n's side). The square's edges are along a fixed tangent frame of
+ * n (lr_near_light_frame); its solid angle depends on that orientation only where the square's
+ * size is comparable to p's distance. */
+double lr_solid_angle_square(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side);
+
+/* Mean over that square of max(0, n . (p - x)) / |p - x|^3: the cell-averaged irradiance of a
+ * unit point light at p, max(0, Omega) / side^2; the point sample cos / d^2 at c when side is
+ * 0. Finite for every p off the square and at most 2 pi / side^2. */
+double lr_patch_irradiance(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side);
+
+/* The tangent frame (t1, t2) the square above uses: t1 . n = t2 . n = t1 . t2 = 0, unit. */
+void lr_near_light_frame(lr_vec3 n, lr_vec3 *t1, lr_vec3 *t2);
+
+#endif
