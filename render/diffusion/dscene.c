@@ -109,9 +109,11 @@ double lr_dscene_irradiance(const lr_scene_object *obj, const lr_light *light, l
     /* The light over the patch the sample stands for (near_light.h), not at its centre: the
      * point sample cos / r^2 diverges as the light nears the surface (the flame 0.1 mm above
      * the pool's floor gave 1e5 times the object's normal light), the patch's mean is at most
-     * 2 pi / cell^2. F_t and the profile stay the centre's (both <= 1). */
-    return lr_fresnel_transmittance(c, eta) * lr_patch_irradiance(light->position, b, n, cell) *
-           shape;
+     * 2 pi / cell^2. F_t at the patch's mean cosine (near the light most of the patch is
+     * lit at grazing angles from the centre's point of view, but not in solid angle); the
+     * spot profile stays the centre's. */
+    double mu = 0.0, E = lr_patch_irradiance(light->position, b, n, cell, &mu);
+    return lr_fresnel_transmittance(mu, eta) * E * shape;
 }
 
 static double q_fn(const void *ctx, lr_vec3 b, lr_vec3 n)

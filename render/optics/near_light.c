@@ -24,24 +24,57 @@ void lr_near_light_frame(lr_vec3 n, lr_vec3 *t1, lr_vec3 *t2)
     *t2 = lr_v3(b, s + n.y * n.y * a, -n.y);
 }
 
-double lr_solid_angle_square(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side)
+/* The square's corners, counter-clockwise about n (t1 x t2 = n). */
+static void square_corners(lr_vec3 c, lr_vec3 n, double side, lr_vec3 q[4])
 {
     lr_vec3 t1, t2;
     lr_near_light_frame(n, &t1, &t2);
-    /* t1 x t2 = n, so the corners counter-clockwise about n. */
     lr_vec3 e1 = lr_v3_scale(t1, 0.5 * side), e2 = lr_v3_scale(t2, 0.5 * side);
-    lr_vec3 q0 = lr_v3_sub(lr_v3_sub(c, e1), e2), q1 = lr_v3_sub(lr_v3_add(c, e1), e2);
-    lr_vec3 q2 = lr_v3_add(lr_v3_add(c, e1), e2), q3 = lr_v3_add(lr_v3_sub(c, e1), e2);
-    return lr_solid_angle_triangle(p, q0, q1, q2) + lr_solid_angle_triangle(p, q0, q2, q3);
+    q[0] = lr_v3_sub(lr_v3_sub(c, e1), e2);
+    q[1] = lr_v3_sub(lr_v3_add(c, e1), e2);
+    q[2] = lr_v3_add(lr_v3_add(c, e1), e2);
+    q[3] = lr_v3_add(lr_v3_sub(c, e1), e2);
 }
 
-double lr_patch_irradiance(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side)
+double lr_solid_angle_square(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side)
 {
-    if (!(side > 0.0)) {
-        lr_vec3 d = lr_v3_sub(p, c);
-        double r2 = lr_v3_dot(d, d);
-        double cn = lr_v3_dot(n, d);
-        return r2 > 0.0 && cn > 0.0 ? cn / (r2 * sqrt(r2)) : 0.0;
+    lr_vec3 q[4];
+    square_corners(c, n, side, q);
+    return lr_solid_angle_triangle(p, q[0], q[1], q[2]) +
+           lr_solid_angle_triangle(p, q[0], q[2], q[3]);
+}
+
+double lr_projected_solid_angle_square(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side)
+{
+    lr_vec3 q[4];
+    square_corners(c, n, side, q);
+    double sum = 0.0;
+    for (int k = 0; k < 4; k++) {
+        lr_vec3 a = lr_v3_sub(q[k], p), b = lr_v3_sub(q[(k + 1) & 3], p);
+        lr_vec3 x = lr_v3_cross(a, b);
+        double sx = lr_v3_len(x);
+        if (!(sx > 0.0))
+            continue; /* p on the edge's line: the edge subtends nothing */
+        double beta = atan2(sx, lr_v3_dot(a, b));
+        sum += beta * lr_v3_dot(x, n) / sx;
     }
-    return fmax(0.0, lr_solid_angle_square(p, c, n, side)) / (side * side);
+    return 0.5 * sum;
+}
+
+double lr_patch_irradiance(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side, double *mean_cos)
+{
+    lr_vec3 d = lr_v3_sub(p, c);
+    double r2 = lr_v3_dot(d, d), cn = lr_v3_dot(n, d);
+    double mu = r2 > 0.0 && cn > 0.0 ? cn / sqrt(r2) : 0.0, E;
+    if (!(side > 0.0)) {
+        E = mu > 0.0 ? mu / r2 : 0.0;
+    } else {
+        double om = lr_solid_angle_square(p, c, n, side);
+        E = fmax(0.0, om) / (side * side);
+        if (om > 0.0)
+            mu = fmin(1.0, fmax(0.0, lr_projected_solid_angle_square(p, c, n, side) / om));
+    }
+    if (mean_cos)
+        *mean_cos = E > 0.0 ? mu : 0.0;
+    return E;
 }

@@ -11,7 +11,10 @@
  * the solid angle P subtends at p (the integrand is the solid-angle measure). So the mean
  * irradiance over the patch is Omega_P / A_P: for d >> sqrt(A_P) it tends to the point sample
  * cos / d^2 (relative difference O(A_P / d^2)), and as d -> 0 it stays at most 2 pi / A_P.
- * Solid angles of triangles by Van Oosterom & Strackee (1983):
+ * Fresnel transmission depends on the cosine, which varies over the patch (near the light it
+ * spans 0..1): the patch's solid-angle-weighted mean cosine, Phi_P / Omega_P with Phi_P the
+ * projected solid angle (int cos d omega; Lambert's polygon formula, the form factor's), is
+ * the cosine to take F_t at. Solid angles of triangles by Van Oosterom & Strackee (1983):
  *
  *     tan(Omega / 2) = a . (b x c) / (|a||b||c| + (a.b)|c| + (a.c)|b| + (b.c)|a|),
  *
@@ -32,10 +35,16 @@ double lr_solid_angle_triangle(lr_vec3 p, lr_vec3 a, lr_vec3 b, lr_vec3 c);
  * size is comparable to p's distance. */
 double lr_solid_angle_square(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side);
 
+/* Projected solid angle of that square seen from p, int (n . w) d omega over the directions w
+ * from the square toward p (Lambert: 1/2 sum over edges of the angle they subtend times the
+ * cosine between n and the edge plane's normal); signed like the solid angle, |Phi| <= pi. */
+double lr_projected_solid_angle_square(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side);
+
 /* Mean over that square of max(0, n . (p - x)) / |p - x|^3: the cell-averaged irradiance of a
  * unit point light at p, max(0, Omega) / side^2; the point sample cos / d^2 at c when side is
- * 0. Finite for every p off the square and at most 2 pi / side^2. */
-double lr_patch_irradiance(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side);
+ * 0. Finite for every p off the square and at most 2 pi / side^2. mean_cos (may be NULL): the
+ * solid-angle-weighted mean cosine Phi / Omega (side 0: the centre's cosine), 0 when unlit. */
+double lr_patch_irradiance(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side, double *mean_cos);
 
 /* The tangent frame (t1, t2) the square above uses: t1 . n = t2 . n = t1 . t2 = 0, unit. */
 void lr_near_light_frame(lr_vec3 n, lr_vec3 *t1, lr_vec3 *t2);
