@@ -181,6 +181,8 @@ static void test_grid_flame_near_wax(void **state)
     lr_vec3 c, n;
     pool_face(s, lr_v3(20, 0, 115.3), &c, &n);
     assert_true(n.z > 0.5 && n.x < 0.0); /* facing up and in */
+    print_message("side: face centroid (%.6f, %.6f, %.6f), normal (%.6f, %.6f, %.6f)\n", c.x,
+                  c.y, c.z, n.x, n.y, n.z);
     sweep(s, d, "side", c, n);
     lr_dscene_destroy(d);
     lr_scene_destroy(s);
