@@ -78,3 +78,23 @@ double lr_patch_irradiance(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side, double 
         *mean_cos = E > 0.0 ? mu : 0.0;
     return E;
 }
+
+double lr_patch_irradiance_far(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side, double *mean_cos)
+{
+    lr_vec3 d = lr_v3_sub(p, c);
+    double r = lr_v3_len(d);
+    double t = side > 0.0 ? (r / side - LR_PATCH_FAR_LO) / (LR_PATCH_FAR_HI - LR_PATCH_FAR_LO)
+                          : 1.0;
+    t = fmin(1.0, fmax(0.0, t));
+    double w = t * t * (3.0 - 2.0 * t); /* GLSL smoothstep's */
+    double mu0 = 0.0, E0 = lr_patch_irradiance(p, c, n, 0.0, &mu0);
+    if (w >= 1.0) {
+        if (mean_cos)
+            *mean_cos = mu0;
+        return E0;
+    }
+    double mu1 = 0.0, E1 = lr_patch_irradiance(p, c, n, side, &mu1);
+    if (mean_cos)
+        *mean_cos = mu1 + w * (mu0 - mu1);
+    return E1 + w * (E0 - E1);
+}

@@ -19,7 +19,8 @@
  *     tan(Omega / 2) = a . (b x c) / (|a||b||c| + (a.b)|c| + (a.c)|b| + (b.c)|a|),
  *
  * a, b, c the corners relative to p (exact; atan2 keeps the branch for Omega up to 2 pi).
- * Users: the diffusion grid's boundary source (render/diffusion/dscene.c). */
+ * Users: the diffusion grid's boundary source (render/diffusion/dscene.c), sh_translucency's
+ * direct term (render/cpu/sh.c, render/shaders/lib/sh_translucency.glsl). */
 #ifndef LR_NEAR_LIGHT_H
 #define LR_NEAR_LIGHT_H
 
@@ -45,6 +46,16 @@ double lr_projected_solid_angle_square(lr_vec3 p, lr_vec3 c, lr_vec3 n, double s
  * 0. Finite for every p off the square and at most 2 pi / side^2. mean_cos (may be NULL): the
  * solid-angle-weighted mean cosine Phi / Omega (side 0: the centre's cosine), 0 when unlit. */
 double lr_patch_irradiance(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side, double *mean_cos);
+
+/* lr_patch_irradiance as a GPU estimator and its CPU twin compute it
+ * (render/shaders/lib/near_light.glsl): the patch mean up to LR_PATCH_FAR_LO sides from the
+ * centre, the point sample beyond LR_PATCH_FAR_HI, smoothstep-blended between. Far off, the
+ * two differ by O(side^2 / d^2) (the mean of a smooth E over the square: E + side^2 / 24
+ * times its tangential Laplacian, ~ 1e-3 E at 16 sides), while the solid angle's triple
+ * product loses ~ (d / side)^2 ulps to cancellation (float: ~1e-4 at 32 sides). */
+#define LR_PATCH_FAR_LO 16.0
+#define LR_PATCH_FAR_HI 32.0
+double lr_patch_irradiance_far(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side, double *mean_cos);
 
 /* The tangent frame (t1, t2) the square above uses: t1 . n = t2 . n = t1 . t2 = 0, unit. */
 void lr_near_light_frame(lr_vec3 n, lr_vec3 *t1, lr_vec3 *t2);
