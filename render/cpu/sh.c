@@ -6,6 +6,7 @@
 
 #include "render/cpu/parallel.h"
 #include "render/cpu/radiosity.h"
+#include "render/optics/near_light.h"
 
 /* The G-buffer's first surface along (org, dir), as render/cpu/radiosity.c's gbuffer_texel:
  * false when obj is missed or another object is nearer. */
@@ -135,21 +136,36 @@ void lr_cpu_sh_B(const lr_scene_object *obj, const lr_light *light, const lr_sh_
     lr_sh_translucency_B(&obj->coeffs, s, env, no, d, out);
     if (!lr_sh_lit(&obj->coeffs, obj->radius, d, lr_v3_dot(ni, no)))
         return;
-    /* The direct term: irradiance of the unit light at x_o (PIPELINE.md pass 4's receivers). */
-    double E, cos_i, direct[3];
+    /* The direct term: irradiance of the unit light at x_o (PIPELINE.md pass 4's receivers).
+     * A point light's is the mean over the square of side mfp about x_o (near_light.h), not
+     * the point sample cos / r^2, which diverges as the light nears the wall (1e-3 mm off the
+     * candle's pool: 524 times the light's power): what leaves x_o entered within the
+     * diffuse reflectance's spread around it, at least a mean free path (the mean of the
+     * bands', as lr_sh_lit's), so the light a point sample stands for is that patch's.
+     * lr_sh_direct takes cos_i times F_t(cos_i): here F_t at the patch's mean cosine times
+     * the patch's mean irradiance. */
+    double direct[3];
     if (light->type == LR_LIGHT_DIRECTIONAL) {
-        cos_i = -lr_v3_dot(no, lr_v3_normalize(light->direction));
-        E = 1.0;
-    } else {
-        lr_vec3 h = lr_v3_sub(light->position, xo);
-        double r2 = lr_v3_dot(h, h);
-        if (!(r2 > 0.0))
-            return;
-        lr_vec3 u = lr_v3_scale(h, 1.0 / sqrt(r2));
-        cos_i = lr_v3_dot(no, u);
-        E = lr_light_shape(light, lr_v3_scale(u, -1.0)) / r2;
+        lr_sh_direct(&obj->coeffs, -lr_v3_dot(no, lr_v3_normalize(light->direction)), direct);
+        for (int b = 0; b < 3; b++)
+            out[b] += direct[b];
+        return;
     }
-    lr_sh_direct(&obj->coeffs, cos_i, direct);
+    lr_vec3 h = lr_v3_sub(light->position, xo);
+    double r2 = lr_v3_dot(h, h);
+    if (!(r2 > 0.0))
+        return;
+    lr_vec3 u = lr_v3_scale(h, 1.0 / sqrt(r2));
+    if (!(lr_v3_dot(no, u) > 0.0))
+        return;
+    double side = (obj->coeffs.mfp[0] + obj->coeffs.mfp[1] + obj->coeffs.mfp[2]) / 3.0;
+    double mu = 0.0;
+    double E = lr_patch_irradiance_far(light->position, xo, no, side, &mu) *
+        lr_light_shape(light, lr_v3_scale(u, -1.0));
+    if (!(mu > 0.0))
+        return;
+    /* lr_sh_direct(mu) = rho F_t(mu) mu: divided by mu, rho F_t(mu). */
+    lr_sh_direct(&obj->coeffs, mu, direct);
     for (int b = 0; b < 3; b++)
-        out[b] += direct[b] * E;
+        out[b] += direct[b] / mu * E;
 }

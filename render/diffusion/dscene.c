@@ -9,6 +9,7 @@
 #include "render/cpu/cavity.h"
 #include "render/diffusion/bounce.h"
 #include "render/diffusion/dscene.h"
+#include "render/optics/near_light.h"
 #include "render/optics/optics.h"
 
 /* Relative residual of the render solves: B is read to float precision in the maps, and the
@@ -73,10 +74,11 @@ double lr_dscene_spacing(const lr_scene_object *o)
 typedef struct qctx {
     const lr_scene_object *obj;
     const lr_light *light;
+    double cell; /* the finest grid's spacing: the side of the patch a sample stands for */
 } qctx;
 
 double lr_dscene_irradiance(const lr_scene_object *obj, const lr_light *light, lr_vec3 b,
-                            lr_vec3 n)
+                            lr_vec3 n, double cell)
 {
     double eta = obj->material.medium.eta;
     double eps = 1e-5 * fmax(obj->radius, 1.0);
@@ -104,13 +106,20 @@ double lr_dscene_irradiance(const lr_scene_object *obj, const lr_light *light, l
         double t = e1 > e0 ? fmin(1.0, fmax(0.0, (x - e0) / (e1 - e0))) : (x >= e0 ? 1.0 : 0.0);
         shape = t * t * (3.0 - 2.0 * t);
     }
-    return lr_fresnel_transmittance(c, eta) * c / r2 * shape;
+    /* The light over the patch the sample stands for (near_light.h), not at its centre: the
+     * point sample cos / r^2 diverges as the light nears the surface (the flame 0.1 mm above
+     * the pool's floor gave 1e5 times the object's normal light), the patch's mean is at most
+     * 2 pi / cell^2. F_t at the patch's mean cosine (near the light most of the patch is
+     * lit at grazing angles from the centre's point of view, but not in solid angle); the
+     * spot profile stays the centre's. */
+    double mu = 0.0, E = lr_patch_irradiance(light->position, b, n, cell, &mu);
+    return lr_fresnel_transmittance(mu, eta) * E * shape;
 }
 
 static double q_fn(const void *ctx, lr_vec3 b, lr_vec3 n)
 {
     const qctx *q = ctx;
-    return lr_dscene_irradiance(q->obj, q->light, b, n);
+    return lr_dscene_irradiance(q->obj, q->light, b, n, q->cell);
 }
 
 /* The solver's B is the exitance, (1 - F_dr) J+ (dgrid.h). Composition renders every model's B
@@ -356,7 +365,9 @@ int lr_dscene_update(lr_dscene *d, const lr_scene *s, lr_err *e)
         const lr_dgrid *g = lr_dsolver_grid(D->solver);
         size_t nodes = lr_dgrid_node_count(g);
         for (int l = 0; l < L; l++) {
-            qctx q = {o, lr_scene_light_at(s, l)};
+            /* Every level's source is the finest cell's: the coarse levels only start the
+             * finest solve, whose right-hand side and field decide the result. */
+            qctx q = {o, lr_scene_light_at(s, l), h};
             if ((rc = lr_dsolver_solve(D->solver, l, q_fn, &q, LR_DSCENE_TOL, e)))
                 return lr_err_prefix(e, "objects[%d] (%s), light %d", i, o->name, l);
             d->iters += lr_dsolver_last_iters(D->solver);

@@ -8,8 +8,9 @@
  * few BiCGSTAB iterations. Objects with another model are skipped.
  *
  * The incident light q(b) per unit intensity (PIPELINE.md's units): point and spot lights
- * F_t(cos) cos / r^2 (spot: times the pass's smoothstep profile), directional lights F_t(cos)
- * cos; zero where the object itself shadows b (a ray against its BVH; other objects do not
+ * F_t(cos) times cos / r^2 averaged over the grid cell's patch of surface around b (the solid
+ * angle it subtends over its area; spot: times the pass's smoothstep profile), directional
+ * lights F_t(cos) cos; zero where the object itself shadows b (a ray against its BVH; other objects do not
  * shadow, as in the pass: "no scattering between objects").
  *
  * Cavity closure: q is the direct light only. When a point or spot light sits in the object's
@@ -70,8 +71,11 @@ int lr_dscene_last_iters(const lr_dscene *d);
 /* The grid spacing object o gets (its dgrid_h_mm, or the auto rule above). */
 double lr_dscene_spacing(const lr_scene_object *o);
 
-/* q for a unit-intensity light at b (normal n out of the object); shadowed by obj's mesh. */
+/* q for a unit-intensity light at b (normal n out of the object); shadowed by obj's mesh.
+ * Point and spot lights: the mean over the square of side `cell` centred at b in its tangent
+ * plane (render/optics/near_light.h: Omega / cell^2, bounded as the light nears the surface;
+ * the point sample cos / r^2 when cell is 0). */
 double lr_dscene_irradiance(const lr_scene_object *obj, const lr_light *light, lr_vec3 b,
-                            lr_vec3 n);
+                            lr_vec3 n, double cell);
 
 #endif

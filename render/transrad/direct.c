@@ -4,7 +4,14 @@
  * (point, spot) or cos (directional: unit radiance on a surface facing it), each point shadowed
  * by every surface (seed 000 Eq. 14's E). On a translucent patch the part that enters is
  * weighted by the boundary's F_t(cos) (Ein); the rest, Edir - Ein, is reflected by the
- * interface. Quad and disk lights: direct_area.c. */
+ * interface. Quad and disk lights: direct_area.c.
+ *
+ * Point and spot lights: the mean of point samples of cos / d^2 diverges as the light nears a
+ * patch (a sample 1e-3 mm off it weighs 1e6 / mm^2), while the patch receives at most 2 pi:
+ * its mean irradiance is Omega / A (near_light.h; Omega the solid angle of its front-facing
+ * triangles seen from the light), times the part of it the samples find lit (unshadowed,
+ * inside the spot's profile), weighted as the samples' own cos / d^2; F_t at the same
+ * weighting. Far off, Omega / A is the point mean to O(A / d^2). */
 #include "render/transrad/tr_priv.h"
 
 #include <math.h>
@@ -12,6 +19,7 @@
 
 #include "render/cpu/parallel.h"
 #include "render/cpu/rng.h"
+#include "render/optics/near_light.h"
 
 typedef struct dl_ctx {
     lr_tr *t;
@@ -78,10 +86,87 @@ void lr_tr_direct_patch(lr_tr *t, size_t p, lr_tr_point_irradiance point, const 
     }
 }
 
+/* Solid angle of patch p's front faces seen from x (the face's normal side). */
+static double patch_solid_angle(const lr_tr *t, size_t p, lr_vec3 x)
+{
+    const lr_tr_patch *P = &t->p[p];
+    const lr_tr_surf *sf = &t->surf[P->surface];
+    lr_vec3 q[4];
+    int nt;
+    double om = 0;
+    if (sf->d.kind == LR_TR_PLANE) {
+        lr_vec3 a = lr_v3_scale(sf->a, 0.5 * sf->d.size_u / sf->nu);
+        lr_vec3 b = lr_v3_scale(sf->b, 0.5 * sf->d.size_v / sf->nv);
+        q[0] = lr_v3_sub(lr_v3_sub(P->c, a), b);
+        q[1] = lr_v3_sub(lr_v3_add(P->c, a), b);
+        q[2] = lr_v3_add(lr_v3_add(P->c, a), b);
+        q[3] = lr_v3_add(lr_v3_sub(P->c, a), b);
+        double s = lr_v3_dot(lr_v3_cross(lr_v3_sub(q[1], q[0]), lr_v3_sub(q[2], q[0])), P->n);
+        om = lr_solid_angle_triangle(x, q[0], q[1], q[2]) +
+             lr_solid_angle_triangle(x, q[0], q[2], q[3]);
+        return fmax(0.0, s < 0 ? -om : om);
+    }
+    nt = (int)P->ntri;
+    for (int i = 0; i < nt; i++) {
+        size_t ti = t->tris[P->tri0 + (size_t)i];
+        lr_mesh_triangle(sf->d.mesh, ti, q);
+        lr_vec3 nn = lr_mesh_triangle_normal(sf->d.mesh, ti);
+        double s = lr_v3_dot(lr_v3_cross(lr_v3_sub(q[1], q[0]), lr_v3_sub(q[2], q[0])), nn);
+        double o = lr_solid_angle_triangle(x, q[0], q[1], q[2]);
+        om += fmax(0.0, s < 0 ? -o : o);
+    }
+    return om;
+}
+
+/* A point or spot light's Edir, Ein on patch p: Omega / A times the lit part (above). */
+static void point_patch(const dl_ctx *c, size_t p)
+{
+    lr_tr *t = c->t;
+    const lr_tr_surf *sf = &t->surf[t->p[p].surface];
+    bool trans = sf->d.kind == LR_TR_TRANSLUCENT;
+    double eta = trans ? sf->d.coeffs->eta : 1.0;
+    unsigned m = (unsigned)t->set.direct_samples;
+    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(t->set.seed, 0xD1EC, p, 0));
+    double ju = lr_cpu_rng_next(&rng), jv = lr_cpu_rng_next(&rng);
+    /* front: the unshadowed, unshaped point samples over the whole patch; lit: the open
+     * samples' shadowed, shaped ones. E = Omega / A times (lit / open) / (front / m): the
+     * whole patch's mean, scaled to its open part's (cover.c) and to the part lit. */
+    double lit = 0, lit_in = 0, front = 0;
+    unsigned open = 0;
+    for (unsigned k = 0; k < m; k++) {
+        lr_vec3 x, n;
+        lr_tr_patch_point(t, p, k, m, ju, jv, &x, &n);
+        lr_vec3 L = lr_v3_sub(c->light->position, x);
+        double d2 = lr_v3_dot(L, L), cs = lr_v3_dot(n, L);
+        if (d2 > 0 && cs > 0)
+            front += cs / (d2 * sqrt(d2));
+        if (lr_tr_point_covered(t, p, x))
+            continue;
+        open++;
+        double ek, eik;
+        point_irradiance(c, p, k, x, n, trans, eta, &ek, &eik);
+        lit += ek;
+        lit_in += eik;
+    }
+    double E = 0, Ein = 0;
+    if (front > 0 && lit > 0) {
+        double mean = patch_solid_angle(t, p, c->light->position) / t->p[p].area;
+        E = mean * (lit / open) / (front / m);
+        Ein = E * lit_in / lit;
+    }
+    for (int b = 0; b < 3; b++) {
+        t->Edir[3 * p + (size_t)b] = E;
+        t->Ein[3 * p + (size_t)b] = Ein;
+    }
+}
+
 static void dl_item(void *vctx, long item)
 {
     dl_ctx *c = vctx;
-    lr_tr_direct_patch(c->t, (size_t)item, point_irradiance, c);
+    if (c->light->type == LR_LIGHT_DIRECTIONAL)
+        lr_tr_direct_patch(c->t, (size_t)item, point_irradiance, c);
+    else
+        point_patch(c, (size_t)item);
 }
 
 int lr_tr_direct(lr_tr *t, const lr_light *light, lr_err *e)

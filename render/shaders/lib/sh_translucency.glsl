@@ -5,6 +5,8 @@
 // G-buffer depth toward x_o (Sec. 2.2) and a_c(d) = exp(-sigma_tr max(d, mfp)) (Eq. 12
 // integrated over the lit face). Needs gbuffer.glsl and material.glsl.
 
+#include "near_light.glsl"
+
 uniform vec3 u_sh_E[3 * LR_MAX_OBJECTS];  // 9 E_lm per object, light of this draw
 uniform vec3 u_sh_scale[LR_MAX_OBJECTS];  // s_c per object
 uniform vec4 u_sh_rho[LR_MAX_OBJECTS];    // rho_c (lr_dipole_rd_total), lit threshold in mm
@@ -61,18 +63,25 @@ vec3 lr_sh_translucency_B(int obj, lr_coeffs_gl mat, vec3 xo, vec3 no)
     // The direct term where x_o is the light's first surface (lr_sh_lit, lr_sh_direct).
     if (!(dot(ni, no) > 0.0) || !(d <= u_sh_rho[o].w))
         return B;
-    float cos_i, E;
+    // A point light's irradiance over the square of side mfp about x_o (lr_cpu_sh_B: the
+    // point sample diverges as the light nears the wall), F_t at the patch's mean cosine.
     if (u_light_type == LR_LIGHT_DIRECTIONAL) {
-        cos_i = -dot(no, u_light_dir);
-        E = 1.0;
-    } else {
-        vec3 h = u_light_pos - xo;
-        float r2 = dot(h, h);
-        vec3 u = h * inversesqrt(r2);
-        cos_i = dot(no, u);
-        E = light_shape(-u) / r2;
+        float cos_i = -dot(no, u_light_dir);
+        if (!(cos_i > 0.0))
+            return B;
+        return B + u_sh_rho[o].rgb * (lr_fresnel_transmittance(cos_i, mat.eta) * cos_i);
     }
-    if (!(cos_i > 0.0))
+    vec3 h = u_light_pos - xo;
+    float r2 = dot(h, h);
+    if (!(r2 > 0.0))
         return B;
-    return B + u_sh_rho[o].rgb * (lr_fresnel_transmittance(cos_i, mat.eta) * cos_i * E);
+    vec3 u = h * inversesqrt(r2);
+    if (!(dot(no, u) > 0.0))
+        return B;
+    float mu;
+    float side = (mat.mfp.x + mat.mfp.y + mat.mfp.z) / 3.0;
+    float E = lr_patch_irradiance_far(u_light_pos, xo, no, side, mu) * light_shape(-u);
+    if (!(mu > 0.0))
+        return B;
+    return B + u_sh_rho[o].rgb * (lr_fresnel_transmittance(mu, mat.eta) * E);
 }
