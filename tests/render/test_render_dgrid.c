@@ -5,7 +5,7 @@
  *     holds the twin's B at that texel's x_o (the twin solving the same scene on its own) to
  *     float rounding: |B_gpu - B_cpu| <= 1e-4 max B + 1e-3 B (the GPU computes the cell
  *     fractions in single precision; B is stored as B R^2 in RGBA32F).
- *  2. A light move re-solves warm-started (fewer iterations than the cold solve) and the maps
+ *  2. A small light move re-solves warm-started (fewer iterations than the cold solve) and the maps
  *     follow it (parity again after the move).
  *  3. Scene fields: model, dgrid_h_mm and dgrid_volume through lr_scene_set; an open mesh or a
  *     bad volume file is an error naming the object, not a crash.
@@ -104,18 +104,28 @@ static void test_parity_candle(void **state)
     assert_true(bmax > 0.0);
     assert_true(worst <= 1.0);
 
-    /* 2. the light moves 5 mm: warm-started re-solve, maps follow */
+    /* 2. the light moves: warm-started re-solves, maps follow. A warm start pays where the
+     * move is small against the flame's 5 mm from the pool floor (a flicker's jitter, a knob's
+     * step): 1 mm sideways takes 27 iterations against 31 cold. A 5 mm move changes 0.72 of
+     * the light on the wax, and the old field is then no better a start than the coarse grids
+     * (36 against 31; render/diffusion/README.md, the warm re-solve): that move checks only
+     * that the re-solve reuses the grid and the maps follow. */
     lr_dscene *d;
     lr_err e = {0};
     assert_int_equal(lr_dscene_create(&d, &e), LR_OK);
     assert_int_equal(lr_dscene_update(d, s, &e), LR_OK);
     int cold = lr_dscene_last_iters(d);
     assert_true(lr_dscene_rebuilt(d, 0));
-    lr_test_set(s, r, "lights[0].position", "5,0,117");
+    lr_test_set(s, r, "lights[0].position", "1,0,117");
     assert_int_equal(lr_dscene_update(d, s, &e), LR_OK);
     int warm = lr_dscene_last_iters(d);
     assert_false(lr_dscene_rebuilt(d, 0));
-    print_message("iterations: cold %d, after a 5 mm light move %d\n", cold, warm);
+    lr_test_set(s, r, "lights[0].position", "5,0,117");
+    assert_int_equal(lr_dscene_update(d, s, &e), LR_OK);
+    int warm5 = lr_dscene_last_iters(d);
+    assert_false(lr_dscene_rebuilt(d, 0));
+    print_message("iterations: cold %d, after a 1 mm light move %d, then 4 mm more %d\n", cold,
+                  warm, warm5);
     assert_true(warm < cold);
     lr_dscene_destroy(d);
     lr_test_converge(r, 4);
