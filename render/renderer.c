@@ -261,7 +261,7 @@ static int blend_run(lr_renderer *r, unsigned dirty, lr_err *e)
     return lr_blend_run(r->blend, &in, e);
 }
 
-/* What each scene change makes due (DESIGN.md "Data flow"; render/schedule.c says why). */
+/* What each scene change makes due (docs/ARCHITECTURE.md "Data flow"; render/schedule.c says why). */
 enum {
     D_TRANSPORT = LR_DIRTY_LIGHT_GEOMETRY | LR_DIRTY_GEOMETRY | LR_DIRTY_SETTINGS,
     D_MAPS = D_TRANSPORT | LR_DIRTY_MATERIAL,

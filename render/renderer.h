@@ -4,7 +4,7 @@
  * the calibration comparison runs use. The estimators each pass computes are fixed in
  * render/passes/PIPELINE.md; render/cpu/ is their CPU twin.
  *
- * Scheduling (DESIGN.md's table): the caller changes the scene with lr_scene_set(), which
+ * Scheduling (docs/ARCHITECTURE.md, "Data flow"): the caller changes the scene with lr_scene_set(), which
  * returns LR_DIRTY_* flags, and hands them to lr_renderer_invalidate(). The next
  * lr_renderer_frame() runs only the passes lr_dirty_passes() (render/schedule.h) names.
  * Composition renders one linear image per light at unit intensity for the current view (objects and receivers); the

@@ -1,7 +1,7 @@
 /* The scheduler's mapping from scene changes to passes (render/schedule.h). */
 #include "render/schedule.h"
 
-/* What each change invalidates (DESIGN.md, "Data flow"; the `dirty` column of the pass
+/* What each change invalidates (docs/ARCHITECTURE.md, "Data flow"; the `dirty` column of the pass
  * table in render/renderer.c):
  *  - intensity, colour, flicker (flicker is applied at composition's blend) and exposure:
  *    light transport is linear in intensity, so only the blend of the per-light

@@ -2,7 +2,7 @@
  *
  * The scene reports what changed (LR_DIRTY_* of render/scene/dirty.h, returned by
  * lr_scene_set); it knows nothing of render passes. The mapping from those changes to the
- * passes to re-run lives here, with the renderer (DESIGN.md's "Data flow" table; issue 15).
+ * passes to re-run lives here, with the renderer (docs/ARCHITECTURE.md, "Data flow" table; issue 15).
  */
 #ifndef LR_SCHEDULE_H
 #define LR_SCHEDULE_H

@@ -1,7 +1,7 @@
-/* lamprig — the planner: per object, the cheapest measured model and settings that meet the
- * scene's quality budget, and what the scene does not need (DESIGN.md, "A planner picks, per
- * object, the cheapest model and parameters (K, N, N_vpl, map sizes) that meet the scene's
- * error budget, from measured speed/error tables, and says what it chose").
+/* lamprig — the planner: per object, the cheapest measured model and parameters (K, N, N_vpl,
+ * map sizes) that meet the scene's quality budget, from measured speed/error tables, saying
+ * what it chose; and what the scene does not need (docs/ARCHITECTURE.md "The planner",
+ * render/plan/README.md).
  *
  * Three parts, pure C (no GL):
  *   table    the measured speed/error front: a CSV written by the bench sweep

@@ -1,7 +1,7 @@
 /* lamprig — the physical reference: a volumetric Monte Carlo path tracer on the CPU.
  *
- * This is the ground truth every rendering mode's error is measured against (DESIGN.md,
- * "CPU reference"; issue 6). It solves the radiative transfer equation by random walks, with
+ * This is the ground truth every rendering mode's error is measured against (docs/ARCHITECTURE.md,
+ * "CPU twin and reference"; issue 6). It solves the radiative transfer equation by random walks, with
  * no diffusion or dipole approximation:
  *
  *   media      homogeneous, sigma_a and sigma_s per colour band (mm^-1), Henyey-Greenstein

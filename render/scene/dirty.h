@@ -1,4 +1,4 @@
-/* lamprig — what a scene change invalidates (DESIGN.md, "Data flow" table).
+/* lamprig — what a scene change invalidates (docs/ARCHITECTURE.md, "Data flow" table).
  *
  * lr_scene_set() ORs one of these into the caller's mask for every parameter it changes. The
  * scene only reports what changed; which render passes that makes due is the renderer's

@@ -28,8 +28,8 @@
  * patch where it entered instead of at whichever centroid an entry point happened to fall
  * next to. An exit past the wall's end (a rim: the votive's 7 mm wax, spread over
  * millimetres) leaves through the end face the spread crosses (end_patch: a ray at mid-wall
- * along the spread); until 27 Nov it stayed where it entered, and the votive's rim, which
- * glows in the reference, rendered at the wall's level: 83 % of its receiver error (render/
+ * along the spread); left where it entered, the votive's rim, which glows in the
+ * reference, rendered at the wall's level: 83 % of its receiver error (render/
  * transrad/README.md). One that finds no face at all (an open one-sided edge; a rim patch's
  * own ray, which runs along the wall instead of across it) falls back to the unshifted point,
  * then to patch i itself: the light stays in the object (energy kept).
@@ -39,8 +39,8 @@
  * the exit at one centroid per patch, get the split between the faces wrong: at 12 mm
  * patches paper 0.1 mm sent 0.47 of the light out of the far face for T 0.22, porcelain
  * 1.5 mm 0.117 / 0.093 / 0.061 for T 0.100 / 0.076 / 0.045, and the votive's 7 mm wax (once
- * its mesh was refined into 12 mm patches) 0.26 for T 0.19. Until 27 Nov the rule was
- * r90 <= patch_mm / 4 (the wider profile's 90 % radius), which left the wax to the sums on the
+ * its mesh was refined into 12 mm patches) 0.26 for T 0.19. An earlier rule,
+ * r90 <= patch_mm / 4 (the wider profile's 90 % radius), left the wax to the sums on the
  * belief that wide profiles make them accurate; a wall curved over tens of patches is still
  * flat over d (the shades' radii are 70-110 mm, the votive's 33-40 mm). Thicker bodies (the
  * candle's 40-120 mm under its pool) keep the sums, whose in-object distances carry light

@@ -160,7 +160,7 @@ int lr_tr_set_albedo(lr_tr *t, int s, const double albedo[3], lr_err *e);
  * spread by the profiles. Why: T spreads over about d, and the two faces' patches overlap,
  * so exit centroids a patch apart sample T too coarsely to split the light between the faces
  * (the votive's 7 mm wax at 12 mm patches: 0.69 / 0.26 out of the lit / far face against the
- * slab's 0.76 / 0.19). The rule before 27 Nov (the wider profile's r90 <= patch_mm / 4) left
+ * slab's 0.76 / 0.19). An earlier rule (the wider profile's r90 <= patch_mm / 4) left
  * such walls to those centroid sums; it implied d <= patch_mm, as T's r90 is at least about
  * d. False for c NULL, d or patch_mm not positive. */
 bool lr_tr_wall_thin(const lr_coeffs *c, double d, double patch_mm);

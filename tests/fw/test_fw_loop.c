@@ -48,9 +48,9 @@ static double scene_num(lr_rig *r, const char *key)
  * MAX_LATENCY_MS; returns the number of events logged. The bound catches an event shown late
  * by a loop stuck behind work, not the work itself: the sim script's first preset (wax to
  * marble) re-plans and re-solves the candle's light on the CPU (its diffusion grid at the
- * finer spacing of the fifteenth session), measured from the event to its frame at 2.1 s
- * without sanitizers and 5.1-5.4 s under ASan on the 2-core machine, the same before and after
- * the seventeenth session's changes: over the 5 s this bound was. */
+ * spacing that resolves the pool's rim), measured from the event to its frame at 2.1 s without
+ * sanitizers and 5.1-5.4 s under ASan on the 2-core machine, over the 5 s a tighter bound
+ * would allow. */
 #define MAX_LATENCY_MS 10000.0
 static int check_stats(const char *path, int min_frames, int min_events)
 {

@@ -343,7 +343,7 @@ static void test_covered_cells(void **state)
  * sum over the planes of A f X (A f a cell's open area), equals the power absorbed,
  * sum A f (1 - rho)(X + E_b) over the planes plus sum A (1 - rho_o) E_b over the block, per
  * band; within 1.5 % (F's reciprocity by 512 rays a patch). With the block absorbing all it
- * gets (albedo 0, before 28 Nov) the balance misses by the block's reflected share. */
+ * gets (albedo 0, as an absorbing block would) the balance misses by the block's reflected share. */
 static void test_object_reflects(void **state)
 {
     (void)state;

@@ -1,5 +1,5 @@
-/* Hard cases of the render passes (DESIGN.md, "Hard cases that must stay finite and
- * sensible"): a light exactly on the surface, an object smaller than one map texel, a
+/* Hard cases of the render passes (docs/ARCHITECTURE.md, "Hard cases that must stay finite
+ * and sensible"): a light exactly on the surface, an object smaller than one map texel, a
  * zero-thickness shade, albedo -> 1 (spectralon), a light outside the object. Each must give
  * finite, non-negative HDR images, maps and VPLs, and an emergent power within the bounds
  * argued at check_energy. */

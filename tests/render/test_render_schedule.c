@@ -1,4 +1,4 @@
-/* Change-driven scheduling (DESIGN.md's table, render/renderer.h): which passes each kind of
+/* Change-driven scheduling (docs/ARCHITECTURE.md "Data flow", render/renderer.h): which passes each kind of
  * change re-runs, that a dimmer change rescales the image exactly, and that accumulation stops
  * at render.frames. */
 #include <setjmp.h>

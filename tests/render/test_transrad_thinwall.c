@@ -250,7 +250,7 @@ static void test_fresnel_slab_split(void **state)
 
 /* A 7 mm wax wall (the votive's), thin by the rule at 12 mm patches, under diffuse light on
  * its lit face: light spread past the wall's edge leaves through the end faces (the votive's
- * rim glows in the reference; until 27 Nov it stayed where it entered), the share the
+ * rim glows in the reference; left where it entered it would not), the share the
  * uniform-entry estimate gives (edge_share: its spread is millimetres, wide against the
  * entries' 0.75 mm spacing). Monte Carlo over the 16 edge patches' 4096 entries, a rim share
  * of a few per cent: 10 % allowed. */
@@ -400,7 +400,7 @@ static void test_rule(void **state)
     assert_false(lr_tr_wall_thin(&pa, 0.1, 0));
     assert_false(lr_tr_wall_thin(NULL, 0.1, 12));
     /* The boundary: d = patch_mm. Wax's r90 (diffusion lengths 8-17 mm) is far over a
-     * quarter of the patch, which the rule before 27 Nov asked for. */
+     * quarter of the patch, which an earlier rule asked for. */
     lr_tr_spread sp;
     lr_tr_spread_build(&wax, 12, &sp);
     assert_true(lr_tr_spread_r90(&sp) > 3);

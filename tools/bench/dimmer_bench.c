@@ -18,8 +18,8 @@
  * per-light images whatever their values (no per-pixel branch), so a converged image is not
  * needed and the first frame is cheaper. LRB_DIMMER_REPS (default 60, 1..1000) pairs;
  * LRB_DIMMER_SCENES ("candle,lampshade"-style list; default both). Runs with the other
- * sections under `make bench` (about a minute); the A/B table in tools/bench/README.md
- * ("SRGB8_ALPHA8 output") was made by running it from two binaries alternately.
+ * sections under `make bench` (about a minute); an A/B comparison runs it from two binaries
+ * alternately (tools/bench/README.md, "Dimmer against the floor").
  */
 #include <stdio.h>
 #include <stdlib.h>

@@ -29,8 +29,8 @@ static const lrb_section *find(const char *name)
 
 /* A section may pin the process to one CPU for its single-threaded timings (optics, cpu:
  * lrb_pin_to_current_cpu); the next section gets the CPUs the process started with back, or
- * llvmpipe, the rig's children and every later figure would run on one core (the whole
- * `make bench` of 27 Nov 04:51 did, after the optics section). */
+ * llvmpipe, the rig's children and every later figure would run on one core (a whole
+ * `make bench` without this did, after the optics section). */
 static int run_one(const lrb_section *s, const lrb_options *opt)
 {
     cpu_set_t cpus;

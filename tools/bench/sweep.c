@@ -134,7 +134,7 @@ static int run_opts(FILE *out, const lrb_options *opt)
         }
         ns++;
     }
-    /* The table in tools/bench/README.md: candle and lamp shade at 640x480. */
+    /* summary.md's timing table: candle and lamp shade at 640x480. */
     lrb_timing_640 t640[2];
     int nt = 0;
     const char *table_scenes[] = {"candle", "lampshade"};

@@ -64,8 +64,8 @@ int lrb_sweep_settings(lrb_setting *out, int cap)
     if (n > 0 && !strcmp(out[n - 1].label, "transrad+K=16"))
         out[n - 1].K = 16;
     ADD("diffusion_grid", model, "diffusion_grid"); /* seed 001 (render/diffusion/) */
-    /* The candles' rims by the flame need K 16 maps with the grid as with the dipole (the
-     * twelfth session's README: candle 0.172 at K 8, 0.088 at K 16). */
+    /* The candles' rims by the flame need K 16 maps with the grid as with the dipole
+     * (measured: candle 0.172 at K 8, 0.088 at K 16). */
     ADD("diffusion_grid+K=16", model, "diffusion_grid");
     if (n > 0 && !strcmp(out[n - 1].label, "diffusion_grid+K=16"))
         out[n - 1].K = 16;

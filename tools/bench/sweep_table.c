@@ -1,4 +1,4 @@
-/* tools/bench/README.md's 640x480 table (issue 6 item 4): per-pass frame times of the sweep's base
+/* summary.md's 640x480 table (issue 6 item 4): per-pass frame times of the sweep's base
  * setting at 640x480, the accumulation frame, and the dimmer-only frame (a light.intensity
  * change: compose alone) with its speed-up over a full update. */
 #include "tools/bench/sweep.h"
