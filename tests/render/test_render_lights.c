@@ -35,9 +35,15 @@
 #include "tests/support/near.h"
 #include "tests/support/render.h"
 
-LR_TEST_GL_FIXTURE(gl) /* tests/support/gl.h: setup(), teardown() */
+static lr_gl *gl;
 
 enum { W = 48, H = 36 };
+
+/* The one-light images (the flame alone, the side spot alone) that three tests compare their
+ * two-light renders with: rendered once per binary on first use (the renderer is
+ * deterministic for a scene, size and seed, so every test got the same numbers from its own
+ * copy) and freed with the context. */
+static float *alone[2];
 
 static const char *const flame =
     "{\"type\": \"point\", \"name\": \"flame\", \"position\": [0, 0, 117], \"intensity\": 0.005,"
@@ -77,6 +83,35 @@ static float *render(lr_scene *s, lr_renderer **keep)
     return h;
 }
 
+/* The image of light 0 (the flame) or 1 (the side spot) alone; owned by the group. */
+static const float *one_light(int which)
+{
+    if (!alone[which]) {
+        lr_scene *s = scene(which ? side : flame, NULL);
+        alone[which] = render(s, NULL);
+        lr_scene_destroy(s);
+    }
+    return alone[which];
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    return lr_test_gl_create(&gl) ? -1 : 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    for (int i = 0; i < 2; i++) {
+        free(alone[i]);
+        alone[i] = NULL;
+    }
+    lr_gl_destroy(gl);
+    gl = NULL;
+    return 0;
+}
+
 static double image_max(const float *a)
 {
     double m = 0.0;
@@ -113,18 +148,15 @@ static void assert_sum(const char *what, const float *got, const float *a, const
 static void test_two_lights_are_the_sum_of_one_light_each(void **state)
 {
     (void)state;
-    lr_scene *sa = scene(flame, NULL), *sb = scene(side, NULL), *s2 = scene(flame, side);
-    float *ha = render(sa, NULL), *hb = render(sb, NULL), *h2 = render(s2, NULL);
+    lr_scene *s2 = scene(flame, side);
+    const float *ha = one_light(0), *hb = one_light(1);
+    float *h2 = render(s2, NULL);
     /* Both lights matter (a renderer ignoring one of them fails the sum by far). */
     double ta = image_sum(ha), tb = image_sum(hb);
     print_message("flame alone %.4g, side spot alone %.4g\n", ta, tb);
     assert_true(ta > 0.05 * (ta + tb) && tb > 0.05 * (ta + tb));
     assert_sum("flame + side spot", h2, ha, hb, 1.0);
-    free(ha);
-    free(hb);
     free(h2);
-    lr_scene_destroy(sa);
-    lr_scene_destroy(sb);
     lr_scene_destroy(s2);
 }
 
@@ -134,8 +166,8 @@ static void test_two_lights_are_the_sum_of_one_light_each(void **state)
 static void test_cavity_gain_per_light(void **state)
 {
     (void)state;
-    lr_scene *sa = scene(flame, NULL), *sb = scene(side, NULL), *s2 = scene(side, flame);
-    float *ha = render(sa, NULL), *hb = render(sb, NULL);
+    lr_scene *s2 = scene(side, flame);
+    const float *ha = one_light(0), *hb = one_light(1);
     lr_renderer *r;
     float *h2 = render(s2, &r);
     double want[1][3];
@@ -156,20 +188,16 @@ static void test_cavity_gain_per_light(void **state)
         }
     }
     assert_sum("side spot + flame (the enclosed light second)", h2, hb, ha, 1.0);
-    free(ha);
-    free(hb);
     free(h2);
     lr_renderer_destroy(r);
-    lr_scene_destroy(sa);
-    lr_scene_destroy(sb);
     lr_scene_destroy(s2);
 }
 
 static void test_dimming_one_light_runs_compose_only(void **state)
 {
     (void)state;
-    lr_scene *sa = scene(flame, NULL), *sb = scene(side, NULL), *s2 = scene(flame, side);
-    float *ha = render(sa, NULL), *hb = render(sb, NULL);
+    lr_scene *s2 = scene(flame, side);
+    const float *ha = one_light(0), *hb = one_light(1);
     lr_renderer *r;
     float *h2 = render(s2, &r);
     assert_false(lr_renderer_needs_frame(r));
@@ -190,11 +218,7 @@ static void test_dimming_one_light_runs_compose_only(void **state)
     free(hz);
     free(hd);
     free(h2);
-    free(ha);
-    free(hb);
     lr_renderer_destroy(r);
-    lr_scene_destroy(sa);
-    lr_scene_destroy(sb);
     lr_scene_destroy(s2);
 }
 
