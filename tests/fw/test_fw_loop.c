@@ -45,13 +45,13 @@ static double scene_num(lr_rig *r, const char *key)
 }
 
 /* Checks a stats file: counts, and every event's latency >= 0 with a frame index, under
- * MAX_LATENCY_MS; returns the number of events logged. The bound catches an event shown late
- * by a loop stuck behind work, not the work itself: the sim script's first preset (wax to
- * marble) re-plans and re-solves the candle's light on the CPU (its diffusion grid at the
- * spacing that resolves the pool's rim), measured from the event to its frame at 2.1 s without
- * sanitizers and 5.1-5.4 s under ASan on the 2-core machine, over the 5 s a tighter bound
- * would allow. */
-#define MAX_LATENCY_MS 10000.0
+ * MAX_LATENCY_MS; returns the number of events logged. The bound catches an event never shown
+ * (a loop stuck behind work), not the work's cost, which `make bench` measures: the sim
+ * script's first preset (wax to marble) re-plans and re-solves the candle's light on the CPU
+ * inside the loop, measured from the event to its frame at 2.1 s without sanitizers and
+ * 5.1-5.4 s under ASan on an idle 2-core machine; tests/run.sh runs another binary beside this
+ * one, which gives the rig about half the CPUs and doubles that, and a loaded CI machine more. */
+#define MAX_LATENCY_MS 30000.0
 static int check_stats(const char *path, int min_frames, int min_events)
 {
     lr_json *j;
@@ -126,7 +126,9 @@ static void test_sim_in_process(void **state)
         fail_msg("%s", e.msg);
     assert_int_equal(lr_rig_run(r, &e), LR_OK); /* returns at --duration (from the end of create) */
     double took = (double)(lr_now_ns() - t0) * 1e-9;
-    assert_true(took >= 0.8 && took < 5.0);
+    /* At least the duration; the upper bound only catches a loop that never reaches it
+     * (start-up under ASan is 1-2 s idle, several times that beside other binaries). */
+    assert_true(took >= 0.8 && took < 20.0);
     assert_near(scene_num(r, "light.intensity"), 0.01, 1e-12);
     assert_near(scene_num(r, "lights[0].flicker.amplitude"), 0.2, 1e-9);
     char buf[64];
@@ -269,11 +271,13 @@ static pid_t spawn(char *const argv[], const char *err_path)
     return pid;
 }
 
-/* Waits for the child to exit (guard 20 s); returns its wait status. */
+/* Waits for the child to exit (guard 60 s: a `--duration 3` run under ASan takes 5-12 s
+ * beside other binaries; the guard only ends a child that never exits); returns its wait
+ * status. */
 static int reap(pid_t pid)
 {
     int st = 0;
-    for (int i = 0; i < 2000; i++) {
+    for (int i = 0; i < 6000; i++) {
         pid_t w = waitpid(pid, &st, WNOHANG);
         if (w == pid)
             return st;
