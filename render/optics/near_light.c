@@ -61,6 +61,21 @@ double lr_projected_solid_angle_square(lr_vec3 p, lr_vec3 c, lr_vec3 n, double s
     return 0.5 * sum;
 }
 
+double lr_projected_solid_angle_triangle(lr_vec3 p, lr_vec3 a, lr_vec3 b, lr_vec3 c, lr_vec3 n)
+{
+    lr_vec3 q[3] = {a, b, c};
+    double sum = 0.0;
+    for (int k = 0; k < 3; k++) {
+        lr_vec3 u = lr_v3_sub(q[k], p), v = lr_v3_sub(q[(k + 1) % 3], p);
+        lr_vec3 x = lr_v3_cross(u, v);
+        double sx = lr_v3_len(x);
+        if (!(sx > 0.0))
+            continue; /* p on the edge's line: the edge subtends nothing */
+        sum += atan2(sx, lr_v3_dot(u, v)) * lr_v3_dot(x, n) / sx;
+    }
+    return 0.5 * sum;
+}
+
 double lr_patch_irradiance(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side, double *mean_cos)
 {
     lr_vec3 d = lr_v3_sub(p, c);

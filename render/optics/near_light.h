@@ -20,7 +20,8 @@
  *
  * a, b, c the corners relative to p (exact; atan2 keeps the branch for Omega up to 2 pi).
  * Users: the diffusion grid's boundary source (render/diffusion/dscene.c), sh_translucency's
- * direct term (render/cpu/sh.c, render/shaders/lib/sh_translucency.glsl). */
+ * direct term (render/cpu/sh.c, render/shaders/lib/sh_translucency.glsl), translucent
+ * radiosity's direct term and its entering part (render/transrad/direct.c). */
 #ifndef LR_NEAR_LIGHT_H
 #define LR_NEAR_LIGHT_H
 
@@ -40,6 +41,12 @@ double lr_solid_angle_square(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side);
  * from the square toward p (Lambert: 1/2 sum over edges of the angle they subtend times the
  * cosine between n and the edge plane's normal); signed like the solid angle, |Phi| <= pi. */
 double lr_projected_solid_angle_square(lr_vec3 p, lr_vec3 c, lr_vec3 n, double side);
+
+/* Projected solid angle of triangle (a, b, c), unit normal n along (b - a) x (c - a), seen
+ * from p: int (n . w) d omega over the directions w toward p (Lambert, as the square's);
+ * signed like lr_solid_angle_triangle, |Phi| <= pi. Phi / Omega is the solid-angle-weighted
+ * mean cosine at which the light arrives on the triangle. */
+double lr_projected_solid_angle_triangle(lr_vec3 p, lr_vec3 a, lr_vec3 b, lr_vec3 c, lr_vec3 n);
 
 /* Mean over that square of max(0, n . (p - x)) / |p - x|^3: the cell-averaged irradiance of a
  * unit point light at p, max(0, Omega) / side^2; the point sample cos / d^2 at c when side is

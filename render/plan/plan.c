@@ -302,10 +302,11 @@ retry:
                 (lr_sss_model_parse(r->model, &rm) && (change_slow & LR_PLAN_MODEL_BIT(rm))) ||
                 !model_ok(r->model, models, o, c, &said))
                 continue;
-            /* A row that leaves a region of the measured view dark (band_excess inf: the wall
-             * of a row without VPLs) predicts no error at all: while a receiver sees the
-             * object, its light would be missing there, so the row never wins. */
-            if (need_vpl && !isfinite(lr_plan_row_error(r))) {
+            /* A row that leaves a region of the measured view dark (lr_plan_row_dark: band
+             * power at a tenth of the reference's or less, inf for the wall of a row without
+             * VPLs): while a receiver sees the object, its light would be missing there, so
+             * the row never wins, however small its error reads elsewhere. */
+            if (need_vpl && lr_plan_row_dark(r)) {
                 ndark += !pass;
                 continue;
             }
@@ -327,9 +328,9 @@ retry:
             cs[ncand++] = x;
         }
         if (!pass && ndark)
-            reason(c, "%d row%s left out: %s a region dark (no finite error), and a receiver "
-                      "sees %s", ndark, ndark == 1 ? "" : "s", ndark == 1 ? "it leaves" :
-                      "they leave", o->name);
+            reason(c, "%d row%s left out: %s a region dark (at a tenth of its light or "
+                      "less), and a receiver sees %s", ndark, ndark == 1 ? "" : "s",
+                   ndark == 1 ? "it leaves" : "they leave", o->name);
         if (!ncand && nscene && !pass)
             reason(c, "no measured row has K >= %d: using the most maps measured (K = %d)",
                    a->K_cover, kmax);
@@ -348,17 +349,18 @@ retry:
                           "allowed (--models) that the object can take%s",
                           o->name, c->table_scene, lr_plan_table_name(t),
                           ndark ? " and that lights every region in sight (the others leave "
-                                  "one dark: no finite error)" : "");
+                                  "one dark)" : "");
     }
 
     const cand *best = NULL;
     int nfeas = 0;
     for (int i = 0; i < ncand; i++) {
         const cand *x = &cs[i];
-        /* A budget holds only with a finite predicted error: a frame-only budget says
-         * nothing of the error, but a row whose error is unknown (a region dark, no receiver
-         * in sight) meets nothing. */
-        bool ok = isfinite(x->err) && (b->max_error <= 0 || x->err <= b->max_error) &&
+        /* A budget holds only with a finite predicted error and every region lit: a
+         * frame-only budget says nothing of the error, but a row that leaves a region dark
+         * (no receiver in sight, so still a candidate) meets nothing. */
+        bool ok = isfinite(x->err) && !lr_plan_row_dark(x->row) &&
+                  (b->max_error <= 0 || x->err <= b->max_error) &&
                   (b->frame_ms <= 0 || x->fms <= b->frame_ms);
         if (!ok)
             continue;
@@ -594,6 +596,7 @@ size_t lr_plan_format_brief(const lr_plan *p, char *buf, size_t cap)
     /* The scene's figures are its worst object's: one settings block renders them all. */
     double err = 0.0, fms = 0.0, over = 0.0;
     bool at_most = false; /* the worst error is a noise floor (error_at_most) */
+    bool dark = false;    /* a chosen row leaves a region dark (lr_plan_row_dark) */
     put(&o, "plan: %s: ", p->scene);
     for (int i = 0; i < p->nobjects; i++) {
         const lr_plan_choice *c = &p->objects[i];
@@ -607,12 +610,14 @@ size_t lr_plan_format_brief(const lr_plan *p, char *buf, size_t cap)
         err = isfinite(c->predicted_error) && isfinite(err) ? fmax(err, c->predicted_error)
                                                             : INFINITY;
         fms = fmax(fms, c->predicted_frame_ms);
+        dark |= lr_plan_row_dark(&c->row);
         over = fmax(over, shortfall(&(cand){.err = c->predicted_error,
                                             .fms = c->predicted_frame_ms},
                                     &p->budget));
     }
     if (isfinite(err))
-        put(&o, ", predicted error %s%.3g", at_most ? "at most " : "", err);
+        put(&o, ", predicted error %s%.3g%s", at_most ? "at most " : "", err,
+            dark ? " (a region left dark)" : "");
     else
         put(&o, ", no finite predicted error (a region left dark)");
     put(&o, ", %.0f ms a frame on this table; the budget (", fms);

@@ -102,6 +102,21 @@ lr_plan_error_parts lr_plan_row_error_parts(const lr_plan_row *r);
  * columns (tables from before them, hand-made tables) predict the RMSE part alone. */
 double lr_plan_row_error(const lr_plan_row *r);
 
+/* A region a person sees as unlit: the worst region-band power ratio R at a tenth of the
+ * reference's light or less, beyond its noise (band_excess = max(0, |ln R| - 2 se / R) over
+ * ln 10). Why a tenth: the eye's response to luminance is about logarithmic (lightness
+ * L* ~ Y^(1/3) puts Y = 0.1 at L* 38 against 100, the step from a lit wall to one in shadow),
+ * so a region at 0.1 of its light reads as not lit by the lamp, while the lit rows of the
+ * committed table stay inside e^-1.8 = 0.17 (jar_candle's sh_translucency) and the VPL-free
+ * row that drops the wall's bounce reads e^-8.03. band_excess holds |ln R| only, so a region
+ * ten times too bright counts too: it is as far from what the lamp gives. */
+#define LR_PLAN_DARK_LN 2.302585092994046 /* ln 10 */
+
+/* Whether the row leaves a region dark: band_excess inf (a region with no light at all, the
+ * wall of a row without VPLs) or above LR_PLAN_DARK_LN. Such a row never wins while a
+ * receiver sees the object and never meets a budget, a frame-only one included. */
+bool lr_plan_row_dark(const lr_plan_row *r);
+
 /* Parses CSV text. The first line is the header; columns are looked up by name, in any order;
  * unknown columns are ignored. Required: scene, model, frame_ms, rel_rmse, K, N, N_vpl,
  * map_size, gbuffer_size, frames, vpl. Errors name "NAME:LINE: column 'C': what" (a missing

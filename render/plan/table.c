@@ -532,3 +532,9 @@ double lr_plan_row_error(const lr_plan_row *r)
         e = p.band;
     return e;
 }
+
+bool lr_plan_row_dark(const lr_plan_row *r)
+{
+    /* NaN (no band column) is not dark: hand-made tables predict the RMSE part alone. */
+    return r->band_excess > LR_PLAN_DARK_LN;
+}
