@@ -5,7 +5,9 @@
  *  - a corrupt cache (a flipped payload byte, a flipped key byte, a truncated file, garbage,
  *    an empty file) is never used: create rebuilds, solves to the same W, and rewrites it, so
  *    the next create hits again;
- *  - a folder that cannot be written costs only the cache (create succeeds, no hit);
+ *  - a folder that cannot be written costs only the cache (create succeeds, no hit); a
+ *    read-only one (a tmpfs mounted ro) is said through the settings' warn sink, once over two
+ *    creates sharing a lr_warn_once, and at each create without one;
  *  - the checked file under both caches (render/reference/cache_file.h): pieces read back as
  *    written, and a flipped magic, header or payload byte, a short file or an absent one read
  *    as absent. */
@@ -16,6 +18,8 @@
 #include <cmocka.h>
 
 #include <dirent.h>
+#include <errno.h>
+#include <sys/stat.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,6 +29,7 @@
 #include "render/base/paths.h"
 #include "render/reference/cache_file.h"
 #include "render/transrad/transrad.h"
+#include "tests/support/fs.h"
 
 static char dir[256];
 
@@ -268,12 +273,78 @@ static void test_unwritable_folder(void **state)
     lr_scene_destroy(s);
 }
 
+typedef struct said {
+    int n;
+    char last[LR_ERR_MSG_MAX];
+} said;
+
+static void count_warning(void *user, const char *msg)
+{
+    said *w = user;
+    w->n++;
+    snprintf(w->last, sizeof w->last, "%s", msg);
+}
+
+static void create_warned(const lr_scene *s, const char *cache, said *w, lr_warn_once *once)
+{
+    lr_tr_settings set = {.patch_mm = 30, .receiver_mm = 150, .rays_per_patch = 64, .seed = 9,
+                          .cache_dir = cache, .warn = {count_warning, w}, .warned = once};
+    lr_tr *t;
+    lr_err e = {0};
+    if (lr_tr_create_scene(s, &set, &t, &e))
+        fail_msg("%s", e.msg);
+    assert_false(lr_tr_cache_hit(t));
+    lr_tr_destroy(t);
+}
+
+/* A read-only cache folder: every store fails; said once per folder over two creates with
+ * the caller's lr_warn_once (the message names the folder and the reason), at every create
+ * without one. A writable folder says nothing. */
+static void test_store_failure_said_once(void **state)
+{
+    (void)state;
+    char *root = lr_test_tmpdir();
+    char *ro = lr_test_path(root, "ro");
+    assert_int_equal(mkdir(ro, 0700), 0);
+    if (lr_test_mount_tmpfs(ro, 256, 1) != 0) {
+        print_message("skipped: mount: %s (needs root)\n", strerror(errno));
+        free(ro);
+        lr_test_rmtree(root);
+        skip();
+    }
+    lr_scene *s = load();
+    said w = {0};
+    lr_warn_once once = {0};
+    create_warned(s, ro, &w, &once);
+    create_warned(s, ro, &w, &once);
+    assert_int_equal(w.n, 1);
+    print_message("said: %s\n", w.last);
+    assert_non_null(strstr(w.last, ro));
+    assert_non_null(strstr(w.last, "Read-only file system"));
+    assert_non_null(strstr(w.last, "rebuilt at every start"));
+    said w2 = {0};
+    create_warned(s, ro, &w2, NULL);
+    create_warned(s, ro, &w2, NULL);
+    assert_int_equal(w2.n, 2);
+    said w3 = {0};
+    lr_warn_once once3 = {0};
+    char *rw = lr_test_path(root, "rw");
+    create_warned(s, rw, &w3, &once3);
+    assert_int_equal(w3.n, 0);
+    lr_scene_destroy(s);
+    lr_test_umount(ro);
+    free(ro);
+    free(rw);
+    lr_test_rmtree(root);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hit_and_keys),
         cmocka_unit_test(test_corrupt),
         cmocka_unit_test(test_unwritable_folder),
+        cmocka_unit_test(test_store_failure_said_once),
         cmocka_unit_test(test_cache_file),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
