@@ -2,6 +2,9 @@
  *  - a second create with the same scene and settings takes F and S from the file and solves
  *    to the same W bit for bit;
  *  - another setting (rays per patch) or another material is another key: a miss, a new file;
+ *  - a file re-signed (a valid hash) with F x 1000 or S x 1000, finite but beyond energy
+ *    conservation (F's row sum with the escape <= 1, S's column power <= the source's), is
+ *    refused and rebuilt to the same W;
  *  - a corrupt cache (a flipped payload byte, a flipped key byte, a truncated file, garbage,
  *    an empty file) is never used: create rebuilds, solves to the same W, and rewrites it, so
  *    the next create hits again;
@@ -202,6 +205,72 @@ static void test_corrupt(void **state)
     lr_scene_destroy(s);
 }
 
+/* Rewrites the cache file with piece `piece` (2 F values, 6 S values: float arrays) scaled by
+ * k and a valid hash (as a foreign writer would). */
+static void resign_scaled(const char *path, int piece, float k)
+{
+    uint64_t w[4];
+    char *data = NULL;
+    const unsigned char *payload;
+    size_t len;
+    assert_true(lr_cache_file_read(path, "LRTRC002", w, 4, &data, &payload, &len));
+    size_t n = (size_t)w[1], nf = (size_t)w[2], ns = (size_t)w[3];
+    size_t b[7] = {(n + 1) * sizeof(size_t), nf * 4, nf * 4, n * sizeof(double),
+                   (n + 1) * sizeof(size_t), ns * 4, 3 * ns * 4};
+    size_t want = 0, off = 0;
+    for (int i = 0; i < 7; i++)
+        want += b[i];
+    assert_int_equal(len, want);
+    unsigned char *copy = malloc(len);
+    assert_non_null(copy);
+    memcpy(copy, payload, len);
+    lr_cache_piece pc[7];
+    for (int i = 0; i < 7; i++) {
+        if (i == piece)
+            for (size_t j = 0; j < b[i] / 4; j++) {
+                float v;
+                memcpy(&v, copy + off + 4 * j, 4);
+                v *= k;
+                memcpy(copy + off + 4 * j, &v, 4);
+            }
+        pc[i] = (lr_cache_piece){copy + off, b[i]};
+        off += b[i];
+    }
+    lr_err e = {0};
+    assert_int_equal(lr_cache_file_write(path, "LRTRC002", w, 4, pc, 7, "test", &e), LR_OK);
+    free(copy);
+    free(data);
+}
+
+static void test_implausible_physics(void **state)
+{
+    teardown(state);
+    assert_int_equal(setup(state), 0);
+    lr_scene *s = load();
+    lr_tr *ref = create(s, dir, 64);
+    char path[600];
+    assert_int_equal(count_files(path, sizeof path), 1);
+    const int pieces[2] = {2, 6};
+    for (int i = 0; i < 2; i++) {
+        resign_scaled(path, pieces[i], 1000.0f);
+        lr_tr *t = create(s, dir, 64);
+        if (lr_tr_cache_hit(t))
+            fail_msg("%s x 1000 with a valid hash was used", i ? "S" : "F");
+        assert_true(max_diff(t, ref) == 0.0);
+        lr_tr_destroy(t);
+        t = create(s, dir, 64); /* rebuilt and rewritten */
+        assert_true(lr_tr_cache_hit(t));
+        lr_tr_destroy(t);
+    }
+    /* A scale within the tolerance's reach is not a change of physics: kept. */
+    resign_scaled(path, 2, 1.0f);
+    lr_tr *t = create(s, dir, 64);
+    assert_true(lr_tr_cache_hit(t));
+    lr_tr_destroy(t);
+    lr_tr_destroy(ref);
+    lr_scene_destroy(s);
+}
+
 /* Flips byte `at` of path (or truncates it to `at` bytes) and expects the read to fail. */
 static void cache_file_refused(const char *path, const unsigned char *good, size_t len, long at,
                                bool truncate)
@@ -343,6 +412,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hit_and_keys),
         cmocka_unit_test(test_corrupt),
+        cmocka_unit_test(test_implausible_physics),
         cmocka_unit_test(test_unwritable_folder),
         cmocka_unit_test(test_store_failure_said_once),
         cmocka_unit_test(test_cache_file),
