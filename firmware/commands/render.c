@@ -288,6 +288,21 @@ static int plan(const char *path, lr_scene *scene, const char *table, bool model
 }
 
 /* Builds an lr_image (rows top to bottom) from the renderer's HDR readback (bottom up). */
+/* "NAME: MODEL, ..." of the scene's objects, for a message. */
+static void object_models(const lr_scene *s, char *buf, size_t cap)
+{
+    size_t len = 0;
+    buf[0] = '\0';
+    for (int i = 0; i < lr_scene_object_count(s) && len < cap; i++) {
+        const lr_scene_object *o = lr_scene_object_at(s, i);
+        int k = snprintf(buf + len, cap - len, "%s%s: %s", i ? ", " : "", o->name,
+                         lr_sss_model_name(o->sss_model));
+        if (k < 0)
+            break;
+        len += (size_t)k;
+    }
+}
+
 static int read_image(lr_renderer *r, lr_image *img, lr_err *e)
 {
     int w, h;
@@ -471,6 +486,17 @@ static int run_render(const lr_cli *c)
     if (out || hdr) {
         if (read_image(r, &img, &e)) {
             status = lr_cli_fail(c->path, "%s", e.msg);
+            goto done;
+        }
+        /* A NaN or Inf is a numerical failure of a model (its material outside what its
+         * numerics hold), never an image: refused, not written as black or white pixels. */
+        size_t bad = lr_image_count_nonfinite(&img);
+        if (bad) {
+            char models[256];
+            object_models(scene, models, sizeof models);
+            status = lr_cli_fail(c->path, "%zu of %d pixels are not finite (NaN or Inf), "
+                                 "objects' models %s: nothing written", bad,
+                                 img.width * img.height, models);
             goto done;
         }
         lr_tonemap tm;

@@ -1,6 +1,8 @@
 /* lamprig firmware — run statistics (see stats.h). */
 #include "firmware/rig/stats.h"
 
+#include "firmware/rig/lat_hist.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -36,8 +38,8 @@ struct lr_rig_stats {
     uint64_t unmatched;
     uint64_t ar_frames;
     double ar_last_px, ar_last_light, ar_max_px, ar_max_light;
-    double *lat;    /* every latency (grown), for quantiles */
-    size_t n_lat, cap_lat;
+    /* Every latency, for quantiles, in constant memory: a rig runs for months. */
+    lr_lat_hist *lat;
 };
 
 int lr_rig_stats_create(int64_t start_ns, lr_rig_stats **out, lr_err *e)
@@ -46,8 +48,9 @@ int lr_rig_stats_create(int64_t start_ns, lr_rig_stats **out, lr_err *e)
     if (s) {
         s->events = calloc(LOG_MAX, sizeof *s->events);
         s->frames = calloc(LOG_MAX, sizeof *s->frames);
+        s->lat = lr_lat_hist_create();
     }
-    if (!s || !s->events || !s->frames) {
+    if (!s || !s->events || !s->frames || !s->lat) {
         lr_rig_stats_destroy(s);
         return lr_err_set(e, LR_ENOMEM, "out of memory");
     }
@@ -62,7 +65,7 @@ void lr_rig_stats_destroy(lr_rig_stats *s)
         return;
     free(s->events);
     free(s->frames);
-    free(s->lat);
+    lr_lat_hist_destroy(s->lat);
     free(s);
 }
 
@@ -106,15 +109,7 @@ void lr_rig_stats_frame(lr_rig_stats *s, const lr_frame_stats *f, int64_t done_n
         /* A device clock ahead of ours (never with CLOCK_MONOTONIC stamps) reads as 0. */
         er->latency_ms = ms > 0 ? ms : 0;
         s->n_events++;
-        if (s->n_lat == s->cap_lat) {
-            size_t cap = s->cap_lat ? 2 * s->cap_lat : 1024;
-            double *p = realloc(s->lat, cap * sizeof *p);
-            if (!p)
-                continue;
-            s->lat = p;
-            s->cap_lat = cap;
-        }
-        s->lat[s->n_lat++] = er->latency_ms;
+        lr_lat_hist_add(s->lat, er->latency_ms);
     }
     s->n_pending = 0;
 }
@@ -123,36 +118,9 @@ int lr_rig_stats_pending(const lr_rig_stats *s) { return s->n_pending; }
 uint64_t lr_rig_stats_frames(const lr_rig_stats *s) { return s->n_frames; }
 uint64_t lr_rig_stats_events(const lr_rig_stats *s) { return s->n_events; }
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double quantile(double *sorted, size_t n, double q)
-{
-    if (!n)
-        return NAN;
-    double pos = q * (double)(n - 1);
-    size_t i = (size_t)floor(pos);
-    if (i + 1 >= n)
-        return sorted[n - 1];
-    double f = pos - (double)i;
-    return sorted[i] * (1 - f) + sorted[i + 1] * f;
-}
-
 double lr_rig_stats_latency_ms(const lr_rig_stats *s, double q)
 {
-    if (!s->n_lat)
-        return NAN;
-    double *tmp = malloc(s->n_lat * sizeof *tmp);
-    if (!tmp)
-        return NAN;
-    memcpy(tmp, s->lat, s->n_lat * sizeof *tmp);
-    qsort(tmp, s->n_lat, sizeof *tmp, cmp_double);
-    double v = quantile(tmp, s->n_lat, q);
-    free(tmp);
-    return v;
+    return lr_lat_hist_quantile(s->lat, q);
 }
 
 static void write_devices(lr_jw *w, const lr_rig_stats_dev *devs, int n)
@@ -220,26 +188,15 @@ int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *conf
         lr_jw_number_or_null(w, "max_clipped_light", s->ar_max_light);
         lr_jw_object_end(w);
     }
-    double *tmp = s->n_lat ? malloc(s->n_lat * sizeof *tmp) : NULL;
-    double mean = NAN;
-    if (tmp) {
-        memcpy(tmp, s->lat, s->n_lat * sizeof *tmp);
-        qsort(tmp, s->n_lat, sizeof *tmp, cmp_double);
-        mean = 0;
-        for (size_t i = 0; i < s->n_lat; i++)
-            mean += tmp[i];
-        mean /= (double)s->n_lat;
-    }
-    size_t n = tmp ? s->n_lat : 0;
+    const lr_lat_hist *h = s->lat;
     lr_jw_object(w, "latency_ms");
-    lr_jw_int(w, "n", (long)n);
-    lr_jw_number_or_null(w, "min", n ? tmp[0] : NAN);
-    lr_jw_number_or_null(w, "median", tmp ? quantile(tmp, n, 0.5) : NAN);
-    lr_jw_number_or_null(w, "p99", tmp ? quantile(tmp, n, 0.99) : NAN);
-    lr_jw_number_or_null(w, "max", n ? tmp[n - 1] : NAN);
-    lr_jw_number_or_null(w, "mean", mean);
+    lr_jw_int(w, "n", (long)lr_lat_hist_n(h));
+    lr_jw_number_or_null(w, "min", lr_lat_hist_min(h));
+    lr_jw_number_or_null(w, "median", lr_lat_hist_quantile(h, 0.5));
+    lr_jw_number_or_null(w, "p99", lr_lat_hist_quantile(h, 0.99));
+    lr_jw_number_or_null(w, "max", lr_lat_hist_max(h));
+    lr_jw_number_or_null(w, "mean", lr_lat_hist_mean(h));
     lr_jw_object_end(w);
-    free(tmp);
     lr_jw_array(w, "event_log");
     uint64_t first = s->n_events > LOG_MAX ? s->n_events - LOG_MAX : 0;
     for (uint64_t i = first; i < s->n_events; i++) {

@@ -13,7 +13,9 @@
  *   "frame_log": [{"index": 38, "t_s": 1.252, "passes": ["compose"], "ms": [0,0,0,0.4],
  *                  "total_ms": 0.4, "samples": 64, "converged": true}, ...]  (last 4096)
  * }
- * t_s are seconds since the stats were created (CLOCK_MONOTONIC).
+ * t_s are seconds since the stats were created (CLOCK_MONOTONIC). The summary covers every
+ * event in constant memory: n, min, max, mean exact, median and p99 from a histogram within
+ * 0.5 % (firmware/rig/lat_hist.h). Nothing here grows with the number of events or frames.
  */
 #ifndef LR_RIG_STATS_H
 #define LR_RIG_STATS_H
@@ -45,7 +47,8 @@ void lr_rig_stats_ar(lr_rig_stats *s, double clipped_pixels, double clipped_ligh
 int lr_rig_stats_pending(const lr_rig_stats *s);
 uint64_t lr_rig_stats_frames(const lr_rig_stats *s);
 uint64_t lr_rig_stats_events(const lr_rig_stats *s); /* with a latency */
-/* Latency quantile q in [0, 1] over every event so far, ms; NaN when none. */
+/* Latency quantile q in [0, 1] over every event so far, ms, within lat_hist.h's bound; NaN
+ * when none. */
 double lr_rig_stats_latency_ms(const lr_rig_stats *s, double q);
 
 /* One device as the stats file shows it ("devices"): its state and, for a Modbus link, every

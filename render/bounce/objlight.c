@@ -218,8 +218,9 @@ done:
 }
 
 int lr_objlight_create(const lr_tr *t, size_t first_source, const lr_objlight_desc *d, int count,
-                       int rays, const char *cache_dir, lr_objlight **out, lr_err *e)
+                       int rays, const lr_objlight_cache *cache, lr_objlight **out, lr_err *e)
 {
+    const char *cache_dir = cache ? cache->dir : NULL;
     *out = NULL;
     if (!t || (count > 0 && !d))
         return lr_err_set(e, LR_EINVAL, "receiver light on objects: NULL %s",
@@ -267,9 +268,13 @@ int lr_objlight_create(const lr_tr *t, size_t first_source, const lr_objlight_de
     for (int i = 0; i < count && !rc && !ol->cache_hit; i++)
         rc = build_mesh(t, ol, i, (const double(*)[3])dirs, rays, e);
     if (!rc && !ol->cache_hit && cache_dir) {
-        /* Best effort: a folder that cannot be written costs the next start a rebuild. */
+        /* Best effort: a folder that cannot be written costs the next start a rebuild, which
+         * is said (once per folder: the same folder fails the same way at every rebuild). */
         lr_err ce = {0};
-        (void)lr_objlight_cache_store(ol, key, cache_dir, &ce);
+        if (lr_objlight_cache_store(ol, key, cache_dir, &ce) &&
+            lr_warn_once_first(cache->warned, cache_dir))
+            lr_warn(&cache->warn, "cache not stored: %s (the rows of %d meshes are rebuilt at "
+                    "every start until the folder is writable)", ce.msg, count);
     }
     free(dirs);
     if (rc) {

@@ -60,13 +60,21 @@ typedef struct lr_objlight_desc {
 /* Default rays per vertex (hemisphere). */
 #define LR_OBJLIGHT_RAYS 512
 
+/* Where the rows are cached: dir (NULL: no cache); a store that fails (read-only, full) is
+ * said to warn, once per folder per `warned` (the caller's; NULL: at every store). */
+typedef struct lr_objlight_cache {
+    const char *dir;
+    lr_warn_sink warn;
+    lr_warn_once *warned;
+} lr_objlight_cache;
+
 /* The form-factor rows of every vertex of the count meshes against t's patches from
  * first_source on (the receivers; earlier patches, the objects, absorb), rays per hemisphere
- * (0: LR_OBJLIGHT_RAYS). cache_dir (NULL: none): the rows are read from
- * <cache_dir>/objlight-<key>.bin when it holds them for this geometry, else built and written
- * there (best effort; objlight_cache.c). LR_EINVAL, LR_ENOMEM. */
+ * (0: LR_OBJLIGHT_RAYS). cache (NULL or dir NULL: none): the rows are read from
+ * <dir>/objlight-<key>.bin when it holds them for this geometry, else built and written
+ * there (best effort, a failure warned; objlight_cache.c). LR_EINVAL, LR_ENOMEM. */
 int lr_objlight_create(const lr_tr *t, size_t first_source, const lr_objlight_desc *d, int count,
-                       int rays, const char *cache_dir, lr_objlight **out, lr_err *e);
+                       int rays, const lr_objlight_cache *cache, lr_objlight **out, lr_err *e);
 void lr_objlight_destroy(lr_objlight *ol);
 
 /* E+ and E- of every vertex from slot's solution (lr_tr_radiosity of the source patches). */

@@ -20,6 +20,7 @@
 
 struct lr_rbounce {
     lr_tr *tr;
+    lr_warn_once cache_warned; /* cache folders whose store failure was said (rebuilds reuse) */
     double key[KEY_MAX];
     int nkey;
     int n_obj, n_rcv, n_lights;
@@ -160,7 +161,8 @@ static int build(lr_rbounce *rb, const lr_scene *s, lr_err *e)
     }
     char cdir[1024];
     lr_tr_settings set = {.rays_per_patch = 512,
-                          .cache_dir = lr_tr_cache_default_dir(cdir, sizeof cdir)};
+                          .cache_dir = lr_tr_cache_default_dir(cdir, sizeof cdir),
+                          .warn = *lr_scene_warn_sink(s), .warned = &rb->cache_warned};
     int rc = lr_tr_create(d, n, &set, &rb->tr, e);
     if (rc)
         return rc;
@@ -205,8 +207,9 @@ static int build(lr_rbounce *rb, const lr_scene *s, lr_err *e)
     }
     size_t first, count;
     lr_tr_surface_patches(rb->tr, no, &first, &count);
-    return lr_objlight_create(rb->tr, first, od, no, 0, lr_tr_cache_default_dir(cdir, sizeof cdir),
-                              &rb->ol, e);
+    lr_objlight_cache oc = {.dir = lr_tr_cache_default_dir(cdir, sizeof cdir),
+                            .warn = *lr_scene_warn_sink(s), .warned = &rb->cache_warned};
+    return lr_objlight_create(rb->tr, first, od, no, 0, &oc, &rb->ol, e);
 }
 
 /* The objects' patches reflect the receivers' light with the albedo their material shows

@@ -63,6 +63,10 @@ float lr_srgb_decode(float encoded);
  * tests/base/test_image.c), so an 8-bit code is the exact one or one step off. */
 float lr_srgb_encode_fast(float linear);
 
+/* Pixels with a NaN or an infinite channel (a writer's caller refuses to write them: a PNG
+ * would show them as black or white, silently). */
+size_t lr_image_count_nonfinite(const lr_image *img);
+
 /* ---- files ---------------------------------------------------------------------------- */
 
 /* Tone-maps, sRGB-encodes and rounds to 8-bit RGB. tm NULL: defaults. */

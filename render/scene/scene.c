@@ -25,6 +25,7 @@ void lr_scene_destroy(lr_scene *s)
 }
 
 const char *lr_scene_name(const lr_scene *s) { return s->name; }
+const lr_warn_sink *lr_scene_warn_sink(const lr_scene *s) { return &s->warn; }
 const char *lr_scene_path(const lr_scene *s) { return s->path; }
 int lr_scene_object_count(const lr_scene *s) { return s->nobj; }
 int lr_scene_light_count(const lr_scene *s) { return s->nlight; }

@@ -273,6 +273,8 @@ int lr_scene_parse(const char *text, size_t len, const char *name, const lr_warn
 void lr_scene_destroy(lr_scene *s);
 
 const char *lr_scene_name(const lr_scene *s);
+/* The sink given at load: for warnings about the scene's rendering too (a cache not stored). */
+const lr_warn_sink *lr_scene_warn_sink(const lr_scene *s);
 const char *lr_scene_path(const lr_scene *s);
 
 /* Pointers into the scene stay valid until the next lr_scene_set() or destroy. */

@@ -149,6 +149,33 @@ static bool finite_f(const float *v, size_t m)
     return true;
 }
 
+/* Physics a valid file cannot break, whatever wrote it (a hash only says the bytes are the
+ * writer's): F's row p is the fraction of p's hemisphere landing on each patch, so with the
+ * escaping fraction it sums to at most 1; S's column p (source p, listed in row p) conserves
+ * energy, sum_q A_q S_qp <= A_p per band (subsurface.c: the column is scaled to the slab's
+ * R + T <= 1). PLAUSIBLE_TOL covers the float rounding of those sums (measured on the shipped
+ * candle and lamp shade: F 1 + 2e-8, S 0.95). */
+#define PLAUSIBLE_TOL 1e-3
+static bool plausible(const lr_tr *t, const lr_tr_rows *F, const lr_tr_rows *S,
+                      const double *escape)
+{
+    for (size_t p = 0; p < t->n; p++) {
+        double f = escape[p];
+        for (size_t k = F->row[p]; k < F->row[p + 1]; k++)
+            f += F->val[k];
+        if (!(f <= 1 + PLAUSIBLE_TOL))
+            return false;
+        double out[3] = {0, 0, 0};
+        for (size_t k = S->row[p]; k < S->row[p + 1]; k++)
+            for (int c = 0; c < 3; c++)
+                out[c] += t->p[S->col[k]].area * S->val[3 * k + c];
+        for (int c = 0; c < 3; c++)
+            if (!(out[c] <= (1 + PLAUSIBLE_TOL) * t->p[p].area))
+                return false;
+    }
+    return true;
+}
+
 bool lr_tr_cache_load(lr_tr *t, uint64_t key, const char *dir)
 {
     char path[1024], *data = NULL;
@@ -188,6 +215,7 @@ bool lr_tr_cache_load(lr_tr *t, uint64_t key, const char *dir)
              finite_f(F.val, nf) && finite_f(S.val, 3 * ns);
         for (size_t p = 0; ok && p < n; p++)
             ok = isfinite(escape[p]) && escape[p] >= 0 && escape[p] <= 1;
+        ok = ok && plausible(t, &F, &S, escape);
     }
     free(data);
     if (!ok) {

@@ -13,6 +13,7 @@
 
 struct lr_tr_scene {
     lr_tr *tr;
+    lr_warn_once cache_warned; /* cache folders whose store failure was said (rebuilds reuse) */
     double key[KEY_MAX];
     int nkey;
     int n_obj, n_rcv, n_lights;
@@ -249,7 +250,8 @@ int lr_tr_scene_update(lr_tr_scene **tsp, const lr_scene *s, lr_err *e)
         /* F and S from the on-disk cache when this geometry was seen before (cache.c). */
         char cdir[1024];
         lr_tr_settings set = {.rays_per_patch = 256,
-                              .cache_dir = lr_tr_cache_default_dir(cdir, sizeof cdir)};
+                              .cache_dir = lr_tr_cache_default_dir(cdir, sizeof cdir),
+                              .warn = *lr_scene_warn_sink(s), .warned = &ts->cache_warned};
         int rc = lr_tr_create_scene(s, &set, &ts->tr, e);
         if (rc)
             return rc;

@@ -105,10 +105,13 @@ int lr_tr_create(const lr_tr_surface_desc *surfaces, int count, const lr_tr_sett
     if (!t->cache_hit) {
         if ((rc = lr_tr_build_form_factors(t, e)) || (rc = lr_tr_build_subsurface(t, e)))
             goto fail;
-        /* Best effort: a folder that cannot be written costs the next start a rebuild. */
+        /* Best effort: a folder that cannot be written costs the next start a rebuild, which
+         * is said (once per folder: the same folder fails the same way at every rebuild). */
         lr_err ce = {0};
-        if (s.cache_dir)
-            (void)lr_tr_cache_store(t, key, s.cache_dir, &ce);
+        if (s.cache_dir && lr_tr_cache_store(t, key, s.cache_dir, &ce) &&
+            lr_warn_once_first(s.warned, s.cache_dir))
+            lr_warn(&s.warn, "cache not stored: %s (F and S of %zu patches are rebuilt at every "
+                    "start until the folder is writable)", ce.msg, t->n);
     }
     t->set.cache_dir = NULL; /* the caller's string: not kept */
     if ((rc = lr_tr_transfer_build(t, e)))

@@ -56,6 +56,8 @@
 
 #include "render/base/err.h"
 #include "render/base/vec3.h"
+#include "render/base/warn.h"
+#include "render/base/warn_once.h"
 #include "render/mesh/bvh.h"
 #include "render/mesh/mesh.h"
 #include "render/optics/optics.h"
@@ -110,6 +112,9 @@ typedef struct lr_tr_settings {
     const char *cache_dir;  /* F and S cached in this folder (cache.c), keyed by a hash of the
                              * geometry, materials and the settings above; NULL: no cache.
                              * Read during create only (the pointer is not kept in use) */
+    lr_warn_sink warn;      /* a store into cache_dir that fails (read-only, full): said here,
+                             * once per folder per `warned` (the next start rebuilds F and S) */
+    lr_warn_once *warned;   /* the caller's: folders already said; NULL: said at every store */
 } lr_tr_settings;
 
 enum { LR_TR_THIN_AUTO = 0, LR_TR_THIN_OFF = 1, LR_TR_THIN_ON = 2 };

@@ -13,7 +13,9 @@
  *  - the factors: kR = <F_t> R_d / t_hem = R_d (the two integrals agree) for a half-space;
  *  - the field: default true, a SETTINGS change, off: no objects' light;
  *  - the on-disk cache of the rows: a second build reads them and gives the same light to
- *    the bit; a corrupt or truncated file is rebuilt (and rewritten), never read. */
+ *    the bit; a corrupt or truncated file is rebuilt (and rewritten), never read; a read-only
+ *    cache folder is said once through the scene's warn sink, over the bounce's two stores
+ *    (F and the rows) and its rebuild after a geometry change. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -31,6 +33,8 @@
 #include "render/optics/optics.h"
 #include "render/scene/dirty.h"
 #include <dirent.h>
+#include <errno.h>
+#include <sys/stat.h>
 
 #include "tests/support/fs.h"
 #include "tests/support/near.h"
@@ -412,6 +416,69 @@ static void test_cache(void **state)
     lr_test_rmtree(home);
 }
 
+static void count_not_stored(void *user, const char *msg)
+{
+    if (strstr(msg, "cache not stored"))
+        ++*(int *)user;
+}
+
+static void test_cache_read_only_said_once(void **state)
+{
+    (void)state;
+    char *home = lr_test_tmpdir();
+    char *dir = lr_test_path(home, "lamprig");
+    assert_int_equal(mkdir(dir, 0700), 0);
+    if (lr_test_mount_tmpfs(dir, 256, 1) != 0) {
+        print_message("skipped: mount: %s (needs root)\n", strerror(errno));
+        free(dir);
+        lr_test_rmtree(home);
+        skip();
+    }
+    const char *old = getenv("XDG_CACHE_HOME");
+    char *saved = old ? strdup(old) : NULL;
+    setenv("XDG_CACHE_HOME", home, 1);
+    char doc[2048];
+    snprintf(doc, sizeof doc,
+             "{\"name\":\"t\",\"objects\":[{\"name\":\"s\",\"material\":\"candle_wax\","
+             "\"mesh\":{\"type\":\"sphere\",\"radius\":%g},\"transform\":{\"translate\":"
+             "[0,0,%g]}}],"
+             "\"lights\":[{\"type\":\"point\",\"position\":[0,0,3000],\"intensity\":1}],"
+             "\"camera\":{\"position\":[0,-3000,100],\"target\":[0,0,0]},"
+             "\"receivers\":[{\"name\":\"table\",\"type\":\"plane\",\"center\":[0,0,0],"
+             "\"normal\":[0,0,1],\"size\":[%g,%g],\"albedo\":[%g,%g,%g]}]}",
+             RS, ZS, 2 * HALF, 2 * HALF, RHO, RHO, RHO);
+    int said = 0;
+    lr_warn_sink warn = {count_not_stored, &said};
+    lr_scene *s;
+    lr_err e = {0};
+    if (lr_scene_parse(doc, strlen(doc), "t.json", &warn, &s, &e) ||
+        lr_scene_set_assignment(s, on[0], NULL, &e))
+        fail_msg("%s", e.msg);
+    lr_rbounce *rb = NULL;
+    assert_int_equal(lr_rbounce_update(&rb, s, &e), LR_OK);
+    assert_non_null(lr_rbounce_objects(rb));
+    assert_false(lr_objlight_cache_hit(lr_rbounce_objects(rb)));
+    assert_int_equal(said, 1);
+    /* Another table: the geometry's key changes, the bounce rebuilds and stores again. */
+    if (lr_scene_set_assignment(s, "receivers[0].size=[7000,7000]", NULL, &e))
+        fail_msg("%s", e.msg);
+    assert_int_equal(lr_rbounce_update(&rb, s, &e), LR_OK);
+    double build_s, direct_s, solve_s;
+    lr_rbounce_times(rb, &build_s, &direct_s, &solve_s);
+    assert_true(build_s > 0);
+    assert_int_equal(said, 1);
+    lr_rbounce_destroy(rb);
+    lr_scene_destroy(s);
+    lr_test_umount(dir);
+    if (saved)
+        setenv("XDG_CACHE_HOME", saved, 1);
+    else
+        unsetenv("XDG_CACHE_HOME");
+    free(saved);
+    free(dir);
+    lr_test_rmtree(home);
+}
+
 static void test_factors_and_field(void **state)
 {
     (void)state;
@@ -444,6 +511,7 @@ int main(void)
         cmocka_unit_test(test_occluder),
         cmocka_unit_test(test_far_face),
         cmocka_unit_test(test_cache),
+        cmocka_unit_test(test_cache_read_only_said_once),
         cmocka_unit_test(test_factors_and_field),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

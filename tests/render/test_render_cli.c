@@ -439,6 +439,43 @@ static void test_deterministic_stops_early(void **state)
     lr_json_destroy(j);
 }
 
+/* A model whose numerics overflow (sh_translucency at sigma_a = 200/mm, outside its range)
+ * gives Inf pixels: the render fails naming the count and the model and writes neither the
+ * PNG nor the PFM (both were written, exit 0). The sphere's light sits inside the ball (a dark
+ * scene, rendered with --allow-dark): the overflow is the model's, whatever lights it. */
+static void test_nonfinite_image_refused(void **state)
+{
+    (void)state;
+    size_t len;
+    char path[600];
+    snprintf(path, sizeof path, "%s/scenes/sphere.json", LR_SOURCE_CONFIGS);
+    unsigned char *text = lr_test_read(path, &len);
+    char *at = strstr((char *)text, "\"sigma_a\": [0, 0, 0]");
+    assert_non_null(at);
+    char scene[4096];
+    snprintf(scene, sizeof scene, "%.*s\"sigma_a\": [200, 200, 200]%s", (int)(at - (char *)text),
+             (const char *)text, at + strlen("\"sigma_a\": [0, 0, 0]"));
+    free(text);
+    char *sph = lr_test_write(dir, "hot.json", scene, (size_t)-1);
+    int st = run("build/bin/lamprig render --scene %s --no-plan --set objects[0].model="
+                 "sh_translucency --width 80 --height 60 --frames 1 --allow-dark --out %s/hot.png "
+                 "--hdr %s/hot.pfm",
+                 sph, dir, dir);
+    char *err = slurp("err");
+    print_message("%s", err);
+    assert_int_equal(st, 1);
+    assert_non_null(strstr(err, "pixels are not finite (NaN or Inf)"));
+    assert_non_null(strstr(err, "ball: sh_translucency"));
+    assert_non_null(strstr(err, "nothing written"));
+    free(err);
+    char f[700];
+    snprintf(f, sizeof f, "%s/hot.png", dir);
+    assert_int_equal(access(f, F_OK), -1);
+    snprintf(f, sizeof f, "%s/hot.pfm", dir);
+    assert_int_equal(access(f, F_OK), -1);
+    free(sph);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -448,6 +485,7 @@ int main(void)
         cmocka_unit_test(test_render_writes_images_and_stats),
         cmocka_unit_test(test_bad_arguments),
         cmocka_unit_test(test_output_paths_checked_first),
+        cmocka_unit_test(test_nonfinite_image_refused),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -2,10 +2,15 @@
  *  - a second create with the same scene and settings takes F and S from the file and solves
  *    to the same W bit for bit;
  *  - another setting (rays per patch) or another material is another key: a miss, a new file;
+ *  - a file re-signed (a valid hash) with F x 1000 or S x 1000, finite but beyond energy
+ *    conservation (F's row sum with the escape <= 1, S's column power <= the source's), is
+ *    refused and rebuilt to the same W;
  *  - a corrupt cache (a flipped payload byte, a flipped key byte, a truncated file, garbage,
  *    an empty file) is never used: create rebuilds, solves to the same W, and rewrites it, so
  *    the next create hits again;
- *  - a folder that cannot be written costs only the cache (create succeeds, no hit);
+ *  - a folder that cannot be written costs only the cache (create succeeds, no hit); a
+ *    read-only one (a tmpfs mounted ro) is said through the settings' warn sink, once over two
+ *    creates sharing a lr_warn_once, and at each create without one;
  *  - the checked file under both caches (render/reference/cache_file.h): pieces read back as
  *    written, and a flipped magic, header or payload byte, a short file or an absent one read
  *    as absent. */
@@ -16,6 +21,8 @@
 #include <cmocka.h>
 
 #include <dirent.h>
+#include <errno.h>
+#include <sys/stat.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,6 +32,7 @@
 #include "render/base/paths.h"
 #include "render/reference/cache_file.h"
 #include "render/transrad/transrad.h"
+#include "tests/support/fs.h"
 
 static char dir[256];
 
@@ -197,6 +205,72 @@ static void test_corrupt(void **state)
     lr_scene_destroy(s);
 }
 
+/* Rewrites the cache file with piece `piece` (2 F values, 6 S values: float arrays) scaled by
+ * k and a valid hash (as a foreign writer would). */
+static void resign_scaled(const char *path, int piece, float k)
+{
+    uint64_t w[4];
+    char *data = NULL;
+    const unsigned char *payload;
+    size_t len;
+    assert_true(lr_cache_file_read(path, "LRTRC002", w, 4, &data, &payload, &len));
+    size_t n = (size_t)w[1], nf = (size_t)w[2], ns = (size_t)w[3];
+    size_t b[7] = {(n + 1) * sizeof(size_t), nf * 4, nf * 4, n * sizeof(double),
+                   (n + 1) * sizeof(size_t), ns * 4, 3 * ns * 4};
+    size_t want = 0, off = 0;
+    for (int i = 0; i < 7; i++)
+        want += b[i];
+    assert_int_equal(len, want);
+    unsigned char *copy = malloc(len);
+    assert_non_null(copy);
+    memcpy(copy, payload, len);
+    lr_cache_piece pc[7];
+    for (int i = 0; i < 7; i++) {
+        if (i == piece)
+            for (size_t j = 0; j < b[i] / 4; j++) {
+                float v;
+                memcpy(&v, copy + off + 4 * j, 4);
+                v *= k;
+                memcpy(copy + off + 4 * j, &v, 4);
+            }
+        pc[i] = (lr_cache_piece){copy + off, b[i]};
+        off += b[i];
+    }
+    lr_err e = {0};
+    assert_int_equal(lr_cache_file_write(path, "LRTRC002", w, 4, pc, 7, "test", &e), LR_OK);
+    free(copy);
+    free(data);
+}
+
+static void test_implausible_physics(void **state)
+{
+    teardown(state);
+    assert_int_equal(setup(state), 0);
+    lr_scene *s = load();
+    lr_tr *ref = create(s, dir, 64);
+    char path[600];
+    assert_int_equal(count_files(path, sizeof path), 1);
+    const int pieces[2] = {2, 6};
+    for (int i = 0; i < 2; i++) {
+        resign_scaled(path, pieces[i], 1000.0f);
+        lr_tr *t = create(s, dir, 64);
+        if (lr_tr_cache_hit(t))
+            fail_msg("%s x 1000 with a valid hash was used", i ? "S" : "F");
+        assert_true(max_diff(t, ref) == 0.0);
+        lr_tr_destroy(t);
+        t = create(s, dir, 64); /* rebuilt and rewritten */
+        assert_true(lr_tr_cache_hit(t));
+        lr_tr_destroy(t);
+    }
+    /* A scale within the tolerance's reach is not a change of physics: kept. */
+    resign_scaled(path, 2, 1.0f);
+    lr_tr *t = create(s, dir, 64);
+    assert_true(lr_tr_cache_hit(t));
+    lr_tr_destroy(t);
+    lr_tr_destroy(ref);
+    lr_scene_destroy(s);
+}
+
 /* Flips byte `at` of path (or truncates it to `at` bytes) and expects the read to fail. */
 static void cache_file_refused(const char *path, const unsigned char *good, size_t len, long at,
                                bool truncate)
@@ -268,12 +342,79 @@ static void test_unwritable_folder(void **state)
     lr_scene_destroy(s);
 }
 
+typedef struct said {
+    int n;
+    char last[LR_ERR_MSG_MAX];
+} said;
+
+static void count_warning(void *user, const char *msg)
+{
+    said *w = user;
+    w->n++;
+    snprintf(w->last, sizeof w->last, "%s", msg);
+}
+
+static void create_warned(const lr_scene *s, const char *cache, said *w, lr_warn_once *once)
+{
+    lr_tr_settings set = {.patch_mm = 30, .receiver_mm = 150, .rays_per_patch = 64, .seed = 9,
+                          .cache_dir = cache, .warn = {count_warning, w}, .warned = once};
+    lr_tr *t;
+    lr_err e = {0};
+    if (lr_tr_create_scene(s, &set, &t, &e))
+        fail_msg("%s", e.msg);
+    assert_false(lr_tr_cache_hit(t));
+    lr_tr_destroy(t);
+}
+
+/* A read-only cache folder: every store fails; said once per folder over two creates with
+ * the caller's lr_warn_once (the message names the folder and the reason), at every create
+ * without one. A writable folder says nothing. */
+static void test_store_failure_said_once(void **state)
+{
+    (void)state;
+    char *root = lr_test_tmpdir();
+    char *ro = lr_test_path(root, "ro");
+    assert_int_equal(mkdir(ro, 0700), 0);
+    if (lr_test_mount_tmpfs(ro, 256, 1) != 0) {
+        print_message("skipped: mount: %s (needs root)\n", strerror(errno));
+        free(ro);
+        lr_test_rmtree(root);
+        skip();
+    }
+    lr_scene *s = load();
+    said w = {0};
+    lr_warn_once once = {0};
+    create_warned(s, ro, &w, &once);
+    create_warned(s, ro, &w, &once);
+    assert_int_equal(w.n, 1);
+    print_message("said: %s\n", w.last);
+    assert_non_null(strstr(w.last, ro));
+    assert_non_null(strstr(w.last, "Read-only file system"));
+    assert_non_null(strstr(w.last, "rebuilt at every start"));
+    said w2 = {0};
+    create_warned(s, ro, &w2, NULL);
+    create_warned(s, ro, &w2, NULL);
+    assert_int_equal(w2.n, 2);
+    said w3 = {0};
+    lr_warn_once once3 = {0};
+    char *rw = lr_test_path(root, "rw");
+    create_warned(s, rw, &w3, &once3);
+    assert_int_equal(w3.n, 0);
+    lr_scene_destroy(s);
+    lr_test_umount(ro);
+    free(ro);
+    free(rw);
+    lr_test_rmtree(root);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hit_and_keys),
         cmocka_unit_test(test_corrupt),
+        cmocka_unit_test(test_implausible_physics),
         cmocka_unit_test(test_unwritable_folder),
+        cmocka_unit_test(test_store_failure_said_once),
         cmocka_unit_test(test_cache_file),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
