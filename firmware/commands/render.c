@@ -104,6 +104,29 @@ const lr_command lr_render_command = {
     .run = run_render,
 };
 
+/* Every event of the script applied in order to a scratch copy of the scene (with the --set
+ * assignments), before anything renders: a bad parameter or value is bad input at start,
+ * named FILE:LINE, not a failure after the frames before it were drawn. */
+static int check_events(const char *scene_path, const char *const *sets, int nsets,
+                        const lr_render_events *ev, lr_err *e)
+{
+    if (!ev->count)
+        return LR_OK;
+    lr_scene *scratch = NULL;
+    int rc = lr_scene_load(scene_path, NULL, &scratch, e);
+    for (int i = 0; !rc && i < nsets; i++)
+        rc = lr_scene_set_assignment(scratch, sets[i], NULL, e);
+    for (int i = 0; !rc && i < ev->count; i++) {
+        unsigned dirty = 0;
+        if (lr_scene_set(scratch, ev->ev[i].key, ev->ev[i].value, &dirty, e)) {
+            lr_err inner = *e;
+            rc = lr_err_set(e, LR_EINVAL, "%s:%d: %s", ev->path, ev->ev[i].line, inner.msg);
+        }
+    }
+    lr_scene_destroy(scratch);
+    return rc;
+}
+
 typedef struct stats_log {
     lr_frame_stats *v;
     int n, cap;
@@ -377,7 +400,8 @@ static int run_render(const lr_cli *c)
             status = lr_cli_usage(c->path, "--set %s: %s", sets[i], e.msg);
             goto done;
         }
-    if (events_path && lr_render_events_load(events_path, &ev, &e)) {
+    if (events_path && (lr_render_events_load(events_path, &ev, &e) ||
+                        check_events(scene_path, sets, nsets, &ev, &e))) {
         status = e.code == LR_EIO ? lr_cli_fail(c->path, "%s", e.msg)
                                   : lr_cli_usage(c->path, "%s", e.msg);
         goto done;

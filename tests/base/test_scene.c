@@ -189,7 +189,8 @@ static void test_candle_scene(void **state)
     assert_true(wall->center.y > hi.y && lr_scene_camera(s)->position.y < lo.y);
     const lr_render_settings *r = lr_scene_render(s);
     assert_true(r->K == 16 && r->N == 16 && r->N_vpl == 64 && r->frames == 64);
-    assert_true(lr_scene_quality(s)->max_error == 0.05);
+    /* The shipped budget, one the proxy's table meets (render/plan/README.md). */
+    assert_true(lr_scene_quality(s)->max_error == 0.15 && lr_scene_quality(s)->frame_ms == 600);
     lr_scene_destroy(s);
 }
 

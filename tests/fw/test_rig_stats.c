@@ -158,7 +158,7 @@ static void test_stats_latency_fields(void **state)
     assert_int_equal(lr_rig_stats_events(s), N);
     char *dir = lr_test_tmpdir();
     char *path = lr_test_path(dir, "stats.json");
-    assert_int_equal(lr_rig_stats_write(s, path, NULL, t, 0, &e), LR_OK);
+    assert_int_equal(lr_rig_stats_write(s, path, NULL, t, 0, NULL, 0, &e), LR_OK);
     lr_json *j;
     assert_int_equal(lr_json_load(path, &j, &e), LR_OK);
     lr_jnode l = lr_json_get(j, lr_json_root(j), "latency_ms");
@@ -212,7 +212,7 @@ static void test_stats_memory_constant(void **state)
         lr_frame_stats f = pass_frame(frame++);
         lr_rig_stats_frame(s, &f, t + 2000000 + (i % 97) * 10000);
     }
-    assert_int_equal(lr_rig_stats_write(s, path, "c.json", t, 0, &e), LR_OK);
+    assert_int_equal(lr_rig_stats_write(s, path, "c.json", t, 0, NULL, 0, &e), LR_OK);
     long rss0 = lr_test_rss_kib(0);
     assert_true(rss0 > 0);
     for (int i = 0; i < 1000000; i++, t += 1000000) {
@@ -222,7 +222,7 @@ static void test_stats_memory_constant(void **state)
         lr_frame_stats f = pass_frame(frame++);
         lr_rig_stats_frame(s, &f, t + 2000000 + (i % 97) * 10000);
         if (i % 100000 == 99999)
-            assert_int_equal(lr_rig_stats_write(s, path, "c.json", t, 0, &e), LR_OK);
+            assert_int_equal(lr_rig_stats_write(s, path, "c.json", t, 0, NULL, 0, &e), LR_OK);
     }
     long rss1 = lr_test_rss_kib(0);
     print_message("VmRSS %ld KiB after warm-up, %ld KiB after 10^6 more events (%+ld)\n", rss0,
