@@ -190,17 +190,13 @@ int lr_sim_script_load(const char *path, lr_sim_script **out, lr_err *e)
 {
     *out = NULL;
     /* A regular file only: a FIFO would block the open for ever, a device read for ever. */
-    int fd = lr_file_open_regular(path, e);
-    if (fd < 0)
-        return -fd;
-    FILE *f = fdopen(fd, "rb");
-    if (!f) {
-        close(fd);
-        return lr_err_set(e, LR_ENOMEM, "%s: out of memory", path);
-    }
+    FILE *f;
+    int rc = lr_file_fopen_regular(path, &f, e);
+    if (rc)
+        return rc;
     size_t cap = 4096, len = 0;
     char *buf = malloc(cap);
-    int rc = LR_OK;
+    rc = LR_OK;
     while (buf) {
         if (len + 1 >= cap) {
             if (cap >= (16u << 20)) {

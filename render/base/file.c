@@ -42,6 +42,20 @@ int lr_file_open_regular(const char *path, lr_err *e)
     return fd;
 }
 
+int lr_file_fopen_regular(const char *path, FILE **out, lr_err *e)
+{
+    *out = NULL;
+    int fd = lr_file_open_regular(path, e);
+    if (fd < 0)
+        return -fd;
+    *out = fdopen(fd, "rb");
+    if (!*out) {
+        close(fd);
+        return lr_err_set(e, LR_ENOMEM, "%s: out of memory", path);
+    }
+    return LR_OK;
+}
+
 int lr_file_read(const char *path, size_t max, char **data, size_t *len, lr_err *e)
 {
     *data = NULL;

@@ -3,6 +3,7 @@
 #define LR_FILE_H
 
 #include <stddef.h>
+#include <stdio.h>
 
 #include "render/base/err.h"
 
@@ -18,6 +19,11 @@
  * socket) or "path: cannot open: <strerror>". Never blocks: a FIFO is opened with O_NONBLOCK
  * and refused; the flag is cleared on the regular file returned. */
 int lr_file_open_regular(const char *path, lr_err *e);
+
+/* The same as a stdio stream ("rb") in *out, for readers that parse with stdio; returns
+ * lr_file_open_regular's code and message (LR_ENOMEM when the stream cannot be made), *out
+ * NULL then. The caller fcloses *out. */
+int lr_file_fopen_regular(const char *path, FILE **out, lr_err *e);
 
 /* Reads the regular file path, at most max bytes (LR_FILE_MAX_*), into a malloc'd buffer with
  * a NUL after the last byte (so text can be used as a string; binary data may hold NULs of

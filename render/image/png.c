@@ -87,18 +87,14 @@ int lr_image_read_png(const char *path, lr_image *out, lr_err *e)
     out->rgb = NULL;
     /* Opened here so a missing file is an I/O error in errno's words, not a PNG error. */
     /* A regular file only: a FIFO would block the open for ever, a device read for ever. */
-    int fd = lr_file_open_regular(path, e);
-    if (fd < 0)
-        return -fd;
-    FILE *f = fdopen(fd, "rb");
-    if (!f) {
-        close(fd);
-        return lr_err_set(e, LR_ENOMEM, "%s: out of memory", path);
-    }
+    FILE *f;
+    int rc = lr_file_fopen_regular(path, &f, e);
+    if (rc)
+        return rc;
     png_image pi;
     memset(&pi, 0, sizeof pi);
     pi.version = PNG_IMAGE_VERSION;
-    int rc = decode(path, f, &pi, out, e);
+    rc = decode(path, f, &pi, out, e);
     png_image_free(&pi);
     fclose(f);
     return rc;

@@ -12,14 +12,10 @@ int lr_mesh_read_file(const char *path, char **buf, size_t *len, lr_err *e)
     *buf = NULL;
     *len = 0;
     /* A regular file only: a FIFO would block the open for ever, a device read for ever. */
-    int fd = lr_file_open_regular(path, e);
-    if (fd < 0)
-        return -fd;
-    FILE *f = fdopen(fd, "rb");
-    if (!f) {
-        close(fd);
-        return lr_err_set(e, LR_ENOMEM, "%s: out of memory", path);
-    }
+    FILE *f;
+    int rc = lr_file_fopen_regular(path, &f, e);
+    if (rc)
+        return rc;
     char *b = NULL;
     size_t n = 0, cap = 0;
     for (;;) {
