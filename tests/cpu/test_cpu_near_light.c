@@ -47,6 +47,7 @@
 #include "render/optics/optics.h"
 #include "render/passes/gbuffer_camera.h"
 #include "render/transrad/tr_scene.h"
+#include "tests/support/mesh_quad.h"
 #include "tests/support/near.h"
 #include "tests/support/render.h"
 
@@ -59,31 +60,6 @@ typedef struct model_ctx {
     lr_tr_scene *ts;     /* TR */
     int N;               /* PROFILE: samples per band */
 } model_ctx;
-
-/* The quadrature's points: triangle t, sub-triangle centroid barycentrics (u, w), area dA. */
-typedef void (*point_fn)(void *user, size_t t, double u, double w, lr_vec3 x, lr_vec3 n,
-                         double dA);
-
-static void quadrature(const lr_mesh *m, point_fn f, void *user)
-{
-    for (size_t t = 0; t < lr_mesh_triangle_count(m); t++) {
-        lr_vec3 p[3];
-        lr_mesh_triangle(m, t, p);
-        lr_vec3 e1 = lr_v3_sub(p[1], p[0]), e2 = lr_v3_sub(p[2], p[0]);
-        lr_vec3 n = lr_mesh_triangle_normal(m, t);
-        double L = fmax(lr_v3_len(e1), fmax(lr_v3_len(e2), lr_v3_len(lr_v3_sub(p[2], p[1]))));
-        int R = (int)ceil(L / 1.0);
-        double dA = lr_mesh_triangle_area(m, t) / ((double)R * R);
-        for (int j = 0; j < R; j++)
-            for (int i = 0; i + j < R; i++)
-                for (int up = 0; up < 2 && (up == 0 || i + j + 1 < R); up++) {
-                    double u = up ? (i + 2.0 / 3.0) / R : (i + 1.0 / 3.0) / R;
-                    double w = up ? (j + 2.0 / 3.0) / R : (j + 1.0 / 3.0) / R;
-                    lr_vec3 x = lr_v3_add(p[0], lr_v3_add(lr_v3_scale(e1, u), lr_v3_scale(e2, w)));
-                    f(user, t, u, w, x, n, dA);
-                }
-    }
-}
 
 typedef struct power_acc {
     model_ctx *mc;
@@ -131,7 +107,7 @@ static void power_at(model_ctx *mc, lr_vec3 x, double P[3])
     }
     power_acc a = {.mc = mc};
     const lr_scene_object *o = lr_scene_object_at(mc->s, 0);
-    quadrature(lr_bvh_mesh(o->bvh), add_point, &a);
+    lrt_mesh_quadrature(lr_bvh_mesh(o->bvh), 1.0, add_point, &a);
     double T = lr_hemi_transmittance(o->material.medium.eta);
     for (int b = 0; b < 3; b++)
         P[b] = T * a.sum[b] / (4.0 * M_PI);
@@ -158,7 +134,8 @@ static void nearest_point(void *user, size_t t, double u, double w, lr_vec3 x, l
 static void sweep(model_ctx *mc, const char *model, const char *label, lr_vec3 target)
 {
     nearest_acc na = {.q = target, .best = INFINITY};
-    quadrature(lr_bvh_mesh(lr_scene_object_at(mc->s, 0)->bvh), nearest_point, &na);
+    lrt_mesh_quadrature(lr_bvh_mesh(lr_scene_object_at(mc->s, 0)->bvh), 1.0, nearest_point,
+                        &na);
     const double dist[] = {5.0, 1.0, 0.1, 0.01};
     double P[4][3];
     for (int i = 0; i < 4; i++) {

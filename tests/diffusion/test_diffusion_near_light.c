@@ -29,6 +29,7 @@
 #include "render/mesh/mesh.h"
 #include "render/optics/near_light.h"
 #include "render/optics/optics.h"
+#include "tests/support/mesh_quad.h"
 #include "tests/support/near.h"
 #include "tests/support/render.h"
 
@@ -94,33 +95,27 @@ static const char *const candle_sets[] = {"objects[0].model=diffusion_grid",
 
 /* T_hem int B dA over the mesh per unit intensity: the field at the centroids of each
  * triangle's R^2 sub-triangles (R = ceil(longest edge / 1 mm)), times their area. */
+typedef struct field_acc {
+    lr_dfield_view v;
+    double sum;
+} field_acc;
+
+static void add_field(void *user, size_t t, double u, double w, lr_vec3 x, lr_vec3 n, double dA)
+{
+    (void)t, (void)u, (void)w, (void)n;
+    field_acc *a = user;
+    double B[3];
+    lr_dfield_eval(a->v.data, a->v.n, a->v.origin, a->v.h, x, B);
+    a->sum += (B[0] + B[1] + B[2]) / 3.0 * dA;
+}
+
 static double object_power(const lr_scene *s, const lr_dscene *d)
 {
-    lr_dfield_view v;
-    assert_true(lr_dscene_field(d, 0, 0, &v));
+    field_acc a = {.sum = 0.0};
+    assert_true(lr_dscene_field(d, 0, 0, &a.v));
     const lr_scene_object *o = lr_scene_object_at(s, 0);
-    const lr_mesh *m = lr_bvh_mesh(o->bvh);
-    double sum = 0.0;
-    for (size_t t = 0; t < lr_mesh_triangle_count(m); t++) {
-        lr_vec3 p[3];
-        lr_mesh_triangle(m, t, p);
-        lr_vec3 e1 = lr_v3_sub(p[1], p[0]), e2 = lr_v3_sub(p[2], p[0]);
-        double L = fmax(lr_v3_len(e1), fmax(lr_v3_len(e2), lr_v3_len(lr_v3_sub(p[2], p[1]))));
-        int R = (int)ceil(L / 1.0);
-        double dA = lr_mesh_triangle_area(m, t) / ((double)R * R);
-        for (int j = 0; j < R; j++)
-            for (int i = 0; i + j < R; i++)
-                for (int up = 0; up < 2 && (up == 0 || i + j + 1 < R); up++) {
-                    /* lower (i, j), (i+1, j), (i, j+1); upper (i+1, j), (i+1, j+1), (i, j+1) */
-                    double u = up ? (i + 2.0 / 3.0) / R : (i + 1.0 / 3.0) / R;
-                    double w = up ? (j + 2.0 / 3.0) / R : (j + 1.0 / 3.0) / R;
-                    lr_vec3 x = lr_v3_add(p[0], lr_v3_add(lr_v3_scale(e1, u), lr_v3_scale(e2, w)));
-                    double B[3];
-                    lr_dfield_eval(v.data, v.n, v.origin, v.h, x, B);
-                    sum += (B[0] + B[1] + B[2]) / 3.0 * dA;
-                }
-    }
-    return lr_hemi_transmittance(o->material.medium.eta) * sum;
+    lrt_mesh_quadrature(lr_bvh_mesh(o->bvh), 1.0, add_field, &a);
+    return lr_hemi_transmittance(o->material.medium.eta) * a.sum;
 }
 
 static double power_at(lr_scene *s, lr_dscene *d, lr_vec3 x)
