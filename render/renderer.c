@@ -701,6 +701,18 @@ int lr_renderer_present(lr_renderer *r, lr_err *e)
     return lr_gl_present(r->gl, e);
 }
 
+const lr_tex *lr_renderer_images(const lr_renderer *r, int *n, float *scale)
+{
+    if (!r->img.valid || !r->img.images) {
+        *n = 0;
+        return NULL;
+    }
+    *n = r->img.n;
+    for (int l = 0; l < r->img.n && l < LR_MAX_LIGHTS; l++)
+        scale[l] = r->img.scale[l];
+    return r->img.images;
+}
+
 const char *lr_renderer_info(const lr_renderer *r)
 {
     return r->info;

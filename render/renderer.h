@@ -27,6 +27,7 @@
 
 #include "render/base/err.h"
 #include "render/gl/gl.h"
+#include "render/gl/tex.h"
 #include "render/image/image.h"
 #include "render/schedule.h"
 #include "render/scene/scene.h"
@@ -95,6 +96,13 @@ int lr_renderer_read_hdr(lr_renderer *r, float *rgb, lr_err *e);
 int lr_renderer_read_rgba8(lr_renderer *r, unsigned char *rgba, lr_err *e);
 /* Draws the last frame to the context's default framebuffer (projector) and presents it. */
 int lr_renderer_present(lr_renderer *r, lr_err *e);
+
+/* The per-light images of the last composition (render/passes/compose.h): a 2D array of
+ * *n layers, layer l holding scale[l] times light l's unit-intensity linear radiance (the
+ * blend weighs it by intensity x colour x flicker / scale[l]); NULL before the first
+ * composition. For render/async/, which copies them to the caller's thread. scale has room
+ * for LR_SCENE_MAX_LIGHTS values. */
+const lr_tex *lr_renderer_images(const lr_renderer *r, int *n, float *scale);
 
 /* One line naming the GL renderer, the map format (RGBA32F, or RGBA16F and why) and the
  * timer kind, for stats and logs. */

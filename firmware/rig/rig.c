@@ -36,6 +36,8 @@
 
 #define MAX_POLL 128
 #define FLUSH_MS 1000
+/* The worker's first image at start-up; minutes only under the sanitizers. */
+#define FIRST_IMAGE_MS 600000
 
 /* What a config builds; swapped whole on reload. */
 typedef struct rigset {
@@ -78,6 +80,7 @@ struct lr_rig {
     unsigned frame_errors;
     bool fading; /* a fade was running at the last apply: apply once more after it ends */
     lr_frame_stats flip_stats; /* KMS: the frame on its way to the screen */
+    lr_rig_frame_info flip_info;
     bool flip_stats_pending;
     bool used_hid; /* hidapi's process-wide state is released once, at the very end */
     bool ar_dirty; /* spatial AR: the scene changed since the last projector frame */
@@ -388,14 +391,24 @@ static void apply(lr_rig *r, int64_t now)
         lr_log_write(&r->log, LR_LOG_WARN, "control map: %s", e.msg);
     if (r->set.replan && (dirty & LR_DIRTY_MATERIAL))
         replan(r, &dirty);
+    uint64_t batch = 0;
     if (dirty) {
-        lr_rig_view_invalidate(r->view, dirty);
+        /* No view yet at start-up and in a scene switch: the view is built on the scene as
+         * the controls have set it. */
+        if (r->view)
+            batch = lr_rig_view_invalidate(r->view, dirty);
         r->ar_dirty = true;
     }
     double level;
     if (lr_control_map_lamp_level(r->set.map, now, &level))
         write_lamp(r, level);
     r->fading = lr_control_map_fading(r->set.map, now);
+    /* The events taken since the last apply show in the frames whose images include this
+     * change (off the loop, render/async/: the batch; 0: the next frame). A fade whose first
+     * step left the scene as it was has not changed anything yet: its events wait for the
+     * apply that does. */
+    if (dirty || !r->fading)
+        lr_rig_stats_tag(r->stats, batch);
 }
 
 static void switch_scene(lr_rig *r, const char *path)
@@ -414,11 +427,18 @@ static void switch_scene(lr_rig *r, const char *path)
         lr_scene_destroy(scene);
         return;
     }
+    /* The controls' values go into the new scene before its view copies it, so that its first
+     * image is the one the controls ask for. */
+    lr_control_map_scene_replaced(r->set.map);
+    unsigned dirty = 0;
+    if (lr_control_map_update(r->set.map, scene, lr_now_ns(), &dirty, &e))
+        lr_log_write(&r->log, LR_LOG_WARN, "control map: %s", e.msg);
     lr_rig_view *view;
     if (view_build(r, scene, no_vpl, &view, &e)) {
         lr_log_write(&r->log, LR_LOG_ERROR, "scene switch: %s", e.msg);
         lr_replan_destroy(rp);
         lr_scene_destroy(scene);
+        lr_control_map_scene_replaced(r->set.map); /* the old scene again, written in full */
         return;
     }
     lr_rig_view_destroy(r->view);
@@ -427,7 +447,6 @@ static void switch_scene(lr_rig *r, const char *path)
     r->view = view;
     r->set.scene = scene;
     r->set.replan = rp;
-    lr_control_map_scene_replaced(r->set.map);
     r->ar_dirty = true;
     lr_log_write(&r->log, LR_LOG_INFO, "scene: %s", path);
 }
@@ -529,8 +548,14 @@ static void ar_frame(lr_rig *r)
 static void frame(lr_rig *r, int64_t now)
 {
     lr_frame_stats st;
+    lr_rig_frame_info info;
     lr_err e = {0};
-    int rc = lr_rig_view_frame(r->view, &st, &e);
+    int rc = lr_rig_view_frame(r->view, &st, &info, &e);
+    if (!rc && info.stage == LR_ASYNC_NONE) {
+        /* Nothing to show yet (the worker's first image is on its way): no frame. */
+        r->next_frame_ns = now + r->frame_interval_ns;
+        return;
+    }
     /* With spatial AR the projector shows the compensated frame (ar_frame), not the view. */
     if (!rc && r->kms && !r->set.calib)
         rc = lr_rig_view_present(r->view, &e);
@@ -553,11 +578,12 @@ static void frame(lr_rig *r, int64_t now)
     if (r->kms && lr_gl_flip_pending(r->gl)) {
         /* On the projector a frame shows at its page flip: the latency ends there. */
         if (r->flip_stats_pending)
-            lr_rig_stats_frame(r->stats, &r->flip_stats, lr_now_ns());
+            lr_rig_stats_frame_shown(r->stats, &r->flip_stats, &r->flip_info, lr_now_ns());
         r->flip_stats = st;
+        r->flip_info = info;
         r->flip_stats_pending = true;
     } else {
-        lr_rig_stats_frame(r->stats, &st, lr_now_ns());
+        lr_rig_stats_frame_shown(r->stats, &st, &info, lr_now_ns());
     }
     r->next_frame_ns = now + r->frame_interval_ns;
 }
@@ -716,20 +742,23 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
     }
     if (!rc && r->kms && r->set.calib)
         rc = ar_output(r, e);
+    /* The controls' initial values first (a dimmer's start level, a knob's preset), so the
+     * view copies the scene the controls ask for; the devices' own states come below. */
+    if (!rc)
+        apply(r, r->start_ns);
     if (!rc)
         rc = view_build(r, r->set.scene, r->set.no_vpl, &r->view, e);
     r->ar_dirty = true;
     if (!rc && ensure_rgba(r))
         rc = lr_err_set(e, LR_ENOMEM, "out of memory");
-    /* The first frame is the costly one: the G-buffers and maps, the receivers' bounce and the
-     * objects' light from it, a diffusion grid's first solve (2-3 s on the 2-core proxy, many
-     * more under the sanitizers or on a loaded machine). It is made here, before the devices
-     * open, so that the rig takes controls once it shows an image: events that came in
-     * during it would all wait for it, and a short run would play less of its script. */
+    /* The first image: with the transport off the loop ("passes") the worker's first
+     * publication, a coarse preview of the scene (render/async/), which it then refines while
+     * the loop runs; on the loop ("passes_inline") the whole first frame (the G-buffers,
+     * maps, bounce, a grid's first solve: seconds on the 2-core proxy). It is made before
+     * the devices open, so that the rig takes controls once it shows an image. */
+    if (!rc && (rc = lr_rig_view_wait_first(r->view, FIRST_IMAGE_MS, e)))
+        lr_err_prefix(e, "the first image");
     if (!rc) {
-        /* The controls' initial values first (a dimmer's start level, a knob's preset), so the
-         * first image is the one the controls ask for; the devices' own states come below. */
-        apply(r, r->start_ns);
         lr_rig_view_set_time(r->view, 0.0);
         frame(r, lr_now_ns());
     }
@@ -884,12 +913,17 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             break;
         /* The poll set and the earliest deadline. */
         struct pollfd fds[MAX_POLL];
-        int owner[MAX_POLL]; /* -1 signalfd, -2 gl, else device index */
+        int owner[MAX_POLL]; /* -1 signalfd, -2 gl, -3 the view, else device index */
         int nf = 0;
         int64_t t = r->end_ns < until_ns ? r->end_ns : until_ns;
         if (r->sigfd >= 0) {
             fds[nf] = (struct pollfd){r->sigfd, POLLIN, 0};
             owner[nf++] = -1;
+        }
+        if (lr_rig_view_event_fd(r->view) >= 0) {
+            /* The worker published images: wake to show them (lr_rig_view_frame drains it). */
+            fds[nf] = (struct pollfd){lr_rig_view_event_fd(r->view), POLLIN, 0};
+            owner[nf++] = -3;
         }
         if (r->kms && lr_gl_flip_pending(r->gl) && lr_gl_event_fd(r->gl) >= 0) {
             fds[nf] = (struct pollfd){lr_gl_event_fd(r->gl), POLLIN, 0};
@@ -942,7 +976,7 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
                 if (lr_gl_dispatch(r->gl, &ge))
                     lr_log_write(&r->log, LR_LOG_ERROR, "output: %s", ge.msg);
                 if (r->flip_stats_pending && !lr_gl_flip_pending(r->gl)) {
-                    lr_rig_stats_frame(r->stats, &r->flip_stats, now);
+                    lr_rig_stats_frame_shown(r->stats, &r->flip_stats, &r->flip_info, now);
                     r->flip_stats_pending = false;
                 }
             }
@@ -958,6 +992,9 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             handle_event(r, &ev, now);
             any = true;
         }
+        lr_err ve = {0};
+        if (lr_rig_view_error(r->view, &ve))
+            lr_log_write(&r->log, LR_LOG_ERROR, "render: %s", ve.msg);
         const char *sw = lr_control_map_scene_request(r->set.map);
         if (sw)
             switch_scene(r, sw);
@@ -1024,7 +1061,7 @@ void lr_rig_get_info(const lr_rig *r, lr_rig_info *out)
     out->lamp_level = r->lamp_written;
     out->output = r->kms ? "kms" : "headless";
     out->view = r->view ? lr_rig_view_name(r->view) : "";
-    out->idle = r->view && !frame_due(r);
+    out->idle = r->view && !frame_due(r) && !lr_rig_view_busy(r->view);
 }
 
 struct lr_scene *lr_rig_scene(lr_rig *r) { return r->set.scene; }

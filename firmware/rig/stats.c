@@ -19,16 +19,27 @@ typedef struct ev_rec {
     lr_event ev;
     uint64_t frame;
     double latency_ms;
+    int stage; /* lr_rig_frame_info.stage of the frame that first showed it */
 } ev_rec;
 
 typedef struct fr_rec {
     lr_frame_stats f;
     int64_t t_ns;
+    lr_rig_frame_info info;
 } fr_rec;
+
+/* An event waiting for a frame that shows it, and then for one that shows it converged. */
+typedef struct pend_rec {
+    lr_event ev;
+    uint64_t batch; /* UNTAGGED until the loop applied it */
+    bool shown;
+} pend_rec;
+
+#define UNTAGGED UINT64_MAX
 
 struct lr_rig_stats {
     int64_t start_ns;
-    lr_event pending[PENDING_MAX];
+    pend_rec pending[PENDING_MAX];
     int n_pending;
     uint64_t dropped_pending;
     ev_rec *events; /* ring of LOG_MAX */
@@ -40,6 +51,7 @@ struct lr_rig_stats {
     double ar_last_px, ar_last_light, ar_max_px, ar_max_light;
     /* Every latency, for quantiles, in constant memory: a rig runs for months. */
     lr_lat_hist *lat;
+    lr_lat_hist *conv; /* event -> first converged frame showing it */
 };
 
 int lr_rig_stats_create(int64_t start_ns, lr_rig_stats **out, lr_err *e)
@@ -49,8 +61,9 @@ int lr_rig_stats_create(int64_t start_ns, lr_rig_stats **out, lr_err *e)
         s->events = calloc(LOG_MAX, sizeof *s->events);
         s->frames = calloc(LOG_MAX, sizeof *s->frames);
         s->lat = lr_lat_hist_create();
+        s->conv = lr_lat_hist_create();
     }
-    if (!s || !s->events || !s->frames || !s->lat) {
+    if (!s || !s->events || !s->frames || !s->lat || !s->conv) {
         lr_rig_stats_destroy(s);
         return lr_err_set(e, LR_ENOMEM, "out of memory");
     }
@@ -66,6 +79,7 @@ void lr_rig_stats_destroy(lr_rig_stats *s)
     free(s->events);
     free(s->frames);
     lr_lat_hist_destroy(s->lat);
+    lr_lat_hist_destroy(s->conv);
     free(s);
 }
 
@@ -77,7 +91,14 @@ void lr_rig_stats_event(lr_rig_stats *s, const lr_event *ev)
         s->n_pending--;
         s->dropped_pending++;
     }
-    s->pending[s->n_pending++] = *ev;
+    s->pending[s->n_pending++] = (pend_rec){.ev = *ev, .batch = UNTAGGED};
+}
+
+void lr_rig_stats_tag(lr_rig_stats *s, uint64_t batch)
+{
+    for (int i = 0; i < s->n_pending; i++)
+        if (s->pending[i].batch == UNTAGGED)
+            s->pending[i].batch = batch;
 }
 
 void lr_rig_stats_unmatched(lr_rig_stats *s) { s->unmatched++; }
@@ -93,25 +114,53 @@ void lr_rig_stats_ar(lr_rig_stats *s, double clipped_pixels, double clipped_ligh
 
 void lr_rig_stats_frame(lr_rig_stats *s, const lr_frame_stats *f, int64_t done_ns)
 {
+    /* The renderer on the loop: every frame shows everything applied before it. */
+    lr_rig_frame_info info = {.batch = UNTAGGED - 1,
+                              .stage = f->converged ? LR_ASYNC_FINAL : LR_ASYNC_REFINING,
+                              .converged = f->converged};
+    lr_rig_stats_tag(s, 0);
+    lr_rig_stats_frame_shown(s, f, &info, done_ns);
+}
+
+void lr_rig_stats_frame_shown(lr_rig_stats *s, const lr_frame_stats *f,
+                              const lr_rig_frame_info *info, int64_t done_ns)
+{
     fr_rec *r = &s->frames[s->n_frames % LOG_MAX];
     r->f = *f;
     r->t_ns = done_ns;
+    r->info = *info;
     s->n_frames++;
     /* A frame that ran no pass re-presents the previous image: it shows no event yet (the
      * first frame of a fade, still at the old level, is one). */
     if (!f->passes)
         return;
+    int keep = 0;
     for (int i = 0; i < s->n_pending; i++) {
-        ev_rec *er = &s->events[s->n_events % LOG_MAX];
-        er->ev = s->pending[i];
-        er->frame = (uint64_t)f->index;
-        double ms = (double)(done_ns - s->pending[i].t_ns) * 1e-6;
+        pend_rec *p = &s->pending[i];
+        /* Untagged: applied after this frame's images were chosen; a later batch: the images
+         * shown are older than the change. */
+        bool shows = p->batch != UNTAGGED && p->batch <= info->batch;
+        double ms = (double)(done_ns - p->ev.t_ns) * 1e-6;
         /* A device clock ahead of ours (never with CLOCK_MONOTONIC stamps) reads as 0. */
-        er->latency_ms = ms > 0 ? ms : 0;
-        s->n_events++;
-        lr_lat_hist_add(s->lat, er->latency_ms);
+        if (ms < 0)
+            ms = 0;
+        if (shows && !p->shown) {
+            ev_rec *er = &s->events[s->n_events % LOG_MAX];
+            er->ev = p->ev;
+            er->frame = (uint64_t)f->index;
+            er->latency_ms = ms;
+            er->stage = info->stage;
+            s->n_events++;
+            lr_lat_hist_add(s->lat, ms);
+            p->shown = true;
+        }
+        if (shows && info->converged) {
+            lr_lat_hist_add(s->conv, ms);
+            continue; /* done with */
+        }
+        s->pending[keep++] = *p;
     }
-    s->n_pending = 0;
+    s->n_pending = keep;
 }
 
 int lr_rig_stats_pending(const lr_rig_stats *s) { return s->n_pending; }
@@ -121,6 +170,11 @@ uint64_t lr_rig_stats_events(const lr_rig_stats *s) { return s->n_events; }
 double lr_rig_stats_latency_ms(const lr_rig_stats *s, double q)
 {
     return lr_lat_hist_quantile(s->lat, q);
+}
+
+double lr_rig_stats_converge_ms(const lr_rig_stats *s, double q)
+{
+    return lr_lat_hist_quantile(s->conv, q);
 }
 
 static void write_devices(lr_jw *w, const lr_rig_stats_dev *devs, int n)
@@ -197,6 +251,13 @@ int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *conf
     lr_jw_number_or_null(w, "max", lr_lat_hist_max(h));
     lr_jw_number_or_null(w, "mean", lr_lat_hist_mean(h));
     lr_jw_object_end(w);
+    h = s->conv;
+    lr_jw_object(w, "converge_ms");
+    lr_jw_int(w, "n", (long)lr_lat_hist_n(h));
+    lr_jw_number_or_null(w, "median", lr_lat_hist_quantile(h, 0.5));
+    lr_jw_number_or_null(w, "p99", lr_lat_hist_quantile(h, 0.99));
+    lr_jw_number_or_null(w, "max", lr_lat_hist_max(h));
+    lr_jw_object_end(w);
     lr_jw_array(w, "event_log");
     uint64_t first = s->n_events > LOG_MAX ? s->n_events - LOG_MAX : 0;
     for (uint64_t i = first; i < s->n_events; i++) {
@@ -209,6 +270,7 @@ int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *conf
         lr_jw_number(w, "t_s", (double)(r->ev.t_ns - s->start_ns) * 1e-9);
         lr_jw_int(w, "frame", (long)r->frame);
         lr_jw_number_or_null(w, "latency_ms", r->latency_ms);
+        lr_jw_string(w, "stage", lr_async_stage_name((lr_async_stage)r->stage));
         lr_jw_object_end(w);
     }
     lr_jw_array_end(w);
@@ -231,6 +293,9 @@ int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *conf
         lr_jw_number_or_null(w, "total_ms", r->f.total_ms);
         lr_jw_int(w, "samples", r->f.samples);
         lr_jw_bool(w, "converged", r->f.converged);
+        lr_jw_string(w, "stage", lr_async_stage_name(r->info.stage));
+        if (r->info.batch < UNTAGGED - 1)
+            lr_jw_int(w, "batch", (long)r->info.batch);
         lr_jw_object_end(w);
     }
     lr_jw_array_end(w);

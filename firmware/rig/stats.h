@@ -8,11 +8,18 @@
  *   "devices": [{"name": "panel", "kind": "modbus", "state": "open",
  *                "modbus": {"requests": 812, "responses": 806, "timeouts": 2, "stale": 4, ...}}],
  *   "latency_ms": {"n": 40, "min": 0.8, "median": 2.1, "p99": 7.9, "max": 8.3, "mean": 2.4},
+ *   "converge_ms": {"n": 40, "median": 310, "p99": 2100, "max": 2300},
  *   "event_log": [{"source": "sim", "control": "dimmer", "kind": "absolute", "value": 0.5,
- *                  "t_s": 1.25, "frame": 38, "latency_ms": 2.1}, ...],     (last 4096)
+ *                  "t_s": 1.25, "frame": 38, "latency_ms": 2.1, "stage": "final"}, ...],
+ *                                                                            (last 4096)
  *   "frame_log": [{"index": 38, "t_s": 1.252, "passes": ["compose"], "ms": [0,0,0,0.4],
- *                  "total_ms": 0.4, "samples": 64, "converged": true}, ...]  (last 4096)
+ *                  "total_ms": 0.4, "samples": 64, "converged": true,
+ *                  "stage": "final", "batch": 12}, ...]                       (last 4096)
  * }
+ * latency_ms: event -> the end of the first frame that shows it, at whatever stage
+ * (render/async/async.h: a preview, refining or final image); converge_ms: event -> the first
+ * frame that shows it converged (the renderer's own settings, accumulation done). An event's
+ * "stage" is that of the frame that first showed it.
  * t_s are seconds since the stats were created (CLOCK_MONOTONIC). The summary covers every
  * event in constant memory: n, min, max, mean exact, median and p99 from a histogram within
  * 0.5 % (firmware/rig/lat_hist.h). Nothing here grows with the number of events or frames.
@@ -25,6 +32,7 @@
 #include "hal/event.h"
 #include "hal/modbus.h"
 #include "render/base/err.h"
+#include "render/async/async.h"
 #include "render/renderer.h"
 
 typedef struct lr_rig_stats lr_rig_stats;
@@ -36,9 +44,26 @@ void lr_rig_stats_destroy(lr_rig_stats *s);
 void lr_rig_stats_event(lr_rig_stats *s, const lr_event *ev);
 /* An event no binding took. */
 void lr_rig_stats_unmatched(lr_rig_stats *s);
+/* The loop applied the pending events: the change is batch `batch` of render/async (0: it
+ * needs no new images, the next blend shows it). */
+void lr_rig_stats_tag(lr_rig_stats *s, uint64_t batch);
+
+/* What a frame shows: images that include every change up to `batch`, at `stage`. */
+typedef struct lr_rig_frame_info {
+    uint64_t batch;
+    lr_async_stage stage;
+    bool converged;
+} lr_rig_frame_info;
+
 /* A frame finished (presented or written) at done_ns: if it ran at least one pass, every
- * pending event gets its latency; a frame with no pass (the previous image again) shows none. */
+ * pending event its images include gets its latency (and, when converged, its convergence
+ * time); a frame with no pass (the previous image again) shows none. */
+void lr_rig_stats_frame_shown(lr_rig_stats *s, const lr_frame_stats *f,
+                              const lr_rig_frame_info *info, int64_t done_ns);
+/* The same for a renderer on the loop: every frame shows every event before it. */
 void lr_rig_stats_frame(lr_rig_stats *s, const lr_frame_stats *f, int64_t done_ns);
+/* Event -> converged image quantile, ms; NaN when none. */
+double lr_rig_stats_converge_ms(const lr_rig_stats *s, double q);
 
 /* A spatial-AR projector frame (calib/ar_frame.h): its clipping, kept for the stats file
  * ("ar": frames, last and worst clipped fraction of pixels and of the light). */

@@ -1,11 +1,13 @@
 /* lamprig firmware — the view table (see view.h). */
 #include "firmware/rig/view.h"
 
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 /* Default first. */
-static const lr_rig_view_ops *const views[] = {&lr_rig_view_passes, &lr_rig_view_preview};
+static const lr_rig_view_ops *const views[] = {&lr_rig_view_passes, &lr_rig_view_inline,
+                                               &lr_rig_view_preview};
 #define N_VIEWS ((int)(sizeof views / sizeof views[0]))
 
 struct lr_rig_view {
@@ -14,7 +16,7 @@ struct lr_rig_view {
     int width, height;
 };
 
-const char *lr_rig_view_names(void) { return "passes, preview"; }
+const char *lr_rig_view_names(void) { return "passes, passes_inline, preview"; }
 
 static const lr_rig_view_ops *find(const char *name)
 {
@@ -65,7 +67,10 @@ void lr_rig_view_destroy(lr_rig_view *v)
 }
 
 const char *lr_rig_view_name(const lr_rig_view *v) { return v->ops->name; }
-void lr_rig_view_invalidate(lr_rig_view *v, unsigned dirty) { v->ops->invalidate(v->impl, dirty); }
+uint64_t lr_rig_view_invalidate(lr_rig_view *v, unsigned dirty)
+{
+    return v->ops->invalidate(v->impl, dirty);
+}
 bool lr_rig_view_needs_frame(const lr_rig_view *v) { return v->ops->needs_frame(v->impl); }
 
 void lr_rig_view_set_time(lr_rig_view *v, double t_seconds)
@@ -74,9 +79,35 @@ void lr_rig_view_set_time(lr_rig_view *v, double t_seconds)
         v->ops->set_time(v->impl, t_seconds);
 }
 
-int lr_rig_view_frame(lr_rig_view *v, lr_frame_stats *stats, lr_err *e)
+int lr_rig_view_frame(lr_rig_view *v, lr_frame_stats *stats, lr_rig_frame_info *info,
+                      lr_err *e)
 {
-    return v->ops->frame(v->impl, stats, e);
+    *stats = (lr_frame_stats){0};
+    *info = (lr_rig_frame_info){.batch = UINT64_MAX - 1};
+    int rc = v->ops->frame(v->impl, stats, info, e);
+    if (!rc && !v->ops->busy) {
+        /* On the loop: the frame shows every change made before it. */
+        info->converged = stats->converged;
+        info->stage = stats->converged ? LR_ASYNC_FINAL : LR_ASYNC_REFINING;
+    }
+    return rc;
+}
+
+int lr_rig_view_event_fd(const lr_rig_view *v)
+{
+    return v->ops->event_fd ? v->ops->event_fd(v->impl) : -1;
+}
+
+bool lr_rig_view_busy(const lr_rig_view *v) { return v->ops->busy && v->ops->busy(v->impl); }
+
+int lr_rig_view_error(lr_rig_view *v, lr_err *e)
+{
+    return v->ops->error ? v->ops->error(v->impl, e) : LR_OK;
+}
+
+int lr_rig_view_wait_first(lr_rig_view *v, int timeout_ms, lr_err *e)
+{
+    return v->ops->wait_first ? v->ops->wait_first(v->impl, timeout_ms, e) : LR_OK;
 }
 
 int lr_rig_view_read_rgba8(lr_rig_view *v, unsigned char *rgba, lr_err *e)

@@ -2,8 +2,14 @@
  * shape of render/renderer.h (invalidate by dirty flags, needs_frame, frame with stats,
  * RGBA8 readback, present), so the loop schedules frames the same way whichever is built in.
  *
- *   "passes"   render/renderer.h, seed 003's passes (the default; needs GL, surfaceless
- *              headless)
+ *   "passes"   seed 003's passes (render/renderer.h) with the light transport on a worker
+ *              thread (render/async/async.h): the loop blends the newest per-light images
+ *              at every frame and never waits for a solve; after a change that re-runs the
+ *              maps the first image is a coarse preview, then it refines (the default;
+ *              needs GL, surfaceless headless)
+ *   "passes_inline"  the same passes on the loop's own thread: a frame runs whatever
+ *              transport is due before the loop goes on (for comparison, and for a driver
+ *              that cannot share a context between threads)
  *   "preview"  a CPU stand-in: a glow whose colour is the sum of the lights' intensity times
  *              colour (relative to the lights when the view was created, tone-mapped
  *              1 - exp(-x)), so a frame's brightness follows the dimmer; converged after
@@ -16,6 +22,7 @@
 
 #include <stdbool.h>
 
+#include "firmware/rig/stats.h"
 #include "render/base/err.h"
 #include "render/gl/gl.h"
 #include "render/renderer.h"
@@ -29,9 +36,10 @@ typedef struct lr_rig_view_desc {
     lr_scene *scene;  /* read at every frame; owned by the caller */
     int width, height;
     bool no_vpl;      /* "passes": skip the VPL pass (the planner found no receiver in sight) */
+    bool no_preview;  /* "passes": no coarse preview stage after a change */
 } lr_rig_view_desc;
 
-/* Comma-separated names of the back ends built in, default first ("passes, preview"). */
+/* Comma-separated names of the back ends built in, default first. */
 const char *lr_rig_view_names(void);
 /* Whether a back end needs a GL context even headless. */
 bool lr_rig_view_needs_gl(const char *name);
@@ -39,12 +47,26 @@ bool lr_rig_view_needs_gl(const char *name);
 int lr_rig_view_create(const lr_rig_view_desc *desc, lr_rig_view **out, lr_err *e);
 void lr_rig_view_destroy(lr_rig_view *v);
 const char *lr_rig_view_name(const lr_rig_view *v);
-void lr_rig_view_invalidate(lr_rig_view *v, unsigned dirty);
+/* Hands a change (the LR_DIRTY_* flags of the scene changes made since the last call) to the
+ * back end. Returns the number the change became (render/async/: its batch; the frames whose
+ * lr_rig_frame_info.batch is at least that show it), 0 when the next frame shows it. */
+uint64_t lr_rig_view_invalidate(lr_rig_view *v, unsigned dirty);
 bool lr_rig_view_needs_frame(const lr_rig_view *v);
 /* The view's clock, seconds since the rig started (the renderer's flicker,
  * lr_renderer_set_time); back ends without one ignore it. */
 void lr_rig_view_set_time(lr_rig_view *v, double t_seconds);
-int lr_rig_view_frame(lr_rig_view *v, lr_frame_stats *stats, lr_err *e);
+/* Draws a frame. info says what it shows; stats->passes 0: nothing new (no image yet). */
+int lr_rig_view_frame(lr_rig_view *v, lr_frame_stats *stats, lr_rig_frame_info *info,
+                      lr_err *e);
+/* A descriptor that becomes readable when the back end has something new to show (the
+ * worker published images), for the loop's poll set; -1: none. */
+int lr_rig_view_event_fd(const lr_rig_view *v);
+/* True while the back end has transport work in hand (off the loop). */
+bool lr_rig_view_busy(const lr_rig_view *v);
+/* An error of work done off the loop (once), LR_OK when none. */
+int lr_rig_view_error(lr_rig_view *v, lr_err *e);
+/* Blocks until there is a first image (start-up only), or timeout_ms. */
+int lr_rig_view_wait_first(lr_rig_view *v, int timeout_ms, lr_err *e);
 /* width*height*4 bytes, rows top to bottom. */
 int lr_rig_view_read_rgba8(lr_rig_view *v, unsigned char *rgba, lr_err *e);
 int lr_rig_view_present(lr_rig_view *v, lr_err *e);
@@ -56,15 +78,22 @@ typedef struct lr_rig_view_ops {
     bool needs_gl;
     int (*create)(const lr_rig_view_desc *desc, void **impl, lr_err *e);
     void (*destroy)(void *impl);
-    void (*invalidate)(void *impl, unsigned dirty);
+    uint64_t (*invalidate)(void *impl, unsigned dirty);
     bool (*needs_frame)(const void *impl);
     void (*set_time)(void *impl, double t_seconds); /* may be NULL */
-    int (*frame)(void *impl, lr_frame_stats *stats, lr_err *e);
+    /* info is preset to "shows everything, converged as stats say" */
+    int (*frame)(void *impl, lr_frame_stats *stats, lr_rig_frame_info *info, lr_err *e);
     int (*read_rgba8)(void *impl, unsigned char *rgba, lr_err *e);
     int (*present)(void *impl, lr_err *e);
+    /* Optional (NULL: the back end works on the loop): */
+    int (*event_fd)(const void *impl);
+    bool (*busy)(const void *impl);
+    int (*error)(void *impl, lr_err *e);
+    int (*wait_first)(void *impl, int timeout_ms, lr_err *e);
 } lr_rig_view_ops;
 
 extern const lr_rig_view_ops lr_rig_view_passes;
+extern const lr_rig_view_ops lr_rig_view_inline;
 extern const lr_rig_view_ops lr_rig_view_preview;
 
 #endif

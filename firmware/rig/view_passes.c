@@ -1,38 +1,75 @@
-/* lamprig firmware — the "passes" view: render/renderer.h (seed 003's passes on GLES 3.1). */
+/* lamprig firmware — the "passes" view: seed 003's passes with the light transport on a
+ * worker thread (render/async/async.h); the loop's thread blends the latest per-light images
+ * at every frame, so no control waits behind a solve. */
 #include "firmware/rig/view.h"
 
 #include <stdlib.h>
+
+#include "render/async/async.h"
+
+/* The first image after a change that re-runs the maps (a material, a light move, a scene
+ * switch) is drawn at these settings, then refined at the scene's own: one map, one sample,
+ * small maps, one frame. A coarse but coherent image of the new state (render/async/). */
+static const char *const preview_sets[] = {
+    "render.K=1", "render.N=1", "render.map_size=32", "render.gbuffer_size=32",
+    "render.vpl_map_size=16", "render.N_vpl=4", "render.frames=1",
+};
+#define N_PREVIEW ((int)(sizeof preview_sets / sizeof preview_sets[0]))
 
 static int v_create(const lr_rig_view_desc *d, void **impl, lr_err *e)
 {
     if (!d->gl)
         return lr_err_set(e, LR_EINVAL, "renderer 'passes' needs a GL context");
-    lr_renderer_desc rd = {.gl = d->gl, .scene = d->scene, .width = d->width,
-                           .height = d->height, .no_vpl = d->no_vpl};
-    lr_renderer *r;
-    int rc = lr_renderer_create(&rd, &r, e);
+    lr_async_desc ad = {.gl = d->gl, .scene = d->scene, .width = d->width,
+                        .height = d->height, .no_vpl = d->no_vpl};
+    if (!d->no_preview) {
+        for (int i = 0; i < N_PREVIEW; i++)
+            ad.preview[i] = preview_sets[i];
+        ad.n_preview = N_PREVIEW;
+    }
+    lr_async *a;
+    int rc = lr_async_create(&ad, &a, e);
     if (rc)
         return rc;
-    *impl = r;
+    *impl = a;
     return LR_OK;
 }
 
-static void v_destroy(void *impl) { lr_renderer_destroy(impl); }
-static void v_invalidate(void *impl, unsigned dirty) { lr_renderer_invalidate(impl, dirty); }
-static bool v_needs_frame(const void *impl) { return lr_renderer_needs_frame(impl); }
-static void v_set_time(void *impl, double t) { lr_renderer_set_time(impl, t); }
+static void v_destroy(void *impl) { lr_async_destroy(impl); }
+static uint64_t v_invalidate(void *impl, unsigned dirty) { return lr_async_commit(impl, dirty); }
+static bool v_needs_frame(const void *impl) { return lr_async_needs_frame(impl); }
+static void v_set_time(void *impl, double t) { lr_async_set_time(impl, t); }
 
-static int v_frame(void *impl, lr_frame_stats *st, lr_err *e)
+static int v_frame(void *impl, lr_frame_stats *st, lr_rig_frame_info *info, lr_err *e)
 {
-    return lr_renderer_frame(impl, st, e);
+    lr_async_frame_stats as;
+    int rc = lr_async_frame(impl, &as, e);
+    if (rc)
+        return rc;
+    /* The loop's frame is the blend; the worker frame whose images it shows is kept for
+     * the samples and convergence. */
+    *st = as.worker;
+    st->passes = as.stage == LR_ASYNC_NONE ? 0u : (unsigned)LR_PASS_BLEND;
+    st->total_ms = as.blend_ms;
+    *info = (lr_rig_frame_info){.batch = as.batch, .stage = as.stage,
+                                .converged = as.stage == LR_ASYNC_FINAL};
+    return LR_OK;
 }
 
 static int v_read(void *impl, unsigned char *rgba, lr_err *e)
 {
-    return lr_renderer_read_rgba8(impl, rgba, e);
+    return lr_async_read_rgba8(impl, rgba, e);
 }
 
-static int v_present(void *impl, lr_err *e) { return lr_renderer_present(impl, e); }
+static int v_present(void *impl, lr_err *e) { return lr_async_present(impl, e); }
+static int v_event_fd(const void *impl) { return lr_async_event_fd(impl); }
+static bool v_busy(const void *impl) { return lr_async_busy(impl); }
+static int v_error(void *impl, lr_err *e) { return lr_async_error(impl, e); }
+
+static int v_wait(void *impl, int timeout_ms, lr_err *e)
+{
+    return lr_async_wait(impl, 0, false, timeout_ms, e);
+}
 
 const lr_rig_view_ops lr_rig_view_passes = {
     .name = "passes",
@@ -45,4 +82,8 @@ const lr_rig_view_ops lr_rig_view_passes = {
     .frame = v_frame,
     .read_rgba8 = v_read,
     .present = v_present,
+    .event_fd = v_event_fd,
+    .busy = v_busy,
+    .error = v_error,
+    .wait_first = v_wait,
 };

@@ -53,7 +53,11 @@ static int p_create(const lr_rig_view_desc *d, void **impl, lr_err *e)
 
 static void p_destroy(void *impl) { free(impl); }
 
-static void p_invalidate(void *impl, unsigned dirty) { ((preview *)impl)->dirty |= dirty; }
+static uint64_t p_invalidate(void *impl, unsigned dirty)
+{
+    ((preview *)impl)->dirty |= dirty;
+    return 0;
+}
 
 static bool p_needs_frame(const void *impl)
 {
@@ -61,8 +65,9 @@ static bool p_needs_frame(const void *impl)
     return p->dirty != 0 || !p->have_frame;
 }
 
-static int p_frame(void *impl, lr_frame_stats *st, lr_err *e)
+static int p_frame(void *impl, lr_frame_stats *st, lr_rig_frame_info *info, lr_err *e)
 {
+    (void)info; /* shows everything: lr_rig_view_frame's preset */
     (void)e;
     preview *p = impl;
     struct timespec t0, t1;

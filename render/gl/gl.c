@@ -96,10 +96,12 @@ void lr_gl_destroy(lr_gl *gl)
             eglDestroyContext(gl->dpy, gl->ctx);
         if (gl->surface != EGL_NO_SURFACE)
             eglDestroySurface(gl->dpy, gl->surface);
-        /* Before the back end frees the native display (GBM device) it was made from. */
-        eglTerminate(gl->dpy);
+        /* Before the back end frees the native display (GBM device) it was made from; a
+         * shared context leaves both to its parent. */
+        if (!gl->shared)
+            eglTerminate(gl->dpy);
     }
-    if (gl->ops && gl->ops->fini)
+    if (!gl->shared && gl->ops && gl->ops->fini)
         gl->ops->fini(gl);
     free(gl);
 }

@@ -10,7 +10,8 @@
  *
  * The passes only ever see GLES 3.1 (no geometry shaders, no desktop GL): the context is asked
  * for 3.1 and rejected when the driver reports less. lr_gl_create makes the context current on
- * the calling thread; all GL work must happen on that thread.
+ * the calling thread; all GL work must happen on that thread (a worker thread gets its own
+ * context, lr_gl_create_shared).
  *
  * Frame loop with the projector (the DRM fd joins the firmware's poll set, as in kmscube):
  *
@@ -96,6 +97,12 @@ enum lr_gl_need {
  * extension missing, GLES < 3.1), LR_EGL (an EGL call failed; the message names it and the
  * EGL error). */
 int lr_gl_create(const lr_gl_desc *desc, lr_gl **out, lr_err *e);
+/* A second context that shares textures and buffers (not framebuffers or vertex arrays)
+ * with `parent`, on the parent's display and without a surface, made current on the calling
+ * thread: a worker thread renders into textures the parent's thread then reads (render/async/).
+ * The parent must outlive it; lr_gl_size reports 0 x 0 and lr_gl_present only flushes. The
+ * two threads order their work on shared objects with fences (glFenceSync). */
+int lr_gl_create_shared(lr_gl *parent, lr_gl **out, lr_err *e);
 /* Releases the context, surfaces and DRM state, in that order; NULL is a no-op. */
 void lr_gl_destroy(lr_gl *gl);
 

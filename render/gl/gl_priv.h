@@ -32,6 +32,9 @@ struct lr_gl {
     int width, height;  /* default framebuffer; 0 on surfaceless */
     GLuint empty_vao;   /* for lr_gl_draw_fullscreen */
     lr_gl_caps caps;
+    /* lr_gl_create_shared: a second context on the parent's display; destroying it leaves
+     * the display and the back end to the parent. */
+    bool shared;
 };
 
 /* Back-end constructors: fill gl->ops, gl->be, gl->dpy/config/surface/size and create the

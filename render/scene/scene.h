@@ -271,6 +271,11 @@ int lr_scene_load(const char *path, const lr_warn_sink *warn, lr_scene **out, lr
 int lr_scene_parse(const char *text, size_t len, const char *name, const lr_warn_sink *warn,
                    lr_scene **out, lr_err *e);
 void lr_scene_destroy(lr_scene *s);
+/* A deep copy (meshes, BVHs, materials, settings, what was given): the copy changes and is
+ * destroyed independently of the original, so a worker thread can render it while the
+ * caller changes the original (render/async/). Warnings of later changes to the copy go to
+ * warn (may be NULL: discarded), not to the original's sink. */
+int lr_scene_clone(const lr_scene *s, const lr_warn_sink *warn, lr_scene **out, lr_err *e);
 
 const char *lr_scene_name(const lr_scene *s);
 /* The sink given at load: for warnings about the scene's rendering too (a cache not stored). */
@@ -321,6 +326,16 @@ bool lr_scene_dark(const lr_scene *s, char *why, size_t cap);
  * current one still reports its flags (callers may want to re-render). A new material preset
  * ("objects[0].material") replaces the whole material, scale included. */
 int lr_scene_set(lr_scene *s, const char *key, const char *value, unsigned *dirty, lr_err *e);
+
+/* Told of every change lr_scene_set makes, after it is made: the key and value as given and
+ * the flags it implied. render/async/ replays them on its worker's copy of the scene, so the
+ * copy goes through exactly the changes (and dirty flags) the caller's scene did. */
+typedef struct lr_scene_journal {
+    void (*fn)(void *user, const char *key, const char *value, unsigned dirty);
+    void *user;
+} lr_scene_journal;
+/* Sets (or, with NULL, clears) the scene's journal. */
+void lr_scene_set_journal(lr_scene *s, const lr_scene_journal *j);
 
 /* "key=value" (a --set argument): split at the first '=' and lr_scene_set. */
 int lr_scene_set_assignment(lr_scene *s, const char *assignment, unsigned *dirty, lr_err *e);

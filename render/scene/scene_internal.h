@@ -73,6 +73,7 @@ struct lr_scene {
      * transport a scene needs only where the scene did not say). */
     unsigned long long render_given;
     lr_quality quality;
+    lr_scene_journal journal; /* lr_scene_set_journal; never copied by lr_scene_clone */
 };
 
 /* Marks the render field `name` as given; unknown names are ignored. */

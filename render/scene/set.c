@@ -460,7 +460,14 @@ int lr_scene_set(lr_scene *s, const char *key, const char *value, unsigned *dirt
     }
     if (dirty)
         *dirty |= d;
+    if (s->journal.fn)
+        s->journal.fn(s->journal.user, key, o.value, d);
     return LR_OK;
+}
+
+void lr_scene_set_journal(lr_scene *s, const lr_scene_journal *j)
+{
+    s->journal = j ? *j : (lr_scene_journal){0};
 }
 
 int lr_scene_get(const lr_scene *s, const char *key, char *buf, size_t cap, lr_err *e)

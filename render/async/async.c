@@ -1,0 +1,825 @@
+/* The renderer on a worker thread (render/async/async.h). */
+#include "render/async/async.h"
+
+#include <GLES3/gl31.h>
+#include <errno.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/eventfd.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "render/base/paths.h"
+#include "render/gl/shader.h"
+#include "render/gl/tex.h"
+#include "render/passes/blend.h"
+#include "render/passes/defines.h"
+#include "render/passes/passes.h"
+
+/* The worker runs at a lower priority than the caller (nice +10 relative): its threads (the
+ * CPU solvers' pools and the GL driver's rasteriser threads, made from it and inheriting it)
+ * yield to the caller's loop on a loaded 2-core board. */
+#define WORKER_NICE 10
+
+/* What lr_scene_set does to light transport: everything but a dimmer/colour (intensity) and
+ * exposure (display). */
+#define TRANSPORT_DIRTY (~(unsigned)(LR_DIRTY_INTENSITY | LR_DIRTY_DISPLAY))
+/* Changes that re-run the maps anyway, so that the preview stage costs little extra. */
+#define HEAVY_DIRTY                                                                       \
+    ((unsigned)(LR_DIRTY_LIGHT_GEOMETRY | LR_DIRTY_GEOMETRY | LR_DIRTY_MATERIAL |           \
+                LR_DIRTY_SETTINGS))
+
+typedef struct set_rec {
+    char *key, *value;
+} set_rec;
+
+typedef struct set_list {
+    set_rec *v;
+    int n, cap;
+    unsigned dirty;
+} set_list;
+
+/* A publication: the per-light images of one worker frame, in textures both contexts see. */
+typedef struct slot {
+    lr_tex *tex;
+    int n, w, h;
+    float scale[LR_SCENE_MAX_LIGHTS];
+    GLsync written; /* the worker's fence after its copy */
+    GLsync read;    /* the caller's fence after its last blend from it */
+    lr_frame_stats st;
+    lr_async_stage stage;
+    uint64_t batch;
+} slot;
+
+struct lr_async {
+    /* ---- the caller's thread ---- */
+    lr_gl *gl;
+    lr_scene *scene;
+    int width, height;
+    bool no_vpl;
+    char shader_dir[512];
+    lr_shader_defines defines;
+    lr_blend *blend;
+    lr_program *blit;
+    set_list rec; /* journal entries since the last commit */
+    uint64_t batches;
+    bool blend_due, clock_set;
+    double time_s;
+    int efd;
+    char preview[LR_ASYNC_MAX_PREVIEW][256];
+    int n_preview;
+    unsigned no_preview_dirty;
+
+    /* ---- shared, under mu ---- */
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    set_list queue;      /* batches not yet replayed */
+    uint64_t queue_batch; /* the last batch in queue */
+    bool stop, busy, started, start_failed;
+    int shown, ready;    /* slot indices; -1: none */
+    slot slots[2];
+    uint64_t published;
+    uint64_t n_stage[LR_ASYNC_FINAL + 1]; /* publications per stage */
+    int err_rc;
+    lr_err err;
+
+    /* ---- the worker's thread ---- */
+    pthread_t th;
+    bool joinable;
+    lr_gl *wgl;
+    lr_scene *wscene;
+    lr_renderer *r;
+    GLuint read_fb, draw_fb;
+};
+
+const char *lr_async_stage_name(lr_async_stage s)
+{
+    switch (s) {
+    case LR_ASYNC_PREVIEW: return "preview";
+    case LR_ASYNC_REFINING: return "refining";
+    case LR_ASYNC_FINAL: return "final";
+    default: return "none";
+    }
+}
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+/* ---- set lists ---- */
+
+static void list_clear(set_list *l)
+{
+    for (int i = 0; i < l->n; i++) {
+        free(l->v[i].key);
+        free(l->v[i].value);
+    }
+    l->n = 0;
+    l->dirty = 0;
+}
+
+static void list_free(set_list *l)
+{
+    list_clear(l);
+    free(l->v);
+    *l = (set_list){0};
+}
+
+static bool list_push(set_list *l, const char *key, const char *value)
+{
+    if (l->n == l->cap) {
+        int cap = l->cap ? 2 * l->cap : 16;
+        set_rec *v = realloc(l->v, (size_t)cap * sizeof *v);
+        if (!v)
+            return false;
+        l->v = v;
+        l->cap = cap;
+    }
+    char *k = strdup(key), *val = strdup(value);
+    if (!k || !val) {
+        free(k);
+        free(val);
+        return false;
+    }
+    l->v[l->n++] = (set_rec){k, val};
+    return true;
+}
+
+/* Moves src's entries to the end of dst (src left empty). */
+static bool list_append(set_list *dst, set_list *src)
+{
+    for (int i = 0; i < src->n; i++) {
+        if (!list_push(dst, src->v[i].key, src->v[i].value))
+            return false;
+    }
+    dst->dirty |= src->dirty;
+    list_clear(src);
+    return true;
+}
+
+static void journal(void *user, const char *key, const char *value, unsigned dirty)
+{
+    lr_async *a = user;
+    if (!list_push(&a->rec, key, value)) {
+        /* Out of memory: the worker's copy would drift from the caller's scene. */
+        pthread_mutex_lock(&a->mu);
+        if (!a->err_rc)
+            a->err_rc = lr_err_set(&a->err, LR_ENOMEM, "async: change %s: out of memory", key);
+        pthread_mutex_unlock(&a->mu);
+    }
+    a->rec.dirty |= dirty;
+}
+
+/* ---- the worker ---- */
+
+static void worker_fail(lr_async *a, int rc, const lr_err *e)
+{
+    pthread_mutex_lock(&a->mu);
+    a->err_rc = rc;
+    a->err = *e;
+    pthread_mutex_unlock(&a->mu);
+}
+
+static void notify(lr_async *a)
+{
+    uint64_t one = 1;
+    if (write(a->efd, &one, sizeof one) < 0) {
+        /* EAGAIN: the counter is already non-zero, the caller will wake. */
+    }
+}
+
+/* Copies the renderer's images into the slot the caller is not reading and publishes it. */
+static int publish(lr_async *a, const lr_frame_stats *st, lr_async_stage stage, uint64_t batch,
+                   lr_err *e)
+{
+    int n;
+    float scale[LR_SCENE_MAX_LIGHTS];
+    const lr_tex *src = lr_renderer_images(a->r, &n, scale);
+    if (!src || n < 1)
+        return LR_OK;
+    pthread_mutex_lock(&a->mu);
+    int w = a->shown == 0 ? 1 : 0;
+    if (a->ready == w)
+        a->ready = -1; /* not taken yet: overwritten by the newer one */
+    GLsync read = a->slots[w].read;
+    a->slots[w].read = NULL;
+    pthread_mutex_unlock(&a->mu);
+    if (read) {
+        /* The caller's last blend from this slot must finish before it is overwritten. */
+        glWaitSync(read, 0, GL_TIMEOUT_IGNORED);
+        glDeleteSync(read);
+    }
+    slot *s = &a->slots[w];
+    if (!s->tex || s->n != n || s->w != a->width || s->h != a->height) {
+        lr_tex_destroy(s->tex);
+        s->tex = NULL;
+        lr_tex_desc td = {.type = LR_TEX_2D_ARRAY, .format = LR_TEX_RGBA32F, .width = a->width,
+                          .height = a->height, .layers = n, .label = "published images"};
+        int rc = lr_tex_create(a->wgl, &td, &s->tex, e);
+        if (rc)
+            return rc;
+        s->n = n;
+        s->w = a->width;
+        s->h = a->height;
+    }
+    for (int l = 0; l < n; l++) {
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, a->read_fb);
+        glFramebufferTextureLayer(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, lr_tex_id(src), 0, l);
+        glReadBuffer(GL_COLOR_ATTACHMENT0);
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, a->draw_fb);
+        glFramebufferTextureLayer(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, lr_tex_id(s->tex), 0,
+                                  l);
+        GLenum att = GL_COLOR_ATTACHMENT0;
+        glDrawBuffers(1, &att);
+        glBlitFramebuffer(0, 0, a->width, a->height, 0, 0, a->width, a->height,
+                          GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    int rc = lr_gl_check("async: publishing the images", e);
+    if (rc)
+        return rc;
+    GLsync written = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    glFlush();
+    pthread_mutex_lock(&a->mu);
+    if (s->written)
+        glDeleteSync(s->written);
+    s->written = written;
+    memcpy(s->scale, scale, sizeof scale);
+    s->st = *st;
+    s->stage = stage;
+    s->batch = batch;
+    a->ready = w;
+    a->n_stage[stage]++;
+    if (batch > a->published)
+        a->published = batch;
+    pthread_cond_broadcast(&a->cv);
+    pthread_mutex_unlock(&a->mu);
+    notify(a);
+    return LR_OK;
+}
+
+/* Replays a batch on the worker's copy. The caller's scene took every one of these changes,
+ * and the copy went through the same ones before, so a refusal here is a defect: reported. */
+static int replay(lr_async *a, set_list *l, unsigned *dirty, lr_err *e)
+{
+    for (int i = 0; i < l->n; i++) {
+        int rc = lr_scene_set(a->wscene, l->v[i].key, l->v[i].value, dirty, e);
+        if (rc)
+            return lr_err_prefix(e, "async: the worker's copy refused a change the scene took");
+    }
+    return LR_OK;
+}
+
+/* The preview stage: its assignments applied, one frame, published, the scene's own values
+ * back (their flags joining `dirty` for the next frames). */
+static int preview_frame(lr_async *a, uint64_t batch, unsigned *dirty, lr_err *e)
+{
+    char old[LR_ASYNC_MAX_PREVIEW][256];
+    int rc = LR_OK, applied = 0;
+    unsigned d = *dirty;
+    for (int i = 0; i < a->n_preview && !rc; i++) {
+        char key[256];
+        const char *eq = strchr(a->preview[i], '=');
+        snprintf(key, sizeof key, "%.*s", (int)(eq - a->preview[i]), a->preview[i]);
+        if (!(rc = lr_scene_get(a->wscene, key, old[i], sizeof old[i], e)) &&
+            !(rc = lr_scene_set(a->wscene, key, eq + 1, &d, e)))
+            applied = i + 1;
+    }
+    lr_frame_stats st;
+    if (!rc) {
+        lr_renderer_invalidate(a->r, d);
+        rc = lr_renderer_frame(a->r, &st, e);
+    }
+    if (!rc)
+        rc = publish(a, &st, LR_ASYNC_PREVIEW, batch, e);
+    /* Restored whatever happened: the copy must stay equal to the caller's scene. */
+    unsigned back = 0;
+    for (int i = applied - 1; i >= 0; i--) {
+        char key[256];
+        const char *eq = strchr(a->preview[i], '=');
+        snprintf(key, sizeof key, "%.*s", (int)(eq - a->preview[i]), a->preview[i]);
+        lr_err re = {0};
+        int rrc = lr_scene_set(a->wscene, key, old[i], &back, &re);
+        if (rrc && !rc) {
+            rc = rrc;
+            *e = re;
+        }
+    }
+    *dirty = back;
+    return rc;
+}
+
+static void *worker_main(void *arg)
+{
+    lr_async *a = arg;
+    lr_err e = {0};
+    /* Lower priority for this thread and every thread it starts (Linux: nice is per thread). */
+    pid_t tid = (pid_t)syscall(SYS_gettid);
+    errno = 0;
+    int nice_now = getpriority(PRIO_PROCESS, (id_t)tid);
+    if (errno == 0)
+        setpriority(PRIO_PROCESS, (id_t)tid, nice_now + WORKER_NICE > 19 ? 19
+                                                                           : nice_now + WORKER_NICE);
+    int rc = lr_gl_create_shared(a->gl, &a->wgl, &e);
+    if (!rc) {
+        glGenFramebuffers(1, &a->read_fb);
+        glGenFramebuffers(1, &a->draw_fb);
+    }
+    pthread_mutex_lock(&a->mu);
+    a->started = true;
+    a->start_failed = rc != LR_OK;
+    if (rc) {
+        a->err_rc = rc;
+        a->err = e;
+    }
+    pthread_cond_broadcast(&a->cv);
+    pthread_mutex_unlock(&a->mu);
+    if (rc)
+        return NULL;
+
+    lr_renderer_desc rd = {.gl = a->wgl, .scene = a->wscene, .width = a->width,
+                           .height = a->height, .no_vpl = a->no_vpl};
+    if ((rc = lr_renderer_create(&rd, &a->r, &e)))
+        worker_fail(a, rc, &e);
+    set_list batch = {0};
+    unsigned dirty = LR_DIRTY_SETTINGS; /* the first frame: everything */
+    bool converged = false, first = true;
+    uint64_t applied = 0;
+    while (a->r) {
+        pthread_mutex_lock(&a->mu);
+        bool work = (dirty & TRANSPORT_DIRTY) || !converged;
+        while (!a->stop && !a->queue.n && !work) {
+            a->busy = false;
+            pthread_cond_broadcast(&a->cv);
+            pthread_cond_wait(&a->cv, &a->mu);
+        }
+        if (a->stop) {
+            pthread_mutex_unlock(&a->mu);
+            break;
+        }
+        a->busy = true;
+        bool fresh = a->queue.n > 0;
+        uint64_t b = a->queue_batch;
+        set_list tmp = a->queue;
+        a->queue = batch; /* empty */
+        batch = tmp;
+        pthread_mutex_unlock(&a->mu);
+        unsigned got = 0;
+        if (fresh) {
+            rc = replay(a, &batch, &got, &e);
+            list_clear(&batch);
+            applied = b;
+            if (rc) {
+                worker_fail(a, rc, &e);
+                break;
+            }
+            dirty |= got;
+            lr_renderer_invalidate(a->r, got);
+            if (!(got & TRANSPORT_DIRTY) && converged) {
+                /* The published images stand for this batch too. */
+                pthread_mutex_lock(&a->mu);
+                if (applied > a->published)
+                    a->published = applied;
+                pthread_cond_broadcast(&a->cv);
+                pthread_mutex_unlock(&a->mu);
+                continue;
+            }
+        }
+        if (a->n_preview && (first || (fresh && (got & HEAVY_DIRTY) &&
+                                        (got & ~a->no_preview_dirty & TRANSPORT_DIRTY)))) {
+            unsigned back = dirty;
+            if ((rc = preview_frame(a, applied, &back, &e))) {
+                worker_fail(a, rc, &e);
+                converged = true; /* wait for the next change */
+                dirty = 0;
+                continue;
+            }
+            dirty = back;
+            lr_renderer_invalidate(a->r, back);
+        }
+        first = false;
+        lr_frame_stats st;
+        rc = lr_renderer_frame(a->r, &st, &e);
+        if (rc) {
+            worker_fail(a, rc, &e);
+            converged = true;
+            dirty = 0;
+            continue;
+        }
+        dirty = 0;
+        converged = !lr_renderer_needs_frame(a->r);
+        if ((st.passes & LR_PASS_COMPOSE) &&
+            (rc = publish(a, &st, converged ? LR_ASYNC_FINAL : LR_ASYNC_REFINING, applied, &e))) {
+            worker_fail(a, rc, &e);
+            converged = true;
+        } else if (!(st.passes & LR_PASS_COMPOSE)) {
+            pthread_mutex_lock(&a->mu);
+            if (applied > a->published)
+                a->published = applied;
+            pthread_mutex_unlock(&a->mu);
+        }
+    }
+    list_free(&batch);
+    lr_renderer_destroy(a->r);
+    a->r = NULL;
+    /* The caller no longer reads the slots (lr_async_destroy freed its side first). */
+    for (int i = 0; i < 2; i++) {
+        lr_tex_destroy(a->slots[i].tex);
+        a->slots[i].tex = NULL;
+        if (a->slots[i].written)
+            glDeleteSync(a->slots[i].written);
+        if (a->slots[i].read)
+            glDeleteSync(a->slots[i].read);
+        a->slots[i].written = a->slots[i].read = NULL;
+    }
+    glDeleteFramebuffers(1, &a->read_fb);
+    glDeleteFramebuffers(1, &a->draw_fb);
+    glFinish();
+    lr_gl_destroy(a->wgl);
+    a->wgl = NULL;
+    pthread_mutex_lock(&a->mu);
+    a->busy = false;
+    pthread_cond_broadcast(&a->cv);
+    pthread_mutex_unlock(&a->mu);
+    return NULL;
+}
+
+/* ---- the caller's side ---- */
+
+static int caller_programs(lr_async *a, lr_err *e)
+{
+    if (lr_shaders_dir(a->shader_dir, sizeof a->shader_dir) != 0)
+        return lr_err_set(e, LR_EINVAL, "async: shader directory path too long");
+    lr_passes_defines(&a->defines);
+    lr_blend_desc bd = {.gl = a->gl, .width = a->width, .height = a->height,
+                        .shader_dir = a->shader_dir, .defines = a->defines.list};
+    int rc = lr_blend_create(&bd, &a->blend, e);
+    if (rc)
+        return rc;
+    lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "blit.frag",
+                          .dir = a->shader_dir, .defines = a->defines.list};
+    return lr_program_create(&pd, &a->blit, e);
+}
+
+static int check_preview(lr_async *a, const lr_async_desc *d, lr_err *e)
+{
+    for (int i = 0; i < d->n_preview; i++) {
+        const char *p = d->preview[i];
+        const char *eq = p ? strchr(p, '=') : NULL;
+        if (!eq || eq == p || strlen(p) >= sizeof a->preview[0])
+            return lr_err_set(e, LR_EINVAL, "async: preview '%s': expected key=value",
+                              p ? p : "(null)");
+        char key[256], cur[256];
+        snprintf(key, sizeof key, "%.*s", (int)(eq - p), p);
+        int rc = lr_scene_get(d->scene, key, cur, sizeof cur, e);
+        if (rc)
+            return lr_err_prefix(e, "async: preview");
+        snprintf(a->preview[i], sizeof a->preview[i], "%s", p);
+    }
+    a->n_preview = d->n_preview;
+    return LR_OK;
+}
+
+int lr_async_create(const lr_async_desc *d, lr_async **out, lr_err *e)
+{
+    *out = NULL;
+    if (!d || !d->gl || !d->scene)
+        return lr_err_set(e, LR_EINVAL, "async: a GL context and a scene are required");
+    if (d->n_preview < 0 || d->n_preview > LR_ASYNC_MAX_PREVIEW)
+        return lr_err_set(e, LR_EINVAL, "async: %d preview assignments; at most %d",
+                          d->n_preview, LR_ASYNC_MAX_PREVIEW);
+    lr_async *a = calloc(1, sizeof *a);
+    if (!a)
+        return lr_err_set(e, LR_ENOMEM, "async: out of memory");
+    a->gl = d->gl;
+    a->scene = d->scene;
+    a->width = d->width > 0 ? d->width : 640;
+    a->height = d->height > 0 ? d->height : 480;
+    a->no_vpl = d->no_vpl;
+    a->no_preview_dirty = d->no_preview_dirty;
+    a->shown = a->ready = -1;
+    a->efd = -1;
+    pthread_mutex_init(&a->mu, NULL);
+    pthread_cond_init(&a->cv, NULL);
+    int rc = check_preview(a, d, e);
+    if (!rc && (a->efd = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) < 0)
+        rc = lr_err_set(e, LR_EIO, "async: eventfd: %s", strerror(errno));
+    if (!rc)
+        rc = caller_programs(a, e);
+    if (!rc)
+        rc = lr_scene_clone(d->scene, NULL, &a->wscene, e);
+    if (!rc && pthread_create(&a->th, NULL, worker_main, a) != 0)
+        rc = lr_err_set(e, LR_ENOMEM, "async: cannot start the worker thread");
+    if (!rc) {
+        a->joinable = true;
+        /* Only the context is waited for (milliseconds): a driver that cannot share one is
+         * an error here, not a black output later. */
+        pthread_mutex_lock(&a->mu);
+        while (!a->started)
+            pthread_cond_wait(&a->cv, &a->mu);
+        if (a->start_failed) {
+            rc = a->err_rc;
+            *e = a->err;
+        }
+        pthread_mutex_unlock(&a->mu);
+    }
+    if (rc) {
+        lr_async_destroy(a);
+        return rc;
+    }
+    lr_scene_set_journal(d->scene, &(lr_scene_journal){journal, a});
+    /* The caller's GL state: the worker's context creation may have changed nothing here,
+     * but be explicit that this thread keeps its own context. */
+    *out = a;
+    return LR_OK;
+}
+
+void lr_async_destroy(lr_async *a)
+{
+    if (!a)
+        return;
+    if (a->scene)
+        lr_scene_set_journal(a->scene, NULL);
+    /* The caller's side first: after this nothing here reads the slots. */
+    if (a->blend || a->blit)
+        glFinish();
+    lr_blend_destroy(a->blend);
+    lr_program_destroy(a->blit);
+    if (a->joinable) {
+        pthread_mutex_lock(&a->mu);
+        a->stop = true;
+        pthread_cond_broadcast(&a->cv);
+        pthread_mutex_unlock(&a->mu);
+        pthread_join(a->th, NULL);
+    }
+    lr_scene_destroy(a->wscene);
+    list_free(&a->rec);
+    list_free(&a->queue);
+    if (a->efd >= 0)
+        close(a->efd);
+    pthread_cond_destroy(&a->cv);
+    pthread_mutex_destroy(&a->mu);
+    free(a);
+}
+
+uint64_t lr_async_commit(lr_async *a, unsigned dirty)
+{
+    if (dirty & (LR_DIRTY_INTENSITY | LR_DIRTY_DISPLAY))
+        a->blend_due = true;
+    if (!a->rec.n)
+        return 0;
+    pthread_mutex_lock(&a->mu);
+    uint64_t b = ++a->batches;
+    if (!list_append(&a->queue, &a->rec) && !a->err_rc)
+        a->err_rc = lr_err_set(&a->err, LR_ENOMEM, "async: a batch of changes: out of memory");
+    a->queue_batch = b;
+    a->busy = true;
+    pthread_cond_broadcast(&a->cv);
+    pthread_mutex_unlock(&a->mu);
+    /* A dimmer, colour, flicker or exposure change: the caller's next blend shows it (the
+     * worker replays it only to keep its copy equal). */
+    return (dirty & TRANSPORT_DIRTY) ? b : 0;
+}
+
+static bool flickers(const lr_light *l)
+{
+    return l->flicker.amplitude > 0.0 && l->intensity > 0.0;
+}
+
+void lr_async_set_time(lr_async *a, double t)
+{
+    if (!isfinite(t) || (a->clock_set && t == a->time_s))
+        return;
+    for (int l = 0; l < lr_scene_light_count(a->scene); l++)
+        if (flickers(lr_scene_light_at(a->scene, l)))
+            a->blend_due = true;
+    a->clock_set = true;
+    a->time_s = t;
+}
+
+bool lr_async_needs_frame(const lr_async *a)
+{
+    lr_async *m = (lr_async *)a; /* the mutex only */
+    pthread_mutex_lock(&m->mu);
+    bool ready = a->ready >= 0;
+    bool shown = a->shown >= 0;
+    pthread_mutex_unlock(&m->mu);
+    return ready || (a->blend_due && shown);
+}
+
+bool lr_async_busy(const lr_async *a)
+{
+    lr_async *m = (lr_async *)a;
+    pthread_mutex_lock(&m->mu);
+    bool b = a->busy || a->queue.n > 0;
+    pthread_mutex_unlock(&m->mu);
+    return b;
+}
+
+uint64_t lr_async_published(const lr_async *a)
+{
+    lr_async *m = (lr_async *)a;
+    pthread_mutex_lock(&m->mu);
+    uint64_t p = a->published;
+    pthread_mutex_unlock(&m->mu);
+    return p;
+}
+
+/* Takes the ready publication once the worker's copy has finished on the GPU. */
+static bool take_ready(lr_async *a)
+{
+    bool took = false;
+    pthread_mutex_lock(&a->mu);
+    if (a->ready >= 0) {
+        slot *s = &a->slots[a->ready];
+        GLenum w = s->written ? glClientWaitSync(s->written, 0, 0) : GL_ALREADY_SIGNALED;
+        if (w == GL_ALREADY_SIGNALED || w == GL_CONDITION_SATISFIED) {
+            a->shown = a->ready;
+            a->ready = -1;
+            took = true;
+        }
+    }
+    pthread_mutex_unlock(&a->mu);
+    return took;
+}
+
+int lr_async_frame(lr_async *a, lr_async_frame_stats *st, lr_err *e)
+{
+    uint64_t drain;
+    if (read(a->efd, &drain, sizeof drain) < 0) {
+        /* EAGAIN: nothing was signalled */
+    }
+    double t0 = now_ms();
+    lr_async_frame_stats out = {0};
+    out.new_images = take_ready(a);
+    if (a->shown < 0) {
+        if (st)
+            *st = out;
+        return LR_OK; /* nothing published yet: nothing to draw */
+    }
+    slot *s = &a->slots[a->shown]; /* the worker does not touch the shown slot */
+    lr_blend_input in = {.images = s->tex, .n = s->n, .exposure =
+                         (float)lr_scene_render(a->scene)->exposure,
+                         .tonemap_op = LR_RENDER_TONEMAP};
+    int nl = lr_scene_light_count(a->scene);
+    if (in.n > nl)
+        in.n = nl;
+    if (in.n > LR_BLEND_MAX_IMAGES)
+        in.n = LR_BLEND_MAX_IMAGES;
+    for (int l = 0; l < in.n; l++) {
+        const lr_light *light = lr_scene_light_at(a->scene, l);
+        double I[3], f = 1.0;
+        lr_light_rgb(light, I);
+        if (a->clock_set && light->flicker.amplitude > 0.0)
+            lr_light_flicker_at(light, a->time_s, &f, NULL);
+        for (int b = 0; b < 3; b++)
+            in.w[l][b] = I[b] * f / s->scale[l];
+    }
+    int rc = lr_blend_run(a->blend, &in, e);
+    if (rc)
+        return rc;
+    GLsync read = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    glFlush();
+    pthread_mutex_lock(&a->mu);
+    if (s->read)
+        glDeleteSync(s->read);
+    s->read = read;
+    out.worker = s->st;
+    out.stage = s->stage;
+    out.batch = s->batch;
+    pthread_mutex_unlock(&a->mu);
+    a->blend_due = false;
+    out.blend_ms = now_ms() - t0;
+    if (st)
+        *st = out;
+    return LR_OK;
+}
+
+int lr_async_wait(lr_async *a, uint64_t batch, bool final, int timeout_ms, lr_err *e)
+{
+    struct timespec until;
+    clock_gettime(CLOCK_REALTIME, &until);
+    until.tv_sec += timeout_ms / 1000;
+    until.tv_nsec += (long)(timeout_ms % 1000) * 1000000L;
+    if (until.tv_nsec >= 1000000000L) {
+        until.tv_sec++;
+        until.tv_nsec -= 1000000000L;
+    }
+    int rc = LR_OK;
+    pthread_mutex_lock(&a->mu);
+    for (;;) {
+        bool have = (a->ready >= 0 || a->shown >= 0) && a->published >= batch;
+        if (have && (!final || (!a->busy && !a->queue.n)))
+            break;
+        if (a->err_rc) {
+            rc = a->err_rc;
+            *e = a->err;
+            a->err_rc = LR_OK;
+            break;
+        }
+        if (pthread_cond_timedwait(&a->cv, &a->mu, &until) == ETIMEDOUT) {
+            rc = lr_err_set(e, LR_ETIMEOUT, "async: no image of change %llu within %d ms",
+                            (unsigned long long)batch, timeout_ms);
+            break;
+        }
+    }
+    pthread_mutex_unlock(&a->mu);
+    return rc;
+}
+
+int lr_async_error(lr_async *a, lr_err *e)
+{
+    pthread_mutex_lock(&a->mu);
+    int rc = a->err_rc;
+    if (rc) {
+        *e = a->err;
+        a->err_rc = LR_OK;
+    }
+    pthread_mutex_unlock(&a->mu);
+    return rc;
+}
+
+uint64_t lr_async_publications(const lr_async *a, lr_async_stage stage)
+{
+    lr_async *m = (lr_async *)a;
+    pthread_mutex_lock(&m->mu);
+    uint64_t n = (unsigned)stage <= LR_ASYNC_FINAL ? a->n_stage[stage] : 0;
+    pthread_mutex_unlock(&m->mu);
+    return n;
+}
+
+int lr_async_event_fd(const lr_async *a) { return a->efd; }
+
+int lr_async_read_rgba8(lr_async *a, unsigned char *out, lr_err *e)
+{
+    size_t n = (size_t)a->width * (size_t)a->height;
+    float *rgba = malloc(n * 4 * sizeof *rgba);
+    if (!rgba)
+        return lr_err_set(e, LR_ENOMEM, "async: readback: out of memory");
+    int rc = lr_fb_read(lr_blend_ldr_fb(a->blend), 0, 0, 0, a->width, a->height, rgba, e);
+    if (!rc)
+        for (int y = 0; y < a->height; y++) {
+            const float *src = rgba + (size_t)(a->height - 1 - y) * a->width * 4;
+            unsigned char *dst = out + (size_t)y * a->width * 4;
+            for (int i = 0; i < a->width * 4; i++) {
+                float v = src[i] * 255.0f + 0.5f;
+                dst[i] = (unsigned char)(v < 0.0f ? 0.0f : v > 255.0f ? 255.0f : v);
+            }
+        }
+    free(rgba);
+    return rc;
+}
+
+int lr_async_read_hdr(lr_async *a, float *rgb, lr_err *e)
+{
+    if (a->shown < 0)
+        return lr_err_set(e, LR_EINVAL, "async: no image yet");
+    lr_fb *hdr;
+    int rc = lr_blend_hdr(a->blend, &hdr, e);
+    if (rc)
+        return rc;
+    size_t n = (size_t)a->width * (size_t)a->height;
+    float *rgba = malloc(n * 4 * sizeof *rgba);
+    if (!rgba)
+        return lr_err_set(e, LR_ENOMEM, "async: HDR readback: out of memory");
+    rc = lr_fb_read(hdr, 0, 0, 0, a->width, a->height, rgba, e);
+    if (!rc)
+        for (size_t i = 0; i < n; i++)
+            memcpy(rgb + 3 * i, rgba + 4 * i, 3 * sizeof *rgb);
+    free(rgba);
+    return rc;
+}
+
+int lr_async_present(lr_async *a, lr_err *e)
+{
+    int w, h;
+    lr_gl_size(a->gl, &w, &h);
+    if (w > 0 && h > 0) {
+        lr_gl_bind_default(a->gl);
+        glDisable(GL_DEPTH_TEST);
+        glDisable(GL_BLEND);
+        glUseProgram(lr_program_id(a->blit));
+        lr_passes_bind_tex(a->blit, "u_src", 0, lr_blend_ldr(a->blend));
+        int rc = lr_program_check(a->blit, e);
+        if (rc)
+            return rc;
+        lr_gl_draw_fullscreen(a->gl);
+    }
+    return lr_gl_present(a->gl, e);
+}
+
+void lr_async_size(const lr_async *a, int *width, int *height)
+{
+    if (width)
+        *width = a->width;
+    if (height)
+        *height = a->height;
+}

@@ -1,0 +1,135 @@
+/* lamprig — the renderer off the caller's loop: light transport on a worker thread, the
+ * latest per-light images blended on the caller's thread at every frame.
+ *
+ * The renderer (render/renderer.h) does a frame's work in one call: a material change re-runs
+ * the maps, a diffusion grid's or translucent radiosity's CPU solve, the VPLs and
+ * composition, 0.1-7 s on the 2-core proxy, and everything the caller's loop does waits for
+ * it. lr_async splits the renderer at its one linear step (render/passes/PIPELINE.md
+ * "Linearity"): a worker thread owns a second GL context (lr_gl_create_shared), a copy of the
+ * scene (lr_scene_clone) and an lr_renderer over the copy, and publishes each composition's
+ * per-light unit-intensity images; the caller's thread owns the blend (render/passes/
+ * blend.h) and weighs the newest published images by its own scene's intensity x colour x
+ * flicker and exposure. So a dimmer, flicker, colour or exposure change is one blend at the
+ * next frame whatever the worker is doing, and the caller never waits for transport.
+ *
+ * Changes reach the worker through the caller's scene journal (lr_scene_set_journal): every
+ * lr_scene_set on the caller's scene is recorded, and lr_async_commit hands the batch to the
+ * worker, which replays it on its copy between its frames (so the copy sees the same
+ * changes and dirty flags, in order) and renders until converged, publishing every frame
+ * that composed new images. Batches queued while the worker is busy are replayed together
+ * before its next frame: a knob turned during a solve costs one more solve, not one per
+ * event.
+ *
+ * Progressive stages: with desc.preview set (assignments such as "render.K=1"), the first
+ * worker frame after a transport change renders with them applied (a coarse, cheap image of
+ * the new state), then the worker restores the scene's own values and refines; each published
+ * image says which stage it is (lr_async_stage). Images never mix states: all of a
+ * publication's layers come from one worker frame, and the blend weights come from the
+ * caller's scene at the caller's frame.
+ *
+ * Publication is double-buffered in textures both contexts share, ordered by fences: the
+ * worker copies into the slot the caller is not reading (after the caller's fence on it) and
+ * fences; the caller takes a publication only once its fence has signalled (polled, never
+ * waited on). lr_async_event_fd becomes readable when a publication is ready, for the
+ * caller's poll set.
+ *
+ * Threads: every call below is made on the caller's thread with its context current.
+ */
+#ifndef LR_ASYNC_H
+#define LR_ASYNC_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "render/base/err.h"
+#include "render/gl/gl.h"
+#include "render/renderer.h"
+#include "render/scene/scene.h"
+
+typedef struct lr_async lr_async;
+
+#define LR_ASYNC_MAX_PREVIEW 16
+
+typedef enum lr_async_stage {
+    LR_ASYNC_NONE = 0,  /* nothing published yet */
+    LR_ASYNC_PREVIEW,   /* the preview settings, first frame after a transport change */
+    LR_ASYNC_REFINING,  /* the scene's own settings, still accumulating */
+    LR_ASYNC_FINAL,     /* the scene's own settings, converged */
+} lr_async_stage;
+
+const char *lr_async_stage_name(lr_async_stage s);
+
+typedef struct lr_async_desc {
+    lr_gl *gl;          /* the caller's context, current on the calling thread */
+    lr_scene *scene;    /* the caller's scene: copied for the worker, its journal set to this
+                         * lr_async until lr_async_destroy */
+    int width, height;  /* 0: 640 x 480 */
+    bool no_vpl;
+    /* "key=value" assignments for the preview stage (NULL-terminated or n_preview long);
+     * none: no preview stage. Keys the scene rejects are an error at create. */
+    const char *preview[LR_ASYNC_MAX_PREVIEW];
+    int n_preview;
+    /* Changes whose flags are only these need no preview (default: a light move, camera,
+     * receivers and settings changes get one; material changes too). 0: every transport
+     * change gets one. */
+    unsigned no_preview_dirty;
+} lr_async_desc;
+
+typedef struct lr_async_frame_stats {
+    lr_frame_stats worker;   /* the worker frame whose images are shown */
+    lr_async_stage stage;    /* of the shown images */
+    uint64_t batch;          /* the last batch (lr_async_commit) the shown images include */
+    bool new_images;         /* this frame took a newer publication */
+    double blend_ms;         /* the caller's blend, CPU wall time including submission */
+} lr_async_frame_stats;
+
+/* Creates the worker (thread, shared context, scene copy, renderer) and queues the first
+ * frame. Errors: the shared context, the scene copy, the preview assignments; errors of the
+ * renderer itself come later from lr_async_error. */
+int lr_async_create(const lr_async_desc *desc, lr_async **out, lr_err *e);
+/* Stops the worker after its current frame (a solve under way finishes first) and frees
+ * everything; clears the scene's journal. */
+void lr_async_destroy(lr_async *a);
+
+/* Ends a batch of the scene's changes (those made since the last commit) and hands it to the
+ * worker when it changes light transport; `dirty` is what the caller's own lr_scene_set calls
+ * returned (intensity and display changes only mark the caller's next blend due). Returns
+ * the batch number (counting from 1), or 0 when there was nothing to hand over. */
+uint64_t lr_async_commit(lr_async *a, unsigned dirty);
+
+/* The renderer's clock (lr_renderer_set_time): flicker enters the blend. */
+void lr_async_set_time(lr_async *a, double t_seconds);
+
+/* True when a frame would show something new: a publication is ready, or the blend is due
+ * (an intensity/display change, a flickering light's new time). */
+bool lr_async_needs_frame(const lr_async *a);
+/* True while the worker has work (a batch queued or frames left to converge). */
+bool lr_async_busy(const lr_async *a);
+/* The number of the last batch the worker has published images for (0: none). */
+uint64_t lr_async_published(const lr_async *a);
+
+/* Takes the newest signalled publication, if any, and blends. Never waits for the worker.
+ * Before the first publication there is no image: nothing is drawn, st->stage is
+ * LR_ASYNC_NONE. */
+int lr_async_frame(lr_async *a, lr_async_frame_stats *st, lr_err *e);
+
+/* Blocks until the worker has published an image of batch `batch` or later (0: any) -- with
+ * `final`, and has then nothing left to do (converged) -- or failed (its error), or
+ * timeout_ms passed (LR_ETIMEOUT). For start-up, tools and tests, never in a loop. */
+int lr_async_wait(lr_async *a, uint64_t batch, bool final, int timeout_ms, lr_err *e);
+
+/* The worker's last error (once: cleared by the call), LR_OK when none. */
+int lr_async_error(lr_async *a, lr_err *e);
+
+/* How many images the worker has published at `stage` (for the stats and tests). */
+uint64_t lr_async_publications(const lr_async *a, lr_async_stage stage);
+
+/* Readable (POLLIN) when a publication is ready; lr_async_frame drains it. */
+int lr_async_event_fd(const lr_async *a);
+
+int lr_async_read_rgba8(lr_async *a, unsigned char *rgba, lr_err *e);
+int lr_async_read_hdr(lr_async *a, float *rgb, lr_err *e);
+int lr_async_present(lr_async *a, lr_err *e);
+void lr_async_size(const lr_async *a, int *width, int *height);
+
+#endif
