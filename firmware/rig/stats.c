@@ -20,6 +20,7 @@ typedef struct ev_rec {
     uint64_t frame;
     double latency_ms;
     int stage; /* lr_rig_frame_info.stage of the frame that first showed it */
+    double converge_ms; /* to the first converged frame showing it; NaN: not yet */
 } ev_rec;
 
 typedef struct fr_rec {
@@ -33,6 +34,7 @@ typedef struct pend_rec {
     lr_event ev;
     uint64_t batch; /* UNTAGGED until the loop applied it */
     bool shown;
+    uint64_t ev_index; /* its ev_rec once shown */
 } pend_rec;
 
 #define UNTAGGED UINT64_MAX
@@ -150,12 +152,16 @@ void lr_rig_stats_frame_shown(lr_rig_stats *s, const lr_frame_stats *f,
             er->frame = (uint64_t)f->index;
             er->latency_ms = ms;
             er->stage = info->stage;
+            er->converge_ms = NAN;
+            p->ev_index = s->n_events;
             s->n_events++;
             lr_lat_hist_add(s->lat, ms);
             p->shown = true;
         }
         if (shows && info->converged) {
             lr_lat_hist_add(s->conv, ms);
+            if (s->n_events - p->ev_index <= LOG_MAX)
+                s->events[p->ev_index % LOG_MAX].converge_ms = ms;
             continue; /* done with */
         }
         s->pending[keep++] = *p;
@@ -271,6 +277,7 @@ int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *conf
         lr_jw_int(w, "frame", (long)r->frame);
         lr_jw_number_or_null(w, "latency_ms", r->latency_ms);
         lr_jw_string(w, "stage", lr_async_stage_name((lr_async_stage)r->stage));
+        lr_jw_number_or_null(w, "converge_ms", r->converge_ms);
         lr_jw_object_end(w);
     }
     lr_jw_array_end(w);

@@ -74,6 +74,7 @@ struct lr_async {
     char preview[LR_ASYNC_MAX_PREVIEW][256];
     int n_preview;
     unsigned no_preview_dirty;
+    bool preview_always;
 
     /* ---- shared, under mu ---- */
     pthread_mutex_t mu;
@@ -95,6 +96,10 @@ struct lr_async {
     lr_scene *wscene;
     lr_renderer *r;
     GLuint read_fb, draw_fb;
+    /* Wall time of the last preview frame and of the last full frame that re-ran the maps:
+     * a preview that costs more than half a full frame (a CPU solve dominates both) is not
+     * worth its delay, and is skipped until a full frame gets dearer again. */
+    double preview_ms, full_ms;
 };
 
 const char *lr_async_stage_name(lr_async_stage s)
@@ -393,10 +398,15 @@ static void *worker_main(void *arg)
                 continue;
             }
         }
-        if (a->n_preview && (first || (fresh && (got & HEAVY_DIRTY) &&
-                                        (got & ~a->no_preview_dirty & TRANSPORT_DIRTY)))) {
+        bool heavy = first || (fresh && (got & HEAVY_DIRTY));
+        bool worth = a->preview_always || !(a->preview_ms > 0.5 * a->full_ms && a->full_ms > 0);
+        if (a->n_preview && worth &&
+            (first || (heavy && (got & ~a->no_preview_dirty & TRANSPORT_DIRTY)))) {
             unsigned back = dirty;
-            if ((rc = preview_frame(a, applied, &back, &e))) {
+            double t0 = now_ms();
+            rc = preview_frame(a, applied, &back, &e);
+            a->preview_ms = now_ms() - t0;
+            if (rc) {
                 worker_fail(a, rc, &e);
                 converged = true; /* wait for the next change */
                 dirty = 0;
@@ -407,7 +417,10 @@ static void *worker_main(void *arg)
         }
         first = false;
         lr_frame_stats st;
+        double t0 = now_ms();
         rc = lr_renderer_frame(a->r, &st, &e);
+        if (heavy && !rc)
+            a->full_ms = now_ms() - t0;
         if (rc) {
             worker_fail(a, rc, &e);
             converged = true;
@@ -505,6 +518,7 @@ int lr_async_create(const lr_async_desc *d, lr_async **out, lr_err *e)
     a->height = d->height > 0 ? d->height : 480;
     a->no_vpl = d->no_vpl;
     a->no_preview_dirty = d->no_preview_dirty;
+    a->preview_always = d->preview_always;
     a->shown = a->ready = -1;
     a->efd = -1;
     pthread_mutex_init(&a->mu, NULL);

@@ -21,7 +21,7 @@
  * event.
  *
  * Progressive stages: with desc.preview set (assignments such as "render.K=1"), the first
- * worker frame after a transport change renders with them applied (a coarse, cheap image of
+ * worker frame after a change that re-runs the maps renders with them applied (a coarse, cheap image of
  * the new state), then the worker restores the scene's own values and refines; each published
  * image says which stage it is (lr_async_stage). Images never mix states: all of a
  * publication's layers come from one worker frame, and the blend weights come from the
@@ -73,6 +73,10 @@ typedef struct lr_async_desc {
      * receivers and settings changes get one; material changes too). 0: every transport
      * change gets one. */
     unsigned no_preview_dirty;
+    /* A preview whose frame took more than half the last full frame that re-ran the maps
+     * (both dominated by a CPU solve the preview settings do not shrink) only delays the
+     * image: it is skipped until a full frame gets dearer again. true: always drawn. */
+    bool preview_always;
 } lr_async_desc;
 
 typedef struct lr_async_frame_stats {

@@ -62,6 +62,7 @@ static lr_async *make(lr_gl *gl, lr_scene *s, bool with_preview)
         for (int i = 0; i < 4; i++)
             d.preview[i] = preview[i];
         d.n_preview = 4;
+        d.preview_always = true; /* the grid's solve costs the preview as much as the rest */
     }
     lr_async *a = NULL;
     lr_err e = {0};
@@ -190,7 +191,8 @@ static void test_dimmer_does_not_wait_for_a_solve(void **state)
 
 /* The preview stage: once at start and once per change that re-runs the maps (a material),
  * none for a camera move (composition alone: a preview would cost a full re-run) nor for a
- * dimmer. */
+ * dimmer. Without preview_always, a preview as dear as the full frame (the grid's solve
+ * dominates both) is skipped after the first. */
 static void test_preview_once_per_heavy_change(void **state)
 {
     fixture *f = *state;
@@ -216,6 +218,21 @@ static void test_preview_once_per_heavy_change(void **state)
     assert_int_equal(lr_async_commit(a, dirty), 0);
     wait_final(a, b);
     assert_int_equal(lr_async_publications(a, LR_ASYNC_PREVIEW), 2);
+    lr_async_destroy(a);
+
+    lr_async_desc d = {.gl = f->gl, .scene = s, .width = W, .height = H,
+                       .preview = {preview[0], preview[1], preview[2], preview[3]},
+                       .n_preview = 4};
+    lr_err e = {0};
+    assert_int_equal(lr_async_create(&d, &a, &e), LR_OK);
+    wait_final(a, 0);
+    assert_int_equal(lr_async_publications(a, LR_ASYNC_PREVIEW), 1);
+    dirty = 0;
+    set(s, "objects[0].material", "candle_wax", &dirty);
+    b = lr_async_commit(a, dirty);
+    wait_final(a, b);
+    /* A 16² preview of the grid scene solves the same grid as the full frame. */
+    assert_int_equal(lr_async_publications(a, LR_ASYNC_PREVIEW), 1);
     lr_async_destroy(a);
     lr_scene_destroy(s);
 }

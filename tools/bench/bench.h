@@ -45,6 +45,9 @@ double lrb_thread_cpu_now(void);
 int lrb_pin_to_current_cpu(void);
 /* One line naming the host CPU (from /proc/cpuinfo), for the record under each table. */
 void lrb_cpu_name(char *buf, size_t len);
+/* The rig section's per-control table (rig_controls.c): runs the shipped sim rig from bindir
+ * with configs' files, scratch files in dir. Nonzero when a run failed. */
+int lrb_rig_controls(FILE *out, const char *bindir, const char *configs, const char *dir);
 
 /* Rate measurement: calls body(ctx, n) (which must perform n evaluations and return a value
  * depending on all of them), choosing n so that one run lasts about min_run_s of thread CPU

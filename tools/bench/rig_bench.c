@@ -10,6 +10,7 @@
  *     and so is never idle (its steady-state cost); and the Modbus demo rig against
  *     lamprig-modbus-sim, whose panel is polled every 50 ms. */
 #include "tools/bench/bench.h"
+#include "tools/bench/proc.h"
 
 #include <arpa/inet.h>
 #include <fcntl.h>
@@ -34,39 +35,6 @@
 
 static char bindir[PATH_MAX];
 static char configs[PATH_MAX]; /* absolute: the rig configs are written to a scratch dir */
-
-static void sleep_s(double s)
-{
-    struct timespec ts = {(time_t)s, (long)((s - (double)(time_t)s) * 1e9)};
-    while (nanosleep(&ts, &ts) != 0)
-        ;
-}
-
-static void print_log(const char *path)
-{
-    FILE *f = fopen(path, "r");
-    if (!f)
-        return;
-    char line[1024];
-    while (fgets(line, sizeof line, f))
-        fprintf(stderr, "  | %s", line);
-    fclose(f);
-}
-
-static pid_t spawn(char *const argv[], const char *log_path)
-{
-    pid_t pid = fork();
-    if (pid == 0) {
-        int fd = open(log_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (fd >= 0) {
-            dup2(fd, 1);
-            dup2(fd, 2);
-        }
-        execv(argv[0], argv);
-        _exit(127);
-    }
-    return pid;
-}
 
 /* utime + stime of pid in clock ticks, or -1. */
 static long cpu_ticks(pid_t pid)
@@ -123,19 +91,6 @@ static int write_rig(const char *path, const char *script, bool steady)
     return write_rig_set(path, script, steady ? ", \"lights[0].flicker.amplitude\": 0" : "");
 }
 
-static int reap(pid_t pid, double guard_s)
-{
-    int st = 0;
-    for (int i = 0; i < (int)(guard_s * 20); i++) {
-        if (waitpid(pid, &st, WNOHANG) == pid)
-            return st;
-        sleep_s(0.05);
-    }
-    kill(pid, SIGKILL);
-    waitpid(pid, &st, 0);
-    return -1;
-}
-
 typedef struct latency {
     long n, pending, frames;
     double median, p99, max, duration;
@@ -186,10 +141,10 @@ static int dimmer_latency(const char *dir, latency *l)
     snprintf(lamprig, sizeof lamprig, "%s/lamprig", bindir);
     char *argv[] = {lamprig, "run", "--config", cfg, "--headless", "--duration", duration,
                     "--stats", stats, NULL};
-    int st = reap(spawn(argv, log), 120);
+    int st = lrb_reap(lrb_spawn(argv, log), 120);
     if (st < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
         fprintf(stderr, "bench rig: lamprig run failed (status %#x):\n", st);
-        print_log(log);
+        lrb_print_log(log);
         return 1;
     }
     return read_stats(stats, l);
@@ -221,7 +176,7 @@ static int idle_cpu_after(char *const argv[], const char *log, bool wait_quiet, 
                           idle_row *row)
 {
     *row = (idle_row){.pct = -1};
-    pid_t pid = spawn(argv, log);
+    pid_t pid = lrb_spawn(argv, log);
     if (pid < 0) {
         snprintf(row->why, sizeof row->why, "could not start %s", argv[0]);
         return 1;
@@ -229,7 +184,7 @@ static int idle_cpu_after(char *const argv[], const char *log, bool wait_quiet, 
     long prev = -1;
     bool alive = true;
     for (int i = 0; i < (int)(warm_s / 0.5 + 0.5); i++) {
-        sleep_s(0.5);
+        lrb_sleep_s(0.5);
         long t = cpu_ticks(pid);
         if (t < 0) {
             alive = false;
@@ -251,7 +206,7 @@ static int idle_cpu_after(char *const argv[], const char *log, bool wait_quiet, 
          waited += STABLE_WINDOW_S) {
         long a = cpu_ticks(pid);
         double wa = lrb_now();
-        sleep_s(STABLE_WINDOW_S);
+        lrb_sleep_s(STABLE_WINDOW_S);
         long b = cpu_ticks(pid);
         if (a < 0 || b < a) {
             alive = false;
@@ -268,7 +223,7 @@ static int idle_cpu_after(char *const argv[], const char *log, bool wait_quiet, 
     if (alive) {
         long t0 = cpu_ticks(pid);
         double w0 = lrb_now();
-        sleep_s(IDLE_WINDOW_S);
+        lrb_sleep_s(IDLE_WINDOW_S);
         long t1 = cpu_ticks(pid);
         double w1 = lrb_now();
         if (t0 >= 0 && t1 >= t0)
@@ -287,23 +242,23 @@ static int idle_cpu_after(char *const argv[], const char *log, bool wait_quiet, 
     int st = 0;
     bool exited = waitpid(pid, &st, WNOHANG) == pid;
     if (!exited && !alive) { /* its /proc entry unreadable: make sure it is gone */
-        st = reap(pid, 10);
+        st = lrb_reap(pid, 10);
         exited = true;
     }
     if (exited) {
         snprintf(row->why, sizeof row->why, "lamprig run exited on its own (status %#x)", st);
         fprintf(stderr, "bench rig: %s:\n", row->why);
-        print_log(log);
+        lrb_print_log(log);
         row->pct = -1;
         return 1;
     }
     kill(pid, SIGTERM);
-    st = reap(pid, 10);
+    st = lrb_reap(pid, 10);
     if (st < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
         snprintf(row->why, sizeof row->why,
                  "lamprig run did not exit cleanly on SIGTERM (status %#x)", st);
         fprintf(stderr, "bench rig: %s:\n", row->why);
-        print_log(log);
+        lrb_print_log(log);
         row->pct = -1;
         return 1;
     }
@@ -385,6 +340,7 @@ static int run(FILE *out)
     fflush(out);
     latency l = {0};
     int rc = dimmer_latency(dir, &l);
+    rc |= lrb_rig_controls(out, bindir, configs, dir);
 
     char lamprig[PATH_MAX + 16], cfg[PATH_MAX], script[PATH_MAX], log[PATH_MAX];
     snprintf(lamprig, sizeof lamprig, "%s/lamprig", bindir);
@@ -415,14 +371,14 @@ static int run(FILE *out)
         snprintf(idle_mb.why, sizeof idle_mb.why, "lamprig-modbus-sim not built next to lamprig-bench");
     } else {
         char *sargv[] = {sim_bin, "--port", port_s, "--panel", "600", NULL};
-        pid_t sim = spawn(sargv, sim_log);
-        sleep_s(0.5);
+        pid_t sim = lrb_spawn(sargv, sim_log);
+        lrb_sleep_s(0.5);
         char *margv[] = {lamprig, "run", "--config", mb_cfg, "--modbus", url, "--headless", NULL};
         real_error |= idle_cpu(margv, log, true, &idle_mb);
         kill(sim, SIGTERM);
-        if (reap(sim, 5) != 0) {
+        if (lrb_reap(sim, 5) != 0) {
             fprintf(stderr, "bench rig: lamprig-modbus-sim did not exit cleanly on SIGTERM:\n");
-            print_log(sim_log);
+            lrb_print_log(sim_log);
             real_error = 1;
         }
     }
@@ -446,12 +402,12 @@ static int run(FILE *out)
         if (port > 0 && access(sim_bin, X_OK) == 0 &&
             !write_modbus_flicker(mb_cfg, fcfg, on ? 0.08 : 0.0)) {
             char *sargv[] = {sim_bin, "--port", port_s, "--panel", "600", NULL};
-            pid_t sim = spawn(sargv, sim_log);
-            sleep_s(0.5);
+            pid_t sim = lrb_spawn(sargv, sim_log);
+            lrb_sleep_s(0.5);
             char *fargv[] = {lamprig, "run", "--config", fcfg, "--modbus", url, "--headless", NULL};
             real_error |= idle_cpu_after(fargv, log, !on, on ? SETTLE_S : 30.0, &idle_fl[1][on]);
             kill(sim, SIGTERM);
-            reap(sim, 5);
+            lrb_reap(sim, 5);
         }
     }
 

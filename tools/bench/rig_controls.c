@@ -1,0 +1,227 @@
+/* Section "rig", per control: the shipped sim rig (configs/rig/sim.json and its demo script,
+ * looping: dimmer, flicker knob, material button, translucency knob, tint) run as a user runs
+ * it, for RUN_S seconds, idle and with two busy loops beside it (a loaded board); from its
+ * --stats file, per control of the shipped control map: event -> the first frame that shows
+ * the change (any stage: a coarse preview counts, render/async/), and event -> the first
+ * converged frame showing it; and the presented frame interval's median and p99 over the run,
+ * while transport work runs on the worker. The same rig with the transport on the loop
+ * ("passes_inline") is the baseline row. */
+#include "tools/bench/bench.h"
+#include "tools/bench/proc.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+
+#include "render/base/json.h"
+
+#define RUN_S 22.0
+#define MAX_CONTROLS 8
+#define MAX_EVENTS 4096
+
+typedef struct ctl_row {
+    char name[32];
+    double first[MAX_EVENTS / 4], conv[MAX_EVENTS / 4];
+    int n_first, n_conv;
+} ctl_row;
+
+typedef struct run_row {
+    ctl_row c[MAX_CONTROLS];
+    int n;
+    double fi_median, fi_p99, first_frame_s;
+    long frames;
+    bool ok;
+} run_row;
+
+static int cmp_d(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double quantile(double *v, int n, double q)
+{
+    if (n < 1)
+        return NAN;
+    qsort(v, (size_t)n, sizeof *v, cmp_d);
+    int i = (int)ceil(q * n) - 1;
+    return v[i < 0 ? 0 : i >= n ? n - 1 : i];
+}
+
+static ctl_row *row_for(run_row *r, const char *name)
+{
+    for (int i = 0; i < r->n; i++)
+        if (!strcmp(r->c[i].name, name))
+            return &r->c[i];
+    if (r->n == MAX_CONTROLS)
+        return NULL;
+    ctl_row *c = &r->c[r->n++];
+    snprintf(c->name, sizeof c->name, "%s", name);
+    return c;
+}
+
+static int read_run(const char *stats, run_row *r)
+{
+    lr_json *j;
+    lr_err e = {0};
+    if (lr_json_load(stats, &j, &e)) {
+        fprintf(stderr, "bench rig: %s\n", e.msg);
+        return 1;
+    }
+    lr_jnode root = lr_json_root(j), evs = lr_json_get(j, root, "event_log"),
+             frs = lr_json_get(j, root, "frame_log");
+    int rc = lr_json_get_int(j, root, "frames", true, &r->frames, &e);
+    for (int i = 0; !rc && i < lr_json_count(j, evs); i++) {
+        lr_jnode ev = lr_json_at(j, evs, i);
+        char name[32] = "";
+        double first = NAN, conv = NAN;
+        rc = lr_json_get_string(j, ev, "control", true, name, sizeof name, &e);
+        lr_jnode c = lr_json_get(j, ev, "converge_ms");
+        if (!rc && lr_json_type(j, lr_json_get(j, ev, "latency_ms")) == LR_JSON_NUMBER)
+            rc = lr_json_get_number(j, ev, "latency_ms", true, &first, &e);
+        if (!rc && c != LR_JNONE && lr_json_type(j, c) == LR_JSON_NUMBER)
+            rc = lr_json_get_number(j, ev, "converge_ms", true, &conv, &e);
+        ctl_row *row = rc ? NULL : row_for(r, name);
+        if (row && isfinite(first) && row->n_first < MAX_EVENTS / 4)
+            row->first[row->n_first++] = first;
+        if (row && isfinite(conv) && row->n_conv < MAX_EVENTS / 4)
+            row->conv[row->n_conv++] = conv;
+    }
+    int nf = lr_json_count(j, frs);
+    double *iv = nf > 1 ? calloc((size_t)nf, sizeof *iv) : NULL;
+    double prev = NAN;
+    int n_iv = 0;
+    for (int i = 0; !rc && i < nf; i++) {
+        double t = NAN;
+        rc = lr_json_get_number(j, lr_json_at(j, frs, i), "t_s", true, &t, &e);
+        if (i == 0)
+            r->first_frame_s = t;
+        if (!rc && iv && isfinite(prev))
+            iv[n_iv++] = (t - prev) * 1e3;
+        prev = t;
+    }
+    r->fi_median = iv ? quantile(iv, n_iv, 0.5) : NAN;
+    r->fi_p99 = iv ? quantile(iv, n_iv, 0.99) : NAN;
+    free(iv);
+    if (rc)
+        fprintf(stderr, "bench rig: %s\n", e.msg);
+    lr_json_destroy(j);
+    r->ok = rc == 0;
+    return rc;
+}
+
+/* The shipped rig, with `renderer` as its view ("" keeps the shipped one). */
+static int write_cfg(const char *configs, const char *path, const char *renderer)
+{
+    char src[PATH_MAX + 32];
+    snprintf(src, sizeof src, "%s/rig/sim.json", configs);
+    FILE *f = fopen(src, "r");
+    if (!f)
+        return 1;
+    char text[8192];
+    size_t n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[n] = '\0';
+    /* Relative paths in the shipped file resolve against its folder: make them absolute. */
+    char out[16384];
+    size_t o = 0;
+    for (const char *p = text; *p && o < sizeof out - PATH_MAX - 64; p++) {
+        if (!strncmp(p, "\"../", 4) || !strncmp(p, "\"sim-demo.sim\"", 14)) {
+            o += (size_t)snprintf(out + o, sizeof out - o, "\"%s/rig/", configs);
+            continue;
+        }
+        if (renderer[0] && !strncmp(p, "\"mode\": \"headless\"", 18)) {
+            o += (size_t)snprintf(out + o, sizeof out - o,
+                                  "\"mode\": \"headless\", \"renderer\": \"%s\"", renderer);
+            p += 17;
+            continue;
+        }
+        out[o++] = *p;
+    }
+    out[o] = '\0';
+    FILE *w = fopen(path, "w");
+    if (!w)
+        return 1;
+    fputs(out, w);
+    return fclose(w) != 0;
+}
+
+static int run_rig(const char *bindir, const char *cfg, const char *dir, int busy,
+                   const char *tag, run_row *r)
+{
+    char lamprig[PATH_MAX + 16], stats[PATH_MAX + 64], log[PATH_MAX + 64], dur[32];
+    snprintf(lamprig, sizeof lamprig, "%s/lamprig", bindir);
+    snprintf(stats, sizeof stats, "%s/controls-%s.json", dir, tag);
+    snprintf(log, sizeof log, "%s/controls-%s.log", dir, tag);
+    snprintf(dur, sizeof dur, "%.1f", RUN_S);
+    pid_t loops[2];
+    if (busy && lrb_busy_start(busy, loops))
+        return 1;
+    fprintf(stderr, "bench rig: the shipped sim rig (%s), %.0f s...\n", tag, RUN_S);
+    char *argv[] = {lamprig, "run", "--config", (char *)cfg, "--headless", "--duration", dur,
+                    "--stats", stats, NULL};
+    int st = lrb_reap(lrb_spawn(argv, log), RUN_S + 300);
+    if (busy)
+        lrb_busy_stop(busy, loops);
+    if (st < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+        fprintf(stderr, "bench rig: lamprig run (%s) failed (status %#x):\n", tag, st);
+        lrb_print_log(log);
+        return 1;
+    }
+    return read_run(stats, r);
+}
+
+static void print_run(FILE *out, const char *label, run_row *r)
+{
+    if (!r->ok) {
+        fprintf(out, "| %s | the run failed | | | | |\n", label);
+        return;
+    }
+    for (int i = 0; i < r->n; i++) {
+        ctl_row *c = &r->c[i];
+        double f50 = quantile(c->first, c->n_first, 0.5), f99 = quantile(c->first, c->n_first, 0.99);
+        double c50 = quantile(c->conv, c->n_conv, 0.5), c99 = quantile(c->conv, c->n_conv, 0.99);
+        fprintf(out, "| %s | %s | %d | %.0f / %.0f ms | ", label, c->name, c->n_first, f50, f99);
+        if (c->n_conv)
+            fprintf(out, "%.0f / %.0f ms (%d) |", c50, c99, c->n_conv);
+        else
+            fprintf(out, "none converged in the run |");
+        fprintf(out, " %.1f / %.1f ms |\n", r->fi_median, r->fi_p99);
+    }
+}
+
+int lrb_rig_controls(FILE *out, const char *bindir, const char *configs, const char *dir)
+{
+    char cfg_async[PATH_MAX + 32], cfg_inline[PATH_MAX + 32];
+    snprintf(cfg_async, sizeof cfg_async, "%s/sim-shipped.json", dir);
+    snprintf(cfg_inline, sizeof cfg_inline, "%s/sim-inline.json", dir);
+    if (write_cfg(configs, cfg_async, "") || write_cfg(configs, cfg_inline, "passes_inline")) {
+        fprintf(stderr, "bench rig: cannot write the scratch rig configs\n");
+        return 1;
+    }
+    static run_row idle, busy, inl;
+    int rc = run_rig(bindir, cfg_async, dir, 0, "idle", &idle);
+    rc |= run_rig(bindir, cfg_async, dir, 2, "two busy loops", &busy);
+    rc |= run_rig(bindir, cfg_inline, dir, 0, "passes_inline, idle", &inl);
+    fprintf(out,
+            "Every control of the shipped sim rig (`configs/rig/sim.json`, its demo script "
+            "looping, %.0f s per run) as shipped (the transport on a worker thread, "
+            "`render/async/`), on an idle machine and beside two busy loops, and with the "
+            "transport on the loop (`passes_inline`) for comparison. First change: event to "
+            "the end of the first frame showing it, at any stage (a coarse preview counts); "
+            "converged: to the first frame showing it at the rig's own settings, converged; "
+            "frame interval: between presented frames over the run (30 fps cap: 33 ms).\n\n"
+            "| run | control | events | first change median / p99 | converged median / p99 "
+            "(events) | frame interval median / p99 |\n|---|---|---|---|---|---|\n",
+            RUN_S);
+    print_run(out, "as shipped, idle", &idle);
+    print_run(out, "as shipped, two busy loops", &busy);
+    print_run(out, "passes_inline, idle", &inl);
+    fprintf(out, "\nFirst frame after start: %.2f s as shipped (idle), %.2f s beside two busy "
+                 "loops, %.2f s with the transport on the loop.\n\n",
+            idle.first_frame_s, busy.first_frame_s, inl.first_frame_s);
+    return rc;
+}
