@@ -169,7 +169,15 @@ void lr_rig_stats_frame_shown(lr_rig_stats *s, const lr_frame_stats *f,
     s->n_pending = keep;
 }
 
-int lr_rig_stats_pending(const lr_rig_stats *s) { return s->n_pending; }
+/* Events not shown by any frame yet (those shown and waiting for a converged frame are not
+ * pending: they have their latency). */
+int lr_rig_stats_pending(const lr_rig_stats *s)
+{
+    int n = 0;
+    for (int i = 0; i < s->n_pending; i++)
+        n += !s->pending[i].shown;
+    return n;
+}
 uint64_t lr_rig_stats_frames(const lr_rig_stats *s) { return s->n_frames; }
 uint64_t lr_rig_stats_events(const lr_rig_stats *s) { return s->n_events; }
 
@@ -235,7 +243,8 @@ int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *conf
     lr_jw_number(w, "duration_s", (double)(now_ns - s->start_ns) * 1e-9);
     lr_jw_int(w, "frames", (long)s->n_frames);
     lr_jw_int(w, "events", (long)s->n_events);
-    lr_jw_int(w, "events_pending", s->n_pending);
+    lr_jw_int(w, "events_pending", lr_rig_stats_pending(s));
+    lr_jw_int(w, "events_converging", s->n_pending - lr_rig_stats_pending(s));
     lr_jw_int(w, "events_unmatched", (long)s->unmatched);
     lr_jw_int(w, "garbage", (long)garbage);
     write_devices(w, devs, n_devs);

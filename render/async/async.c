@@ -21,10 +21,10 @@
 #include "render/passes/defines.h"
 #include "render/passes/passes.h"
 
-/* The worker runs at a lower priority than the caller (nice +10 relative): its threads (the
+/* The worker runs at a lower priority than the caller (nice +3 relative: about half the CPU share of a nice-0 thread, so two busy loops beside the rig slow the transport but do not starve it): its threads (the
  * CPU solvers' pools and the GL driver's rasteriser threads, made from it and inheriting it)
  * yield to the caller's loop on a loaded 2-core board. */
-#define WORKER_NICE 10
+#define WORKER_NICE 3
 
 /* What lr_scene_set does to light transport: everything but a dimmer/colour (intensity) and
  * exposure (display). */

@@ -273,13 +273,14 @@ static pid_t spawn(char *const argv[], const char *err_path)
     return pid;
 }
 
-/* Waits for the child to exit (guard 60 s: a `--duration 3` run under ASan takes 5-12 s
- * beside other binaries; the guard only ends a child that never exits); returns its wait
- * status. */
+/* Waits for the child to exit (guard 180 s: a `--duration 3` run under ASan takes 5-12 s
+ * beside other binaries, and at exit the rig waits for the worker's frame under way, a grid
+ * solve of tens of seconds under ASan on a loaded machine; the guard only ends a child that
+ * never exits); returns its wait status. */
 static int reap(pid_t pid)
 {
     int st = 0;
-    for (int i = 0; i < 6000; i++) {
+    for (int i = 0; i < 18000; i++) {
         pid_t w = waitpid(pid, &st, WNOHANG);
         if (w == pid)
             return st;
