@@ -35,6 +35,7 @@
 #include "firmware/plan_scene.h"
 
 #define MAX_POLL 128
+#define RETIRED_MAX 8
 #define FLUSH_MS 1000
 /* The worker's first image at start-up; minutes only under the sanitizers. */
 #define FIRST_IMAGE_MS 600000
@@ -68,6 +69,10 @@ struct lr_rig {
     lr_gl *gl;
     bool kms;
     lr_rig_view *view;
+    /* Views replaced by a scene switch or reload whose work off the loop is still finishing
+     * (lr_rig_view_retire): destroyed once done, so the loop never waits for them. */
+    lr_rig_view *retired[RETIRED_MAX];
+    int n_retired;
     unsigned char *rgba;
     lr_rig_stats *stats;
     int sigfd;
@@ -411,6 +416,34 @@ static void apply(lr_rig *r, int64_t now)
         lr_rig_stats_tag(r->stats, batch);
 }
 
+/* Hands the current view to the retired list (the oldest is destroyed, waiting, when the list
+ * is full: eight switches within one solve). */
+static void retire_view(lr_rig *r)
+{
+    if (!r->view)
+        return;
+    if (r->n_retired == RETIRED_MAX) {
+        lr_rig_view_destroy(r->retired[0]);
+        memmove(r->retired, r->retired + 1, (RETIRED_MAX - 1) * sizeof r->retired[0]);
+        r->n_retired--;
+    }
+    lr_rig_view_retire(r->view);
+    r->retired[r->n_retired++] = r->view;
+    r->view = NULL;
+}
+
+static void reap_views(lr_rig *r)
+{
+    int keep = 0;
+    for (int i = 0; i < r->n_retired; i++) {
+        if (lr_rig_view_retired(r->retired[i]))
+            lr_rig_view_destroy(r->retired[i]);
+        else
+            r->retired[keep++] = r->retired[i];
+    }
+    r->n_retired = keep;
+}
+
 static void switch_scene(lr_rig *r, const char *path)
 {
     lr_scene *scene = NULL;
@@ -441,7 +474,7 @@ static void switch_scene(lr_rig *r, const char *path)
         lr_control_map_scene_replaced(r->set.map); /* the old scene again, written in full */
         return;
     }
-    lr_rig_view_destroy(r->view);
+    retire_view(r);
     lr_replan_destroy(r->set.replan);
     lr_scene_destroy(r->set.scene);
     r->view = view;
@@ -853,7 +886,7 @@ static int reload(lr_rig *r, lr_err *e)
     lr_event ev;
     while (lr_event_ring_pop(r->ring, &ev))
         ;
-    lr_rig_view_destroy(r->view);
+    retire_view(r);
     r->used_hid |= r->set.has_hid;
     set_free(&r->set);
     r->set = s;
@@ -992,6 +1025,8 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             handle_event(r, &ev, now);
             any = true;
         }
+        if (r->n_retired)
+            reap_views(r);
         lr_err ve = {0};
         if (lr_rig_view_error(r->view, &ve))
             lr_log_write(&r->log, LR_LOG_ERROR, "render: %s", ve.msg);
@@ -1034,6 +1069,8 @@ void lr_rig_destroy(lr_rig *r)
     if (r->stats && r->set.cfg)
         write_stats(r, lr_now_ns());
     lr_rig_view_destroy(r->view);
+    for (int i = 0; i < r->n_retired; i++)
+        lr_rig_view_destroy(r->retired[i]);
     lr_ar_present_destroy(r->ar_out);
     if (r->gl)
         lr_gl_destroy(r->gl);

@@ -105,6 +105,17 @@ int lr_rig_view_error(lr_rig_view *v, lr_err *e)
     return v->ops->error ? v->ops->error(v->impl, e) : LR_OK;
 }
 
+void lr_rig_view_retire(lr_rig_view *v)
+{
+    if (v->ops->retire)
+        v->ops->retire(v->impl);
+}
+
+bool lr_rig_view_retired(const lr_rig_view *v)
+{
+    return !v->ops->retired || v->ops->retired(v->impl);
+}
+
 int lr_rig_view_wait_first(lr_rig_view *v, int timeout_ms, lr_err *e)
 {
     return v->ops->wait_first ? v->ops->wait_first(v->impl, timeout_ms, e) : LR_OK;

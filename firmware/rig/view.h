@@ -65,6 +65,11 @@ int lr_rig_view_event_fd(const lr_rig_view *v);
 bool lr_rig_view_busy(const lr_rig_view *v);
 /* An error of work done off the loop (once), LR_OK when none. */
 int lr_rig_view_error(lr_rig_view *v, lr_err *e);
+/* Retires a view without waiting for work under way off the loop (a scene switch): it stops
+ * drawing and its scene may be destroyed; destroy it once lr_rig_view_retired is true (then
+ * lr_rig_view_destroy does not wait). */
+void lr_rig_view_retire(lr_rig_view *v);
+bool lr_rig_view_retired(const lr_rig_view *v);
 /* Blocks until there is a first image (start-up only), or timeout_ms. */
 int lr_rig_view_wait_first(lr_rig_view *v, int timeout_ms, lr_err *e);
 /* width*height*4 bytes, rows top to bottom. */
@@ -90,6 +95,8 @@ typedef struct lr_rig_view_ops {
     bool (*busy)(const void *impl);
     int (*error)(void *impl, lr_err *e);
     int (*wait_first)(void *impl, int timeout_ms, lr_err *e);
+    void (*retire)(void *impl);
+    bool (*retired)(const void *impl);
 } lr_rig_view_ops;
 
 extern const lr_rig_view_ops lr_rig_view_passes;

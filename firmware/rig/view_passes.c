@@ -66,6 +66,9 @@ static int v_event_fd(const void *impl) { return lr_async_event_fd(impl); }
 static bool v_busy(const void *impl) { return lr_async_busy(impl); }
 static int v_error(void *impl, lr_err *e) { return lr_async_error(impl, e); }
 
+static void v_retire(void *impl) { lr_async_stop(impl); }
+static bool v_retired(const void *impl) { return lr_async_stopped(impl); }
+
 static int v_wait(void *impl, int timeout_ms, lr_err *e)
 {
     return lr_async_wait(impl, 0, false, timeout_ms, e);
@@ -86,4 +89,6 @@ const lr_rig_view_ops lr_rig_view_passes = {
     .busy = v_busy,
     .error = v_error,
     .wait_first = v_wait,
+    .retire = v_retire,
+    .retired = v_retired,
 };

@@ -67,6 +67,7 @@ struct lr_async {
     lr_blend *blend;
     lr_program *blit;
     set_list rec; /* journal entries since the last commit */
+    bool scene_detached; /* lr_async_stop: the caller's scene may be gone */
     uint64_t batches;
     bool blend_due, clock_set;
     double time_s;
@@ -81,7 +82,7 @@ struct lr_async {
     pthread_cond_t cv;
     set_list queue;      /* batches not yet replayed */
     uint64_t queue_batch; /* the last batch in queue */
-    bool stop, busy, started, start_failed;
+    bool stop, busy, started, start_failed, exited;
     int shown, ready;    /* slot indices; -1: none */
     slot slots[2];
     uint64_t published;
@@ -460,6 +461,7 @@ static void *worker_main(void *arg)
     a->wgl = NULL;
     pthread_mutex_lock(&a->mu);
     a->busy = false;
+    a->exited = true;
     pthread_cond_broadcast(&a->cv);
     pthread_mutex_unlock(&a->mu);
     return NULL;
@@ -556,11 +558,33 @@ int lr_async_create(const lr_async_desc *d, lr_async **out, lr_err *e)
     return LR_OK;
 }
 
-void lr_async_destroy(lr_async *a)
+void lr_async_stop(lr_async *a)
 {
     if (!a)
         return;
     if (a->scene)
+        lr_scene_set_journal(a->scene, NULL);
+    a->scene_detached = true;
+    pthread_mutex_lock(&a->mu);
+    a->stop = true;
+    pthread_cond_broadcast(&a->cv);
+    pthread_mutex_unlock(&a->mu);
+}
+
+bool lr_async_stopped(const lr_async *a)
+{
+    lr_async *m = (lr_async *)a;
+    pthread_mutex_lock(&m->mu);
+    bool x = a->exited || !a->joinable;
+    pthread_mutex_unlock(&m->mu);
+    return x;
+}
+
+void lr_async_destroy(lr_async *a)
+{
+    if (!a)
+        return;
+    if (a->scene && !a->scene_detached)
         lr_scene_set_journal(a->scene, NULL);
     /* The caller's side first: after this nothing here reads the slots. */
     if (a->blend || a->blit)

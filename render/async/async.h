@@ -95,6 +95,14 @@ int lr_async_create(const lr_async_desc *desc, lr_async **out, lr_err *e);
  * everything; clears the scene's journal. */
 void lr_async_destroy(lr_async *a);
 
+/* Asks the worker to stop after its current frame and detaches from the caller's scene
+ * (which may then be destroyed), without waiting: a scene switch retires the old one this
+ * way and destroys it once lr_async_stopped says its worker has exited (then
+ * lr_async_destroy does not wait). Nothing but lr_async_stopped and lr_async_destroy may be
+ * called after it. */
+void lr_async_stop(lr_async *a);
+bool lr_async_stopped(const lr_async *a);
+
 /* Ends a batch of the scene's changes (those made since the last commit) and hands it to the
  * worker when it changes light transport; `dirty` is what the caller's own lr_scene_set calls
  * returned (intensity and display changes only mark the caller's next blend due). Returns
