@@ -643,42 +643,14 @@ int lr_renderer_read_hdr(lr_renderer *r, float *rgb, lr_err *e)
 {
     if (!r->blend)
         return lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
-    lr_fb *hdr;
-    int rc = lr_blend_hdr(r->blend, &hdr, e);
-    if (rc)
-        return rc;
-    size_t n = (size_t)r->width * (size_t)r->height;
-    float *rgba = malloc(n * 4 * sizeof *rgba);
-    if (!rgba)
-        return lr_err_set(e, LR_ENOMEM, "renderer: HDR readback: out of memory");
-    rc = lr_fb_read(hdr, 0, 0, 0, r->width, r->height, rgba, e);
-    if (!rc)
-        for (size_t i = 0; i < n; i++)
-            memcpy(rgb + 3 * i, rgba + 4 * i, 3 * sizeof *rgb);
-    free(rgba);
-    return rc;
+    return lr_blend_read_hdr(r->blend, rgb, e);
 }
 
 int lr_renderer_read_rgba8(lr_renderer *r, unsigned char *out, lr_err *e)
 {
     if (!r->blend)
         return lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
-    size_t n = (size_t)r->width * (size_t)r->height;
-    float *rgba = malloc(n * 4 * sizeof *rgba);
-    if (!rgba)
-        return lr_err_set(e, LR_ENOMEM, "renderer: readback: out of memory");
-    int rc = lr_fb_read(lr_blend_ldr_fb(r->blend), 0, 0, 0, r->width, r->height, rgba, e);
-    if (!rc)
-        for (int y = 0; y < r->height; y++) {
-            const float *src = rgba + (size_t)(r->height - 1 - y) * r->width * 4;
-            unsigned char *dst = out + (size_t)y * r->width * 4;
-            for (int i = 0; i < r->width * 4; i++) {
-                float v = src[i] * 255.0f + 0.5f;
-                dst[i] = (unsigned char)(v < 0.0f ? 0.0f : v > 255.0f ? 255.0f : v);
-            }
-        }
-    free(rgba);
-    return rc;
+    return lr_blend_read_rgba8(r->blend, out, e);
 }
 
 int lr_renderer_present(lr_renderer *r, lr_err *e)

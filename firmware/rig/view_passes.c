@@ -5,14 +5,23 @@
 
 #include <stdlib.h>
 
+#include <stdio.h>
+
 #include "render/async/async.h"
+#include "render/plan/limits.h"
 
 /* The first image after a change that re-runs the maps (a material, a light move, a scene
  * switch) is drawn at these settings, then refined at the scene's own: one map, one sample,
- * small maps, one frame. A coarse but coherent image of the new state (render/async/). */
+ * small maps, one frame, no receiver inter-reflection; and an object whose model costs a CPU solve (a diffusion grid,
+ * translucent radiosity) is drawn with the profile model the planner names for a preview
+ * (lr_plan_preview_model: the directional dipole where it fits). A coarse but coherent image
+ * of the new state (render/async/). */
 static const char *const preview_sets[] = {
     "render.K=1", "render.N=1", "render.map_size=32", "render.gbuffer_size=32",
     "render.vpl_map_size=16", "render.N_vpl=4", "render.frames=1",
+    /* The receivers' inter-reflection is a CPU solve (1.3 s of a 1.4 s preview frame on the
+     * proxy): the preview shows their direct and emergent light without it. */
+    "render.receiver_bounce=false", "render.opening_light=false",
 };
 #define N_PREVIEW ((int)(sizeof preview_sets / sizeof preview_sets[0]))
 
@@ -22,10 +31,20 @@ static int v_create(const lr_rig_view_desc *d, void **impl, lr_err *e)
         return lr_err_set(e, LR_EINVAL, "renderer 'passes' needs a GL context");
     lr_async_desc ad = {.gl = d->gl, .scene = d->scene, .width = d->width,
                         .height = d->height, .no_vpl = d->no_vpl};
+    char model_sets[LR_ASYNC_MAX_PREVIEW - N_PREVIEW][128];
     if (!d->no_preview) {
         for (int i = 0; i < N_PREVIEW; i++)
             ad.preview[i] = preview_sets[i];
         ad.n_preview = N_PREVIEW;
+        int n = lr_scene_object_count(d->scene);
+        for (int i = 0; i < n && ad.n_preview < LR_ASYNC_MAX_PREVIEW; i++) {
+            const char *m = lr_plan_preview_model(lr_scene_object_at(d->scene, i));
+            if (!m)
+                continue;
+            char *set = model_sets[ad.n_preview - N_PREVIEW];
+            snprintf(set, sizeof model_sets[0], "objects[%d].model=%s", i, m);
+            ad.preview[ad.n_preview++] = set;
+        }
     }
     lr_async *a;
     int rc = lr_async_create(&ad, &a, e);

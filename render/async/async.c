@@ -300,11 +300,16 @@ static int preview_frame(lr_async *a, uint64_t batch, unsigned *dirty, lr_err *e
             applied = i + 1;
     }
     lr_frame_stats st;
-    if (!rc) {
+    /* An assignment the copy refuses now (a preview model outside what the new material
+     * allows): no preview this time, the refined image comes as usual. */
+    bool skip = rc != LR_OK;
+    if (skip)
+        rc = LR_OK;
+    if (!rc && !skip) {
         lr_renderer_invalidate(a->r, d);
         rc = lr_renderer_frame(a->r, &st, e);
     }
-    if (!rc)
+    if (!rc && !skip)
         rc = publish(a, &st, LR_ASYNC_PREVIEW, batch, e);
     /* Restored whatever happened: the copy must stay equal to the caller's scene. */
     unsigned back = 0;
@@ -415,6 +420,16 @@ static void *worker_main(void *arg)
             }
             dirty = back;
             lr_renderer_invalidate(a->r, back);
+            /* A newer change already waits (a knob still turning): preview it next instead of
+             * refining a state that is already stale; the refinement comes when the controls
+             * rest. */
+            pthread_mutex_lock(&a->mu);
+            bool newer = a->queue.n > 0;
+            pthread_mutex_unlock(&a->mu);
+            if (newer) {
+                first = false;
+                continue;
+            }
         }
         first = false;
         lr_frame_stats st;
@@ -798,42 +813,14 @@ int lr_async_event_fd(const lr_async *a) { return a->efd; }
 
 int lr_async_read_rgba8(lr_async *a, unsigned char *out, lr_err *e)
 {
-    size_t n = (size_t)a->width * (size_t)a->height;
-    float *rgba = malloc(n * 4 * sizeof *rgba);
-    if (!rgba)
-        return lr_err_set(e, LR_ENOMEM, "async: readback: out of memory");
-    int rc = lr_fb_read(lr_blend_ldr_fb(a->blend), 0, 0, 0, a->width, a->height, rgba, e);
-    if (!rc)
-        for (int y = 0; y < a->height; y++) {
-            const float *src = rgba + (size_t)(a->height - 1 - y) * a->width * 4;
-            unsigned char *dst = out + (size_t)y * a->width * 4;
-            for (int i = 0; i < a->width * 4; i++) {
-                float v = src[i] * 255.0f + 0.5f;
-                dst[i] = (unsigned char)(v < 0.0f ? 0.0f : v > 255.0f ? 255.0f : v);
-            }
-        }
-    free(rgba);
-    return rc;
+    return lr_blend_read_rgba8(a->blend, out, e);
 }
 
 int lr_async_read_hdr(lr_async *a, float *rgb, lr_err *e)
 {
     if (a->shown < 0)
         return lr_err_set(e, LR_EINVAL, "async: no image yet");
-    lr_fb *hdr;
-    int rc = lr_blend_hdr(a->blend, &hdr, e);
-    if (rc)
-        return rc;
-    size_t n = (size_t)a->width * (size_t)a->height;
-    float *rgba = malloc(n * 4 * sizeof *rgba);
-    if (!rgba)
-        return lr_err_set(e, LR_ENOMEM, "async: HDR readback: out of memory");
-    rc = lr_fb_read(hdr, 0, 0, 0, a->width, a->height, rgba, e);
-    if (!rc)
-        for (size_t i = 0; i < n; i++)
-            memcpy(rgb + 3 * i, rgba + 4 * i, 3 * sizeof *rgb);
-    free(rgba);
-    return rc;
+    return lr_blend_read_hdr(a->blend, rgb, e);
 }
 
 int lr_async_present(lr_async *a, lr_err *e)

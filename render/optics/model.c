@@ -15,11 +15,13 @@ static const char *const names[LR_SSS_MODEL_COUNT] = {"directional_dipole", "sta
  * all-zero row), which is what lr_sss_sd_fresnel_n's default branch evaluates. */
 static const lr_sss_model_props props[LR_SSS_MODEL_COUNT] = {
     [LR_SSS_MULTIPOLE] = {.needs_thickness = "needs thickness_mm (the wall the multipole models)"},
-    [LR_SSS_TRANSLUCENT_RADIOSITY] = {.no_closure = "translucent radiosity solves the cavity's "
+    [LR_SSS_TRANSLUCENT_RADIOSITY] = {.solves = "its patch system is solved on the CPU",
+                                      .no_closure = "translucent radiosity solves the cavity's "
                                                     "inter-reflection itself",
                                       .no_openings = "its receiver grid carries the inner "
                                                      "faces' light (render/transrad/tr_scene.h)"},
     [LR_SSS_DIFFUSION_GRID] = {.no_profile = true,
+                               .solves = "the diffusion equation is solved on the CPU grid",
                                .needs_closed = "needs a closed mesh (the grid diffusion solves "
                                                "inside a solid body)",
                                .no_closure = "the grid closes the cavity in its own field "

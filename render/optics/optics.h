@@ -247,6 +247,9 @@ typedef struct lr_sss_model_props {
      * (render/openings); NULL: it is (its B is known at any point: the profile sampler's, or
      * the grid's solved field). */
     const char *no_openings;
+    /* Why a material change costs a CPU solve before its first image (seconds on the proxy,
+     * configs/bench/models.csv); NULL: the model is evaluated on the GPU frame by frame. */
+    const char *solves;
 } lr_sss_model_props;
 /* The model's row; an all-zero row for a value outside the enum. */
 const lr_sss_model_props *lr_sss_model_props_of(enum lr_sss_model m);

@@ -183,3 +183,45 @@ int lr_blend_hdr(lr_blend *b, lr_fb **out, lr_err *e)
 
 lr_tex *lr_blend_ldr(const lr_blend *b) { return b->ldr; }
 lr_fb *lr_blend_ldr_fb(const lr_blend *b) { return b->fb_ldr; }
+
+int lr_blend_read_hdr(lr_blend *b, float *rgb, lr_err *e)
+{
+    lr_fb *hdr;
+    int rc = lr_blend_hdr(b, &hdr, e);
+    if (rc)
+        return rc;
+    int w, h;
+    lr_fb_size(hdr, &w, &h);
+    size_t n = (size_t)w * (size_t)h;
+    float *rgba = malloc(n * 4 * sizeof *rgba);
+    if (!rgba)
+        return lr_err_set(e, LR_ENOMEM, "blend: HDR readback: out of memory");
+    rc = lr_fb_read(hdr, 0, 0, 0, w, h, rgba, e);
+    if (!rc)
+        for (size_t i = 0; i < n; i++)
+            memcpy(rgb + 3 * i, rgba + 4 * i, 3 * sizeof *rgb);
+    free(rgba);
+    return rc;
+}
+
+int lr_blend_read_rgba8(lr_blend *b, unsigned char *out, lr_err *e)
+{
+    int w, h;
+    lr_fb_size(b->fb_ldr, &w, &h);
+    size_t n = (size_t)w * (size_t)h;
+    float *rgba = malloc(n * 4 * sizeof *rgba);
+    if (!rgba)
+        return lr_err_set(e, LR_ENOMEM, "blend: readback: out of memory");
+    int rc = lr_fb_read(b->fb_ldr, 0, 0, 0, w, h, rgba, e);
+    if (!rc)
+        for (int y = 0; y < h; y++) {
+            const float *src = rgba + (size_t)(h - 1 - y) * w * 4;
+            unsigned char *dst = out + (size_t)y * w * 4;
+            for (int i = 0; i < w * 4; i++) {
+                float v = src[i] * 255.0f + 0.5f;
+                dst[i] = (unsigned char)(v < 0.0f ? 0.0f : v > 255.0f ? 255.0f : v);
+            }
+        }
+    free(rgba);
+    return rc;
+}

@@ -49,6 +49,11 @@ int lr_blend_run(lr_blend *b, const lr_blend_input *in, lr_err *e);
 /* The linear sum of the last lr_blend_run's input, RGBA32F, drawn if not yet drawn for it. */
 int lr_blend_hdr(lr_blend *b, lr_fb **out, lr_err *e);
 
+/* The last output read back: linear RGB (w*h*3 floats, rows bottom to top, PFM order) and
+ * tone-mapped sRGB (w*h*4 bytes, rows top to bottom, PNG order). */
+int lr_blend_read_hdr(lr_blend *b, float *rgb, lr_err *e);
+int lr_blend_read_rgba8(lr_blend *b, unsigned char *rgba, lr_err *e);
+
 lr_tex *lr_blend_ldr(const lr_blend *b);
 lr_fb *lr_blend_ldr_fb(const lr_blend *b);
 

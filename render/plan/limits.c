@@ -54,3 +54,18 @@ int lr_plan_check_models(const lr_scene *s, lr_err *e)
     }
     return LR_OK;
 }
+
+const char *lr_plan_preview_model(const lr_scene_object *o)
+{
+    if (!lr_sss_model_props_of(o->sss_model)->solves)
+        return NULL;
+    for (int m = 0; m < LR_SSS_MODEL_COUNT; m++) {
+        const lr_sss_model_props *p = lr_sss_model_props_of((enum lr_sss_model)m);
+        char why[256];
+        if (p->solves || p->no_profile || lr_scene_object_model_unmet(o, (enum lr_sss_model)m) ||
+            lr_plan_model_limit(o, (enum lr_sss_model)m, why, sizeof why))
+            continue;
+        return lr_sss_model_name((enum lr_sss_model)m);
+    }
+    return NULL;
+}

@@ -37,6 +37,12 @@
 const char *lr_plan_model_limit(const lr_scene_object *o, enum lr_sss_model m, char *buf,
                                 size_t cap);
 
+/* A model for a quick preview of object o after a change (render/async/): when o's own model
+ * costs a CPU solve (lr_sss_model_props.solves), the first profile model in the enum's order
+ * that o can render and that is within its limits for o's material (lr_plan_model_limit),
+ * evaluated on the GPU frame by frame; NULL when o's own model needs no solve, or none fits. */
+const char *lr_plan_preview_model(const lr_scene_object *o);
+
 /* Refuses a scene an object of which is to render with a model outside these limits for its
  * material (objects[i].model forced by the scene file, `--set` or a control, where the planner
  * would have left the model out: the grid on porcelain otherwise fails after its solver's
