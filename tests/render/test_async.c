@@ -16,6 +16,7 @@
 #include "render/async/async.h"
 #include "render/mesh/bvh.h"
 #include "render/mesh/mesh.h"
+#include "render/plan/limits.h"
 #include "render/renderer.h"
 #include "tests/support/gl.h"
 #include "tests/support/render.h"
@@ -28,8 +29,9 @@
 /* The candle with a deterministic model (a diffusion grid: no per-frame sample, so two
  * renderers that reach the same state draw the same image whatever their frame counts,
  * render/renderer.h) and a CPU solve long enough that the worker is still at it when the
- * caller turns the dimmer. */
-static const char *const grid_sets[] = {"objects[0].model=diffusion_grid",
+ * caller turns the dimmer (a 5 mm grid: a few thousand cells, a solve of a fraction of a
+ * second under the sanitizers, still far longer than the dimmer's blend). */
+static const char *const grid_sets[] = {"objects[0].model=diffusion_grid", "objects[0].dgrid_h_mm=5",
                                         "lights[0].flicker.amplitude=0", NULL};
 
 static const char *const preview[] = {"render.K=1", "render.N=1", "render.map_size=16",
@@ -220,9 +222,10 @@ static void test_preview_once_per_heavy_change(void **state)
     assert_int_equal(lr_async_publications(a, LR_ASYNC_PREVIEW), 2);
     lr_async_destroy(a);
 
+    /* A "preview" at the scene's own settings costs what the full frame costs (the same
+     * passes, the same solve): after the first it is skipped. */
     lr_async_desc d = {.gl = f->gl, .scene = s, .width = W, .height = H,
-                       .preview = {preview[0], preview[1], preview[2], preview[3]},
-                       .n_preview = 4};
+                       .preview = {"render.N=4", "render.frames=1"}, .n_preview = 2};
     lr_err e = {0};
     assert_int_equal(lr_async_create(&d, &a, &e), LR_OK);
     wait_final(a, 0);
@@ -231,7 +234,6 @@ static void test_preview_once_per_heavy_change(void **state)
     set(s, "objects[0].material", "candle_wax", &dirty);
     b = lr_async_commit(a, dirty);
     wait_final(a, b);
-    /* A 16² preview of the grid scene solves the same grid as the full frame. */
     assert_int_equal(lr_async_publications(a, LR_ASYNC_PREVIEW), 1);
     lr_async_destroy(a);
     lr_scene_destroy(s);
@@ -286,11 +288,28 @@ static void test_clone_is_independent(void **state)
     lr_scene_destroy(c);
 }
 
+/* The rig previews an object whose model solves on the CPU with a profile model the planner
+ * allows, and leaves an object whose model needs no solve as it is. */
+static void test_preview_model(void **state)
+{
+    (void)state;
+    lr_scene *s = lr_test_scene("candle", lr_test_small_settings, grid_sets);
+    const char *m = lr_plan_preview_model(lr_scene_object_at(s, 0));
+    assert_non_null(m);
+    assert_string_equal(m, "directional_dipole");
+    set(s, "objects[0].model", "translucent_radiosity", NULL);
+    assert_non_null(lr_plan_preview_model(lr_scene_object_at(s, 0)));
+    set(s, "objects[0].model", "standard_dipole", NULL);
+    assert_null(lr_plan_preview_model(lr_scene_object_at(s, 0)));
+    lr_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_clone_is_independent),
         cmocka_unit_test(test_bad_preview_refused),
+        cmocka_unit_test(test_preview_model),
         cmocka_unit_test(test_final_is_the_renderers_image),
         cmocka_unit_test(test_dimmer_does_not_wait_for_a_solve),
         cmocka_unit_test(test_preview_once_per_heavy_change),
