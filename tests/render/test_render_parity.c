@@ -156,6 +156,15 @@ static void check_parity(const parity *p)
     check_parity_at(p, 0.005);
 }
 
+/* The maps against the twin's exact rays (no G-buffer emulation) and B at the VPLs against
+ * the reference estimator are figures, never assertions (above: the model against the GPU's
+ * quantised x_i; test_vpls); LR_PARITY_DEBUG=1 prints them. Left out of the default run: they
+ * were half the two maps tests' time and most of test_vpls'. */
+static bool exact_rays_reported(void)
+{
+    return getenv("LR_PARITY_DEBUG") != NULL;
+}
+
 static const char *const parity_settings[] = {
     "render.K=3", "render.N=16", "render.map_size=24", "render.gbuffer_size=256",
     "render.vpl_map_size=32", "render.N_vpl=48", "render.frames=8", NULL};
@@ -181,8 +190,10 @@ static void test_maps_lampshade(void **state)
     compare_maps(r, s, 256, true, &p);
     report("lampshade maps (G-buffer emulated)", &p);
     check_parity(&p);
-    compare_maps(r, s, 256, false, &p);
-    report("lampshade maps (exact rays)", &p);
+    if (exact_rays_reported()) {
+        compare_maps(r, s, 256, false, &p);
+        report("lampshade maps (exact rays)", &p);
+    }
     lr_renderer_destroy(r);
     lr_scene_destroy(s);
 }
@@ -199,8 +210,10 @@ static void test_maps_sphere_outside_light(void **state)
     compare_maps(r, s, 256, true, &p);
     report("sphere maps (light outside, G-buffer emulated)", &p);
     check_parity(&p);
-    compare_maps(r, s, 256, false, &p);
-    report("sphere maps (light outside, exact rays)", &p);
+    if (exact_rays_reported()) {
+        compare_maps(r, s, 256, false, &p);
+        report("sphere maps (light outside, exact rays)", &p);
+    }
     lr_renderer_destroy(r);
     lr_scene_destroy(s);
 }
@@ -310,10 +323,10 @@ static void test_maps_votive_built_mesh(void **state)
  * centre. Same validity; positions within 1.5 cube texels (|x_v - c| * 2 / size * 1.5 /
  * max(|n.u|, 0.3): a texel's footprint on a tilted surface); normals within 0.05 where the
  * positions agree to a texel; areas within 10 % (the area uses n_v . u_v, interpolated at a
- * texel centre on the GPU). Measured: 0.58 texels, 9.3 %, 0.040. Also reported (not
- * asserted): sum A_v B_v of the GPU against the reference estimator at the GPU's own VPL
- * positions -- with K = 3 maps it is +26 %, dominated by one VPL near the flame that no map
- * sees (Algorithm 1's fallback). */
+ * texel centre on the GPU). Measured: 0.58 texels, 9.3 %, 0.040. With LR_PARITY_DEBUG,
+ * reported (not asserted): sum A_v B_v of the GPU against the reference estimator at the
+ * GPU's own VPL positions -- with K = 3 maps it is +26 %, dominated by one VPL near the flame
+ * that no map sees (Algorithm 1's fallback). */
 static void test_vpls(void **state)
 {
     (void)state;
@@ -349,9 +362,10 @@ static void test_vpls(void **state)
             worst_n = fmax(worst_n, dn);
     }
     /* B at the VPLs: the GPU's (Algorithm 1 over its maps) against the reference estimator at
-     * the GPU's own positions, weighted by area (what the receivers see). */
+     * the GPU's own positions, weighted by area (what the receivers see). A figure, not an
+     * assertion: with LR_PARITY_DEBUG only (1000 reference samples at each VPL). */
     double sg = 0, sr = 0, sv = 0, sa_g = 0, sa_c = 0;
-    for (int v = 0; v < n; v++) {
+    for (int v = 0; v < n && exact_rays_reported(); v++) {
         if (!g[v].valid)
             continue;
         lr_cpu_radiosity_desc rd = {.N = 1000, .sampler = LR_CPU_REFERENCE};
@@ -368,9 +382,10 @@ static void test_vpls(void **state)
                           g[v].B[1], est.mean[1], sqrt(est.var[1] / est.n), g[v].weight,
                           g[v].area, c[v].area);
     }
-    print_message("VPLs: sum A B: GPU %.5g, reference at the GPU's positions %.5g +- %.2g "
-                  "(%+.1f %%); sum A: GPU %.5g, CPU %.5g\n", sg, sr, sqrt(sv),
-                  100 * (sg / sr - 1), sa_g, sa_c);
+    if (exact_rays_reported())
+        print_message("VPLs: sum A B: GPU %.5g, reference at the GPU's positions %.5g +- %.2g "
+                      "(%+.1f %%); sum A: GPU %.5g, CPU %.5g\n", sg, sr, sqrt(sv),
+                      100 * (sg / sr - 1), sa_g, sa_c);
     print_message("VPLs: worst position error %.2f texels, area %.1f %%, normal %.3f\n", worst_pos,
                   100 * worst_area, worst_n);
     assert_true(worst_pos < 1.5);
