@@ -48,6 +48,7 @@
 
 #include "render/base/err.h"
 #include "render/base/vec3.h"
+#include "render/base/warn.h"
 #include "render/image/image.h"
 #include "render/reference/rng.h"
 
@@ -384,13 +385,25 @@ void lr_ref_cache_key(const lr_ref_scene *s, const lr_ref_camera *cam,
                       const lr_ref_render_desc *d, char key[17]);
 
 /* The reference for (s, cam, d): read from dir/<key>.pfm and dir/<key>.var.pfm when both are
- * there and match, otherwise rendered (progress may be NULL) and written there atomically
- * (dir is created). *hit says which; mean and var are filled either way. dir NULL means
- * "build/reference-cache". */
+ * there and pass the checks below, otherwise rendered (progress may be NULL) and written there
+ * atomically (dir is created). *hit says which; mean and var are filled either way. dir NULL
+ * means "build/reference-cache".
+ *
+ * An entry is served only when dir/<key>.json names the key and holds both images' content
+ * hashes (lr_ref_image_hash), both images have the key's size and match their hashes, and every
+ * value is finite and non-negative. An entry that fails (a damaged or edited file, a truncated
+ * one, a NaN) is refused with one warning to warn (may be NULL) naming the file, and rendered
+ * again; one without hashes (an older cache format) is stale and rendered again the same way.
+ * A render with a value the checks would refuse is not stored: an error. */
 int lr_ref_render_cached(const lr_ref_scene *s, const lr_ref_camera *cam,
                          const lr_ref_render_desc *d, const char *dir,
                          void (*progress)(const lr_ref_render *r, void *user), void *user,
-                         lr_ref_image *mean, lr_ref_image *var, bool *hit, lr_err *e);
+                         const lr_warn_sink *warn, lr_ref_image *mean, lr_ref_image *var,
+                         bool *hit, lr_err *e);
+
+/* Content hash of an image as the cache keeps it: 64-bit FNV-1a of the width and height
+ * (uint64) and every value's bits (uint32), little-endian, rows top to bottom. */
+uint64_t lr_ref_image_hash(const lr_ref_image *img);
 
 /* ---- scene files ------------------------------------------------------------------------ */
 

@@ -542,7 +542,9 @@ static void test_error_falls_with_frames(void **state)
     /* The bench's reference settings (tools/bench/sweep.h: 64x48, 512 spp). */
     assert_lr_ok(lr_ref_render_cached(rs, &cam,
                                       &(lr_ref_render_desc){.width = W, .height = H, .spp = 512},
-                                      refdir, NULL, NULL, &mean, &var, &hit, &e),
+                                      refdir, NULL, NULL,
+                                      &(const lr_warn_sink){lr_warn_stderr, "test_eval"},
+                                      &mean, &var, &hit, &e),
                  e);
     lr_eval_masks m;
     assert_lr_ok(lr_eval_masks_create(s, W, H, &m, &e), e);

@@ -231,8 +231,8 @@ static void test_cache_reuse(void **state)
     lr_ref_render_desc d = {.width = 12, .height = 9, .spp = 4, .seed = 1};
     lr_ref_image m1, v1, m2, v2;
     bool hit = true;
-    assert_int_equal(lr_ref_render_cached(s, &lamp_cam, &d, sub, NULL, NULL, &m1, &v1, &hit,
-                                          NULL), LR_OK);
+    assert_int_equal(lr_ref_render_cached(s, &lamp_cam, &d, sub, NULL, NULL, NULL, &m1, &v1,
+                                          &hit, NULL), LR_OK);
     assert_false(hit);
     char key[17];
     lr_ref_cache_key(s, &lamp_cam, &d, key);
@@ -256,8 +256,8 @@ static void test_cache_reuse(void **state)
     assert_int_equal(files, 3);
 
     sleep(1); /* so that a rewrite would show in the modification time */
-    assert_int_equal(lr_ref_render_cached(s, &lamp_cam, &d, sub, NULL, NULL, &m2, &v2, &hit,
-                                          NULL), LR_OK);
+    assert_int_equal(lr_ref_render_cached(s, &lamp_cam, &d, sub, NULL, NULL, NULL, &m2, &v2,
+                                          &hit, NULL), LR_OK);
     assert_true(hit);
     snprintf(path, sizeof path, "%s/%s.pfm", sub, key);
     assert_int_equal(stat(path, &st2), 0);
@@ -268,8 +268,8 @@ static void test_cache_reuse(void **state)
     lr_ref_image_free(&v2);
 
     d.spp = 5; /* a changed input: a miss, a new entry */
-    assert_int_equal(lr_ref_render_cached(s, &lamp_cam, &d, sub, NULL, NULL, &m2, &v2, &hit,
-                                          NULL), LR_OK);
+    assert_int_equal(lr_ref_render_cached(s, &lamp_cam, &d, sub, NULL, NULL, NULL, &m2, &v2,
+                                          &hit, NULL), LR_OK);
     assert_false(hit);
     lr_ref_image_free(&m1);
     lr_ref_image_free(&v1);
@@ -278,6 +278,221 @@ static void test_cache_reuse(void **state)
     lr_ref_scene_destroy(s);
     snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
     assert_int_equal(system(cmd), 0);
+}
+
+/* ---- damaged entries: refused with a warning naming the file, rendered again ---------- */
+
+typedef struct warns {
+    int n;
+    bool quiet;
+    char last[LR_ERR_MSG_MAX];
+} warns;
+
+static void collect(void *user, const char *msg)
+{
+    warns *w = user;
+    w->n++;
+    snprintf(w->last, sizeof w->last, "%s", msg);
+    if (!w->quiet)
+        printf("  warning: %s\n", msg);
+}
+
+typedef struct entry_fx {
+    char dir[64], sub[128], mean[256], var[256], meta[256];
+    lr_ref_scene *s;
+    lr_ref_render_desc d;
+    lr_ref_image m0, v0; /* the images as first rendered */
+    warns w;
+} entry_fx;
+
+/* The entry once more: whether it was served from the cache; the images are the first
+ * render's bits either way (the renderer is deterministic, so a rebuild gives the same), so a
+ * damaged value is never what comes back. */
+static bool fetch(entry_fx *f)
+{
+    lr_ref_image m, v;
+    bool hit = false;
+    lr_err e = {0};
+    assert_int_equal(lr_ref_render_cached(f->s, &lamp_cam, &f->d, f->sub, NULL, NULL,
+                                          &(const lr_warn_sink){collect, &f->w}, &m, &v, &hit,
+                                          &e), LR_OK);
+    assert_int_equal(m.width, f->m0.width);
+    assert_int_equal(m.height, f->m0.height);
+    assert_memory_equal(m.rgb, f->m0.rgb, npix3(&m) * sizeof *m.rgb);
+    assert_memory_equal(v.rgb, f->v0.rgb, npix3(&m) * sizeof *m.rgb);
+    lr_ref_image_free(&m);
+    lr_ref_image_free(&v);
+    return hit;
+}
+
+static void fx_setup(entry_fx *f, int w, int h, int spp)
+{
+    memset(f, 0, sizeof *f);
+    tmpdir(f->dir, sizeof f->dir);
+    snprintf(f->sub, sizeof f->sub, "%s/refs", f->dir);
+    f->s = lamp_scene(0.3);
+    f->d = (lr_ref_render_desc){.width = w, .height = h, .spp = spp, .seed = 1};
+    char key[17];
+    lr_ref_cache_key(f->s, &lamp_cam, &f->d, key);
+    snprintf(f->mean, sizeof f->mean, "%s/%s.pfm", f->sub, key);
+    snprintf(f->var, sizeof f->var, "%s/%s.var.pfm", f->sub, key);
+    snprintf(f->meta, sizeof f->meta, "%s/%s.json", f->sub, key);
+    bool hit = true;
+    assert_int_equal(lr_ref_render_cached(f->s, &lamp_cam, &f->d, f->sub, NULL, NULL, NULL,
+                                          &f->m0, &f->v0, &hit, NULL), LR_OK);
+    assert_false(hit);
+    for (size_t i = 0; i < npix3(&f->m0); i++) /* what the loader demands of a good entry */
+        assert_true(isfinite(f->m0.rgb[i]) && f->m0.rgb[i] >= 0 && isfinite(f->v0.rgb[i]) &&
+                    f->v0.rgb[i] >= 0);
+    assert_true(fetch(f));
+    assert_int_equal(f->w.n, 0);
+}
+
+static void fx_teardown(entry_fx *f)
+{
+    lr_ref_image_free(&f->m0);
+    lr_ref_image_free(&f->v0);
+    lr_ref_scene_destroy(f->s);
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf %s", f->dir);
+    assert_int_equal(system(cmd), 0);
+}
+
+/* After a damage: refused (not a hit) with exactly one warning that names the file and says
+ * `why`; the rebuild rewrote the entry, so the next call is a quiet hit. */
+static void expect_refused(entry_fx *f, const char *file, const char *why)
+{
+    int before = f->w.n;
+    assert_false(fetch(f));
+    assert_int_equal(f->w.n, before + 1);
+    if (!strstr(f->w.last, file) || !strstr(f->w.last, why))
+        fail_msg("warning '%s' lacks '%s' or '%s'", f->w.last, file, why);
+    assert_true(fetch(f));
+    assert_int_equal(f->w.n, before + 1);
+}
+
+static void flip_byte(const char *path, long from_end, unsigned char mask)
+{
+    size_t len = 0;
+    unsigned char *b = lr_test_read(path, &len);
+    assert_non_null(b);
+    assert_true((size_t)from_end <= len);
+    b[len - (size_t)from_end] ^= mask;
+    lr_test_put(path, b, len);
+    free(b);
+}
+
+/* Replaces the 16 hex digits after `"field": "` in the .json by hash. */
+static void resign(const char *meta, const char *field, uint64_t hash)
+{
+    size_t len = 0;
+    char *t = (char *)lr_test_read(meta, &len), pat[64], hex[17];
+    assert_non_null(t);
+    snprintf(pat, sizeof pat, "\"%s\": \"", field);
+    char *p = strstr(t, pat);
+    assert_non_null(p);
+    snprintf(hex, sizeof hex, "%016llx", (unsigned long long)hash);
+    memcpy(p + strlen(pat), hex, 16);
+    lr_test_put(meta, t, len);
+    free(t);
+}
+
+/* Sets one value of a PFM and, when field is given, re-signs the .json with the new image's
+ * hash (a valid hash over implausible values: only the finite check can catch it). */
+static void poke(const char *pfm, size_t i, float value, const char *meta, const char *field)
+{
+    lr_ref_image img;
+    assert_int_equal(lr_image_read_pfm(pfm, &img, NULL), LR_OK);
+    img.rgb[i] = value;
+    assert_int_equal(lr_image_write_pfm(pfm, &img, NULL), LR_OK);
+    if (field)
+        resign(meta, field, lr_ref_image_hash(&img));
+    lr_ref_image_free(&img);
+}
+
+/* What the cache without content hashes wrote (the .json's first lines, no hash fields). */
+static void write_old_meta(const entry_fx *f)
+{
+    char key[17], text[512];
+    lr_ref_cache_key(f->s, &lamp_cam, &f->d, key);
+    snprintf(text, sizeof text,
+             "{\n  \"key\": \"%s\",\n  \"version\": \"%s\",\n  \"spp\": 4,\n  \"paths\": 432,\n"
+             "  \"nee\": 0,\n  \"nee_refracted\": 0,\n  \"nee_unsolved\": 0,\n"
+             "  \"truncated\": 0,\n  \"medium_mismatch\": 0,\n  \"nonfinite\": 0\n}\n",
+             key, LR_REF_VERSION);
+    lr_test_put(f->meta, text, (size_t)-1);
+}
+
+/* The reference cache serves an entry only when both images match the content hashes in
+ * its .json and every value is finite and non-negative: a flipped byte in either image, a
+ * NaN or a negative variance under a valid (recomputed) hash, a NaN under an old-format .json
+ * (no hashes: stale), a truncated image or .json, a .json naming another key: each refused
+ * with a warning naming the file and rendered again, never served. */
+static void test_cache_refuses_bad_entries(void **state)
+{
+    (void)state;
+    entry_fx f;
+    fx_setup(&f, 12, 9, 4);
+    flip_byte(f.mean, 40, 0x01); /* the low bit of a value: a silently wrong pixel */
+    expect_refused(&f, f.mean, "content hash");
+    flip_byte(f.var, 100, 0x40);
+    expect_refused(&f, f.var, "content hash");
+    poke(f.mean, 7, NAN, f.meta, "mean_hash");
+    expect_refused(&f, f.mean, "not finite and non-negative");
+    poke(f.mean, 0, INFINITY, f.meta, "mean_hash");
+    expect_refused(&f, f.mean, "not finite and non-negative");
+    poke(f.var, 11, -1e-3f, f.meta, "var_hash");
+    expect_refused(&f, f.var, "not finite and non-negative");
+    /* The old format: the same NaN, the .json as the cache without hashes wrote it. */
+    poke(f.mean, 7, NAN, NULL, NULL);
+    write_old_meta(&f);
+    expect_refused(&f, f.meta, "no content hash");
+    /* A truncated image, a truncated .json. */
+    assert_int_equal(truncate(f.mean, 100), 0);
+    expect_refused(&f, f.mean, "truncated");
+    assert_int_equal(truncate(f.meta, 30), 0);
+    expect_refused(&f, f.meta, ".json");
+    /* A .json of another entry under this one's name. */
+    resign(f.meta, "key", 0x0123456789abcdefULL);
+    expect_refused(&f, f.meta, "0123456789abcdef");
+    fx_teardown(&f);
+}
+
+/* Random damage (120 single-byte changes, a third in each of the three files, fixed seed;
+ * a 6x4 image at 1 sample so that each of the rebuilds costs little): every call returns the
+ * first render's bits (asserted in fetch), each either a hit with no warning (a change the
+ * checks need not see: a PFM header's whitespace or scale digits, a counter in the .json) or
+ * a miss with exactly one warning. Of an image's 300 bytes only the 12 of its header can be
+ * harmless (4 %), so of the 80 image changes at least 68 are refused (expected harmless
+ * under 3.2; more than 12 has a Poisson probability below 1e-5). */
+static void test_cache_random_damage(void **state)
+{
+    (void)state;
+    enum { ROUNDS = 120 };
+    entry_fx f;
+    fx_setup(&f, 6, 4, 1);
+    lr_ref_rng rng;
+    lr_ref_rng_seed(&rng, 7, 0);
+    f.w.quiet = true; /* a warning each, like those of the test above */
+    int refused[3] = {0};
+    for (int round = 0; round < ROUNDS; round++) {
+        const char *path = round % 3 == 0 ? f.mean : round % 3 == 1 ? f.var : f.meta;
+        size_t len = 0;
+        unsigned char *b = lr_test_read(path, &len);
+        assert_non_null(b);
+        size_t at = (size_t)(lr_ref_rng_uniform(&rng) * (double)len) % len;
+        b[at] ^= (unsigned char)(1 + (int)(lr_ref_rng_uniform(&rng) * 255) % 255);
+        lr_test_put(path, b, len);
+        free(b);
+        int before = f.w.n;
+        bool hit = fetch(&f);
+        assert_int_equal(f.w.n, before + !hit);
+        refused[round % 3] += !hit;
+    }
+    printf("  refused of %d changes each: mean %d, variance %d, .json %d\n", ROUNDS / 3,
+           refused[0], refused[1], refused[2]);
+    assert_true(refused[0] + refused[1] >= 68);
+    fx_teardown(&f);
 }
 
 /* Scene files: a full file loads into the same scene (same hash) as the equivalent calls, and
@@ -440,9 +655,13 @@ int main(void)
         cmocka_unit_test(test_pfm_roundtrip),
         cmocka_unit_test(test_cache_key),
         cmocka_unit_test(test_cache_reuse),
+        cmocka_unit_test(test_cache_refuses_bad_entries),
+        cmocka_unit_test(test_cache_random_damage),
         cmocka_unit_test(test_scene_file),
         cmocka_unit_test(test_scene_validation),
         cmocka_unit_test(test_from_project_scene),
     };
+    if (getenv("LR_TEST_FILTER")) /* e.g. LR_TEST_FILTER='test_cache*' to run some tests */
+        cmocka_set_test_filter(getenv("LR_TEST_FILTER"));
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -229,7 +229,9 @@ static int first_reference(const lr_ref_scene *rs, const lr_ref_camera *cam, con
     int most = most_cached(rs, cam, dir, rd);
     rd.spp = most ? most : LRB_SWEEP_SPP;
     *spp = rd.spp;
-    return lr_ref_render_cached(rs, cam, &rd, dir, NULL, NULL, mean, var, hit, e);
+    return lr_ref_render_cached(rs, cam, &rd, dir, NULL, NULL,
+                                &(const lr_warn_sink){lr_warn_stderr, "lamprig-bench"}, mean, var,
+                                hit, e);
 }
 
 /* The second reference (seed LRB_SWEEP_SEED2): from the cache at the most samples committed
@@ -251,7 +253,9 @@ static int second_reference(const lr_ref_scene *rs, const lr_ref_camera *cam, co
         return lr_err_set(e, LR_EIO, "no seed-%d reference at %d or %d spp in %s "
                           "(LRB_SWEEP_REF2=cached)", LRB_SWEEP_SEED2, LRB_SWEEP_SPP,
                           LRB_SWEEP_SPP2, dir);
-    return lr_ref_render_cached(rs, cam, &rd, dir, NULL, NULL, mean, var, hit, e);
+    return lr_ref_render_cached(rs, cam, &rd, dir, NULL, NULL,
+                                &(const lr_warn_sink){lr_warn_stderr, "lamprig-bench"}, mean, var,
+                                hit, e);
 }
 
 /* Two references of the same count (independent seeds) are one reference of twice the

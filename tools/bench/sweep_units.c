@@ -58,7 +58,9 @@ int lrb_sweep_units(lr_gl *gl, const char *name, double *ratio, double *se, long
     if (!rc)
         rc = lr_ref_render_cached(rs, &cam,
                                   &(lr_ref_render_desc){.width = UW, .height = UH, .spp = USPP},
-                                  NULL, NULL, NULL, &mean, &var, &hit, &e);
+                                  NULL, NULL, NULL,
+                                  &(const lr_warn_sink){lr_warn_stderr, "lamprig-bench"}, &mean,
+                                  &var, &hit, &e);
     if (!rc)
         rc = lr_eval_masks_create(s, UW, UH, &m, &e);
     if (!rc)

@@ -175,8 +175,9 @@ static int cmd_render(int argc, char **argv)
     bool hit = false;
     const char *cache_dir = lr_args_get(&a, "--cache-dir");
     if (cache_dir || lr_args_has(&a, "--cache")) {
-        if (lr_ref_render_cached(s, &cam, &d, cache_dir, show_progress, pr, &mean, &vimg, &hit,
-                                 &e))
+        if (lr_ref_render_cached(s, &cam, &d, cache_dir, show_progress, pr,
+                                 &(const lr_warn_sink){lr_warn_stderr, "lamprig-reference"},
+                                 &mean, &vimg, &hit, &e))
             status = 1;
     } else {
         lr_ref_render *r = NULL;
