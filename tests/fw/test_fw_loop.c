@@ -5,7 +5,8 @@
  * event that changed something, each non-negative. The soak: 30 s (three loops of its script)
  * of the shipped sim demo as `lamprig run` in a sanitized child, ended by SIGTERM
  * (LAMPRIG_SOAK_S sets the length: `make soak` runs 120 s);
- * a fast one (19000 events/s) whose resident memory and descriptors stay flat. */
+ * a fast one (19000 events/s, beside four misbehaving Modbus peers) whose resident memory and
+ * descriptors stay flat and whose frames keep coming. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -31,6 +32,7 @@
 #include "tests/support/fs.h"
 #include "tests/support/gl.h"
 #include "tests/support/hal_test.h"
+#include "tests/support/modbus_rogue.h"
 #include "tests/support/modbus_server.h"
 #include "tests/support/near.h"
 #include "tests/support/proc.h"
@@ -534,32 +536,100 @@ static int fd_floor(pid_t pid)
     return lo;
 }
 
-static long stats_events(const char *path)
+/* What a stats file says at one moment: events, frames, and of the modbus device `dev` (NULL:
+ * none) its timeouts, stale and bad answers and exceptions. -1 when the file is not there or
+ * not complete yet. */
+typedef struct soak_snap {
+    long events, frames;
+    long timeouts, stale, bad, exceptions;
+} soak_snap;
+
+static soak_snap stats_snap(const char *path, const char *dev)
 {
+    soak_snap n = {-1, -1, -1, -1, -1, -1};
     lr_json *j;
     lr_err e = {0};
     if (lr_json_load(path, &j, &e))
-        return -1;
-    long n = -1;
-    lr_json_get_int(j, lr_json_root(j), "events", true, &n, &e);
+        return n;
+    lr_jnode root = lr_json_root(j), devs = lr_json_get(j, root, "devices");
+    lr_json_get_int(j, root, "events", true, &n.events, &e);
+    lr_json_get_int(j, root, "frames", true, &n.frames, &e);
+    for (int i = 0; dev && i < lr_json_count(j, devs); i++) {
+        lr_jnode d = lr_json_at(j, devs, i);
+        if (!lr_json_str_eq(j, lr_json_get(j, d, "name"), dev))
+            continue;
+        lr_jnode mb = lr_json_get(j, d, "modbus");
+        lr_json_get_int(j, mb, "timeouts", true, &n.timeouts, &e);
+        lr_json_get_int(j, mb, "stale", true, &n.stale, &e);
+        lr_json_get_int(j, mb, "bad_responses", true, &n.bad, &e);
+        lr_json_get_int(j, mb, "exceptions", true, &n.exceptions, &e);
+    }
     lr_json_destroy(j);
     return n;
 }
 
-/* A knob spun fast for long: build/bin/lamprig (no sanitizer: its own allocator's footprint)
- * with a sim script of 20 absolute moves per millisecond, looping (about 19000 events/s at
- * 70 frames/s on the 2-core machine), the preview view at 32x24 and a stats write every
- * 0.2 s. After a 5 s warm-up (the event log of 4096 full, the heap at its size), over a
- * window of 25 s (LAMPRIG_SOAK_S, if shorter): at least 1000 events/s; VmRSS grows by at most
- * 576 KiB: what may still grow is the frame log filling (4096 records of about 80 bytes,
- * 320 KiB) and 256 KiB of heap and page slack; the latencies kept (8 bytes an event, 3.8 MB
- * in the window) and their sorted copy at each write grew it before. Descriptors: the same
- * floor at both ends. */
+static long stats_events(const char *path) { return stats_snap(path, NULL).events; }
+
+/* The misbehaving Modbus peers of the fast soak (tests/support/modbus_rogue.h), one device
+ * each: the rig polls and writes all of them the whole time. */
+static const struct {
+    lr_test_rogue_mode mode;
+    const char *name;
+    bool lamp;
+} rogue_peers[] = {
+    /* An answer to a read a byte per 45 ms: each poll ends at timeout_ms. No lamp: a level
+     * pending is sent before any poll, and the knob keeps one pending, so a lamp here would
+     * keep the reads (the only requests this peer drips on) from being sent. */
+    {LR_ROGUE_DRIP, "drip", false},
+    {LR_ROGUE_LATE, "late", true},     /* every answer after the previous request's: stale */
+    {LR_ROGUE_RANDOM, "random", true}, /* wrong unit, wrong function, exceptions, good ones */
+    {LR_ROGUE_CLOSE, "close", true},   /* accepts and closes: a reconnect every retry */
+};
+#define N_ROGUES ((int)(sizeof rogue_peers / sizeof rogue_peers[0]))
+
+/* A knob spun fast for long, beside misbehaving Modbus peers: build/bin/lamprig (no sanitizer:
+ * its own allocator's footprint) with a sim script of 20 absolute moves per millisecond,
+ * looping (about 19000 events/s at 70 frames/s on the 2-core machine), four modbus devices
+ * on loopback, each a peer of tests/support/modbus_rogue.c (DRIP, LATE, RANDOM, CLOSE; polls
+ * every 20 ms, answers bounded at 200 ms, reconnects after 50..200 ms), the knob's binding
+ * written to the lamp driver of the last three, the preview view at 32x24 and a stats
+ * write every 0.2 s. After a 5 s warm-up (the event log of 4096 full, the heap at its size,
+ * every peer connected to), over a window of 15 s (LAMPRIG_SOAK_S, if shorter):
+ * - at least 1000 events/s;
+ * - frames keep coming: at least 5 a second, a twentieth of the 100 fps cap (and of the
+ *   measured ~70, a fourteenth: room for a loaded CI machine); a loop held by the drip (the
+ *   defect this guards against: 2 frames in 15 s) gives a fraction of one;
+ * - VmRSS grows by at most 576 KiB: what may still grow is the frame log filling (4096
+ *   records of about 80 bytes, 320 KiB) and 256 KiB of heap and page slack; the latencies
+ *   kept (8 bytes an event, 2.3 MB in the window) and their sorted copy at each write grew it
+ *   before, and so would anything kept per Modbus answer, timeout or reconnect;
+ * - descriptors: the floor at the end within 2 of the floor at the start. Two devices (drip,
+ *   close) drop and reopen their socket all the time, so each may hold one more or one fewer
+ *   at a reading; the close peer is reconnected at least 10 times in the window (measured:
+ *   one every 200 ms, the retry bound), so a descriptor lost per reconnect shows as 10 or
+ *   more;
+ * and every peer was asked during the window, and at exit the link counters show each one's
+ * fault (timeouts, stale answers, bad answers or exceptions). */
 static void test_soak_fast_events(void **state)
 {
     (void)state;
     const char *env = getenv("LAMPRIG_SOAK_S");
-    double window = env && atof(env) > 0 && atof(env) < 25 ? atof(env) : 25;
+    double window = env && atof(env) > 0 && atof(env) < 15 ? atof(env) : 15;
+    lr_test_rogue *peer[N_ROGUES];
+    char devices[4096];
+    size_t dlen = 0;
+    for (int i = 0; i < N_ROGUES; i++) {
+        peer[i] = lr_test_rogue_start(rogue_peers[i].mode, 0);
+        lr_test_rogue_set_reg(peer[i], 0, 500);
+        dlen += (size_t)snprintf(
+            devices + dlen, sizeof devices - dlen,
+            ",\n  {\"type\": \"modbus\", \"name\": \"%s\", \"url\": \"tcp://127.0.0.1:%d\",\n"
+            "   \"poll_ms\": 20, \"timeout_ms\": 200, \"retry_min_ms\": 50, "
+            "\"retry_max_ms\": 200,\n"
+            "   \"inputs\": [{\"control\": \"panel\", \"unit\": 1, \"reg\": 0}]%s}",
+            rogue_peers[i].name, lr_test_rogue_port(peer[i]),
+            rogue_peers[i].lamp ? ",\n   \"lamp\": {\"unit\": 2, \"reg\": 0}" : "");
+    }
     char *dir = lr_test_tmpdir();
     char script[8192] = "";
     size_t len = 0;
@@ -568,52 +638,72 @@ static void test_soak_fast_events(void **state)
             len += (size_t)snprintf(script + len, sizeof script - len,
                                     "0.%03d knob1 absolute %.2f\\n", ms,
                                     ((ms * 20 + k) % 101) / 100.0);
-    char text[12288];
+    char text[16384];
     snprintf(text, sizeof text,
              "{\"scene\": \"%s/scenes/candle.json\",\n"
-             " \"devices\": [{\"type\": \"sim\", \"loop\": true, \"text\": \"%s0.010 end\\n\"}],\n"
+             " \"devices\": [{\"type\": \"sim\", \"loop\": true, \"text\": \"%s0.010 end\\n\"}%s],\n"
              " \"controls\": [{\"control\": \"knob1\", \"param\": "
-             "\"lights[0].flicker.amplitude\", \"range\": [0, 1]}],\n"
+             "\"lights[0].flicker.amplitude\", \"range\": [0, 1], \"lamp\": true}],\n"
              " \"output\": {\"width\": 32, \"height\": 24, \"fps\": 100, \"renderer\": "
              "\"preview\"},\n"
              " \"stats\": {\"period_s\": 0.2}}\n",
-             LR_SOURCE_CONFIGS, script);
+             LR_SOURCE_CONFIGS, script, devices);
     char *cfg = lr_test_write(dir, "rig.json", text, (size_t)-1);
     char *stats = lr_test_path(dir, "stats.json");
     char *err = lr_test_path(dir, "stderr.txt");
     char *argv[] = {LAMPRIG, "run", "--config", cfg, "--headless", "--stats", stats, NULL};
     pid_t pid = spawn(argv, err);
     int64_t t0 = lr_now_ns();
-    while (lr_now_ns() - t0 < 5000 * MS || stats_events(stats) < 8192) {
+    bool all_asked = false;
+    while (lr_now_ns() - t0 < 5000 * MS || stats_events(stats) < 8192 || !all_asked) {
         if (waitpid(pid, NULL, WNOHANG) != 0 || lr_now_ns() - t0 > 60000 * MS) {
             print_file(err);
-            fail_msg("lamprig exited or logged under 8192 events in 60 s");
+            fail_msg("lamprig exited, or logged under 8192 events or left a peer unasked in "
+                     "60 s");
         }
         usleep(100000);
+        all_asked = true;
+        for (int i = 0; i < N_ROGUES; i++)
+            all_asked &= lr_test_rogue_accepted(peer[i]) > 0;
     }
-    long rss0 = lr_test_rss_kib(pid), ev0 = stats_events(stats);
-    int fd0 = fd_floor(pid);
+    soak_snap s0 = stats_snap(stats, NULL);
+    long rss0 = lr_test_rss_kib(pid);
+    int fd0 = fd_floor(pid), req0[N_ROGUES], acc0 = lr_test_rogue_accepted(peer[3]);
+    for (int i = 0; i < N_ROGUES; i++)
+        req0[i] = lr_test_rogue_requests(peer[i]);
     int64_t t1 = lr_now_ns();
     while (lr_now_ns() - t1 < (int64_t)(window * 1e9)) {
         assert_int_equal(waitpid(pid, NULL, WNOHANG), 0);
         usleep(100000);
     }
-    long rss1 = lr_test_rss_kib(pid), ev1 = stats_events(stats);
-    int fd1 = fd_floor(pid);
+    long rss1 = lr_test_rss_kib(pid);
+    soak_snap s1 = stats_snap(stats, NULL);
+    int fd1 = fd_floor(pid), reconnects = lr_test_rogue_accepted(peer[3]) - acc0;
     double secs = (double)(lr_now_ns() - t1) * 1e-9;
+    int asked[N_ROGUES];
+    for (int i = 0; i < N_ROGUES; i++)
+        asked[i] = lr_test_rogue_requests(peer[i]) - req0[i];
     assert_int_equal(kill(pid, SIGTERM), 0);
     int st = reap(pid);
-    print_message("fast soak: %.0f events/s over %.1f s, VmRSS %ld -> %ld KiB (%+ld), fds %d -> "
-                  "%d\n",
-                  (double)(ev1 - ev0) / secs, secs, rss0, rss1, rss1 - rss0, fd0, fd1);
+    print_message("fast soak beside %d rogue Modbus peers: %.0f events/s, %.1f frames/s over "
+                  "%.1f s, VmRSS %ld -> %ld KiB (%+ld), fds %d -> %d, %d reconnects of the "
+                  "closing peer, requests drip %d late %d random %d\n",
+                  N_ROGUES, (double)(s1.events - s0.events) / secs,
+                  (double)(s1.frames - s0.frames) / secs, secs, rss0, rss1, rss1 - rss0, fd0,
+                  fd1, reconnects, asked[0], asked[1], asked[2]);
     assert_true(WIFEXITED(st));
     assert_int_equal(WEXITSTATUS(st), 0);
-    assert_true(rss0 > 0 && rss1 > 0 && fd0 > 0);
-    assert_true((double)(ev1 - ev0) >= 1000 * secs);
+    assert_true(rss0 > 0 && rss1 > 0 && fd0 > 0 && s0.events >= 0 && s1.events >= 0);
+    assert_true((double)(s1.events - s0.events) >= 1000 * secs);
+    assert_true((double)(s1.frames - s0.frames) >= 5 * secs);
     assert_true(rss1 - rss0 <= 576);
-    assert_int_equal(fd1, fd0);
+    assert_true(fd1 >= fd0 - 2 && fd1 <= fd0 + 2);
+    assert_true(reconnects >= 10);
+    for (int i = 0; i < 3; i++) /* the close peer is never asked: it hangs up first */
+        assert_true(asked[i] > 0);
 
-    /* The file at exit: every event in the latency count, the log its last 4096. */
+    /* The file at exit: every event in the latency count, the log its last 4096; each peer's
+     * fault in its device's counters. */
     lr_json *j;
     lr_err e = {0};
     assert_int_equal(lr_json_load(stats, &j, &e), LR_OK);
@@ -627,10 +717,20 @@ static void test_soak_fast_events(void **state)
     assert_int_equal(lr_json_get_number(j, lat, "p99", true, &p99, &e), LR_OK);
     assert_int_equal(lr_json_get_number(j, lat, "max", true, &max, &e), LR_OK);
     assert_int_equal(n, events);
-    assert_true(events >= ev1);
+    assert_true(events >= s1.events);
     assert_true(med >= 0 && p99 >= med && max >= p99);
     assert_int_equal(lr_json_count(j, lr_json_get(j, root, "event_log")), 4096);
     lr_json_destroy(j);
+    soak_snap drip = stats_snap(stats, "drip"), late = stats_snap(stats, "late"),
+              rnd = stats_snap(stats, "random");
+    print_message("at exit: drip %ld timeouts, late %ld stale, random %ld bad + %ld "
+                  "exceptions\n",
+                  drip.timeouts, late.stale, rnd.bad, rnd.exceptions);
+    assert_true(drip.timeouts > 0);
+    assert_true(late.stale > 0);
+    assert_true(rnd.bad > 0 && rnd.exceptions > 0);
+    for (int i = 0; i < N_ROGUES; i++)
+        lr_test_rogue_free(peer[i]);
     free(cfg);
     free(stats);
     free(err);

@@ -3,6 +3,7 @@
 #include "tests/support/modbus_rogue.h"
 
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <pthread.h>
@@ -201,7 +202,7 @@ static void *thread(void *arg)
         if (p[0].revents)
             break;
         if (p[1].revents & POLLIN) {
-            int c = accept(r->listen_fd, NULL, NULL);
+            int c = accept4(r->listen_fd, NULL, NULL, SOCK_CLOEXEC);
             if (c >= 0) {
                 pthread_mutex_lock(&r->mu);
                 r->accepted++;
@@ -235,7 +236,9 @@ lr_test_rogue *lr_test_rogue_start(lr_test_rogue_mode mode, int drip_ms)
     r->drip_ms = drip_ms > 0 ? drip_ms : 45;
     r->client = -1;
     pthread_mutex_init(&r->mu, NULL);
-    if (pipe(r->stop) != 0)
+    /* Close-on-exec, like every descriptor here: a test that forks the rig after starting a
+     * peer must not hand the peer's descriptors to the rig (its descriptor count is watched). */
+    if (pipe2(r->stop, O_CLOEXEC) != 0)
         die("pipe");
     r->listen_fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
     if (r->listen_fd < 0)

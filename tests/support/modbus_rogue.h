@@ -10,6 +10,9 @@
  *  RANDOM  answers carry the right transaction id but cycle through a wrong unit, a wrong
  *          function, an exception (codes 1..11) and a good answer, each with varying numbers
  *  CLOSE   accepts a connection and closes it at once
+ *
+ * Its descriptors are close-on-exec: a test may start peers and then fork and exec the rig
+ * (test_fw_loop's fast soak), whose descriptor count it watches.
  */
 #ifndef LR_TEST_MODBUS_ROGUE_H
 #define LR_TEST_MODBUS_ROGUE_H
