@@ -953,8 +953,10 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             fds[nf] = (struct pollfd){r->sigfd, POLLIN, 0};
             owner[nf++] = -1;
         }
-        if (lr_rig_view_event_fd(r->view) >= 0) {
-            /* The worker published images: wake to show them (lr_rig_view_frame drains it). */
+        /* The worker's publications wake the loop only while no frame is wanted: once one is,
+         * the frame deadline below wakes it, and the descriptor (drained by the frame) would
+         * otherwise stay readable and spin the loop until that deadline. */
+        if (lr_rig_view_event_fd(r->view) >= 0 && !frame_wanted(r, now)) {
             fds[nf] = (struct pollfd){lr_rig_view_event_fd(r->view), POLLIN, 0};
             owner[nf++] = -3;
         }
