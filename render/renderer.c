@@ -97,7 +97,7 @@ static lr_pass_ctx pass_ctx(const lr_renderer *r)
 static int check_programs(lr_renderer *r, lr_err *e)
 {
     lr_program *ps[] = {r->prog.surface, r->prog.depth, r->prog.radiosity, r->prog.vpl,
-                        r->prog.obj,     r->prog.recv[0], r->prog.blit,    r->prog.irr,
+                        r->prog.obj,     r->prog.recv[0], r->prog.irr,
                         r->prog.area,
                         r->prog.cache,   r->prog.obj_cached[0], r->prog.obj_cached[1],
                         r->prog.obj_cached[2], r->prog.obj_cached[3], r->prog.recv[1],
@@ -413,7 +413,6 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
         (rc = program(r, "radiosity.vert", "radiosity.frag", &pr->radiosity, e)) ||
         (rc = program(r, "fullscreen.vert", "vpl.frag", &pr->vpl, e)) ||
         (rc = program(r, "compose_object.vert", "compose_object.frag", &pr->obj, e)) ||
-        (rc = program(r, "fullscreen.vert", "blit.frag", &pr->blit, e)) ||
         (rc = program(r, "fullscreen.vert", "irradiance.frag", &pr->irr, e)) ||
         (rc = program(r, "fullscreen.vert", "area_direct.frag", &pr->area, e)) ||
         (rc = program(r, "fullscreen.vert", "surface_cache.frag", &pr->cache, e)))
@@ -466,7 +465,7 @@ void lr_renderer_destroy(lr_renderer *r)
     lr_pass_objects_free(&r->objs);
     const lr_pass_programs *pr = &r->prog;
     lr_program *ps[] = {pr->surface,       pr->depth,         pr->radiosity,     pr->vpl,
-                        pr->obj,           pr->recv[0],       pr->blit,          pr->irr,
+                        pr->obj,           pr->recv[0],       pr->irr,
                         pr->cache,         pr->obj_cached[0], pr->obj_cached[1],
                         pr->obj_cached[2], pr->obj_cached[3], pr->area,
                         pr->recv[1],       pr->recv[2],       pr->recv[3]};
@@ -477,17 +476,12 @@ void lr_renderer_destroy(lr_renderer *r)
 }
 
 /* Whether light l's intensity changes with time. */
-static bool flickers(const lr_light *l)
-{
-    return l->flicker.amplitude > 0.0 && l->intensity > 0.0;
-}
-
 void lr_renderer_set_time(lr_renderer *r, double t_seconds)
 {
     if (!isfinite(t_seconds) || (r->clock_set && t_seconds == r->time_s))
         return;
     for (int l = 0; l < lr_scene_light_count(r->scene); l++)
-        if (flickers(lr_scene_light_at(r->scene, l)))
+        if (lr_light_flickers(lr_scene_light_at(r->scene, l)))
             r->dirty |= LR_DIRTY_INTENSITY; /* the blend alone (transport is linear) */
     r->clock_set = true;
     r->time_s = t_seconds;
@@ -655,22 +649,9 @@ int lr_renderer_read_rgba8(lr_renderer *r, unsigned char *out, lr_err *e)
 
 int lr_renderer_present(lr_renderer *r, lr_err *e)
 {
-    int w, h;
     if (!r->blend)
         return lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
-    lr_gl_size(r->gl, &w, &h);
-    if (w > 0 && h > 0) {
-        lr_gl_bind_default(r->gl);
-        glDisable(GL_DEPTH_TEST);
-        glDisable(GL_BLEND);
-        glUseProgram(lr_program_id(r->prog.blit));
-        lr_passes_bind_tex(r->prog.blit, "u_src", 0, lr_blend_ldr(r->blend));
-        int rc = lr_program_check(r->prog.blit, e);
-        if (rc)
-            return rc;
-        lr_gl_draw_fullscreen(r->gl);
-    }
-    return lr_gl_present(r->gl, e);
+    return lr_blend_present(r->blend, e);
 }
 
 const lr_tex *lr_renderer_images(const lr_renderer *r, int *n, float *scale)

@@ -956,7 +956,8 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
         /* The worker's publications wake the loop only while no frame is wanted: once one is,
          * the frame deadline below wakes it, and the descriptor (drained by the frame) would
          * otherwise stay readable and spin the loop until that deadline. */
-        if (lr_rig_view_event_fd(r->view) >= 0 && !frame_wanted(r, now)) {
+        bool want = frame_wanted(r, now);
+        if (lr_rig_view_event_fd(r->view) >= 0 && !want) {
             fds[nf] = (struct pollfd){lr_rig_view_event_fd(r->view), POLLIN, 0};
             owner[nf++] = -3;
         }
@@ -975,7 +976,6 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             if (d < t)
                 t = d;
         }
-        bool want = frame_wanted(r, now);
         if (want && !(r->kms && lr_gl_flip_pending(r->gl)) && r->next_frame_ns < t)
             t = r->next_frame_ns;
         if (r->fading && fade_wake(r, now) < t)

@@ -65,14 +65,14 @@ struct lr_async {
     char shader_dir[512];
     lr_shader_defines defines;
     lr_blend *blend;
-    lr_program *blit;
     set_list rec; /* journal entries since the last commit */
     bool scene_detached; /* lr_async_stop: the caller's scene may be gone */
     uint64_t batches;
     bool blend_due, clock_set;
     double time_s;
     int efd;
-    char preview[LR_ASYNC_MAX_PREVIEW][256];
+    char preview_key[LR_ASYNC_MAX_PREVIEW][128];
+    char preview_value[LR_ASYNC_MAX_PREVIEW][128];
     int n_preview;
     unsigned no_preview_dirty;
     bool preview_always;
@@ -291,14 +291,10 @@ static int preview_frame(lr_async *a, uint64_t batch, unsigned *dirty, lr_err *e
     char old[LR_ASYNC_MAX_PREVIEW][256];
     int rc = LR_OK, applied = 0;
     unsigned d = *dirty;
-    for (int i = 0; i < a->n_preview && !rc; i++) {
-        char key[256];
-        const char *eq = strchr(a->preview[i], '=');
-        snprintf(key, sizeof key, "%.*s", (int)(eq - a->preview[i]), a->preview[i]);
-        if (!(rc = lr_scene_get(a->wscene, key, old[i], sizeof old[i], e)) &&
-            !(rc = lr_scene_set(a->wscene, key, eq + 1, &d, e)))
+    for (int i = 0; i < a->n_preview && !rc; i++)
+        if (!(rc = lr_scene_get(a->wscene, a->preview_key[i], old[i], sizeof old[i], e)) &&
+            !(rc = lr_scene_set(a->wscene, a->preview_key[i], a->preview_value[i], &d, e)))
             applied = i + 1;
-    }
     lr_frame_stats st;
     /* An assignment the copy refuses now (a preview model outside what the new material
      * allows): no preview this time, the refined image comes as usual. */
@@ -314,11 +310,8 @@ static int preview_frame(lr_async *a, uint64_t batch, unsigned *dirty, lr_err *e
     /* Restored whatever happened: the copy must stay equal to the caller's scene. */
     unsigned back = 0;
     for (int i = applied - 1; i >= 0; i--) {
-        char key[256];
-        const char *eq = strchr(a->preview[i], '=');
-        snprintf(key, sizeof key, "%.*s", (int)(eq - a->preview[i]), a->preview[i]);
         lr_err re = {0};
-        int rrc = lr_scene_set(a->wscene, key, old[i], &back, &re);
+        int rrc = lr_scene_set(a->wscene, a->preview_key[i], old[i], &back, &re);
         if (rrc && !rc) {
             rc = rrc;
             *e = re;
@@ -491,12 +484,7 @@ static int caller_programs(lr_async *a, lr_err *e)
     lr_passes_defines(&a->defines);
     lr_blend_desc bd = {.gl = a->gl, .width = a->width, .height = a->height,
                         .shader_dir = a->shader_dir, .defines = a->defines.list};
-    int rc = lr_blend_create(&bd, &a->blend, e);
-    if (rc)
-        return rc;
-    lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "blit.frag",
-                          .dir = a->shader_dir, .defines = a->defines.list};
-    return lr_program_create(&pd, &a->blit, e);
+    return lr_blend_create(&bd, &a->blend, e);
 }
 
 static int check_preview(lr_async *a, const lr_async_desc *d, lr_err *e)
@@ -504,15 +492,16 @@ static int check_preview(lr_async *a, const lr_async_desc *d, lr_err *e)
     for (int i = 0; i < d->n_preview; i++) {
         const char *p = d->preview[i];
         const char *eq = p ? strchr(p, '=') : NULL;
-        if (!eq || eq == p || strlen(p) >= sizeof a->preview[0])
+        if (!eq || eq == p || (size_t)(eq - p) >= sizeof a->preview_key[0] ||
+            strlen(eq + 1) >= sizeof a->preview_value[0])
             return lr_err_set(e, LR_EINVAL, "async: preview '%s': expected key=value",
                               p ? p : "(null)");
-        char key[256], cur[256];
-        snprintf(key, sizeof key, "%.*s", (int)(eq - p), p);
-        int rc = lr_scene_get(d->scene, key, cur, sizeof cur, e);
+        snprintf(a->preview_key[i], sizeof a->preview_key[i], "%.*s", (int)(eq - p), p);
+        snprintf(a->preview_value[i], sizeof a->preview_value[i], "%s", eq + 1);
+        char cur[256];
+        int rc = lr_scene_get(d->scene, a->preview_key[i], cur, sizeof cur, e);
         if (rc)
             return lr_err_prefix(e, "async: preview");
-        snprintf(a->preview[i], sizeof a->preview[i], "%s", p);
     }
     a->n_preview = d->n_preview;
     return LR_OK;
@@ -602,10 +591,9 @@ void lr_async_destroy(lr_async *a)
     if (a->scene && !a->scene_detached)
         lr_scene_set_journal(a->scene, NULL);
     /* The caller's side first: after this nothing here reads the slots. */
-    if (a->blend || a->blit)
+    if (a->blend)
         glFinish();
     lr_blend_destroy(a->blend);
-    lr_program_destroy(a->blit);
     if (a->joinable) {
         pthread_mutex_lock(&a->mu);
         a->stop = true;
@@ -642,17 +630,12 @@ uint64_t lr_async_commit(lr_async *a, unsigned dirty)
     return (dirty & TRANSPORT_DIRTY) ? b : 0;
 }
 
-static bool flickers(const lr_light *l)
-{
-    return l->flicker.amplitude > 0.0 && l->intensity > 0.0;
-}
-
 void lr_async_set_time(lr_async *a, double t)
 {
     if (!isfinite(t) || (a->clock_set && t == a->time_s))
         return;
     for (int l = 0; l < lr_scene_light_count(a->scene); l++)
-        if (flickers(lr_scene_light_at(a->scene, l)))
+        if (lr_light_flickers(lr_scene_light_at(a->scene, l)))
             a->blend_due = true;
     a->clock_set = true;
     a->time_s = t;
@@ -823,23 +806,7 @@ int lr_async_read_hdr(lr_async *a, float *rgb, lr_err *e)
     return lr_blend_read_hdr(a->blend, rgb, e);
 }
 
-int lr_async_present(lr_async *a, lr_err *e)
-{
-    int w, h;
-    lr_gl_size(a->gl, &w, &h);
-    if (w > 0 && h > 0) {
-        lr_gl_bind_default(a->gl);
-        glDisable(GL_DEPTH_TEST);
-        glDisable(GL_BLEND);
-        glUseProgram(lr_program_id(a->blit));
-        lr_passes_bind_tex(a->blit, "u_src", 0, lr_blend_ldr(a->blend));
-        int rc = lr_program_check(a->blit, e);
-        if (rc)
-            return rc;
-        lr_gl_draw_fullscreen(a->gl);
-    }
-    return lr_gl_present(a->gl, e);
-}
+int lr_async_present(lr_async *a, lr_err *e) { return lr_blend_present(a->blend, e); }
 
 void lr_async_size(const lr_async *a, int *width, int *height)
 {

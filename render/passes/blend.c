@@ -8,6 +8,7 @@
 
 #include "render/gl/shader.h"
 #include "render/passes/defines.h"
+#include "render/passes/passes.h"
 
 struct lr_blend {
     lr_gl *gl;
@@ -15,6 +16,7 @@ struct lr_blend {
      * non-zero weight (LR_BLEND_OP, LR_BLEND_N), built on first use: a candle's frame reads
      * one image and runs no per-pixel loop or branch. */
     lr_program *prog[LR_BLEND_OPS + 1][LR_BLEND_MAX_IMAGES + 1];
+    lr_program *blit; /* lr_blend_present's copy to the default framebuffer, built on use */
     const char *shader_dir;
     const char *const *defines;
     lr_tex *ldr, *hdr;
@@ -72,6 +74,7 @@ void lr_blend_destroy(lr_blend *b)
     for (int op = 0; op <= LR_BLEND_OPS; op++)
         for (int n = 0; n <= LR_BLEND_MAX_IMAGES; n++)
             lr_program_destroy(b->prog[op][n]);
+    lr_program_destroy(b->blit);
     free(b);
 }
 
@@ -224,4 +227,29 @@ int lr_blend_read_rgba8(lr_blend *b, unsigned char *out, lr_err *e)
         }
     free(rgba);
     return rc;
+}
+
+int lr_blend_present(lr_blend *b, lr_err *e)
+{
+    int w, h;
+    lr_gl_size(b->gl, &w, &h);
+    if (w > 0 && h > 0) {
+        if (!b->blit) {
+            lr_program_desc pd = {.vertex = "fullscreen.vert", .fragment = "blit.frag",
+                                  .dir = b->shader_dir, .defines = b->defines};
+            int rc = lr_program_create(&pd, &b->blit, e);
+            if (rc)
+                return rc;
+        }
+        lr_gl_bind_default(b->gl);
+        glDisable(GL_DEPTH_TEST);
+        glDisable(GL_BLEND);
+        glUseProgram(lr_program_id(b->blit));
+        lr_passes_bind_tex(b->blit, "u_src", 0, b->ldr);
+        int rc = lr_program_check(b->blit, e);
+        if (rc)
+            return rc;
+        lr_gl_draw_fullscreen(b->gl);
+    }
+    return lr_gl_present(b->gl, e);
 }

@@ -54,6 +54,10 @@ int lr_blend_hdr(lr_blend *b, lr_fb **out, lr_err *e);
 int lr_blend_read_hdr(lr_blend *b, float *rgb, lr_err *e);
 int lr_blend_read_rgba8(lr_blend *b, unsigned char *rgba, lr_err *e);
 
+/* Draws the tone-mapped output to the context's default framebuffer (the projector; nothing
+ * to draw on surfaceless) and presents it (lr_gl_present). */
+int lr_blend_present(lr_blend *b, lr_err *e);
+
 lr_tex *lr_blend_ldr(const lr_blend *b);
 lr_fb *lr_blend_ldr_fb(const lr_blend *b);
 

@@ -73,7 +73,7 @@ typedef struct lr_pass_objects {
  * the uniforms its program declares: another name is an error at the end of the pass
  * (lr_program_check). */
 typedef struct lr_pass_programs {
-    lr_program *surface, *depth, *radiosity, *vpl, *obj, *blit, *irr;
+    lr_program *surface, *depth, *radiosity, *vpl, *obj, *irr;
     /* compose_receiver.frag, [n - 1] for n lights (LR_RECV_LIGHTS) */
     lr_program *recv[LR_MAX_LIGHTS];
     lr_program *area; /* area lights' direct grid (area_direct.c) */

@@ -68,6 +68,11 @@ static double wobble(const lr_flicker *f, double t, unsigned channel)
     return s;
 }
 
+bool lr_light_flickers(const lr_light *l)
+{
+    return l->flicker.amplitude > 0.0 && l->intensity > 0.0;
+}
+
 void lr_light_flicker_at(const lr_light *l, double t, double *scale, lr_vec3 *offset)
 {
     const lr_flicker *f = &l->flicker;

@@ -164,6 +164,9 @@ double lr_light_shape(const lr_light *l, lr_vec3 dir);
  * (mm). Deterministic in (seed, t): a sum of three sines at incommensurate multiples of
  * frequency_hz with seed-derived phases, so that replays and tests see the same flame. */
 void lr_light_flicker_at(const lr_light *l, double t, double *scale, lr_vec3 *offset);
+/* Whether the light's intensity changes with time (flicker amplitude > 0 and a non-zero
+ * intensity): a renderer's new clock then wants a blend. */
+bool lr_light_flickers(const lr_light *l);
 /* Area lights: the unit normal of the emitting side and the area (mm^2; 0 for others). */
 lr_vec3 lr_light_area_normal(const lr_light *l);
 double lr_light_area(const lr_light *l);
