@@ -37,6 +37,7 @@ struct lr_renderer {
     char info[256];           /* renderer string for the stats */
     char shader_dir[512];
     lr_shader_defines defines; /* lr_passes_defines: every program is built with them */
+    const lr_cancel *cancel;   /* lr_renderer_set_cancel; NULL: never */
     lr_timer *timer;
     lr_pass_programs prog;
 
@@ -83,7 +84,8 @@ static lr_pass_ctx pass_ctx(const lr_renderer *r)
                      .objs = &r->objs, .prog = &r->prog, .shader_dir = r->shader_dir,
                      .width = r->width, .height = r->height, .n_lights = r->n_lights,
                      .map_format = r->map_format, .seed = r->seed, .no_vpl = r->no_vpl,
-                     .vpl_visibility = r->vpl_visibility || r->rs.vpl_visibility};
+                     .vpl_visibility = r->vpl_visibility || r->rs.vpl_visibility,
+                     .cancel = r->cancel};
     for (int l = 0; l < r->n_lights && l < LR_MAX_LIGHTS; l++) {
         lr_light_rgb(lr_scene_light_at(r->scene, l), c.I[l]);
         double f = lr_renderer_flicker(r, l);
@@ -602,6 +604,10 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
         const lr_pass_desc *p = &pass_table[i];
         if (!(passes & p->bit))
             continue;
+        /* A frame cut short keeps r->dirty as it came in: the next frame redoes every pass
+         * this one would have run (the passes' own caches keep what was complete). */
+        if ((rc = lr_cancel_check(r->cancel, "renderer: frame", e)))
+            return rc;
         if ((rc = lr_timer_begin(r->timer, p->name, e)))
             return rc;
         rc = p->run(r, dirty, e);
@@ -665,6 +671,8 @@ const lr_tex *lr_renderer_images(const lr_renderer *r, int *n, float *scale)
         scale[l] = r->img.scale[l];
     return r->img.images;
 }
+
+void lr_renderer_set_cancel(lr_renderer *r, const lr_cancel *cancel) { r->cancel = cancel; }
 
 const char *lr_renderer_info(const lr_renderer *r)
 {

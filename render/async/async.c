@@ -89,6 +89,11 @@ struct lr_async {
     uint64_t n_stage[LR_ASYNC_FINAL + 1]; /* publications per stage */
     int err_rc;
     lr_err err;
+    /* The renderer's token (lr_renderer_set_cancel): requested by a stop, and by a transport
+     * batch while `cancellable` (the worker's frame then solves a stale state). */
+    lr_cancel cancel;
+    bool cancellable;
+    uint64_t n_cancelled; /* worker frames cut short (by a newer batch or a stop) */
 
     /* ---- the worker's thread ---- */
     pthread_t th;
@@ -321,6 +326,29 @@ static int preview_frame(lr_async *a, uint64_t batch, unsigned *dirty, lr_err *e
     return rc;
 }
 
+/* Starts a worker frame: false when it must not start (a stop; or, for a frame a newer batch
+ * may cut, that batch already waits -- the loop takes it first). The token is reset here,
+ * under the lock commit requests it under, so a request meant for an earlier frame never
+ * cuts this one, and a stop's is never cleared. */
+static bool frame_begin(lr_async *a, bool cancellable)
+{
+    pthread_mutex_lock(&a->mu);
+    bool go = !a->stop && !(cancellable && a->queue.n > 0);
+    if (go) {
+        lr_cancel_reset(&a->cancel);
+        a->cancellable = cancellable;
+    }
+    pthread_mutex_unlock(&a->mu);
+    return go;
+}
+
+static void frame_end(lr_async *a)
+{
+    pthread_mutex_lock(&a->mu);
+    a->cancellable = false;
+    pthread_mutex_unlock(&a->mu);
+}
+
 static void *worker_main(void *arg)
 {
     lr_async *a = arg;
@@ -353,9 +381,15 @@ static void *worker_main(void *arg)
                            .height = a->height, .no_vpl = a->no_vpl};
     if ((rc = lr_renderer_create(&rd, &a->r, &e)))
         worker_fail(a, rc, &e);
+    else
+        lr_renderer_set_cancel(a->r, &a->cancel);
     set_list batch = {0};
     unsigned dirty = LR_DIRTY_SETTINGS; /* the first frame: everything */
     bool converged = false, first = true;
+    /* A frame was cut for a newer batch and nothing has been published since: the next full
+     * frame runs to its end whatever arrives, so that a knob turned without rest on a scene
+     * without a preview stage still shows images (one per full frame, as before cutting). */
+    bool cut_unshown = false;
     uint64_t applied = 0;
     while (a->r) {
         pthread_mutex_lock(&a->mu);
@@ -402,9 +436,23 @@ static void *worker_main(void *arg)
         if (a->n_preview && worth &&
             (first || (heavy && (got & ~a->no_preview_dirty & TRANSPORT_DIRTY)))) {
             unsigned back = dirty;
+            if (!frame_begin(a, false))
+                continue; /* a stop */
             double t0 = now_ms();
             rc = preview_frame(a, applied, &back, &e);
+            frame_end(a);
             a->preview_ms = now_ms() - t0;
+            if (rc == LR_ECANCELED) {
+                pthread_mutex_lock(&a->mu);
+                a->n_cancelled++;
+                pthread_mutex_unlock(&a->mu);
+                converged = false; /* a stop: the loop's top ends it */
+                dirty = back;
+                lr_renderer_invalidate(a->r, back);
+                continue;
+            }
+            if (!rc)
+                cut_unshown = false;
             if (rc) {
                 worker_fail(a, rc, &e);
                 converged = true; /* wait for the next change */
@@ -426,8 +474,25 @@ static void *worker_main(void *arg)
         }
         first = false;
         lr_frame_stats st;
+        /* A newer batch arriving during this frame cuts it (lr_async_commit), unless the last
+         * cut one left nothing shown. */
+        if (!frame_begin(a, !cut_unshown)) {
+            converged = false; /* a stop, or a newer batch waits: taken at the loop's top */
+            continue;
+        }
         double t0 = now_ms();
         rc = lr_renderer_frame(a->r, &st, &e);
+        frame_end(a);
+        if (rc == LR_ECANCELED) {
+            /* The renderer kept everything due; the newer batch (or the stop) is taken at the
+             * loop's top. */
+            pthread_mutex_lock(&a->mu);
+            a->n_cancelled++;
+            cut_unshown = true;
+            pthread_mutex_unlock(&a->mu);
+            converged = false;
+            continue;
+        }
         if (heavy && !rc)
             a->full_ms = now_ms() - t0;
         if (rc) {
@@ -438,6 +503,8 @@ static void *worker_main(void *arg)
         }
         dirty = 0;
         converged = !lr_renderer_needs_frame(a->r);
+        if (st.passes & LR_PASS_COMPOSE)
+            cut_unshown = false;
         if ((st.passes & LR_PASS_COMPOSE) &&
             (rc = publish(a, &st, converged ? LR_ASYNC_FINAL : LR_ASYNC_REFINING, applied, &e))) {
             worker_fail(a, rc, &e);
@@ -529,6 +596,7 @@ int lr_async_create(const lr_async_desc *d, lr_async **out, lr_err *e)
     a->efd = -1;
     pthread_mutex_init(&a->mu, NULL);
     pthread_cond_init(&a->cv, NULL);
+    lr_cancel_init(&a->cancel);
     int rc = check_preview(a, d, e);
     if (!rc && (a->efd = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) < 0)
         rc = lr_err_set(e, LR_EIO, "async: eventfd: %s", strerror(errno));
@@ -571,6 +639,7 @@ void lr_async_stop(lr_async *a)
     a->scene_detached = true;
     pthread_mutex_lock(&a->mu);
     a->stop = true;
+    lr_cancel_request(&a->cancel); /* a solve under way ends at its next poll */
     pthread_cond_broadcast(&a->cv);
     pthread_mutex_unlock(&a->mu);
 }
@@ -597,6 +666,7 @@ void lr_async_destroy(lr_async *a)
     if (a->joinable) {
         pthread_mutex_lock(&a->mu);
         a->stop = true;
+        lr_cancel_request(&a->cancel);
         pthread_cond_broadcast(&a->cv);
         pthread_mutex_unlock(&a->mu);
         pthread_join(a->th, NULL);
@@ -623,6 +693,12 @@ uint64_t lr_async_commit(lr_async *a, unsigned dirty)
         a->err_rc = lr_err_set(&a->err, LR_ENOMEM, "async: a batch of changes: out of memory");
     a->queue_batch = b;
     a->busy = true;
+    /* The worker's frame solves a state this batch replaces: cut it (render/base/cancel.h),
+     * so that the new state's first image does not wait for the stale one's. */
+    if ((dirty & TRANSPORT_DIRTY) && a->cancellable) {
+        lr_cancel_request(&a->cancel);
+        a->cancellable = false;
+    }
     pthread_cond_broadcast(&a->cv);
     pthread_mutex_unlock(&a->mu);
     /* A dimmer, colour, flicker or exposure change: the caller's next blend shows it (the
@@ -788,6 +864,24 @@ uint64_t lr_async_publications(const lr_async *a, lr_async_stage stage)
     lr_async *m = (lr_async *)a;
     pthread_mutex_lock(&m->mu);
     uint64_t n = (unsigned)stage <= LR_ASYNC_FINAL ? a->n_stage[stage] : 0;
+    pthread_mutex_unlock(&m->mu);
+    return n;
+}
+
+bool lr_async_cuttable(const lr_async *a)
+{
+    lr_async *m = (lr_async *)a;
+    pthread_mutex_lock(&m->mu);
+    bool c = a->cancellable;
+    pthread_mutex_unlock(&m->mu);
+    return c;
+}
+
+uint64_t lr_async_cancelled(const lr_async *a)
+{
+    lr_async *m = (lr_async *)a;
+    pthread_mutex_lock(&m->mu);
+    uint64_t n = a->n_cancelled;
     pthread_mutex_unlock(&m->mu);
     return n;
 }

@@ -20,6 +20,16 @@
  * before its next frame: a knob turned during a solve costs one more solve, not one per
  * event.
  *
+ * Cutting stale work (render/base/cancel.h, lr_renderer_set_cancel): a batch that changes
+ * transport while the worker runs a full (non-preview) frame cuts that frame short at its
+ * next cancellation poll (between passes, inside the grid's, translucent radiosity's and the
+ * receiver bounce's solves): its state is already stale, and the new state's preview (or
+ * full frame) starts at once instead of after it. A preview frame is never cut by a batch
+ * (it is the cheap image of a state, and the newest batch is previewed right after it), and
+ * after a cut the next full frame runs to its end if nothing was published since, so a knob
+ * turned without rest still shows a new image per full frame. lr_async_stop and destroy cut
+ * whatever runs.
+ *
  * Progressive stages: with desc.preview set (assignments such as "render.K=1"), the first
  * worker frame after a change that re-runs the maps renders with them applied (a coarse, cheap image of
  * the new state), then the worker restores the scene's own values and refines; each published
@@ -91,15 +101,15 @@ typedef struct lr_async_frame_stats {
  * frame. Errors: the shared context, the scene copy, the preview assignments; errors of the
  * renderer itself come later from lr_async_error. */
 int lr_async_create(const lr_async_desc *desc, lr_async **out, lr_err *e);
-/* Stops the worker after its current frame (a solve under way finishes first) and frees
- * everything; clears the scene's journal. */
+/* Stops the worker (a solve under way ends at its next cancellation poll, tens of ms) and
+ * frees everything; clears the scene's journal. */
 void lr_async_destroy(lr_async *a);
 
-/* Asks the worker to stop after its current frame and detaches from the caller's scene
+/* Asks the worker to stop (cutting its frame short) and detaches from the caller's scene
  * (which may then be destroyed), without waiting: a scene switch retires the old one this
  * way and destroys it once lr_async_stopped says its worker has exited (then
- * lr_async_destroy does not wait). Nothing but lr_async_stopped and lr_async_destroy may be
- * called after it. */
+ * lr_async_destroy does not wait). Nothing but lr_async_stopped, lr_async_cancelled and
+ * lr_async_destroy may be called after it. */
 void lr_async_stop(lr_async *a);
 bool lr_async_stopped(const lr_async *a);
 
@@ -135,6 +145,12 @@ int lr_async_error(lr_async *a, lr_err *e);
 
 /* How many images the worker has published at `stage` (for the stats and tests). */
 uint64_t lr_async_publications(const lr_async *a, lr_async_stage stage);
+
+/* How many worker frames were cut short, by a newer batch or a stop (for the stats and
+ * tests; may be called after lr_async_stop, once lr_async_stopped). */
+uint64_t lr_async_cancelled(const lr_async *a);
+/* True while the worker runs a full frame that a transport batch would cut (tests, stats). */
+bool lr_async_cuttable(const lr_async *a);
 
 /* Readable (POLLIN) when a publication is ready; lr_async_frame drains it. */
 int lr_async_event_fd(const lr_async *a);

@@ -62,6 +62,7 @@ const char *lr_status_str(int code)
     case LR_EGL: return "GL error";
     case LR_ETIMEOUT: return "timeout";
     case LR_EPROTO: return "protocol error";
+    case LR_ECANCELED: return "cancelled";
     default: return "unknown error";
     }
 }

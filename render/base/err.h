@@ -20,6 +20,7 @@ enum lr_status {
     LR_EGL,         /* EGL/GLES failure, shader compile/link error */
     LR_ETIMEOUT,    /* device did not answer in time */
     LR_EPROTO,      /* device answered garbage (bad CRC, exception, short report) */
+    LR_ECANCELED,   /* long work stopped early on request (render/base/cancel.h) */
 };
 
 #define LR_ERR_MSG_MAX 512

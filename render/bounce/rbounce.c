@@ -33,6 +33,7 @@ struct lr_rbounce {
     double *E;              /* n x 3 scratch */
     unsigned char *covered[LR_TR_MAX_SURFACES]; /* per receiver, R^2: texel inside a body */
     float *out[LR_TR_MAX_SURFACES][LR_TR_MAX_SLOTS]; /* per receiver, slot: R^2 x 3 */
+    const lr_cancel *cancel; /* the last update's (polled by builds and solves) */
     lr_objlight *ol;        /* render.receiver_light_on_objects: the objects' E (objlight.h) */
     double build_s, direct_s, solve_s;
 };
@@ -162,7 +163,8 @@ static int build(lr_rbounce *rb, const lr_scene *s, lr_err *e)
     char cdir[1024];
     lr_tr_settings set = {.rays_per_patch = 512,
                           .cache_dir = lr_tr_cache_default_dir(cdir, sizeof cdir),
-                          .warn = *lr_scene_warn_sink(s), .warned = &rb->cache_warned};
+                          .warn = *lr_scene_warn_sink(s), .warned = &rb->cache_warned,
+                          .cancel = rb->cancel};
     int rc = lr_tr_create(d, n, &set, &rb->tr, e);
     if (rc)
         return rc;
@@ -227,7 +229,7 @@ static int set_object_albedo(lr_rbounce *rb, const lr_scene *s, lr_err *e)
     return LR_OK;
 }
 
-int lr_rbounce_update(lr_rbounce **rbp, const lr_scene *s, lr_err *e)
+int lr_rbounce_update(lr_rbounce **rbp, const lr_scene *s, const lr_cancel *cancel, lr_err *e)
 {
     if (!rbp)
         return lr_err_set(e, LR_EINVAL, "receiver bounce: NULL handle");
@@ -245,6 +247,8 @@ int lr_rbounce_update(lr_rbounce **rbp, const lr_scene *s, lr_err *e)
             return lr_err_set(e, LR_ENOMEM, "receiver bounce: out of memory");
         *rbp = rb;
     }
+    rb->cancel = cancel;
+    lr_tr_set_cancel(rb->tr, cancel);
     double key[KEY_MAX];
     int nk = scene_key(s, key), rc;
     double t0 = now_s();

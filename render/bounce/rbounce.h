@@ -50,8 +50,10 @@ bool lr_rbounce_needed(const lr_scene *s);
 /* Creates *rb on first use; destroys it and sets *rb = NULL when not needed. Rebuilds the
  * patches and F when the objects' or receivers' geometry (or albedo) changed since the last
  * call, the direct irradiance of a light when its shape (type, position, direction, cone,
- * emitter) changed. */
-int lr_rbounce_update(lr_rbounce **rb, const lr_scene *s, lr_err *e);
+ * emitter) changed. `cancel` (NULL: never) is polled by this build and by the solves until
+ * the next update (render/base/cancel.h): LR_ECANCELED then, and the next update or solve
+ * redoes what was cut short. */
+int lr_rbounce_update(lr_rbounce **rb, const lr_scene *s, const lr_cancel *cancel, lr_err *e);
 void lr_rbounce_destroy(lr_rbounce *rb);
 
 /* The VPLs' irradiance on plane receiver r for the next solve: its grid's LR_RECV_GRID^2

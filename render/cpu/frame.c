@@ -275,7 +275,7 @@ static int opening_light(rctx *r, lr_err *e)
 static int receiver_bounce(rctx *r, lr_err *e)
 {
     lr_rbounce *rb = NULL;
-    int rc = lr_rbounce_update(&rb, r->s, e);
+    int rc = lr_rbounce_update(&rb, r->s, NULL, e);
     if (rc || !rb) {
         lr_rbounce_destroy(rb);
         return rc;
@@ -660,7 +660,7 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
                 goto fail;
         }
     double samples = 0.0;
-    if (!ref && (rc = lr_tr_scene_update(&r.tr, s, e)))
+    if (!ref && (rc = lr_tr_scene_update(&r.tr, s, NULL, e)))
         goto fail;
     if (!ref) {
         for (int o = 0; o < r.nobj; o++)

@@ -12,6 +12,8 @@ typedef struct job {
     long count;
     lr_cpu_item_fn fn;
     void *ctx;
+    const lr_cancel *cancel;
+    atomic_bool stopped;
 } job;
 
 int lr_cpu_threads_default(void)
@@ -26,6 +28,10 @@ static void *worker(void *p)
 {
     job *j = p;
     for (;;) {
+        if (lr_cancel_requested(j->cancel)) {
+            atomic_store(&j->stopped, true);
+            break;
+        }
         long start = atomic_fetch_add(&j->next, LR_CPU_CHUNK);
         if (start >= j->count)
             break;
@@ -38,12 +44,19 @@ static void *worker(void *p)
 
 void lr_cpu_parallel_for(long count, int threads, lr_cpu_item_fn fn, void *ctx)
 {
+    (void)lr_cpu_parallel_for_cancel(count, threads, fn, ctx, NULL);
+}
+
+bool lr_cpu_parallel_for_cancel(long count, int threads, lr_cpu_item_fn fn, void *ctx,
+                                const lr_cancel *cancel)
+{
     if (threads <= 0)
         threads = lr_cpu_threads_default();
     if (threads > LR_CPU_MAX_THREADS)
         threads = LR_CPU_MAX_THREADS;
-    job j = {.count = count, .fn = fn, .ctx = ctx};
+    job j = {.count = count, .fn = fn, .ctx = ctx, .cancel = cancel};
     atomic_init(&j.next, 0);
+    atomic_init(&j.stopped, false);
     pthread_t tid[LR_CPU_MAX_THREADS];
     int started = 0;
     for (int t = 1; t < threads && t < count; t++) {
@@ -54,4 +67,6 @@ void lr_cpu_parallel_for(long count, int threads, lr_cpu_item_fn fn, void *ctx)
     worker(&j); /* the calling thread works too */
     for (int t = 0; t < started; t++)
         pthread_join(tid[t], NULL);
+    /* A thread that saw the request after the last chunk was taken ran nothing less. */
+    return !atomic_load(&j.stopped) || atomic_load(&j.next) >= count;
 }

@@ -4,6 +4,10 @@
 #ifndef LR_CPU_PARALLEL_H
 #define LR_CPU_PARALLEL_H
 
+#include <stdbool.h>
+
+#include "render/base/cancel.h"
+
 typedef void (*lr_cpu_item_fn)(void *ctx, long item);
 
 /* Number of online CPUs (at least 1). */
@@ -13,5 +17,11 @@ int lr_cpu_threads_default(void);
  * items handed out in chunks by an atomic counter; the calling thread works too. A thread that
  * cannot start only makes the loop slower: every item is run either way. */
 void lr_cpu_parallel_for(long count, int threads, lr_cpu_item_fn fn, void *ctx);
+
+/* The same, polling `cancel` (may be NULL) before each chunk: once it is requested no new
+ * chunk starts (those under way finish), and the call returns false -- some items did not
+ * run, so the outputs are incomplete and the caller must discard them. True: every item ran. */
+bool lr_cpu_parallel_for_cancel(long count, int threads, lr_cpu_item_fn fn, void *ctx,
+                                const lr_cancel *cancel);
 
 #endif

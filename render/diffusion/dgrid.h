@@ -46,6 +46,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "render/base/cancel.h"
 #include "render/base/err.h"
 #include "render/base/vec3.h"
 #include "render/mesh/bvh.h"
@@ -179,6 +180,11 @@ void lr_dsystem_apply_t(const lr_dsystem *s, const double *x, double *y);
  * reached); *iters may be NULL. */
 int lr_dsystem_solve(const lr_dsystem *s, bool transpose, const double *b, double *x,
                      double tol, int max_iter, int *iters, lr_err *e);
+/* The same, polling `cancel` (may be NULL) between iterations: LR_ECANCELED once requested, x
+ * then a partial iterate to be discarded. */
+int lr_dsystem_solve_cancel(const lr_dsystem *s, bool transpose, const double *b, double *x,
+                            double tol, int max_iter, int *iters, const lr_cancel *cancel,
+                            lr_err *e);
 /* Gradient accumulation for the adjoint method: for objective F with M phi = rhs and
  * M^T lambda = dF/dphi, dF/dD_p += -sum lambda^T (dM/dD_p) phi, same for mu. */
 void lr_dsystem_grad(const lr_dsystem *s, const double *lambda, const double *phi,
@@ -227,6 +233,9 @@ int lr_dsolver_solve_rgb(lr_dsolver *s, int slot, lr_dirradiance_rgb_fn q, const
 /* New coefficients on the same grids (a material edit, seed 001 Sec. 5.4): the slots' last
  * solutions stay as warm starts. */
 int lr_dsolver_set_material(lr_dsolver *s, const lr_dmaterial *m, lr_err *e);
+/* Polled by the solves from now on (NULL: never cancelled; render/base/cancel.h). A cancelled
+ * solve returns LR_ECANCELED and forgets the slot's solution, as a failed one does. */
+void lr_dsolver_set_cancel(lr_dsolver *s, const lr_cancel *cancel);
 /* Forgets the slot's solution (the next solve starts coarse-to-fine). */
 void lr_dsolver_reset(lr_dsolver *s, int slot);
 const double *lr_dsolver_phi(const lr_dsolver *s, int slot, int band);

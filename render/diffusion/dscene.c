@@ -34,7 +34,10 @@ typedef struct dobj {
 struct lr_dscene {
     dobj obj[LR_DSCENE_MAX_OBJECTS];
     int iters;
+    const lr_cancel *cancel;
 };
+
+void lr_dscene_set_cancel(lr_dscene *d, const lr_cancel *cancel) { d->cancel = cancel; }
 
 int lr_dscene_create(lr_dscene **out, lr_err *e)
 {
@@ -362,6 +365,7 @@ int lr_dscene_update(lr_dscene *d, const lr_scene *s, lr_err *e)
             return rc;
         }
         D->active = true;
+        lr_dsolver_set_cancel(D->solver, d->cancel);
         const lr_dgrid *g = lr_dsolver_grid(D->solver);
         size_t nodes = lr_dgrid_node_count(g);
         for (int l = 0; l < L; l++) {
@@ -369,7 +373,9 @@ int lr_dscene_update(lr_dscene *d, const lr_scene *s, lr_err *e)
              * finest solve, whose right-hand side and field decide the result. */
             qctx q = {o, lr_scene_light_at(s, l), h};
             if ((rc = lr_dsolver_solve(D->solver, l, q_fn, &q, LR_DSCENE_TOL, e)))
-                return lr_err_prefix(e, "objects[%d] (%s), light %d", i, o->name, l);
+                return rc == LR_ECANCELED ? rc
+                                          : lr_err_prefix(e, "objects[%d] (%s), light %d", i,
+                                                          o->name, l);
             d->iters += lr_dsolver_last_iters(D->solver);
             if (!D->field[l] && !(D->field[l] = malloc(4 * nodes * sizeof(float))))
                 return lr_err_set(e, LR_ENOMEM, "diffusion grid: out of memory");

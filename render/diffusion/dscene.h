@@ -58,6 +58,10 @@ int lr_dscene_create(lr_dscene **out, lr_err *e);
 void lr_dscene_destroy(lr_dscene *d);
 /* Brings every diffusion_grid object of s up to date for every light. */
 int lr_dscene_update(lr_dscene *d, const lr_scene *s, lr_err *e);
+/* Polled by the updates' solves from now on (NULL: never cancelled; render/base/cancel.h): a
+ * cancelled update returns LR_ECANCELED; the objects keep their grids, and the next update
+ * solves every light again (a field then may be the last state's until it does). */
+void lr_dscene_set_cancel(lr_dscene *d, const lr_cancel *cancel);
 /* Object i's field for light l; false when the object has none (another model). The field
  * includes the cavity closure's gain when the light sits in the object's hull. */
 bool lr_dscene_field(const lr_dscene *d, int object, int light, lr_dfield_view *out);

@@ -21,6 +21,7 @@ struct lr_dsolver {
     double *phi[LR_DSOLVER_SLOTS][3];               /* finest level */
     bool has[LR_DSOLVER_SLOTS];
     int last_iters;
+    const lr_cancel *cancel; /* polled by the solves (lr_dsolver_set_cancel) */
 };
 
 void lr_dsolver_destroy(lr_dsolver *s)
@@ -137,6 +138,8 @@ const double *lr_dsolver_phi(const lr_dsolver *s, int slot, int band)
     return s->phi[slot][band];
 }
 int lr_dsolver_last_iters(const lr_dsolver *s) { return s->last_iters; }
+void lr_dsolver_set_cancel(lr_dsolver *s, const lr_cancel *cancel) { s->cancel = cancel; }
+
 void lr_dsolver_reset(lr_dsolver *s, int slot)
 {
     if (slot >= 0 && slot < LR_DSOLVER_SLOTS)
@@ -223,8 +226,9 @@ int lr_dsolver_solve_rgb(lr_dsolver *s, int slot, lr_dirradiance_rgb_fn q, const
                 memset(x, 0, n * sizeof *x);
             }
             int it = 0;
-            rc = lr_dsystem_solve(s->sys[l][c], false, rhs[l][c], x,
-                                  l == 0 ? tol : fmax(tol, 1e-3), 20000, &it, e);
+            rc = lr_dsystem_solve_cancel(s->sys[l][c], false, rhs[l][c], x,
+                                         l == 0 ? tol : fmax(tol, 1e-3), 20000, &it, s->cancel,
+                                         e);
             if (l == 0)
                 s->last_iters += it;
             prev = x;
@@ -238,7 +242,7 @@ int lr_dsolver_solve_rgb(lr_dsolver *s, int slot, lr_dirradiance_rgb_fn q, const
         for (int c = 0; c < 3; c++)
             free(rhs[l][c]);
     s->has[slot] = rc == LR_OK;
-    if (rc)
+    if (rc && rc != LR_ECANCELED)
         lr_err_prefix(e, "diffusion solver");
     return rc;
 }

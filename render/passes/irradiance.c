@@ -142,7 +142,7 @@ void lr_irradiance_bind_objects(const lr_irradiance *irr, const lr_pass_ctx *c, 
  * and the bounce E_b added to the grids in place; composition then reads it like E_vpl. */
 static int bounce(lr_irradiance *irr, const lr_pass_ctx *c, const lr_radiosity *rad, lr_err *e)
 {
-    int rc = lr_rbounce_update(&irr->rb, c->scene, e);
+    int rc = lr_rbounce_update(&irr->rb, c->scene, c->cancel, e);
     /* render.opening_light (render/openings/openings.h): rebuilt only when the geometry, a
      * light or a material changed; its grid joins E_vpl before the bounce reads it. */
     if (!rc)

@@ -11,6 +11,7 @@
 #include <GLES3/gl31.h>
 #include <stdbool.h>
 
+#include "render/base/cancel.h"
 #include "render/base/err.h"
 #include "render/base/vec3.h"
 #include "render/gl/gl.h"
@@ -100,6 +101,9 @@ typedef struct lr_pass_ctx {
     /* Per light and band: intensity x colour x flicker at the renderer's clock (the blend's
      * weights, lights.glsl's u_lights_I); 0 beyond n_lights. */
     double I[LR_MAX_LIGHTS][3];
+    /* The renderer's (lr_renderer_set_cancel), handed to the CPU solves a pass runs (the
+     * diffusion grid, translucent radiosity, the receiver bounce); NULL: never cancelled. */
+    const lr_cancel *cancel;
 } lr_pass_ctx;
 
 /* common.c */

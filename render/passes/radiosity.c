@@ -131,6 +131,7 @@ static int dgrid_update(lr_radiosity *rad, const lr_pass_ctx *c, lr_err *e)
         return LR_OK;
     if (!rad->dscene && (rc = lr_dscene_create(&rad->dscene, e)))
         return rc;
+    lr_dscene_set_cancel(rad->dscene, c->cancel);
     if ((rc = lr_dscene_update(rad->dscene, c->scene, e)))
         return rc;
     for (int i = 0; i < LR_MAX_OBJECTS; i++) {
@@ -186,7 +187,7 @@ float lr_radiosity_blend_weight(lr_tex_format format, int F)
  * changed) and upload each such object's per-vertex B, light l's block at rows l tr_rows. */
 static int tr_refresh(lr_radiosity *rad, const lr_pass_ctx *c, lr_err *e)
 {
-    int rc = lr_tr_scene_update(&rad->tr, c->scene, e);
+    int rc = lr_tr_scene_update(&rad->tr, c->scene, c->cancel, e);
     for (int i = 0; i < LR_MAX_OBJECTS; i++) {
         lr_tex_destroy(rad->trB[i]);
         rad->trB[i] = NULL;

@@ -119,7 +119,10 @@ int lr_tr_build_form_factors(lr_tr *t, lr_err *e)
         rc = lr_err_set(e, LR_ENOMEM, "transrad: out of memory (form factors, %zu patches)", n);
         goto done;
     }
-    lr_cpu_parallel_for((long)n, t->set.threads, ff_item, &c);
+    if (!lr_cpu_parallel_for_cancel((long)n, t->set.threads, ff_item, &c, t->set.cancel)) {
+        rc = lr_cancel_check(t->set.cancel, "transrad: form factors", e);
+        goto done;
+    }
     if (c.failed) {
         rc = lr_err_set(e, LR_ENOMEM, "transrad: out of memory (form-factor rows)");
         goto done;

@@ -83,6 +83,14 @@ static int solve(lr_tr *t, int slot, lr_tr_stats *st, lr_err *e)
     memset(sl->Wsss, 0, 3 * n * sizeof *sl->Wsss);
     lr_tr_stats s = {0};
     for (int it = 0; it < t->set.max_iterations; it++) {
+        if (lr_cancel_requested(t->set.cancel)) {
+            /* W is a partial sweep's: not a solution (H, Hind not built from it). */
+            sl->valid = false;
+            free(refl);
+            free(Wn);
+            free(phi);
+            return lr_cancel_check(t->set.cancel, "transrad: solve", e);
+        }
         memcpy(Wn, sl->W, 3 * n * sizeof *Wn);
         /* Gauss-Seidel: patch p gathers H_p = F_p. W from the latest W (patches before it in
          * this sweep included) and scatters the change of what enters it through column p

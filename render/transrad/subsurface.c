@@ -323,11 +323,16 @@ int lr_tr_build_subsurface(lr_tr *t, lr_err *e)
             goto done;
         }
         c.dist = dist;
-        lr_cpu_parallel_for((long)t->surf[s].count, t->set.threads, ss_item, &c);
+        bool all = lr_cpu_parallel_for_cancel((long)t->surf[s].count, t->set.threads, ss_item,
+                                              &c, t->set.cancel);
         free(dist);
         free(c.thick);
         free(c.thin);
         free(c.spreads);
+        if (!all) {
+            rc = lr_cancel_check(t->set.cancel, "transrad: subsurface", e);
+            goto done;
+        }
         if (c.failed) {
             rc = lr_err_set(e, LR_ENOMEM, "transrad: surface %d: out of memory (subsurface)", s);
             goto done;

@@ -226,7 +226,7 @@ static int receiver_values(lr_tr_scene *ts, const lr_scene *s, int ri, int l, lr
     return LR_OK;
 }
 
-int lr_tr_scene_update(lr_tr_scene **tsp, const lr_scene *s, lr_err *e)
+int lr_tr_scene_update(lr_tr_scene **tsp, const lr_scene *s, const lr_cancel *cancel, lr_err *e)
 {
     if (!lr_tr_scene_needed(s)) {
         lr_tr_scene_destroy(*tsp);
@@ -251,7 +251,8 @@ int lr_tr_scene_update(lr_tr_scene **tsp, const lr_scene *s, lr_err *e)
         char cdir[1024];
         lr_tr_settings set = {.rays_per_patch = 256,
                               .cache_dir = lr_tr_cache_default_dir(cdir, sizeof cdir),
-                              .warn = *lr_scene_warn_sink(s), .warned = &ts->cache_warned};
+                              .warn = *lr_scene_warn_sink(s), .warned = &ts->cache_warned,
+                              .cancel = cancel};
         int rc = lr_tr_create_scene(s, &set, &ts->tr, e);
         if (rc)
             return rc;
@@ -259,6 +260,7 @@ int lr_tr_scene_update(lr_tr_scene **tsp, const lr_scene *s, lr_err *e)
         ts->nkey = nk;
         ts->build_s = now_s() - t0;
     }
+    lr_tr_set_cancel(ts->tr, cancel);
     free_arrays(ts);
     ts->n_obj = lr_scene_object_count(s);
     ts->n_rcv = lr_scene_receiver_count(s);

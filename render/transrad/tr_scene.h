@@ -44,8 +44,10 @@ void lr_tr_key_mesh(double *k, int *n, const lr_mesh *m, const lr_bvh *b);
 bool lr_tr_scene_needed(const lr_scene *s);
 /* Creates *ts on first use (NULL when no object needs it: *ts stays NULL), rebuilds the
  * solver when the scene's geometry, materials or receivers differ from the last call's, and
- * solves every light. */
-int lr_tr_scene_update(lr_tr_scene **ts, const lr_scene *s, lr_err *e);
+ * solves every light. `cancel` (NULL: never; render/base/cancel.h) is polled by the build and
+ * the solves: LR_ECANCELED, and the next update rebuilds or re-solves what was cut short (a
+ * vertex B may be the last state's until then). */
+int lr_tr_scene_update(lr_tr_scene **ts, const lr_scene *s, const lr_cancel *cancel, lr_err *e);
 void lr_tr_scene_destroy(lr_tr_scene *ts);
 
 /* Per-vertex B (vertex_count x 3, the object's mesh's vertex order) of object o and light l;

@@ -123,6 +123,12 @@ fail:
     return rc;
 }
 
+void lr_tr_set_cancel(lr_tr *t, const lr_cancel *cancel)
+{
+    if (t)
+        t->set.cancel = cancel;
+}
+
 void lr_tr_destroy(lr_tr *t)
 {
     if (!t)

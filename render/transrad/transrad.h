@@ -54,6 +54,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "render/base/cancel.h"
 #include "render/base/err.h"
 #include "render/base/vec3.h"
 #include "render/base/warn.h"
@@ -115,6 +116,11 @@ typedef struct lr_tr_settings {
     lr_warn_sink warn;      /* a store into cache_dir that fails (read-only, full): said here,
                              * once per folder per `warned` (the next start rebuilds F and S) */
     lr_warn_once *warned;   /* the caller's: folders already said; NULL: said at every store */
+    /* Polled during create (form factors, subsurface, direct light) and by every solve (per
+     * sweep); kept (lr_tr_set_cancel replaces it). NULL: never cancelled. A cancelled create
+     * fails with LR_ECANCELED and stores no cache; a cancelled solve leaves its slot invalid
+     * (the next solve starts cold). Not part of the cache key. */
+    const lr_cancel *cancel;
 } lr_tr_settings;
 
 enum { LR_TR_THIN_AUTO = 0, LR_TR_THIN_OFF = 1, LR_TR_THIN_ON = 2 };
@@ -140,6 +146,8 @@ int lr_tr_create(const lr_tr_surface_desc *surfaces, int count, const lr_tr_sett
 int lr_tr_create_scene(const lr_scene *s, const lr_tr_settings *settings, lr_tr **out,
                        lr_err *e);
 void lr_tr_destroy(lr_tr *t);
+/* The token the solves poll from now on (NULL: never cancelled). */
+void lr_tr_set_cancel(lr_tr *t, const lr_cancel *cancel);
 
 /* Direct light of a unit-intensity light (shadowed, per patch) and the solve, warm-started
  * from slot's last solution. */

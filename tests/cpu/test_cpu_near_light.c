@@ -102,7 +102,7 @@ static void power_at(model_ctx *mc, lr_vec3 x, double P[3])
         lr_gb_camera_scene(mc->s, 0, &cam);
         const lr_scene_object *o = lr_scene_object_at(mc->s, 0);
         lr_cpu_sh_env(o, lr_scene_light_at(mc->s, 0), &cam, 64, NULL, 0, 0, &mc->env);
-    } else if (mc->kind == TR && lr_tr_scene_update(&mc->ts, mc->s, &e)) {
+    } else if (mc->kind == TR && lr_tr_scene_update(&mc->ts, mc->s, NULL, &e)) {
         fail_msg("%s", e.msg);
     }
     power_acc a = {.mc = mc};

@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "render/async/async.h"
 #include "render/mesh/bvh.h"
@@ -239,6 +240,105 @@ static void test_preview_once_per_heavy_change(void **state)
     lr_scene_destroy(s);
 }
 
+/* Polls until the worker runs a full frame that a batch would cut (it takes a batch within
+ * milliseconds of its commit; the hang guard only bounds a broken worker). */
+static void wait_cuttable(lr_async *a)
+{
+    for (int i = 0; i < WAIT_MS / 5 && !lr_async_cuttable(a); i++) {
+        struct timespec ts = {0, 5 * 1000 * 1000};
+        nanosleep(&ts, NULL);
+    }
+    assert_true(lr_async_cuttable(a));
+}
+
+/* The image of `s` as a fresh renderer on the caller's thread draws it. */
+static float *fresh_image(lr_gl *gl, lr_scene *s)
+{
+    lr_renderer *r = lr_test_renderer(gl, s, W, H, false, 1);
+    lr_test_converge(r, 50);
+    float *px = lr_test_hdr(r);
+    lr_renderer_destroy(r);
+    return px;
+}
+
+/* A long solve does not delay the next change: a material change's grid solve (a fraction of
+ * a second, hundreds of the cut's polls) is under way when a second material change arrives;
+ * the worker cuts the stale solve at its next poll and solves the new state. So the
+ * stale state is never published (one final image for the two batches, none of the first),
+ * one frame was cut, and the image is the new state's as a fresh renderer draws it: the cut
+ * solve left nothing behind. The grid restarts cold after a cut, as a fresh renderer's does,
+ * so both run the same iterations to the same tolerance: float rounding apart (the same
+ * 1e-5 of the peak as above), they agree. Without the cut the stale state is solved and
+ * published first (two finals, no cut frame). */
+static void test_newer_change_cuts_a_stale_solve(void **state)
+{
+    fixture *f = *state;
+    lr_scene *s = lr_test_scene("candle", lr_test_small_settings, grid_sets);
+    lr_async *a = make(f->gl, s, false);
+    wait_final(a, 0);
+    uint64_t finals = lr_async_publications(a, LR_ASYNC_FINAL);
+    assert_int_equal(lr_async_cancelled(a), 0);
+
+    unsigned dirty = 0;
+    set(s, "objects[0].material", "skin1", &dirty);
+    uint64_t b1 = lr_async_commit(a, dirty);
+    wait_cuttable(a);
+    dirty = 0;
+    set(s, "objects[0].material", "marble", &dirty);
+    uint64_t b2 = lr_async_commit(a, dirty);
+    assert_true(b2 > b1);
+    wait_final(a, b2);
+    printf("cut frames %llu, finals %llu\n", (unsigned long long)lr_async_cancelled(a),
+           (unsigned long long)(lr_async_publications(a, LR_ASYNC_FINAL) - finals));
+    assert_int_equal(lr_async_cancelled(a), 1);
+    assert_int_equal(lr_async_publications(a, LR_ASYNC_FINAL), finals + 1);
+    lr_async_frame_stats st;
+    float *got = frame_hdr(a, &st);
+    assert_int_equal(st.batch, b2);
+    assert_int_equal(st.stage, LR_ASYNC_FINAL);
+    float *want = fresh_image(f->gl, s);
+    size_t n = (size_t)W * H * 3;
+    double peak = max_abs(want, n), worst = 0;
+    assert_true(peak > 0);
+    for (size_t i = 0; i < n; i++)
+        worst = fmax(worst, fabs((double)got[i] - want[i]));
+    printf("after a cut vs a fresh renderer: worst |diff| %.3g of peak %.3g\n", worst, peak);
+    assert_true(worst <= 1e-5 * peak);
+    free(got);
+    free(want);
+    lr_async_destroy(a);
+    lr_scene_destroy(s);
+}
+
+/* A stop (a scene switch retiring the worker, or exit) cuts the frame under way instead of
+ * waiting for its solve: the worker exits with that frame cut and nothing of its state
+ * published. */
+static void test_stop_cuts_the_frame(void **state)
+{
+    fixture *f = *state;
+    lr_scene *s = lr_test_scene("candle", lr_test_small_settings, grid_sets);
+    lr_async *a = make(f->gl, s, false);
+    wait_final(a, 0);
+    uint64_t published = lr_async_publications(a, LR_ASYNC_FINAL) +
+                         lr_async_publications(a, LR_ASYNC_REFINING);
+    unsigned dirty = 0;
+    set(s, "objects[0].material", "skin1", &dirty);
+    assert_true(lr_async_commit(a, dirty) > 0);
+    wait_cuttable(a);
+    lr_async_stop(a);
+    for (int i = 0; i < WAIT_MS / 5 && !lr_async_stopped(a); i++) {
+        struct timespec ts = {0, 5 * 1000 * 1000};
+        nanosleep(&ts, NULL);
+    }
+    assert_true(lr_async_stopped(a));
+    assert_int_equal(lr_async_cancelled(a), 1);
+    assert_int_equal(lr_async_publications(a, LR_ASYNC_FINAL) +
+                         lr_async_publications(a, LR_ASYNC_REFINING),
+                     published);
+    lr_async_destroy(a);
+    lr_scene_destroy(s);
+}
+
 /* A bad preview assignment is refused at create, naming it. */
 static void test_bad_preview_refused(void **state)
 {
@@ -313,6 +413,8 @@ int main(void)
         cmocka_unit_test(test_final_is_the_renderers_image),
         cmocka_unit_test(test_dimmer_does_not_wait_for_a_solve),
         cmocka_unit_test(test_preview_once_per_heavy_change),
+        cmocka_unit_test(test_newer_change_cuts_a_stale_solve),
+        cmocka_unit_test(test_stop_cuts_the_frame),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -68,7 +68,7 @@ static lr_rbounce *solved(const lr_scene *s, double X)
 {
     lr_rbounce *rb = NULL;
     lr_err e = {0};
-    if (lr_rbounce_update(&rb, s, &e))
+    if (lr_rbounce_update(&rb, s, NULL, &e))
         fail_msg("%s", e.msg);
     assert_non_null(rb);
     const size_t n = (size_t)LR_RECV_GRID * LR_RECV_GRID;
@@ -455,14 +455,14 @@ static void test_cache_read_only_said_once(void **state)
         lr_scene_set_assignment(s, on[0], NULL, &e))
         fail_msg("%s", e.msg);
     lr_rbounce *rb = NULL;
-    assert_int_equal(lr_rbounce_update(&rb, s, &e), LR_OK);
+    assert_int_equal(lr_rbounce_update(&rb, s, NULL, &e), LR_OK);
     assert_non_null(lr_rbounce_objects(rb));
     assert_false(lr_objlight_cache_hit(lr_rbounce_objects(rb)));
     assert_int_equal(said, 1);
     /* Another table: the geometry's key changes, the bounce rebuilds and stores again. */
     if (lr_scene_set_assignment(s, "receivers[0].size=[7000,7000]", NULL, &e))
         fail_msg("%s", e.msg);
-    assert_int_equal(lr_rbounce_update(&rb, s, &e), LR_OK);
+    assert_int_equal(lr_rbounce_update(&rb, s, NULL, &e), LR_OK);
     double build_s, direct_s, solve_s;
     lr_rbounce_times(rb, &build_s, &direct_s, &solve_s);
     assert_true(build_s > 0);

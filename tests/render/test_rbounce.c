@@ -52,7 +52,7 @@ static lr_rbounce *bounce_of(const lr_scene *s)
 {
     lr_rbounce *rb = NULL;
     lr_err e = {0};
-    if (lr_rbounce_update(&rb, s, &e))
+    if (lr_rbounce_update(&rb, s, NULL, &e))
         fail_msg("%s", e.msg);
     assert_non_null(rb);
     return rb;
@@ -248,7 +248,7 @@ static void test_closed_box(void **state)
     /* The next update forgets the VPL grids (a new accumulation frame brings new ones) and
      * keeps F (same geometry): slot 2, warm-started from its VPL solution, then decays to
      * nothing (the sweeps shrink it by about rho each: 50 sweeps). */
-    if (lr_rbounce_update(&rb, s, &e))
+    if (lr_rbounce_update(&rb, s, NULL, &e))
         fail_msg("%s", e.msg);
     double bs;
     lr_rbounce_times(rb, &bs, NULL, NULL);
@@ -393,7 +393,7 @@ static void test_object_reflects(void **state)
         if (k == 1) {
             unsigned dirty = 0;
             assert_int_equal(lr_scene_set(s, "objects[0].material", "ketchup", &dirty, &e), LR_OK);
-            if (lr_rbounce_update(&rb, s, &e))
+            if (lr_rbounce_update(&rb, s, NULL, &e))
                 fail_msg("%s", e.msg);
             for (int r = 0; r < 6; r++) /* an update forgets the VPL grids */
                 lr_rbounce_vpl_d(rb, r, vg, 6);
@@ -506,10 +506,10 @@ static void test_field(void **state)
     assert_int_equal(lr_scene_set(s, "objects[0].model", "translucent_radiosity", NULL, &e), LR_OK);
     assert_false(lr_rbounce_needed(s));
     lr_rbounce *rb = NULL;
-    assert_int_equal(lr_rbounce_update(&rb, s, &e), LR_OK);
+    assert_int_equal(lr_rbounce_update(&rb, s, NULL, &e), LR_OK);
     assert_null(rb);
     /* Bad calls return errors, not crashes. */
-    assert_int_not_equal(lr_rbounce_update(NULL, s, &e), LR_OK);
+    assert_int_not_equal(lr_rbounce_update(NULL, s, NULL, &e), LR_OK);
     assert_int_not_equal(lr_rbounce_solve(NULL, 0, NULL, &e), LR_OK);
     assert_null(lr_rbounce_grid(NULL, 0, 0));
     lr_scene_destroy(s);

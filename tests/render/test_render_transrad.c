@@ -34,7 +34,7 @@ static lr_tr_scene *ts;
 static void compare(lr_renderer *r, const lr_scene *s)
 {
     lr_err e = {0};
-    if (lr_tr_scene_update(&ts, s, &e))
+    if (lr_tr_scene_update(&ts, s, NULL, &e))
         fail_msg("%s", e.msg);
     assert_non_null(ts);
     lr_debug_map_info info;

@@ -41,6 +41,31 @@ pid_t lrb_spawn(char *const argv[], const char *log_path)
     return pid;
 }
 
+pid_t lrb_spawn_piped(char *const argv[], const char *log_path, int *stdin_fd)
+{
+    int p[2];
+    *stdin_fd = -1;
+    if (pipe2(p, O_CLOEXEC) != 0)
+        return -1;
+    pid_t pid = fork();
+    if (pid == 0) {
+        dup2(p[0], 0);
+        int fd = open(log_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (fd >= 0) {
+            dup2(fd, 1);
+            dup2(fd, 2);
+        }
+        execv(argv[0], argv);
+        _exit(127);
+    }
+    close(p[0]);
+    if (pid < 0)
+        close(p[1]);
+    else
+        *stdin_fd = p[1];
+    return pid;
+}
+
 int lrb_reap(pid_t pid, double guard_s)
 {
     int st = 0;

@@ -10,6 +10,8 @@ void lrb_sleep_s(double s);
 void lrb_print_log(const char *path);
 /* Starts argv[0] with stdout and stderr to log_path. */
 pid_t lrb_spawn(char *const argv[], const char *log_path);
+/* The same with its stdin a pipe: *stdin_fd is the writing end (the caller closes it). */
+pid_t lrb_spawn_piped(char *const argv[], const char *log_path, int *stdin_fd);
 /* Waits up to guard_s for pid, then kills it: its wait status, or -1 when it had to be killed. */
 int lrb_reap(pid_t pid, double guard_s);
 /* n processes spinning on a core each (a loaded board), and their end. */

@@ -341,6 +341,11 @@ static int run(FILE *out)
     latency l = {0};
     int rc = dimmer_latency(dir, &l);
     rc |= lrb_rig_controls(out, bindir, configs, dir);
+    int mb_port = free_port();
+    if (mb_port > 0)
+        rc |= lrb_rig_modbus(out, bindir, configs, dir, mb_port);
+    else
+        fprintf(out, "The Modbus demo rows: not measured (no free TCP port on 127.0.0.1).\n\n");
 
     char lamprig[PATH_MAX + 16], cfg[PATH_MAX], script[PATH_MAX], log[PATH_MAX];
     snprintf(lamprig, sizeof lamprig, "%s/lamprig", bindir);

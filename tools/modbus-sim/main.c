@@ -3,11 +3,16 @@
  * 0-255), answered by libmodbus's own modbus_reply, so `lamprig run --config
  * configs/rig/modbus-demo.json --modbus tcp://127.0.0.1:PORT` can be tried without hardware.
  *
- *   lamprig-modbus-sim [--port 1502] [--panel 500] [--sweep SECONDS]
+ *   lamprig-modbus-sim [--port 1502] [--panel 500] [--sweep SECONDS] [--trace]
  *
  * Type a number 0..1000 and Enter to move the panel; every change of the driver register is
  * printed ("driver 128 (50.2 %)"). --sweep turns the panel 0 → 1000 → 0 over SECONDS, again
  * and again. One thread, one poll loop; SIGINT (Ctrl-C) or SIGTERM ends it (exit 0).
+ *
+ * --trace also prints a timestamped line per request and per change, for a benchmark to
+ * measure the rig's poll cadence and its panel-to-lamp delay from the peer's side:
+ * "@T request unit U function F", "@T panel V", "@T driver V", T in seconds of
+ * CLOCK_MONOTONIC (the same clock as the rig's, so the lines compare across processes).
  *
  * Runs like a daemon when stdin is not a terminal: at end of input (stdin /dev/null, a closed
  * pipe) it stops reading stdin and goes on serving; poll() then waits on the sockets (and
@@ -19,6 +24,7 @@
 #include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -39,7 +45,7 @@ static double now_s(void)
 static int usage(void)
 {
     fprintf(stderr, "usage: lamprig-modbus-sim [--port 1502] [--panel 0..1000] "
-                    "[--sweep SECONDS]\n");
+                    "[--sweep SECONDS] [--trace]\n");
     return 2;
 }
 
@@ -47,7 +53,12 @@ int main(int argc, char **argv)
 {
     int port = 1502, panel = 500;
     double sweep = 0;
+    bool trace = false;
     for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--trace") == 0) {
+            trace = true;
+            continue;
+        }
         if (i + 1 >= argc)
             return usage();
         char *end;
@@ -134,6 +145,8 @@ int main(int argc, char **argv)
                 if (v >= 0 && v <= 1000)
                     units[1]->tab_registers[0] = (uint16_t)v;
                 printf("panel %d\n", units[1]->tab_registers[0]);
+                if (trace)
+                    printf("@%.6f panel %d\n", now_s(), units[1]->tab_registers[0]);
             }
             fflush(stdout);
         }
@@ -151,7 +164,10 @@ int main(int argc, char **argv)
             modbus_set_socket(ctx, clients[i]);
             int rc = modbus_receive(ctx, q);
             if (rc > 0) {
-                int unit = q[modbus_get_header_length(ctx) - 1];
+                int hl = modbus_get_header_length(ctx);
+                int unit = q[hl - 1];
+                if (trace)
+                    printf("@%.6f request unit %d function %d\n", now_s(), unit, q[hl]);
                 if (unit == 1 || unit == 2)
                     modbus_reply(ctx, q, rc, units[unit]);
             } else if (rc < 0) {
@@ -163,6 +179,8 @@ int main(int argc, char **argv)
         int d = units[2]->tab_registers[0];
         if (d != last_driver) {
             printf("driver %d (%.1f %%)\n", d, d / 2.55);
+            if (trace)
+                printf("@%.6f driver %d\n", now_s(), d);
             fflush(stdout);
             last_driver = d;
         }
