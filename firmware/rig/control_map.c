@@ -444,6 +444,29 @@ int lr_control_map_update(lr_control_map *m, lr_scene *scene, int64_t now_ns, un
     return rc;
 }
 
+void lr_control_map_carry(lr_control_map *to, const lr_control_map *from, int64_t now_ns)
+{
+    (void)now_ns;
+    if (!to || !from)
+        return;
+    for (int i = 0; i < to->n; i++) {
+        bstate *t = &to->st[i];
+        const lr_rig_binding *tb = t->b;
+        if (tb->kind != LR_BIND_LEVEL)
+            continue;
+        for (int j = 0; j < from->n; j++) {
+            const lr_rig_binding *fb = from->st[j].b;
+            if (fb->kind != LR_BIND_LEVEL || strcmp(fb->name, tb->name) ||
+                strcmp(fb->source, tb->source) || strcmp(fb->control, tb->control) ||
+                strcmp(fb->param, tb->param))
+                continue;
+            t->x = from->st[j].x;
+            lr_fade_init(&t->fade, level_of(tb, t->x));
+            break;
+        }
+    }
+}
+
 void lr_control_map_scene_replaced(lr_control_map *m)
 {
     for (int g = 0; g < m->n_groups; g++) {

@@ -52,6 +52,13 @@ int lr_control_map_event(lr_control_map *m, const lr_event *ev, int64_t now_ns);
  * rejects is reported in e (the other parameters are still written). */
 int lr_control_map_update(lr_control_map *m, lr_scene *scene, int64_t now_ns, unsigned *dirty,
                           lr_err *e);
+/* A reload's new map takes over where the old one's controls stand: every level binding of
+ * `to` with a binding of `from` of the same name, source, control and parameter gets that
+ * binding's position (a knob or dimmer is where the hardware left it, and a Modbus panel that
+ * reads the same again sends no event), its level at now_ns recomputed with its own curve and
+ * shown without a fade. Cycle bindings (material presets, the scene) start as the new config
+ * says: a reload loads the config's scene. Writes nothing: call lr_control_map_update. */
+void lr_control_map_carry(lr_control_map *to, const lr_control_map *from, int64_t now_ns);
 /* The scene was replaced (scene switch or reload): the next update rewrites everything. */
 void lr_control_map_scene_replaced(lr_control_map *m);
 

@@ -853,6 +853,10 @@ static int reload(lr_rig *r, lr_err *e)
 {
     rigset s;
     int rc = set_build(r, &s, true, e);
+    /* The controls stay where they are (the dimmer, the knobs): the lamp does not jump back to
+     * the config's initial level and fade to the panel again. */
+    if (!rc)
+        lr_control_map_carry(s.map, r->set.map, lr_now_ns());
     lr_rig_view *view = NULL;
     if (!rc && r->kms && s.calib && !r->ar_out && (rc = ar_output(r, e))) {
         r->used_hid |= s.has_hid;

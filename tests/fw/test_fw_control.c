@@ -147,6 +147,51 @@ static void test_dimmer_curve_range_fade(void **state)
     fx_free(&f);
 }
 
+/* A reload's map takes over the old map's level positions (the Modbus demo's lamp went back to
+ * the config's initial level and faded to the panel again: 51 -> 128 -> 51 of 255 after every
+ * SIGHUP): the dimmer stays at the panel's position, shown at once, and the panel's next read
+ * of the same value is no event. A binding the old map lacks starts as configured; cycles
+ * start as configured. */
+static void test_reload_carries_positions(void **state)
+{
+    (void)state;
+    const char *ctl = "[{\"name\": \"dimmer\", \"control\": \"panel/dimmer\", "
+                      "\"param\": \"light.level\", \"range\": [0, 2], \"fade_s\": 0.15, "
+                      "\"initial\": 0.5, \"lamp\": true}, "
+                      "{\"name\": \"material\", \"control\": \"button1\", "
+                      "\"param\": \"objects[0].material\", \"values\": [\"candle_wax\", "
+                      "\"marble\"]}]";
+    fx a, b;
+    fx_make(&a, ctl);
+    update(&a, 0);
+    int64_t t0 = 1000 * MS;
+    lr_event e1 = ev("panel", "dimmer", LR_EV_ABSOLUTE, 0.2, t0);
+    assert_int_equal(lr_control_map_event(a.map, &e1, t0), 0);
+    lr_event press = ev("", "button1", LR_EV_PRESS, 1, t0);
+    assert_int_equal(lr_control_map_event(a.map, &press, t0), 1);
+    update(&a, t0 + 500 * MS);
+    double la;
+    assert_true(lr_control_map_lamp_level(a.map, t0 + 500 * MS, &la));
+    assert_near(la, 0.2, 1e-12);
+
+    fx_make(&b, ctl); /* the reloaded config */
+    assert_near(lr_control_map_position(b.map, 0), 0.5, 1e-12);
+    int64_t t1 = t0 + 600 * MS;
+    lr_control_map_carry(b.map, a.map, t1);
+    assert_near(lr_control_map_position(b.map, 0), 0.2, 1e-12);
+    double lb;
+    assert_true(lr_control_map_lamp_level(b.map, t1, &lb));
+    assert_near(lb, 0.2, 1e-12);
+    assert_false(lr_control_map_fading(b.map, t1));
+    update(&b, t1);
+    assert_near(get(&b, "lights[0].intensity"), get(&a, "lights[0].intensity"), 1e-15);
+    lr_event same = ev("panel", "dimmer", LR_EV_ABSOLUTE, 0.2, t1 + 50 * MS);
+    assert_int_equal(lr_control_map_event(b.map, &same, t1 + 50 * MS), -1);
+    assert_int_equal(lr_control_map_index(b.map, 1), 0); /* the cycle as configured */
+    fx_free(&a);
+    fx_free(&b);
+}
+
 /* The four curves at one position, through the range [min, max] with max < min (reversed). */
 static void test_curves_and_reversed_range(void **state)
 {
@@ -540,6 +585,7 @@ static void test_shipped_cycles_are_visible(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_reload_carries_positions),
         cmocka_unit_test(test_dimmer_curve_range_fade),
         cmocka_unit_test(test_curves_and_reversed_range),
         cmocka_unit_test(test_encoder_step_accel_clamp),

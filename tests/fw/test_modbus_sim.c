@@ -20,6 +20,7 @@
 #include <string.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "tests/support/fs.h"
@@ -40,8 +41,8 @@ static int free_port(void)
     return ntohs(a.sin_port);
 }
 
-/* Starts the simulator with stdin from in_fd, stdout+stderr to log. */
-static pid_t spawn_sim(int port, int panel, int in_fd, const char *log)
+/* Starts the simulator with stdin from in_fd, stdout+stderr to log (trace: --trace). */
+static pid_t spawn_sim_opt(int port, int panel, int in_fd, const char *log, bool trace)
 {
     char port_s[16], panel_s[16];
     snprintf(port_s, sizeof port_s, "%d", port);
@@ -52,11 +53,17 @@ static pid_t spawn_sim(int port, int panel, int in_fd, const char *log)
         int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
         if (fd < 0 || dup2(in_fd, 0) < 0 || dup2(fd, 1) < 0 || dup2(fd, 2) < 0)
             _exit(127);
-        char *argv[] = {SIM, "--port", port_s, "--panel", panel_s, NULL};
+        char *argv[] = {SIM, "--port", port_s, "--panel", panel_s, trace ? "--trace" : NULL,
+                        NULL};
         execv(argv[0], argv);
         _exit(127);
     }
     return pid;
+}
+
+static pid_t spawn_sim(int port, int panel, int in_fd, const char *log)
+{
+    return spawn_sim_opt(port, panel, in_fd, log, false);
 }
 
 static bool log_has(const char *log, const char *needle)
@@ -186,6 +193,60 @@ static void test_stdin_dev_null_serves_until_sigterm(void **state)
     free(log);
 }
 
+/* --trace: a timestamped line per request (unit and function code: 3 reads the panel, 6
+ * writes the driver) and per change, on the clock of the caller's CLOCK_MONOTONIC (the bench
+ * compares it with its own), in order and within the span of the exchange. */
+static void test_trace_lines(void **state)
+{
+    fixture *f = *state;
+    char *log = lr_test_path(f->dir, "sim.log");
+    int p[2];
+    assert_int_equal(pipe2(p, O_CLOEXEC), 0);
+    int port = free_port();
+    pid_t pid = f->pid = spawn_sim_opt(port, 400, p[0], log, true);
+    close(p[0]);
+    wait_log(pid, log, "modbus simulator on");
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    assert_int_equal(write(p[1], "650\n", 4), 4);
+    wait_log(pid, log, "panel 650");
+    talk(port, log, pid, 650, 77);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    close(p[1]);
+    stop(pid, log); /* the trace's request lines are flushed at exit */
+    FILE *in = fopen(log, "r");
+    assert_non_null(in);
+    char line[256];
+    double last = 0, a = (double)t0.tv_sec + t0.tv_nsec * 1e-9,
+           b = (double)t1.tv_sec + t1.tv_nsec * 1e-9;
+    int reads = 0, writes = 0, panels = 0, drivers = 0;
+    while (fgets(line, sizeof line, in)) {
+        double t;
+        int u, fc, v;
+        if (line[0] != '@')
+            continue;
+        assert_int_equal(sscanf(line, "@%lf", &t), 1);
+        assert_true(t >= a - 1e-3 && t <= b + 1e-3 && t >= last);
+        last = t;
+        if (sscanf(line, "@%lf request unit %d function %d", &t, &u, &fc) == 3) {
+            reads += u == 1 && fc == 3;
+            writes += u == 2 && fc == 6;
+        } else if (sscanf(line, "@%lf panel %d", &t, &v) == 2) {
+            panels += v == 650;
+        } else if (sscanf(line, "@%lf driver %d", &t, &v) == 2) {
+            drivers += v == 77;
+        } else {
+            fail_msg("unexpected trace line: %s", line);
+        }
+    }
+    fclose(in);
+    assert_int_equal(reads, 1);
+    assert_int_equal(writes, 1);
+    assert_int_equal(panels, 1);
+    assert_int_equal(drivers, 1);
+    free(log);
+}
+
 static void test_closed_stdin_pipe_does_not_spin(void **state)
 {
     fixture *f = *state;
@@ -221,6 +282,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_stdin_dev_null_serves_until_sigterm, setup,
                                         teardown),
         cmocka_unit_test_setup_teardown(test_closed_stdin_pipe_does_not_spin, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_trace_lines, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -47,10 +47,19 @@ int lrb_pin_to_current_cpu(void);
 void lrb_cpu_name(char *buf, size_t len);
 /* The rig section's per-control table (rig_controls.c): runs the shipped sim rig from bindir
  * with configs' files, scratch files in dir. Nonzero when a run failed. */
-int lrb_rig_controls(FILE *out, const char *bindir, const char *configs, const char *dir);
+/* README.md's figures block (figures.c): mode "print" writes it to stdout, "check" compares
+ * README.md's block with it (1: differs), "write" replaces README.md's block; readme: another
+ * file than the tree's README.md (NULL: that one). */
+#define LRB_FIGURES_BEGIN "<!-- BEGIN figures -->"
+#define LRB_FIGURES_END "<!-- END figures -->"
+int lrb_figures(const char *mode, const char *readme);
+/* csv (may be NULL): "run,control,figure,value" rows for build/bench/rig.csv (figures.c). */
+int lrb_rig_controls(FILE *out, FILE *csv, const char *bindir, const char *configs,
+                     const char *dir);
 /* The Modbus demo rig's rows (rig_modbus.c): poll cadence and panel -> lamp, idle and loaded,
  * against lamprig-modbus-sim on 127.0.0.1:port. */
-int lrb_rig_modbus(FILE *out, const char *bindir, const char *configs, const char *dir, int port);
+int lrb_rig_modbus(FILE *out, FILE *csv, const char *bindir, const char *configs,
+                   const char *dir, int port);
 
 /* Rate measurement: calls body(ctx, n) (which must perform n evaluations and return a value
  * depending on all of them), choosing n so that one run lasts about min_run_s of thread CPU

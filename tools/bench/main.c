@@ -1,6 +1,8 @@
 /* lamprig-bench: `lamprig-bench` runs every section; `lamprig-bench NAME...` runs those;
  * `lamprig-bench --list` lists them; `--update-front` makes the sweep also write
- * configs/bench/front.csv. Output is markdown, ready for tools/bench/README.md. */
+ * configs/bench/front.csv. Output is markdown, ready for tools/bench/README.md.
+ * `lamprig-bench --figures [--check|--write]` prints README.md's figures block from the
+ * committed results (figures.c), checks README.md's against it, or replaces it. */
 #include "tools/bench/bench.h"
 
 #include <sched.h>
@@ -45,10 +47,23 @@ int main(int argc, char **argv)
 {
     if (argc >= 2 && (!strcmp(argv[1], "--list") || !strcmp(argv[1], "--help") ||
                       !strcmp(argv[1], "-h"))) {
-        printf("usage: lamprig-bench [--update-front] [SECTION...]\n\nsections:\n");
+        printf("usage: lamprig-bench [--update-front] [SECTION...]\n"
+               "       lamprig-bench --figures [--check|--write [README]]   README.md's figures "
+               "block\n"
+               "\nsections:\n");
         for (size_t k = 0; k < NSECTIONS; k++)
             printf("  %-10s %s\n", sections[k]->name, sections[k]->summary);
         return 0;
+    }
+    if (argc >= 2 && !strcmp(argv[1], "--figures")) {
+        if (argc == 2)
+            return lrb_figures("print", NULL);
+        if ((argc == 3 || argc == 4) && !strcmp(argv[2], "--check"))
+            return lrb_figures("check", argc == 4 ? argv[3] : NULL);
+        if ((argc == 3 || argc == 4) && !strcmp(argv[2], "--write"))
+            return lrb_figures("write", argc == 4 ? argv[3] : NULL);
+        fprintf(stderr, "usage: lamprig-bench --figures [--check|--write [README]]\n");
+        return 2;
     }
     lrb_options opt = {0};
     const char *names[64];

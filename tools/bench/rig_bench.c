@@ -13,6 +13,7 @@
 #include "tools/bench/proc.h"
 
 #include <arpa/inet.h>
+#include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
 #include <netinet/in.h>
@@ -20,10 +21,12 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
+#include "render/base/atomic_file.h"
 #include "render/base/json.h"
 #include "render/base/paths.h"
 
@@ -340,10 +343,23 @@ static int run(FILE *out)
     fflush(out);
     latency l = {0};
     int rc = dimmer_latency(dir, &l);
-    rc |= lrb_rig_controls(out, bindir, configs, dir);
+    /* The figures README.md's block is made of (tools/bench/figures.c). */
+    lr_atomic_file *af = NULL;
+    lr_err ce = {0};
+    if (((mkdir("build", 0777) && errno != EEXIST) ||
+         (mkdir("build/bench", 0777) && errno != EEXIST)) ||
+        lr_atomic_file_open("build/bench/rig.csv", &af, &ce)) {
+        fprintf(stderr, "bench rig: cannot write build/bench/rig.csv: %s\n",
+                ce.msg[0] ? ce.msg : strerror(errno));
+        af = NULL;
+    }
+    FILE *csv = af ? lr_atomic_file_stream(af) : NULL;
+    if (csv)
+        fprintf(csv, "run,control,figure,value\n");
+    rc |= lrb_rig_controls(out, csv, bindir, configs, dir);
     int mb_port = free_port();
     if (mb_port > 0)
-        rc |= lrb_rig_modbus(out, bindir, configs, dir, mb_port);
+        rc |= lrb_rig_modbus(out, csv, bindir, configs, dir, mb_port);
     else
         fprintf(out, "The Modbus demo rows: not measured (no free TCP port on 127.0.0.1).\n\n");
 
@@ -416,6 +432,23 @@ static int run(FILE *out)
         }
     }
 
+    if (csv) {
+        for (int on = 0; on < 2; on++) {
+            if (idle_fl[0][on].pct >= 0)
+                fprintf(csv, "sim,,idle_cpu_%s_pct,%.2f\n", on ? "flickering" : "steady",
+                        idle_fl[0][on].pct);
+            if (idle_fl[1][on].pct >= 0)
+                fprintf(csv, "modbus_idle,,idle_cpu_%s_pct,%.2f\n",
+                        on ? "flickering" : "steady", idle_fl[1][on].pct);
+        }
+        if (lr_atomic_file_commit(af, &ce)) {
+            fprintf(stderr, "bench rig: %s\n", ce.msg);
+            real_error = 1;
+        } else {
+            fprintf(out, "Wrote build/bench/rig.csv (README.md's figures block: "
+                         "tools/bench/README.md, \"The README's figures\").\n\n");
+        }
+    }
     if (rc == 0) {
         fprintf(out, "Control-to-frame latency of a dimmer turn: %d absolute dimmer moves, one "
                      "every %.1f s, through the candle's control map (square curve, 0.25 s fade) "

@@ -174,17 +174,27 @@ static int run_rig(const char *bindir, const char *cfg, const char *dir, int bus
     return read_run(stats, r);
 }
 
-static void print_run(FILE *out, const char *label, run_row *r)
+static void print_run(FILE *out, FILE *csv, const char *label, const char *key, run_row *r)
 {
     if (!r->ok) {
         fprintf(out, "| %s | the run failed | | | | |\n", label);
         return;
+    }
+    if (csv) {
+        fprintf(csv, "%s,,frame_interval_p99_ms,%.1f\n", key, r->fi_p99);
+        fprintf(csv, "%s,,first_frame_s,%.2f\n", key, r->first_frame_s);
     }
     for (int i = 0; i < r->n; i++) {
         ctl_row *c = &r->c[i];
         double f50 = quantile(c->first, c->n_first, 0.5), f99 = quantile(c->first, c->n_first, 0.99);
         double c50 = quantile(c->conv, c->n_conv, 0.5), c99 = quantile(c->conv, c->n_conv, 0.99);
         fprintf(out, "| %s | %s | %d | %.0f / %.0f ms | ", label, c->name, c->n_first, f50, f99);
+        if (csv) {
+            fprintf(csv, "%s,%s,first_median_ms,%.0f\n%s,%s,first_p99_ms,%.0f\n", key, c->name,
+                    f50, key, c->name, f99);
+            if (c->n_conv)
+                fprintf(csv, "%s,%s,converged_median_ms,%.0f\n", key, c->name, c50);
+        }
         if (c->n_conv)
             fprintf(out, "%.0f / %.0f ms (%d) |", c50, c99, c->n_conv);
         else
@@ -193,7 +203,8 @@ static void print_run(FILE *out, const char *label, run_row *r)
     }
 }
 
-int lrb_rig_controls(FILE *out, const char *bindir, const char *configs, const char *dir)
+int lrb_rig_controls(FILE *out, FILE *csv, const char *bindir, const char *configs,
+                     const char *dir)
 {
     char cfg_async[PATH_MAX + 32], cfg_inline[PATH_MAX + 32];
     snprintf(cfg_async, sizeof cfg_async, "%s/sim-shipped.json", dir);
@@ -217,9 +228,9 @@ int lrb_rig_controls(FILE *out, const char *bindir, const char *configs, const c
             "| run | control | events | first change median / p99 | converged median / p99 "
             "(events) | frame interval median / p99 |\n|---|---|---|---|---|---|\n",
             RUN_S);
-    print_run(out, "as shipped, idle", &idle);
-    print_run(out, "as shipped, two busy loops", &busy);
-    print_run(out, "passes_inline, idle", &inl);
+    print_run(out, csv, "as shipped, idle", "idle", &idle);
+    print_run(out, csv, "as shipped, two busy loops", "busy", &busy);
+    print_run(out, csv, "passes_inline, idle", "inline", &inl);
     fprintf(out, "\nFirst frame after start: %.2f s as shipped (idle), %.2f s beside two busy "
                  "loops, %.2f s with the transport on the loop.\n\n",
             idle.first_frame_s, busy.first_frame_s, inl.first_frame_s);

@@ -225,7 +225,8 @@ static void run_once(const char *bindir, const char *configs, const char *dir, i
         snprintf(m->why, sizeof m->why, "no polls in the simulator's trace");
 }
 
-int lrb_rig_modbus(FILE *out, const char *bindir, const char *configs, const char *dir, int port)
+int lrb_rig_modbus(FILE *out, FILE *csv, const char *bindir, const char *configs,
+                   const char *dir, int port)
 {
     mb_run r[2];
     for (int busy = 0; busy < 2; busy++) {
@@ -252,6 +253,14 @@ int lrb_rig_modbus(FILE *out, const char *bindir, const char *configs, const cha
             fprintf(out, "| %s | not measured: %s | | | | | |\n", name, m->why);
             continue;
         }
+        const char *key = busy ? "modbus_busy" : "modbus_idle";
+        if (csv)
+            fprintf(csv,
+                    "%s,,poll_p99_ms,%.0f\n%s,,poll_max_ms,%.0f\n%s,,reload_poll_max_ms,%.0f\n"
+                    "%s,,lamp_first_median_ms,%.0f\n%s,,lamp_settled_median_ms,%.0f\n"
+                    "%s,,lamp_settled_max_ms,%.0f\n",
+                    key, m->poll_p99, key, m->poll_max, key, m->rl_max, key, m->first_med, key,
+                    m->settle_med, key, m->settle_max);
         fprintf(out, "| %s | %d | %.0f / %.0f / %.0f ms | %.0f / %.0f / %.0f ms | %.0f / %.0f ms "
                      "| %.0f / %.0f ms | %d of %d |\n",
                 name, m->polls, m->poll_med, m->poll_p99, m->poll_max, m->rl_med, m->rl_p99,
