@@ -170,6 +170,13 @@ int lr_multipole_thickness_validate(double d, lr_err *e);
  * lr_dipole_rd_total and T = 0; within lr_multipole_tail(n) of the exact totals. */
 void lr_multipole_total(const lr_coeffs *c, double d, double R[3], double T[3]);
 void lr_multipole_total_n(const lr_coeffs *c, double d, int n, double R[3], double T[3]);
+/* T_total e^{sigma_tr d} per band: the slab's diffuse transmission over the attenuation
+ * e^{-sigma_tr d}, evaluated without forming either (both underflow to 0 for an optically thick
+ * slab, sigma_tr d beyond about 745, where T / e^{-sigma_tr d} is 0/0). Finite for every
+ * coefficient set lr_coeffs_derive accepts: at most alpha' e^{sqrt 3} (e^{sigma_tr l} <=
+ * e^{sqrt 3}, l the source depth; the other two factors <= 1); as sigma_tr d -> inf it tends
+ * to alpha' e^{sigma_tr l} (1 + e^{-2 sigma_tr z_b}) / 2. */
+void lr_multipole_transmission_gain(const lr_coeffs *c, double d, double out[3]);
 /* As a BSSRDF diffusion term, mm^-2 sr^-1, without Fresnel factors (like lr_dipole_sd):
  * n_i . n_o < 0 (entry and exit on opposite faces of the wall): T(r_perp) / pi with
  * r_perp = sqrt(|x_o - x_i|^2 - d^2), on a flat slab the distance from x_o to x_i's
