@@ -257,9 +257,20 @@ typedef struct lr_sss_model_props {
     /* Why a material change costs a CPU solve before its first image (seconds on the proxy,
      * configs/bench/models.csv); NULL: the model is evaluated on the GPU frame by frame. */
     const char *solves;
+    /* The largest sigma_tr = sqrt(3 sigma_a (sigma_a + sigma_s')), mm^-1, in any band, at which
+     * the model's numerics hold, and why (lr_sss_model_check_medium); 0: no limit of its own
+     * beyond lr_medium_validate's. */
+    double max_sigma_tr;
+    const char *max_sigma_tr_why;
 } lr_sss_model_props;
 /* The model's row; an all-zero row for a value outside the enum. */
 const lr_sss_model_props *lr_sss_model_props_of(enum lr_sss_model m);
+/* Whether model m holds medium med (already through lr_medium_validate): LR_OK, or LR_EINVAL
+ * with "sigma_a = A, sigma_s_prime = S (BAND): sigma_tr = sqrt(3 sigma_a (sigma_a +
+ * sigma_s_prime)) = T /mm, outside MODEL's valid range sigma_tr <= MAX /mm (WHY)" for the first
+ * band over the row's max_sigma_tr. The scene's loader and lr_scene_set refuse such a material
+ * or model change with it; the planner leaves the model out (render/plan/limits.h). */
+int lr_sss_model_check_medium(enum lr_sss_model m, const lr_medium *med, lr_err *e);
 
 /* ---- Directional dipole, Frisvad, Hachisuka, Kjeldsen 2014 (dirpole.c) ----------------- */
 
