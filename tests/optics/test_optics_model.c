@@ -17,6 +17,7 @@
 #include "render/cpu/cavity.h"
 #include "render/material/material.h"
 #include "render/optics/optics.h"
+#include "render/scene/fields.h"
 #include "render/scene/scene.h"
 
 static void test_profile(void **state)
@@ -153,6 +154,14 @@ static void test_sigma_tr_limit(void **state)
     assert_true(lr_sss_model_props_of(LR_SSS_TRANSLUCENT_RADIOSITY)->max_sigma_tr > 0.0);
     assert_true(sqrt(3.0 * 1e4 * (1e4 + 1.0)) >
                 lr_sss_model_props_of(LR_SSS_TRANSLUCENT_RADIOSITY)->max_sigma_tr);
+    /* the scene reference (`lamprig render --help-scene`, objects[i].model) states the limit */
+    const lr_field *fm = lr_field_find(&lr_scene_object_desc, 0, "model");
+    assert_non_null(fm);
+    char lim[64];
+    snprintf(lim, sizeof lim, "<= %g /mm",
+             lr_sss_model_props_of(LR_SSS_TRANSLUCENT_RADIOSITY)->max_sigma_tr);
+    if (!strstr(fm->help, lim))
+        fail_msg("objects[i].model's help lacks '%s': %s", lim, fm->help);
     char **names;
     int n = 0;
     lr_err e = {0};
