@@ -5,6 +5,7 @@
  * exp(-sigma_tr d)). */
 #include "render/optics/optics.h"
 
+#include <math.h>
 #include <string.h>
 
 static const char *const names[LR_SSS_MODEL_COUNT] = {"directional_dipole", "standard_dipole",
@@ -19,7 +20,23 @@ static const lr_sss_model_props props[LR_SSS_MODEL_COUNT] = {
                                       .no_closure = "translucent radiosity solves the cavity's "
                                                     "inter-reflection itself",
                                       .no_openings = "its receiver grid carries the inner "
-                                                     "faces' light (render/transrad/tr_scene.h)"},
+                                                     "faces' light (render/transrad/tr_scene.h)",
+                                      /* S integrates the profile over each entry patch with 256
+                                       * points about 0.75 mm apart on the renderer's 12 mm
+                                       * patches and scales each column to the profile's total
+                                       * (render/transrad/subsurface.c). e^{-sigma_tr r} falls
+                                       * below DBL_MIN at sigma_tr r = 708: at 500 /mm that is
+                                       * r = 1.4 mm, twice the points' spacing, so every patch
+                                       * keeps points whose profile is a normal double. Measured
+                                       * on the candle: right at 980 /mm; Inf in S (the total
+                                       * over a subnormal sum) at 1340 /mm, columns lost (sum 0:
+                                       * the light that enters vanishes) at 1470 /mm. */
+                                      .max_sigma_tr = 500.0,
+                                      .max_sigma_tr_why =
+                                          "a diffusion length of at least 2 um: its S samples "
+                                          "the profile about 0.75 mm apart on each 12 mm patch, "
+                                          "and a narrower profile underflows between the "
+                                          "points"},
     [LR_SSS_DIFFUSION_GRID] = {.no_profile = true,
                                .solves = "the diffusion equation is solved on the CPU grid",
                                .needs_closed = "needs a closed mesh (the grid diffusion solves "
@@ -36,6 +53,26 @@ const lr_sss_model_props *lr_sss_model_props_of(enum lr_sss_model m)
 {
     static const lr_sss_model_props none;
     return (unsigned)m < LR_SSS_MODEL_COUNT ? &props[m] : &none;
+}
+
+int lr_sss_model_check_medium(enum lr_sss_model m, const lr_medium *med, lr_err *e)
+{
+    static const char *const band[3] = {"red", "green", "blue"};
+    const lr_sss_model_props *p = lr_sss_model_props_of(m);
+    if (!(p->max_sigma_tr > 0.0))
+        return LR_OK;
+    for (int b = 0; b < 3; b++) {
+        double sa = med->sigma_a[b], ssp = med->sigma_s_prime[b];
+        double str = sqrt(3.0 * sa * (sa + ssp)); /* as lr_coeffs_derive's sigma_tr */
+        if (!(str <= p->max_sigma_tr))
+            return lr_err_set(e, LR_EINVAL,
+                              "sigma_a = %g, sigma_s_prime = %g (%s): sigma_tr = sqrt(3 sigma_a "
+                              "(sigma_a + sigma_s_prime)) = %.3g /mm, outside %s's valid range "
+                              "sigma_tr <= %g /mm (%s)",
+                              sa, ssp, band[b], str, lr_sss_model_name(m), p->max_sigma_tr,
+                              p->max_sigma_tr_why);
+    }
+    return LR_OK;
 }
 
 /* Translucent radiosity (seed 000) evaluates a profile of its own choosing: the slab multipole

@@ -177,6 +177,19 @@ void lr_multipole_total(const lr_coeffs *c, double d, double R[3], double T[3])
     }
 }
 
+void lr_multipole_transmission_gain(const lr_coeffs *c, double d, double out[3])
+{
+    for (int j = 0; j < 3; j++) {
+        /* T e^{k d} with T as in lr_multipole_total: the e^{-k (d - l)} there becomes e^{k l},
+         * and k l = sigma_tr min(1/sigma_t', d/2) <= sigma_tr / sigma_t' = sqrt(3 sigma_a /
+         * sigma_t') <= sqrt(3): finite however large k d is (T alone underflows to 0 there,
+         * and T over e^{-k d} is 0/0). */
+        double k = c->sigma_tr[j], l = source_depth(c, j, d), zb = 0.5 * (c->z_v[j] - c->z_r[j]);
+        double L = d + 2.0 * zb, ch = 0.5 * (1.0 + exp(-2.0 * k * zb));
+        out[j] = c->albedo_prime[j] * ch * exp(k * l) * sinh_ratio(k, l + zb, L);
+    }
+}
+
 void lr_multipole_sd(const lr_coeffs *c, double d, lr_vec3 xi, lr_vec3 ni, lr_vec3 xo,
                      lr_vec3 no, double out[3])
 {

@@ -170,6 +170,13 @@ int lr_multipole_thickness_validate(double d, lr_err *e);
  * lr_dipole_rd_total and T = 0; within lr_multipole_tail(n) of the exact totals. */
 void lr_multipole_total(const lr_coeffs *c, double d, double R[3], double T[3]);
 void lr_multipole_total_n(const lr_coeffs *c, double d, int n, double R[3], double T[3]);
+/* T_total e^{sigma_tr d} per band: the slab's diffuse transmission over the attenuation
+ * e^{-sigma_tr d}, evaluated without forming either (both underflow to 0 for an optically thick
+ * slab, sigma_tr d beyond about 745, where T / e^{-sigma_tr d} is 0/0). Finite for every
+ * coefficient set lr_coeffs_derive accepts: at most alpha' e^{sqrt 3} (e^{sigma_tr l} <=
+ * e^{sqrt 3}, l the source depth; the other two factors <= 1); as sigma_tr d -> inf it tends
+ * to alpha' e^{sigma_tr l} (1 + e^{-2 sigma_tr z_b}) / 2. */
+void lr_multipole_transmission_gain(const lr_coeffs *c, double d, double out[3]);
 /* As a BSSRDF diffusion term, mm^-2 sr^-1, without Fresnel factors (like lr_dipole_sd):
  * n_i . n_o < 0 (entry and exit on opposite faces of the wall): T(r_perp) / pi with
  * r_perp = sqrt(|x_o - x_i|^2 - d^2), on a flat slab the distance from x_o to x_i's
@@ -250,9 +257,20 @@ typedef struct lr_sss_model_props {
     /* Why a material change costs a CPU solve before its first image (seconds on the proxy,
      * configs/bench/models.csv); NULL: the model is evaluated on the GPU frame by frame. */
     const char *solves;
+    /* The largest sigma_tr = sqrt(3 sigma_a (sigma_a + sigma_s')), mm^-1, in any band, at which
+     * the model's numerics hold, and why (lr_sss_model_check_medium); 0: no limit of its own
+     * beyond lr_medium_validate's. */
+    double max_sigma_tr;
+    const char *max_sigma_tr_why;
 } lr_sss_model_props;
 /* The model's row; an all-zero row for a value outside the enum. */
 const lr_sss_model_props *lr_sss_model_props_of(enum lr_sss_model m);
+/* Whether model m holds medium med (already through lr_medium_validate): LR_OK, or LR_EINVAL
+ * with "sigma_a = A, sigma_s_prime = S (BAND): sigma_tr = sqrt(3 sigma_a (sigma_a +
+ * sigma_s_prime)) = T /mm, outside MODEL's valid range sigma_tr <= MAX /mm (WHY)" for the first
+ * band over the row's max_sigma_tr. The scene's loader and lr_scene_set refuse such a material
+ * or model change with it; the planner leaves the model out (render/plan/limits.h). */
+int lr_sss_model_check_medium(enum lr_sss_model m, const lr_medium *med, lr_err *e);
 
 /* ---- Directional dipole, Frisvad, Hachisuka, Kjeldsen 2014 (dirpole.c) ----------------- */
 

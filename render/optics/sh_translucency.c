@@ -84,10 +84,18 @@ void lr_sh_direct(const lr_coeffs *c, double cos_i, double out[3])
 
 void lr_sh_fit_scale(const lr_coeffs *c, double d_fit, double out[3])
 {
-    double R[3], T[3];
-    lr_multipole_total(c, d_fit, R, T);
-    for (int b = 0; b < 3; b++)
-        out[b] = T[b] / (LR_SH_DELTA_GAIN * lr_sh_atten(c->sigma_tr[b], c->sigma_t_prime[b], d_fit));
+    /* T(d_fit) / a(d_fit) as (T e^{sigma_tr d_fit}) e^{sigma_tr (max(d_fit, mfp) - d_fit)}: an
+     * optically thick material (sigma_tr d_fit beyond about 745: sigma_a 100 /mm, or sigma_s'
+     * 1e6 /mm) makes both T and a underflow to 0, and their quotient NaN or Inf in every map
+     * texel; the limit is finite (lr_multipole_transmission_gain, at most alpha' e^{sqrt 3},
+     * and the second factor at most e^{sigma_tr mfp} <= e^{sqrt 3}). B = s a E then goes to 0
+     * with a: a thick material transmits nothing. */
+    double g[3];
+    lr_multipole_transmission_gain(c, d_fit, g);
+    for (int b = 0; b < 3; b++) {
+        double k = c->sigma_tr[b], clamp = fmax(d_fit, 1.0 / c->sigma_t_prime[b]);
+        out[b] = g[b] * exp(k * (clamp - d_fit)) / LR_SH_DELTA_GAIN;
+    }
 }
 
 void lr_sh_object_scale(const lr_coeffs *c, const double preset[3], double out[3])

@@ -10,6 +10,11 @@ const char *lr_plan_model_limit(const lr_scene_object *o, enum lr_sss_model m, c
                                 size_t cap)
 {
     const lr_coeffs *c = &o->coeffs;
+    lr_err le = {0};
+    if (lr_sss_model_check_medium(m, &o->material.medium, &le)) { /* the model's numerics */
+        snprintf(buf, cap, "%s", le.msg);
+        return buf;
+    }
     if (m == LR_SSS_DIFFUSION_GRID) {
         double h = lr_dscene_spacing(o);
         double s = fmax(c->sigma_tr[0], fmax(c->sigma_tr[1], c->sigma_tr[2]));
@@ -45,7 +50,7 @@ int lr_plan_check_models(const lr_scene *s, lr_err *e)
 {
     for (int i = 0; i < lr_scene_object_count(s); i++) {
         const lr_scene_object *o = lr_scene_object_at(s, i);
-        char why[320];
+        char why[LR_ERR_MSG_MAX];
         if (lr_plan_model_limit(o, o->sss_model, why, sizeof why))
             return lr_err_set(e, LR_EINVAL, "objects[%d].model: %s is outside its validity "
                               "limit for '%s' in %s: %s", i, lr_sss_model_name(o->sss_model),

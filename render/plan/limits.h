@@ -19,6 +19,11 @@
  *                    that mean free path in some band sits wholly in the clamp: the model cannot
  *                    tell that wall from a thicker one, so its figures do not carry over.
  *
+ *   max_sigma_tr     a model whose row in render/optics/model.c has one (translucent
+ *                    radiosity: 500 /mm): beyond it (lr_sss_model_check_medium) its numerics
+ *                    fail; the scene's loader and lr_scene_set refuse that material with that
+ *                    model, and the planner leaves the model out.
+ *
  * The other models have no limit that depends on the material here (the multipole needs a
  * thickness_mm, the grid a closed mesh: lr_scene_object_model_unmet, geometry).
  */

@@ -211,6 +211,26 @@ static int check_rendered(const char *path, const lr_ref_image *img, lr_err *e)
     return LR_OK;
 }
 
+/* The paths of entry key under dir (each 4200 bytes). */
+static entry entry_paths(const char *dir, const char *key, char *mp, char *vp, char *jp)
+{
+    snprintf(mp, 4200, "%s/%s.pfm", dir, key);
+    snprintf(vp, 4200, "%s/%s.var.pfm", dir, key);
+    snprintf(jp, 4200, "%s/%s.json", dir, key);
+    return (entry){key, mp, vp, jp};
+}
+
+bool lr_ref_cache_load(const char *dir, const char key[17], int width, int height,
+                       const lr_warn_sink *warn, lr_ref_image *mean, lr_ref_image *var)
+{
+    *mean = (lr_ref_image){0};
+    *var = (lr_ref_image){0};
+    char k[17], mp[4200], vp[4200], jp[4200];
+    snprintf(k, sizeof k, "%s", key);
+    const entry en = entry_paths(dir ? dir : DEFAULT_DIR, k, mp, vp, jp);
+    return load(&en, width, height, warn, mean, var);
+}
+
 int lr_ref_render_cached(const lr_ref_scene *s, const lr_ref_camera *cam,
                          const lr_ref_render_desc *d, const char *dir,
                          void (*progress)(const lr_ref_render *r, void *user), void *user,
@@ -224,11 +244,8 @@ int lr_ref_render_cached(const lr_ref_scene *s, const lr_ref_camera *cam,
         dir = DEFAULT_DIR;
     char key[17], mp[4200], vp[4200], jp[4200];
     lr_ref_cache_key(s, cam, d, key);
-    snprintf(mp, sizeof mp, "%s/%s.pfm", dir, key);
-    snprintf(vp, sizeof vp, "%s/%s.var.pfm", dir, key);
-    snprintf(jp, sizeof jp, "%s/%s.json", dir, key);
     lr_ref_render_desc rd = lr_ref_render_desc_resolve(d);
-    const entry en = {key, mp, vp, jp};
+    const entry en = entry_paths(dir, key, mp, vp, jp);
     if (load(&en, rd.width, rd.height, warn, mean, var)) {
         *hit = true;
         return LR_OK;

@@ -401,6 +401,15 @@ int lr_ref_render_cached(const lr_ref_scene *s, const lr_ref_camera *cam,
                          const lr_warn_sink *warn, lr_ref_image *mean, lr_ref_image *var,
                          bool *hit, lr_err *e);
 
+/* The loader under lr_ref_render_cached, without the render: the entry `key` (lr_ref_cache_key)
+ * of a width x height reference under dir (NULL: "build/reference-cache"). True with *mean and
+ * *var filled (the caller frees them) when the entry passes every check above; false with
+ * nothing to free otherwise: quietly when dir/<key>.pfm is absent, else after one warning to
+ * warn naming the file and what failed. Any bytes in the three files give one of the two
+ * (tests/reference/test_reference_cache.c mutates them by the thousand under ASan). */
+bool lr_ref_cache_load(const char *dir, const char key[17], int width, int height,
+                       const lr_warn_sink *warn, lr_ref_image *mean, lr_ref_image *var);
+
 /* Content hash of an image as the cache keeps it: 64-bit FNV-1a of the width and height
  * (uint64) and every value's bits (uint32), little-endian, rows top to bottom. */
 uint64_t lr_ref_image_hash(const lr_ref_image *img);

@@ -194,7 +194,9 @@ static const lr_field object_fields[] = {
     {"model", LR_FT_ENUM, 0, O(pub.sss_model), .names = sss_models, .dirty = LR_DIRTY_MATERIAL,
      .help = "the S_d of the radiosity maps (seed 003; standard: Jensen 2001; multipole: "
              "Donner & Jensen 2005 slab, T across the wall, R on the same face; "
-             "translucent_radiosity: seed 000's patch solve with the receivers; "
+             "translucent_radiosity: seed 000's patch solve with the receivers, for materials "
+             "of sigma_tr = sqrt(3 sigma_a (sigma_a + sigma_s_prime)) <= 500 /mm in every band "
+             "(render/optics/model.c's max_sigma_tr; a material beyond is refused); "
              "diffusion_grid: seed 001's grid solve, closed meshes; sh_translucency: seed 002, SH "
              "of the entering light times a thickness attenuation, the cheapest)"},
     /* The range is lr_multipole_thickness_validate's (LR_MULTIPOLE_D_MIN..MAX). */

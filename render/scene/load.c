@@ -316,7 +316,8 @@ static int parse_object(ctx *c, lr_jnode obj, int i, obj_rec *o)
         (rc = parse_mesh(c, mesh, where, &o->mesh)) ||
         (rc = parse_transform(c, lr_json_get(c->j, obj, "transform"), where, &o->xf)))
         return rc;
-    if ((rc = lr_coeffs_derive(&o->pub.material.medium, &o->pub.coeffs, &inner)))
+    if ((rc = lr_coeffs_derive(&o->pub.material.medium, &o->pub.coeffs, &inner)) ||
+        (rc = lr_sss_model_check_medium(o->pub.sss_model, &o->pub.material.medium, &inner)))
         return lr_json_fail(c->j, mat, cat(f, sizeof f, where, "material"), c->e, rc, "%s",
                             inner.msg);
     o->pub.kind = o->mesh.kind;

@@ -225,7 +225,10 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
         snprintf(mw, sizeof mw, "%s.material", where);
         if ((rc = lr_scene_resolve_material(&m, mw, &mat, &inner)))
             return material_failed(o, rc, &inner);
-        if ((rc = lr_coeffs_derive(&mat.medium, &co, &inner)))
+        /* The object's model must hold the new material (its numerics: optics.h,
+         * lr_sss_model_props.max_sigma_tr). */
+        if ((rc = lr_coeffs_derive(&mat.medium, &co, &inner)) ||
+            (rc = lr_sss_model_check_medium(rec->pub.sss_model, &mat.medium, &inner)))
             return lr_err_set(o->e, rc, "%s: %s", o->key, inner.msg);
         rec->mat = m;
         rec->pub.material = mat;
@@ -248,6 +251,9 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
             return lr_field_fail(o, LR_EINVAL, strcmp(f, "model") == 0
                                           ? "multipole needs the object's thickness_mm set first"
                                           : "the multipole needs a thickness > 0 mm");
+        if ((rc = lr_sss_model_check_medium(next.pub.sss_model, &next.pub.material.medium,
+                                            &inner)))
+            return lr_err_set(o->e, rc, "%s: the material's %s", o->key, inner.msg);
         *rec = next;
         return LR_OK;
     }

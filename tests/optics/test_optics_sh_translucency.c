@@ -216,6 +216,51 @@ static void test_scale_predicts_slabs(void **state)
     }
 }
 
+/* An optically thick material (sigma_tr d_fit beyond about 745 in double) underflows both the
+ * slab's T(10 mm) and a(10 mm) to 0; their quotient, the scale, was then NaN (0/0) and every
+ * map texel of the object NaN or Inf (issue 34: sigma_a >= 100 or sigma_s' = 1e6 /mm).
+ *
+ * Expected value without the stable form: scaling sigma_a and sigma_s' by one factor keeps
+ * alpha', sigma_tr / sigma_t' and sigma_tr z_b (z_b = 2 A / (3 sigma_t')), and with them every
+ * factor of T / a but the slab's 1 / (1 - e^{-2 sigma_tr L}) (lr_multipole_total, while
+ * mfp <= d_fit so that a = e^{-sigma_tr d_fit}). So the scale of the thick material equals
+ * the plain quotient T / (17/16 a) of its twin scaled down to sigma_tr d_fit = 60, where
+ * nothing underflows and e^{-2 sigma_tr L} < e^{-120} is below rounding. Tolerance 1e-12
+ * relative: exp and expm1 of arguments up to 60, each good to a few ulp of the result, times
+ * the arguments' own rounding (60 * 2^-53 ~ 7e-15). */
+static void test_scale_thick_materials(void **state)
+{
+    (void)state;
+    const double sa[] = {1.0, 100.0, 1e4}, ssp[] = {1.0, 1e6};
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 2; k++) {
+            lr_medium m = {.sigma_a = {sa[i], sa[i], sa[i]},
+                           .sigma_s_prime = {ssp[k], ssp[k], ssp[k]}, .eta = 1.44, .g = 0.0};
+            lr_coeffs c, tw;
+            lr_err e = {0};
+            if (lr_coeffs_derive(&m, &c, &e) != LR_OK)
+                fail_msg("%s", e.msg);
+            double lambda = fmax(1.0, c.sigma_tr[0] * LR_SH_FIT_MM / 60.0);
+            lr_medium twin = m;
+            for (int b = 0; b < 3; b++) {
+                twin.sigma_a[b] /= lambda;
+                twin.sigma_s_prime[b] /= lambda;
+            }
+            if (lr_coeffs_derive(&twin, &tw, &e) != LR_OK)
+                fail_msg("%s", e.msg);
+            assert_true(tw.mfp[0] <= LR_SH_FIT_MM);
+            double s[3], R[3], T[3];
+            lr_sh_fit_scale(&c, LR_SH_FIT_MM, s);
+            lr_multipole_total(&tw, LR_SH_FIT_MM, R, T);
+            for (int b = 0; b < 3; b++) {
+                double want = T[b] / (LR_SH_DELTA_GAIN * exp(-tw.sigma_tr[b] * LR_SH_FIT_MM));
+                if (!(isfinite(s[b]) && s[b] > 0.0 && fabs(s[b] / want - 1.0) <= 1e-12))
+                    fail_msg("sigma_a %g sigma_s' %g band %d: scale %.17g, expected %.17g",
+                             sa[i], ssp[k], b, s[b], want);
+            }
+        }
+}
+
 /* Snell: the refracted direction at normal incidence is straight on; at 45 degrees into
  * eta 1.5 sin t = sin 45 / 1.5; under total internal reflection the mirror direction. */
 static void test_refract(void **state)
@@ -240,6 +285,7 @@ int main(void)
         cmocka_unit_test(test_eq12_closed_form),
         cmocka_unit_test(test_slab_environment),
         cmocka_unit_test(test_scale_predicts_slabs),
+        cmocka_unit_test(test_scale_thick_materials),
         cmocka_unit_test(test_refract),
     };
     return cmocka_run_group_tests_name("optics_sh_translucency", tests, NULL, NULL);

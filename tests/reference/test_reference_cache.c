@@ -495,6 +495,101 @@ static void test_cache_random_damage(void **state)
     fx_teardown(&f);
 }
 
+/* The loader's fuzz harness (every parser and cache loader has one): 3000 mutations of a good
+ * entry, a fixed seed, a third in each of its three files, the file put back after each:
+ * 1 to 4 bytes changed at random places, a truncation at a random length (0 included), or 1
+ * to 64 random bytes appended. Each lr_ref_cache_load (the loader alone: no rebuild, so the
+ * loop is cheap; ASan and UBSan watch every read) either serves images with the first
+ * render's bits, hence its hashes, finite and non-negative, and says nothing, or refuses
+ * with exactly one warning naming one of the entry's files (its key is in the name). A
+ * truncated image always loses pixel bytes, so each of those must be refused; at most the
+ * .json's trailing newline and appended bytes after a valid entry can be harmless. */
+static void test_cache_loader_mutations(void **state)
+{
+    (void)state;
+    enum { ROUNDS = 3000 };
+    entry_fx f;
+    fx_setup(&f, 6, 4, 1);
+    char key[17];
+    lr_ref_cache_key(f.s, &lamp_cam, &f.d, key);
+    const char *paths[3] = {f.mean, f.var, f.meta};
+    unsigned char *good[3];
+    size_t glen[3];
+    for (int k = 0; k < 3; k++)
+        good[k] = lr_test_read(paths[k], &glen[k]);
+    const uint64_t hm = lr_ref_image_hash(&f.m0), hv = lr_ref_image_hash(&f.v0);
+    lr_ref_rng rng;
+    lr_ref_rng_seed(&rng, 11, 0);
+    f.w.quiet = true;
+    int served[3][3] = {{0}}, refused[3][3] = {{0}}; /* [file][kind] */
+    unsigned char *buf = malloc(glen[0] + glen[1] + glen[2] + 64);
+    assert_non_null(buf);
+    for (int round = 0; round < ROUNDS; round++) {
+        int k = round % 3, kind = (int)(lr_ref_rng_uniform(&rng) * 3.0) % 3;
+        size_t len = glen[k];
+        memcpy(buf, good[k], len);
+        if (kind == 0) {
+            int n = 1 + (int)(lr_ref_rng_uniform(&rng) * 4.0) % 4;
+            for (int i = 0; i < n; i++) {
+                size_t at = (size_t)(lr_ref_rng_uniform(&rng) * (double)len) % len;
+                buf[at] ^= (unsigned char)(1 + (int)(lr_ref_rng_uniform(&rng) * 255) % 255);
+            }
+        } else if (kind == 1) {
+            len = (size_t)(lr_ref_rng_uniform(&rng) * (double)len) % len;
+        } else {
+            int n = 1 + (int)(lr_ref_rng_uniform(&rng) * 64.0) % 64;
+            for (int i = 0; i < n; i++)
+                buf[len++] = (unsigned char)((int)(lr_ref_rng_uniform(&rng) * 256.0) & 255);
+        }
+        lr_test_put(paths[k], buf, len);
+        lr_ref_image m, v;
+        int before = f.w.n;
+        bool hit = lr_ref_cache_load(f.sub, key, 6, 4, &(const lr_warn_sink){collect, &f.w},
+                                     &m, &v);
+        if (hit) {
+            assert_int_equal(f.w.n, before);
+            assert_true(lr_ref_image_hash(&m) == hm && lr_ref_image_hash(&v) == hv);
+            assert_int_equal(m.width * m.height, 24);
+            assert_memory_equal(m.rgb, f.m0.rgb, npix3(&m) * sizeof *m.rgb);
+            assert_memory_equal(v.rgb, f.v0.rgb, npix3(&v) * sizeof *v.rgb);
+            lr_ref_image_free(&m);
+            lr_ref_image_free(&v);
+            served[k][kind]++;
+        } else {
+            assert_int_equal(f.w.n, before + 1);
+            if (!strstr(f.w.last, key))
+                fail_msg("round %d: warning names none of the entry's files: %s", round,
+                         f.w.last);
+            assert_null(m.rgb);
+            assert_null(v.rgb);
+            refused[k][kind]++;
+        }
+        lr_test_put(paths[k], good[k], glen[k]);
+    }
+    static const char *const file[3] = {"mean", "variance", ".json"};
+    for (int k = 0; k < 3; k++)
+        printf("  %s: bytes changed %d served / %d refused, truncated %d / %d, extended "
+               "%d / %d\n", file[k], served[k][0], refused[k][0], served[k][1], refused[k][1],
+               served[k][2], refused[k][2]);
+    assert_int_equal(served[0][1] + served[1][1], 0);
+    /* every kind of mutation was tried on every file */
+    for (int k = 0; k < 3; k++)
+        for (int kind = 0; kind < 3; kind++)
+            assert_true(served[k][kind] + refused[k][kind] > 0);
+    /* the good entry is still served, quietly */
+    lr_ref_image m, v;
+    int before = f.w.n;
+    assert_true(lr_ref_cache_load(f.sub, key, 6, 4, &(const lr_warn_sink){collect, &f.w}, &m,
+                                  &v));
+    assert_int_equal(f.w.n, before);
+    lr_ref_image_free(&m);
+    lr_ref_image_free(&v);
+    free(buf);
+    for (int k = 0; k < 3; k++)
+        free(good[k]);
+    fx_teardown(&f);
+}
+
 /* Scene files: a full file loads into the same scene (same hash) as the equivalent calls, and
  * mistakes are reported with file:line and the field. */
 static void test_scene_file(void **state)
@@ -657,6 +752,7 @@ int main(void)
         cmocka_unit_test(test_cache_reuse),
         cmocka_unit_test(test_cache_refuses_bad_entries),
         cmocka_unit_test(test_cache_random_damage),
+        cmocka_unit_test(test_cache_loader_mutations),
         cmocka_unit_test(test_scene_file),
         cmocka_unit_test(test_scene_validation),
         cmocka_unit_test(test_from_project_scene),

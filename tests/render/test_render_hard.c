@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "render/plan/limits.h"
 #include "render/renderer.h"
 #include "render/renderer_debug.h"
 #include "tests/support/gl.h"
@@ -28,9 +29,8 @@ LR_TEST_GL_FIXTURE(gl) /* tests/support/gl.h: setup(), teardown() */
 /* Renders to convergence and checks every HDR pixel, map texel and VPL; returns the emergent
  * power per band for unit intensity, sum_v B_v A_v, divided by 4 pi (the power of a unit
  * point light), and the HDR image in *hdr_out unless that is NULL (the caller frees it). */
-static void render_and_scan_hdr(lr_scene *s, double frac[3], float **hdr_out)
+static void scan_renderer(lr_renderer *r, double frac[3], float **hdr_out)
 {
-    lr_renderer *r = lr_test_renderer(gl, s, W, H, false, 1);
     lr_test_converge(r, 8);
     float *hdr = lr_test_hdr(r);
     for (int i = 0; i < W * H * 3; i++)
@@ -75,6 +75,12 @@ static void render_and_scan_hdr(lr_scene *s, double frac[3], float **hdr_out)
         }
     }
     free(v);
+}
+
+static void render_and_scan_hdr(lr_scene *s, double frac[3], float **hdr_out)
+{
+    lr_renderer *r = lr_test_renderer(gl, s, W, H, false, 1);
+    scan_renderer(r, frac, hdr_out);
     lr_renderer_destroy(r);
 }
 
@@ -252,6 +258,81 @@ static void test_fp16_accumulation(void **state)
     lr_scene_destroy(s);
 }
 
+/* Optically thick and extreme materials on every model (issue 34: sh_translucency gave Inf
+ * pixels from sigma_a 44 /mm or sigma_s' 1e6 /mm, translucent radiosity Inf at sigma_s' 1e6
+ * and sigma_a 1e4 /mm): sigma_a in {1, 100, 1e4} x sigma_s' in {1, 1e6} /mm on a ball lit
+ * from outside, over a table, each set on marble. Each combination is either refused with a
+ * message that starts with the key that was set and says why in terms of sigma_tr
+ * (lr_scene_set: the model's numerics, render/optics/model.c's max_sigma_tr;
+ * lr_plan_check_models, which `lamprig render` and the rig run before rendering: the
+ * planner's limits, the grid's spacing), or renders an image, maps and VPLs that are finite
+ * and >= 0, with the emergent power within check_energy's bound (a finite 1e32 fails there: at
+ * most 1.6 of the light's power). Cheap: one renderer per model, one frame of K 2, N 1,
+ * 16^2 maps after each change. */
+static void test_extreme_materials(void **state)
+{
+    (void)state;
+    static const char *const tiny[] = {"render.K=2", "render.N=1", "render.map_size=16",
+                                       "render.gbuffer_size=32", "render.vpl_map_size=8",
+                                       "render.N_vpl=8", "render.frames=1", NULL};
+    static const char text[] =
+        "{\"name\": \"ball\", \"objects\": [{\"name\": \"ball\", \"material\": \"marble\","
+        " \"mesh\": {\"type\": \"sphere\", \"radius\": 40, \"subdivisions\": 2}}],"
+        " \"lights\": [{\"type\": \"point\", \"position\": [0, -60, 120], \"intensity\": 1}],"
+        " \"camera\": {\"position\": [0, -300, 120], \"target\": [0, 0, 0]},"
+        " \"receivers\": [{\"name\": \"table\", \"type\": \"plane\", \"center\": [0, 0, -40],"
+        " \"normal\": [0, 0, 1], \"size\": [160, 160], \"albedo\": [0.8, 0.8, 0.8]}]}";
+    static const char *const sa[] = {"1", "100", "1e4"}, *const ssp[] = {"1", "1e6"};
+    int rendered = 0, refused = 0;
+    for (int m = 0; m < LR_SSS_MODEL_COUNT; m++) {
+        const char *model = lr_sss_model_name((enum lr_sss_model)m);
+        lr_scene *s = lr_test_scene_text(text, tiny);
+        lr_err e = {0};
+        if (lr_sss_model_props_of((enum lr_sss_model)m)->needs_thickness &&
+            lr_scene_set(s, "objects[0].thickness_mm", "5", NULL, &e))
+            fail_msg("%s", e.msg);
+        if (lr_scene_set(s, "objects[0].model", model, NULL, &e))
+            fail_msg("%s: %s", model, e.msg); /* marble: within every model */
+        lr_renderer *r = NULL;
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 2; k++) {
+                char a[32], b[32];
+                snprintf(a, sizeof a, "%s,%s,%s", sa[i], sa[i], sa[i]);
+                snprintf(b, sizeof b, "%s,%s,%s", ssp[k], ssp[k], ssp[k]);
+                unsigned d0 = 0, d1 = 0, d2 = 0;
+                if (lr_scene_set(s, "objects[0].material", "marble", &d0, &e))
+                    fail_msg("%s", e.msg);
+                const char *key = NULL;
+                if (lr_scene_set(s, "objects[0].material.sigma_s_prime", b, &d1, &e))
+                    key = "objects[0].material.sigma_s_prime: ";
+                else if (lr_scene_set(s, "objects[0].material.sigma_a", a, &d2, &e))
+                    key = "objects[0].material.sigma_a: ";
+                else if (lr_plan_check_models(s, &e))
+                    key = "objects[0].model: ";
+                printf("%s sigma_a %s sigma_s' %s: %s\n", model, sa[i], ssp[k],
+                       key ? e.msg : "rendered");
+                if (key) {
+                    assert_true(strncmp(e.msg, key, strlen(key)) == 0);
+                    assert_non_null(strstr(e.msg, "sigma_tr"));
+                    refused++;
+                    continue;
+                }
+                if (r)
+                    lr_renderer_invalidate(r, d0 | d1 | d2);
+                else
+                    r = lr_test_renderer(gl, s, W, H, false, 1);
+                double f[3];
+                scan_renderer(r, f, NULL);
+                check_energy(model, f, 0.0);
+                rendered++;
+            }
+        lr_renderer_destroy(r);
+        lr_scene_destroy(s);
+    }
+    /* both outcomes occur (else the sweep checks only one of them) */
+    assert_true(rendered > 0 && refused > 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -262,6 +343,7 @@ int main(void)
         cmocka_unit_test(test_light_outside),
         cmocka_unit_test(test_directional_and_spot),
         cmocka_unit_test(test_fp16_accumulation),
+        cmocka_unit_test(test_extreme_materials),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
