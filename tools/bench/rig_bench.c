@@ -433,6 +433,10 @@ static int run(FILE *out)
     }
 
     if (csv) {
+        /* How idle "idle" was: the 1-minute load average as the section ends. */
+        double la[3] = {0};
+        if (getloadavg(la, 3) >= 1)
+            fprintf(csv, "host,,load_average,%.2f\n", la[0]);
         for (int on = 0; on < 2; on++) {
             if (idle_fl[0][on].pct >= 0)
                 fprintf(csv, "sim,,idle_cpu_%s_pct,%.2f\n", on ? "flickering" : "steady",
