@@ -639,7 +639,7 @@ void lr_async_stop(lr_async *a)
     a->scene_detached = true;
     pthread_mutex_lock(&a->mu);
     a->stop = true;
-    lr_cancel_request(&a->cancel); /* a solve under way ends at its next poll */
+    lr_cancel_request(&a->cancel, LR_CANCEL_STOP); /* what runs ends at its next poll */
     pthread_cond_broadcast(&a->cv);
     pthread_mutex_unlock(&a->mu);
 }
@@ -666,7 +666,7 @@ void lr_async_destroy(lr_async *a)
     if (a->joinable) {
         pthread_mutex_lock(&a->mu);
         a->stop = true;
-        lr_cancel_request(&a->cancel);
+        lr_cancel_request(&a->cancel, LR_CANCEL_STOP);
         pthread_cond_broadcast(&a->cv);
         pthread_mutex_unlock(&a->mu);
         pthread_join(a->th, NULL);
@@ -696,7 +696,7 @@ uint64_t lr_async_commit(lr_async *a, unsigned dirty)
     /* The worker's frame solves a state this batch replaces: cut it (render/base/cancel.h),
      * so that the new state's first image does not wait for the stale one's. */
     if ((dirty & TRANSPORT_DIRTY) && a->cancellable) {
-        lr_cancel_request(&a->cancel);
+        lr_cancel_request(&a->cancel, LR_CANCEL_STALE);
         a->cancellable = false;
     }
     pthread_cond_broadcast(&a->cv);

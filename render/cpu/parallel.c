@@ -13,6 +13,7 @@ typedef struct job {
     lr_cpu_item_fn fn;
     void *ctx;
     const lr_cancel *cancel;
+    enum lr_cancel_level level;
     atomic_bool stopped;
 } job;
 
@@ -28,7 +29,7 @@ static void *worker(void *p)
 {
     job *j = p;
     for (;;) {
-        if (lr_cancel_requested(j->cancel)) {
+        if (lr_cancel_at(j->cancel, j->level)) {
             atomic_store(&j->stopped, true);
             break;
         }
@@ -44,17 +45,17 @@ static void *worker(void *p)
 
 void lr_cpu_parallel_for(long count, int threads, lr_cpu_item_fn fn, void *ctx)
 {
-    (void)lr_cpu_parallel_for_cancel(count, threads, fn, ctx, NULL);
+    (void)lr_cpu_parallel_for_cancel(count, threads, fn, ctx, NULL, LR_CANCEL_STALE);
 }
 
 bool lr_cpu_parallel_for_cancel(long count, int threads, lr_cpu_item_fn fn, void *ctx,
-                                const lr_cancel *cancel)
+                                const lr_cancel *cancel, enum lr_cancel_level level)
 {
     if (threads <= 0)
         threads = lr_cpu_threads_default();
     if (threads > LR_CPU_MAX_THREADS)
         threads = LR_CPU_MAX_THREADS;
-    job j = {.count = count, .fn = fn, .ctx = ctx, .cancel = cancel};
+    job j = {.count = count, .fn = fn, .ctx = ctx, .cancel = cancel, .level = level};
     atomic_init(&j.next, 0);
     atomic_init(&j.stopped, false);
     pthread_t tid[LR_CPU_MAX_THREADS];

@@ -18,10 +18,11 @@ int lr_cpu_threads_default(void);
  * cannot start only makes the loop slower: every item is run either way. */
 void lr_cpu_parallel_for(long count, int threads, lr_cpu_item_fn fn, void *ctx);
 
-/* The same, polling `cancel` (may be NULL) before each chunk: once it is requested no new
- * chunk starts (those under way finish), and the call returns false -- some items did not
- * run, so the outputs are incomplete and the caller must discard them. True: every item ran. */
+/* The same, polling `cancel` (may be NULL) before each chunk: once it is requested at `level`
+ * or above no new chunk starts (those under way finish), and the call returns false -- some
+ * items did not run, so the outputs are incomplete and the caller must discard them. True:
+ * every item ran. */
 bool lr_cpu_parallel_for_cancel(long count, int threads, lr_cpu_item_fn fn, void *ctx,
-                                const lr_cancel *cancel);
+                                const lr_cancel *cancel, enum lr_cancel_level level);
 
 #endif

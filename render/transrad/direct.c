@@ -190,7 +190,8 @@ int lr_tr_direct(lr_tr *t, const lr_light *light, lr_err *e)
     if (lr_light_is_area(light))
         return lr_tr_direct_area(t, light, e);
     dl_ctx c = {t, light, lr_tr_eps(t)};
-    if (!lr_cpu_parallel_for_cancel((long)t->n, t->set.threads, dl_item, &c, t->set.cancel))
+    if (!lr_cpu_parallel_for_cancel((long)t->n, t->set.threads, dl_item, &c, t->set.cancel,
+                                    LR_CANCEL_STALE))
         return lr_cancel_check(t->set.cancel, "transrad: direct light", e);
     return LR_OK;
 }

@@ -119,8 +119,10 @@ int lr_tr_build_form_factors(lr_tr *t, lr_err *e)
         rc = lr_err_set(e, LR_ENOMEM, "transrad: out of memory (form factors, %zu patches)", n);
         goto done;
     }
-    if (!lr_cpu_parallel_for_cancel((long)n, t->set.threads, ff_item, &c, t->set.cancel)) {
-        rc = lr_cancel_check(t->set.cancel, "transrad: form factors", e);
+    /* F depends on the geometry alone and is cached on disk: only a stop cuts it. */
+    if (!lr_cpu_parallel_for_cancel((long)n, t->set.threads, ff_item, &c, t->set.cancel,
+                                    LR_CANCEL_STOP)) {
+        rc = lr_cancel_check_at(t->set.cancel, LR_CANCEL_STOP, "transrad: form factors", e);
         goto done;
     }
     if (c.failed) {

@@ -323,14 +323,15 @@ int lr_tr_build_subsurface(lr_tr *t, lr_err *e)
             goto done;
         }
         c.dist = dist;
+        /* Cached on disk with F: only a stop cuts it. */
         bool all = lr_cpu_parallel_for_cancel((long)t->surf[s].count, t->set.threads, ss_item,
-                                              &c, t->set.cancel);
+                                              &c, t->set.cancel, LR_CANCEL_STOP);
         free(dist);
         free(c.thick);
         free(c.thin);
         free(c.spreads);
         if (!all) {
-            rc = lr_cancel_check(t->set.cancel, "transrad: subsurface", e);
+            rc = lr_cancel_check_at(t->set.cancel, LR_CANCEL_STOP, "transrad: subsurface", e);
             goto done;
         }
         if (c.failed) {

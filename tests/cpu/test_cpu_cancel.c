@@ -1,6 +1,6 @@
 /* The cancellation token (render/base/cancel.h) in the CPU loops it cuts: a parallel loop
- * starts no chunk once the token is requested and says so; without a request (or without a
- * token) every item runs exactly once. */
+ * starts no chunk once the token is requested (at the loop's level) and says so; without a
+ * request (or without a token) every item runs exactly once. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -20,6 +20,7 @@ typedef struct ctx {
     unsigned char *hit;
     lr_cancel *cancel;
     long cut_at; /* the item that requests the cancel; -1: none */
+    enum lr_cancel_level request; /* what it requests (0: stale) */
 } ctx;
 
 static void item(void *p, long i)
@@ -28,15 +29,21 @@ static void item(void *p, long i)
     c->hit[i]++;
     atomic_fetch_add(&c->ran, 1);
     if (i == c->cut_at)
-        lr_cancel_request(c->cancel);
+        lr_cancel_request(c->cancel, c->request ? c->request : LR_CANCEL_STALE);
 }
 
-static void run(ctx *c, const lr_cancel *token, int threads, bool *all)
+static void run_at(ctx *c, const lr_cancel *token, int threads, enum lr_cancel_level level,
+                   bool *all)
 {
     c->hit = calloc(COUNT, 1);
     assert_non_null(c->hit);
     atomic_init(&c->ran, 0);
-    *all = lr_cpu_parallel_for_cancel(COUNT, threads, item, c, token);
+    *all = lr_cpu_parallel_for_cancel(COUNT, threads, item, c, token, level);
+}
+
+static void run(ctx *c, const lr_cancel *token, int threads, bool *all)
+{
+    run_at(c, token, threads, LR_CANCEL_STALE, all);
 }
 
 static void test_no_request_runs_every_item_once(void **state)
@@ -61,7 +68,7 @@ static void test_request_before_runs_nothing(void **state)
     (void)state;
     lr_cancel t;
     lr_cancel_init(&t);
-    lr_cancel_request(&t);
+    lr_cancel_request(&t, LR_CANCEL_STALE);
     assert_true(lr_cancel_requested(&t));
     ctx c = {.cancel = &t, .cut_at = -1};
     bool all;
@@ -100,12 +107,38 @@ static void test_request_midway_stops_new_chunks(void **state)
     }
 }
 
+/* A loop that only a stop may cut (a cache build that outlives the state): a stale request
+ * lets every item run; a stop midway cuts it; a stop is never lowered back to stale. */
+static void test_levels(void **state)
+{
+    (void)state;
+    lr_cancel t;
+    lr_cancel_init(&t);
+    ctx c = {.cancel = &t, .cut_at = 1000, .request = LR_CANCEL_STALE};
+    bool all;
+    run_at(&c, &t, 2, LR_CANCEL_STOP, &all);
+    assert_true(all);
+    assert_int_equal(atomic_load(&c.ran), COUNT);
+    assert_true(lr_cancel_requested(&t));
+    assert_false(lr_cancel_at(&t, LR_CANCEL_STOP));
+    free(c.hit);
+    lr_cancel_reset(&t);
+    ctx d = {.cancel = &t, .cut_at = 1000, .request = LR_CANCEL_STOP};
+    run_at(&d, &t, 2, LR_CANCEL_STOP, &all);
+    assert_false(all);
+    assert_true(atomic_load(&d.ran) < COUNT);
+    free(d.hit);
+    lr_cancel_request(&t, LR_CANCEL_STALE);
+    assert_true(lr_cancel_at(&t, LR_CANCEL_STOP));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_no_request_runs_every_item_once),
         cmocka_unit_test(test_request_before_runs_nothing),
         cmocka_unit_test(test_request_midway_stops_new_chunks),
+        cmocka_unit_test(test_levels),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
