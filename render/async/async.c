@@ -736,14 +736,17 @@ bool lr_async_busy(const lr_async *a)
     return b;
 }
 
-uint64_t lr_async_published(const lr_async *a)
+/* A counter the worker writes, read under the lock. */
+static uint64_t locked_u64(const lr_async *a, const uint64_t *field)
 {
-    lr_async *m = (lr_async *)a;
+    lr_async *m = (lr_async *)a; /* the mutex only */
     pthread_mutex_lock(&m->mu);
-    uint64_t p = a->published;
+    uint64_t v = *field;
     pthread_mutex_unlock(&m->mu);
-    return p;
+    return v;
 }
+
+uint64_t lr_async_published(const lr_async *a) { return locked_u64(a, &a->published); }
 
 /* Takes the ready publication once the worker's copy has finished on the GPU. */
 static bool take_ready(lr_async *a)
@@ -861,11 +864,7 @@ int lr_async_error(lr_async *a, lr_err *e)
 
 uint64_t lr_async_publications(const lr_async *a, lr_async_stage stage)
 {
-    lr_async *m = (lr_async *)a;
-    pthread_mutex_lock(&m->mu);
-    uint64_t n = (unsigned)stage <= LR_ASYNC_FINAL ? a->n_stage[stage] : 0;
-    pthread_mutex_unlock(&m->mu);
-    return n;
+    return (unsigned)stage <= LR_ASYNC_FINAL ? locked_u64(a, &a->n_stage[stage]) : 0;
 }
 
 bool lr_async_cuttable(const lr_async *a)
@@ -877,14 +876,7 @@ bool lr_async_cuttable(const lr_async *a)
     return c;
 }
 
-uint64_t lr_async_cancelled(const lr_async *a)
-{
-    lr_async *m = (lr_async *)a;
-    pthread_mutex_lock(&m->mu);
-    uint64_t n = a->n_cancelled;
-    pthread_mutex_unlock(&m->mu);
-    return n;
-}
+uint64_t lr_async_cancelled(const lr_async *a) { return locked_u64(a, &a->n_cancelled); }
 
 int lr_async_event_fd(const lr_async *a) { return a->efd; }
 

@@ -101,6 +101,18 @@ static double max_abs(const float *x, size_t n)
     return m;
 }
 
+/* got against want within 1e-5 of want's peak (float rounding of the same sums). */
+static void assert_same_image(const float *got, const float *want, const char *what)
+{
+    size_t n = (size_t)W * H * 3;
+    double peak = max_abs(want, n), worst = 0;
+    assert_true(peak > 0);
+    for (size_t i = 0; i < n; i++)
+        worst = fmax(worst, fabs((double)got[i] - want[i]));
+    printf("%s: worst |diff| %.3g of peak %.3g\n", what, worst, peak);
+    assert_true(worst <= 1e-5 * peak);
+}
+
 static void set(lr_scene *s, const char *key, const char *value, unsigned *dirty)
 {
     lr_err e = {0};
@@ -127,13 +139,7 @@ static void test_final_is_the_renderers_image(void **state)
     lr_renderer *r = lr_test_renderer(f->gl, s, W, H, false, 1);
     lr_test_converge(r, 50);
     float *want = lr_test_hdr(r);
-    size_t n = (size_t)W * H * 3;
-    double peak = max_abs(want, n), worst = 0;
-    assert_true(peak > 0);
-    for (size_t i = 0; i < n; i++)
-        worst = fmax(worst, fabs((double)got[i] - want[i]));
-    printf("async vs renderer: worst |diff| %.3g of peak %.3g\n", worst, peak);
-    assert_true(worst <= 1e-5 * peak);
+    assert_same_image(got, want, "async vs renderer");
     free(got);
     free(want);
     lr_renderer_destroy(r);
@@ -297,13 +303,7 @@ static void test_newer_change_cuts_a_stale_solve(void **state)
     assert_int_equal(st.batch, b2);
     assert_int_equal(st.stage, LR_ASYNC_FINAL);
     float *want = fresh_image(f->gl, s);
-    size_t n = (size_t)W * H * 3;
-    double peak = max_abs(want, n), worst = 0;
-    assert_true(peak > 0);
-    for (size_t i = 0; i < n; i++)
-        worst = fmax(worst, fabs((double)got[i] - want[i]));
-    printf("after a cut vs a fresh renderer: worst |diff| %.3g of peak %.3g\n", worst, peak);
-    assert_true(worst <= 1e-5 * peak);
+    assert_same_image(got, want, "after a cut vs a fresh renderer");
     free(got);
     free(want);
     lr_async_destroy(a);

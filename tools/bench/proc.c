@@ -26,10 +26,13 @@ void lrb_print_log(const char *path)
     fclose(f);
 }
 
-pid_t lrb_spawn(char *const argv[], const char *log_path)
+/* The child: stdin from in_fd (-1: inherited), stdout and stderr to log_path, argv[0]. */
+static pid_t spawn(char *const argv[], const char *log_path, int in_fd)
 {
     pid_t pid = fork();
     if (pid == 0) {
+        if (in_fd >= 0)
+            dup2(in_fd, 0);
         int fd = open(log_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
         if (fd >= 0) {
             dup2(fd, 1);
@@ -41,23 +44,18 @@ pid_t lrb_spawn(char *const argv[], const char *log_path)
     return pid;
 }
 
+pid_t lrb_spawn(char *const argv[], const char *log_path)
+{
+    return spawn(argv, log_path, -1);
+}
+
 pid_t lrb_spawn_piped(char *const argv[], const char *log_path, int *stdin_fd)
 {
     int p[2];
     *stdin_fd = -1;
     if (pipe2(p, O_CLOEXEC) != 0)
         return -1;
-    pid_t pid = fork();
-    if (pid == 0) {
-        dup2(p[0], 0);
-        int fd = open(log_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (fd >= 0) {
-            dup2(fd, 1);
-            dup2(fd, 2);
-        }
-        execv(argv[0], argv);
-        _exit(127);
-    }
+    pid_t pid = spawn(argv, log_path, p[0]);
     close(p[0]);
     if (pid < 0)
         close(p[1]);
