@@ -95,8 +95,8 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e);
  * radiosity's and the receiver bounce's builds and sweeps). Once it is requested the frame
  * returns LR_ECANCELED with nothing composed and everything it would have done still due:
  * the next frame (after the owner resets the token) redoes it, and its image is the one an
- * uninterrupted frame would have given (to the solvers' tolerances: a cut solve restarts
- * cold, not warm). The pointer must stay valid until the renderer is destroyed or it is
+ * uninterrupted frame would have given (to the solvers' tolerances: a cut solve's partial
+ * iterate is the next one's warm start). The pointer must stay valid until the renderer is destroyed or it is
  * set again. For a caller that runs the renderer on a thread of its own (render/async). */
 void lr_renderer_set_cancel(lr_renderer *r, const lr_cancel *cancel);
 

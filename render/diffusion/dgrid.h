@@ -234,7 +234,8 @@ int lr_dsolver_solve_rgb(lr_dsolver *s, int slot, lr_dirradiance_rgb_fn q, const
  * solutions stay as warm starts. */
 int lr_dsolver_set_material(lr_dsolver *s, const lr_dmaterial *m, lr_err *e);
 /* Polled by the solves from now on (NULL: never cancelled; render/base/cancel.h). A cancelled
- * solve returns LR_ECANCELED and forgets the slot's solution, as a failed one does. */
+ * solve returns LR_ECANCELED; its partial iterate stays in the slot as the next solve's warm
+ * start (a failed solve forgets the slot). */
 void lr_dsolver_set_cancel(lr_dsolver *s, const lr_cancel *cancel);
 /* Forgets the slot's solution (the next solve starts coarse-to-fine). */
 void lr_dsolver_reset(lr_dsolver *s, int slot);

@@ -193,6 +193,7 @@ int lr_dsolver_solve_rgb(lr_dsolver *s, int slot, lr_dirradiance_rgb_fn q, const
         return lr_err_set(e, LR_EINVAL, "diffusion solver: tol = %g: must be in (0, 1)", tol);
     s->last_iters = 0;
     int first = s->has[slot] ? 0 : s->levels - 1;
+    bool fine_started = false;
     double *xs[LR_DSOLVER_MAX_LEVELS] = {0}, *rhs[LR_DSOLVER_MAX_LEVELS][3] = {{0}};
     int rc = LR_OK;
     /* The right-hand side (the incident light at the ghosts' surface points, one ray cast
@@ -226,6 +227,8 @@ int lr_dsolver_solve_rgb(lr_dsolver *s, int slot, lr_dirradiance_rgb_fn q, const
                 memset(x, 0, n * sizeof *x);
             }
             int it = 0;
+            if (l == 0)
+                fine_started = true;
             rc = lr_dsystem_solve_cancel(s->sys[l][c], false, rhs[l][c], x,
                                          l == 0 ? tol : fmax(tol, 1e-3), 20000, &it, s->cancel,
                                          e);
@@ -241,7 +244,14 @@ int lr_dsolver_solve_rgb(lr_dsolver *s, int slot, lr_dirradiance_rgb_fn q, const
     for (int l = 0; l < LR_DSOLVER_MAX_LEVELS; l++)
         for (int c = 0; c < 3; c++)
             free(rhs[l][c]);
-    s->has[slot] = rc == LR_OK;
+    /* A cut solve's fluence is a partial iterate, not a solution, but a fine start for the
+     * next solve (BiCGSTAB takes any guess; this one is nearer the new state than the last
+     * solution was): kept as the warm start when the finest level was reached or the slot had
+     * one. A failed solve forgets the slot. */
+    if (rc == LR_ECANCELED)
+        s->has[slot] = s->has[slot] || fine_started;
+    else
+        s->has[slot] = rc == LR_OK;
     if (rc && rc != LR_ECANCELED)
         lr_err_prefix(e, "diffusion solver");
     return rc;

@@ -84,8 +84,9 @@ static int solve(lr_tr *t, int slot, lr_tr_stats *st, lr_err *e)
     lr_tr_stats s = {0};
     for (int it = 0; it < t->set.max_iterations; it++) {
         if (lr_cancel_requested(t->set.cancel)) {
-            /* W is a partial sweep's: not a solution (H, Hind not built from it). */
-            sl->valid = false;
+            /* W is a partial sweep's: not a solution (H, Hind are the last solve's), but a fine
+             * warm start (a warm start rebuilds phi and refl from W against the new E); the
+             * slot is read only after a whole solve. */
             free(refl);
             free(Wn);
             free(phi);

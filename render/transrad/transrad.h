@@ -118,8 +118,8 @@ typedef struct lr_tr_settings {
     lr_warn_once *warned;   /* the caller's: folders already said; NULL: said at every store */
     /* Polled during create (form factors, subsurface, direct light) and by every solve (per
      * sweep); kept (lr_tr_set_cancel replaces it). NULL: never cancelled. A cancelled create
-     * fails with LR_ECANCELED and stores no cache; a cancelled solve leaves its slot invalid
-     * (the next solve starts cold). Not part of the cache key. */
+     * fails with LR_ECANCELED and stores no cache; a cancelled solve leaves its partial sweep
+     * as the next solve's warm start. Not part of the cache key. */
     const lr_cancel *cancel;
 } lr_tr_settings;
 

@@ -272,9 +272,10 @@ static float *fresh_image(lr_gl *gl, lr_scene *s)
  * the worker cuts the stale solve at its next poll and solves the new state. So the
  * stale state is never published (one final image for the two batches, none of the first),
  * one frame was cut, and the image is the new state's as a fresh renderer draws it: the cut
- * solve left nothing behind. The grid restarts cold after a cut, as a fresh renderer's does,
- * so both run the same iterations to the same tolerance: float rounding apart (the same
- * 1e-5 of the peak as above), they agree. Without the cut the stale state is solved and
+ * solve left nothing behind. The cut solve's partial iterate is the next solve's warm start
+ * and the fresh renderer starts cold; both solve to the grid's relative residual 1e-5
+ * (render/diffusion/dscene.c), and the surface field is linear in the fluence, so the images
+ * agree to about that: the same 1e-5 of the peak as above (measured: 3e-13). Without the cut the stale state is solved and
  * published first (two finals, no cut frame). */
 static void test_newer_change_cuts_a_stale_solve(void **state)
 {
