@@ -341,9 +341,17 @@ int lr_dscene_update(lr_dscene *d, const lr_scene *s, lr_err *e)
         dobj *D = &d->obj[i];
         D->rebuilt = false;
         const lr_scene_object *o = i < n ? lr_scene_object_at(s, i) : NULL;
-        if (!o || o->sss_model != LR_SSS_DIFFUSION_GRID) {
-            if (D->active)
-                dobj_clear(D);
+        if (!o) {
+            dobj_clear(D);
+            continue;
+        }
+        if (o->sss_model != LR_SSS_DIFFUSION_GRID) {
+            /* Kept, not freed: the rig's preview frame renders the object with a profile
+             * model and the refinement right after it comes back to the grid (render/async/);
+             * a freed grid was built again at every change (its build is most of a 5 mm
+             * solve's cost). Inactive, it gives no field; its memory stays until the object
+             * goes or the dscene is destroyed. */
+            D->active = false;
             continue;
         }
         double h = lr_dscene_spacing(o);

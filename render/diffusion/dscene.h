@@ -56,7 +56,8 @@ typedef struct lr_dfield_view {
 
 int lr_dscene_create(lr_dscene **out, lr_err *e);
 void lr_dscene_destroy(lr_dscene *d);
-/* Brings every diffusion_grid object of s up to date for every light. */
+/* Brings every diffusion_grid object of s up to date for every light. An object that turns to
+ * another model keeps its grid (inactive: no field) for when it turns back. */
 int lr_dscene_update(lr_dscene *d, const lr_scene *s, lr_err *e);
 /* Polled by the updates' solves from now on (NULL: never cancelled; render/base/cancel.h): a
  * cancelled update returns LR_ECANCELED; the objects keep their grids, and the next update

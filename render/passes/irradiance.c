@@ -142,6 +142,14 @@ void lr_irradiance_bind_objects(const lr_irradiance *irr, const lr_pass_ctx *c, 
  * and the bounce E_b added to the grids in place; composition then reads it like E_vpl. */
 static int bounce(lr_irradiance *irr, const lr_pass_ctx *c, const lr_radiosity *rad, lr_err *e)
 {
+    if (!lr_rbounce_needed(c->scene) && irr->rb) {
+        lr_rbounce_destroy(irr->rb_parked);
+        irr->rb_parked = irr->rb;
+        irr->rb = NULL;
+    } else if (lr_rbounce_needed(c->scene) && !irr->rb && irr->rb_parked) {
+        irr->rb = irr->rb_parked; /* rebuilds only what changed since (keyed) */
+        irr->rb_parked = NULL;
+    }
     int rc = lr_rbounce_update(&irr->rb, c->scene, c->cancel, e);
     /* render.opening_light (render/openings/openings.h): rebuilt only when the geometry, a
      * light or a material changed; its grid joins E_vpl before the bounce reads it. */
@@ -212,6 +220,8 @@ void lr_irradiance_free(lr_irradiance *irr)
     lr_irradiance_free_grids(irr);
     lr_rbounce_destroy(irr->rb);
     irr->rb = NULL;
+    lr_rbounce_destroy(irr->rb_parked);
+    irr->rb_parked = NULL;
     lr_openings_destroy(irr->op);
     irr->op = NULL;
 }

@@ -24,6 +24,10 @@ typedef struct lr_irradiance {
      * after the grids are drawn they are read back, the receivers' radiosity solved per light
      * and the bounce added to them; NULL when off. */
     struct lr_rbounce *rb;
+    /* The bounce while it is off, kept for when it comes back (the rig's preview frame turns
+     * it off and the refinement right after it on again: rebuilt, its F and the receivers'
+     * light on the objects cost about a second on the candle at every change). */
+    struct lr_rbounce *rb_parked;
     /* The receivers' light on the objects (render/bounce/objlight.h;
      * render.receiver_light_on_objects), per object: E+ and E- per vertex and light at unit
      * intensity, LR_RL_TEX_WIDTH texels a row, light l side s (0: E+, 1: E-) from row
