@@ -41,8 +41,11 @@ typedef struct pend_rec {
 
 struct lr_rig_stats {
     int64_t start_ns;
+    /* A ring, oldest first from pending_head: with no converged frame (a flickering scene)
+     * it stays full, and dropping the oldest by moving the other 1023 (120 KiB) cost more
+     * than everything else an event does. */
     pend_rec pending[PENDING_MAX];
-    int n_pending;
+    int pending_head, n_pending;
     uint64_t dropped_pending;
     ev_rec *events; /* ring of LOG_MAX */
     uint64_t n_events;
@@ -85,22 +88,30 @@ void lr_rig_stats_destroy(lr_rig_stats *s)
     free(s);
 }
 
+/* The i-th pending event, oldest first. */
+static pend_rec *pending_at(lr_rig_stats *s, int i)
+{
+    return &s->pending[(s->pending_head + i) % PENDING_MAX];
+}
+
 void lr_rig_stats_event(lr_rig_stats *s, const lr_event *ev)
 {
     if (s->n_pending == PENDING_MAX) {
         /* A frame that never comes (renderer failing): keep the newest. */
-        memmove(s->pending, s->pending + 1, (PENDING_MAX - 1) * sizeof s->pending[0]);
+        s->pending_head = (s->pending_head + 1) % PENDING_MAX;
         s->n_pending--;
         s->dropped_pending++;
     }
-    s->pending[s->n_pending++] = (pend_rec){.ev = *ev, .batch = UNTAGGED};
+    *pending_at(s, s->n_pending++) = (pend_rec){.ev = *ev, .batch = UNTAGGED};
 }
 
+/* The untagged events are the newest ones: an event joins untagged at the end, a tag tags
+ * all of them and frames keep the order. So the scan stops at the first tagged one from the
+ * end (with 1024 waiting it was a third of a frame's bookkeeping). */
 void lr_rig_stats_tag(lr_rig_stats *s, uint64_t batch)
 {
-    for (int i = 0; i < s->n_pending; i++)
-        if (s->pending[i].batch == UNTAGGED)
-            s->pending[i].batch = batch;
+    for (int i = s->n_pending - 1; i >= 0 && pending_at(s, i)->batch == UNTAGGED; i--)
+        pending_at(s, i)->batch = batch;
 }
 
 void lr_rig_stats_unmatched(lr_rig_stats *s) { s->unmatched++; }
@@ -138,7 +149,7 @@ void lr_rig_stats_frame_shown(lr_rig_stats *s, const lr_frame_stats *f,
         return;
     int keep = 0;
     for (int i = 0; i < s->n_pending; i++) {
-        pend_rec *p = &s->pending[i];
+        pend_rec *p = pending_at(s, i);
         /* Untagged: applied after this frame's images were chosen; a later batch: the images
          * shown are older than the change. */
         bool shows = p->batch != UNTAGGED && p->batch <= info->batch;
@@ -164,7 +175,10 @@ void lr_rig_stats_frame_shown(lr_rig_stats *s, const lr_frame_stats *f,
                 s->events[p->ev_index % LOG_MAX].converge_ms = ms;
             continue; /* done with */
         }
-        s->pending[keep++] = *p;
+        /* Kept in order; keep <= i, so this never overwrites one not yet read. */
+        if (keep != i)
+            *pending_at(s, keep) = *p;
+        keep++;
     }
     s->n_pending = keep;
 }
@@ -175,7 +189,7 @@ int lr_rig_stats_pending(const lr_rig_stats *s)
 {
     int n = 0;
     for (int i = 0; i < s->n_pending; i++)
-        n += !s->pending[i].shown;
+        n += !s->pending[(s->pending_head + i) % PENDING_MAX].shown;
     return n;
 }
 uint64_t lr_rig_stats_frames(const lr_rig_stats *s) { return s->n_frames; }

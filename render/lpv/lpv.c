@@ -12,6 +12,7 @@ struct lr_lpv {
     lr_lpv_desc d;
     lr_lpv_stencil st;
     double *cur, *tmp; /* n^3 * 12 */
+    double *scale;     /* n^3 * 3: lr_lpv_step's scratch */
     double *abs;       /* (n+1)^3 * 18 */
     float *blk;              /* (n+1)^3 * 4 */
     double dropped[3];
@@ -39,7 +40,8 @@ int lr_lpv_create(const lr_lpv_desc *d, lr_lpv **out, lr_err *e)
     v->abs = calloc(corners(d->n) * 18, sizeof *v->abs);
     v->tmp = calloc(m, sizeof *v->tmp);
     v->blk = calloc(corners(d->n) * 4, sizeof *v->blk);
-    if (!v->cur || !v->abs || !v->tmp || !v->blk) {
+    v->scale = calloc(cells(d->n) * 3, sizeof *v->scale);
+    if (!v->cur || !v->abs || !v->tmp || !v->blk || !v->scale) {
         lr_lpv_destroy(v);
         return lr_err_set(e, LR_ENOMEM, "lpv: out of memory for %d^3 cells", d->n);
     }
@@ -56,6 +58,7 @@ void lr_lpv_destroy(lr_lpv *v)
     free(v->abs);
     free(v->tmp);
     free(v->blk);
+    free(v->scale);
     free(v);
 }
 
@@ -206,7 +209,7 @@ int lr_lpv_propagate(lr_lpv *v, int steps, lr_err *e)
         return lr_err_set(e, LR_EINVAL, "lpv: steps = %d, must be 0 to %d (4 n)", steps,
                           4 * v->d.n);
     for (int s = 0; s < steps; s++) {
-        lr_lpv_step(&v->st, v->d.n, v->blk, v->cur, v->tmp, v->abs);
+        lr_lpv_step(&v->st, v->d.n, v->blk, v->cur, v->tmp, v->abs, v->scale);
         double *t = v->cur;
         v->cur = v->tmp;
         v->tmp = t;

@@ -140,8 +140,9 @@ const float *lr_lpv_blocking(const lr_lpv *v);
 const double *lr_lpv_absorbed(const lr_lpv *v);
 
 /* One propagation step on raw arrays (the CPU reference of the compute shader): dst = the
- * transfer of src (n^3 * 12 each), adding the blocked flux to absorbed. */
+ * transfer of src (n^3 * 12 each), adding the blocked flux to absorbed; scale is n^3 * 3
+ * scratch (each source cell's clamp scale per channel). */
 void lr_lpv_step(const lr_lpv_stencil *st, int n, const float *blocking, const double *src,
-                 double *dst, double *absorbed);
+                 double *dst, double *absorbed, double *scale);
 
 #endif

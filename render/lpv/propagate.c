@@ -23,9 +23,16 @@ static double source_scale(const lr_lpv_stencil *st, const double *c)
 }
 
 void lr_lpv_step(const lr_lpv_stencil *st, int n, const float *blocking, const double *src,
-                 double *dst, double *absorbed)
+                 double *dst, double *absorbed, double *scale)
 {
     size_t n1 = (size_t)n + 1;
+    /* Each source cell's scale per channel, once a step: its six destinations read the same
+     * value (the shader recomputes it per destination, in parallel; here that was six times
+     * the 30 face products a source needs, most of a step's arithmetic). The same function
+     * of the same coefficients, so the same numbers. */
+    for (size_t c = 0; c < (size_t)n * n * n; c++)
+        for (int ch = 0; ch < 3; ch++)
+            scale[c * 3 + ch] = source_scale(st, &src[c * 12 + ch * 4]);
     for (int k = 0; k < n; k++)
         for (int j = 0; j < n; j++)
             for (int i = 0; i < n; i++) {
@@ -49,10 +56,11 @@ void lr_lpv_step(const lr_lpv_stencil *st, int n, const float *blocking, const d
                     /* The travel sign: 1 toward -axis. Only this destination's pass touches
                      * this interface in this direction, so the record needs no atomics. */
                     double *ab = &absorbed[(iface * 6 + 2 * a + (m % 2)) * 3];
-                    const double *cs = &src[(((size_t)s[2] * n + s[1]) * n + s[0]) * 12];
+                    size_t sidx = ((size_t)s[2] * n + s[1]) * n + s[0];
+                    const double *cs = &src[sidx * 12];
                     for (int ch = 0; ch < 3; ch++) {
                         const double *c = &cs[ch * 4];
-                        double sc = source_scale(st, c);
+                        double sc = scale[sidx * 3 + ch];
                         if (sc <= 0.0)
                             continue;
                         double sent = 0.0;

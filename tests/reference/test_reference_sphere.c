@@ -172,7 +172,13 @@ static void test_conservative_sphere_emits_all(void **state)
  * every camera-path connection refracts through the cavity wall (Newton-solved NEE, curved
  * interface). Photons: all power leaves (no absorption), exactly. Camera paths: their share of
  * it, and Newton solves (practically) every connection: at most 1 in 10^4 unsolved. Then the
- * same with absorption. 256 000 camera paths, 400 000 photons. */
+ * same with absorption. 128 000 camera paths (the binary's cost: Newton solves every NEE
+ * connection), 400 000 photons. The camera SE scales as 1/sqrt(paths): measured 1.8e-3 and
+ * 1.1e-3 at 256 000, so about 2.5e-3 and 1.6e-3 here against the bound 4e-3 sqrt(2) = 5.7e-3;
+ * with the photons' SE the agreement's 4 SE is about 1.1e-2 on 0.78 and 7e-3 on 0.52 (1.4 %
+ * relative), still well under what a dropped Fresnel transmittance at the cavity wall (>= 3 %
+ * at eta 1.4) or a wrong (n1/n2)^2 or Jacobian of the refracted connection (tens of %) move
+ * the camera estimate by. */
 static void test_shell_around_light(void **state)
 {
     (void)state;
@@ -191,13 +197,13 @@ static void test_shell_around_light(void **state)
         assert_int_equal(r.stats.medium_mismatch, 0);
         lr_ref_scene *s = shell_scene(&md, R, cavity, light);
         lr_ref_stats st;
-        lr_ref_estimate cam = lrt_camera_outflow(s, R, 256000, 34 + (uint64_t)absorbing, &st);
-        assert_true(cam.se < 4e-3 && r.escaped_scattered.se < 2e-3);
+        lr_ref_estimate cam = lrt_camera_outflow(s, R, 128000, 34 + (uint64_t)absorbing, &st);
+        assert_true(cam.se < 5.7e-3 && r.escaped_scattered.se < 2e-3);
         /* Every connection crosses the curved cavity wall: Newton must solve all of them
          * (a smooth convex wall has exactly one refracted path to each point). */
         printf("  %llu refracted connections, %llu unsolved\n",
                (unsigned long long)st.nee_refracted, (unsigned long long)st.nee_unsolved);
-        assert_true(st.nee_refracted > 100000);
+        assert_true(st.nee_refracted > 100000); /* measured 1.0-1.1 10^6 */
         assert_true(st.nee_unsolved <= st.nee_refracted / 10000);
         lrt_assert_agree(absorbing ? "shell, absorbing: camera vs photons"
                                : "shell: camera vs photons", cam, nee_share(&r));
