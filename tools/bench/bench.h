@@ -35,6 +35,8 @@ extern const lrb_section lrb_camera_section;
 
 /* Monotonic wall clock in seconds. */
 double lrb_now(void);
+/* The q-quantile (0..1, nearest rank) of v[0..n), sorting v in place; NaN when n < 1. */
+double lrb_quantile(double *v, int n, double q);
 /* CPU time of the calling thread in seconds: what the rates are measured in, so that time the
  * scheduler gives to other processes on a shared machine does not count (on an idle core it
  * equals wall time). */

@@ -36,21 +36,6 @@ typedef struct run_row {
     bool ok;
 } run_row;
 
-static int cmp_d(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double quantile(double *v, int n, double q)
-{
-    if (n < 1)
-        return NAN;
-    qsort(v, (size_t)n, sizeof *v, cmp_d);
-    int i = (int)ceil(q * n) - 1;
-    return v[i < 0 ? 0 : i >= n ? n - 1 : i];
-}
-
 static ctl_row *row_for(run_row *r, const char *name)
 {
     for (int i = 0; i < r->n; i++)
@@ -103,8 +88,8 @@ static int read_run(const char *stats, run_row *r)
             iv[n_iv++] = (t - prev) * 1e3;
         prev = t;
     }
-    r->fi_median = iv ? quantile(iv, n_iv, 0.5) : NAN;
-    r->fi_p99 = iv ? quantile(iv, n_iv, 0.99) : NAN;
+    r->fi_median = iv ? lrb_quantile(iv, n_iv, 0.5) : NAN;
+    r->fi_p99 = iv ? lrb_quantile(iv, n_iv, 0.99) : NAN;
     free(iv);
     if (rc)
         fprintf(stderr, "bench rig: %s\n", e.msg);
@@ -186,8 +171,10 @@ static void print_run(FILE *out, FILE *csv, const char *label, const char *key, 
     }
     for (int i = 0; i < r->n; i++) {
         ctl_row *c = &r->c[i];
-        double f50 = quantile(c->first, c->n_first, 0.5), f99 = quantile(c->first, c->n_first, 0.99);
-        double c50 = quantile(c->conv, c->n_conv, 0.5), c99 = quantile(c->conv, c->n_conv, 0.99);
+        double f50 = lrb_quantile(c->first, c->n_first, 0.5),
+               f99 = lrb_quantile(c->first, c->n_first, 0.99);
+        double c50 = lrb_quantile(c->conv, c->n_conv, 0.5),
+               c99 = lrb_quantile(c->conv, c->n_conv, 0.99);
         fprintf(out, "| %s | %s | %d | %.0f / %.0f ms | ", label, c->name, c->n_first, f50, f99);
         if (csv) {
             fprintf(csv, "%s,%s,first_median_ms,%.0f\n%s,%s,first_p99_ms,%.0f\n", key, c->name,

@@ -36,29 +36,11 @@ typedef struct mb_run {
     int steps, answered, polls;
 } mb_run;
 
-static double mono_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
-}
-
-static int cmp_d(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 static void stats3(double *v, int n, double *med, double *p99, double *max)
 {
-    *med = *p99 = *max = NAN;
-    if (n < 1)
-        return;
-    qsort(v, (size_t)n, sizeof *v, cmp_d);
-    *med = v[(n - 1) / 2];
-    int i = (int)ceil(0.99 * n) - 1;
-    *p99 = v[i < 0 ? 0 : i];
-    *max = v[n - 1];
+    *med = lrb_quantile(v, n, 0.5);
+    *p99 = lrb_quantile(v, n, 0.99);
+    *max = lrb_quantile(v, n, 1.0);
 }
 
 /* Waits until the simulator's log shows a poll of the panel (the rig is up and connected). */
@@ -198,7 +180,7 @@ static void run_once(const char *bindir, const char *configs, const char *dir, i
                 break;
             if (k == HUP_AFTER_STEP) {
                 lrb_sleep_s(STEP_S / 2);
-                t_hup = mono_s();
+                t_hup = lrb_now(); /* CLOCK_MONOTONIC, as the trace */
                 kill(rig, SIGHUP);
             }
         }
