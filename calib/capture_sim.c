@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/cpu/rng.h"
+#include "render/base/rng.h"
 
 static double gamma_of(const lr_sensor *s)
 {
@@ -181,16 +181,16 @@ int lr_sensor_parse_vignette(const char *text, lr_sensor *s, lr_err *e)
     return LR_OK;
 }
 
-static double gauss(lr_cpu_rng *r)
+static double gauss(lr_rng *r)
 {
     /* Box-Muller; 1 - u keeps the log finite. */
-    double u1 = 1.0 - lr_cpu_rng_next(r), u2 = lr_cpu_rng_next(r);
+    double u1 = 1.0 - lr_rng_next(r), u2 = lr_rng_next(r);
     return sqrt(-2.0 * log(u1)) * cos(2.0 * M_PI * u2);
 }
 
 /* Photo-electron count for mean lambda: Knuth's product method below 64 (exact Poisson,
  * where its skew matters), the normal approximation N(lambda, lambda) above. */
-static double poisson(lr_cpu_rng *r, double lambda)
+static double poisson(lr_rng *r, double lambda)
 {
     if (lambda <= 0)
         return 0;
@@ -200,7 +200,7 @@ static double poisson(lr_cpu_rng *r, double lambda)
     int k = -1;
     do {
         k++;
-        p *= lr_cpu_rng_next(r);
+        p *= lr_rng_next(r);
     } while (p > limit);
     return k;
 }
@@ -229,7 +229,7 @@ int lr_sensor_capture(const lr_sensor *s, const lr_image *radiance, lr_img *out,
         for (int c = 0; c < 3; c++) {
             double x = X[3 * i + c];
             if (s->full_well_e > 0) {
-                lr_cpu_rng r = lr_cpu_rng_init(lr_cpu_key(seed, i, (uint64_t)c, 0x43415053u));
+                lr_rng r = lr_rng_init(lr_rng_key(seed, i, (uint64_t)c, 0x43415053u));
                 double el = poisson(&r, x > 0 ? x / sat[c] * s->full_well_e : 0.0);
                 if (s->read_noise_e > 0)
                     el += s->read_noise_e * gauss(&r);

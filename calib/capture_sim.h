@@ -28,7 +28,7 @@
  * evaluated analytically: z = 255 (X (128/255)^gamma)^(1/gamma).
  *
  * Noise is a pure function of (seed, pixel, channel): a counter-based generator
- * (render/cpu/rng.h), so a capture is reproducible and independent of evaluation order.
+ * (render/base/rng.h), so a capture is reproducible and independent of evaluation order.
  * With full_well_e = 0 there is no shot noise; with read_noise_e = 0 no read noise.
  */
 #ifndef LR_CALIB_CAPTURE_SIM_H

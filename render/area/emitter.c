@@ -3,7 +3,7 @@
 #include <stdlib.h>
 
 #include "render/area/emitter.h"
-#include "render/cpu/rng.h"
+#include "render/base/rng.h"
 
 int lr_area_quad(lr_vec3 center, lr_vec3 half_u, lr_vec3 half_v, bool two_sided,
                  lr_area_emitter *out, lr_err *e)
@@ -78,10 +78,10 @@ void lr_area_stratified(const lr_area_emitter *em, int n, uint64_t seed, lr_vec3
     while (g > 1 && n % g)
         g--;
     int h = n / g;
-    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(seed, (uint64_t)n, 0x57A7, 0));
+    lr_rng rng = lr_rng_init(lr_rng_key(seed, (uint64_t)n, 0x57A7, 0));
     for (int i = 0; i < g; i++)
         for (int j = 0; j < h; j++) {
-            double u1 = (i + lr_cpu_rng_next(&rng)) / g, u2 = (j + lr_cpu_rng_next(&rng)) / h;
+            double u1 = (i + lr_rng_next(&rng)) / g, u2 = (j + lr_rng_next(&rng)) / h;
             out[i * h + j] = lr_area_point(em, u1, u2);
         }
 }
@@ -103,12 +103,12 @@ static double torus_d2(const double a[2], const double b[2], double sx, double s
 void lr_area_poisson_uv(double sx, double sy, double r_min, int cap, int max_fails,
                         uint64_t seed, double (*uv)[2], int *n)
 {
-    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(seed, 0x9015, 0, 0));
+    lr_rng rng = lr_rng_init(lr_rng_key(seed, 0x9015, 0, 0));
     double r2 = r_min * r_min;
     int fails = 0, count = 0;
     /* Few points on an emitter (tens to a few thousand): a linear scan is simple enough. */
     while (count < cap && fails < max_fails) {
-        double c[2] = {lr_cpu_rng_next(&rng), lr_cpu_rng_next(&rng)};
+        double c[2] = {lr_rng_next(&rng), lr_rng_next(&rng)};
         bool ok = true;
         for (int i = 0; i < count && ok; i++)
             ok = torus_d2(c, uv[i], sx, sy) >= r2;

@@ -2,7 +2,7 @@
 #include <math.h>
 
 #include "render/area/frames.h"
-#include "render/cpu/rng.h"
+#include "render/base/rng.h"
 
 int lr_area_from_light(const lr_light *l, lr_area_emitter *out, lr_err *e)
 {
@@ -35,9 +35,9 @@ lr_vec3 lr_area_frame_point(const lr_area_sequence *seq, long frame)
     int j = (int)(f % seq->n);
     double s0 = 0.0, s1 = 0.0;
     if (c > 0) {
-        lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(0xC9A7, (uint64_t)c, 0, 0));
-        s0 = lr_cpu_rng_next(&rng);
-        s1 = lr_cpu_rng_next(&rng);
+        lr_rng rng = lr_rng_init(lr_rng_key(0xC9A7, (uint64_t)c, 0, 0));
+        s0 = lr_rng_next(&rng);
+        s1 = lr_rng_next(&rng);
     }
     double u = seq->uv[j][0] + s0, v = seq->uv[j][1] + s1;
     return lr_area_point(&seq->em, u - floor(u), v - floor(v));

@@ -3,7 +3,7 @@
 #include <stdlib.h>
 
 #include "render/area/poisson_mesh.h"
-#include "render/cpu/rng.h"
+#include "render/base/rng.h"
 #include "render/mesh/area_pick.h"
 
 /* A hash grid of r_min cells: cell -> chain of sample indices. */
@@ -17,7 +17,7 @@ typedef struct grid {
 
 static size_t bucket(const grid *g, long ix, long iy, long iz)
 {
-    uint64_t h = lr_cpu_key((uint64_t)ix, (uint64_t)iy, (uint64_t)iz, 0x6A1D);
+    uint64_t h = lr_rng_key((uint64_t)ix, (uint64_t)iy, (uint64_t)iz, 0x6A1D);
     return (size_t)(h % g->buckets);
 }
 
@@ -72,15 +72,15 @@ int lr_poisson_mesh(const lr_mesh *m, double r_min, int cap, int max_fails, uint
     double total = 0.0;
     for (size_t t = 0; t < nt; t++)
         cdf[t] = total += lr_mesh_triangle_area(m, t);
-    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(seed, 0x7D05, nt, 0));
+    lr_rng rng = lr_rng_init(lr_rng_key(seed, 0x7D05, nt, 0));
     double r2 = r_min * r_min;
     int n = 0, fails = 0;
     while (n < cap && fails < max_fails) {
-        size_t t = lr_cdf_pick(cdf, nt, lr_cpu_rng_next(&rng) * total);
+        size_t t = lr_cdf_pick(cdf, nt, lr_rng_next(&rng) * total);
         lr_vec3 q[3];
         lr_mesh_triangle(m, t, q);
         /* Uniform in the triangle: the square root folds the unit square onto it. */
-        double a = sqrt(lr_cpu_rng_next(&rng)), b = lr_cpu_rng_next(&rng);
+        double a = sqrt(lr_rng_next(&rng)), b = lr_rng_next(&rng);
         lr_vec3 p = lr_v3_add(lr_v3_scale(q[0], 1.0 - a),
                               lr_v3_add(lr_v3_scale(q[1], a * (1.0 - b)),
                                         lr_v3_scale(q[2], a * b)));

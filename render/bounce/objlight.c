@@ -7,7 +7,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "render/cpu/parallel.h"
+#include "render/base/parallel.h"
 #include "render/lpv/objfield.h"
 #include "render/optics/optics.h"
 
@@ -175,7 +175,7 @@ static int build_mesh(const lr_tr *t, lr_objlight *ol, int i, const double (*dir
                         "(%zu vertices)", i, nv);
         goto done;
     }
-    lr_cpu_parallel_for((long)items, 0, row_item, &c);
+    lr_parallel_for((long)items, 0, row_item, &c);
     if (c.failed) {
         rc = lr_err_set(e, LR_ENOMEM, "receiver light on objects: object %d: out of memory "
                         "(rows)", i);

@@ -8,7 +8,7 @@
 #include <time.h>
 
 #include "render/bounce/objlight.h"
-#include "render/cpu/recv_grid.h"
+#include "render/core/recv_grid.h"
 #include "render/transrad/tr_scene.h"
 
 #define KEY_MAX (3 + LR_TR_MAX_SURFACES * (LR_TR_KEY_MESH + 5))

@@ -1,7 +1,7 @@
 /* lamprig — receiver inter-reflection for every model (issue 12 part 4; render/bounce/README.md).
  *
  * The plane receivers get the light's direct light (per pixel in composition) and the objects'
- * emergent light through the VPLs (the receiver irradiance grid, render/cpu/recv_grid.h), but
+ * emergent light through the VPLs (the receiver irradiance grid, render/core/recv_grid.h), but
  * the light a receiver reflects never reaches another: the candle's table, lit only by what
  * the wall sends back, stayed black. This adds the receivers' radiosity solution of seed 000
  * with S = P (the albedo) on the receivers,

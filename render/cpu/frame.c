@@ -8,19 +8,19 @@
 #include <time.h>
 
 #include "render/base/mat4.h"
-#include "render/cpu/cavity.h"
+#include "render/models/cavity_gains.h"
 #include "render/cpu/maps.h"
-#include "render/cpu/parallel.h"
+#include "render/base/parallel.h"
 #include "render/bounce/objlight.h"
 #include "render/bounce/rbounce.h"
 #include "render/openings/openings.h"
-#include "render/cpu/recv_grid.h"
+#include "render/core/recv_grid.h"
 #include "render/lpv/scene_lpv.h"
 #include "render/transrad/tr_scene.h"
-#include "render/cpu/rng.h"
-#include "render/cpu/sh.h"
-#include "render/cpu/surface.h"
-#include "render/cpu/vpl.h"
+#include "render/base/rng.h"
+#include "render/models/sh.h"
+#include "render/core/surface.h"
+#include "render/core/vpl.h"
 
 void lr_cpu_camera_ray(const lr_scene *s, int width, int height, int px, int py, lr_vec3 *org,
                        lr_vec3 *dir)
@@ -45,14 +45,14 @@ typedef struct rctx {
     double inv_vp[16];
     lr_cpu_maps **maps;  /* [obj * nlight + light] (PASS) */
     const lr_scene_object **objs; /* every object: occluders of each other's light lookups */
-    lr_cpu_vpl *vpl;     /* [obj * nvpl + v]; B per band already summed over lights with I */
+    lr_vpl_point *vpl;     /* [obj * nvpl + v]; B per band already summed over lights with I */
     double (*I)[3];      /* per light: intensity * color */
-    double (*gain)[3];   /* [obj * nlight + light]: cavity gain (render/cpu/cavity.h) */
+    double (*gain)[3];   /* [obj * nlight + light]: cavity gain (render/core/cavity.h) */
     lr_sh_env *sh;       /* [obj * nlight + light]: sh_translucency environments */
     lr_image *rgb, *var;
     long *object_px, *fallback_px; /* per pixel flags, summed at the end */
     /* PASS: per receiver, E_vpl and its variance at the grid's texel centres (6 doubles per
-     * texel; render/cpu/recv_grid.h, the GPU's receiver irradiance grid), NULL for a receiver
+     * texel; render/core/recv_grid.h, the GPU's receiver irradiance grid), NULL for a receiver
      * without a grid. */
     double **grid;
     /* render.receiver_bounce: per receiver, the bounced irradiance F B on the receiver grid
@@ -83,7 +83,7 @@ typedef struct rctx {
     int *nfl;
     /* PASS with render.surface_cache: per object its lattice (render/mesh/lattice.h) and,
      * per light, side and lattice point, B (3 doubles), its variance (3) and whether a map
-     * saw it (1): the GPU's surface cache (render/cpu/surface.h), interpolated per pixel. NULL: per pixel. */
+     * saw it (1): the GPU's surface cache (render/core/surface.h), interpolated per pixel. NULL: per pixel. */
     lr_refined *ref;
     double **cache;
     long *cache_first; /* item -> (object, light, side, vertex): prefix over objects */
@@ -98,7 +98,7 @@ static double direct_at(const rctx *r, int l, lr_vec3 x, lr_vec3 n)
 {
     double sum = 0.0;
     for (int f = 0; f < r->nfl[l]; f++)
-        sum += lr_cpu_direct_irradiance(r->s, &r->fl[l][f], x, n);
+        sum += lr_direct_irradiance(r->s, &r->fl[l][f], x, n);
     return sum / r->nfl[l];
 }
 
@@ -133,7 +133,7 @@ static void radiosity_at(const rctx *r, int o, int l, lr_vec3 x, lr_vec3 n, uint
         for (int f = 0; f < m; f++) {
             lr_cpu_estimate est;
             lr_cpu_radiosity(lr_scene_object_at(r->s, o), &r->fl[l][f], x, n, &rd,
-                             lr_cpu_key(key, (uint64_t)f, 0, 0), &est);
+                             lr_rng_key(key, (uint64_t)f, 0, 0), &est);
             for (int c = 0; c < 3; c++) {
                 B[c] += est.mean[c] / m;
                 var[c] += est.var[c] / est.n / ((double)m * m);
@@ -152,13 +152,13 @@ static void vpl_item(void *p, long item)
 {
     rctx *r = p;
     int o = (int)(item / r->nvpl);
-    lr_cpu_vpl *v = &r->vpl[item];
+    lr_vpl_point *v = &r->vpl[item];
     if (!v->valid)
         return;
     for (int l = 0; l < r->nlight; l++) {
         double B[3], var[3];
         radiosity_at(r, o, l, v->x, v->n,
-                     lr_cpu_key(seed_of(r) ^ 0x7B1u, (uint64_t)item, (uint64_t)l, 0), B, var, NULL);
+                     lr_rng_key(seed_of(r) ^ 0x7B1u, (uint64_t)item, (uint64_t)l, 0), B, var, NULL);
         for (int c = 0; c < 3; c++) {
             v->B[c] += r->I[l][c] * B[c];
             v->var[c] += r->I[l][c] * r->I[l][c] * var[c];
@@ -237,7 +237,7 @@ static void grid_item(void *p, long item)
     double *E = r->grid[i] + 6 * (size_t)k;
     const lr_scene *vis = lr_scene_render(r->s)->vpl_visibility ? r->s : NULL;
     for (int o = 0; o < r->nobj; o++)
-        lr_cpu_vpl_irradiance_vis(vis, r->vpl + (size_t)o * r->nvpl, r->nvpl,
+        lr_vpl_point_irradiance_vis(vis, r->vpl + (size_t)o * r->nvpl, r->nvpl,
                                   lr_scene_object_at(r->s, o)->coeffs.eta, x, rc->normal, E,
                                   E + 3);
     /* Translucent radiosity: what the VPLs do not carry, per light at unit intensity
@@ -391,7 +391,7 @@ static bool trace(const lr_scene *s, lr_vec3 org, lr_vec3 dir, int *kind, int *i
         return false;
     if (*kind == 0) {
         /* Same hit again, now with the interpolated normal. */
-        lr_cpu_first_surface(lr_scene_object_at(s, *index), org, dir, 0.0, x, n);
+        lr_first_surface(lr_scene_object_at(s, *index), org, dir, 0.0, x, n);
     } else {
         *x = lr_v3_add(org, lr_v3_scale(dir, best));
     }
@@ -418,14 +418,14 @@ static void render_pixels(rctx *r)
     const lr_progress *pg = r->d->progress;
     long n = (long)r->W * r->H;
     if (!pg || !pg->fn) {
-        lr_cpu_parallel_for(n, r->d->threads, pixel_item, r);
+        lr_parallel_for(n, r->d->threads, pixel_item, r);
         return;
     }
     enum { SPANS = 16 };
     lr_progress_report(pg, "cpu pixels", 0, SPANS);
     for (int k = 0; k < SPANS; k++) {
         pixel_span s = {r, n * k / SPANS};
-        lr_cpu_parallel_for(n * (k + 1) / SPANS - s.base, r->d->threads, span_item, &s);
+        lr_parallel_for(n * (k + 1) / SPANS - s.base, r->d->threads, span_item, &s);
         lr_progress_report(pg, "cpu pixels", k + 1, SPANS);
     }
 }
@@ -462,7 +462,7 @@ static void pixel_item(void *p, long item)
                 cached_at(r, idx, l, side, hit.triangle, hit.u, hit.v, B, var, &fb);
             else
                 radiosity_at(r, idx, l, x, n,
-                             lr_cpu_key(seed_of(r), (uint64_t)item, (uint64_t)l, 1), B, var, &fb);
+                             lr_rng_key(seed_of(r), (uint64_t)item, (uint64_t)l, 1), B, var, &fb);
             if (fb)
                 r->fallback_px[item] = 1;
             if (r->lpv_obj && r->lpv_obj[l])
@@ -496,7 +496,7 @@ static void pixel_item(void *p, long item)
         } else if (!r->d->no_vpl) {
             const lr_scene *vis = lr_scene_render(r->s)->vpl_visibility ? r->s : NULL;
             for (int o = 0; o < r->nobj; o++)
-                lr_cpu_vpl_irradiance_vis(vis, r->vpl + (size_t)o * r->nvpl, r->nvpl,
+                lr_vpl_point_irradiance_vis(vis, r->vpl + (size_t)o * r->nvpl, r->nvpl,
                                           lr_scene_object_at(r->s, o)->coeffs.eta, x, n, E, EV);
             /* render.opening_light at the pixel itself (the PASS grid's cells, exactly). */
             for (int l = 0; r->op && l < r->nlight; l++) {
@@ -646,7 +646,7 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
             rc = lr_err_set(e, LR_ENOMEM, "cpu render: out of memory");
             goto fail;
         }
-        rc = lr_cpu_cavity_scene_gains(s, l, d->threads, g, r.nobj, e);
+        rc = lr_cavity_scene_gains(s, l, d->threads, g, r.nobj, e);
         for (int o = 0; o < r.nobj && !rc; o++)
             for (int c = 0; c < 3; c++)
                 r.gain[o * r.nlight + l][c] = g[o][c];
@@ -671,7 +671,7 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
                                        .K = d->K ? d->K : rs->K,
                                        .map_size = d->map_size ? d->map_size : rs->map_size,
                                        .N = d->N ? d->N : rs->N,
-                                       .seed = (unsigned)lr_cpu_key(seed_of(&r), (uint64_t)o,
+                                       .seed = (unsigned)lr_rng_key(seed_of(&r), (uint64_t)o,
                                                                     (uint64_t)l, 2),
                                        .threads = d->threads,
                                        .others = r.objs,
@@ -717,7 +717,7 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
                 goto fail;
             }
         }
-        lr_cpu_parallel_for(r.cache_first[r.nobj], d->threads, cache_item, &r);
+        lr_parallel_for(r.cache_first[r.nobj], d->threads, cache_item, &r);
     }
     int nv = 0;
     /* render.opening_light: both modes (PASS through the grid, REFERENCE per pixel). */
@@ -725,8 +725,8 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
         goto fail;
     if (r.nvpl > 0) {
         for (int o = 0; o < r.nobj; o++)
-            lr_cpu_vpl_place(lr_scene_object_at(s, o), r.nvpl, r.vpl + (size_t)o * r.nvpl);
-        lr_cpu_parallel_for((long)r.nobj * r.nvpl, d->threads, vpl_item, &r);
+            lr_vpl_place(lr_scene_object_at(s, o), r.nvpl, r.vpl + (size_t)o * r.nvpl);
+        lr_parallel_for((long)r.nobj * r.nvpl, d->threads, vpl_item, &r);
         for (long v = 0; v < (long)r.nobj * r.nvpl; v++)
             nv += r.vpl[v].valid;
         if (ref)
@@ -753,7 +753,7 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
                 goto fail;
             }
         }
-        lr_cpu_parallel_for((long)(r.nrecv * n), d->threads, grid_item, &r);
+        lr_parallel_for((long)(r.nrecv * n), d->threads, grid_item, &r);
         if ((rc = opening_light(&r, e)) || (rc = receiver_bounce(&r, e)))
             goto fail;
         if (ref) { /* the reference's pixels sum the VPLs themselves */

@@ -6,8 +6,8 @@
 #include <string.h>
 
 #include "render/area/frames.h"
-#include "render/cpu/parallel.h"
-#include "render/cpu/rng.h"
+#include "render/base/parallel.h"
+#include "render/base/rng.h"
 #include "render/transrad/tr_scene.h"
 #include "render/optics/sh_translucency.h"
 
@@ -64,7 +64,7 @@ static void raster_item(void *p, long item)
     memset(t, 0, sizeof *t);
     lr_vec3 x, n;
     lr_vec3 back = lr_v3_scale(m->dir[k], -1.0);
-    if (lr_cpu_first_surface(m->obj, org, back, 0.0, &x, &n)) {
+    if (lr_first_surface(m->obj, org, back, 0.0, &x, &n)) {
         if (!m->obj->closed && lr_v3_dot(n, m->dir[k]) < 0.0)
             n = lr_v3_scale(n, -1.0); /* two-sided open surface: the side the map sees */
         t->valid = true;
@@ -118,7 +118,7 @@ int lr_cpu_maps_create(const lr_cpu_maps_desc *d, lr_cpu_maps **out, lr_err *e)
     }
     place_views(m);
     raster_ctx rc = {m};
-    lr_cpu_parallel_for((long)m->K * m->S * m->S, m->threads, raster_item, &rc);
+    lr_parallel_for((long)m->K * m->S * m->S, m->threads, raster_item, &rc);
     *out = m;
     return LR_OK;
 }
@@ -170,7 +170,7 @@ static void acc_item(void *p, long item)
                                .sh_env = m->has_sh ? &m->sh : NULL};
     lr_cpu_estimate est;
     lr_cpu_radiosity(m->obj, &a->light, t->x, t->n, &d,
-                     lr_cpu_key(m->seed, (uint64_t)k, (uint64_t)texel, (uint64_t)a->frame), &est);
+                     lr_rng_key(m->seed, (uint64_t)k, (uint64_t)texel, (uint64_t)a->frame), &est);
     /* Running mean and pooled variance (Chan et al.'s pairwise update). */
     long na = t->samples, nb = est.n, n = na + nb;
     for (int c = 0; c < 3; c++) {
@@ -189,7 +189,7 @@ void lr_cpu_maps_accumulate(lr_cpu_maps *m, int frames)
     for (int f = 0; f < frames; f++) {
         acc_ctx a = {m, m->frames, m->light};
         lr_light_at_frame(&m->light, m->frames, &a.light);
-        lr_cpu_parallel_for((long)m->K * m->S * m->S, m->threads, acc_item, &a);
+        lr_parallel_for((long)m->K * m->S * m->S, m->threads, acc_item, &a);
         m->frames++;
     }
 }

@@ -16,7 +16,7 @@
 #include <stdbool.h>
 
 #include "render/base/err.h"
-#include "render/cpu/radiosity.h"
+#include "render/models/radiosity.h"
 #include "render/scene/scene.h"
 
 typedef struct lr_cpu_maps lr_cpu_maps;
@@ -59,7 +59,7 @@ int lr_cpu_maps_create(const lr_cpu_maps_desc *d, lr_cpu_maps **out, lr_err *e);
 void lr_cpu_maps_destroy(lr_cpu_maps *m);
 
 /* Adds `frames` frames: frame f (counted from 0 since create) draws N samples per band and
- * texel from key lr_cpu_key(seed, k, texel index j * size + i, f). */
+ * texel from key lr_rng_key(seed, k, texel index j * size + i, f). */
 void lr_cpu_maps_accumulate(lr_cpu_maps *m, int frames);
 int lr_cpu_maps_frames(const lr_cpu_maps *m);
 

@@ -5,7 +5,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "render/cpu/radiosity.h"
+#include "render/core/ray.h"
 #include "render/optics/optics.h"
 
 /* A turn in [0, 1) from b's coordinates, so neighbouring points do not share one pattern. */
@@ -30,7 +30,7 @@ void lr_dbounce_q(const void *ctx, lr_vec3 b, lr_vec3 n, double q[3])
     q[0] = q[1] = q[2] = 0.0;
     const int s = (int)sqrt((double)(k->rays > 1 ? k->rays : 1));
     lr_vec3 t1, t2;
-    lr_cpu_tangents(n, &t1, &t2);
+    lr_tangents(n, &t1, &t2);
     const lr_vec3 o = lr_v3_add(b, lr_v3_scale(n, eps));
     const double turn = turn_of(b);
     for (int i = 0; i < s; i++)
@@ -41,7 +41,7 @@ void lr_dbounce_q(const void *ctx, lr_vec3 b, lr_vec3 n, double q[3])
             lr_vec3 d = lr_v3_add(lr_v3_scale(n, z), lr_v3_add(lr_v3_scale(t1, r * cos(ph)),
                                                             lr_v3_scale(t2, r * sin(ph))));
             lr_vec3 y, ny;
-            if (!(z > 0.0) || !lr_cpu_first_surface(obj, o, d, eps, &y, &ny))
+            if (!(z > 0.0) || !lr_first_surface(obj, o, d, eps, &y, &ny))
                 continue;
             double cy = -lr_v3_dot(ny, d);
             if (!(cy > 0.0))

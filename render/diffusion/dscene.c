@@ -6,7 +6,7 @@
 #include <unistd.h>
 
 #include "render/base/paths.h"
-#include "render/cpu/cavity.h"
+#include "render/core/cavity.h"
 #include "render/diffusion/bounce.h"
 #include "render/diffusion/dscene.h"
 #include "render/optics/near_light.h"
@@ -214,7 +214,7 @@ static int spread_by_bounce(dobj *D, const lr_scene_object *o, int l, const doub
     return LR_OK;
 }
 
-/* Cavity closure (render/cpu/cavity.h) from the grid's own solved field: q is the light's
+/* Cavity closure (render/core/cavity.h) from the grid's own solved field: q is the light's
  * direct irradiance only, so the light the lit surface sends back into a cavity around the
  * light (Fresnel reflection and what re-emerges there) and that meets the object again is
  * added: as much as the closure's gain says, spread like the first bounce across the cavity
@@ -229,11 +229,11 @@ static int close_cavity(dobj *D, const lr_scene *s, int i, int l, lr_err *e)
         return LR_OK;
     lr_dfield_view f;
     view_of(D, l, &f);
-    lr_cpu_cavity_desc cd = {.directions = LR_DSCENE_CAVITY_DIRECTIONS,
+    lr_cavity_desc cd = {.directions = LR_DSCENE_CAVITY_DIRECTIONS,
                              .points = LR_DSCENE_CAVITY_POINTS, .seed = 1};
-    lr_cpu_cavity cav;
+    lr_cavity cav;
     const lr_scene_object *o = lr_scene_object_at(s, i);
-    int rc = lr_cpu_cavity_measure_field(o, lr_scene_light_at(s, l), enc, &cd, field_b, &f,
+    int rc = lr_cavity_measure_field(o, lr_scene_light_at(s, l), enc, &cd, field_b, &f,
                                          &cav, e);
     bool spread = false;
     if (!rc)

@@ -15,8 +15,8 @@
  *
  * Cavity closure: q is the direct light only. When a point or spot light sits in the object's
  * hull (the flame in its melt pool), the light the lit surface sends back into the cavity and
- * that meets the object again is the closure's gain (render/cpu/cavity.h), measured from the
- * solved field itself (lr_cpu_cavity_measure_field) and applied to the field.
+ * that meets the object again is the closure's gain (render/core/cavity.h), measured from the
+ * solved field itself (lr_cavity_measure_field) and applied to the field.
  */
 #ifndef LR_DSCENE_H
 #define LR_DSCENE_H
@@ -35,7 +35,7 @@
 #define LR_DSCENE_AUTO_CELLS 20.0
 #define LR_DSCENE_WALL_CELLS 2.5
 #define LR_DSCENE_MAX_CELLS 64.0
-/* The cavity closure's measurement (render/cpu/cavity.h): light directions and surface points;
+/* The cavity closure's measurement (render/core/cavity.h): light directions and surface points;
  * the field is cheap to evaluate, so many points (a few ms). */
 #define LR_DSCENE_CAVITY_DIRECTIONS 4096
 #define LR_DSCENE_CAVITY_POINTS 8192

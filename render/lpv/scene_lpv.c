@@ -8,8 +8,8 @@
 #include "render/area/emitter.h"
 #include "render/area/frames.h"
 #include "render/area/poisson_mesh.h"
-#include "render/cpu/recv_grid.h"
-#include "render/cpu/vpl.h"
+#include "render/core/recv_grid.h"
+#include "render/core/vpl.h"
 #include "render/lpv/tpl.h"
 #include "render/mesh/bvh.h"
 #include "render/optics/optics.h"
@@ -116,7 +116,7 @@ static int receiver_samples(const lr_scene *s, const lr_lpv *v, samples *ss, int
 }
 
 /* Whether a surface point x of normal n faces out from the outermost surface of o along the
- * ray from its bounding-box centre c (the VPLs' placement, render/cpu/vpl.h): n . u > 0 and
+ * ray from its bounding-box centre c (the VPLs' placement, render/core/vpl.h): n . u > 0 and
  * no object beyond x along u = (x - c) / |x - c|. */
 static bool outermost(const lr_scene *s, const lr_scene_object *o, lr_vec3 x, lr_vec3 n)
 {
@@ -340,7 +340,7 @@ int lr_lpv_scene_indirect(const lr_scene *s, int light, const lr_lpv_scene_desc 
         for (int side = 0; side < (x->two_sided ? 2 : 1); side++) {
             lr_vec3 nn = side_n(x, side);
             double Es = area ? direct(s, &em, pts, x->p, nn)
-                             : lr_cpu_direct_irradiance(s, li, x->p, nn);
+                             : lr_direct_irradiance(s, li, x->p, nn);
             for (int c = 0; c < 3; c++)
                 E[side][c] = Es;
         }

@@ -1,7 +1,7 @@
 /* lamprig — the light-propagation volume of a scene (seed 004 Sec. 3.2, 4.1-4.4): the
  * indirect irradiance on the plane receivers that the maps and VPLs do not carry (issue 12
  * parts 3-4), per light at unit radiance, on the receivers' irradiance grids
- * (render/cpu/recv_grid.h), for composition to add to the direct light.
+ * (render/core/recv_grid.h), for composition to add to the direct light.
  *
  *  - Volume: n^3 cells around the objects' bounds, widened on every side by 1.25 times their
  *    largest extent (the table and wall near a lamp fall a few cells inside; light reaching
@@ -20,7 +20,7 @@
  *          lobe along the lit face's normal: light the inner face of a shade returns into the
  *          cavity and that leaves through the openings. Thin walls (thickness_mm) send T E A
  *          out of the other face (the multipole's total transmittance). Light leaving a side
- *          that is the outermost surface facing out (the VPLs' surface, render/cpu/vpl.h) is
+ *          that is the outermost surface facing out (the VPLs' surface, render/core/vpl.h) is
  *          not injected but becomes a TPL: the VPLs give the receivers its first bounce, the
  *          volume the receivers' reflection of it (a votive's outer glow on the table, then
  *          table to wall). Light leaving any other side (a cavity's inner wall) is a lobe.
@@ -36,7 +36,7 @@
  *
  * Area lights (quad, disk) per unit radiance; point and spot lights per unit intensity, their
  * direct irradiance I cos / d^2 (spot: times the cone's shape) at every sample, 0 where an
- * object is in the way (lr_cpu_direct_irradiance: the renderer's shadow test, with rays);
+ * object is in the way (lr_direct_irradiance: the renderer's shadow test, with rays);
  * directional lights get nothing (LR_OK, zero grids). */
 #ifndef LR_LPV_SCENE_H
 #define LR_LPV_SCENE_H

@@ -1,5 +1,5 @@
 /* lamprig — a refined copy of a triangle mesh: every edge at most h long (issue 11, the
- * objects' surface cache: render/passes/surface.h, render/cpu/surface.h; and the mesh every
+ * objects' surface cache: render/passes/surface.h, render/core/surface.h; and the mesh every
  * scene object is drawn with, render/scene/scene_internal.h LR_SCENE_MAX_EDGE_MM).
  *
  * Edges longer than h are split at their midpoints, shared between the two triangles of an

@@ -7,11 +7,11 @@
 #include <string.h>
 #include <time.h>
 
-#include "render/cpu/cavity.h"
-#include "render/cpu/parallel.h"
-#include "render/cpu/radiosity.h"
-#include "render/cpu/recv_grid.h"
-#include "render/cpu/rng.h"
+#include "render/models/cavity_gains.h"
+#include "render/base/parallel.h"
+#include "render/models/radiosity.h"
+#include "render/core/recv_grid.h"
+#include "render/base/rng.h"
 #include "render/diffusion/dscene.h"
 #include "render/mesh/area_pick.h"
 #include "render/mesh/bvh.h"
@@ -167,7 +167,7 @@ void lr_openings_destroy(lr_openings *op)
 }
 
 /* The emitting points of object o (index oi): LR_OPENINGS_POINTS points stratified over the
- * area CDF (as render/cpu/cavity.c), each kept on the sides the VPLs do not emit from; calls
+ * area CDF (as render/core/cavity.c), each kept on the sides the VPLs do not emit from; calls
  * emit(ctx, x, n, a) for each kept side (a = area / LR_OPENINGS_POINTS), stopping at its first
  * nonzero return. */
 typedef int (*emit_fn)(void *ctx, lr_vec3 x, lr_vec3 n, double a);
@@ -193,11 +193,11 @@ static int walk_emitters(const lr_scene_object *o, int oi, emit_fn emit, void *c
     }
     const int M = LR_OPENINGS_POINTS;
     double a = area / M, tmin = 1e-4 * o->radius;
-    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(1, 0x0BE4, (uint64_t)oi, 0));
+    lr_rng rng = lr_rng_init(lr_rng_key(1, 0x0BE4, (uint64_t)oi, 0));
     int rc = LR_OK;
     for (int i = 0; i < M && !rc; i++) {
-        double pick = (i + lr_cpu_rng_next(&rng)) / M * area;
-        double s = lr_cpu_rng_next(&rng), t = lr_cpu_rng_next(&rng);
+        double pick = (i + lr_rng_next(&rng)) / M * area;
+        double s = lr_rng_next(&rng), t = lr_rng_next(&rng);
         size_t lo = lr_cdf_pick(cdf, nt, pick);
         lr_vec3 v[3];
         lr_mesh_triangle(o->mesh, lo, v);
@@ -208,7 +208,7 @@ static int walk_emitters(const lr_scene_object *o, int oi, emit_fn emit, void *c
         lr_vec3 n = lr_v3_normalize(cr), cx = lr_v3_sub(x, o->center);
         double dc = lr_v3_len(cx);
         /* Inner: the ray from the centre through x meets the object again beyond x, so the
-         * VPLs (the farthest hit along that ray, lr_cpu_vpl_place) never stand here. */
+         * VPLs (the farthest hit along that ray, lr_vpl_place) never stand here. */
         bool inner = dc > 0.0 && lr_bvh_occluded(o->bvh, x, lr_v3_scale(cx, 1.0 / dc), tmin,
                                                  4.0 * o->radius + 1.0);
         for (int side = 0; side < 2 && !rc; side++) {
@@ -369,7 +369,7 @@ static int build(lr_openings *op, const lr_scene *s, int threads, lr_err *e)
     }
     kernel_ctx kc = {op, s};
     if (op->ne > 0)
-        lr_cpu_parallel_for((long)np, threads, kernel_item, &kc);
+        lr_parallel_for((long)np, threads, kernel_item, &kc);
     else
         memset(op->K, 0, sizeof *op->K);
     return LR_OK;
@@ -417,7 +417,7 @@ static void b_item(void *ctx, long j)
         lr_dscene_field(k->grid, m->obj, k->l, &d.dfield);
     lr_cpu_estimate est;
     lr_cpu_radiosity(lr_scene_object_at(k->s, m->obj), lr_scene_light_at(k->s, k->l), m->x, m->n,
-                     &d, lr_cpu_key(0x0BE5, (uint64_t)j, (uint64_t)k->l, 0), &est);
+                     &d, lr_rng_key(0x0BE5, (uint64_t)j, (uint64_t)k->l, 0), &est);
     for (int c = 0; c < 3; c++) {
         double b = est.mean[c] * k->gain[m->obj][c];
         B[c] = isfinite(b) && b > 0.0 ? b : 0.0;
@@ -433,14 +433,14 @@ static int solve_light(lr_openings *op, const lr_scene *s, const struct lr_dscen
     memset(op->B[l], 0, 3 * op->ne * sizeof *op->B[l]);
     if (op->ne && (L->type == LR_LIGHT_POINT || L->type == LR_LIGHT_SPOT)) {
         double gain[MAXO][3];
-        int rc = lr_cpu_cavity_scene_gains(s, l, threads, gain, op->nobj, e);
+        int rc = lr_cavity_scene_gains(s, l, threads, gain, op->nobj, e);
         if (rc)
             return rc;
         const lr_scene_object *objs[MAXO];
         for (int i = 0; i < op->nobj; i++)
             objs[i] = lr_scene_object_at(s, i);
         b_ctx bc = {op, s, objs, l, (const double(*)[3])gain, grid};
-        lr_cpu_parallel_for((long)op->ne, threads, b_item, &bc);
+        lr_parallel_for((long)op->ne, threads, b_item, &bc);
     }
     const size_t R2 = (size_t)LR_RECV_GRID * LR_RECV_GRID;
     for (int r = 0; r < op->nrcv; r++) {

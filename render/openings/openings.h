@@ -15,13 +15,13 @@
  *
  * (composition's emitted radiance L_o = F_t(w_o) B / pi, seed 003 Eq. 5, and the VPLs' bounded
  * geometry term), V a ray cast against every object's BVH: light that meets the shade again is
- * the cavity closure's (render/cpu/cavity.h, which multiplies B by the gain for the fraction
+ * the cavity closure's (render/core/cavity.h, which multiplies B by the gain for the fraction
  * F that returns), so only the light that leaves through the openings is added here. B_j is
  * the object's model at x_j for the light at unit intensity (lr_cpu_radiosity, the untruncated
- * sampler, fixed seeds) times that light's cavity gain (lr_cpu_cavity_scene_gains): the same
+ * sampler, fixed seeds) times that light's cavity gain (lr_cavity_scene_gains): the same
  * numbers on the GPU and in the CPU twin. E is evaluated at the centres of a grid of cells of
  * about LR_OPENINGS_CELL_MM over each plane receiver and written bilinearly at the receiver
- * grid's texel centres (render/cpu/recv_grid.h), where the GPU's irradiance pass
+ * grid's texel centres (render/core/recv_grid.h), where the GPU's irradiance pass
  * (render/passes/irradiance.c) and the twin (render/cpu/frame.c) add it to E_vpl before the
  * receiver bounce (render/bounce/) reads the grid, so the bounce carries it too.
  *

@@ -233,7 +233,7 @@ int lr_sss_pairs(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm);
 /* Power the model lets out per unit power that entered, per band, when nothing comes back:
  * the multipole's R_total + T_total (lr_multipole_total), the standard dipole's
  * lr_dipole_rd_total for the two dipoles (the normalised directional dipole's half-space
- * total, PIPELINE.md "Energy"). The cavity closure's A (render/cpu/cavity.h). */
+ * total, PIPELINE.md "Energy"). The cavity closure's A (render/core/cavity.h). */
 void lr_sss_total(enum lr_sss_model m, const lr_coeffs *c, double thickness_mm, double out[3]);
 
 /* What sets a model apart, in one table (render/optics/model.c) for the code that treats
@@ -247,7 +247,7 @@ typedef struct lr_sss_model_props {
      * (lr_scene_object_model_unmet returns these); NULL: it does not need it. */
     const char *needs_thickness;
     const char *needs_closed;
-    /* Why the one-gain cavity closure (render/cpu/cavity.h) does not apply to it; NULL: it
+    /* Why the one-gain cavity closure (render/core/cavity.h) does not apply to it; NULL: it
      * applies. */
     const char *no_closure;
     /* Why the light its inner faces send through the openings is not gathered for it

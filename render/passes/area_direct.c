@@ -1,6 +1,6 @@
 /* The area lights' direct light on the plane receivers (area_direct.h): frame F adds the
  * direct irradiance from each area light's sample p_F (render/area/frames.h) at the receiver
- * grid's texel centres (render/cpu/recv_grid.h), shadowed through the G-buffer drawn at p_F,
+ * grid's texel centres (render/core/recv_grid.h), shadowed through the G-buffer drawn at p_F,
  * with blend weight 1/F, so the grid keeps the running mean
  *     E(x) = (1/F) sum_f L-less A cos(theta_e,f) cos(theta_x,f) / d_f^2 V_f,
  * the twin's direct_at (render/cpu/frame.c) over the same samples. A shadow cast per pixel
@@ -11,7 +11,7 @@
 
 #include <stdlib.h>
 
-#include "render/cpu/recv_grid.h"
+#include "render/core/recv_grid.h"
 #include "render/passes/radiosity.h"
 
 bool lr_area_direct_needed(const lr_scene *s)

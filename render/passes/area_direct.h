@@ -1,7 +1,7 @@
 /* lamprig — the area lights' direct light on the plane receivers (render/area/frames.h,
  * area_direct.c): the running mean over accumulation frames of the direct irradiance from
  * each area light's frame sample p_f, shadowed through that frame's light G-buffer, at the
- * receiver irradiance grid's texel centres (render/cpu/recv_grid.h). Composition reads it
+ * receiver irradiance grid's texel centres (render/core/recv_grid.h). Composition reads it
  * like the VPL grid (four fetches), so it needs no accumulation of its own. */
 #ifndef LR_AREA_DIRECT_H
 #define LR_AREA_DIRECT_H

@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "render/base/mat4.h"
-#include "render/cpu/cavity.h"
+#include "render/models/cavity_gains.h"
 #include "render/passes/passes.h"
 
 int lr_passes_upload_arrays(lr_gpu_mesh *g, const float *pos, const float *nrm, size_t nv,
@@ -153,7 +153,7 @@ int lr_pass_objects_update_cavity(lr_pass_objects *objs, const lr_scene *s, lr_e
         nl = LR_MAX_LIGHTS;
     for (int l = 0; l < nl; l++) {
         double g[LR_MAX_OBJECTS][3];
-        int rc = lr_cpu_cavity_scene_gains(s, l, 0, g, no, e);
+        int rc = lr_cavity_scene_gains(s, l, 0, g, no, e);
         if (rc)
             return rc;
         for (int i = 0; i < no; i++)
@@ -225,15 +225,4 @@ void lr_passes_bind_tex(lr_program *p, const char *name, int unit, const lr_tex 
     if (t)
         glBindTexture(lr_tex_target(t), lr_tex_id(t));
     lr_passes_uniform_i(p, name, unit);
-}
-
-void lr_passes_cube_face_vp(lr_vec3 at, int f, double znear, double zfar, double out[16])
-{
-    static const double dir[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-    static const double up[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
-    double view[16], proj[16];
-    lr_vec3 target = lr_v3_add(at, lr_v3(dir[f][0], dir[f][1], dir[f][2]));
-    lr_mat4_look_at(at, target, lr_v3(up[f][0], up[f][1], up[f][2]), view);
-    lr_mat4_perspective(M_PI / 2.0, 1.0, znear, zfar, proj);
-    lr_mat4_mul(proj, view, out);
 }

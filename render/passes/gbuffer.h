@@ -4,7 +4,7 @@
 #ifndef LR_GBUFFER_H
 #define LR_GBUFFER_H
 
-#include "render/passes/gbuffer_camera.h"
+#include "render/core/gbuffer_camera.h"
 #include "render/passes/passes.h"
 
 

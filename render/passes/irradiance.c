@@ -1,5 +1,5 @@
 /* The receiver irradiance pass (issue 11; render/passes/PIPELINE.md "Receiver irradiance
- * cache"; the grid is render/cpu/recv_grid.h's, shared with the CPU twin): E_vpl per light at
+ * cache"; the grid is render/core/recv_grid.h's, shared with the CPU twin): E_vpl per light at
  * unit intensity over every plane receiver, view-independent, redrawn only when the VPLs'
  * radiosity or the receivers change. Composition reads it with four fetches per receiver
  * pixel, so a camera or projector move costs no VPL sum.
@@ -12,7 +12,7 @@
 
 #include "render/bounce/objlight.h"
 #include "render/bounce/rbounce.h"
-#include "render/cpu/recv_grid.h"
+#include "render/core/recv_grid.h"
 #include "render/openings/openings.h"
 #include "render/passes/radiosity.h"
 

@@ -5,7 +5,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "render/cpu/recv_grid.h"
+#include "render/core/recv_grid.h"
 #include "render/lpv/gpu.h"
 
 /* Further bounces off the objects in the volume (scene_lpv.h): a paper shade's cavity

@@ -63,7 +63,7 @@ typedef struct lr_pass_objects {
      * (PIPELINE.md "Energy"). */
     float sd_norm[3 * LR_MAX_OBJECTS];
     /* Per light and object, [3 (l LR_MAX_OBJECTS + i) + c]: the cavity gain of object i for
-     * light l (render/cpu/cavity.h, measured on the CPU when the maps restart; 1 for lights
+     * light l (render/core/cavity.h, measured on the CPU when the maps restart; 1 for lights
      * beyond the scene's). Composition multiplies light l's B of object i by it: folded into
      * the gather's weights per object (compose_object) and compose_receiver's u_cavity_gain
      * for the VPLs. */
@@ -128,7 +128,5 @@ void lr_passes_uniform_v3(lr_program *p, const char *name, lr_vec3 v);
 void lr_passes_uniform_i(lr_program *p, const char *name, int v);
 void lr_passes_uniform_f(lr_program *p, const char *name, float v);
 void lr_passes_bind_tex(lr_program *p, const char *name, int unit, const lr_tex *t);
-/* View-projection of cube face f (0..5 = +X..-Z) around `at`. */
-void lr_passes_cube_face_vp(lr_vec3 at, int f, double znear, double zfar, double out[16]);
 
 #endif

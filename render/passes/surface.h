@@ -7,7 +7,7 @@
 #ifndef LR_SURFACE_H
 #define LR_SURFACE_H
 
-#include "render/cpu/surface.h"
+#include "render/core/surface.h"
 #include "render/passes/passes.h"
 #include "render/passes/radiosity.h"
 

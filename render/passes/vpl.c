@@ -9,6 +9,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "render/core/gbuffer_camera.h"
 #include "render/optics/optics.h"
 #include "render/passes/vpl.h"
 
@@ -98,7 +99,7 @@ static void draw_outer(lr_vpl *v, const lr_pass_ctx *ctx)
         glClearBufferfv(GL_COLOR, 1, zero);
         glClearDepthf(0.0f);
         glClear(GL_DEPTH_BUFFER_BIT);
-        lr_passes_cube_face_vp(c, f, 1e-3 * R, 3.0 * R, vp);
+        lr_cube_face_vp(c, f, 1e-3 * R, 3.0 * R, vp);
         lr_passes_uniform_mat4(p, "u_vp", vp);
         for (int i = 0; i < ctx->objs->n_objects; i++) {
             lr_passes_uniform_i(p, "u_object", i);

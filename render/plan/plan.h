@@ -230,7 +230,7 @@ const char *lr_plan_transport_key(enum lr_plan_transport_kind k);
  * models[i] (NULL: the scene's own models): none without a point or spot light or a plane
  * receiver, or with render.lpv (its volumes carry the receivers' light); the bounce and the
  * openings' light not with translucent radiosity (its F has the receivers); VPL visibility
- * from LR_PLAN_VPL_SAMPLES VPLs per object (lr_cpu_vpl_place) against 16 x 16 points per
+ * from LR_PLAN_VPL_SAMPLES VPLs per object (lr_vpl_place) against 16 x 16 points per
  * plane receiver, each VPL weighted by the lights' irradiance at it ignoring the body (light
  * leaves the wax near where it entered), each pair by the VPL kernel's cos cos / d^2.
  * Deterministic. LR_ENOMEM only. */

@@ -15,7 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/cpu/vpl.h"
+#include "render/core/vpl.h"
 #include "render/mesh/bvh.h"
 #include "render/openings/openings.h"
 
@@ -85,13 +85,13 @@ static bool facing_pair(const lr_scene *s, char *what, size_t cap)
 static int blocked_share(const lr_scene *s, double *share, lr_err *e)
 {
     enum { NV = LR_PLAN_VPL_SAMPLES };
-    lr_cpu_vpl *v = malloc(NV * sizeof *v);
+    lr_vpl_point *v = malloc(NV * sizeof *v);
     if (!v)
         return lr_err_set(e, LR_ENOMEM, "planner: out of memory (VPL samples)");
     double all = 0.0, blocked = 0.0;
     const int no = lr_scene_object_count(s);
     for (int oi = 0; oi < no; oi++) {
-        lr_cpu_vpl_place(lr_scene_object_at(s, oi), NV, v);
+        lr_vpl_place(lr_scene_object_at(s, oi), NV, v);
         for (int i = 0; i < NV; i++) {
             if (!v[i].valid)
                 continue;

@@ -1,5 +1,5 @@
 // The area lights' direct light on a plane receiver (render/passes/area_direct.c): at the
-// centre of texel (s, t) of its grid (render/cpu/recv_grid.h), the direct irradiance from
+// centre of texel (s, t) of its grid (render/core/recv_grid.h), the direct irradiance from
 // each area light's sample of this frame (the G-buffer was drawn there), unit radiance,
 // profile A cos(theta_e) (lib/lights.glsl); 0 for the other lights, whose direct light
 // composition shadows per pixel. The caller blends it into the running mean (weight 1/F).

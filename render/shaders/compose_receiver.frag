@@ -2,7 +2,7 @@
 // (render/passes/PIPELINE.md, pass 4), one image per light l at unit intensity (the blend pass
 // weights them). E_direct,l: 1 / distance^2 * cos, shadowed by the objects through light l's
 // G-buffer, per pixel. E_vpl,l: from the receiver irradiance grid where the receiver has one
-// (a plane: irradiance.frag filled it, render/cpu/recv_grid.h; bilinear over texel centres,
+// (a plane: irradiance.frag filled it, render/core/recv_grid.h; bilinear over texel centres,
 // clamped at the edges), else the sum over the VPLs here (lib/vpl_irradiance.glsl).
 #include "lib/material.glsl"
 #include "lib/lights.glsl"

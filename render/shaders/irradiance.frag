@@ -1,5 +1,5 @@
 // The receiver irradiance pass (render/passes/irradiance.c): E_vpl,l per light l at unit
-// intensity at the centre of texel (s, t) of a plane receiver's grid (render/cpu/recv_grid.h:
+// intensity at the centre of texel (s, t) of a plane receiver's grid (render/core/recv_grid.h:
 // x = c + ((s + 1/2) / R - 1/2) w a + ((t + 1/2) / R - 1/2) h b), one layer per light. It
 // depends on neither camera nor projector, so composition reads it with four fetches.
 #include "lib/material.glsl"

@@ -20,13 +20,13 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "render/cpu/rng.h"
+#include "render/base/rng.h"
 
 void lr_tr_ff_jitter(const lr_tr *t, size_t p, double j[4])
 {
-    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(t->set.seed, 0xF0F0, p, 0));
+    lr_rng rng = lr_rng_init(lr_rng_key(t->set.seed, 0xF0F0, p, 0));
     for (int k = 0; k < 4; k++)
-        j[k] = lr_cpu_rng_next(&rng);
+        j[k] = lr_rng_next(&rng);
 }
 
 /* Whether plane cell p's rectangle meets covering surface s's bounds (grown by the ray

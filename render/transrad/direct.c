@@ -18,8 +18,8 @@
 #include <math.h>
 #include <string.h>
 
-#include "render/cpu/parallel.h"
-#include "render/cpu/rng.h"
+#include "render/base/parallel.h"
+#include "render/base/rng.h"
 #include "render/optics/near_light.h"
 
 typedef struct dl_ctx {
@@ -65,8 +65,8 @@ void lr_tr_direct_patch(lr_tr *t, size_t p, lr_tr_point_irradiance point, const 
     bool trans = sf->d.kind == LR_TR_TRANSLUCENT;
     double eta = trans ? sf->d.coeffs->eta : 1.0;
     unsigned m = (unsigned)t->set.direct_samples;
-    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(t->set.seed, 0xD1EC, p, 0));
-    double ju = lr_cpu_rng_next(&rng), jv = lr_cpu_rng_next(&rng);
+    lr_rng rng = lr_rng_init(lr_rng_key(t->set.seed, 0xD1EC, p, 0));
+    double ju = lr_rng_next(&rng), jv = lr_rng_next(&rng);
     double e = 0, ein = 0;
     unsigned open = 0;
     for (unsigned k = 0; k < m; k++) {
@@ -136,8 +136,8 @@ static void point_patch(const dl_ctx *c, size_t p)
     bool trans = sf->d.kind == LR_TR_TRANSLUCENT;
     double eta = trans ? sf->d.coeffs->eta : 1.0;
     unsigned m = (unsigned)t->set.direct_samples;
-    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(t->set.seed, 0xD1EC, p, 0));
-    double ju = lr_cpu_rng_next(&rng), jv = lr_cpu_rng_next(&rng);
+    lr_rng rng = lr_rng_init(lr_rng_key(t->set.seed, 0xD1EC, p, 0));
+    double ju = lr_rng_next(&rng), jv = lr_rng_next(&rng);
     /* front: the unshadowed, unshaped point samples over the whole patch; lit: the open
      * samples' shadowed, shaped ones. E = Omega / A times (lit / open) / (front / m): the
      * whole patch's mean, scaled to its open part's (cover.c) and to the part lit. */
@@ -190,7 +190,7 @@ int lr_tr_direct(lr_tr *t, const lr_light *light, lr_err *e)
     if (lr_light_is_area(light))
         return lr_tr_direct_area(t, light, e);
     dl_ctx c = {t, light, lr_tr_eps(t)};
-    if (!lr_cpu_parallel_for_cancel((long)t->n, t->set.threads, dl_item, &c, t->set.cancel,
+    if (!lr_parallel_for_cancel((long)t->n, t->set.threads, dl_item, &c, t->set.cancel,
                                     LR_CANCEL_STALE))
         return lr_cancel_check(t->set.cancel, "transrad: direct light", e);
     return LR_OK;

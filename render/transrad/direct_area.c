@@ -22,8 +22,8 @@
 #include <stdlib.h>
 
 #include "render/area/frames.h"
-#include "render/cpu/parallel.h"
-#include "render/cpu/rng.h"
+#include "render/base/parallel.h"
+#include "render/base/rng.h"
 
 #define AREA_SAMPLES_MAX 256
 
@@ -82,7 +82,7 @@ static void area_point(const void *vctx, size_t p, unsigned k, lr_vec3 x, lr_vec
                        double eta, double *e, double *ein)
 {
     const da_ctx *c = vctx;
-    point_light(c, x, n, trans, eta, lr_cpu_key(c->t->set.seed, 0xA7EA, p, k), e, ein);
+    point_light(c, x, n, trans, eta, lr_rng_key(c->t->set.seed, 0xA7EA, p, k), e, ein);
 }
 
 static void da_item(void *vctx, long item)
@@ -98,6 +98,6 @@ int lr_tr_direct_area(lr_tr *t, const lr_light *light, lr_err *e)
     if (rc)
         return rc;
     da_ctx c = {t, &em, lr_tr_eps(t)};
-    lr_cpu_parallel_for((long)t->n, t->set.threads, da_item, &c);
+    lr_parallel_for((long)t->n, t->set.threads, da_item, &c);
     return LR_OK;
 }

@@ -12,8 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/cpu/parallel.h"
-#include "render/cpu/rng.h"
+#include "render/base/parallel.h"
+#include "render/base/rng.h"
 
 typedef struct ff_ctx {
     lr_tr *t;
@@ -120,7 +120,7 @@ int lr_tr_build_form_factors(lr_tr *t, lr_err *e)
         goto done;
     }
     /* F depends on the geometry alone and is cached on disk: only a stop cuts it. */
-    if (!lr_cpu_parallel_for_cancel((long)n, t->set.threads, ff_item, &c, t->set.cancel,
+    if (!lr_parallel_for_cancel((long)n, t->set.threads, ff_item, &c, t->set.cancel,
                                     LR_CANCEL_STOP)) {
         rc = lr_cancel_check_at(t->set.cancel, LR_CANCEL_STOP, "transrad: form factors", e);
         goto done;

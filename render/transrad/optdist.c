@@ -18,7 +18,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "render/cpu/parallel.h"
+#include "render/base/parallel.h"
 
 #define OD_NEIGHBOURS 16
 #define OD_CANDIDATES 32
@@ -209,8 +209,8 @@ int lr_tr_optical_distances(const lr_tr *t, int s, double **out, lr_err *e)
     }
     for (size_t i = 0; i < ns; i++)
         c.pin[i] = lr_v3_sub(t->p[c.first + i].c, lr_v3_scale(t->p[c.first + i].n, delta));
-    lr_cpu_parallel_for((long)ns, t->set.threads, neighbours_item, &c);
-    lr_cpu_parallel_for((long)ns, t->set.threads, dijkstra_item, &c);
+    lr_parallel_for((long)ns, t->set.threads, neighbours_item, &c);
+    lr_parallel_for((long)ns, t->set.threads, dijkstra_item, &c);
     free(c.pin);
     free(c.adj);
     free(c.adjw);

@@ -37,7 +37,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/cpu/parallel.h"
+#include "render/base/parallel.h"
 
 #define SS_NEAR_POINTS 256
 #define SS_DROP 1e-7
@@ -324,7 +324,7 @@ int lr_tr_build_subsurface(lr_tr *t, lr_err *e)
         }
         c.dist = dist;
         /* Cached on disk with F: only a stop cuts it. */
-        bool all = lr_cpu_parallel_for_cancel((long)t->surf[s].count, t->set.threads, ss_item,
+        bool all = lr_parallel_for_cancel((long)t->surf[s].count, t->set.threads, ss_item,
                                               &c, t->set.cancel, LR_CANCEL_STOP);
         free(dist);
         free(c.thick);

@@ -7,7 +7,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "render/cpu/recv_grid.h"
+#include "render/core/recv_grid.h"
 
 #define KEY_MAX (LR_TR_MAX_SURFACES * 26)
 

@@ -29,7 +29,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/cpu/parallel.h"
+#include "render/base/parallel.h"
 
 size_t lr_tr_transfer_need(size_t n) { return 3 * n * n * sizeof(double) + 3 * n * sizeof(uint32_t); }
 
@@ -109,7 +109,7 @@ static int lu_factor(double *A, uint32_t *perm, size_t n, int threads)
         if (k + 1 < n) {
             lu_ctx c = {A, n, k};
             long blocks = (long)((n - k - 1 + 63) / 64);
-            lr_cpu_parallel_for(blocks, blocks > 4 ? threads : 1, lu_rows, &c);
+            lr_parallel_for(blocks, blocks > 4 ? threads : 1, lu_rows, &c);
         }
     }
     return 0;

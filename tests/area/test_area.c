@@ -15,7 +15,7 @@
 
 #include "render/area/emitter.h"
 #include "render/area/poisson_mesh.h"
-#include "render/cpu/rng.h"
+#include "render/base/rng.h"
 #include "render/mesh/shapes.h"
 #include "tests/support/near.h"
 
@@ -258,7 +258,7 @@ static void check_mesh(const lr_mesh *m, double r)
                 fail_msg("samples %d and %d are %g apart, r_min %g", i, j, lr_v3_len(d), r);
         }
     size_t nt = lr_mesh_triangle_count(m);
-    lr_cpu_rng rng = lr_cpu_rng_init(99);
+    lr_rng rng = lr_rng_init(99);
     int within = 0, tests = 20000;
     double worst = 0.0;
     for (int k = 0; k < tests; k++) {
@@ -268,11 +268,11 @@ static void check_mesh(const lr_mesh *m, double r)
         for (size_t i = 0; i < nt; i++)
             amax = fmax(amax, lr_mesh_triangle_area(m, i));
         do
-            t = (size_t)(lr_cpu_rng_next(&rng) * nt);
-        while (lr_cpu_rng_next(&rng) * amax > lr_mesh_triangle_area(m, t));
+            t = (size_t)(lr_rng_next(&rng) * nt);
+        while (lr_rng_next(&rng) * amax > lr_mesh_triangle_area(m, t));
         lr_vec3 q[3];
         lr_mesh_triangle(m, t, q);
-        double a = sqrt(lr_cpu_rng_next(&rng)), b = lr_cpu_rng_next(&rng);
+        double a = sqrt(lr_rng_next(&rng)), b = lr_rng_next(&rng);
         lr_vec3 p = lr_v3_add(lr_v3_scale(q[0], 1 - a), lr_v3_add(lr_v3_scale(q[1], a * (1 - b)),
                                                                  lr_v3_scale(q[2], a * b)));
         double best = INFINITY;

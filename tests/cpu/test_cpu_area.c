@@ -13,10 +13,10 @@
 #include <string.h>
 
 #include "render/area/frames.h"
-#include "render/cpu/cavity.h"
-#include "render/cpu/radiosity.h"
-#include "render/cpu/rng.h"
-#include "render/cpu/vpl.h"
+#include "render/models/cavity_gains.h"
+#include "render/models/radiosity.h"
+#include "render/base/rng.h"
+#include "render/core/vpl.h"
 #include "render/material/material.h"
 #include "render/optics/optics.h"
 #include "tests/support/near.h"
@@ -101,7 +101,7 @@ static void test_light_shape(void **st)
     assert_near(lr_light_shape(&d, lr_v3(0, 0, 1)), 0.0, 0.0);
 }
 
-/* The receivers' direct light of the twin (lr_cpu_direct_irradiance at each frame's light,
+/* The receivers' direct light of the twin (lr_direct_irradiance at each frame's light,
  * averaged over the frames as the accumulation does) against the closed form, unoccluded:
  * within 1 % after one cycle of the Poisson set. The scene's object is far off to the side. */
 static void test_direct_light_converges(void **st)
@@ -139,7 +139,7 @@ static void test_direct_light_converges(void **st)
             for (int j = 0; j < seq.n; j++) {
                 lr_light fl = *l; /* lr_light_at_frame without remaking the sequence */
                 fl.position = lr_area_frame_point(&seq, (long)c * seq.n + j);
-                sum += lr_cpu_direct_irradiance(s, &fl, xs[i], ns[i]);
+                sum += lr_direct_irradiance(s, &fl, xs[i], ns[i]);
             }
             cyc[c] = sum / seq.n;
             mean += cyc[c] / C;
@@ -163,7 +163,7 @@ static void test_direct_light_converges(void **st)
         /* Below the one-sided panel: nothing. */
         lr_light fl;
         lr_light_at_frame(l, 0, &fl);
-        assert_near(lr_cpu_direct_irradiance(s, &fl, lr_v3(0, 0, 50), lr_v3(0, 0, 1)), 0.0, 0.0);
+        assert_near(lr_direct_irradiance(s, &fl, lr_v3(0, 0, 50), lr_v3(0, 0, 1)), 0.0, 0.0);
     }
     lr_scene_destroy(s);
 }
@@ -194,7 +194,7 @@ static double t_hem(double eta)
 
 /* The closed shell (issue 14: within 10 %): a hollow non-absorbing sphere (R 40, a 2 mm wall,
  * eta 1.5) around a one-sided 6 x 3 mm quad at its centre. Power out of the outer surface
- * = T_hem A_sphere mean B x the cavity gain (render/cpu/cavity.h, measured for the area light
+ * = T_hem A_sphere mean B x the cavity gain (render/core/cavity.h, measured for the area light
  * with its A cos profile), averaged over 16 frames of the light's sequence; the light's power
  * per unit radiance is pi A. */
 static void test_closed_shell(void **st)
@@ -205,9 +205,9 @@ static void test_closed_shell(void **st)
     lrt_object o;
     lrt_object_make(lrt_shell_mesh(R, R - 2.0, 4), &m, &o);
     lr_light l = quad_light(lr_v3(0, 0, 0), lr_v3(3, 0, 0), lr_v3(0, 1.5, 0));
-    lr_cpu_cavity cav;
+    lr_cavity cav;
     lr_err e = {0};
-    if (lr_cpu_cavity_measure(&o.obj, &l, LR_ENCLOSURE_HULL, NULL, &cav, &e))
+    if (lr_cavity_measure(&o.obj, &l, LR_ENCLOSURE_HULL, NULL, &cav, &e))
         fail_msg("%s", e.msg);
     assert_true(cav.applies);
     const int F = 16, npts = 32, N = 1000;
@@ -218,10 +218,10 @@ static void test_closed_shell(void **st)
         lr_cpu_radiosity_desc d = {.N = N, .sampler = LR_CPU_REFERENCE};
         for (int p = 0; p < npts; p++) {
             lr_vec3 u = lr_halton_sphere((unsigned)p + 1), xo, no;
-            assert_true(lr_cpu_first_surface(&o.obj, lr_v3_scale(u, 3.0 * R), lr_v3_scale(u, -1),
+            assert_true(lr_first_surface(&o.obj, lr_v3_scale(u, 3.0 * R), lr_v3_scale(u, -1),
                                              0, &xo, &no));
             lr_cpu_estimate est;
-            lr_cpu_radiosity(&o.obj, &fl, xo, no, &d, lr_cpu_key(91, (uint64_t)p, (uint64_t)f, 0),
+            lr_cpu_radiosity(&o.obj, &fl, xo, no, &d, lr_rng_key(91, (uint64_t)p, (uint64_t)f, 0),
                              &est);
             for (int c = 0; c < 3; c++) {
                 sum[c] += est.mean[c];

@@ -11,7 +11,7 @@
 #include <stdlib.h>
 
 #include "render/base/cancel.h"
-#include "render/cpu/parallel.h"
+#include "render/base/parallel.h"
 
 #define COUNT 100000L
 
@@ -38,7 +38,7 @@ static void run_at(ctx *c, const lr_cancel *token, int threads, enum lr_cancel_l
     c->hit = calloc(COUNT, 1);
     assert_non_null(c->hit);
     atomic_init(&c->ran, 0);
-    *all = lr_cpu_parallel_for_cancel(COUNT, threads, item, c, token, level);
+    *all = lr_parallel_for_cancel(COUNT, threads, item, c, token, level);
 }
 
 static void run(ctx *c, const lr_cancel *token, int threads, bool *all)

@@ -14,7 +14,7 @@
  *     behind, so Phi = 0; the scene loader warns about it (never silently).
  *  3. Bookkeeping: in a thick shell, power out + power back into the cavity = 4 pi I F_t(0)
  *     (normalised model, albedo 1) within 5 %.
- *  4. With the cavity closure (render/cpu/cavity.h) the outer surface of a closed hollow
+ *  4. With the cavity closure (render/core/cavity.h) the outer surface of a closed hollow
  *     non-absorbing sphere emits 4 pi I within 5 %: 2 mm, 3 mm and 20 mm walls, eta 1 and 1.5,
  *     for the pass (the twin) and the untruncated reference sampler. */
 #include <setjmp.h>
@@ -29,9 +29,9 @@
 #include <string.h>
 
 #include "render/base/paths.h"
-#include "render/cpu/cavity.h"
-#include "render/cpu/radiosity.h"
-#include "render/cpu/rng.h"
+#include "render/models/cavity_gains.h"
+#include "render/models/radiosity.h"
+#include "render/base/rng.h"
 #include "render/material/material.h"
 #include "tests/support/near.h"
 #include "tests/support/objects.h"
@@ -153,12 +153,12 @@ static void surface_power(const lrt_object *o, const lr_light *l, double radius,
     lr_cpu_radiosity_desc d = {.N = N, .sampler = sampler};
     for (int p = 0; p < npts; p++) {
         lr_vec3 u = lr_halton_sphere((unsigned)p + 1), xo, no;
-        bool hit = inner ? lr_cpu_first_surface(&o->obj, lr_v3(0, 0, 0), u, 0, &xo, &no)
-                         : lr_cpu_first_surface(&o->obj, lr_v3_scale(u, 3.0 * radius),
+        bool hit = inner ? lr_first_surface(&o->obj, lr_v3(0, 0, 0), u, 0, &xo, &no)
+                         : lr_first_surface(&o->obj, lr_v3_scale(u, 3.0 * radius),
                                                 lr_v3_scale(u, -1), 0, &xo, &no);
         assert_true(hit);
         lr_cpu_estimate est;
-        lr_cpu_radiosity(&o->obj, l, xo, no, &d, lr_cpu_key(inner ? 77 : 78, (uint64_t)p, 0, 0),
+        lr_cpu_radiosity(&o->obj, l, xo, no, &d, lr_rng_key(inner ? 77 : 78, (uint64_t)p, 0, 0),
                          &est);
         for (int c = 0; c < 3; c++) {
             sum[c] += est.mean[c];
@@ -202,11 +202,11 @@ static void test_sphere_scene_light_in_medium(void **state)
     lr_cpu_radiosity_desc d = {.N = 256};
     for (int p = 0; p < 16; p++) {
         lr_vec3 u = lr_halton_sphere((unsigned)p + 1), xo, no;
-        assert_true(lr_cpu_first_surface(o, lr_v3_scale(u, 200), lr_v3_scale(u, -1), 0, &xo, &no));
+        assert_true(lr_first_surface(o, lr_v3_scale(u, 200), lr_v3_scale(u, -1), 0, &xo, &no));
         for (int mode = 0; mode < 2; mode++) {
             d.sampler = mode ? LR_CPU_REFERENCE : LR_CPU_PASS;
             lr_cpu_estimate est;
-            lr_cpu_radiosity(o, l, xo, no, &d, lr_cpu_key(1, (uint64_t)p, 0, 0), &est);
+            lr_cpu_radiosity(o, l, xo, no, &d, lr_rng_key(1, (uint64_t)p, 0, 0), &est);
             for (int c = 0; c < 3; c++)
                 assert_true(est.mean[c] == 0.0);
         }
@@ -252,7 +252,7 @@ static void test_shell_energy_bookkeeping(void **state)
 /* Finding 4, issue 3's requirement: a closed hollow sphere (R 40) of non-absorbing material
  * around a point light at its centre, power out of the outer surface with the cavity gain =
  * 4 pi I within 5 %, for walls of 2 mm (a porcelain globe), 3 mm and 20 mm, eta 1.5 and 1.
- * The gain comes from lr_cpu_cavity_measure (its own 256 random points, stratified by area);
+ * The gain comes from lr_cavity_measure (its own 256 random points, stratified by area);
  * the power is integrated here over 32 Halton points (a fixed quadrature: the sphere's area
  * per solid angle is uniform), with the twin's pass sampler and with the untruncated
  * reference sampler. The reference's Monte Carlo error (4 standard errors, times the gain) is
@@ -265,9 +265,9 @@ static void check_closed_shell_model(double ri, double eta, enum lr_sss_model mo
     o.obj.sss_model = model;
     o.obj.thickness_mm = 40 - ri;
     lr_light l = lrt_point_light(lr_v3(0, 0, 0));
-    lr_cpu_cavity cav;
+    lr_cavity cav;
     lr_err e = {0};
-    if (lr_cpu_cavity_measure(&o.obj, &l, LR_ENCLOSURE_HULL, NULL, &cav, &e))
+    if (lr_cavity_measure(&o.obj, &l, LR_ENCLOSURE_HULL, NULL, &cav, &e))
         fail_msg("%s", e.msg);
     assert_true(cav.applies);
     assert_near(cav.C, 1.0, 1e-12); /* every direction meets the closed shell */
@@ -339,18 +339,18 @@ static void test_closure_only_where_it_applies(void **state)
     lrt_object o;
     lrt_object_make(lrt_shell_mesh(40, 38, 3), &m, &o);
     lr_light l = lrt_point_light(lr_v3(0, 0, 0));
-    lr_cpu_cavity cav;
-    lr_cpu_cavity_desc d = {.points = 16, .N = 16};
-    assert_int_equal(lr_cpu_cavity_measure(&o.obj, &l, LR_ENCLOSURE_NONE, &d, &cav, NULL), 0);
+    lr_cavity cav;
+    lr_cavity_desc d = {.points = 16, .N = 16};
+    assert_int_equal(lr_cavity_measure(&o.obj, &l, LR_ENCLOSURE_NONE, &d, &cav, NULL), 0);
     assert_false(cav.applies);
     lr_vec3 xo = lr_v3(0, 0, 40), no = lr_v3(0, 0, 1);
     lr_cpu_radiosity_desc rd = {.N = 64};
     lr_cpu_estimate norm, raw;
-    lr_cpu_radiosity(&o.obj, &l, xo, no, &rd, lr_cpu_key(5, 0, 0, 0), &norm);
+    lr_cpu_radiosity(&o.obj, &l, xo, no, &rd, lr_rng_key(5, 0, 0, 0), &norm);
     o.obj.sd_raw = true;
-    assert_int_equal(lr_cpu_cavity_measure(&o.obj, &l, LR_ENCLOSURE_HULL, &d, &cav, NULL), 0);
+    assert_int_equal(lr_cavity_measure(&o.obj, &l, LR_ENCLOSURE_HULL, &d, &cav, NULL), 0);
     assert_false(cav.applies);
-    lr_cpu_radiosity(&o.obj, &l, xo, no, &rd, lr_cpu_key(5, 0, 0, 0), &raw);
+    lr_cpu_radiosity(&o.obj, &l, xo, no, &rd, lr_rng_key(5, 0, 0, 0), &raw);
     for (int c = 0; c < 3; c++) {
         assert_true(cav.gain[c] == 1.0);
         /* Same random stream: exactly the factor, to rounding. */

@@ -16,8 +16,8 @@
 #include "render/base/paths.h"
 #include "render/cpu/frame.h"
 #include "render/cpu/maps.h"
-#include "render/cpu/rng.h"
-#include "render/cpu/vpl.h"
+#include "render/base/rng.h"
+#include "render/core/vpl.h"
 #include "render/material/material.h"
 #include "tests/support/near.h"
 #include "tests/support/objects.h"
@@ -108,7 +108,7 @@ static void test_progressive_convergence(void **state)
         if (!tx->valid)
             continue;
         lr_cpu_estimate est;
-        lr_cpu_radiosity(&o.obj, &l, tx->x, tx->n, &rd, lr_cpu_key(99, (uint64_t)t, 0, 0), &est);
+        lr_cpu_radiosity(&o.obj, &l, tx->x, tx->n, &rd, lr_rng_key(99, (uint64_t)t, 0, 0), &est);
         for (int c = 0; c < 3; c++) {
             ref[t][c] = est.mean[c];
             rvar[t][c] = est.var[c] / est.n;
@@ -170,11 +170,11 @@ static void test_compose_uniform_sphere(void **state)
     lr_cpu_radiosity_desc rd = {.N = 20000, .sampler = LR_CPU_REFERENCE};
     lr_cpu_estimate ref;
     lr_vec3 xo, no;
-    assert_true(lr_cpu_first_surface(&o.obj, lr_v3(0, 0, 100), lr_v3(0, 0, -1), 0, &xo, &no));
+    assert_true(lr_first_surface(&o.obj, lr_v3(0, 0, 100), lr_v3(0, 0, -1), 0, &xo, &no));
     lr_cpu_radiosity(&o.obj, &l, xo, no, &rd, 5, &ref);
     for (int p = 0; p < 64; p++) {
         lr_vec3 u = lr_halton_sphere((unsigned)p + 100);
-        assert_true(lr_cpu_first_surface(&o.obj, lr_v3_scale(u, 100), lr_v3_scale(u, -1), 0, &xo, &no));
+        assert_true(lr_first_surface(&o.obj, lr_v3_scale(u, 100), lr_v3_scale(u, -1), 0, &xo, &no));
         double B[3], V[3], B2[3];
         bool fb = true;
         lr_cpu_maps_compose(m, xo, no, B, V, &fb);
@@ -200,8 +200,8 @@ static void test_vpl_placement(void **state)
     lrt_object o;
     lr_light l;
     shell(&o, &l);
-    lr_cpu_vpl v[256];
-    lr_cpu_vpl_place(&o.obj, 256, v);
+    lr_vpl_point v[256];
+    lr_vpl_place(&o.obj, 256, v);
     double area = 0;
     for (int i = 0; i < 256; i++) {
         assert_true(v[i].valid);
@@ -214,7 +214,7 @@ static void test_vpl_placement(void **state)
 
     lr_scene *s = load("lampshade");
     const lr_scene_object *sh = lr_scene_object_at(s, 0);
-    lr_cpu_vpl_place(sh, 256, v);
+    lr_vpl_place(sh, 256, v);
     int valid = 0;
     for (int i = 0; i < 256; i++) {
         if (!v[i].valid)
@@ -239,25 +239,25 @@ static void test_receivers_direct_shadow_vpl(void **state)
     lr_vec3 wall = lr_v3(0, 250, 300), nw = lr_v3(0, -1, 0);
     lr_vec3 to = lr_v3_sub(fl->position, wall);
     double d = lr_v3_len(to);
-    assert_near_rel(lr_cpu_direct_irradiance(s, fl, wall, nw), lr_v3_dot(nw, to) / (d * d * d), 1e-12);
+    assert_near_rel(lr_direct_irradiance(s, fl, wall, nw), lr_v3_dot(nw, to) / (d * d * d), 1e-12);
     lr_vec3 table = lr_v3(0, -60, 0), nt = lr_v3(0, 0, 1);
-    assert_true(lr_cpu_direct_irradiance(s, fl, table, nt) == 0.0);
+    assert_true(lr_direct_irradiance(s, fl, table, nt) == 0.0);
 
     const lr_scene_object *o = lr_scene_object_at(s, 0);
-    lr_cpu_vpl v[64];
-    lr_cpu_vpl_place(o, 64, v);
+    lr_vpl_point v[64];
+    lr_vpl_place(o, 64, v);
     for (int i = 0; i < 64; i++)
         if (v[i].valid)
             for (int c = 0; c < 3; c++)
                 v[i].B[c] = 1.0; /* unit radiosity: the geometry alone */
     double E[3] = {0};
-    lr_cpu_vpl_irradiance(v, 64, o->coeffs.eta, table, nt, E, NULL);
+    lr_vpl_point_irradiance(v, 64, o->coeffs.eta, table, nt, E, NULL);
     print_message("table point in the candle's shadow: E_vpl = %.4g per unit B\n", E[0]);
     assert_true(E[0] > 0.0 && isfinite(E[0]));
     /* Bounded geometry term: a receiver point on a VPL gets at most F_t B / pi * cos_v cos_x. */
     double Eon[3] = {0};
     lr_vec3 xv = lr_v3_add(v[0].x, lr_v3_scale(v[0].n, 1e-9));
-    lr_cpu_vpl_irradiance(v, 1, o->coeffs.eta, xv, lr_v3_scale(v[0].n, -1.0), Eon, NULL);
+    lr_vpl_point_irradiance(v, 1, o->coeffs.eta, xv, lr_v3_scale(v[0].n, -1.0), Eon, NULL);
     assert_true(isfinite(Eon[0]) && Eon[0] <= 1.0 / M_PI + 1e-12);
     lr_scene_destroy(s);
 }

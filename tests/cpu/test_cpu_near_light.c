@@ -40,12 +40,12 @@
 #include <string.h>
 #include <time.h>
 
-#include "render/cpu/radiosity.h"
-#include "render/cpu/rng.h"
-#include "render/cpu/sh.h"
+#include "render/models/radiosity.h"
+#include "render/base/rng.h"
+#include "render/models/sh.h"
 #include "render/mesh/mesh.h"
 #include "render/optics/optics.h"
-#include "render/passes/gbuffer_camera.h"
+#include "render/core/gbuffer_camera.h"
 #include "render/transrad/tr_scene.h"
 #include "tests/support/mesh_quad.h"
 #include "tests/support/near.h"
@@ -82,7 +82,7 @@ static void add_point(void *user, size_t t, double u, double w, lr_vec3 x, lr_ve
     } else {
         lr_cpu_radiosity_desc d = {.N = mc->N}; /* profile models: not swept (see the top) */
         lr_cpu_estimate est;
-        lr_cpu_radiosity(o, l, x, n, &d, lr_cpu_key(33, a->k++, 0, 0), &est);
+        lr_cpu_radiosity(o, l, x, n, &d, lr_rng_key(33, a->k++, 0, 0), &est);
         memcpy(B, est.mean, sizeof B);
     }
     for (int b = 0; b < 3; b++)

@@ -1,4 +1,4 @@
-/* CPU twin, pass 2 (render/cpu/radiosity.h): the stereographic Jacobian integrates to 4 pi over
+/* CPU twin, pass 2 (render/models/radiosity.h): the stereographic Jacobian integrates to 4 pi over
  * the plane; the estimator is unbiased on a slab under a directional light (closed form by
  * quadrature of lr_dirpole_sd), per band for ketchup (no colour shift); its error falls like
  * 1/sqrt(N); pass and reference samplers agree; hard cases stay finite with asserted values.
@@ -18,8 +18,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/cpu/radiosity.h"
-#include "render/cpu/rng.h"
+#include "render/models/radiosity.h"
+#include "render/base/rng.h"
 #include "render/material/material.h"
 #include "render/mesh/shapes.h"
 #include "tests/support/near.h"
@@ -87,7 +87,7 @@ static void test_jacobian_integrates_to_4pi(void **state)
         /* n_o at angle acos(c) to h = x_l - x_o, and rotated about h so no axis is special. */
         lr_vec3 hdir = lr_v3_normalize(lr_v3(0.3, -0.5, 0.8));
         lr_vec3 a, b;
-        lr_cpu_tangents(hdir, &a, &b);
+        lr_tangents(hdir, &a, &b);
         struct jac_ctx2 q = {.r0 = 1e-6 * d, .r1 = 1e9 * d};
         q.k.xl = lr_v3_add(xo, lr_v3_scale(hdir, d));
         q.k.no = lr_v3_add(lr_v3_scale(hdir, c), lr_v3_scale(lr_v3_normalize(lr_v3_add(a, b)), s));
@@ -98,7 +98,7 @@ static void test_jacobian_integrates_to_4pi(void **state)
             double w0 = 2.0 * lr_v3_dot(h, h) / lr_v3_dot(q.k.t2, h);
             q.k.origin = lr_v3_add(xo, lr_v3_scale(q.k.t2, w0));
         } else {
-            lr_cpu_tangents(q.k.no, &q.k.t1, &q.k.t2);
+            lr_tangents(q.k.no, &q.k.t1, &q.k.t2);
             q.k.origin = xo;
         }
         q.k.xo = xo;
@@ -170,7 +170,7 @@ static void check_slab(const char *name, int N, double k_sigma)
     lr_light l = lrt_directional_light(lr_v3(0, 0, -1));
     lr_cpu_radiosity_desc d = {.N = N};
     lr_cpu_estimate est;
-    lr_cpu_radiosity(&o.obj, &l, lr_v3(0, 0, 0), lr_v3(0, 0, 1), &d, lr_cpu_key(7, 0, 0, 0), &est);
+    lr_cpu_radiosity(&o.obj, &l, lr_v3(0, 0, 0), lr_v3(0, 0, 1), &d, lr_rng_key(7, 0, 0, 0), &est);
     for (int c = 0; c < 3; c++) {
         double want = slab_B(&o.obj.coeffs, c, 1000.0);
         double se = sqrt(est.var[c] / est.n);
@@ -202,7 +202,7 @@ static void test_slab_ketchup_no_colour_shift(void **state)
     lr_light l = lrt_directional_light(lr_v3(0, 0, -1));
     lr_cpu_radiosity_desc d = {.N = 20000};
     lr_cpu_estimate est;
-    lr_cpu_radiosity(&o.obj, &l, lr_v3(0, 0, 0), lr_v3(0, 0, 1), &d, lr_cpu_key(8, 0, 0, 0), &est);
+    lr_cpu_radiosity(&o.obj, &l, lr_v3(0, 0, 0), lr_v3(0, 0, 1), &d, lr_rng_key(8, 0, 0, 0), &est);
     /* Chromaticity red / (r + g + b) against quadrature, within 4 sigma by error propagation
      * (bands independent). */
     double w[3], sum = 0, ssum = 0;
@@ -236,7 +236,7 @@ static void test_slab_spectralon(void **state)
     lr_light l = lrt_directional_light(lr_v3(0, 0, -1));
     lr_cpu_estimate ref;
     lr_cpu_radiosity_desc dr = {.N = 20000, .sampler = LR_CPU_REFERENCE};
-    lr_cpu_radiosity(&o.obj, &l, lr_v3(0, 0, 0), lr_v3(0, 0, 1), &dr, lr_cpu_key(9, 0, 0, 0), &ref);
+    lr_cpu_radiosity(&o.obj, &l, lr_v3(0, 0, 0), lr_v3(0, 0, 1), &dr, lr_rng_key(9, 0, 0, 0), &ref);
     for (int c = 0; c < 3; c++) {
         assert_true(o.obj.coeffs.sigma_tr[c] == 0.0);
         /* The square slab's corners beyond r = 1000 add < 0.1 % (S_d ~ r^-3 there). */
@@ -273,7 +273,7 @@ static void test_convergence_slope(void **state)
         for (int s = 0; s < M; s++) {
             lr_cpu_estimate est;
             lr_cpu_radiosity(&o.obj, &l, lr_v3(0, 0, 0), lr_v3(0, 0, 1), &d,
-                             lr_cpu_key(11, (uint64_t)f, (uint64_t)s, 0), &est);
+                             lr_rng_key(11, (uint64_t)f, (uint64_t)s, 0), &est);
             se2 += (est.mean[1] - want) * (est.mean[1] - want);
             vsum += est.var[1];
         }
@@ -311,8 +311,8 @@ static void check_pass_vs_ref(lrt_object *o, const lr_light *l, lr_vec3 xo, lr_v
 {
     lr_cpu_estimate p, r;
     lr_cpu_radiosity_desc dp = {.N = N}, dr = {.N = N, .sampler = LR_CPU_REFERENCE};
-    lr_cpu_radiosity(&o->obj, l, xo, no, &dp, lr_cpu_key(21, 0, 0, 0), &p);
-    lr_cpu_radiosity(&o->obj, l, xo, no, &dr, lr_cpu_key(22, 0, 0, 0), &r);
+    lr_cpu_radiosity(&o->obj, l, xo, no, &dp, lr_rng_key(21, 0, 0, 0), &p);
+    lr_cpu_radiosity(&o->obj, l, xo, no, &dr, lr_rng_key(22, 0, 0, 0), &r);
     for (int c = 0; c < 3; c++) {
         double se = sqrt(p.var[c] / p.n + r.var[c] / r.n);
         print_message("band %d: pass %.6g, reference %.6g, sigma %.2g\n", c, p.mean[c],
@@ -333,7 +333,7 @@ static void test_pass_matches_reference(void **state)
     /* Point light 30 mm above the north pole; x_o at the pole, facing it. */
     lr_light l = lrt_point_light(lr_v3(0, 0, 70));
     lr_vec3 xo, no;
-    assert_true(lr_cpu_first_surface(&o.obj, lr_v3(0, 0, 100), lr_v3(0, 0, -1), 0, &xo, &no));
+    assert_true(lr_first_surface(&o.obj, lr_v3(0, 0, 100), lr_v3(0, 0, -1), 0, &xo, &no));
     check_pass_vs_ref(&o, &l, xo, no, 8000, NULL);
     lrt_object_free(&o);
 
@@ -341,7 +341,7 @@ static void test_pass_matches_reference(void **state)
     lrt_object_make(lrt_shell_mesh(40, 37, 4), &m, &o);
     l = lrt_point_light(lr_v3(0, 0, 0));
     lr_vec3 u = lr_v3_normalize(lr_v3(0.2, -0.4, 1));
-    assert_true(lr_cpu_first_surface(&o.obj, lr_v3_scale(u, 100), lr_v3_scale(u, -1), 0, &xo, &no));
+    assert_true(lr_first_surface(&o.obj, lr_v3_scale(u, 100), lr_v3_scale(u, -1), 0, &xo, &no));
     check_pass_vs_ref(&o, &l, xo, no, 8000, NULL);
     lrt_object_free(&o);
 }
@@ -370,16 +370,16 @@ static void test_pass_blind_spot_facing_away(void **state)
     lrt_object_make(lrt_shell_mesh(40, 0, 4), &m, &o);
     lr_light l = lrt_point_light(lr_v3(0, 0, 70));
     lr_vec3 u = lr_v3_normalize(lr_v3(1, 0, 0.3)), xo, no;
-    assert_true(lr_cpu_first_surface(&o.obj, lr_v3_scale(u, 100), lr_v3_scale(u, -1), 0, &xo, &no));
+    assert_true(lr_first_surface(&o.obj, lr_v3_scale(u, 100), lr_v3_scale(u, -1), 0, &xo, &no));
     lr_cpu_estimate p, r;
     lr_cpu_radiosity_desc dp = {.N = 2000}, dr = {.N = 20000, .sampler = LR_CPU_REFERENCE};
-    lr_cpu_radiosity(&o.obj, &l, xo, no, &dr, lr_cpu_key(24, 0, 0, 0), &r);
+    lr_cpu_radiosity(&o.obj, &l, xo, no, &dr, lr_rng_key(24, 0, 0, 0), &r);
     /* 2.905e-7 with the raw S_d; the default normalised S_d is sd_norm[0] (0.8144) of it. */
     double want = 2.905e-7 * o.obj.coeffs.sd_norm[0];
     assert_near(r.mean[0], want, 4.0 * sqrt(r.var[0] / r.n) + 0.005 * want);
     double ratio[15];
     for (int k = 0; k < 15; k++) {
-        lr_cpu_radiosity(&o.obj, &l, xo, no, &dp, lr_cpu_key(23, (uint64_t)k, 0, 0), &p);
+        lr_cpu_radiosity(&o.obj, &l, xo, no, &dp, lr_rng_key(23, (uint64_t)k, 0, 0), &p);
         ratio[k] = p.mean[0] / r.mean[0];
     }
     qsort(ratio, 15, sizeof ratio[0], cmp_double);
@@ -411,7 +411,7 @@ static void test_light_on_surface(void **state)
     lr_light l = lrt_point_light(vtx);
     lr_cpu_radiosity_desc d = {.N = 2000};
     lr_cpu_estimate est;
-    lr_cpu_radiosity(&o.obj, &l, vtx, lr_v3_normalize(vtx), &d, lr_cpu_key(30, 0, 0, 0), &est);
+    lr_cpu_radiosity(&o.obj, &l, vtx, lr_v3_normalize(vtx), &d, lr_rng_key(30, 0, 0, 0), &est);
     for (int c = 0; c < 3; c++)
         assert_true(est.mean[c] == 0.0 && est.var[c] == 0.0);
     lrt_object_free(&o);
@@ -424,20 +424,20 @@ static void test_light_on_surface(void **state)
         fail_msg("%s", e.msg);
     lrt_object_make(mesh, &m, &o);
     lr_vec3 bottom, nb, xo, no;
-    assert_true(lr_cpu_first_surface(&o.obj, lr_v3(0, 0, 200), lr_v3(0, 0, -1), 0, &bottom, &nb));
+    assert_true(lr_first_surface(&o.obj, lr_v3(0, 0, 200), lr_v3(0, 0, -1), 0, &bottom, &nb));
     assert_near(bottom.z, 112.0, 1e-3);
     l = lrt_point_light(bottom);
-    assert_true(lr_cpu_first_surface(&o.obj, lr_v3(5, 0, 200), lr_v3(0, 0, -1), 0, &xo, &no));
+    assert_true(lr_first_surface(&o.obj, lr_v3(5, 0, 200), lr_v3(0, 0, -1), 0, &xo, &no));
     check_pass_vs_ref(&o, &l, xo, no, 6000, NULL);
 
     lr_cpu_radiosity_desc dr = {.N = 4000, .sampler = LR_CPU_REFERENCE};
     lr_cpu_estimate pass, at, near;
     lr_vec3 t1, t2;
-    lr_cpu_tangents(nb, &t1, &t2);
-    lr_cpu_radiosity(&o.obj, &l, bottom, nb, &d, lr_cpu_key(30, 0, 0, 0), &pass);
-    lr_cpu_radiosity(&o.obj, &l, bottom, nb, &dr, lr_cpu_key(31, 0, 0, 0), &at);
+    lr_tangents(nb, &t1, &t2);
+    lr_cpu_radiosity(&o.obj, &l, bottom, nb, &d, lr_rng_key(30, 0, 0, 0), &pass);
+    lr_cpu_radiosity(&o.obj, &l, bottom, nb, &dr, lr_rng_key(31, 0, 0, 0), &at);
     lr_cpu_radiosity(&o.obj, &l, lr_v3_add(bottom, lr_v3_scale(t1, 1e-6)), nb, &dr,
-                     lr_cpu_key(32, 0, 0, 0), &near);
+                     lr_rng_key(32, 0, 0, 0), &near);
     for (int c = 0; c < 3; c++) {
         print_message("light on the pool, band %d: B(x_l): pass %.3g, reference %.6g +- %.2g\n",
                       c, pass.mean[c], at.mean[c], sqrt(at.var[c] / at.n));
@@ -460,7 +460,7 @@ static void test_albedo_one_sphere(void **state)
     lrt_object_make(lrt_shell_mesh(40, 0, 4), &m, &o);
     lr_light l = lrt_point_light(lr_v3(0, 0, 70));
     lr_vec3 xo, no;
-    assert_true(lr_cpu_first_surface(&o.obj, lr_v3(0, 0, 100), lr_v3(0, 0, -1), 0, &xo, &no));
+    assert_true(lr_first_surface(&o.obj, lr_v3(0, 0, 100), lr_v3(0, 0, -1), 0, &xo, &no));
     check_pass_vs_ref(&o, &l, xo, no, 20000, NULL);
     lrt_object_free(&o);
 }
@@ -484,7 +484,7 @@ static void test_zero_thickness_shade(void **state)
     assert_false(o.obj.closed);
     lr_light inside = lrt_point_light(lr_v3(0, 0, 75));
     lr_vec3 xo, no;
-    assert_true(lr_cpu_first_surface(&o.obj, lr_v3(300, 0, 75), lr_v3(-1, 0, 0), 0, &xo, &no));
+    assert_true(lr_first_surface(&o.obj, lr_v3(300, 0, 75), lr_v3(-1, 0, 0), 0, &xo, &no));
     assert_true(no.x > 0.5); /* the outward side */
     double out[3], in[3];
     check_pass_vs_ref(&o, &inside, xo, no, 6000, out);
@@ -510,13 +510,13 @@ static void test_tiny_object(void **state)
     lrt_object_make(lrt_shell_mesh(0.05, 0, 2), &m, &o);
     lr_light l = lrt_point_light(lr_v3(0, 0, 5));
     lr_vec3 xo, no;
-    assert_true(lr_cpu_first_surface(&o.obj, lr_v3(0.2, 0, 0), lr_v3(-1, 0, 0), 0, &xo, &no));
+    assert_true(lr_first_surface(&o.obj, lr_v3(0.2, 0, 0), lr_v3(-1, 0, 0), 0, &xo, &no));
     lr_cpu_estimate p, p2, r;
     lr_cpu_radiosity_desc dp = {.N = 8000, .r_max = 1.0}, dp2 = {.N = 8000},
                           dr = {.N = 8000, .sampler = LR_CPU_REFERENCE};
-    lr_cpu_radiosity(&o.obj, &l, xo, no, &dp, lr_cpu_key(51, 0, 0, 0), &p);
-    lr_cpu_radiosity(&o.obj, &l, xo, no, &dp2, lr_cpu_key(52, 0, 0, 0), &p2);
-    lr_cpu_radiosity(&o.obj, &l, xo, no, &dr, lr_cpu_key(53, 0, 0, 0), &r);
+    lr_cpu_radiosity(&o.obj, &l, xo, no, &dp, lr_rng_key(51, 0, 0, 0), &p);
+    lr_cpu_radiosity(&o.obj, &l, xo, no, &dp2, lr_rng_key(52, 0, 0, 0), &p2);
+    lr_cpu_radiosity(&o.obj, &l, xo, no, &dr, lr_rng_key(53, 0, 0, 0), &r);
     for (int c = 0; c < 3; c++) {
         print_message("band %d: pass (r_max 1 mm) %.4g, pass (default: 100 mm) %.4g +- %.2g, ref. "
                       "%.4g +- %.2g\n", c, p.mean[c], p2.mean[c], sqrt(p2.var[c] / p2.n),
@@ -549,11 +549,11 @@ static void test_all_presets_finite(void **state)
         lr_light lights[2] = {lrt_point_light(lr_v3(0, 0, 70)), lrt_point_light(lr_v3(0, 0, 0))};
         for (int j = 0; j < 2; j++) {
             lr_vec3 xo, no;
-            assert_true(lr_cpu_first_surface(&o[j].obj, lr_v3(0, 0, 100), lr_v3(0, 0, -1), 0, &xo, &no));
+            assert_true(lr_first_surface(&o[j].obj, lr_v3(0, 0, 100), lr_v3(0, 0, -1), 0, &xo, &no));
             for (int mode = 0; mode < 2; mode++) {
                 lr_cpu_radiosity_desc d = {.N = 64, .sampler = mode ? LR_CPU_REFERENCE : LR_CPU_PASS};
                 lr_cpu_estimate est;
-                lr_cpu_radiosity(&o[j].obj, &lights[j], xo, no, &d, lr_cpu_key(61, (uint64_t)i, 0, 0), &est);
+                lr_cpu_radiosity(&o[j].obj, &lights[j], xo, no, &d, lr_rng_key(61, (uint64_t)i, 0, 0), &est);
                 for (int c = 0; c < 3; c++) {
                     if (!(isfinite(est.mean[c]) && est.mean[c] >= 0.0 && isfinite(est.var[c])))
                         fail_msg("%s, %s, %s band %d: B = %g, var %g", names[i],

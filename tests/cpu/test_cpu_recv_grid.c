@@ -1,4 +1,4 @@
-/* The receiver irradiance grid (render/cpu/recv_grid.h), shared by the GPU's irradiance pass
+/* The receiver irradiance grid (render/core/recv_grid.h), shared by the GPU's irradiance pass
  * and the CPU twin:
  *  - geometry: texel centres lie on the plane at the stated offsets, a texel centre's taps put
  *    all weight on that texel, points beyond the outer centres take the edge texels;
@@ -23,9 +23,9 @@
 #include <stdlib.h>
 
 #include "render/base/paths.h"
-#include "render/cpu/recv_grid.h"
-#include "render/cpu/rng.h"
-#include "render/cpu/vpl.h"
+#include "render/core/recv_grid.h"
+#include "render/base/rng.h"
+#include "render/core/vpl.h"
 #include "tests/support/near.h"
 
 static lr_scene *load(const char *name)
@@ -88,10 +88,10 @@ static void test_linear_is_exact(void **state)
     lr_recv_grid_frame f;
     assert_true(lr_recv_grid_frame_of(rc, &f));
     /* g(x) = 3 + 0.01 (x . a) - 0.02 (x . b) sampled at the centres, read anywhere inside. */
-    lr_cpu_rng rng = lr_cpu_rng_init(5);
+    lr_rng rng = lr_rng_init(5);
     for (int i = 0; i < 200; i++) {
-        double u = (lr_cpu_rng_next(&rng) - 0.5) * (1.0 - 1.0 / LR_RECV_GRID) * f.w;
-        double v = (lr_cpu_rng_next(&rng) - 0.5) * (1.0 - 1.0 / LR_RECV_GRID) * f.h;
+        double u = (lr_rng_next(&rng) - 0.5) * (1.0 - 1.0 / LR_RECV_GRID) * f.w;
+        double v = (lr_rng_next(&rng) - 0.5) * (1.0 - 1.0 / LR_RECV_GRID) * f.h;
         lr_vec3 x = lr_v3_add(f.c, lr_v3_add(lr_v3_scale(f.a, u), lr_v3_scale(f.b, v)));
         int idx[4];
         double w[4], got = 0.0;
@@ -106,11 +106,11 @@ static void test_linear_is_exact(void **state)
     lr_scene_destroy(s);
 }
 
-static void exact_E(const lr_scene *s, const lr_cpu_vpl *v, int n, lr_vec3 x, lr_vec3 nx,
+static void exact_E(const lr_scene *s, const lr_vpl_point *v, int n, lr_vec3 x, lr_vec3 nx,
                     double E[3])
 {
     E[0] = E[1] = E[2] = 0.0;
-    lr_cpu_vpl_irradiance(v, n, lr_scene_object_at(s, 0)->coeffs.eta, x, nx, E, NULL);
+    lr_vpl_point_irradiance(v, n, lr_scene_object_at(s, 0)->coeffs.eta, x, nx, E, NULL);
 }
 
 static void test_interpolation_error_candle(void **state)
@@ -118,12 +118,12 @@ static void test_interpolation_error_candle(void **state)
     (void)state;
     lr_scene *s = load("candle");
     const int n = lr_scene_render(s)->N_vpl;
-    lr_cpu_vpl *v = calloc((size_t)n, sizeof *v);
+    lr_vpl_point *v = calloc((size_t)n, sizeof *v);
     assert_non_null(v);
-    lr_cpu_vpl_place(lr_scene_object_at(s, 0), n, v);
+    lr_vpl_place(lr_scene_object_at(s, 0), n, v);
     for (int i = 0; i < n; i++)
         v[i].B[0] = v[i].B[1] = v[i].B[2] = 1.0;
-    lr_cpu_rng rng = lr_cpu_rng_init(9);
+    lr_rng rng = lr_rng_init(9);
     for (int r = 0; r < lr_scene_receiver_count(s); r++) {
         const lr_receiver *rc = lr_scene_receiver_at(s, r);
         lr_recv_grid_frame f;
@@ -131,8 +131,8 @@ static void test_interpolation_error_candle(void **state)
         double sum_exact = 0.0, sum_diff = 0.0, worst = 0.0, Emax = 0.0;
         const int P = 4000;
         for (int i = 0; i < P; i++) {
-            double u = (lr_cpu_rng_next(&rng) - 0.5) * f.w;
-            double w2 = (lr_cpu_rng_next(&rng) - 0.5) * f.h;
+            double u = (lr_rng_next(&rng) - 0.5) * f.w;
+            double w2 = (lr_rng_next(&rng) - 0.5) * f.h;
             lr_vec3 x = lr_v3_add(f.c, lr_v3_add(lr_v3_scale(f.a, u), lr_v3_scale(f.b, w2)));
             double E[3], G = 0.0, Eq[3];
             exact_E(s, v, n, x, rc->normal, E);

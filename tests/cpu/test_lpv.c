@@ -14,15 +14,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/cpu/rng.h"
+#include "render/base/rng.h"
 #include "render/lpv/lpv.h"
 #include "render/lpv/sh4.h"
 #include "render/lpv/stencil.h"
 #include "tests/support/near.h"
 
-static lr_vec3 random_dir(lr_cpu_rng *r)
+static lr_vec3 random_dir(lr_rng *r)
 {
-    double z = 2.0 * lr_cpu_rng_next(r) - 1.0, ph = 2.0 * M_PI * lr_cpu_rng_next(r);
+    double z = 2.0 * lr_rng_next(r) - 1.0, ph = 2.0 * M_PI * lr_rng_next(r);
     double s = sqrt(fmax(0.0, 1.0 - z * z));
     return lr_v3(s * cos(ph), s * sin(ph), z);
 }
@@ -53,7 +53,7 @@ static double clamped_cos(lr_vec3 w, const void *ctx)
 static void test_cosine_lobe_exact(void **st)
 {
     (void)st;
-    lr_cpu_rng r = lr_cpu_rng_init(1);
+    lr_rng r = lr_rng_init(1);
     for (int t = 0; t < 6; t++) {
         lr_vec3 n = random_dir(&r);
         double c[4], q[4];
@@ -137,7 +137,7 @@ static void test_face_transfers(void **st_)
     enum { N = 400000 };
     static double acc[6][5][4];
     memset(acc, 0, sizeof acc);
-    lr_cpu_rng r = lr_cpu_rng_init(7);
+    lr_rng r = lr_rng_init(7);
     for (int s = 0; s < N; s++) {
         lr_vec3 w = random_dir(&r);
         int m, f;
@@ -165,13 +165,13 @@ static lr_lpv *make(int n, double h)
     return v;
 }
 
-static void random_injections(lr_lpv *v, lr_cpu_rng *r, int count, double half)
+static void random_injections(lr_lpv *v, lr_rng *r, int count, double half)
 {
     lr_err e = {0};
     for (int q = 0; q < count; q++) {
-        lr_vec3 p = lr_v3((2 * lr_cpu_rng_next(r) - 1) * half, (2 * lr_cpu_rng_next(r) - 1) * half,
-                          (2 * lr_cpu_rng_next(r) - 1) * half);
-        double phi[3] = {lr_cpu_rng_next(r), lr_cpu_rng_next(r), lr_cpu_rng_next(r)};
+        lr_vec3 p = lr_v3((2 * lr_rng_next(r) - 1) * half, (2 * lr_rng_next(r) - 1) * half,
+                          (2 * lr_rng_next(r) - 1) * half);
+        double phi[3] = {lr_rng_next(r), lr_rng_next(r), lr_rng_next(r)};
         if (q % 5 == 4)
             assert_int_equal(lr_lpv_inject_point(v, p, phi, &e), LR_OK);
         else
@@ -216,7 +216,7 @@ enum { STEPS = 24 };
 static void test_no_energy_gain_empty(void **st)
 {
     (void)st;
-    lr_cpu_rng r = lr_cpu_rng_init(11);
+    lr_rng r = lr_rng_init(11);
     for (int trial = 0; trial < 20; trial++) {
         lr_lpv *v = make(16, 2.0);
         /* A single lobe or point in the middle: conserved exactly for the 6 steps before it
@@ -230,14 +230,14 @@ static void test_no_energy_gain_empty(void **st)
 static void test_no_energy_gain_blockers(void **st)
 {
     (void)st;
-    lr_cpu_rng r = lr_cpu_rng_init(12);
+    lr_rng r = lr_rng_init(12);
     lr_err e = {0};
     for (int trial = 0; trial < 20; trial++) {
         lr_lpv *v = make(16, 2.0);
         for (int b = 0; b < 300; b++) {
-            lr_vec3 p = lr_v3((2 * lr_cpu_rng_next(&r) - 1) * 16, (2 * lr_cpu_rng_next(&r) - 1) * 16,
-                              (2 * lr_cpu_rng_next(&r) - 1) * 16);
-            assert_int_equal(lr_lpv_add_blocker(v, p, random_dir(&r), 8.0 * lr_cpu_rng_next(&r), &e),
+            lr_vec3 p = lr_v3((2 * lr_rng_next(&r) - 1) * 16, (2 * lr_rng_next(&r) - 1) * 16,
+                              (2 * lr_rng_next(&r) - 1) * 16);
+            assert_int_equal(lr_lpv_add_blocker(v, p, random_dir(&r), 8.0 * lr_rng_next(&r), &e),
                              LR_OK);
         }
         random_injections(v, &r, 30, 14.0);
@@ -327,13 +327,13 @@ static void test_homogeneous(void **st)
 {
     (void)st;
     lr_err e = {0};
-    lr_cpu_rng r1 = lr_cpu_rng_init(5), r2 = lr_cpu_rng_init(5);
+    lr_rng r1 = lr_rng_init(5), r2 = lr_rng_init(5);
     lr_lpv *a = make(12, 3.0), *b = make(12, 3.0);
     for (int q = 0; q < 20; q++) {
-        lr_vec3 p = lr_v3(lr_cpu_rng_next(&r1) * 20 - 10, lr_cpu_rng_next(&r1) * 20 - 10,
-                          lr_cpu_rng_next(&r1) * 20 - 10);
+        lr_vec3 p = lr_v3(lr_rng_next(&r1) * 20 - 10, lr_rng_next(&r1) * 20 - 10,
+                          lr_rng_next(&r1) * 20 - 10);
         lr_vec3 nn = random_dir(&r1);
-        double phi[3] = {lr_cpu_rng_next(&r1), 0.5, 0.25}, phi2[3];
+        double phi[3] = {lr_rng_next(&r1), 0.5, 0.25}, phi2[3];
         for (int c = 0; c < 3; c++)
             phi2[c] = 3.0 * phi[c];
         assert_int_equal(lr_lpv_inject_lobe(a, p, nn, phi, &e), LR_OK);

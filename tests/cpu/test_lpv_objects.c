@@ -18,7 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/cpu/recv_grid.h"
+#include "render/core/recv_grid.h"
 #include "render/lpv/objfield.h"
 #include "render/lpv/scene_lpv.h"
 #include "render/optics/optics.h"

@@ -16,7 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/cpu/recv_grid.h"
+#include "render/core/recv_grid.h"
 #include "render/lpv/scene_lpv.h"
 #include "tests/support/near.h"
 #include "tests/support/render.h"

@@ -1,5 +1,5 @@
-/* The diffusion_grid model's cavity closure (render/diffusion/dscene.h, render/cpu/cavity.h
- * lr_cpu_cavity_measure_field).
+/* The diffusion_grid model's cavity closure (render/diffusion/dscene.h, render/core/cavity.h
+ * lr_cavity_measure_field).
  *
  * The grid's boundary source q is the light's direct irradiance, so light the lit surface
  * sends back into a cavity around the light is lost unless the closure adds it. Asserted:

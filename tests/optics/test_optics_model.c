@@ -14,7 +14,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "render/cpu/cavity.h"
+#include "render/models/cavity_gains.h"
 #include "render/material/material.h"
 #include "render/optics/optics.h"
 #include "render/scene/fields.h"
@@ -87,9 +87,9 @@ static void test_needs_and_closure(void **state)
         if (lr_scene_set(s, key, val, NULL, &e))
             fail_msg("%s", e.msg);
         o = lr_scene_object_at(s, 0);
-        lr_cpu_cavity cav;
-        assert_int_equal(lr_cpu_cavity_measure(o, lr_scene_light_at(s, 0), LR_ENCLOSURE_HULL,
-                                               &(lr_cpu_cavity_desc){.directions = 64,
+        lr_cavity cav;
+        assert_int_equal(lr_cavity_measure(o, lr_scene_light_at(s, 0), LR_ENCLOSURE_HULL,
+                                               &(lr_cavity_desc){.directions = 64,
                                                                      .points = 16, .N = 4,
                                                                      .threads = 1},
                                                &cav, &e),

@@ -13,12 +13,12 @@
 #include "render/base/mat4.h"
 #include "render/material/material.h"
 #include "render/optics/sh_translucency.h"
-#include "render/passes/passes.h"
+#include "render/core/gbuffer_camera.h"
 #include "tests/support/near.h"
 #include "tests/support/quadrature.h"
 
 /* Projects f over the sphere with the six cube-face G-buffer cameras of a light at the origin
- * (lr_passes_cube_face_vp, the pass's own matrices) at n x n texels per face:
+ * (lr_cube_face_vp, the pass's own matrices) at n x n texels per face:
  * c_lm = sum_texels f(u) Y_lm(u) dOmega (seed 002 Eq. 6 as the G-buffer quadrature). */
 static double project_cube(int n, double (*f)(lr_vec3, const void *), const void *ctx,
                            double c[9])
@@ -28,7 +28,7 @@ static double project_cube(int n, double (*f)(lr_vec3, const void *), const void
         c[k] = 0.0;
     for (int face = 0; face < 6; face++) {
         double vp[16];
-        lr_passes_cube_face_vp(lr_v3(0, 0, 0), face, 0.1, 10.0, vp);
+        lr_cube_face_vp(lr_v3(0, 0, 0), face, 0.1, 10.0, vp);
         for (int j = 0; j < n; j++)
             for (int i = 0; i < n; i++) {
                 lr_vec3 o, u;

@@ -13,9 +13,9 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "render/cpu/rng.h"
+#include "render/base/rng.h"
 #include "render/lpv/gpu.h"
-#include "render/cpu/recv_grid.h"
+#include "render/core/recv_grid.h"
 #include "render/lpv/lpv.h"
 #include "render/lpv/scene_lpv.h"
 #include <stdlib.h>
@@ -25,9 +25,9 @@
 
 LR_TEST_GL_FIXTURE(gl)
 
-static lr_vec3 random_dir(lr_cpu_rng *r)
+static lr_vec3 random_dir(lr_rng *r)
 {
-    double z = 2.0 * lr_cpu_rng_next(r) - 1.0, ph = 2.0 * M_PI * lr_cpu_rng_next(r);
+    double z = 2.0 * lr_rng_next(r) - 1.0, ph = 2.0 * M_PI * lr_rng_next(r);
     double s = sqrt(fmax(0.0, 1.0 - z * z));
     return lr_v3(s * cos(ph), s * sin(ph), z);
 }
@@ -49,17 +49,17 @@ static lr_lpv *scene(uint64_t seed)
             assert_int_equal(lr_lpv_add_blocker(v, lr_v3(6, a, b), lr_v3(1, 0, 0), 0.125, &e),
                              LR_OK);
         }
-    lr_cpu_rng r = lr_cpu_rng_init(seed);
+    lr_rng r = lr_rng_init(seed);
     for (int q = 0; q < 200; q++) {
-        lr_vec3 p = lr_v3(32 * lr_cpu_rng_next(&r) - 16, 32 * lr_cpu_rng_next(&r) - 16,
-                          32 * lr_cpu_rng_next(&r) - 16);
-        assert_int_equal(lr_lpv_add_blocker(v, p, random_dir(&r), 3.0 * lr_cpu_rng_next(&r), &e),
+        lr_vec3 p = lr_v3(32 * lr_rng_next(&r) - 16, 32 * lr_rng_next(&r) - 16,
+                          32 * lr_rng_next(&r) - 16);
+        assert_int_equal(lr_lpv_add_blocker(v, p, random_dir(&r), 3.0 * lr_rng_next(&r), &e),
                          LR_OK);
     }
     for (int q = 0; q < 45; q++) {
-        lr_vec3 p = lr_v3(24 * lr_cpu_rng_next(&r) - 12, 24 * lr_cpu_rng_next(&r) - 12,
-                          16 * lr_cpu_rng_next(&r) - 6);
-        double phi[3] = {lr_cpu_rng_next(&r), lr_cpu_rng_next(&r), 0.5};
+        lr_vec3 p = lr_v3(24 * lr_rng_next(&r) - 12, 24 * lr_rng_next(&r) - 12,
+                          16 * lr_rng_next(&r) - 6);
+        double phi[3] = {lr_rng_next(&r), lr_rng_next(&r), 0.5};
         if (q < 40)
             assert_int_equal(lr_lpv_inject_lobe(v, p, random_dir(&r), phi, &e), LR_OK);
         else

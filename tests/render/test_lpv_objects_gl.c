@@ -23,8 +23,8 @@
 #include <string.h>
 
 #include "render/cpu/frame.h"
-#include "render/cpu/radiosity.h"
-#include "render/cpu/recv_grid.h"
+#include "render/models/radiosity.h"
+#include "render/core/recv_grid.h"
 #include "render/lpv/scene_lpv.h"
 #include "render/mesh/bvh.h"
 #include "render/optics/optics.h"
@@ -127,7 +127,7 @@ static void parity(const char *cache)
                 if (lr_bvh_intersect(lr_scene_receiver_at(s, i)->bvh, org, dir, 0.0, best, &h))
                     best = h.t;
             if (!lr_bvh_intersect(o->bvh, org, dir, 0.0, best, &h) ||
-                !lr_cpu_first_surface(o, org, dir, 0.0, &x, &n))
+                !lr_first_surface(o, org, dir, 0.0, &x, &n))
                 continue;
             if (!o->closed && lr_v3_dot(n, dir) > 0.0)
                 n = lr_v3_scale(n, -1.0);

@@ -29,7 +29,7 @@
 
 #include "render/bounce/objlight.h"
 #include "render/bounce/rbounce.h"
-#include "render/cpu/recv_grid.h"
+#include "render/core/recv_grid.h"
 #include "render/optics/optics.h"
 #include "render/scene/dirty.h"
 #include <dirent.h>

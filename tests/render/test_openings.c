@@ -26,7 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/cpu/recv_grid.h"
+#include "render/core/recv_grid.h"
 #include "render/diffusion/dscene.h"
 #include "render/openings/openings.h"
 #include "render/scene/dirty.h"

@@ -24,7 +24,7 @@
 
 #include "render/bounce/objlight.h"
 #include "render/bounce/rbounce.h"
-#include "render/cpu/recv_grid.h"
+#include "render/core/recv_grid.h"
 #include "render/scene/dirty.h"
 #include "tests/support/near.h"
 #include "tests/support/render.h"

@@ -11,7 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "render/cpu/recv_grid.h"
+#include "render/core/recv_grid.h"
 #include "render/optics/optics.h"
 #include "render/renderer.h"
 #include "render/renderer_debug.h"

@@ -7,7 +7,7 @@
  *
  * (a texel of map k covers h^2 / (n . d_k) of surface; weighting map k by (n . d_k) / sum_j
  * max(0, n . d_j) counts every point of the convex outer surface once over the maps that see
- * it), with `gain` the cavity gain composition applies (render/cpu/cavity.h). The CPU side of
+ * it), with `gain` the cavity gain composition applies (render/core/cavity.h). The CPU side of
  * the same requirement is tests/cpu/test_cpu_energy.c. */
 #include <setjmp.h>
 #include <stdarg.h>

@@ -12,7 +12,7 @@
  *    per-light sampler arrays of render/shaders/lib/lights.glsl see both.
  *  - The cavity gain is per light (PIPELINE.md "Energy"): the flame sits in the candle's hull
  *    (gain ~1.04), the side spot does not (gain 1). Linearity holds with either light first,
- *    and the renderer's gains are lr_cpu_cavity_scene_gains' for each light.
+ *    and the renderer's gains are lr_cavity_scene_gains' for each light.
  *  - Area lights (quad): the final image against the CPU twin (test_area_lights_match_twin),
  *    and a box receiver, which has no grid for their direct light, is refused.
  */
@@ -27,7 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/cpu/cavity.h"
+#include "render/models/cavity_gains.h"
 #include "render/cpu/frame.h"
 #include "render/renderer.h"
 #include "render/renderer_debug.h"
@@ -173,7 +173,7 @@ static void test_cavity_gain_per_light(void **state)
     double want[1][3];
     lr_err e = {0};
     for (int l = 0; l < 2; l++) {
-        if (lr_cpu_cavity_scene_gains(s2, l, 0, want, 1, &e))
+        if (lr_cavity_scene_gains(s2, l, 0, want, 1, &e))
             fail_msg("%s", e.msg);
         double got[3];
         lr_renderer_debug_light_cavity_gain(r, l, 0, got);

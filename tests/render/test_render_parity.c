@@ -25,9 +25,9 @@
 
 #include "render/base/mat4.h"
 #include "render/cpu/frame.h"
-#include "render/cpu/radiosity.h"
-#include "render/cpu/rng.h"
-#include "render/cpu/vpl.h"
+#include "render/models/radiosity.h"
+#include "render/base/rng.h"
+#include "render/core/vpl.h"
 #include "render/renderer.h"
 #include "render/renderer_debug.h"
 #include "tests/support/gbuffer_snap.h"
@@ -80,7 +80,7 @@ static void compare_light_maps(lr_renderer *r, lr_scene *s, int light, int n_cpu
                                        .snap_ctx = &g};
             lr_cpu_estimate est;
             lr_cpu_radiosity(objs[obj[t]], L, xo, no, &d,
-                             lr_cpu_key(4242, (uint64_t)k, t, 0), &est);
+                             lr_rng_key(4242, (uint64_t)k, t, 0), &est);
             for (int c = 0; c < 3; c++) {
                 double gv = B[3 * t + c], v = est.var[c] / n_gpu + est.var[c] / n_cpu;
                 assert_true(isfinite(gv) && gv >= 0.0);
@@ -349,8 +349,8 @@ static void test_vpls(void **state)
     const lr_scene_object *o = lr_scene_object_at(s, 0);
     lr_vec3 gc = lr_renderer_debug_vpl_center(r);
     assert_near(lr_v3_len(lr_v3_sub(gc, o->center)), 0.0, 1e-3);
-    lr_cpu_vpl c[48];
-    lr_cpu_vpl_place(o, 48, c);
+    lr_vpl_point c[48];
+    lr_vpl_place(o, 48, c);
     double worst_pos = 0, worst_area = 0, worst_n = 0;
     for (int v = 0; v < n; v++) {
         assert_int_equal(g[v].valid, c[v].valid);
@@ -378,7 +378,7 @@ static void test_vpls(void **state)
         lr_cpu_radiosity_desc rd = {.N = 1000, .sampler = LR_CPU_REFERENCE};
         lr_cpu_estimate est;
         lr_cpu_radiosity(o, lr_scene_light_at(s, 0), g[v].pos, lr_v3_normalize(g[v].nrm), &rd,
-                         lr_cpu_key(77, (uint64_t)v, 0, 0), &est);
+                         lr_rng_key(77, (uint64_t)v, 0, 0), &est);
         sg += g[v].area * g[v].B[1];
         sr += g[v].area * est.mean[1];
         sv += g[v].area * g[v].area * est.var[1] / est.n;

@@ -29,7 +29,7 @@
 #include <string.h>
 
 #include "render/cpu/frame.h"
-#include "render/cpu/surface.h"
+#include "render/core/surface.h"
 #include "render/mesh/bvh.h"
 #include "render/mesh/lattice.h"
 #include "render/optics/optics.h"

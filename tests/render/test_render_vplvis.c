@@ -14,8 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/cpu/recv_grid.h"
-#include "render/cpu/vpl.h"
+#include "render/core/recv_grid.h"
+#include "render/core/vpl.h"
 #include "render/optics/optics.h"
 #include "render/renderer.h"
 #include "render/renderer_debug.h"
@@ -193,7 +193,7 @@ static void test_jar_wall(void **state)
     lr_scene_destroy(s);
 }
 
-/* The CPU twin mirrors the setting with its own VPLs (render/cpu/vpl.h: exact placement, a
+/* The CPU twin mirrors the setting with its own VPLs (render/core/vpl.h: exact placement, a
  * ray cast per VPL and grid point): on jar_candle every receiver pixel is in the jar's
  * shadow, so the receivers' light is all VPL light, and the GPU's and the twin's images agree
  * (tests/support/render.h: objects within 4 sigma + 5 %, receivers within 20 %). Measured at

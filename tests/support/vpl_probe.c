@@ -7,8 +7,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
-#include "render/cpu/recv_grid.h"
-#include "render/cpu/vpl.h"
+#include "render/core/recv_grid.h"
+#include "render/core/vpl.h"
 
 void lr_test_vpl_irradiance(lr_renderer *r, const lr_scene *s, const lr_debug_vpl *v, int n,
                             lr_vec3 x, lr_vec3 nx, bool vis, double E[3])
@@ -17,13 +17,13 @@ void lr_test_vpl_irradiance(lr_renderer *r, const lr_scene *s, const lr_debug_vp
     for (int i = 0; i < n; i++) {
         if (!v[i].valid)
             continue;
-        lr_cpu_vpl c = {.valid = true, .x = v[i].pos, .n = v[i].nrm, .u = v[i].u,
+        lr_vpl_point c = {.valid = true, .x = v[i].pos, .n = v[i].nrm, .u = v[i].u,
                         .area = v[i].area};
         double gain[3];
         lr_renderer_debug_cavity_gain(r, v[i].object, gain);
         for (int b = 0; b < 3; b++)
             c.B[b] = v[i].B[b] * gain[b];
-        lr_cpu_vpl_irradiance_vis(vis ? s : NULL, &c, 1,
+        lr_vpl_point_irradiance_vis(vis ? s : NULL, &c, 1,
                                   lr_scene_object_at(s, v[i].object)->coeffs.eta, x, nx, E, NULL);
     }
 }

@@ -12,7 +12,7 @@
 
 #include "render/base/paths.h"
 #include "render/cpu/maps.h"
-#include "render/cpu/rng.h"
+#include "render/base/rng.h"
 #include "render/scene/scene.h"
 
 typedef struct rate_ctx {
@@ -68,7 +68,7 @@ static int progressive(FILE *out, const char *name)
             if (!tx->valid)
                 continue;
             lr_cpu_estimate est;
-            lr_cpu_radiosity(d.object, d.light, tx->x, tx->n, &rd, lr_cpu_key(5, k, t, 0), &est);
+            lr_cpu_radiosity(d.object, d.light, tx->x, tx->n, &rd, lr_rng_key(5, k, t, 0), &est);
             for (int c = 0; c < 3; c++) {
                 ref[k * S * S + t][c] = est.mean[c];
                 rv[k * S * S + t][c] = est.var[c] / est.n;
@@ -111,7 +111,7 @@ static int run(FILE *out)
         return 1;
     const lr_scene_object *o = lr_scene_object_at(s, 0);
     rate_ctx c = {.o = o, .l = lr_scene_light_at(s, 0), .key = 1};
-    if (!lr_cpu_first_surface(o, lr_v3(0, -200, 60), lr_v3(0, 1, 0), 0, &c.xo, &c.no)) {
+    if (!lr_first_surface(o, lr_v3(0, -200, 60), lr_v3(0, 1, 0), 0, &c.xo, &c.no)) {
         lr_scene_destroy(s);
         return 1;
     }

@@ -12,8 +12,8 @@
  * a = u_dir, b = normal x u_dir, w, h the plane's size. A point between the outermost texel
  * centres and the plane's edge takes the edge texels' values (clamped taps). Box receivers are
  * not cached (their VPL sum stays per pixel). */
-#ifndef LR_CPU_RECV_GRID_H
-#define LR_CPU_RECV_GRID_H
+#ifndef LR_CORE_RECV_GRID_H
+#define LR_CORE_RECV_GRID_H
 
 #include <stdbool.h>
 

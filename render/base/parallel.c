@@ -1,4 +1,4 @@
-#include "render/cpu/parallel.h"
+#include "render/base/parallel.h"
 
 #include <pthread.h>
 #include <stdatomic.h>
@@ -10,14 +10,14 @@
 typedef struct job {
     atomic_long next;
     long count;
-    lr_cpu_item_fn fn;
+    lr_item_fn fn;
     void *ctx;
     const lr_cancel *cancel;
     enum lr_cancel_level level;
     atomic_bool stopped;
 } job;
 
-int lr_cpu_threads_default(void)
+int lr_threads_default(void)
 {
     long n = sysconf(_SC_NPROCESSORS_ONLN);
     if (n < 1)
@@ -43,16 +43,16 @@ static void *worker(void *p)
     return NULL;
 }
 
-void lr_cpu_parallel_for(long count, int threads, lr_cpu_item_fn fn, void *ctx)
+void lr_parallel_for(long count, int threads, lr_item_fn fn, void *ctx)
 {
-    (void)lr_cpu_parallel_for_cancel(count, threads, fn, ctx, NULL, LR_CANCEL_STALE);
+    (void)lr_parallel_for_cancel(count, threads, fn, ctx, NULL, LR_CANCEL_STALE);
 }
 
-bool lr_cpu_parallel_for_cancel(long count, int threads, lr_cpu_item_fn fn, void *ctx,
+bool lr_parallel_for_cancel(long count, int threads, lr_item_fn fn, void *ctx,
                                 const lr_cancel *cancel, enum lr_cancel_level level)
 {
     if (threads <= 0)
-        threads = lr_cpu_threads_default();
+        threads = lr_threads_default();
     if (threads > LR_CPU_MAX_THREADS)
         threads = LR_CPU_MAX_THREADS;
     job j = {.count = count, .fn = fn, .ctx = ctx, .cancel = cancel, .level = level};

@@ -2,14 +2,14 @@
  * the light G-buffer replaced by ray casts through the same texels (render/passes/
  * gbuffer_camera.h), so the projection and the thickness are the GPU pass's, up to the
  * rasteriser's coverage at silhouettes. */
-#ifndef LR_CPU_SH_H
-#define LR_CPU_SH_H
+#ifndef LR_MODELS_SH_H
+#define LR_MODELS_SH_H
 
 #include <stdbool.h>
 
-#include "render/cpu/radiosity.h"
+#include "render/models/radiosity.h"
 #include "render/optics/sh_translucency.h"
-#include "render/passes/gbuffer_camera.h"
+#include "render/core/gbuffer_camera.h"
 #include "render/scene/scene.h"
 
 /* Projects the light entering `obj` from `light` (unit intensity) through cam's views of

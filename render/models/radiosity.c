@@ -1,12 +1,12 @@
 /* CPU twin of the scattered-radiosity pass (PIPELINE.md pass 2) and its untruncated reference.
  * See radiosity.h. */
-#include "render/cpu/radiosity.h"
+#include "render/models/radiosity.h"
 
 #include <math.h>
 #include <stdint.h>
 
-#include "render/cpu/rng.h"
-#include "render/cpu/sh.h"
+#include "render/base/rng.h"
+#include "render/models/sh.h"
 #include "render/optics/optics.h"
 
 /* A light closer to x_o than this many bounding radii is taken to sit on it: the lookup sphere
@@ -16,16 +16,6 @@
 /* Rays from the light ignore hits closer than this many bounding radii (a light on the
  * surface must not see its own triangle at t = 0). */
 #define LR_CPU_TMIN 1e-7
-
-void lr_cpu_tangents(lr_vec3 n, lr_vec3 *t1, lr_vec3 *t2)
-{
-    /* Duff et al. 2017, "Building an Orthonormal Basis, Revisited". */
-    double sign = copysign(1.0, n.z);
-    double a = -1.0 / (sign + n.z);
-    double b = n.x * n.y * a;
-    *t1 = lr_v3(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-    *t2 = lr_v3(b, sign + n.y * n.y * a, -n.y);
-}
 
 double lr_cpu_stereo_lookup(lr_vec3 xl, lr_vec3 xo, lr_vec3 no, lr_vec3 xj, lr_vec3 *v)
 {
@@ -47,28 +37,6 @@ double lr_cpu_stereo_lookup(lr_vec3 xl, lr_vec3 xo, lr_vec3 no, lr_vec3 xj, lr_v
      * t^2 |l.n_o| / (|xj - A|^2 |l.n_P|), |l.n_P| = |h.l| / d), over d^2 for solid angle. */
     double t = fabs(2.0 * hl);
     return 2.0 * t * fabs(lr_v3_dot(l, no)) / (d * ja2);
-}
-
-bool lr_cpu_first_surface(const lr_scene_object *obj, lr_vec3 o, lr_vec3 dir, double tmin,
-                          lr_vec3 *xi, lr_vec3 *ni)
-{
-    lr_hit hit;
-    if (!lr_bvh_intersect(obj->bvh, o, dir, tmin, INFINITY, &hit))
-        return false;
-    *xi = lr_v3_add(o, lr_v3_scale(dir, hit.t));
-    const lr_mesh *m = obj->mesh;
-    const uint32_t *idx = lr_mesh_indices(m) + 3 * hit.triangle;
-    const float *nv = lr_mesh_normals(m);
-    double w0 = 1.0 - hit.u - hit.v;
-    lr_vec3 n = lr_v3(0, 0, 0);
-    const double w[3] = {w0, hit.u, hit.v};
-    for (int k = 0; k < 3; k++) {
-        const float *p = nv + 3 * idx[k];
-        n = lr_v3_add(n, lr_v3_scale(lr_v3(p[0], p[1], p[2]), w[k]));
-    }
-    double len = lr_v3_len(n);
-    *ni = len > 1e-12 ? lr_v3_scale(n, 1.0 / len) : lr_mesh_triangle_normal(m, hit.triangle);
-    return true;
 }
 
 /* Everything one estimate needs, fixed per call. */
@@ -94,7 +62,7 @@ typedef struct ctx {
 static bool gbuffer_texel(const ctx *k, lr_vec3 org, lr_vec3 dir, double tmin, lr_vec3 *xi,
                           lr_vec3 *ni)
 {
-    if (!lr_cpu_first_surface(k->obj, org, dir, tmin, xi, ni))
+    if (!lr_first_surface(k->obj, org, dir, tmin, xi, ni))
         return false;
     if (!k->obj->closed && lr_v3_dot(*ni, dir) > 0.0)
         *ni = lr_v3_scale(*ni, -1.0);
@@ -147,10 +115,10 @@ static lr_vec3 plane_point(const ctx *k, double r, double alpha)
 }
 
 /* One sample of the pass estimator (PIPELINE.md pass 2), band c. */
-static double sample_pass(const ctx *k, int c, double rmax, lr_cpu_rng *rng)
+static double sample_pass(const ctx *k, int c, double rmax, lr_rng *rng)
 {
     double sig = k->obj->coeffs.sigma_tr[c];
-    double xi1 = lr_cpu_rng_next(rng), xi2 = lr_cpu_rng_next(rng);
+    double xi1 = lr_rng_next(rng), xi2 = lr_rng_next(rng);
     double r = lr_exp_radius_sample(sig, rmax, xi1);   /* seed 003 Eq. 12 (truncated) */
     double pr = lr_exp_radius_pdf(sig, rmax, r);       /* Eq. 11 */
     if (!(r > 0.0) || !(pr > 0.0))
@@ -237,11 +205,11 @@ static double cone_cos(const ctx *k, lr_vec3 *axis)
     return sqrt(fmax(0.0, 1.0 - (R / dist) * (R / dist)));
 }
 
-static double sample_ref(const ctx *k, int c, lr_cpu_rng *rng)
+static double sample_ref(const ctx *k, int c, lr_rng *rng)
 {
     rates rt = ref_rates(k, c);
-    double pick = lr_cpu_rng_next(rng);
-    double xi1 = lr_cpu_rng_next(rng), xi2 = lr_cpu_rng_next(rng);
+    double pick = lr_rng_next(rng);
+    double xi1 = lr_rng_next(rng), xi2 = lr_rng_next(rng);
     if (k->light->type == LR_LIGHT_DIRECTIONAL) {
         /* Mixture of the exp ladder around x_o and uniform over the projected disk. */
         double R = 1.0001 * k->obj->radius;
@@ -276,7 +244,7 @@ static double sample_ref(const ctx *k, int c, lr_cpu_rng *rng)
         double z = 1.0 - (1.0 - cmax) * xi1, phi = 2.0 * M_PI * xi2;
         double s = sqrt(fmax(0.0, (1.0 - z) * (1.0 + z)));
         lr_vec3 a1, a2;
-        lr_cpu_tangents(axis, &a1, &a2);
+        lr_tangents(axis, &a1, &a2);
         vh = lr_v3_add(lr_v3_scale(axis, z),
                        lr_v3_add(lr_v3_scale(a1, s * cos(phi)), lr_v3_scale(a2, s * sin(phi))));
     }
@@ -287,7 +255,7 @@ static double sample_ref(const ctx *k, int c, lr_cpu_rng *rng)
     return lit_point(k, vh, c) / p;
 }
 
-/* Seed 002's sh_translucency (render/cpu/sh.h): deterministic, so the variance is 0. Without a
+/* Seed 002's sh_translucency (render/models/sh.h): deterministic, so the variance is 0. Without a
  * precomputed environment one is projected here through a cube of LR_CPU_SH_FALLBACK_SIZE^2
  * texels per face around the light (the caller's G-buffer cameras are unknown here). */
 #define LR_CPU_SH_FALLBACK_SIZE 32
@@ -324,11 +292,11 @@ void lr_cpu_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3
              .snap = d ? d->snap : NULL, .snap_ctx = d ? d->snap_ctx : NULL};
     if (light->type == LR_LIGHT_DIRECTIONAL) {
         k.wl = light->direction;
-        lr_cpu_tangents(k.wl, &k.t1, &k.t2);
+        lr_tangents(k.wl, &k.t1, &k.t2);
         k.cp = lr_v3_sub(obj->center,
                          lr_v3_scale(k.wl, lr_v3_dot(lr_v3_sub(obj->center, xo), k.wl)));
     } else {
-        lr_cpu_tangents(no, &k.t1, &k.t2);
+        lr_tangents(no, &k.t1, &k.t2);
         k.xl = light->position;
         k.xs = k.xl;
         double eps = LR_CPU_ON_SURFACE_EPS * obj->radius;
@@ -354,7 +322,7 @@ void lr_cpu_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3
     }
     for (int c = 0; c < 3; c++) {
         /* seed 003 Sec. 3.1: a separate set of samples per colour band. */
-        lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(stream, (uint64_t)c, 0x5A3D, 0));
+        lr_rng rng = lr_rng_init(lr_rng_key(stream, (uint64_t)c, 0x5A3D, 0));
         double mean = 0.0, m2 = 0.0;
         for (int j = 0; j < N; j++) {
             double f = mode == LR_CPU_REFERENCE ? sample_ref(&k, c, &rng)

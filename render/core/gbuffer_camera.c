@@ -1,12 +1,22 @@
 /* The light G-buffer's cameras (gbuffer_camera.h): moved out of gbuffer.c unchanged so that the
  * GPU pass and the CPU twin share them. */
-#include "render/passes/gbuffer_camera.h"
+#include "render/core/gbuffer_camera.h"
 
 #include <math.h>
 
 #include "render/area/frames.h"
 #include "render/base/mat4.h"
-#include "render/passes/passes.h"
+
+void lr_cube_face_vp(lr_vec3 at, int f, double znear, double zfar, double out[16])
+{
+    static const double dir[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    static const double up[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+    double view[16], proj[16];
+    lr_vec3 target = lr_v3_add(at, lr_v3(dir[f][0], dir[f][1], dir[f][2]));
+    lr_mat4_look_at(at, target, lr_v3(up[f][0], up[f][1], up[f][2]), view);
+    lr_mat4_perspective(M_PI / 2.0, 1.0, znear, zfar, proj);
+    lr_mat4_mul(proj, view, out);
+}
 
 static lr_vec3 up_for(lr_vec3 dir)
 {
@@ -31,7 +41,7 @@ void lr_gb_camera_make(const lr_light *light, lr_vec3 c, double R, bool enclosed
         double znear = fmax(1e-4 * R, 1e-3), zfar = dist + 3.0 * R;
         out->views = 6;
         for (int f = 0; f < 6; f++)
-            lr_passes_cube_face_vp(light->position, f, znear, zfar, out->vp[f]);
+            lr_cube_face_vp(light->position, f, znear, zfar, out->vp[f]);
         return;
     }
     double view[16], proj[16];

@@ -1,23 +1,23 @@
 /* VPL placement and receiver lighting; see vpl.h. */
-#include "render/cpu/vpl.h"
+#include "render/core/vpl.h"
 
 #include <math.h>
 #include <string.h>
 
-#include "render/cpu/radiosity.h"
+#include "render/core/ray.h"
 
-void lr_cpu_vpl_place(const lr_scene_object *obj, int count, lr_cpu_vpl *out)
+void lr_vpl_place(const lr_scene_object *obj, int count, lr_vpl_point *out)
 {
     lr_vec3 c = obj->center;
     double far = 2.0 * obj->radius + 1.0;
     for (int v = 0; v < count; v++) {
-        lr_cpu_vpl *p = &out[v];
+        lr_vpl_point *p = &out[v];
         memset(p, 0, sizeof *p);
         lr_vec3 u = lr_halton_sphere((unsigned)v + 1);
         p->u = u;
         lr_vec3 x, n;
         /* From outside inwards: the first hit is the outermost surface along the line. */
-        if (!lr_cpu_first_surface(obj, lr_v3_add(c, lr_v3_scale(u, far)), lr_v3_scale(u, -1.0),
+        if (!lr_first_surface(obj, lr_v3_add(c, lr_v3_scale(u, far)), lr_v3_scale(u, -1.0),
                                   0.0, &x, &n))
             continue;
         if (lr_v3_dot(lr_v3_sub(x, c), u) < 0.0)
@@ -33,16 +33,16 @@ void lr_cpu_vpl_place(const lr_scene_object *obj, int count, lr_cpu_vpl *out)
     }
 }
 
-void lr_cpu_vpl_irradiance(const lr_cpu_vpl *v, int count, double eta, lr_vec3 x, lr_vec3 n,
+void lr_vpl_point_irradiance(const lr_vpl_point *v, int count, double eta, lr_vec3 x, lr_vec3 n,
                            double E[3], double var[3])
 {
-    lr_cpu_vpl_irradiance_vis(NULL, v, count, eta, x, n, E, var);
+    lr_vpl_point_irradiance_vis(NULL, v, count, eta, x, n, E, var);
 }
 
 /* Whether any object of s blocks the segment from VPL p to x (dist = |x - x_v|, w its unit
  * direction). The VPL lies on its object's surface and the segment leaves it outward
  * (cos_v > 0): tmin 1e-6 of each object's radius, as the direct light's shadow rays. */
-static bool vpl_hidden(const lr_scene *s, const lr_cpu_vpl *p, lr_vec3 w, double dist)
+static bool vpl_hidden(const lr_scene *s, const lr_vpl_point *p, lr_vec3 w, double dist)
 {
     for (int i = 0; i < lr_scene_object_count(s); i++) {
         const lr_scene_object *o = lr_scene_object_at(s, i);
@@ -52,11 +52,11 @@ static bool vpl_hidden(const lr_scene *s, const lr_cpu_vpl *p, lr_vec3 w, double
     return false;
 }
 
-void lr_cpu_vpl_irradiance_vis(const lr_scene *s, const lr_cpu_vpl *v, int count, double eta,
+void lr_vpl_point_irradiance_vis(const lr_scene *s, const lr_vpl_point *v, int count, double eta,
                                lr_vec3 x, lr_vec3 n, double E[3], double var[3])
 {
     for (int i = 0; i < count; i++) {
-        const lr_cpu_vpl *p = &v[i];
+        const lr_vpl_point *p = &v[i];
         if (!p->valid)
             continue;
         lr_vec3 w = lr_v3_sub(x, p->x);
@@ -79,7 +79,7 @@ void lr_cpu_vpl_irradiance_vis(const lr_scene *s, const lr_cpu_vpl *v, int count
     }
 }
 
-double lr_cpu_direct_irradiance(const lr_scene *s, const lr_light *l, lr_vec3 x, lr_vec3 n)
+double lr_direct_irradiance(const lr_scene *s, const lr_light *l, lr_vec3 x, lr_vec3 n)
 {
     lr_vec3 dir;
     double dist, e;

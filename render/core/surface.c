@@ -1,6 +1,6 @@
 /* The surface cache's refinement, shared by the GPU pass and the CPU twin
- * (render/cpu/surface.h). */
-#include "render/cpu/surface.h"
+ * (render/core/surface.h). */
+#include "render/core/surface.h"
 
 #include <math.h>
 

@@ -1,12 +1,12 @@
 /* Cavity gain: see cavity.h. */
-#include "render/cpu/cavity.h"
+#include "render/core/cavity.h"
 
 #include <math.h>
 #include <stdlib.h>
 
-#include "render/cpu/parallel.h"
-#include "render/cpu/radiosity.h"
-#include "render/cpu/rng.h"
+#include "render/base/parallel.h"
+#include "render/base/rng.h"
+#include "render/core/ray.h"
 #include "render/mesh/area_pick.h"
 #include "render/mesh/bvh.h"
 #include "render/optics/optics.h"
@@ -18,6 +18,8 @@ typedef struct point_ctx {
     size_t nt;
     int npts, N;
     unsigned seed;
+    lr_cavity_sample_fn B;
+    const void *B_ctx;
     double (*P)[3];    /* per point: B of its unlit side(s) */
 } point_ctx;
 
@@ -37,10 +39,10 @@ static bool lit_side(const lr_scene_object *o, lr_vec3 xl, lr_vec3 x, lr_vec3 n)
  * surface's area, in the mesh's triangle order), which keeps the points spread over the whole
  * surface; n its face's outward normal. */
 static void surface_point(const lr_scene_object *o, const double *cdf, size_t nt, long i,
-                          int npts, lr_cpu_rng *rng, lr_vec3 *x, lr_vec3 *n)
+                          int npts, lr_rng *rng, lr_vec3 *x, lr_vec3 *n)
 {
-    double pick = (i + lr_cpu_rng_next(rng)) / npts;
-    double s = lr_cpu_rng_next(rng), t = lr_cpu_rng_next(rng);
+    double pick = (i + lr_rng_next(rng)) / npts;
+    double s = lr_rng_next(rng), t = lr_rng_next(rng);
     lr_vec3 v[3];
     lr_mesh_triangle(o->mesh, lr_cdf_pick(cdf, nt, pick), v); /* first triangle with cdf > pick */
     *x = lr_triangle_fold_point(v, s, t);
@@ -51,7 +53,7 @@ static void point_item(void *p, long i)
 {
     point_ctx *k = p;
     const lr_scene_object *o = k->obj;
-    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(k->seed, 0xCA71, (uint64_t)i, 0));
+    lr_rng rng = lr_rng_init(lr_rng_key(k->seed, 0xCA71, (uint64_t)i, 0));
     lr_vec3 x, n;
     surface_point(o, k->cdf, k->nt, i, k->npts, &rng, &x, &n);
     /* Closed: the outward side only. Open (two-sided): both sides emit. */
@@ -59,12 +61,10 @@ static void point_item(void *p, long i)
         lr_vec3 ns = side ? lr_v3_scale(n, -1.0) : n;
         if (lit_side(o, k->light->position, x, ns))
             continue;
-        lr_cpu_radiosity_desc d = {.N = k->N, .sampler = LR_CPU_REFERENCE};
-        lr_cpu_estimate est;
-        lr_cpu_radiosity(o, k->light, x, ns, &d,
-                         lr_cpu_key(k->seed, 0xCA72, (uint64_t)i, (uint64_t)side), &est);
+        double b[3] = {0.0, 0.0, 0.0};
+        k->B(k->B_ctx, x, ns, k->N, lr_rng_key(k->seed, 0xCA72, (uint64_t)i, (uint64_t)side), b);
         for (int c = 0; c < 3; c++)
-            k->P[i][c] += est.mean[c];
+            k->P[i][c] += b[c];
     }
 }
 
@@ -73,16 +73,16 @@ static void point_item(void *p, long i)
  * the object's front; from each such point one cosine-distributed ray into the cavity tells
  * whether the light it sends back meets the object again. */
 static void cavity_geometry(const lr_scene_object *obj, const lr_light *l, int ndir,
-                            unsigned seed, lr_cpu_cavity *out)
+                            unsigned seed, lr_cavity *out)
 {
     double eta = obj->coeffs.eta, hit = 0.0, entered = 0.0, rehit = 0.0, w = 4.0 * M_PI / ndir;
-    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(seed, 0xCA70, 0, 0));
+    lr_rng rng = lr_rng_init(lr_rng_key(seed, 0xCA70, 0, 0));
     for (int i = 0; i < ndir; i++) {
         lr_vec3 u = lr_halton_sphere((unsigned)i + 1), xi, ni;
         double shape = lr_light_shape(l, u);
-        double xi1 = lr_cpu_rng_next(&rng), xi2 = lr_cpu_rng_next(&rng);
+        double xi1 = lr_rng_next(&rng), xi2 = lr_rng_next(&rng);
         if (!(shape > 0.0) ||
-            !lr_cpu_first_surface(obj, l->position, u, 1e-9 * obj->radius, &xi, &ni))
+            !lr_first_surface(obj, l->position, u, 1e-9 * obj->radius, &xi, &ni))
             continue;
         if (!obj->closed && lr_v3_dot(ni, u) > 0.0)
             ni = lr_v3_scale(ni, -1.0); /* open surfaces are two-sided */
@@ -92,7 +92,7 @@ static void cavity_geometry(const lr_scene_object *obj, const lr_light *l, int n
         hit += w * shape;
         entered += w * shape * lr_fresnel_transmittance(mu, eta);
         lr_vec3 t1, t2;
-        lr_cpu_tangents(ni, &t1, &t2);
+        lr_tangents(ni, &t1, &t2);
         double rr = sqrt(xi1), ph = 2.0 * M_PI * xi2, z = sqrt(fmax(0.0, 1.0 - xi1));
         lr_vec3 dir = lr_v3_add(lr_v3_scale(ni, z), lr_v3_add(lr_v3_scale(t1, rr * cos(ph)),
                                                                lr_v3_scale(t2, rr * sin(ph))));
@@ -142,10 +142,10 @@ static int no_area(const lr_scene_object *obj, double area, lr_err *e)
  * enters, C, R_1, F and the power entering, and the surface's area CDF in *cdf (the caller
  * frees it). *cdf stays NULL when there is nothing more to measure. */
 static int cavity_begin(const lr_scene_object *obj, const lr_light *l, bool applies,
-                        const lr_cpu_cavity_desc *d, lr_cpu_cavity *out, double **cdf,
+                        const lr_cavity_desc *d, lr_cavity *out, double **cdf,
                         double *area, lr_err *e)
 {
-    *out = (lr_cpu_cavity){.gain = {1.0, 1.0, 1.0}, .applies = applies};
+    *out = (lr_cavity){.gain = {1.0, 1.0, 1.0}, .applies = applies};
     *cdf = NULL;
     if (!applies)
         return LR_OK;
@@ -157,7 +157,7 @@ static int cavity_begin(const lr_scene_object *obj, const lr_light *l, bool appl
 }
 
 /* The gain from C, R_1, F, b (cavity.h's geometric series), per band. */
-static void cavity_gain(lr_cpu_cavity *out, double T)
+static void cavity_gain(lr_cavity *out, double T)
 {
     for (int c = 0; c < 3; c++) {
         double R1 = out->R1, F = out->F;
@@ -169,22 +169,16 @@ static void cavity_gain(lr_cpu_cavity *out, double T)
     }
 }
 
-int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
-                          enum lr_enclosure enclosure, const lr_cpu_cavity_desc *d,
-                          lr_cpu_cavity *out, lr_err *e)
+int lr_cavity_measure_energy(const lr_scene_object *obj, const lr_light *l, bool applies,
+                             const double A[3], const lr_cavity_desc *d, lr_cavity_sample_fn B,
+                             const void *ctx, lr_cavity *out, lr_err *e)
 {
-    if (!obj || !l || !out)
-        return lr_err_set(e, LR_EINVAL, "cavity: NULL %s", !obj ? "object" : !l ? "light" : "out");
+    if (!obj || !l || !out || !B || !A)
+        return lr_err_set(e, LR_EINVAL, "cavity: NULL %s",
+                          !obj ? "object" : !l ? "light" : !out ? "out" : !B ? "B" : "A");
     int npts = d && d->points > 0 ? d->points : 256;
     int N = d && d->N > 0 ? d->N : 64;
     unsigned seed = d && d->seed ? d->seed : 1;
-    /* Not for the raw directional dipole (its total exceeds 1); the standard dipole is the
-     * normalisation's reference, so "normalize" does not change it (lr_scene_object_sd_norm). */
-    bool applies = enclosure == LR_ENCLOSURE_HULL && l->type != LR_LIGHT_DIRECTIONAL &&
-                   !(obj->sd_raw && obj->sss_model == LR_SSS_DIRECTIONAL_DIPOLE) &&
-                   /* the models that close the cavity themselves or are fitted
-                    * (lr_sss_model_props: no_closure says why) */
-                   !lr_sss_model_props_of(obj->sss_model)->no_closure;
     double area, *cdf;
     int rc = cavity_begin(obj, l, applies, d, out, &cdf, &area, e);
     if (rc || !cdf)
@@ -197,12 +191,9 @@ int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
         free(cdf);
         return lr_err_set(e, LR_ENOMEM, "cavity: out of memory for %d points", npts);
     }
-    point_ctx pc = {obj, l, cdf, lr_mesh_triangle_count(obj->mesh), npts, N, seed, P};
-    lr_cpu_parallel_for(npts, d ? d->threads : 0, point_item, &pc);
-    double T = lr_hemi_transmittance(obj->coeffs.eta), A[3];
-    /* The normalised model's half-space total; for the multipole the slab's R + T total
-     * (what entered and was not absorbed: a thin wall absorbs less than a half-space). */
-    lr_sss_total(obj->sss_model, &obj->coeffs, obj->thickness_mm, A);
+    point_ctx pc = {obj, l, cdf, lr_mesh_triangle_count(obj->mesh), npts, N, seed, B, ctx, P};
+    lr_parallel_for(npts, d ? d->threads : 0, point_item, &pc);
+    double T = lr_hemi_transmittance(obj->coeffs.eta);
     for (int c = 0; c < 3; c++) {
         double sum = 0.0;
         for (int i = 0; i < npts; i++)
@@ -217,9 +208,9 @@ int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
     return LR_OK;
 }
 
-int lr_cpu_cavity_measure_field(const lr_scene_object *obj, const lr_light *l,
-                                enum lr_enclosure enclosure, const lr_cpu_cavity_desc *d,
-                                lr_cavity_b_fn B, const void *ctx, lr_cpu_cavity *out, lr_err *e)
+int lr_cavity_measure_field(const lr_scene_object *obj, const lr_light *l,
+                                enum lr_enclosure enclosure, const lr_cavity_desc *d,
+                                lr_cavity_b_fn B, const void *ctx, lr_cavity *out, lr_err *e)
 {
     if (!obj || !l || !B || !out)
         return lr_err_set(e, LR_EINVAL, "cavity: NULL %s",
@@ -235,11 +226,11 @@ int lr_cpu_cavity_measure_field(const lr_scene_object *obj, const lr_light *l,
      * (a) and out of the one it sees (b, the cavity side), both as the renderer emits them
      * (T_hem int B dA), by points stratified over the area. A finite-geometry model's
      * cavity-side B is what that side really sends back, so b comes from it, not from the
-     * energy balance of a half-space profile (lr_cpu_cavity_measure). Closed meshes: the
+     * energy balance of a half-space profile (lr_cavity_measure). Closed meshes: the
      * outward side only. */
     size_t nt = lr_mesh_triangle_count(obj->mesh);
     double lit[3] = {0.0, 0.0, 0.0}, unlit[3] = {0.0, 0.0, 0.0};
-    lr_cpu_rng rng = lr_cpu_rng_init(lr_cpu_key(seed, 0xCA73, 0, 0));
+    lr_rng rng = lr_rng_init(lr_rng_key(seed, 0xCA73, 0, 0));
     for (int i = 0; i < npts; i++) {
         lr_vec3 x, n;
         surface_point(obj, cdf, nt, i, npts, &rng, &x, &n);
@@ -257,26 +248,5 @@ int lr_cpu_cavity_measure_field(const lr_scene_object *obj, const lr_light *l,
         out->b[c] = fmax(0.0, T * lit[c] * area / npts / out->entered);
     }
     cavity_gain(out, T);
-    return LR_OK;
-}
-
-int lr_cpu_cavity_scene_gains(const lr_scene *s, int light, int threads, double (*gain)[3],
-                              int nobj, lr_err *e)
-{
-    for (int o = 0; o < nobj; o++)
-        gain[o][0] = gain[o][1] = gain[o][2] = 1.0;
-    const lr_light *l = lr_scene_light_at(s, light);
-    int k = -1;
-    enum lr_enclosure enc = l ? lr_scene_light_enclosure(s, light, &k) : LR_ENCLOSURE_NONE;
-    if (enc != LR_ENCLOSURE_HULL || k < 0 || k >= nobj)
-        return LR_OK;
-    lr_cpu_cavity_desc d = LR_CAVITY_SCENE_DESC;
-    d.threads = threads;
-    lr_cpu_cavity cav;
-    int rc = lr_cpu_cavity_measure(lr_scene_object_at(s, k), l, enc, &d, &cav, e);
-    if (rc)
-        return rc;
-    for (int c = 0; c < 3; c++)
-        gain[k][c] = cav.gain[c];
     return LR_OK;
 }

@@ -2,8 +2,8 @@
  * its CPU twin (render/cpu/frame.c): the edge bound of each object's lattice and the lattice
  * itself (render/mesh/lattice.h, in an lr_refined), so that both sides cache B at the same
  * points and interpolate alike (PIPELINE.md "Surface cache"). */
-#ifndef LR_CPU_SURFACE_H
-#define LR_CPU_SURFACE_H
+#ifndef LR_CORE_SURFACE_H
+#define LR_CORE_SURFACE_H
 
 #include <stddef.h>
 

@@ -1,14 +1,14 @@
 /* CPU twin of the sh_translucency model; see sh.h. */
-#include "render/cpu/sh.h"
+#include "render/models/sh.h"
 
 #include <math.h>
 #include <stdlib.h>
 
-#include "render/cpu/parallel.h"
-#include "render/cpu/radiosity.h"
+#include "render/base/parallel.h"
+#include "render/models/radiosity.h"
 #include "render/optics/near_light.h"
 
-/* The G-buffer's first surface along (org, dir), as render/cpu/radiosity.c's gbuffer_texel:
+/* The G-buffer's first surface along (org, dir), as render/models/radiosity.c's gbuffer_texel:
  * false when obj is missed or another object is nearer. */
 static bool first_own(const lr_scene_object *obj, lr_vec3 org, lr_vec3 dir,
                       const lr_scene_object *const *others, int n_others, lr_vec3 *xi,
@@ -16,7 +16,7 @@ static bool first_own(const lr_scene_object *obj, lr_vec3 org, lr_vec3 dir,
 {
     *blocked = false;
     double tmin = 1e-7 * obj->radius;
-    if (!lr_cpu_first_surface(obj, org, dir, tmin, xi, ni))
+    if (!lr_first_surface(obj, org, dir, tmin, xi, ni))
         return false;
     if (!obj->closed && lr_v3_dot(*ni, dir) > 0.0)
         *ni = lr_v3_scale(*ni, -1.0);
@@ -78,7 +78,7 @@ void lr_cpu_sh_env(const lr_scene_object *obj, const lr_light *light, const lr_g
     if (!part)
         return; /* out of memory: an empty environment (B = 0) */
     env_ctx c = {obj, light, cam, size, others, n_others, part};
-    lr_cpu_parallel_for(rows, threads, env_row, &c);
+    lr_parallel_for(rows, threads, env_row, &c);
     for (long r = 0; r < rows; r++) {
         for (int k = 0; k < 9; k++)
             out->E[k] += part[r].E[k];

@@ -1,8 +1,8 @@
 /* lamprig — the light G-buffer's cameras (pass 1, render/passes/PIPELINE.md) as plain math, so
  * that the CPU twin can cast its rays through the very texels the GPU draws (the sh_translucency
  * projection, render/optics/sh_translucency.h). No GL here. */
-#ifndef LR_GBUFFER_CAMERA_H
-#define LR_GBUFFER_CAMERA_H
+#ifndef LR_CORE_GBUFFER_CAMERA_H
+#define LR_CORE_GBUFFER_CAMERA_H
 
 #include <stdbool.h>
 
@@ -15,7 +15,7 @@ enum lr_gb_mode { LR_GB_CUBE = 0, LR_GB_PERSPECTIVE = 1, LR_GB_ORTHO = 2 };
 
 typedef struct lr_gb_camera {
     enum lr_gb_mode mode;
-    int views;        /* 6 cube faces (lr_passes_cube_face_vp order) or 1 */
+    int views;        /* 6 cube faces (lr_cube_face_vp order) or 1 */
     double vp[6][16]; /* world -> clip of each view */
 } lr_gb_camera;
 
@@ -30,5 +30,8 @@ void lr_gb_camera_make(const lr_light *light, lr_vec3 c, double R, bool enclosed
  * lr_gb_camera_scene (the sh_translucency projection sees an area light from that sample). */
 void lr_gb_camera_scene(const lr_scene *s, int l, lr_gb_camera *out);
 void lr_gb_camera_scene_frame(const lr_scene *s, int l, long frame, lr_gb_camera *out);
+
+/* View-projection of cube face f (0..5 = +X..-Z) around `at`. */
+void lr_cube_face_vp(lr_vec3 at, int f, double znear, double zfar, double out[16]);
 
 #endif

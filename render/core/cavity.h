@@ -25,8 +25,11 @@
  * for b. Only for point and spot lights inside the object's hull (LR_ENCLOSURE_HULL); the raw
  * model ("normalize": false with the directional dipole) has no closure (A > 1 there: the
  * series would diverge); the standard dipole ("model": "standard_dipole") has it either way. */
-#ifndef LR_CPU_CAVITY_H
-#define LR_CPU_CAVITY_H
+#ifndef LR_CORE_CAVITY_H
+#define LR_CORE_CAVITY_H
+
+#include <stdbool.h>
+#include <stdint.h>
 
 #include "render/base/err.h"
 #include "render/scene/scene.h"
@@ -35,15 +38,15 @@
  * ~1/a bounces; beyond this the closure is not meaningful. */
 #define LR_CAVITY_GAIN_MAX 1000.0
 
-typedef struct lr_cpu_cavity_desc {
+typedef struct lr_cavity_desc {
     int directions; /* light directions (Halton) for C, R_1 and F; 0: 4096 */
     int points;     /* surface points (uniform by area) for a; 0: 256 */
     int N;          /* samples per band and point (LR_CPU_REFERENCE sampler); 0: 64 */
     unsigned seed;  /* 0: 1 */
     int threads;    /* 0: all CPUs */
-} lr_cpu_cavity_desc;
+} lr_cavity_desc;
 
-typedef struct lr_cpu_cavity {
+typedef struct lr_cavity {
     double C;          /* fraction of the light's power that meets the object's front side */
     double R1;         /* flux-weighted Fresnel reflectance there */
     double F;          /* flux-weighted view factor of the lit surface to the object */
@@ -53,13 +56,21 @@ typedef struct lr_cpu_cavity {
     double b[3];       /* cavity-side albedo from energy, max(0, A - a) */
     double gain[3];    /* the cavity gain; 1 where the closure does not apply */
     bool applies;      /* enclosed point/spot light and the normalised model */
-} lr_cpu_cavity;
+} lr_cavity;
 
-/* Measures the closure for object obj and light l (enclosure: lr_scene_light_enclosure's
- * answer for this pair; the gain is 1 unless it is LR_ENCLOSURE_HULL). */
-int lr_cpu_cavity_measure(const lr_scene_object *obj, const lr_light *l,
-                          enum lr_enclosure enclosure, const lr_cpu_cavity_desc *d,
-                          lr_cpu_cavity *out, lr_err *e);
+/* B per unit intensity at surface point x, normal n, estimated with N samples per band from the
+ * random stream `key` (the untruncated sampler of the profile models:
+ * render/models/cavity_gains.c). */
+typedef void (*lr_cavity_sample_fn)(const void *ctx, lr_vec3 x, lr_vec3 n, int N, uint64_t key,
+                                    double B[3]);
+
+/* The closure with b from energy (b = max(0, A - a), the comment above) for a half-space
+ * profile model: `applies` says whether it closes the cavity at all (an enclosed point/spot
+ * light and a model with a closure; the models decide: lr_cavity_measure), A[c] the model's
+ * total (what entered and was not absorbed), B its estimator at surface points. */
+int lr_cavity_measure_energy(const lr_scene_object *obj, const lr_light *l, bool applies,
+                             const double A[3], const lr_cavity_desc *d, lr_cavity_sample_fn B,
+                             const void *ctx, lr_cavity *out, lr_err *e);
 
 /* B per unit intensity leaving an object at surface point x, outward normal n, as a model
  * that is not a profile solved it (the grid's field: render/diffusion/dscene.c). */
@@ -69,16 +80,8 @@ typedef void (*lr_cavity_b_fn)(const void *ctx, lr_vec3 x, lr_vec3 n, double B[3
  * a and b from that model's solved B (b: what the cavity side really sends back, not
  * max(0, A - a)). d->points: surface points, 0: 4096 (B is cheap to evaluate); d->N unused.
  * Applies to point and spot lights with LR_ENCLOSURE_HULL whatever the object's model. */
-int lr_cpu_cavity_measure_field(const lr_scene_object *obj, const lr_light *l,
-                                enum lr_enclosure enclosure, const lr_cpu_cavity_desc *d,
-                                lr_cavity_b_fn B, const void *ctx, lr_cpu_cavity *out, lr_err *e);
-
-/* The gains the renderer (GLSL composition) and lr_cpu_render apply, so that both get the same
- * numbers: for light `light` of scene s, gain[o] for every object o < nobj, 1 except for the
- * object that encloses the light (lr_scene_light_enclosure: LR_ENCLOSURE_HULL), measured with
- * LR_CAVITY_SCENE_DESC (a few ms). */
-#define LR_CAVITY_SCENE_DESC {.directions = 2048, .points = 128, .N = 32, .seed = 1}
-int lr_cpu_cavity_scene_gains(const lr_scene *s, int light, int threads, double (*gain)[3],
-                              int nobj, lr_err *e);
+int lr_cavity_measure_field(const lr_scene_object *obj, const lr_light *l,
+                                enum lr_enclosure enclosure, const lr_cavity_desc *d,
+                                lr_cavity_b_fn B, const void *ctx, lr_cavity *out, lr_err *e);
 
 #endif

@@ -1,5 +1,5 @@
-/* The receiver irradiance grid (render/cpu/recv_grid.h). */
-#include "render/cpu/recv_grid.h"
+/* The receiver irradiance grid (render/core/recv_grid.h). */
+#include "render/core/recv_grid.h"
 
 #include <math.h>
 

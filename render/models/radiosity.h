@@ -22,13 +22,14 @@
  *                     antipodal cap, so the variance is finite for every material, albedo 1
  *                     (sigma_tr = 0, plane sampled at rate 1/radius) included.
  */
-#ifndef LR_CPU_RADIOSITY_H
-#define LR_CPU_RADIOSITY_H
+#ifndef LR_MODELS_RADIOSITY_H
+#define LR_MODELS_RADIOSITY_H
 
 #include <stdbool.h>
 #include <stdint.h>
 
 #include "render/base/vec3.h"
+#include "render/core/ray.h"
 #include "render/diffusion/dscene.h"
 #include "render/scene/scene.h"
 
@@ -55,7 +56,7 @@ typedef struct lr_cpu_radiosity_desc {
     /* "model": "diffusion_grid" (seed 001): B is the solved field at x_o (lr_dfield_eval, the
      * pass's arithmetic; no samples, variance 0); data NULL gives 0. Both samplers. */
     lr_dfield_view dfield;
-    /* Objects with model sh_translucency: the light's projected environment (render/cpu/sh.h,
+    /* Objects with model sh_translucency: the light's projected environment (render/models/sh.h,
      * lr_cpu_sh_env through the scene's G-buffer cameras). NULL: projected per call through a
      * small cube (slow). Their estimate is deterministic (variance 0, the sampler unused). */
     const struct lr_sh_env *sh_env;
@@ -68,7 +69,7 @@ typedef struct lr_cpu_estimate {
 } lr_cpu_estimate;
 
 /* Estimates B at (xo, no) (no unit, pointing out of the medium) for object `obj` lit by
- * `light`; `stream` keys the random numbers (lr_cpu_key of seed, map, texel, frame): the same
+ * `light`; `stream` keys the random numbers (lr_rng_key of seed, map, texel, frame): the same
  * key gives the same result on any thread. Finite and >= 0 for every finite input. */
 void lr_cpu_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3 xo, lr_vec3 no,
                       const lr_cpu_radiosity_desc *d, uint64_t stream, lr_cpu_estimate *out);
@@ -79,12 +80,5 @@ void lr_cpu_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3
  * from the plane to directions around the light (PIPELINE.md). 0 where undefined (xj == A). */
 double lr_cpu_stereo_lookup(lr_vec3 xl, lr_vec3 xo, lr_vec3 no, lr_vec3 xj, lr_vec3 *v);
 
-/* The light G-buffer's texel along unit direction dir from origin o: first surface of the
- * object with t > tmin; x_i and its interpolated unit normal. False when the ray misses. */
-bool lr_cpu_first_surface(const lr_scene_object *obj, lr_vec3 o, lr_vec3 dir, double tmin,
-                          lr_vec3 *xi, lr_vec3 *ni);
-
-/* Orthonormal tangents t1, t2 of unit n (t1 x t2 = n). */
-void lr_cpu_tangents(lr_vec3 n, lr_vec3 *t1, lr_vec3 *t2);
 
 #endif
