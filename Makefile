@@ -17,7 +17,7 @@
 # tests/AREA/test_NAME.c (plus tests/support/*.c) builds one test binary per area,
 # build/test/test_NAME (the binary name has no sub-folder: make build/test/test_scene).
 
-PUBLIC_TARGETS := all build test soak run bench install deb test-install
+PUBLIC_TARGETS := all build test soak run bench install deb test-install test-boot
 
 ifndef LAMPRIG_INNER
 # Outer make: install dependencies first, then re-enter with pkg-config available.
@@ -170,7 +170,7 @@ SHADER_FILES := $(sort $(wildcard render/shaders/* render/shaders/*/*))
 SUBST = sed -e 's|@BINDIR@|$(BINDIR)|g' -e 's|@DATADIR@|$(DATADIR)|g' \
             -e 's|@SYSCONFDIR@|$(SYSCONFDIR)|g' -e 's|@STATEDIR@|$(STATEDIR)|g'
 
-.PHONY: install deb test-install
+.PHONY: install deb test-install test-boot
 install: $(INSTALL_BINS:%=build/bin/%)
 	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(DATADIR) $(DESTDIR)$(MANDIR)/man1 \
 	    $(DESTDIR)$(SYSCONFDIR)/lamprig $(DESTDIR)$(UNITDIR) $(DESTDIR)$(UDEVDIR) \
@@ -199,6 +199,11 @@ deb: $(INSTALL_BINS:%=build/bin/%)
 
 test-install: deb
 	sh tests/install.sh build
+
+# The package under a booted systemd: debootstrap root + apt + systemd-nspawn --boot (root;
+# .ci/run runs it after make test). Starts, renders, reloads, stops; the sandbox's score.
+test-boot: deb
+	sh tests/boot.sh build
 
 # 8 progressive frames (the scene converges at 64): about a minute on llvmpipe; leave out
 # --frames to render until render.frames are accumulated. --no-plan: the demo shows the scene

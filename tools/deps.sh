@@ -7,6 +7,8 @@ set -eu
 # (examples/data/left*.jpg, left_intrinsics.yml): tests/calib/test_calib_camera.c checks against them.
 # libsystemd-dev: sd_notify from the rig loop. lintian and systemd (systemd-analyze verify)
 # check `make deb`'s package and unit in tests/install.sh; dpkg-dev comes with build-essential.
+# systemd-container (systemd-nspawn) and debootstrap boot the package under systemd in
+# tests/boot.sh (make test-boot).
 PKGS="build-essential pkg-config
 libgpiod-dev libhidapi-dev libusb-1.0-0-dev libmodbus-dev
 libegl-dev libgles-dev libgbm-dev libdrm-dev libegl-mesa0 libgl1-mesa-dri libgbm1
@@ -14,7 +16,8 @@ libopencv-dev libopencv-contrib-dev
 opencv-doc
 libpng-dev libcairo2-dev liblcms2-dev libcmocka-dev
 libsystemd-dev
-lintian systemd"
+lintian systemd
+systemd-container debootstrap"
 
 missing=""
 for p in $PKGS; do
