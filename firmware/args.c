@@ -189,7 +189,7 @@ static void bound_text(double v, char *buf, size_t cap)
 
 static int has_range(const lr_argspec *s)
 {
-    return s->min != 0 || s->max != 0 || (s->flags & LR_ARG_ABOVE_MIN);
+    return s->min != 0 || s->max != 0 || (s->flags & (LR_ARG_ABOVE_MIN | LR_ARG_FLOOR));
 }
 
 static int in_range(const lr_argspec *s, double v)
@@ -252,6 +252,24 @@ int lr_args_int(const lr_args *a, const char *name, int *out, lr_err *e)
     if (fabs(d) > 2147483647.0)
         return lr_err_set(e, LR_EINVAL, "%s %s: out of range", name, v);
     *out = (int)d;
+    return LR_OK;
+}
+
+int lr_args_int64(const lr_args *a, const char *name, long long *out, lr_err *e)
+{
+    const char *v;
+    const lr_argspec *s = given(a, name, &v);
+    if (!s)
+        return LR_OK;
+    double d;
+    int rc = whole_text(s, v, &d, e);
+    if (rc)
+        return rc;
+    /* Above 2^53 a double no longer holds every whole number: "9007199254740993" would read
+     * as its neighbour. */
+    if (fabs(d) > 9007199254740992.0)
+        return lr_err_set(e, LR_EINVAL, "%s %s: out of range", name, v);
+    *out = (long long)d;
     return LR_OK;
 }
 

@@ -35,6 +35,7 @@ enum {
     LR_ARG_LIST = 1u << 2,      /* takes the following arguments up to the next --option */
     LR_ARG_OUTPUT = 1u << 3,    /* LR_ARG_PATH written by the command: checked before it runs */
     LR_ARG_ALONE = 1u << 4,     /* answers by itself (`--help-scene`): no option is required with it */
+    LR_ARG_FLOOR = 1u << 5,     /* min is a bound even when it and max are 0: ">= 0" */
 };
 
 typedef struct lr_argspec {
@@ -43,8 +44,8 @@ typedef struct lr_argspec {
     const char *metavar; /* the value's name in --help ("R,G,B"); NULL: from the type */
     const char *help;    /* the line after the option in --help; '\n' continues it */
     unsigned flags;      /* LR_ARG_* above */
-    /* Value range: both 0 means any value (unless LR_ARG_ABOVE_MIN: then > 0); max <= min
-     * means no upper bound. */
+    /* Value range: both 0 means any value (unless LR_ARG_ABOVE_MIN: then > 0, or
+     * LR_ARG_FLOOR: then >= 0); max <= min means no upper bound. */
     double min, max;
     int repeat;          /* most values when it may repeat (or LR_ARG_LIST); 0: given once */
     const char *choices; /* LR_ARG_CHOICE: "chessboard|circles|acircles" */
@@ -94,6 +95,8 @@ int lr_args_values(const lr_args *a, const char *name, const char **out, int cap
  * caller's default); a value that is malformed or outside the table's range is LR_EINVAL with
  * one line naming the flag and the value. */
 int lr_args_int(const lr_args *a, const char *name, int *out, lr_err *e);
+/* The same for whole numbers beyond int (seeds up to 2^53, the largest exact in a double). */
+int lr_args_int64(const lr_args *a, const char *name, long long *out, lr_err *e);
 int lr_args_double(const lr_args *a, const char *name, double *out, lr_err *e);
 /* LR_ARG_TRIPLE (3 numbers) or LR_ARG_NUMBERS (1..cap numbers) into out; *count how many. */
 int lr_args_list(const lr_args *a, const char *name, double *out, int cap, int *count,

@@ -80,5 +80,8 @@ lr_progress_meter *lr_cli_progress(const lr_cli *c);
 
 /* The generated help of cmd at path ("calib projector") into f (firmware/help.c). */
 void lr_help_print(FILE *f, const lr_command *cmd, const char *path);
+/* The same for a program of its own (a tool, firmware/tool.h): cmd->name is the program
+ * ("lamprig-cpuref"), the usage line `usage: lamprig-cpuref OPTIONS...`. */
+void lr_help_print_tool(FILE *f, const lr_command *cmd);
 
 #endif

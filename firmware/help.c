@@ -117,10 +117,12 @@ static void list_subs(FILE *f, const lr_command *g, const char *prefix)
     }
 }
 
-void lr_help_print(FILE *f, const lr_command *c, const char *path)
+/* head: the usage line's program and command words ("lamprig calib projector",
+ * "lamprig-cpuref"); path: the command's path for `lamprig help PATH` (groups only). */
+static void print_help(FILE *f, const lr_command *c, const char *program, const char *path)
 {
     char head[300];
-    snprintf(head, sizeof head, "usage: lamprig %s", path);
+    snprintf(head, sizeof head, "usage: %s", program);
     fputs(head, f);
     wrap w = {f, (int)strlen(head), (int)strlen(head) + 1, 0};
     if (c->subs) {
@@ -143,4 +145,16 @@ void lr_help_print(FILE *f, const lr_command *c, const char *path)
     }
     if (c->notes)
         fprintf(f, "\n%s\n", c->notes);
+}
+
+void lr_help_print(FILE *f, const lr_command *c, const char *path)
+{
+    char program[280];
+    snprintf(program, sizeof program, "lamprig %s", path);
+    print_help(f, c, program, path);
+}
+
+void lr_help_print_tool(FILE *f, const lr_command *c)
+{
+    print_help(f, c, c->name, c->name);
 }

@@ -2,8 +2,12 @@
  * `lamprig-bench --list` lists them; `--update-front` makes the sweep also write
  * configs/bench/front.csv. Output is markdown, ready for tools/bench/README.md.
  * `lamprig-bench --figures [--check|--write]` prints README.md's figures block from the
- * committed results (figures.c), checks README.md's against it, or replaces it. */
+ * committed results (figures.c), checks README.md's against it, or replaces it. The options
+ * are the table below (firmware/tool.h: the generated --help, one line naming the flag and
+ * exit 2 for a bad argument). */
 #include "tools/bench/bench.h"
+
+#include "firmware/tool.h"
 
 #include <sched.h>
 #include <stdbool.h>
@@ -43,51 +47,97 @@ static int run_one(const lrb_section *s, const lrb_options *opt)
     return rc;
 }
 
+#define PROGRAM "lamprig-bench"
+#define MAX_NAMES 64
+
+/* --figures, --check and --write read as one synopsis word. */
+#define FIGURES_GROUP "[--figures [--check|--write [README]]]"
+
+static const lr_argspec opts[] = {
+    {.name = "--list", .flags = LR_ARG_ALONE, .help = "the sections, one line each"},
+    {.name = "--update-front",
+     .help = "the sweep also copies its results.csv to configs/bench/front.csv"},
+    {.name = "--figures",
+     .help = "print README.md's figures block from the committed results (figures.c)\n"
+             "instead of running sections",
+     .group = FIGURES_GROUP},
+    {.name = "--check", .help = "with --figures: compare README.md's block (or README's, the\n"
+                                "operand) with it; exit 1 when they differ",
+     .group = FIGURES_GROUP},
+    {.name = "--write", .help = "with --figures: replace README.md's block (or README's)",
+     .group = FIGURES_GROUP},
+    {0},
+};
+
+static void list_sections(FILE *f)
+{
+    for (size_t k = 0; k < NSECTIONS; k++)
+        fprintf(f, "  %-10s %s\n", sections[k]->name, sections[k]->summary);
+}
+
+/* `--figures [--check|--write] [README]`. */
+static int figures(const lr_args *a)
+{
+    int check = lr_args_has(a, "--check"), write = lr_args_has(a, "--write");
+    if (check && write)
+        return lr_tool_usage(PROGRAM, "--figures takes --check or --write, not both");
+    if (lr_args_has(a, "--update-front"))
+        return lr_tool_usage(PROGRAM, "--update-front runs the sweep; not with --figures");
+    if (a->npos > 1 || (a->npos == 1 && !check && !write))
+        return lr_tool_usage(PROGRAM, "unexpected argument '%s' (--figures takes one README "
+                             "with --check or --write)", a->pos[a->npos > 1 ? 1 : 0]);
+    const char *readme = a->npos ? a->pos[0] : NULL;
+    return lrb_figures(check ? "check" : write ? "write" : "print", readme);
+}
+
 int main(int argc, char **argv)
 {
-    if (argc >= 2 && (!strcmp(argv[1], "--list") || !strcmp(argv[1], "--help") ||
-                      !strcmp(argv[1], "-h"))) {
-        printf("usage: lamprig-bench [--update-front] [SECTION...]\n"
-               "       lamprig-bench --figures [--check|--write [README]]   README.md's figures "
-               "block\n"
-               "\nsections:\n");
-        for (size_t k = 0; k < NSECTIONS; k++)
-            printf("  %-10s %s\n", sections[k]->name, sections[k]->summary);
+    /* The sections' list is the help's notes: built here from the table above. */
+    char notes[2048];
+    size_t n = (size_t)snprintf(notes, sizeof notes, "SECTION: the sections to run, in the "
+                                "order given (default every one, in this order):");
+    for (size_t k = 0; k < NSECTIONS && n < sizeof notes; k++)
+        n += (size_t)snprintf(notes + n, sizeof notes - n, "\n  %-10s %s", sections[k]->name,
+                              sections[k]->summary);
+    if (n < sizeof notes)
+        snprintf(notes + n, sizeof notes - n, "\n\nExit status 0, 1 (a section failed; "
+                 "--figures --check: the block differs),\n2 (bad arguments).");
+    const lr_command tool = {
+        .name = PROGRAM,
+        .about = "Speed and error figures as markdown tables on stdout (tools/bench/README.md);\n"
+                 "progress on stderr. Run it from the repository root.",
+        .opts = opts,
+        .operands = "[SECTION...]",
+        .max_operands = MAX_NAMES,
+        .notes = notes,
+    };
+    lr_args args;
+    int st = lr_tool_args(&tool, argc, argv, &args);
+    if (st >= 0)
+        return st;
+    if (lr_args_has(&args, "--list")) {
+        list_sections(stdout);
         return 0;
     }
-    if (argc >= 2 && !strcmp(argv[1], "--figures")) {
-        if (argc == 2)
-            return lrb_figures("print", NULL);
-        if ((argc == 3 || argc == 4) && !strcmp(argv[2], "--check"))
-            return lrb_figures("check", argc == 4 ? argv[3] : NULL);
-        if ((argc == 3 || argc == 4) && !strcmp(argv[2], "--write"))
-            return lrb_figures("write", argc == 4 ? argv[3] : NULL);
-        fprintf(stderr, "usage: lamprig-bench --figures [--check|--write [README]]\n");
-        return 2;
-    }
-    lrb_options opt = {0};
-    const char *names[64];
-    int n = 0;
-    for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--update-front")) {
-            opt.update_front = true;
-            continue;
-        }
-        if (!find(argv[i])) {
-            fprintf(stderr, "lamprig-bench: unknown section '%s' (see --list)\n", argv[i]);
+    if (lr_args_has(&args, "--figures"))
+        return figures(&args);
+    if (lr_args_has(&args, "--check") || lr_args_has(&args, "--write"))
+        return lr_tool_usage(PROGRAM, "%s needs --figures",
+                             lr_args_has(&args, "--check") ? "--check" : "--write");
+    lrb_options opt = {.update_front = lr_args_has(&args, "--update-front")};
+    for (int i = 0; i < args.npos; i++)
+        if (!find(args.pos[i])) {
+            fprintf(stderr, "lamprig-bench: unknown section '%s' (see --list)\n", args.pos[i]);
             return 2;
         }
-        if (n < 64)
-            names[n++] = argv[i];
-    }
     int status = 0;
-    if (!n) {
+    if (!args.npos) {
         for (size_t k = 0; k < NSECTIONS; k++)
             if (run_one(sections[k], &opt))
                 status = 1;
     } else {
-        for (int i = 0; i < n; i++)
-            if (run_one(find(names[i]), &opt))
+        for (int i = 0; i < args.npos; i++)
+            if (run_one(find(args.pos[i]), &opt))
                 status = 1;
     }
     return status;

@@ -26,108 +26,104 @@
 #include "calib/capture_sim.h"
 #include "calib/rig.h"
 #include "calib/view_render.h"
+#include "firmware/tool.h"
 #include "render/scene/scene.h"
 
+#define PROGRAM "lamprig-capsim"
 #define MAX_SETS 64
 
-static int usage(const char *msg, const char *arg)
-{
-    if (msg) {
-        fprintf(stderr, "lamprig-capsim: ");
-        fprintf(stderr, msg, arg);
-        fprintf(stderr, "\n");
-    }
-    fprintf(stderr,
-            "usage: lamprig-capsim --scene FILE --calib DIR --out IMG.png [--exposure S] "
-            "[--gain G] [--noise FULL_WELL,READ|none] [--seed N] [--bits 8|16] "
-            "[--vignette none|cos4|poly:V1,V2,V3] [--gamma G] [--cpu] [--frames N] "
-            "[--hdr RADIANCE.pfm] [--set key=value ...] [--quiet]\n");
-    return 2;
-}
+static const lr_argspec opts[] = {
+    {.name = "--scene", .type = LR_ARG_PATH, .flags = LR_ARG_REQUIRED,
+     .help = "the scene file (configs/scenes/)"},
+    {.name = "--calib", .type = LR_ARG_PATH, .metavar = "DIR", .flags = LR_ARG_REQUIRED,
+     .help = "the rig's calibration folder: camera.json and pose.json (needed),\n"
+             "camera_response.json and color.json (used when present)"},
+    {.name = "--out", .type = LR_ARG_PATH, .metavar = "IMG.png", .flags = LR_ARG_REQUIRED,
+     .help = "the simulated capture"},
+    {.name = "--exposure", .type = LR_ARG_NUMBER, .metavar = "S", .min = 1e-9, .max = 1e6,
+     .help = "exposure time in seconds (1e-9..1e6, default 1)"},
+    {.name = "--gain", .type = LR_ARG_NUMBER, .metavar = "G", .min = 1e-12, .max = 1e12,
+     .help = "radiance to sensor gain (1e-12..1e12; default the scene's\n"
+             "render.exposure)"},
+    {.name = "--noise", .type = LR_ARG_STRING, .metavar = "FULL_WELL,READ|none",
+     .help = "shot and read noise: full well and read noise in electrons (default\n"
+             "10000,4), or none"},
+    {.name = "--seed", .type = LR_ARG_INT, .metavar = "N", .min = 0, .max = 4294967295.0,
+     .help = "seed of the sensor noise (default 1; the render keeps its own)"},
+    {.name = "--bits", .type = LR_ARG_CHOICE, .choices = "8|16", .help = "bits per channel (default 8)"},
+    {.name = "--vignette", .type = LR_ARG_STRING, .metavar = "none|cos4|poly:V1,V2,V3",
+     .help = "vignetting model (default none)"},
+    {.name = "--gamma", .type = LR_ARG_NUMBER, .metavar = "G", .min = 0.1, .max = 10,
+     .help = "the camera's gamma when the rig has no camera_response.json\n"
+             "(0.1..10, default 2.2)"},
+    {.name = "--cpu", .help = "render with the CPU twin instead of the GPU renderer"},
+    {.name = "--frames", .type = LR_ARG_INT, .min = 1, .max = 1e6,
+     .help = "progressive frames of the render (1..1000000; default the scene's)"},
+    {.name = "--hdr", .type = LR_ARG_PATH, .metavar = "RADIANCE.pfm",
+     .help = "also write the rendered radiance before the sensor model"},
+    {.name = "--set", .type = LR_ARG_STRING, .metavar = "key=value", .repeat = MAX_SETS,
+     .help = "change a scene field before rendering (repeatable)"},
+    LR_CLI_QUIET_OPT,
+    {0},
+};
 
-static int number(const char *s, double lo, double hi, double *out)
+static const lr_command tool = {
+    .name = PROGRAM,
+    .about = "What the rig's camera would record for a scene and a calibration folder: the\n"
+             "calibrated camera's view rendered by the GPU renderer (or the CPU twin with --cpu),\n"
+             "then the sensor model (exposure, vignetting, the inverse of the rig's camera\n"
+             "response, the inverse of color.json, shot + read noise, 8/16-bit).",
+    .opts = opts,
+    .notes = "Exit status 0, 1 (failure, message on stderr), 2 (bad arguments).",
+};
+
+/* --noise: "none" or FULL_WELL,READ in electrons, the full well > 0 and the read noise >= 0. */
+static int parse_noise(const char *v, lr_sensor *s, lr_err *e)
 {
-    char *end;
-    double v = s ? strtod(s, &end) : 0;
-    if (!s || !*s || *end || !(v >= lo && v <= hi))
-        return -1;
-    *out = v;
-    return 0;
+    if (!strcmp(v, "none")) {
+        s->full_well_e = s->read_noise_e = 0;
+        return LR_OK;
+    }
+    double x[2];
+    int n = 0;
+    if (lr_args_numbers("--noise", v, x, 2, 2, &n, e) || !(x[0] > 0) || !(x[1] >= 0))
+        return lr_err_set(e, LR_EINVAL, "--noise '%s': expected FULL_WELL,READ (electrons, "
+                          "FULL_WELL > 0, READ >= 0) or none", v);
+    s->full_well_e = x[0];
+    s->read_noise_e = x[1];
+    return LR_OK;
 }
 
 int main(int argc, char **argv)
 {
-    const char *scene_path = NULL, *calib = NULL, *out = NULL, *hdr = NULL;
-    const char *sets[MAX_SETS];
-    int nsets = 0;
     lr_sensor s = {.full_well_e = 10000, .read_noise_e = 4, .seed = 1};
-    bool cpu = false, gain_given = false, quiet = false;
-    double frames = 0, seed = 1, gamma = 0;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "--cpu")) {
-            cpu = true;
-            continue;
-        }
-        if (!strcmp(a, "--quiet")) {
-            quiet = true;
-            continue;
-        }
-        if (!strcmp(a, "--help") || !strcmp(a, "-h"))
-            return usage(NULL, NULL), 0;
-        if (!v)
-            return usage("option '%s' needs a value (or is unknown)", a);
-        i++;
-        if (!strcmp(a, "--scene"))
-            scene_path = v;
-        else if (!strcmp(a, "--calib"))
-            calib = v;
-        else if (!strcmp(a, "--out"))
-            out = v;
-        else if (!strcmp(a, "--hdr"))
-            hdr = v;
-        else if (!strcmp(a, "--set")) {
-            if (nsets >= MAX_SETS)
-                return usage("too many --set (at most 64)%s", "");
-            sets[nsets++] = v;
-        } else if (!strcmp(a, "--exposure")) {
-            if (number(v, 1e-9, 1e6, &s.exposure_s))
-                return usage("--exposure '%s': expected seconds > 0", v);
-        } else if (!strcmp(a, "--gain")) {
-            if (number(v, 1e-12, 1e12, &s.gain))
-                return usage("--gain '%s': expected a number > 0", v);
-            gain_given = true;
-        } else if (!strcmp(a, "--gamma")) {
-            if (number(v, 0.1, 10, &gamma))
-                return usage("--gamma '%s': expected 0.1..10", v);
-        } else if (!strcmp(a, "--seed")) {
-            if (number(v, 0, 4294967295.0, &seed) || seed != floor(seed))
-                return usage("--seed '%s': expected a non-negative integer", v);
-        } else if (!strcmp(a, "--frames")) {
-            if (number(v, 1, 1e6, &frames) || frames != floor(frames))
-                return usage("--frames '%s': expected a count >= 1", v);
-        } else if (!strcmp(a, "--bits")) {
-            if (strcmp(v, "8") && strcmp(v, "16"))
-                return usage("--bits '%s': expected 8 or 16", v);
-            s.bits = atoi(v);
-        } else if (!strcmp(a, "--noise")) {
-            int n = 0;
-            if (!strcmp(v, "none")) {
-                s.full_well_e = s.read_noise_e = 0;
-            } else if (sscanf(v, "%lf,%lf%n", &s.full_well_e, &s.read_noise_e, &n) != 2 ||
-                       v[n] || !(s.full_well_e > 0) || !(s.read_noise_e >= 0)) {
-                return usage("--noise '%s': expected FULL_WELL,READ (electrons) or none", v);
-            }
-        } else if (!strcmp(a, "--vignette")) {
-            lr_err ve = {0};
-            if (lr_sensor_parse_vignette(v, &s, &ve))
-                return usage("--vignette %s", ve.msg);
-        } else {
-            return usage("unknown option '%s'", a);
-        }
-    }
-    if (!scene_path || !calib || !out)
-        return usage("--scene, --calib and --out are required%s", "");
+    long long seed = 1;
+    int frames = 0, bits = 0;
+    double gamma = 0;
+    lr_args args;
+    int st = lr_tool_args(&tool, argc, argv, &args);
+    if (st >= 0)
+        return st;
+    lr_err ae = {0};
+    const char *noise = lr_args_get(&args, "--noise"), *vig = lr_args_get(&args, "--vignette");
+    if ((st = lr_tool_check(PROGRAM, lr_args_double(&args, "--exposure", &s.exposure_s, &ae), &ae)) ||
+        (st = lr_tool_check(PROGRAM, lr_args_double(&args, "--gain", &s.gain, &ae), &ae)) ||
+        (st = lr_tool_check(PROGRAM, lr_args_double(&args, "--gamma", &gamma, &ae), &ae)) ||
+        (st = lr_tool_check(PROGRAM, lr_args_int64(&args, "--seed", &seed, &ae), &ae)) ||
+        (st = lr_tool_check(PROGRAM, lr_args_int(&args, "--frames", &frames, &ae), &ae)) ||
+        (st = lr_tool_check(PROGRAM, lr_args_choice(&args, "--bits", &bits, &ae), &ae)) ||
+        (noise && (st = lr_tool_check(PROGRAM, parse_noise(noise, &s, &ae), &ae))))
+        return st;
+    if (vig && lr_sensor_parse_vignette(vig, &s, &ae))
+        return lr_tool_usage(PROGRAM, "--vignette %s", ae.msg);
+    if (lr_args_has(&args, "--bits"))
+        s.bits = bits ? 16 : 8;
+    const char *scene_path = lr_args_get(&args, "--scene"), *calib = lr_args_get(&args, "--calib");
+    const char *out = lr_args_get(&args, "--out"), *hdr = lr_args_get(&args, "--hdr");
+    const char *sets[MAX_SETS];
+    int nsets = lr_args_values(&args, "--set", sets, MAX_SETS);
+    bool cpu = lr_args_has(&args, "--cpu"), quiet = lr_args_has(&args, "--quiet");
+    bool gain_given = lr_args_has(&args, "--gain");
     s.seed = (uint64_t)seed;
 
     lr_err e = {0};

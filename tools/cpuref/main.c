@@ -9,7 +9,8 @@
  * (`lamprig-reference render`, REF.var.pfm beside it) on the bench's masks (compare.c).
  * --samples: reference samples per band per pixel and per VPL (default 1024). The variance
  * image defaults to the --out name with ".var.pfm" for ".pfm". A summary line (time, samples,
- * samples/s, pixels) goes to stdout. */
+ * samples/s, pixels) goes to stdout. The options are the table below (firmware/tool.h: its
+ * --help is generated from it, a bad argument is one line naming the flag, exit 2). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,92 +18,76 @@
 #include "render/cpu/frame.h"
 #include "render/image/image.h"
 #include "render/scene/scene.h"
+#include "firmware/tool.h"
 #include "tools/cpuref/compare.h"
 
-static void usage(FILE *f)
-{
-    fprintf(f, "usage: lamprig-cpuref --scene FILE --out F.pfm [--width W] [--height H] "
-               "[--samples N] [--var F.var.pfm] [--twin] [--frames F] [--vpl N] [--no-vpl] "
-               "[--threads T] [--seed S] [--set key=value ...] [--compare REF.pfm]\n");
-}
+#define PROGRAM "lamprig-cpuref"
+#define MAX_SETS 64
 
-static int int_arg(const char *opt, const char *v, int lo, int hi, int *out)
-{
-    char *end;
-    long x = strtol(v, &end, 10);
-    if (!*v || *end || x < lo || x > hi) {
-        fprintf(stderr, "lamprig-cpuref: %s %s: expected an integer in [%d, %d]\n", opt, v, lo, hi);
-        return -1;
-    }
-    *out = (int)x;
-    return 0;
-}
+static const lr_argspec opts[] = {
+    {.name = "--scene", .type = LR_ARG_PATH, .flags = LR_ARG_REQUIRED,
+     .help = "the scene file (configs/scenes/)"},
+    {.name = "--out", .type = LR_ARG_PATH, .metavar = "F.pfm", .flags = LR_ARG_REQUIRED,
+     .help = "the image, linear PFM"},
+    {.name = "--var", .type = LR_ARG_PATH, .metavar = "F.var.pfm",
+     .help = "the variance image (default: the --out name with .var.pfm for .pfm)"},
+    {.name = "--width", .type = LR_ARG_INT, .metavar = "W", .min = 1, .max = LR_IMAGE_MAX_SIDE,
+     .help = "image width in pixels (default 160)"},
+    {.name = "--height", .type = LR_ARG_INT, .metavar = "H", .min = 1, .max = LR_IMAGE_MAX_SIDE,
+     .help = "image height in pixels (default 120)"},
+    {.name = "--samples", .type = LR_ARG_INT, .min = 1, .max = 1 << 24,
+     .help = "reference samples per band per pixel and per VPL (default 1024)"},
+    {.name = "--twin", .help = "the CPU twin of the GPU renderer instead of the converged reference"},
+    {.name = "--frames", .type = LR_ARG_INT, .metavar = "F", .min = 1, .max = 1 << 20,
+     .help = "frames the twin accumulates (default: the scene's render.frames)"},
+    {.name = "--vpl", .type = LR_ARG_INT, .min = 1, .max = 1 << 20,
+     .help = "virtual point lights (default: render.N_vpl with --twin, else 1024)"},
+    {.name = "--no-vpl", .help = "no virtual point lights (direct light and the maps only)"},
+    {.name = "--threads", .type = LR_ARG_INT, .metavar = "T", .min = 1, .max = 64,
+     .help = "worker threads (default: every CPU)"},
+    {.name = "--seed", .type = LR_ARG_INT, .metavar = "S", .min = 1, .max = 1 << 30,
+     .help = "sample seed (default 1)"},
+    {.name = "--set", .type = LR_ARG_STRING, .metavar = "key=value", .repeat = MAX_SETS,
+     .help = "change a scene field before rendering (repeatable)"},
+    {.name = "--compare", .type = LR_ARG_PATH, .metavar = "REF.pfm",
+     .help = "also print the errors against a physical reference of the same\n"
+             "size (`lamprig-reference render`, REF.var.pfm beside it) on the\n"
+             "bench's masks"},
+    {0},
+};
+
+static const lr_command tool = {
+    .name = PROGRAM,
+    .about = "The converged CPU reference of a scene's camera view (render/cpu/frame.h), or with\n"
+             "--twin the CPU twin of the GPU renderer, written as linear PFM plus a variance PFM.",
+    .opts = opts,
+    .notes = "A summary line (time, samples, samples/s, pixels) goes to stdout. Exit status 0, 1\n"
+             "(failure, message on stderr), 2 (bad arguments).",
+};
 
 int main(int argc, char **argv)
 {
-    const char *scene_path = NULL, *out = NULL, *var_path = NULL, *compare = NULL;
     lr_cpu_render_desc d = {.mode = LR_CPU_REFERENCE, .width = 160, .height = 120};
-    const char *sets[64];
-    int nsets = 0, seed = 1;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        int bad = 0;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            usage(stdout);
-            return 0;
-        } else if (!strcmp(a, "--twin")) {
-            d.mode = LR_CPU_PASS;
-            continue;
-        } else if (!strcmp(a, "--no-vpl")) {
-            d.no_vpl = true;
-            continue;
-        }
-        if (!v) {
-            fprintf(stderr, "lamprig-cpuref: %s: missing value\n", a);
-            usage(stderr);
-            return 2;
-        }
-        i++;
-        if (!strcmp(a, "--scene"))
-            scene_path = v;
-        else if (!strcmp(a, "--out"))
-            out = v;
-        else if (!strcmp(a, "--compare"))
-            compare = v;
-        else if (!strcmp(a, "--var"))
-            var_path = v;
-        else if (!strcmp(a, "--width"))
-            bad = int_arg(a, v, 1, LR_IMAGE_MAX_SIDE, &d.width);
-        else if (!strcmp(a, "--height"))
-            bad = int_arg(a, v, 1, LR_IMAGE_MAX_SIDE, &d.height);
-        else if (!strcmp(a, "--samples"))
-            bad = int_arg(a, v, 1, 1 << 24, &d.samples);
-        else if (!strcmp(a, "--frames"))
-            bad = int_arg(a, v, 1, 1 << 20, &d.frames);
-        else if (!strcmp(a, "--vpl"))
-            bad = int_arg(a, v, 1, 1 << 20, &d.vpl_count);
-        else if (!strcmp(a, "--threads"))
-            bad = int_arg(a, v, 1, 64, &d.threads);
-        else if (!strcmp(a, "--seed"))
-            bad = int_arg(a, v, 1, 1 << 30, &seed);
-        else if (!strcmp(a, "--set") && nsets < 64)
-            sets[nsets++] = v;
-        else {
-            fprintf(stderr, "lamprig-cpuref: unknown option '%s'\n", a);
-            usage(stderr);
-            return 2;
-        }
-        if (bad)
-            return 2;
-    }
-    if (!scene_path || !out) {
-        fprintf(stderr, "lamprig-cpuref: --scene and --out are required\n");
-        usage(stderr);
-        return 2;
-    }
-    d.seed = (unsigned)seed;
+    int seed = 1;
+    lr_args args;
+    int status = lr_tool_args(&tool, argc, argv, &args);
+    if (status >= 0)
+        return status;
     lr_err e = {0};
+    static const char *const ints[] = {"--width", "--height", "--samples", "--frames",
+                                       "--vpl",   "--threads", "--seed"};
+    int *dest[] = {&d.width, &d.height, &d.samples, &d.frames, &d.vpl_count, &d.threads, &seed};
+    for (size_t k = 0; k < sizeof ints / sizeof ints[0]; k++)
+        if ((status = lr_tool_check(PROGRAM, lr_args_int(&args, ints[k], dest[k], &e), &e)))
+            return status;
+    if (lr_args_has(&args, "--twin"))
+        d.mode = LR_CPU_PASS;
+    d.no_vpl = lr_args_has(&args, "--no-vpl");
+    const char *scene_path = lr_args_get(&args, "--scene"), *out = lr_args_get(&args, "--out");
+    const char *var_path = lr_args_get(&args, "--var"), *compare = lr_args_get(&args, "--compare");
+    const char *sets[MAX_SETS];
+    int nsets = lr_args_values(&args, "--set", sets, MAX_SETS);
+    d.seed = (unsigned)seed;
     lr_scene *s;
     if (lr_scene_load(scene_path, &(const lr_warn_sink){lr_warn_stderr, "lamprig-cpuref"}, &s, &e)) {
         fprintf(stderr, "lamprig-cpuref: %s\n", e.msg);

@@ -33,6 +33,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "firmware/tool.h"
+
 #define MAX_CLIENTS 8
 
 static double now_s(void)
@@ -42,37 +44,47 @@ static double now_s(void)
     return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
 }
 
-static int usage(void)
-{
-    fprintf(stderr, "usage: lamprig-modbus-sim [--port 1502] [--panel 0..1000] "
-                    "[--sweep SECONDS] [--trace]\n");
-    return 2;
-}
+#define PROGRAM "lamprig-modbus-sim"
+
+static const lr_argspec opts[] = {
+    {.name = "--port", .type = LR_ARG_INT, .metavar = "PORT", .min = 1, .max = 65535,
+     .help = "TCP port on 127.0.0.1, 1..65535 (default 1502)"},
+    {.name = "--panel", .type = LR_ARG_INT, .metavar = "0..1000", .min = 0, .max = 1000,
+     .help = "the dimmer panel's register at start (default 500)"},
+    {.name = "--sweep", .type = LR_ARG_NUMBER, .metavar = "SECONDS", .flags = LR_ARG_FLOOR,
+     .help = "turn the panel 0 -> 1000 -> 0 over SECONDS (>= 0), again and\n"
+             "again (default 0: it moves only when a number is typed)"},
+    {.name = "--trace", .help = "also a timestamped line per request and per change\n"
+                                "(\"@T request unit U function F\", \"@T panel V\", \"@T driver V\")"},
+    {0},
+};
+
+static const lr_command tool = {
+    .name = PROGRAM,
+    .about = "A Modbus TCP simulator of the modbus-demo rig: the dimmer panel (unit 1, holding\n"
+             "register 0, 0-1000) and the lamp driver (unit 2, holding register 0, 0-255).\n"
+             "Type a number 0..1000 and Enter to move the panel; every change of the driver\n"
+             "register is printed. With stdin at its end (/dev/null, a closed pipe) it goes on\n"
+             "serving.",
+    .opts = opts,
+    .notes = "SIGINT or SIGTERM ends it (exit 0). Exit status 1 when it cannot listen, 2 on\n"
+             "bad arguments.",
+};
 
 int main(int argc, char **argv)
 {
     int port = 1502, panel = 500;
     double sweep = 0;
-    bool trace = false;
-    for (int i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "--trace") == 0) {
-            trace = true;
-            continue;
-        }
-        if (i + 1 >= argc)
-            return usage();
-        char *end;
-        if (strcmp(argv[i], "--port") == 0)
-            port = (int)strtol(argv[++i], &end, 10);
-        else if (strcmp(argv[i], "--panel") == 0)
-            panel = (int)strtol(argv[++i], &end, 10);
-        else if (strcmp(argv[i], "--sweep") == 0)
-            sweep = strtod(argv[++i], &end);
-        else
-            return usage();
-        if (*end || port < 1 || port > 65535 || panel < 0 || panel > 1000 || sweep < 0)
-            return usage();
-    }
+    lr_args args;
+    lr_err e = {0};
+    int st = lr_tool_args(&tool, argc, argv, &args);
+    if (st >= 0)
+        return st;
+    if ((st = lr_tool_check(PROGRAM, lr_args_int(&args, "--port", &port, &e), &e)) ||
+        (st = lr_tool_check(PROGRAM, lr_args_int(&args, "--panel", &panel, &e), &e)) ||
+        (st = lr_tool_check(PROGRAM, lr_args_double(&args, "--sweep", &sweep, &e), &e)))
+        return st;
+    bool trace = lr_args_has(&args, "--trace");
     signal(SIGPIPE, SIG_IGN);
     /* SIGINT/SIGTERM arrive as a readable fd in the poll set: no handler, no race with
      * poll(), and the loop ends through the same cleanup as at any other exit. */

@@ -22,6 +22,7 @@
 
 #include "render/scene/scene.h"
 #include "render/transrad/transrad.h"
+#include "firmware/tool.h"
 #include "tools/transrad/split.h"
 
 static double now_s(void)
@@ -31,55 +32,82 @@ static double now_s(void)
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
+#define PROGRAM "lamprig-transrad"
+#define MAX_SETS 64
+
+static const lr_argspec opts[] = {
+    {.name = "--set", .type = LR_ARG_STRING, .metavar = "KEY=VALUE", .repeat = MAX_SETS,
+     .help = "change a scene field first (repeatable)"},
+    {.name = "--patch", .type = LR_ARG_NUMBER, .metavar = "MM", .flags = LR_ARG_FLOOR,
+     .help = "object patch (cluster cell) edge in mm (default 0: 12 mm)"},
+    {.name = "--receiver", .type = LR_ARG_NUMBER, .metavar = "MM", .flags = LR_ARG_FLOOR,
+     .help = "receiver grid cell in mm (default 0: 30 mm, at most 64 cells\n"
+             "a side)"},
+    {.name = "--rays", .type = LR_ARG_INT, .flags = LR_ARG_FLOOR,
+     .help = "form-factor rays per patch (default 0: 512)"},
+    {.name = "--transfer-mb", .type = LR_ARG_INT, .metavar = "MB", .flags = LR_ARG_FLOOR,
+     .help = "build the precomputed transfer within MB (default 0: none,\n"
+             "the warm-started sweeps)"},
+    {.name = "--thin-wall", .type = LR_ARG_CHOICE, .choices = "auto|off|on",
+     .help = "S on slab walls (render/transrad/thinwall.c): by its rule\n"
+             "(default), never, on every slab patch"},
+    {.name = "--split", .help = "per light and object: where S sends the light that entered, by\n"
+                                "distance and facing (split.c)"},
+    {.name = "--no-cache", .help = "build F and S even when $XDG_CACHE_HOME/lamprig has them (by\n"
+                                   "default they are read from and written to the cache)"},
+    {0},
+};
+
+static const lr_command tool = {
+    .name = PROGRAM,
+    .about = "Seed 000's translucent radiosity on a scene, with its figures: patches,\n"
+             "precomputation time, direct-light and solve time, the time after a light move\n"
+             "(warm start), residuals, and where the light goes.",
+    .opts = opts,
+    .operands = "SCENE.json",
+    .max_operands = 1,
+    .notes = "Exit status 0, 1 (failure, message on stderr), 2 (bad arguments).",
+};
+
 int main(int argc, char **argv)
 {
-    if (argc < 2) {
-        fprintf(stderr, "usage: lamprig-transrad SCENE.json [--set K=V]... [--patch MM] "
-                        "[--receiver MM] [--rays N] [--transfer-mb MB] [--thin-wall auto|off|on] "
-                        "[--split] [--no-cache]\n");
-        return 2;
-    }
+    lr_args args;
+    int status = lr_tool_args(&tool, argc, argv, &args);
+    if (status >= 0)
+        return status;
+    if (args.npos != 1)
+        return lr_tool_usage(PROGRAM, "SCENE.json is required");
+    char cdir[1024];
+    lr_tr_settings set = {.cache_dir = lr_tr_cache_default_dir(cdir, sizeof cdir)};
     lr_err e = {0};
+    /* The table's order of --thin-wall's choices is the enum's: auto 0, off 1, on 2. */
+    _Static_assert(LR_TR_THIN_AUTO == 0 && LR_TR_THIN_OFF == 1 && LR_TR_THIN_ON == 2,
+                   "--thin-wall's choices in the enum's order");
+    if ((status = lr_tool_check(PROGRAM, lr_args_double(&args, "--patch", &set.patch_mm, &e), &e)) ||
+        (status = lr_tool_check(PROGRAM, lr_args_double(&args, "--receiver", &set.receiver_mm, &e),
+                            &e)) ||
+        (status = lr_tool_check(PROGRAM, lr_args_int(&args, "--rays", &set.rays_per_patch, &e), &e)) ||
+        (status = lr_tool_check(PROGRAM, lr_args_int(&args, "--transfer-mb", &set.transfer_mb, &e),
+                            &e)) ||
+        (status = lr_tool_check(PROGRAM, lr_args_choice(&args, "--thin-wall", &set.thin_wall, &e),
+                            &e)))
+        return status;
+    if (lr_args_has(&args, "--no-cache"))
+        set.cache_dir = NULL;
+    int split = lr_args_has(&args, "--split");
     lr_scene *s;
-    if (lr_scene_load(argv[1], &(const lr_warn_sink){lr_warn_stderr, "lamprig-transrad"}, &s, &e)) {
+    if (lr_scene_load(args.pos[0], &(const lr_warn_sink){lr_warn_stderr, PROGRAM}, &s, &e)) {
         fprintf(stderr, "lamprig-transrad: %s\n", e.msg);
         return 1;
     }
-    char cdir[1024];
-    int split = 0;
-    lr_tr_settings set = {.cache_dir = lr_tr_cache_default_dir(cdir, sizeof cdir)};
-    for (int i = 2; i < argc; i++) {
-        if (!strcmp(argv[i], "--set") && i + 1 < argc) {
-            if (lr_scene_set_assignment(s, argv[++i], NULL, &e)) {
-                fprintf(stderr, "lamprig-transrad: %s\n", e.msg);
-                return 1;
-            }
-        } else if (!strcmp(argv[i], "--patch") && i + 1 < argc) {
-            set.patch_mm = atof(argv[++i]);
-        } else if (!strcmp(argv[i], "--receiver") && i + 1 < argc) {
-            set.receiver_mm = atof(argv[++i]);
-        } else if (!strcmp(argv[i], "--split")) {
-            split = 1;
-        } else if (!strcmp(argv[i], "--no-cache")) {
-            set.cache_dir = NULL;
-        } else if (!strcmp(argv[i], "--transfer-mb") && i + 1 < argc) {
-            set.transfer_mb = atoi(argv[++i]);
-        } else if (!strcmp(argv[i], "--thin-wall") && i + 1 < argc) {
-            const char *v = argv[++i];
-            set.thin_wall = !strcmp(v, "off") ? LR_TR_THIN_OFF
-                            : !strcmp(v, "on") ? LR_TR_THIN_ON
-                            : !strcmp(v, "auto") ? LR_TR_THIN_AUTO : -1;
-            if (set.thin_wall < 0) {
-                fprintf(stderr, "lamprig-transrad: --thin-wall: '%s', not auto, off or on\n", v);
-                return 2;
-            }
-        } else if (!strcmp(argv[i], "--rays") && i + 1 < argc) {
-            set.rays_per_patch = atoi(argv[++i]);
-        } else {
-            fprintf(stderr, "lamprig-transrad: unknown argument '%s'\n", argv[i]);
-            return 2;
+    const char *sets[MAX_SETS];
+    int nsets = lr_args_values(&args, "--set", sets, MAX_SETS);
+    for (int i = 0; i < nsets; i++)
+        if (lr_scene_set_assignment(s, sets[i], NULL, &e)) {
+            fprintf(stderr, "lamprig-transrad: %s\n", e.msg);
+            lr_scene_destroy(s);
+            return 1;
         }
-    }
     double t0 = now_s();
     lr_tr *t;
     if (lr_tr_create_scene(s, &set, &t, &e)) {
