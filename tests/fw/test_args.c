@@ -136,8 +136,16 @@ static const lr_argspec typed[] = {
     {.name = "--capture", .type = LR_ARG_PATH, .flags = LR_ARG_LIST | LR_ARG_REQUIRED,
      .repeat = 4},
     {.name = "--out", .type = LR_ARG_PATH, .flags = LR_ARG_REQUIRED},
+    /* ">= 0" with no upper bound (min and max 0 alone would mean any value). */
+    {.name = "--wait", .type = LR_ARG_NUMBER, .flags = LR_ARG_FLOOR},
+    {.name = "--rays", .type = LR_ARG_INT, .flags = LR_ARG_FLOOR},
+    /* Whole numbers beyond int, read with lr_args_int64 (read_one picks it by name). */
+    {.name = "--seed", .type = LR_ARG_INT, .min = 0, .max = 4294967295.0},
+    {.name = "--big", .type = LR_ARG_INT},
     {0},
 };
+
+static int wide(const char *flag) { return !strcmp(flag, "--seed") || !strcmp(flag, "--big"); }
 
 /* Parses one option (plus the required ones) and reads it with the getter of its type. */
 static int read_one(const char *flag, const char *value, lr_err *e)
@@ -148,11 +156,12 @@ static int read_one(const char *flag, const char *value, lr_err *e)
     assert_int_equal(lr_args_parse(6, argv, typed, 0, a, e), LR_OK);
     int i = 0, w = 0, h = 0, n = 0;
     double d = 0, v[3];
+    long long ll = 0;
     int rc;
     const lr_argspec *s = lr_args_spec(a, flag);
     switch (s->type) {
     case LR_ARG_INT:
-        rc = lr_args_int(a, flag, &i, e);
+        rc = wide(flag) ? lr_args_int64(a, flag, &ll, e) : lr_args_int(a, flag, &i, e);
         break;
     case LR_ARG_NUMBER:
         rc = lr_args_double(a, flag, &d, e);
@@ -198,6 +207,18 @@ static void test_typed_values(void **state)
         {"--sigma", "1,2,3", NULL},
         {"--sigma", "1,0,3", "--sigma 1,0,3: item 2 must be > 0"},
         {"--sigma", "1,2", "--sigma: expected 3 comma-separated numbers, got 2"},
+        {"--wait", "0", NULL},
+        {"--wait", "1e9", NULL},
+        {"--wait", "-0.5", "--wait -0.5: must be >= 0"},
+        {"--rays", "0", NULL},
+        {"--rays", "-1", "--rays -1: must be a whole number >= 0"},
+        {"--seed", "0", NULL},
+        {"--seed", "4294967295", NULL},
+        {"--seed", "4294967296", "--seed 4294967296: must be a whole number in 0..4294967295"},
+        {"--seed", "-1", "--seed -1: must be a whole number in 0..4294967295"},
+        /* 2^53 is the last whole number a double holds with all below it; 1e16 is past it. */
+        {"--big", "9007199254740992", NULL},
+        {"--big", "1e16", "--big 1e16: out of range"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         lr_err e = {0};
@@ -221,6 +242,13 @@ static void test_typed_values(void **state)
     assert_int_equal(lr_args_choice(a, "--pattern", &p, &e), LR_OK);
     assert_int_equal(lr_args_int(a, "--n", &n, &e), LR_OK);
     assert_true(w == 640 && h == 480 && p == 2 && n == 42);
+    /* The largest seed comes back whole: above 2^31 lr_args_int would refuse it. */
+    char *seed[] = {"--seed", "4294967295", "--capture", "a", "--out", "o"};
+    long long s64 = 0;
+    assert_int_equal(lr_args_parse(6, seed, typed, 0, a, &e), LR_OK);
+    assert_int_equal(lr_args_int(a, "--seed", &n, &e), LR_EINVAL);
+    assert_int_equal(lr_args_int64(a, "--seed", &s64, &e), LR_OK);
+    assert_true(s64 == 4294967295LL);
     free(a);
 }
 
