@@ -19,11 +19,6 @@ int lr_tool_usage(const char *program, const char *fmt, ...)
     return LR_EXIT_USAGE;
 }
 
-int lr_tool_check(const char *program, int rc, const lr_err *e)
-{
-    return rc ? lr_tool_usage(program, "%s", e->msg) : LR_EXIT_OK;
-}
-
 int lr_tool_args(const lr_command *cmd, int argc, char **argv, lr_args *out)
 {
     for (int i = 1; i < argc; i++)

@@ -18,11 +18,8 @@
 int lr_tool_args(const lr_command *cmd, int argc, char **argv, lr_args *out);
 
 /* The usage error: `PROGRAM: MESSAGE (see `PROGRAM --help`)` on one line on stderr (control
- * characters shown as '?'); returns LR_EXIT_USAGE. */
+ * characters shown as '?'); returns LR_EXIT_USAGE. For the typed getters' errors:
+ * `if (lr_args_int(&a, "--n", &n, &e) || ...) return lr_tool_usage(P, "%s", e.msg);`. */
 int lr_tool_usage(const char *program, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-
-/* lr_tool_usage with e's message when rc is set, LR_EXIT_OK otherwise, for the typed getters:
- * `if ((st = lr_tool_check(P, lr_args_int(&a, "--n", &n, &e), &e))) return st;`. */
-int lr_tool_check(const char *program, int rc, const lr_err *e);
 
 #endif

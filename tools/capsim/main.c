@@ -50,7 +50,8 @@ static const lr_argspec opts[] = {
              "10000,4), or none"},
     {.name = "--seed", .type = LR_ARG_INT, .metavar = "N", .min = 0, .max = 4294967295.0,
      .help = "seed of the sensor noise (default 1; the render keeps its own)"},
-    {.name = "--bits", .type = LR_ARG_CHOICE, .choices = "8|16", .help = "bits per channel (default 8)"},
+    {.name = "--bits", .type = LR_ARG_CHOICE, .choices = "8|16",
+     .help = "bits per channel (default 8)"},
     {.name = "--vignette", .type = LR_ARG_STRING, .metavar = "none|cos4|poly:V1,V2,V3",
      .help = "vignetting model (default none)"},
     {.name = "--gamma", .type = LR_ARG_NUMBER, .metavar = "G", .min = 0.1, .max = 10,
@@ -106,14 +107,14 @@ int main(int argc, char **argv)
         return st;
     lr_err ae = {0};
     const char *noise = lr_args_get(&args, "--noise"), *vig = lr_args_get(&args, "--vignette");
-    if ((st = lr_tool_check(PROGRAM, lr_args_double(&args, "--exposure", &s.exposure_s, &ae), &ae)) ||
-        (st = lr_tool_check(PROGRAM, lr_args_double(&args, "--gain", &s.gain, &ae), &ae)) ||
-        (st = lr_tool_check(PROGRAM, lr_args_double(&args, "--gamma", &gamma, &ae), &ae)) ||
-        (st = lr_tool_check(PROGRAM, lr_args_int64(&args, "--seed", &seed, &ae), &ae)) ||
-        (st = lr_tool_check(PROGRAM, lr_args_int(&args, "--frames", &frames, &ae), &ae)) ||
-        (st = lr_tool_check(PROGRAM, lr_args_choice(&args, "--bits", &bits, &ae), &ae)) ||
-        (noise && (st = lr_tool_check(PROGRAM, parse_noise(noise, &s, &ae), &ae))))
-        return st;
+    /* The first reader that refuses its value stops the chain; ae says which and why. */
+    if (lr_args_double(&args, "--exposure", &s.exposure_s, &ae) ||
+        lr_args_double(&args, "--gain", &s.gain, &ae) ||
+        lr_args_double(&args, "--gamma", &gamma, &ae) ||
+        lr_args_int64(&args, "--seed", &seed, &ae) ||
+        lr_args_int(&args, "--frames", &frames, &ae) ||
+        lr_args_choice(&args, "--bits", &bits, &ae) || (noise && parse_noise(noise, &s, &ae)))
+        return lr_tool_usage(PROGRAM, "%s", ae.msg);
     if (vig && lr_sensor_parse_vignette(vig, &s, &ae))
         return lr_tool_usage(PROGRAM, "--vignette %s", ae.msg);
     if (lr_args_has(&args, "--bits"))

@@ -37,7 +37,8 @@ static const lr_argspec opts[] = {
      .help = "image height in pixels (default 120)"},
     {.name = "--samples", .type = LR_ARG_INT, .min = 1, .max = 1 << 24,
      .help = "reference samples per band per pixel and per VPL (default 1024)"},
-    {.name = "--twin", .help = "the CPU twin of the GPU renderer instead of the converged reference"},
+    {.name = "--twin",
+     .help = "the CPU twin of the GPU renderer instead of the converged reference"},
     {.name = "--frames", .type = LR_ARG_INT, .metavar = "F", .min = 1, .max = 1 << 20,
      .help = "frames the twin accumulates (default: the scene's render.frames)"},
     {.name = "--vpl", .type = LR_ARG_INT, .min = 1, .max = 1 << 20,
@@ -78,8 +79,8 @@ int main(int argc, char **argv)
                                        "--vpl",   "--threads", "--seed"};
     int *dest[] = {&d.width, &d.height, &d.samples, &d.frames, &d.vpl_count, &d.threads, &seed};
     for (size_t k = 0; k < sizeof ints / sizeof ints[0]; k++)
-        if ((status = lr_tool_check(PROGRAM, lr_args_int(&args, ints[k], dest[k], &e), &e)))
-            return status;
+        if (lr_args_int(&args, ints[k], dest[k], &e))
+            return lr_tool_usage(PROGRAM, "%s", e.msg);
     if (lr_args_has(&args, "--twin"))
         d.mode = LR_CPU_PASS;
     d.no_vpl = lr_args_has(&args, "--no-vpl");

@@ -54,8 +54,9 @@ static const lr_argspec opts[] = {
     {.name = "--sweep", .type = LR_ARG_NUMBER, .metavar = "SECONDS", .flags = LR_ARG_FLOOR,
      .help = "turn the panel 0 -> 1000 -> 0 over SECONDS (>= 0), again and\n"
              "again (default 0: it moves only when a number is typed)"},
-    {.name = "--trace", .help = "also a timestamped line per request and per change\n"
-                                "(\"@T request unit U function F\", \"@T panel V\", \"@T driver V\")"},
+    {.name = "--trace",
+     .help = "also a timestamped line per request and per change\n"
+             "(\"@T request unit U function F\", \"@T panel V\", \"@T driver V\")"},
     {0},
 };
 
@@ -80,10 +81,9 @@ int main(int argc, char **argv)
     int st = lr_tool_args(&tool, argc, argv, &args);
     if (st >= 0)
         return st;
-    if ((st = lr_tool_check(PROGRAM, lr_args_int(&args, "--port", &port, &e), &e)) ||
-        (st = lr_tool_check(PROGRAM, lr_args_int(&args, "--panel", &panel, &e), &e)) ||
-        (st = lr_tool_check(PROGRAM, lr_args_double(&args, "--sweep", &sweep, &e), &e)))
-        return st;
+    if (lr_args_int(&args, "--port", &port, &e) || lr_args_int(&args, "--panel", &panel, &e) ||
+        lr_args_double(&args, "--sweep", &sweep, &e))
+        return lr_tool_usage(PROGRAM, "%s", e.msg);
     bool trace = lr_args_has(&args, "--trace");
     signal(SIGPIPE, SIG_IGN);
     /* SIGINT/SIGTERM arrive as a readable fd in the poll set: no handler, no race with

@@ -4,15 +4,10 @@
  * indirect from objects and from receivers; the power that leaves the scene).
  *
  *   lamprig-transrad SCENE.json [--set KEY=VALUE]... [--patch MM] [--receiver MM] [--rays N]
- *                    [--transfer-mb MB]   (build the precomputed transfer within MB; default
- *                                          none: the warm-started sweeps)
- *                    [--thin-wall auto|off|on]  (S on slab walls, render/transrad/thinwall.c:
- *                                          by its rule (default), never, on every slab patch)
- *                    [--split]            (per light and object: where S sends the light
- *                                          that entered, by distance and facing; split.c)
- *                    [--no-cache]         (build F and S even when $XDG_CACHE_HOME/lamprig has
- *                                          them; by default they are read from and written to
- *                                          the cache, render/transrad/cache.c)
+ *                    [--transfer-mb MB] [--thin-wall auto|off|on] [--split] [--no-cache]
+ *
+ * The options, their defaults and ranges are the table below (firmware/tool.h: `--help` is
+ * generated from it; a bad argument is one line naming the flag, exit status 2).
  */
 #include <math.h>
 #include <stdio.h>
@@ -83,15 +78,13 @@ int main(int argc, char **argv)
     /* The table's order of --thin-wall's choices is the enum's: auto 0, off 1, on 2. */
     _Static_assert(LR_TR_THIN_AUTO == 0 && LR_TR_THIN_OFF == 1 && LR_TR_THIN_ON == 2,
                    "--thin-wall's choices in the enum's order");
-    if ((status = lr_tool_check(PROGRAM, lr_args_double(&args, "--patch", &set.patch_mm, &e), &e)) ||
-        (status = lr_tool_check(PROGRAM, lr_args_double(&args, "--receiver", &set.receiver_mm, &e),
-                            &e)) ||
-        (status = lr_tool_check(PROGRAM, lr_args_int(&args, "--rays", &set.rays_per_patch, &e), &e)) ||
-        (status = lr_tool_check(PROGRAM, lr_args_int(&args, "--transfer-mb", &set.transfer_mb, &e),
-                            &e)) ||
-        (status = lr_tool_check(PROGRAM, lr_args_choice(&args, "--thin-wall", &set.thin_wall, &e),
-                            &e)))
-        return status;
+    /* The first reader that refuses its value stops the chain; e says which and why. */
+    if (lr_args_double(&args, "--patch", &set.patch_mm, &e) ||
+        lr_args_double(&args, "--receiver", &set.receiver_mm, &e) ||
+        lr_args_int(&args, "--rays", &set.rays_per_patch, &e) ||
+        lr_args_int(&args, "--transfer-mb", &set.transfer_mb, &e) ||
+        lr_args_choice(&args, "--thin-wall", &set.thin_wall, &e))
+        return lr_tool_usage(PROGRAM, "%s", e.msg);
     if (lr_args_has(&args, "--no-cache"))
         set.cache_dir = NULL;
     int split = lr_args_has(&args, "--split");
