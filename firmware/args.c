@@ -3,6 +3,7 @@
 #include <errno.h>
 #include <float.h>
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -239,38 +240,43 @@ static const lr_argspec *given(const lr_args *a, const char *name, const char **
     return *v ? &a->specs[k] : NULL;
 }
 
-int lr_args_int(const lr_args *a, const char *name, int *out, lr_err *e)
+/* The whole number given to `name`, at most `limit` in magnitude; *given false when absent. */
+static int whole_arg(const lr_args *a, const char *name, double limit, double *out, bool *given_,
+                     lr_err *e)
 {
     const char *v;
     const lr_argspec *s = given(a, name, &v);
+    *given_ = s != NULL;
     if (!s)
         return LR_OK;
-    double d;
-    int rc = whole_text(s, v, &d, e);
+    int rc = whole_text(s, v, out, e);
     if (rc)
         return rc;
-    if (fabs(d) > 2147483647.0)
+    if (fabs(*out) > limit)
         return lr_err_set(e, LR_EINVAL, "%s %s: out of range", name, v);
-    *out = (int)d;
     return LR_OK;
+}
+
+int lr_args_int(const lr_args *a, const char *name, int *out, lr_err *e)
+{
+    double d;
+    bool got;
+    int rc = whole_arg(a, name, 2147483647.0, &d, &got, e);
+    if (!rc && got)
+        *out = (int)d;
+    return rc;
 }
 
 int lr_args_int64(const lr_args *a, const char *name, long long *out, lr_err *e)
 {
-    const char *v;
-    const lr_argspec *s = given(a, name, &v);
-    if (!s)
-        return LR_OK;
-    double d;
-    int rc = whole_text(s, v, &d, e);
-    if (rc)
-        return rc;
     /* Above 2^53 a double no longer holds every whole number: "9007199254740993" would read
      * as its neighbour. */
-    if (fabs(d) > 9007199254740992.0)
-        return lr_err_set(e, LR_EINVAL, "%s %s: out of range", name, v);
-    *out = (long long)d;
-    return LR_OK;
+    double d;
+    bool got;
+    int rc = whole_arg(a, name, 9007199254740992.0, &d, &got, e);
+    if (!rc && got)
+        *out = (long long)d;
+    return rc;
 }
 
 int lr_args_double(const lr_args *a, const char *name, double *out, lr_err *e)
