@@ -28,15 +28,16 @@ lr_sacn_result lr_sacn_parse(const uint8_t *buf, size_t len, lr_sacn_packet *out
         return LR_SACN_ACN_ID;
     if (len > LR_SACN_MAX_LEN)
         return LR_SACN_LONG;
+    uint32_t root_vector = be32(buf + 18);
+    /* A data packet cut short is "short", not a length mismatch of its root layer. */
+    if (root_vector == 0x00000004 && len < LR_SACN_MIN_LEN)
+        return LR_SACN_SHORT;
     if (!flags_length_ok(buf, len, 16))
         return LR_SACN_ROOT_LENGTH;
-    uint32_t root_vector = be32(buf + 18);
     if (root_vector == 0x00000008)
         return LR_SACN_EXTENDED;
     if (root_vector != 0x00000004)
         return LR_SACN_ROOT_VECTOR;
-    if (len < LR_SACN_MIN_LEN)
-        return LR_SACN_SHORT;
     memcpy(out->cid, buf + 22, 16);
     if (!flags_length_ok(buf, len, 38))
         return LR_SACN_FRAMING_LENGTH;
@@ -48,8 +49,8 @@ lr_sacn_result lr_sacn_parse(const uint8_t *buf, size_t len, lr_sacn_packet *out
     out->sync_address = (int)be16(buf + 109);
     out->sequence = buf[111];
     out->options = buf[112];
-    out->preview = (buf[112] & LR_SACN_OPT_PREVIEW) != 0;
-    out->terminated = (buf[112] & LR_SACN_OPT_TERMINATED) != 0;
+    out->preview = (buf[112] & LR_SACN_BIT_PREVIEW) != 0;
+    out->terminated = (buf[112] & LR_SACN_BIT_TERMINATED) != 0;
     out->universe = (int)be16(buf + 113);
     if (out->priority > LR_SACN_PRIORITY_MAX)
         return LR_SACN_PRIORITY;

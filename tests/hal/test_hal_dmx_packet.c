@@ -15,6 +15,7 @@
 
 #include "hal/artnet_packet.h"
 #include "hal/sacn_packet.h"
+#include "tests/support/dmx_build.h"
 
 /* The harnesses, under names of their own (each defines LLVMFuzzerTestOneInput). */
 #define LLVMFuzzerTestOneInput fuzz_sacn
@@ -32,37 +33,11 @@ static void put16(uint8_t *p, unsigned v)
     p[1] = (uint8_t)v;
 }
 
-/* An E1.31 data packet per E1.31-2018 Table 4-1 (offsets in the comments are the table's);
- * returns its length, 126 + n. */
+/* tests/support/dmx_build.c lays the packets out per the standards' tables. */
 static size_t sacn_build(uint8_t *b, int universe, int priority, int seq, int options, int start,
                          const uint8_t *slots, int n)
 {
-    size_t len = 126 + (size_t)n;
-    memset(b, 0, len);
-    put16(b + 0, 0x0010);                       /* preamble size */
-    put16(b + 2, 0x0000);                       /* postamble size */
-    memcpy(b + 4, "ASC-E1.17\0\0\0", 12);       /* ACN packet identifier */
-    put16(b + 16, 0x7000 | (unsigned)(len - 16)); /* root flags & length */
-    b[21] = 0x04;                               /* VECTOR_ROOT_E131_DATA */
-    for (int i = 0; i < 16; i++)
-        b[22 + i] = (uint8_t)(0xa0 + i);        /* CID */
-    put16(b + 38, 0x7000 | (unsigned)(len - 38)); /* framing flags & length */
-    b[43] = 0x02;                               /* VECTOR_E131_DATA_PACKET */
-    memcpy(b + 44, "console", 7);               /* source name */
-    b[108] = (uint8_t)priority;
-    b[111] = (uint8_t)seq;
-    b[112] = (uint8_t)options;
-    put16(b + 113, (unsigned)universe);
-    put16(b + 115, 0x7000 | (unsigned)(len - 115)); /* DMP flags & length */
-    b[117] = 0x02;                              /* VECTOR_DMP_SET_PROPERTY */
-    b[118] = 0xa1;                              /* address & data type */
-    put16(b + 119, 0x0000);                     /* first property address */
-    put16(b + 121, 0x0001);                     /* address increment */
-    put16(b + 123, (unsigned)n + 1);            /* property value count: START code + slots */
-    b[125] = (uint8_t)start;
-    if (n)
-        memcpy(b + 126, slots, (size_t)n);
-    return len;
+    return lr_test_sacn_build(b, universe, priority, seq, options, start, slots, n, 0xaf);
 }
 
 static void sacn_valid(void **state)
@@ -87,7 +62,7 @@ static void sacn_valid(void **state)
     assert_false(p.terminated);
 
     /* A short universe (24 slots), the options bits, a 64-byte name without its NUL. */
-    len = sacn_build(b, 1, 0, 255, LR_SACN_OPT_PREVIEW | LR_SACN_OPT_TERMINATED, 0, slots, 24);
+    len = sacn_build(b, 1, 0, 255, LR_SACN_BIT_PREVIEW | LR_SACN_BIT_TERMINATED, 0, slots, 24);
     memset(b + 44, 'x', 64);
     assert_int_equal(lr_sacn_parse(b, len, &p), LR_SACN_OK);
     assert_int_equal(p.n_slots, 24);
@@ -161,22 +136,9 @@ static void sacn_broken_fields(void **state)
             assert_string_not_equal(lr_sacn_result_name(i), lr_sacn_result_name(k));
 }
 
-/* ArtDmx per Art-Net 4: ID, OpCode 0x5000 little-endian, ProtVer 14 big-endian, Sequence,
- * Physical, SubUni, Net, Length big-endian, data. */
 static size_t artdmx_build(uint8_t *b, int port_address, const uint8_t *slots, int n)
 {
-    memcpy(b, "Art-Net\0", 8);
-    b[8] = 0x00;
-    b[9] = 0x50;
-    b[10] = 0;
-    b[11] = 14;
-    b[12] = 1;
-    b[13] = 0;
-    b[14] = (uint8_t)(port_address & 0xff);
-    b[15] = (uint8_t)(port_address >> 8);
-    put16(b + 16, (unsigned)n);
-    memcpy(b + 18, slots, (size_t)n);
-    return 18 + (size_t)n;
+    return lr_test_artdmx_build(b, port_address, slots, n);
 }
 
 static void artnet_packets(void **state)
