@@ -17,6 +17,8 @@ const lr_opt lr_osc_opts[] = {
                            .help = "address prefix"},
     [LR_OSC_OPT_SCENES] = {"scenes", LR_OPT_LIST,
                            .help = "scene names for PREFIX/scene s, in the scene binding's order"},
+    [LR_OSC_OPT_SCENE_CONTROL] = {"scene_control", LR_OPT_STRING, .dflt_text = "scene",
+                                  .help = "control of PREFIX/scene events"},
     [LR_OSC_OPT_MAX_PACKETS] = {"max_packets", LR_OPT_INT, 1, 4096, 64,
                                 .help = "messages read per loop turn"},
     LR_OPT_END,
@@ -25,6 +27,7 @@ const lr_opt lr_osc_opts[] = {
 struct lr_osc {
     lr_dev base;
     char prefix[64];
+    char scene_control[LR_EVENT_NAME_MAX];
     char scenes[LR_OSC_MAX_SCENES][LR_EVENT_NAME_MAX];
     int n_scenes;
     int port, max_packets;
@@ -125,7 +128,7 @@ static int on_message(const char *path, const char *types, lo_arg **argv, int ar
         if (k < 0)
             bad(o, LR_OSC_BAD_SCENE, path);
         else
-            emit(o, "scene", (k + 0.5) / o->n_scenes);
+            emit(o, o->scene_control, (k + 0.5) / o->n_scenes);
         return 0;
     }
     bad(o, LR_OSC_BAD_ADDRESS, path);
@@ -219,6 +222,11 @@ static int configure(lr_osc *o, const lr_osc_desc *desc, lr_err *e)
         return lr_err_set(e, LR_EINVAL, "%s: prefix '%s' is not /NAME[/NAME...] (at most %zu "
                           "characters, no trailing '/')", pf, p, sizeof o->prefix - 1);
     memcpy(o->prefix, p, pl + 1);
+    const char *sc = desc->scene_control ? desc->scene_control
+                                         : op[LR_OSC_OPT_SCENE_CONTROL].dflt_text;
+    if (!valid_name(sc))
+        return lr_err_set(e, LR_EINVAL, "%s: scene_control '%s' is not a name", pf, sc);
+    snprintf(o->scene_control, sizeof o->scene_control, "%s", sc);
     if (desc->n_scenes < 0 || desc->n_scenes > LR_OSC_MAX_SCENES ||
         (desc->n_scenes && !desc->scenes))
         return lr_err_set(e, LR_EINVAL, "%s: %d scenes (0..%d)", pf, desc->n_scenes,

@@ -4,9 +4,10 @@
  * cannot bind one address):
  *   PREFIX/dimmer f              absolute event "dimmer" with the value (i, h, d also taken)
  *   PREFIX/control/NAME f        absolute event NAME (1..31 of A-Z a-z 0-9 _ . -)
- *   PREFIX/scene s               absolute event "scene" at (k + 0.5) / n for the k-th of the n
- *                                configured `scenes`: a cycle binding on "scene" whose values
- *                                list the same scenes in the same order picks floor(x n) = k
+ *   PREFIX/scene s               absolute event `scene_control` (default "scene") at
+ *                                (k + 0.5) / n for the k-th of the n configured `scenes`: a
+ *                                cycle binding on that control whose values list the same
+ *                                scenes in the same order picks floor(x n) = k
  *   PREFIX/scene i               the same by index k
  * Anything else is counted (unknown address, wrong argument types, unknown scene, non-finite
  * values, packets liblo could not parse) and the first of each kind logged. TCP is not offered:
@@ -30,6 +31,7 @@
 typedef struct lr_osc_desc {
     lr_dev_desc dev;            /* name default "osc" */
     const char *prefix;         /* NULL: "/lamprig" */
+    const char *scene_control;  /* NULL: "scene" */
     const char *const *scenes;  /* names for PREFIX/scene s */
     int n_scenes;
     int port, max_packets;      /* 0: the default (lr_osc_opts) */
@@ -39,6 +41,7 @@ enum {
     LR_OSC_OPT_PORT = 0,
     LR_OSC_OPT_PREFIX,
     LR_OSC_OPT_SCENES,
+    LR_OSC_OPT_SCENE_CONTROL,
     LR_OSC_OPT_MAX_PACKETS,
 };
 extern const lr_opt lr_osc_opts[];

@@ -20,11 +20,14 @@
 #include "firmware/rig/notify.h"
 #include "firmware/rig/stats.h"
 #include "firmware/rig/view.h"
+#include "hal/artnet.h"
 #include "hal/dev.h"
 #include "hal/event.h"
 #include "hal/gpio.h"
 #include "hal/hid.h"
 #include "hal/modbus.h"
+#include "hal/osc.h"
+#include "hal/sacn.h"
 #include "hal/sim.h"
 #include "hal/usb.h"
 #include "render/base/out_dir.h"
@@ -114,6 +117,20 @@ static void scene_warn(void *user, const char *msg)
 {
     lr_rig *r = user;
     lr_log_write(&r->log, LR_LOG_WARN, "scene: %s", msg);
+}
+
+/* A console channel's home for a loss fade (hal/dmx_in.h): the position the control map took
+ * from the scene (or "initial") for the level binding of this device's control; NaN (hold)
+ * when no level binding takes it. */
+static double channel_home(const rigset *s, const lr_rig_device *d, const char *control)
+{
+    for (int i = 0; i < s->cfg->n_bindings; i++) {
+        const lr_rig_binding *b = &s->cfg->bindings[i];
+        if (b->kind == LR_BIND_LEVEL && strcmp(b->control, control) == 0 &&
+            (!b->source[0] || strcmp(b->source, d->name) == 0))
+            return lr_control_map_position(s->map, i);
+    }
+    return NAN;
 }
 
 static int create_device(lr_rig *r, rigset *s, const lr_rig_device *d, lr_err *e)
@@ -213,6 +230,52 @@ static int create_device(lr_rig *r, rigset *s, const lr_rig_device *d, lr_err *e
         lr_usb *u;
         if (!(rc = lr_usb_create(&ud, &u, e)))
             out = lr_usb_dev(u);
+        break;
+    }
+    case LR_RIG_DEV_SACN:
+    case LR_RIG_DEV_ARTNET: {
+        lr_dmx_channel ch[LR_RIG_MAX_CHANNELS];
+        for (int i = 0; i < d->n_channels; i++)
+            ch[i] = (lr_dmx_channel){.control = d->channels[i].control,
+                                     .universe = d->channels[i].universe,
+                                     .channel = d->channels[i].channel,
+                                     .fine = d->channels[i].fine,
+                                     .home = channel_home(s, d, d->channels[i].control)};
+        if (d->type == LR_RIG_DEV_SACN) {
+            lr_sacn_desc sd = {.dev = dev, .bind = d->bind, .interface = d->interface,
+                               .unicast_only = d->unicast_only, .channels = ch,
+                               .n_channels = d->n_channels, .loss = (lr_dmx_loss)d->loss,
+                               .preview = d->preview, .port = d->port,
+                               .max_sources = d->max_sources, .loss_ms = d->loss_ms,
+                               .fade_ms = d->fade_ms, .max_packets = d->max_packets};
+            lr_sacn *sa;
+            if (!(rc = lr_sacn_create(&sd, &sa, e)))
+                out = lr_sacn_dev(sa);
+        } else {
+            lr_artnet_desc ad = {.dev = dev, .bind = d->bind, .announce = d->announce,
+                                 .short_name = d->short_name, .channels = ch,
+                                 .n_channels = d->n_channels,
+                                 .merge = (lr_dmx_merge_mode)d->merge,
+                                 .loss = (lr_dmx_loss)d->loss, .port = d->port,
+                                 .merge_timeout_ms = d->merge_timeout_ms,
+                                 .fade_ms = d->fade_ms, .max_packets = d->max_packets};
+            lr_artnet *an;
+            if (!(rc = lr_artnet_create(&ad, &an, e)))
+                out = lr_artnet_dev(an);
+        }
+        break;
+    }
+    case LR_RIG_DEV_OSC: {
+        const char *sc[LR_RIG_MAX_SCENE_NAMES];
+        for (int i = 0; i < d->n_scenes; i++)
+            sc[i] = d->scenes[i];
+        lr_osc_desc od = {.dev = dev, .prefix = d->prefix, .scene_control = d->scene_control,
+                          .scenes = sc,
+                          .n_scenes = d->n_scenes, .port = d->port,
+                          .max_packets = d->max_packets};
+        lr_osc *o;
+        if (!(rc = lr_osc_create(&od, &o, e)))
+            out = lr_osc_dev(o);
         break;
     }
     }
