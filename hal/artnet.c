@@ -23,7 +23,7 @@ const lr_opt lr_artnet_opts[] = {
                             .help = "IPv4 address to receive on"},
     [LR_ARTNET_OPT_PORT] = {"port", LR_OPT_INT, 1, 65535, LR_ARTNET_PORT, .help = "UDP port"},
     [LR_ARTNET_OPT_ANNOUNCE] = {"announce", LR_OPT_STRING, .dflt_text = "255.255.255.255",
-                                .help = "where the ArtPollReply at start goes; \"\": none"},
+                                .help = "where the ArtPollReply at start goes; `none`: nowhere"},
     [LR_ARTNET_OPT_SHORT_NAME] = {"short_name", LR_OPT_STRING, .dflt_text = "lamprig",
                                   .help = "node name in ArtPollReply"},
     [LR_ARTNET_OPT_MERGE] = {"merge", LR_OPT_ENUM, .dflt = LR_DMX_HTP, .names = MERGE_NAMES,
@@ -258,6 +258,8 @@ static int configure(lr_artnet *a, const lr_artnet_desc *desc, lr_err *e)
     snprintf(a->bind, sizeof a->bind, "%s", desc->bind ? desc->bind : "");
     snprintf(a->announce, sizeof a->announce, "%s",
              desc->announce ? desc->announce : o[LR_ARTNET_OPT_ANNOUNCE].dflt_text);
+    if (strcmp(a->announce, "none") == 0)
+        a->announce[0] = '\0';
     struct in_addr ia;
     if (a->announce[0] && inet_pton(AF_INET, a->announce, &ia) != 1)
         return lr_err_set(e, LR_EINVAL, "%s: announce '%s' is not an IPv4 address", pf,

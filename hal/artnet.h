@@ -25,7 +25,7 @@ typedef struct lr_artnet_desc {
     lr_dev_desc dev;          /* name default "artnet" */
     const char *bind;         /* NULL/"": 0.0.0.0 */
     const char *announce;     /* where the ArtPollReply at start goes; NULL: 255.255.255.255,
-                               * "": none */
+                               * "" or "none": nowhere */
     const char *short_name;   /* in ArtPollReply; NULL: "lamprig" */
     const lr_dmx_channel *channels;
     int n_channels;
