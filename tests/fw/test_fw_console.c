@@ -101,10 +101,10 @@ static void console_moves_the_dimmer(void **state)
     assert_int_equal(lr_test_udp_send(tx, 15530, b, n), (long)n);
     run_for(r, 600);
     assert_near(scene_num(r, "light.intensity"), 2 * i0, 1e-12);
-    /* Art-Net port-address 0 channel 1 at 0: level 0 (the latest event wins: the two
+    /* Art-Net port-address 1 channel 1 at 0: level 0 (the latest event wins: the two
      * receivers are two devices feeding one binding, as two faders would). */
     sl[0] = 0;
-    n = lr_test_artdmx_build(b, 0, sl, 4);
+    n = lr_test_artdmx_build(b, 1, sl, 4);
     assert_int_equal(lr_test_udp_send(tx, 15531, b, n), (long)n);
     run_for(r, 600);
     assert_near(scene_num(r, "light.intensity"), 0, 1e-12);
@@ -126,7 +126,7 @@ static void console_moves_the_dimmer(void **state)
     /* The three inputs opened; the lamp (nobody on 15533) retries without stopping them. */
     assert_int_equal(lr_test_log_count(&log, "sacn: udp 0.0.0.0:15530, universe 1 (unicast): open"),
                      1);
-    assert_int_equal(lr_test_log_count(&log, "artnet: udp 0.0.0.0:15531, port-address 0: open"), 1);
+    assert_int_equal(lr_test_log_count(&log, "artnet: udp 0.0.0.0:15531, port-address 1: open"), 1);
     assert_int_equal(lr_test_log_count(&log, "osc: udp port 15532, /lamprig/...: open"), 1);
     lr_rig_destroy(r);
     free(cfg);
