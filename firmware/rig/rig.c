@@ -21,6 +21,7 @@
 #include "firmware/rig/stats.h"
 #include "firmware/rig/view.h"
 #include "hal/artnet.h"
+#include "hal/artnet_packet.h"
 #include "hal/dev.h"
 #include "hal/event.h"
 #include "hal/gpio.h"
@@ -28,6 +29,7 @@
 #include "hal/modbus.h"
 #include "hal/osc.h"
 #include "hal/sacn.h"
+#include "hal/sacn_packet.h"
 #include "hal/sim.h"
 #include "hal/usb.h"
 #include "render/base/out_dir.h"
@@ -51,6 +53,9 @@ typedef struct rigset {
     lr_dev *devs[LR_RIG_MAX_DEVICES];
     lr_modbus *lamp[LR_RIG_MAX_DEVICES]; /* modbus devices with a lamp driver */
     lr_modbus *modbus[LR_RIG_MAX_DEVICES]; /* per devs[i]: its modbus link, or NULL */
+    lr_sacn *sacn[LR_RIG_MAX_DEVICES];     /* per devs[i], or NULL; the same for these: */
+    lr_artnet *artnet[LR_RIG_MAX_DEVICES];
+    lr_osc *osc[LR_RIG_MAX_DEVICES];
     int n_devs, n_lamps;
     bool has_hid;
     bool no_vpl; /* the planner found no receiver that sees any object */
@@ -98,6 +103,63 @@ struct lr_rig {
     lr_notify *notify;     /* sd_notify: READY, watchdog pings, RELOADING, STOPPING */
     bool ready_sent;
 };
+
+/* A console input's counters for the stats file (names: static strings, or the parsers'
+ * result names behind "bad_"). */
+#define INPUT_COUNTERS_MAX (12 + LR_DMX_MAX_KINDS)
+static int dmx_counters(const lr_dmx_counters *c, const char *(*kind_name)(int), int n_kinds,
+                        lr_rig_stats_counter *out)
+{
+    const lr_rig_stats_counter fixed[] = {
+        {"", "packets", c->packets},       {"", "taken", c->taken},
+        {"", "other", c->other},           {"", "sequence", c->sequence},
+        {"", "full", c->full},             {"", "preview", c->preview},
+        {"", "terminated", c->terminated}, {"", "losses", c->losses},
+        {"", "polls", c->polls},           {"", "replies", c->replies},
+        {"", "events", c->events},         {"", "bad", c->bad},
+    };
+    int n = 0;
+    for (size_t k = 0; k < sizeof fixed / sizeof fixed[0]; k++)
+        out[n++] = fixed[k];
+    for (int k = 0; k < n_kinds && k < LR_DMX_MAX_KINDS; k++)
+        if (c->bad_kind[k])
+            out[n++] = (lr_rig_stats_counter){"bad_", kind_name(k), c->bad_kind[k]};
+    return n;
+}
+
+static const char *sacn_kind(int k) { return lr_sacn_result_name((lr_sacn_result)k); }
+static const char *artnet_kind(int k) { return lr_artnet_result_name((lr_artnet_result)k); }
+static const char *osc_kind(int k)
+{
+    static const char *const key[LR_OSC_N_BAD] = {"address", "types", "value", "scene",
+                                                  "packet"}; /* lr_osc_bad */
+    return (unsigned)k < LR_OSC_N_BAD ? key[k] : "?";
+}
+
+static int input_counters(const rigset *s, int i, lr_rig_stats_counter *out)
+{
+    lr_dmx_counters c;
+    if (s->sacn[i]) {
+        lr_sacn_get_counters(s->sacn[i], &c);
+        return dmx_counters(&c, sacn_kind, LR_SACN_N_RESULTS, out);
+    }
+    if (s->artnet[i]) {
+        lr_artnet_get_counters(s->artnet[i], &c);
+        return dmx_counters(&c, artnet_kind, LR_ARTNET_N_RESULTS, out);
+    }
+    if (!s->osc[i])
+        return 0;
+    lr_osc_counters oc;
+    lr_osc_get_counters(s->osc[i], &oc);
+    int n = 0;
+    out[n++] = (lr_rig_stats_counter){"", "messages", oc.messages};
+    out[n++] = (lr_rig_stats_counter){"", "events", oc.events};
+    out[n++] = (lr_rig_stats_counter){"", "bad", oc.bad};
+    for (int k = 0; k < LR_OSC_N_BAD; k++)
+        if (oc.bad_kind[k])
+            out[n++] = (lr_rig_stats_counter){"bad_", osc_kind(k), oc.bad_kind[k]};
+    return n;
+}
 
 static void set_free(rigset *s)
 {
@@ -249,8 +311,10 @@ static int create_device(lr_rig *r, rigset *s, const lr_rig_device *d, lr_err *e
                                .max_sources = d->max_sources, .loss_ms = d->loss_ms,
                                .fade_ms = d->fade_ms, .max_packets = d->max_packets};
             lr_sacn *sa;
-            if (!(rc = lr_sacn_create(&sd, &sa, e)))
+            if (!(rc = lr_sacn_create(&sd, &sa, e))) {
                 out = lr_sacn_dev(sa);
+                s->sacn[s->n_devs] = sa;
+            }
         } else {
             lr_artnet_desc ad = {.dev = dev, .bind = d->bind, .announce = d->announce,
                                  .short_name = d->short_name, .channels = ch,
@@ -260,8 +324,10 @@ static int create_device(lr_rig *r, rigset *s, const lr_rig_device *d, lr_err *e
                                  .merge_timeout_ms = d->merge_timeout_ms,
                                  .fade_ms = d->fade_ms, .max_packets = d->max_packets};
             lr_artnet *an;
-            if (!(rc = lr_artnet_create(&ad, &an, e)))
+            if (!(rc = lr_artnet_create(&ad, &an, e))) {
                 out = lr_artnet_dev(an);
+                s->artnet[s->n_devs] = an;
+            }
         }
         break;
     }
@@ -274,8 +340,10 @@ static int create_device(lr_rig *r, rigset *s, const lr_rig_device *d, lr_err *e
                           .n_scenes = d->n_scenes, .port = d->port,
                           .max_packets = d->max_packets};
         lr_osc *o;
-        if (!(rc = lr_osc_create(&od, &o, e)))
+        if (!(rc = lr_osc_create(&od, &o, e))) {
             out = lr_osc_dev(o);
+            s->osc[s->n_devs] = o;
+        }
         break;
     }
     }
@@ -717,14 +785,17 @@ static void write_stats(lr_rig *r, int64_t now)
     lr_err e = {0};
     lr_rig_stats_dev devs[LR_RIG_MAX_DEVICES];
     lr_modbus_counters mc[LR_RIG_MAX_DEVICES];
+    lr_rig_stats_counter in[LR_RIG_MAX_DEVICES][INPUT_COUNTERS_MAX];
     for (int i = 0; i < r->set.n_devs; i++) {
         lr_dev *d = r->set.devs[i];
         devs[i] = (lr_rig_stats_dev){lr_dev_name(d), lr_dev_kind(d),
-                                     lr_dev_state_name(lr_dev_get_state(d)), NULL};
+                                     lr_dev_state_name(lr_dev_get_state(d)), NULL, NULL, 0};
         if (r->set.modbus[i]) {
             lr_modbus_get_counters(r->set.modbus[i], &mc[i]);
             devs[i].modbus = &mc[i];
         }
+        devs[i].n_input = input_counters(&r->set, i, in[i]);
+        devs[i].input = in[i];
     }
     if (lr_rig_stats_write(r->stats, r->stats_path, r->config_path, now,
                            lr_control_map_garbage(r->set.map), devs, r->set.n_devs, &e))

@@ -19,6 +19,7 @@
 
 #include "firmware/rig/rig.h"
 #include "hal/dev.h"
+#include "render/base/json.h"
 #include "render/scene/scene.h"
 #include "tests/support/dmx_build.h"
 #include "tests/support/fs.h"
@@ -114,6 +115,11 @@ static void console_moves_the_dimmer(void **state)
     lo_address_free(to);
     run_for(r, 600);
     assert_near(scene_num(r, "light.intensity"), 0.5 * i0, 1e-12);
+    /* A packet that is not sACN (a wrong ACN identifier): counted by kind in the stats. */
+    n = lr_test_sacn_build(b, 1, 100, 1, 0, 0, sl, 4, 1);
+    b[4] = 'X';
+    assert_int_equal(lr_test_udp_send(tx, 15530, b, n), (long)n);
+    run_for(r, 100);
     close(tx);
     lr_rig_info info;
     lr_rig_get_info(r, &info);
@@ -128,7 +134,29 @@ static void console_moves_the_dimmer(void **state)
                      1);
     assert_int_equal(lr_test_log_count(&log, "artnet: udp 0.0.0.0:15531, port-address 1: open"), 1);
     assert_int_equal(lr_test_log_count(&log, "osc: udp port 15532, /lamprig/...: open"), 1);
-    lr_rig_destroy(r);
+    lr_rig_destroy(r); /* writes the stats */
+    /* The stats file's devices: each input with its counters. */
+    lr_json *j;
+    if (lr_json_load(stats, &j, &e))
+        fail_msg("%s", e.msg);
+    lr_jnode devs = lr_json_get(j, lr_json_root(j), "devices");
+    assert_int_equal(lr_json_count(j, devs), 4);
+    long v = -1;
+    lr_jnode in = lr_json_get(j, lr_json_at(j, devs, 0), "input");
+    assert_int_equal(lr_json_get_int(j, in, "packets", true, &v, &e), LR_OK);
+    assert_int_equal(v, 2);
+    assert_int_equal(lr_json_get_int(j, in, "taken", true, &v, &e), LR_OK);
+    assert_int_equal(v, 1);
+    assert_int_equal(lr_json_get_int(j, in, "bad_acn-id", true, &v, &e), LR_OK);
+    assert_int_equal(v, 1);
+    in = lr_json_get(j, lr_json_at(j, devs, 1), "input");
+    assert_int_equal(lr_json_get_int(j, in, "taken", true, &v, &e), LR_OK);
+    assert_int_equal(v, 1);
+    in = lr_json_get(j, lr_json_at(j, devs, 2), "input");
+    assert_int_equal(lr_json_get_int(j, in, "messages", true, &v, &e), LR_OK);
+    assert_int_equal(v, 1);
+    assert_int_equal(lr_json_get(j, lr_json_at(j, devs, 3), "input"), LR_JNONE); /* modbus */
+    lr_json_destroy(j);
     free(cfg);
     free(stats);
     lr_test_rmtree(dir);
