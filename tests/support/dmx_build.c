@@ -87,3 +87,18 @@ long lr_test_udp_send(int fd, int port, const void *buf, size_t len)
                             .sin_addr.s_addr = htonl(INADDR_LOOPBACK)};
     return (long)sendto(fd, buf, len, 0, (struct sockaddr *)&a, sizeof a);
 }
+
+int lr_test_tcp_connect(const char *ip, int port)
+{
+    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
+    if (inet_pton(AF_INET, ip, &a.sin_addr) != 1)
+        return -1;
+    int s = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    if (s < 0)
+        return -1;
+    if (connect(s, (struct sockaddr *)&a, sizeof a) != 0) {
+        close(s);
+        return -1;
+    }
+    return s;
+}

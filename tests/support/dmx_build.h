@@ -1,6 +1,6 @@
 /* Test support: sACN and Art-Net packets laid out byte by byte from the standards' tables
- * (E1.31-2018 Table 4-1; Art-Net 4 ArtDmx/ArtPoll), independent of hal/'s parsers, and a UDP
- * sender on loopback. */
+ * (E1.31-2018 Table 4-1; Art-Net 4 ArtDmx/ArtPoll), independent of hal/'s parsers, a UDP
+ * sender on loopback, and a TCP connect (the consoles' web sockets). */
 #ifndef LR_TEST_DMX_BUILD_H
 #define LR_TEST_DMX_BUILD_H
 
@@ -19,5 +19,7 @@ size_t lr_test_artpoll_build(uint8_t *b);
 int lr_test_udp_socket(int port);
 /* Sends to 127.0.0.1:port; returns what sendto returns. */
 long lr_test_udp_send(int fd, int port, const void *buf, size_t len);
+/* A TCP connection to ip:port (IPv4 text), blocking; -1 when refused or unreachable. */
+int lr_test_tcp_connect(const char *ip, int port);
 
 #endif
