@@ -2,8 +2,9 @@
  * console drives it: an sACN packet, an ArtDmx and an OSC message move the candle's dimmer.
  * The file is used as shipped except for what a test on a shared machine must change: the
  * ports (sACN 5568 -> 15530 unicast, Art-Net 6454 -> 15531 without the broadcast announce,
- * OSC 9000 -> 15532, the Modbus lamp to a port nobody listens on, 15533), absolute paths, a
- * 16x16 preview output. Real consoles (OLA, QLC+) are in test_fw_console_peers. */
+ * OSC 9000 -> 15532, the Modbus lamp driver a libmodbus server on a free port), absolute
+ * paths, a 16x16 preview output. Real consoles (OLA, QLC+) drive the receivers in
+ * tests/hal/test_hal_dmx_peers.c. */
 #include <lo/lo.h>
 #include <math.h>
 #include <setjmp.h>
@@ -24,6 +25,7 @@
 #include "tests/support/dmx_build.h"
 #include "tests/support/fs.h"
 #include "tests/support/hal_test.h"
+#include "tests/support/modbus_server.h"
 #include "tests/support/near.h"
 
 #define MS 1000000LL
@@ -74,7 +76,11 @@ static void console_moves_the_dimmer(void **state)
     replace(text, sizeof text, "\"type\": \"artnet\", \"name\": \"artnet\",",
             "\"type\": \"artnet\", \"name\": \"artnet\", \"port\": 15531, \"announce\": \"none\",");
     replace(text, sizeof text, "\"port\": 9000", "\"port\": 15532");
-    replace(text, sizeof text, "tcp://127.0.0.1:1502", "tcp://127.0.0.1:15533");
+    /* The lamp driver: a libmodbus server (unit 2, holding register 0) on a free port. */
+    lr_test_mb_server *mb = lr_test_mb_server_start();
+    char url[64];
+    snprintf(url, sizeof url, "tcp://127.0.0.1:%d", lr_test_mb_server_port(mb));
+    replace(text, sizeof text, "tcp://127.0.0.1:1502", url);
     replace(text, sizeof text, "\"width\": 320, \"height\": 240",
             "\"width\": 16, \"height\": 16, \"renderer\": \"preview\"");
     char *dir = lr_test_tmpdir();
@@ -102,6 +108,8 @@ static void console_moves_the_dimmer(void **state)
     assert_int_equal(lr_test_udp_send(tx, 15530, b, n), (long)n);
     run_for(r, 600);
     assert_near(scene_num(r, "light.intensity"), 2 * i0, 1e-12);
+    /* The lamp gets the curved level y = x^2 = 1: raw 255 of 0..255. */
+    assert_int_equal(lr_test_mb_server_reg(mb, 2, 0), 255);
     /* Art-Net port-address 1 channel 1 at 0: level 0 (the latest event wins: the two
      * receivers are two devices feeding one binding, as two faders would). */
     sl[0] = 0;
@@ -109,12 +117,15 @@ static void console_moves_the_dimmer(void **state)
     assert_int_equal(lr_test_udp_send(tx, 15531, b, n), (long)n);
     run_for(r, 600);
     assert_near(scene_num(r, "light.intensity"), 0, 1e-12);
+    assert_int_equal(lr_test_mb_server_reg(mb, 2, 0), 0);
     /* OSC /lamprig/dimmer 0.5: level 2 * 0.25 = 0.5. */
     lo_address to = lo_address_new("127.0.0.1", "15532");
     assert_true(lo_send(to, "/lamprig/dimmer", "f", 0.5f) > 0);
     lo_address_free(to);
     run_for(r, 600);
     assert_near(scene_num(r, "light.intensity"), 0.5 * i0, 1e-12);
+    /* y = 0.25: raw round(0.25 * 255) = round(63.75) = 64. */
+    assert_int_equal(lr_test_mb_server_reg(mb, 2, 0), 64);
     /* A packet that is not sACN (a wrong ACN identifier): counted by kind in the stats. */
     n = lr_test_sacn_build(b, 1, 100, 1, 0, 0, sl, 4, 1);
     b[4] = 'X';
@@ -129,12 +140,14 @@ static void console_moves_the_dimmer(void **state)
      * Art-Net and OSC dimmers: 3 + 1 + 1. */
     assert_int_equal(info.events, 5);
     assert_near(scene_num(r, "lights[0].flicker.amplitude"), 0, 1e-12);
-    /* The three inputs opened; the lamp (nobody on 15533) retries without stopping them. */
+    /* The three inputs opened. */
     assert_int_equal(lr_test_log_count(&log, "sacn: udp 0.0.0.0:15530, universe 1 (unicast): open"),
                      1);
     assert_int_equal(lr_test_log_count(&log, "artnet: udp 0.0.0.0:15531, port-address 1: open"), 1);
     assert_int_equal(lr_test_log_count(&log, "osc: udp port 15532, /lamprig/...: open"), 1);
-    lr_rig_destroy(r); /* writes the stats */
+    lr_rig_destroy(r); /* writes the stats and the safe level 0 */
+    assert_int_equal(lr_test_mb_server_reg(mb, 2, 0), 0);
+    lr_test_mb_server_free(mb);
     /* The stats file's devices: each input with its counters. */
     lr_json *j;
     if (lr_json_load(stats, &j, &e))
