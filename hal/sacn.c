@@ -52,6 +52,8 @@ struct lr_sacn {
     int fd;
     bool more; /* the last dispatch stopped at max_packets */
     bool join_logged;
+    bool joined[LR_DMX_MAX_UNIVERSES];
+    int64_t join_retry_at; /* LR_NO_DEADLINE: every group joined (or unicast only) */
 };
 
 static const char *const *result_names(void)
@@ -70,36 +72,55 @@ static void sa_close(lr_dev *d)
     s->fd = -1;
 }
 
+/* Joins the groups not joined yet. A rig that starts before its network is up (no route,
+ * no such interface yet) tries again every JOIN_RETRY_NS; the first shortfall and the
+ * recovery are logged, the retries are not. */
+#define JOIN_RETRY_NS (5000 * MS)
+static void join_groups(lr_sacn *s, int64_t now_ns)
+{
+    struct in_addr ifa = {.s_addr = htonl(INADDR_ANY)};
+    if (s->interface[0])
+        inet_pton(AF_INET, s->interface, &ifa); /* checked at create */
+    int joined = 0, err = 0;
+    for (int u = 0; u < s->core.n_uni; u++) {
+        if (!s->joined[u]) {
+            struct ip_mreq mr = {
+                .imr_multiaddr.s_addr = htonl(lr_sacn_multicast_group(s->core.uni[u].number)),
+                .imr_interface = ifa};
+            if (setsockopt(s->fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &mr, sizeof mr) == 0)
+                s->joined[u] = true;
+            else
+                err = errno;
+        }
+        joined += s->joined[u];
+    }
+    if (joined == s->core.n_uni) {
+        s->join_retry_at = LR_NO_DEADLINE;
+        if (s->join_logged)
+            lr_dev_log(&s->base, LR_LOG_INFO, "joined all %d multicast groups", joined);
+        s->join_logged = false;
+        return;
+    }
+    s->join_retry_at = now_ns + JOIN_RETRY_NS;
+    if (!s->join_logged) {
+        /* No multicast route (a host with only loopback) or no such interface: unicast works. */
+        s->join_logged = true;
+        lr_dev_log(&s->base, LR_LOG_WARN, "joined %d of %d multicast groups (%s); unicast to "
+                   "port %d still taken; trying again every %d s", joined, s->core.n_uni,
+                   strerror(err), s->port, (int)(JOIN_RETRY_NS / (1000 * MS)));
+    }
+}
+
 static int sa_open(lr_dev *d, int64_t now_ns, lr_err *e)
 {
-    (void)now_ns;
     lr_sacn *s = (lr_sacn *)d;
     int rc = dmx_udp_open(s->bind, s->port, false, &s->fd, e);
     if (rc)
         return rc;
-    if (s->unicast_only)
-        return LR_OK;
-    struct in_addr ifa = {.s_addr = htonl(INADDR_ANY)};
-    if (s->interface[0] && inet_pton(AF_INET, s->interface, &ifa) != 1) {
-        sa_close(d);
-        return lr_err_set(e, LR_EINVAL, "interface '%s' is not an IPv4 address", s->interface);
-    }
-    int joined = 0, err = 0;
-    for (int u = 0; u < s->core.n_uni; u++) {
-        struct ip_mreq mr = {
-            .imr_multiaddr.s_addr = htonl(lr_sacn_multicast_group(s->core.uni[u].number)),
-            .imr_interface = ifa};
-        if (setsockopt(s->fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &mr, sizeof mr) == 0)
-            joined++;
-        else
-            err = errno;
-    }
-    if (joined < s->core.n_uni && !s->join_logged) {
-        /* No multicast route (a host with only loopback) or no such interface: unicast works. */
-        s->join_logged = true;
-        lr_dev_log(d, LR_LOG_WARN, "joined %d of %d multicast groups (%s); unicast to port %d "
-                   "still taken", joined, s->core.n_uni, strerror(err), s->port);
-    }
+    memset(s->joined, 0, sizeof s->joined);
+    s->join_retry_at = LR_NO_DEADLINE;
+    if (!s->unicast_only)
+        join_groups(s, now_ns);
     return LR_OK;
 }
 
@@ -174,6 +195,8 @@ static void sa_dispatch(lr_dev *d, int64_t now_ns)
             s->more = true;
     }
     dmx_core_tick(&s->core, now_ns);
+    if (now_ns >= s->join_retry_at)
+        join_groups(s, now_ns);
 }
 
 static int64_t sa_next_deadline(lr_dev *d)
@@ -182,6 +205,8 @@ static int64_t sa_next_deadline(lr_dev *d)
     if (s->more)
         return 0; /* the rest of a burst, after the other devices had their turn */
     int64_t t = dmx_core_deadline(&s->core);
+    if (s->join_retry_at < t)
+        t = s->join_retry_at;
     return t == INT64_MAX ? LR_NO_DEADLINE : t;
 }
 
@@ -213,6 +238,10 @@ static int configure(lr_sacn *s, const lr_sacn_desc *desc, lr_err *e)
         return lr_err_set(e, LR_EINVAL, "%s: loss %d unknown", pf, (int)desc->loss);
     snprintf(s->bind, sizeof s->bind, "%s", desc->bind ? desc->bind : "");
     snprintf(s->interface, sizeof s->interface, "%s", desc->interface ? desc->interface : "");
+    struct in_addr ia;
+    if (s->interface[0] && inet_pton(AF_INET, s->interface, &ia) != 1)
+        return lr_err_set(e, LR_EINVAL, "%s: interface '%s' is not an IPv4 address", pf,
+                          s->interface);
     s->unicast_only = desc->unicast_only;
     s->preview = desc->preview;
     s->port = (int)lr_opt_or_default(&o[LR_SACN_OPT_PORT], desc->port);

@@ -3,7 +3,8 @@
  * One UDP socket on port 5568 (bind 0.0.0.0 by default): unicast packets to this host are
  * taken, and the socket joins the multicast group 239.255.hi.lo of every configured universe
  * (on `interface`, an IPv4 address of the NIC; default: the kernel's choice). A host with no
- * multicast route (a bare loopback) cannot join: logged once, unicast still works.
+ * multicast route (a bare loopback, a network not up yet) cannot join: logged once, unicast
+ * still works, and the join is tried again every 5 s until it succeeds (logged once).
  *
  * Each datagram is parsed (hal/sacn_packet.h); a malformed one is counted by kind and the first
  * of each kind logged with its sender. Data for configured universes is merged per universe

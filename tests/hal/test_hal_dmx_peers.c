@@ -467,11 +467,53 @@ static void qlcplus_drives_both(void **state)
     lr_artnet_destroy(a);
 }
 
+/* A rig started before its network: no multicast route, so the join fails (one warning) and
+ * unicast works; once an interface with a route is up, the retry 5 s later joins (one line).
+ * Runs in the test's own namespace, which has only its loopback until the test adds one. */
+static void multicast_join_retry(void **state)
+{
+    (void)state;
+    char why[160];
+    if (!common_ok(why, sizeof why)) {
+        print_message("%s\n", why);
+        skip();
+    }
+    sh("ip route del 224.0.0.0/4 2>/dev/null; ip link del lrv0 2>/dev/null");
+    rec r = {0};
+    lr_test_log log = {0};
+    const lr_dmx_channel ch[] = {{.control = "dimmer", .universe = 7, .channel = 1, .home = NAN}};
+    lr_sacn_desc sd = {.dev = {.sink = {rec_fn, &r}, .log = {lr_test_log_fn, &log}},
+                       .port = 15540, .channels = ch, .n_channels = 1};
+    lr_sacn *s;
+    lr_err e = {0};
+    if (lr_sacn_create(&sd, &s, &e))
+        fail_msg("%s", e.msg);
+    lr_dev *d = lr_sacn_dev(s);
+    assert_int_equal(lr_dev_get_state(d), LR_DEV_OPEN);
+    assert_int_equal(lr_test_log_count(&log, "joined 0 of 1 multicast groups"), 1);
+    int64_t retry = lr_dev_next_deadline(d);
+    int64_t now = lr_now_ns();
+    /* 5 s from the open, which was just before `now`. */
+    assert_true(retry > now + 4900 * MS && retry <= now + 5000 * MS);
+    lr_dev_dispatch(d, retry - 1);
+    assert_int_equal(lr_test_log_count(&log, "multicast groups"), 1); /* no retry yet */
+    /* The network comes up: a veth pair (no dummy module in every kernel) with a route. */
+    assert_int_equal(sh("ip link add lrv0 type veth peer name lrv1 && "
+                        "ip addr add 10.157.0.1/24 dev lrv0 && ip link set lrv0 up && "
+                        "ip link set lrv1 up && ip route add 224.0.0.0/4 dev lrv0"), 0);
+    lr_dev_dispatch(d, retry);
+    assert_int_equal(lr_test_log_count(&log, "joined all 1 multicast groups"), 1);
+    assert_int_equal(lr_dev_next_deadline(d), LR_NO_DEADLINE);
+    lr_sacn_destroy(s);
+    sh("ip link del lrv0");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(ola_drives_both, peer_setup, peer_teardown),
         cmocka_unit_test_setup_teardown(qlcplus_drives_both, peer_setup, peer_teardown),
+        cmocka_unit_test(multicast_join_retry),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
