@@ -131,6 +131,7 @@ static void lost(dmx_core *k, int uni, int64_t now_ns)
     if (!u->live || lr_dmx_merge_count(&u->merge) > 0)
         return;
     u->live = false;
+    u->was_lost = true;
     k->c.losses++;
     lr_dev_log(k->dev, LR_LOG_INFO, "universe %d: no source left; %s", u->number,
                k->loss == LR_DMX_FADE ? "fading to the scene's values" : "holding the look");
@@ -160,7 +161,7 @@ lr_dmx_take dmx_core_put(dmx_core *k, int uni, const uint8_t key[LR_DMX_KEY_LEN]
         k->c.taken++;
         if (!u->live) {
             u->live = true;
-            if (k->c.losses)
+            if (u->was_lost)
                 lr_dev_log(k->dev, LR_LOG_INFO, "universe %d: receiving again", u->number);
         }
         follow(k, uni, now_ns);
@@ -259,6 +260,10 @@ int dmx_udp_open(const char *bind_addr, int port, bool broadcast, int *fd, lr_er
     setsockopt(s, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
     if (broadcast)
         setsockopt(s, SOL_SOCKET, SO_BROADCAST, &one, sizeof one);
+    /* Room for a burst: a console sending 16 universes at once while the loop renders.
+     * The kernel caps it at net.core.rmem_max (212992 bytes by default); failure is harmless. */
+    int rcvbuf = 1 << 20;
+    setsockopt(s, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
     if (bind(s, (struct sockaddr *)&a, sizeof a) != 0) {
         int err = errno;
         close(s);

@@ -12,6 +12,7 @@ typedef struct dmx_universe {
     int number;
     lr_dmx_merge merge;
     bool live; /* has had a source since the last loss */
+    bool was_lost; /* lost its sources at least once: the next source is logged */
 } dmx_universe;
 
 typedef struct dmx_chan {
