@@ -195,13 +195,17 @@ static void an_dispatch(lr_dev *d, int64_t now_ns)
     a->more = false;
     uint8_t buf[2048];
     for (int i = 0; i < a->max_packets; i++) {
+        /* The last datagram this turn may take: more may wait behind it. */
+        a->more = i == a->max_packets - 1;
         struct sockaddr_in from = {0};
         socklen_t fl = sizeof from;
         ssize_t n = recvfrom(a->fd, buf, sizeof buf, MSG_TRUNC | MSG_DONTWAIT,
                              (struct sockaddr *)&from, &fl);
         if (n < 0) {
-            if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)
+            if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) {
+                a->more = false; /* all read */
                 break;
+            }
             lr_dev_lost(d, LR_EIO, now_ns, "receive: %s", strerror(errno));
             return;
         }
@@ -213,8 +217,6 @@ static void an_dispatch(lr_dev *d, int64_t now_ns)
             continue;
         }
         handle(a, buf, (size_t)n, &from, now_ns);
-        if (i == a->max_packets - 1)
-            a->more = true;
     }
     dmx_core_tick(&a->core, now_ns);
 }

@@ -171,14 +171,18 @@ static void sa_dispatch(lr_dev *d, int64_t now_ns)
     s->more = false;
     uint8_t buf[2048];
     for (int i = 0; i < s->max_packets; i++) {
+        /* The last datagram this turn may take: more may wait behind it. */
+        s->more = i == s->max_packets - 1;
         struct sockaddr_in from = {0};
         socklen_t fl = sizeof from;
         /* MSG_TRUNC: the datagram's real length, so an oversized one is seen as such. */
         ssize_t n = recvfrom(s->fd, buf, sizeof buf, MSG_TRUNC | MSG_DONTWAIT,
                              (struct sockaddr *)&from, &fl);
         if (n < 0) {
-            if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)
+            if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) {
+                s->more = false; /* all read */
                 break;
+            }
             lr_dev_lost(d, LR_EIO, now_ns, "receive: %s", strerror(errno));
             return;
         }
@@ -191,8 +195,6 @@ static void sa_dispatch(lr_dev *d, int64_t now_ns)
             continue;
         }
         handle(s, buf, len, &from, now_ns);
-        if (i == s->max_packets - 1)
-            s->more = true;
     }
     dmx_core_tick(&s->core, now_ns);
     if (now_ns >= s->join_retry_at)
