@@ -59,30 +59,40 @@ static void run_for(lr_rig *r, int ms)
         fail_msg("%s", e.msg);
 }
 
-static void console_moves_the_dimmer(void **state)
+/* The shipped console.json as this test runs it (see the top); sacn_extra: more sACN options
+ * ("" none); lamp_port: the lamp driver's Modbus TCP port. */
+static void console_text(char *text, size_t cap, const char *sacn_extra, int lamp_port)
 {
-    (void)state;
     size_t len;
     char *shipped = (char *)lr_test_read(CFG "/rig/console.json", &len);
-    char text[8192];
-    assert_true(len < sizeof text / 2);
+    assert_true(len < cap / 2);
     memcpy(text, shipped, len);
     text[len] = '\0';
     free(shipped);
-    replace(text, sizeof text, "\"../scenes/", "\"" CFG "/scenes/");
-    replace(text, sizeof text, "\"../controls/", "\"" CFG "/controls/");
-    replace(text, sizeof text, "\"type\": \"sacn\", \"name\": \"sacn\",",
-            "\"type\": \"sacn\", \"name\": \"sacn\", \"port\": 15530, \"unicast_only\": true,");
-    replace(text, sizeof text, "\"type\": \"artnet\", \"name\": \"artnet\",",
+    replace(text, cap, "\"../scenes/", "\"" CFG "/scenes/");
+    replace(text, cap, "\"../controls/", "\"" CFG "/controls/");
+    char sacn[256];
+    snprintf(sacn, sizeof sacn,
+             "\"type\": \"sacn\", \"name\": \"sacn\", \"port\": 15530, \"unicast_only\": true,%s",
+             sacn_extra);
+    replace(text, cap, "\"type\": \"sacn\", \"name\": \"sacn\",", sacn);
+    replace(text, cap, "\"type\": \"artnet\", \"name\": \"artnet\",",
             "\"type\": \"artnet\", \"name\": \"artnet\", \"port\": 15531, \"announce\": \"none\",");
-    replace(text, sizeof text, "\"port\": 9000", "\"port\": 15532");
+    replace(text, cap, "\"port\": 9000", "\"port\": 15532");
+    char url[64];
+    snprintf(url, sizeof url, "tcp://127.0.0.1:%d", lamp_port);
+    replace(text, cap, "tcp://127.0.0.1:1502", url);
+    replace(text, cap, "\"width\": 320, \"height\": 240",
+            "\"width\": 16, \"height\": 16, \"renderer\": \"preview\"");
+}
+
+static void console_moves_the_dimmer(void **state)
+{
+    (void)state;
     /* The lamp driver: a libmodbus server (unit 2, holding register 0) on a free port. */
     lr_test_mb_server *mb = lr_test_mb_server_start();
-    char url[64];
-    snprintf(url, sizeof url, "tcp://127.0.0.1:%d", lr_test_mb_server_port(mb));
-    replace(text, sizeof text, "tcp://127.0.0.1:1502", url);
-    replace(text, sizeof text, "\"width\": 320, \"height\": 240",
-            "\"width\": 16, \"height\": 16, \"renderer\": \"preview\"");
+    char text[8192];
+    console_text(text, sizeof text, "", lr_test_mb_server_port(mb));
     char *dir = lr_test_tmpdir();
     char *cfg = lr_test_write(dir, "rig.json", text, (size_t)-1);
     char *stats = lr_test_path(dir, "stats.json");
@@ -175,10 +185,53 @@ static void console_moves_the_dimmer(void **state)
     lr_test_rmtree(dir);
 }
 
+/* "loss": "fade": when the console goes quiet for loss_ms, the dimmer fades back to the
+ * position the control map took from the scene (light.level 1 of range [0, 2], square curve:
+ * x = sqrt(1/2)), so the intensity returns to the scene's own 0.005 W/sr. */
+static void console_loss_fades_to_the_scene(void **state)
+{
+    (void)state;
+    char text[8192];
+    console_text(text, sizeof text, " \"loss\": \"fade\", \"loss_ms\": 300, \"fade_ms\": 200,",
+                 9); /* nobody on port 9: the lamp retries, the rest runs */
+    char *dir = lr_test_tmpdir();
+    char *cfg = lr_test_write(dir, "rig.json", text, (size_t)-1);
+    lr_test_log log = {0};
+    lr_rig_opts o = {.config = cfg, .no_signals = true, .log = {lr_test_log_fn, &log}};
+    lr_rig *r;
+    lr_err e = {0};
+    if (lr_rig_create(&o, &r, &e))
+        fail_msg("%s", e.msg);
+    run_for(r, 100);
+    int tx = lr_test_udp_socket(0);
+    uint8_t b[700], sl[1] = {255};
+    size_t n = lr_test_sacn_build(b, 1, 100, 0, 0, 0, sl, 1, 1);
+    assert_int_equal(lr_test_udp_send(tx, 15530, b, n), (long)n);
+    close(tx);
+    /* 0.2 s: the packet is taken and its 0.25 s fade is under way; before the 0.3 s loss. */
+    run_for(r, 200);
+    assert_int_equal(lr_test_log_count(&log, "no source left"), 0);
+    /* The loss at 0.3 s, the 0.2 s loss fade and the binding's own 0.25 s fade: all done by
+     * 1.5 s. Level 2 (1/2) = 1: the scene's intensity again. */
+    run_for(r, 1300);
+    assert_int_equal(lr_test_log_count(&log, "universe 1: no source left; fading to the scene's "
+                                             "values"), 1);
+    assert_near(scene_num(r, "light.intensity"), 0.005, 1e-12);
+    /* The packet moved the dimmer up, and the loss fade brought it back: the loss line says a
+     * source was there, the events that the dimmer moved at least twice. */
+    lr_rig_info info;
+    lr_rig_get_info(r, &info);
+    assert_true(info.events >= 2);
+    lr_rig_destroy(r);
+    free(cfg);
+    lr_test_rmtree(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(console_moves_the_dimmer),
+        cmocka_unit_test(console_loss_fades_to_the_scene),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
