@@ -4,6 +4,7 @@
 #include <arpa/inet.h>
 #include <errno.h>
 #include <math.h>
+#include <stdarg.h>
 #include <netinet/in.h>
 #include <stdio.h>
 #include <string.h>
@@ -14,6 +15,11 @@
 /* Steps of a loss fade: 40 per second is smoother than a console's own fader resolution at
  * the usual 1-3 s fades, and the control map may smooth further (fade_s). */
 #define FADE_STEP_NS (25 * MS)
+/* Loss and recovery lines. OLA sends only on change, so a quiet OLA is lost and back at every
+ * pause of a show: LOSS_BURST lines per LOSS_WINDOW_NS, the rest counted (losses) and the
+ * next line let through says how many were dropped. */
+#define LOSS_BURST 4
+#define LOSS_WINDOW_NS (60000 * MS)
 
 /* The channel options shared by both receivers; only the universe range differs. */
 #define CH_CONTROL {"control", LR_OPT_STRING, .required = true, .help = "event control name"}
@@ -45,6 +51,7 @@ int dmx_core_init(dmx_core *k, lr_dev *dev, const dmx_core_cfg *cfg, lr_err *e)
     k->loss = cfg->loss;
     k->fade_ns = (int64_t)cfg->fade_ms * MS;
     k->kind_names = cfg->kind_names;
+    lr_log_limit_init(&k->loss_limit, LOSS_BURST, LOSS_WINDOW_NS);
     const char *pf = dev->prefix;
     if (cfg->n_channels < 1 || cfg->n_channels > LR_DMX_MAX_CHANNELS || !cfg->channels)
         return lr_err_set(e, LR_EINVAL, "%s: %d channels (1..%d)", pf, cfg->n_channels,
@@ -99,6 +106,24 @@ int dmx_core_universe(const dmx_core *k, int number)
     return -1;
 }
 
+static void state_line(dmx_core *k, int64_t now_ns, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static void state_line(dmx_core *k, int64_t now_ns, const char *fmt, ...)
+{
+    unsigned dropped;
+    if (!lr_log_limit_take(&k->loss_limit, now_ns, &dropped))
+        return;
+    char msg[256];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    if (dropped)
+        lr_dev_log(k->dev, LR_LOG_INFO, "%s (%u similar lines dropped)", msg, dropped);
+    else
+        lr_dev_log(k->dev, LR_LOG_INFO, "%s", msg);
+}
+
 static void emit(dmx_core *k, dmx_chan *d, double v, int64_t now_ns)
 {
     if (d->have && v == d->last)
@@ -133,7 +158,7 @@ static void lost(dmx_core *k, int uni, int64_t now_ns)
     u->live = false;
     u->was_lost = true;
     k->c.losses++;
-    lr_dev_log(k->dev, LR_LOG_INFO, "universe %d: no source left; %s", u->number,
+    state_line(k, now_ns, "universe %d: no source left; %s", u->number,
                k->loss == LR_DMX_FADE ? "fading to the scene's values" : "holding the look");
     if (k->loss != LR_DMX_FADE)
         return;
@@ -153,8 +178,12 @@ lr_dmx_take dmx_core_put(dmx_core *k, int uni, const uint8_t key[LR_DMX_KEY_LEN]
 {
     dmx_universe *u = &k->uni[uni];
     /* Timeouts first: a source back after a pause is a new source (no stale sequence). */
-    if (lr_dmx_merge_expire(&u->merge, now_ns))
-        lost(k, uni, now_ns);
+    if (lr_dmx_merge_expire(&u->merge, now_ns)) {
+        if (lr_dmx_merge_count(&u->merge) > 0)
+            follow(k, uni, now_ns); /* the others' look, even if this packet is refused */
+        else
+            lost(k, uni, now_ns);
+    }
     lr_dmx_take t = lr_dmx_merge_put(&u->merge, key, priority, seq, slots, n, now_ns);
     switch (t) {
     case LR_DMX_TAKEN:
@@ -162,7 +191,7 @@ lr_dmx_take dmx_core_put(dmx_core *k, int uni, const uint8_t key[LR_DMX_KEY_LEN]
         if (!u->live) {
             u->live = true;
             if (u->was_lost)
-                lr_dev_log(k->dev, LR_LOG_INFO, "universe %d: receiving again", u->number);
+                state_line(k, now_ns, "universe %d: receiving again", u->number);
         }
         follow(k, uni, now_ns);
         break;

@@ -38,6 +38,7 @@ typedef struct dmx_core {
     int64_t fade_next; /* the next step of a loss fade */
     const char *const *kind_names; /* per bad kind, for the log line */
     bool kind_logged[LR_DMX_MAX_KINDS];
+    lr_log_limit loss_limit; /* loss and recovery lines */
     lr_dmx_counters c;
 } dmx_core;
 

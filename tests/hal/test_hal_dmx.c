@@ -244,6 +244,41 @@ static void sacn_loss(void **state)
     }
 }
 
+/* A console that pauses often (OLA on static looks) is lost and back at every pause: the
+ * loss and recovery lines are limited to 4 per minute, the losses all counted. */
+static void sacn_loss_lines_limited(void **state)
+{
+    (void)state;
+    rec r = {0};
+    lr_test_log log = {0};
+    lr_sacn *s = sacn_make(&r, &log, 15505, LR_DMX_HOLD, true);
+    lr_dev *d = lr_sacn_dev(s);
+    int tx = lr_test_udp_socket(0);
+    uint8_t b[700], sl[1];
+    /* Five pauses of 3 s (> the 2.5 s loss) in 15 s: 5 losses and 4 recoveries. */
+    for (int k = 0; k < 5; k++) {
+        sl[0] = (uint8_t)(10 * k);
+        size_t n = lr_test_sacn_build(b, 1, 100, k, 0, 0, sl, 1, 1);
+        lr_test_udp_send(tx, 15505, b, n);
+        pump(d, T0 + k * 3 * S, (uint64_t)k + 1);
+        lr_dev_dispatch(d, T0 + k * 3 * S + 2500 * MS);
+    }
+    lr_dmx_counters c;
+    lr_sacn_get_counters(s, &c);
+    assert_int_equal(c.losses, 5);
+    int lines = lr_test_log_count(&log, "no source left") +
+                lr_test_log_count(&log, "receiving again");
+    assert_int_equal(lines, 4);
+    /* A minute after the first line (at 2.5 s), the next one says how many were dropped: 9
+     * lines were due, 4 let through. */
+    size_t n = lr_test_sacn_build(b, 1, 100, 9, 0, 0, sl, 1, 1);
+    lr_test_udp_send(tx, 15505, b, n);
+    pump(d, T0 + 63 * S, 6);
+    assert_int_equal(lr_test_log_count(&log, "receiving again (5 similar lines dropped)"), 1);
+    close(tx);
+    lr_sacn_destroy(s);
+}
+
 static void sacn_bad_packets_and_flood(void **state)
 {
     (void)state;
@@ -440,6 +475,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(sacn_channels_and_merge),
         cmocka_unit_test(sacn_loss),
+        cmocka_unit_test(sacn_loss_lines_limited),
         cmocka_unit_test(sacn_bad_packets_and_flood),
         cmocka_unit_test(sacn_multicast_join),
         cmocka_unit_test(artnet_merge_and_poll),
