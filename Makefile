@@ -10,6 +10,9 @@
 #   make install  PREFIX=/usr/local DESTDIR= (see tools/install/README.md)
 #   make deb      build/lamprig_VERSION_ARCH.deb from a staged install (tools/debian/)
 #   make test-install  the package, its lintian, unit, udev rules and installed binary
+#   make fuzz     libFuzzer binaries of the packet parsers (clang), build/fuzz/fuzz_NAME; run
+#                 one with a scratch folder first (libFuzzer writes new inputs into the first):
+#                 build/fuzz/fuzz_sacn_packet -max_total_time=60 NEW/ tests/fuzz/corpus/sacn
 #   make clean
 #
 # Sources are found by wildcard: every .c under render/ hal/ calib/ and firmware/ (except
@@ -17,7 +20,7 @@
 # tests/AREA/test_NAME.c (plus tests/support/*.c) builds one test binary per area,
 # build/test/test_NAME (the binary name has no sub-folder: make build/test/test_scene).
 
-PUBLIC_TARGETS := all build test soak run bench install deb test-install test-boot
+PUBLIC_TARGETS := all build test soak run bench install deb test-install test-boot fuzz
 
 ifndef LAMPRIG_INNER
 # Outer make: install dependencies first, then re-enter with pkg-config available.
@@ -43,7 +46,7 @@ else
 CC      ?= cc
 CXX     ?= c++
 PKGS    := egl glesv2 gbm libdrm libgpiod hidapi-libusb libusb-1.0 libmodbus libpng cairo lcms2 \
-           libsystemd
+           libsystemd liblo
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS))
 PKG_LIBS   := $(shell pkg-config --libs $(PKGS))
 CV_CFLAGS  := $(shell pkg-config --cflags opencv4)
@@ -144,6 +147,16 @@ test: $(TESTS:%=build/test/%) build/bin/lamprig $(TOOLS:%=build/bin/lamprig-%)
 # scale with the length). LAMPRIG_SOAK_S=N make soak for another length.
 soak: build/test/test_fw_loop build/bin/lamprig
 	@LAMPRIG_SOAK_S=$${LAMPRIG_SOAK_S:-120} sh tests/run.sh build/test/test_fw_loop
+
+# libFuzzer harnesses (tests/fuzz/fuzz_NAME.c) with the hal/ sources they name, built by clang
+# (GCC has no libFuzzer). make test runs the same harnesses on the corpus through cmocka.
+FUZZ := $(sort $(notdir $(basename $(wildcard tests/fuzz/fuzz_*.c))))
+.PHONY: fuzz
+fuzz: $(FUZZ:%=build/fuzz/%)
+build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c hal/%.c
+	@mkdir -p $(@D)
+	@echo "  FUZZ    $@"
+	$(Q)clang -std=c11 -D_GNU_SOURCE -I. -g -O1 -fsanitize=fuzzer,address,undefined -o $@ $^
 
 # ---- install, package ----
 # The layout paths.h looks for: BINDIR/lamprig finds BINDIR/../share/lamprig/{configs,shaders}

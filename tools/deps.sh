@@ -9,6 +9,9 @@ set -eu
 # check `make deb`'s package and unit in tests/install.sh; dpkg-dev comes with build-essential.
 # systemd-container (systemd-nspawn) and debootstrap boot the package under systemd in
 # tests/boot.sh (make test-boot).
+# liblo-dev: the OSC input (hal/osc.c). The console peers the tests start: liblo-tools
+# (oscsend), ola (olad, ola_set_dmx, ola_streaming_client), qlcplus; iproute2 (ip netns, veth)
+# for the namespace OLA's E1.31 output needs.
 PKGS="build-essential pkg-config
 libgpiod-dev libhidapi-dev libusb-1.0-0-dev libmodbus-dev
 libegl-dev libgles-dev libgbm-dev libdrm-dev libegl-mesa0 libgl1-mesa-dri libgbm1
@@ -17,7 +20,8 @@ opencv-doc
 libpng-dev libcairo2-dev liblcms2-dev libcmocka-dev
 libsystemd-dev
 lintian systemd
-systemd-container debootstrap"
+systemd-container debootstrap
+liblo-dev liblo-tools ola qlcplus iproute2"
 
 missing=""
 for p in $PKGS; do
