@@ -16,6 +16,7 @@
 
 #include "render/base/mat4.h"
 #include "render/diffusion/dscene.h"
+#include "render/models/twin/radiosity.h"
 #include "render/optics/optics.h"
 #include "render/passes/radiosity.h"
 
@@ -308,6 +309,7 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
             lr_passes_uniform_i(p, "u_N", c->rs->N);
             lr_passes_uniform_f(p, "u_r_max", (float)rad->r_max);
             lr_passes_uniform_f(p, "u_r_max_dist", 20.0f);
+            lr_passes_uniform_f(p, "u_near_mix", (float)LR_PASS_NEAR_MIX);
             /* Its own unit even without a diffusion_grid object: the default 0 is the
              * G-buffer's cube, and two sampler types on one unit fail the draw. */
             lr_passes_uniform_i(p, "u_dg_field", LR_DGRID_TEX_UNIT);

@@ -24,6 +24,7 @@ uniform bool u_area_two_sided;
 uniform int u_N;
 uniform float u_r_max;      // 20 R; point/spot lights: r_max = max(u_r_max, u_r_max_dist d)
 uniform float u_r_max_dist; // 20 (PIPELINE.md: r_max = 20 max(R, |x_l - x_o|))
+uniform float u_near_mix;   // LR_PASS_NEAR_MIX (render/models/twin/radiosity.h): near lights
 uniform uint u_seed;
 uniform uint u_map;
 uniform uint u_frame;
@@ -52,6 +53,33 @@ float light_shape(vec3 dir)
 }
 
 #include "lib/sh_translucency.glsl"
+
+// Density per unit solid angle of the light's direction u under the stereographic lookup
+// (seed 003 Eq. 13 inverted: the plane point on the line from the antipode A through
+// x_l + d u), in coordinates relative to x_o (h = x_l - x_o); 0 where no sampled radius maps
+// there. The twin's stereo_pdf_omega.
+float stereo_pdf(vec3 u, vec3 h, float d, vec3 no, float sigma_tr, float mass, bool flat_r,
+                 float r_max)
+{
+    vec3 hA = 2.0 * h;
+    vec3 pa = h + d * u - hA;
+    float den = dot(no, pa);
+    if (den == 0.0)
+        return 0.0;
+    float s = -dot(no, hA) / den;
+    if (!(s > 0.0))
+        return 0.0;
+    vec3 q = s * pa;  // x_j - A
+    vec3 rj = hA + q; // x_j - x_o
+    float r = length(rj);
+    if (!(r > 0.0) || r > r_max * 1.000001)
+        return 0.0;
+    float pr = flat_r ? 1.0 / r_max : sigma_tr * exp(-sigma_tr * min(r, r_max)) / mass;
+    float q2 = dot(q, q);
+    vec3 l = q * inversesqrt(q2);
+    float J = 2.0 * abs(2.0 * dot(h, l)) * abs(dot(l, no)) / (d * q2);
+    return J > 0.0 ? pr / (2.0 * LR_PI * r) / J : 0.0;
+}
 
 void main()
 {
@@ -101,9 +129,33 @@ void main()
         bool flat_r = sigma_tr * r_max < 1e-30;
         float mass = flat_r ? 1.0 : -lr_expm1(-sigma_tr * r_max);
         float sum = 0.0;
+        // A near point or spot light (sigma_tr d < u_near_mix): odd samples a direction from
+        // the light uniform over the sphere, combined with the lookup's by the balance
+        // heuristic, a_d = floor(N / 2) / N (the twin's sample_pass, PIPELINE.md "Near lights").
+        bool near = u_light_type != LR_LIGHT_DIRECTIONAL && sigma_tr * d < u_near_mix && u_N > 1;
+        float ad = near ? float(u_N / 2) / float(u_N) : 0.0;
         for (int j = 0; j < u_N; j++) {
             float xi1 = lr_rand(state);
             float xi2 = lr_rand(state);
+            if (near && (j & 1) == 1) {
+                float z = 1.0 - 2.0 * xi1, ph = 2.0 * LR_PI * xi2;
+                float sz = sqrt(max(0.0, 1.0 - z * z));
+                vec3 u = vec3(sz * cos(ph), sz * sin(ph), z);
+                float p = (1.0 - ad) * stereo_pdf(u, h, d, no, sigma_tr, mass, flat_r, r_max) +
+                          ad / (4.0 * LR_PI);
+                vec3 xi, ni;
+                int id;
+                if (!(d > 1e-6) || !lr_gbuffer_fetch(u, xi, ni, id) || id != u_object)
+                    continue;
+                vec3 wi = normalize(u_light_pos - xi);
+                float cos_i = dot(ni, wi);
+                if (!(cos_i > 0.0))
+                    continue;
+                float Ft = lr_fresnel_transmittance(cos_i, mat.eta);
+                float sd = lr_sss_sd_band(mat, sss, c, xi, ni, wi, xo, no);
+                sum += sd * Ft * light_shape(u) / p;
+                continue;
+            }
             float r, pr;
             if (flat_r) {
                 r = xi1 * r_max;
@@ -153,7 +205,9 @@ void main()
                 continue;
             float Ft = lr_fresnel_transmittance(cos_i, mat.eta);
             float sd = lr_sss_sd_band(mat, sss, c, xi, ni, wi, xo, no);
-            sum += sd * Ft * J * inv_pA * shape;
+            // near: p_s = p_A / J for this direction, mixed with the direction samples'
+            float w = near ? 1.0 / ((1.0 - ad) + ad / (4.0 * LR_PI) * J * inv_pA) : 1.0;
+            sum += sd * Ft * J * inv_pA * shape * w;
         }
         B[c] = LR_PI * sum / float(u_N) * u_sd_norm[clamp(u_object, 0, LR_MAX_OBJECTS - 1)][c];
     }

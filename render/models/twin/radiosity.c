@@ -114,11 +114,56 @@ static lr_vec3 plane_point(const ctx *k, double r, double alpha)
                                       lr_v3_scale(k->t2, r * sin(alpha))));
 }
 
-/* One sample of the pass estimator (PIPELINE.md pass 2), band c. */
-static double sample_pass(const ctx *k, int c, double rmax, lr_rng *rng)
+/* The pass's plane density per unit area at radius r (seed 003 Eq. 11 over 2 pi r); 0 outside
+ * (0, r_max] (a hair over for the round trip of a sampled r). */
+static double plane_pA(double sig, double rmax, double r)
+{
+    if (!(r > 0.0) || r > rmax * (1.0 + 1e-9))
+        return 0.0;
+    return lr_exp_radius_pdf(sig, rmax, fmin(r, rmax)) / (2.0 * M_PI * r);
+}
+
+/* Density per unit solid angle of the light's direction u (unit) under the stereographic
+ * lookup: the plane point whose lookup gives u is where the line from the antipode A through
+ * x_s + d u meets x_o's tangent plane (seed 003 Eq. 13 inverted); p_A there over the lookup's
+ * Jacobian. In coordinates relative to x_o (a float pass at 0.01 mm from the light keeps its
+ * digits so). */
+static double stereo_pdf_omega(const ctx *k, lr_vec3 u, double sig, double rmax)
+{
+    lr_vec3 h = lr_v3_sub(k->xs, k->xo), hA = lr_v3_scale(h, 2.0);
+    lr_vec3 pa = lr_v3_sub(lr_v3_add(h, lr_v3_scale(u, k->d)), hA); /* P - A */
+    double den = lr_v3_dot(k->no, pa);
+    if (den == 0.0)
+        return 0.0;
+    double s = -lr_v3_dot(k->no, hA) / den;
+    if (!(s > 0.0))
+        return 0.0;
+    lr_vec3 rj = lr_v3_add(hA, lr_v3_scale(pa, s)); /* x_j - x_o */
+    lr_vec3 v;
+    double J = lr_cpu_stereo_lookup(k->xs, k->xo, k->no, lr_v3_add(k->xo, rj), &v);
+    double pA = plane_pA(sig, rmax, lr_v3_len(rj));
+    return J > 0.0 && pA > 0.0 ? pA / J : 0.0;
+}
+
+/* One sample of the pass estimator (PIPELINE.md pass 2), band c; sample j of the estimate
+ * (with a near light, LR_PASS_NEAR_MIX: odd j a direction from the light, even j the
+ * stereographic lookup). */
+static double sample_pass(const ctx *k, int c, double rmax, int j, int N, lr_rng *rng)
 {
     double sig = k->obj->coeffs.sigma_tr[c];
     double xi1 = lr_rng_next(rng), xi2 = lr_rng_next(rng);
+    bool near = k->light->type != LR_LIGHT_DIRECTIONAL && sig * k->d < LR_PASS_NEAR_MIX && N > 1;
+    /* Balance heuristic over the two strategies with n_d = floor(N / 2) direction samples:
+     * the sum of f / (n_s p_s + n_d p_d), i.e. each sample's f / (a_s p_s + a_d p_d) averaged,
+     * p per unit solid angle of the light's direction. */
+    double ad = near ? (double)(N / 2) / N : 0.0;
+    if (near && j % 2) {
+        /* uniform over the sphere of directions (the same two numbers) */
+        double z = 1.0 - 2.0 * xi1, s = sqrt(fmax(0.0, 1.0 - z * z)), ph = 2.0 * M_PI * xi2;
+        lr_vec3 u = lr_v3(s * cos(ph), s * sin(ph), z);
+        double p = (1.0 - ad) * stereo_pdf_omega(k, u, sig, rmax) + ad / (4.0 * M_PI);
+        return lit_point(k, u, c) / p;
+    }
     double r = lr_exp_radius_sample(sig, rmax, xi1);   /* seed 003 Eq. 12 (truncated) */
     double pr = lr_exp_radius_pdf(sig, rmax, r);       /* Eq. 11 */
     if (!(r > 0.0) || !(pr > 0.0))
@@ -131,7 +176,10 @@ static double sample_pass(const ctx *k, int c, double rmax, lr_rng *rng)
     double J = lr_cpu_stereo_lookup(k->xs, k->xo, k->no, xj, &v);
     if (!(J > 0.0))
         return 0.0;
-    return lit_point(k, lr_v3_normalize(v), c) * J * inv_pA;
+    if (!near)
+        return lit_point(k, lr_v3_normalize(v), c) * J * inv_pA;
+    /* p_s of this direction is p_A / J (the lookup's own density) */
+    return lit_point(k, lr_v3_normalize(v), c) / ((1.0 - ad) / (J * inv_pA) + ad / (4.0 * M_PI));
 }
 
 /* Reference plane strategy: a ladder of exponential rates, sigma_tr and sigma_t'/4^k down to
@@ -326,7 +374,7 @@ void lr_cpu_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3
         double mean = 0.0, m2 = 0.0;
         for (int j = 0; j < N; j++) {
             double f = mode == LR_CPU_REFERENCE ? sample_ref(&k, c, &rng)
-                                                : sample_pass(&k, c, rmax, &rng);
+                                                : sample_pass(&k, c, rmax, j, N, &rng);
             if (!isfinite(f) || f < 0.0)
                 f = 0.0; /* cannot happen for finite input; never let one sample poison a map */
             double delta = f - mean; /* Welford */
