@@ -7,6 +7,9 @@ set -eu
 # (examples/data/left*.jpg, left_intrinsics.yml): tests/calib/test_calib_camera.c checks against them.
 # libsystemd-dev: sd_notify from the rig loop. lintian and systemd (systemd-analyze verify)
 # check `make deb`'s package and unit in tests/install.sh; dpkg-dev comes with build-essential.
+# libmicrohttpd-dev: the rig's HTTP endpoint (firmware/rig/http.h); curl, chromium and
+# chromium-driver: its tests (tests/fw/test_fw_http.c drives the API with curl and the page in
+# headless chromium through chromedriver's WebDriver protocol).
 # systemd-container (systemd-nspawn) and debootstrap boot the package under systemd in
 # tests/boot.sh (make test-boot).
 PKGS="build-essential pkg-config
@@ -16,6 +19,7 @@ libopencv-dev libopencv-contrib-dev
 opencv-doc
 libpng-dev libcairo2-dev liblcms2-dev libcmocka-dev
 libsystemd-dev
+libmicrohttpd-dev curl chromium chromium-driver
 lintian systemd
 systemd-container debootstrap"
 
