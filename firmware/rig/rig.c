@@ -102,6 +102,8 @@ struct lr_rig {
     /* The status others read (firmware/rig/status_json.h, the HTTP endpoint). */
     lr_http *http;          /* "http" in the config; NULL: no server */
     lr_rig_http_config http_cfg; /* what it was started with (a reload keeps it) */
+    int64_t http_retry_ns;       /* the next attempt to listen; INT64_MAX: none due */
+    bool http_failed;            /* a failure to listen was logged */
     lr_log user_log;        /* the caller's log; r->log records warnings and errors first */
     lr_rig_status_line warnings[LR_STATUS_LOG_KEEP], errors[LR_STATUS_LOG_KEEP];
     int n_warnings, n_errors;
@@ -133,6 +135,8 @@ static void rig_log(void *user, lr_log_level level, const char *msg)
     snprintf(l[*n].msg, sizeof l[*n].msg, "%s", msg);
     (*n)++;
 }
+
+static void http_start(lr_rig *r, int64_t now);
 
 static void set_free(rigset *s)
 {
@@ -868,20 +872,9 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
                                      : INT64_MAX;
     /* The HTTP endpoint last: it answers once the rig shows an image and takes controls. */
     r->http_cfg = c->http;
-    if (c->http.enabled) {
-        lr_http_desc hd = {.host = c->http.host, .port = c->http.port,
-                           .loopback = c->http.loopback, .token = c->http.token, .rig = r,
-                           .log = r->log};
-        int hrc = lr_http_create(&hd, &r->http, e);
-        if (hrc) {
-            lr_rig_destroy(r);
-            return hrc;
-        }
-        lr_log_write(&r->log, LR_LOG_INFO, "http: listening on %s%s%s:%d%s", 
-                     strchr(c->http.host, ':') ? "[" : "", c->http.host,
-                     strchr(c->http.host, ':') ? "]" : "", lr_http_port(r->http),
-                     c->http.token[0] ? ", token required for changes" : "");
-    }
+    r->http_retry_ns = INT64_MAX;
+    if (c->http.enabled)
+        http_start(r, devices_ns);
     r->next_stats_ns = c->stats_period_s > 0 ? r->start_ns + (int64_t)(c->stats_period_s * 1e9)
                                              : INT64_MAX;
     lr_log_write(&r->log, LR_LOG_INFO, "config %s: scene %s, %d devices, %d controls, view %s",
@@ -890,6 +883,30 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
     apply(r, r->start_ns);
     *out = r;
     return LR_OK;
+}
+
+/* Starts the HTTP endpoint. A failure (the port taken by another program) is logged once
+ * and retried every HTTP_RETRY_NS, as a missing device is: the controls and the lamp do not
+ * depend on the page, and a show box must not go dark because a port is busy. */
+#define HTTP_RETRY_NS 2000000000LL
+static void http_start(lr_rig *r, int64_t now)
+{
+    const lr_rig_http_config *c = &r->http_cfg;
+    lr_http_desc hd = {.host = c->host, .port = c->port, .loopback = c->loopback,
+                       .token = c->token, .rig = r, .log = r->log};
+    lr_err e = {0};
+    if (lr_http_create(&hd, &r->http, &e)) {
+        if (!r->http_failed)
+            lr_log_write(&r->log, LR_LOG_ERROR, "%s; retrying every %lld s", e.msg,
+                         HTTP_RETRY_NS / 1000000000LL);
+        r->http_failed = true;
+        r->http_retry_ns = now + HTTP_RETRY_NS;
+        return;
+    }
+    r->http_retry_ns = INT64_MAX;
+    lr_log_write(&r->log, LR_LOG_INFO, "http: listening on %s%s%s:%d%s",
+                 strchr(c->host, ':') ? "[" : "", c->host, strchr(c->host, ':') ? "]" : "",
+                 lr_http_port(r->http), c->token[0] ? ", token required for changes" : "");
 }
 
 /* One line for `systemctl status` (STATUS=). */
@@ -1046,6 +1063,8 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             fds[nf] = (struct pollfd){lr_gl_event_fd(r->gl), POLLIN, 0};
             owner[nf++] = -2;
         }
+        if (r->http_retry_ns < t)
+            t = r->http_retry_ns;
         if (r->http && nf < MAX_POLL) {
             fds[nf] = (struct pollfd){lr_http_pollfd(r->http), POLLIN, 0};
             owner[nf++] = -4;
@@ -1113,6 +1132,8 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
          * events into the ring, drained just below with the devices' own. */
         if (r->http)
             lr_http_dispatch(r->http, now);
+        else if (now >= r->http_retry_ns)
+            http_start(r, now);
         lr_event ev;
         bool any = false;
         while (lr_event_ring_pop(r->ring, &ev)) {
