@@ -170,8 +170,11 @@ static void run_ms(lr_rig *r, int ms)
     assert_int_equal(lr_rig_run_until(r, lr_now_ns() + ms * MS, &e), LR_OK);
 }
 
-static lr_rig *make_rig(const char *dir, int port, const char *http_extra, const char *renderer,
-                        lr_test_log *log)
+/* The rig of these tests: the candle's map cut to a dimmer, a material and a scene binding,
+ * no devices (nothing else moves the controls). renderer "preview" (no GL, instant) or
+ * "passes" with the planner (what the shipped sim rig shows), at w x h. */
+static lr_rig *make_rig_at(const char *dir, int port, const char *http_extra,
+                           const char *renderer, int w, int h, lr_test_log *log)
 {
     char text[4096];
     snprintf(text, sizeof text,
@@ -188,13 +191,13 @@ static lr_rig *make_rig(const char *dir, int port, const char *http_extra, const
              "   \"initial\": 0},\n"
              "  {\"name\": \"scene\", \"control\": \"button2\", \"param\": \"scene\",\n"
              "   \"values\": [\"%s/scenes/candle.json\", \"%s/scenes/votive.json\"]}],\n"
-             " \"output\": {\"width\": 160, \"height\": 120, \"fps\": 30, \"renderer\": \"%s\"},\n"
+             " \"output\": {\"width\": %d, \"height\": %d, \"fps\": 30, \"renderer\": \"%s\"},\n"
              " \"http\": {\"listen\": \"127.0.0.1:%d\"%s}}\n",
-             LR_SOURCE_CONFIGS, LR_SOURCE_CONFIGS, LR_SOURCE_CONFIGS, renderer, port,
+             LR_SOURCE_CONFIGS, LR_SOURCE_CONFIGS, LR_SOURCE_CONFIGS, w, h, renderer, port,
              http_extra);
     char *cfg = lr_test_write(dir, "rig.json", text, (size_t)-1);
     lr_rig_opts o = {.config = cfg, .no_signals = true, .log = {lr_test_log_fn, log},
-                     .no_plan = true};
+                     .no_plan = strcmp(renderer, "passes") != 0};
     lr_rig *r;
     lr_err e = {0};
     if (lr_rig_create(&o, &r, &e))
@@ -202,6 +205,12 @@ static lr_rig *make_rig(const char *dir, int port, const char *http_extra, const
     free(cfg);
     assert_int_equal(lr_rig_http_port(r), port);
     return r;
+}
+
+static lr_rig *make_rig(const char *dir, int port, const char *http_extra, const char *renderer,
+                        lr_test_log *log)
+{
+    return make_rig_at(dir, port, http_extra, renderer, 160, 120, log);
 }
 
 static lr_json *parse(const char *body)
@@ -586,6 +595,69 @@ static void test_http_config(void **state)
     lr_test_rmtree(dir);
 }
 
+/* The page in headless chromium (tests/fw/http_browser.py over chromedriver): it loads,
+ * shows the frame, the dimmer's slider moved with the keyboard reaches the rig through the
+ * control map (the scene's light changes), the page shows the rig's new position and a newer
+ * frame; the screenshot is build/test/http-page.png (firmware/README.md, README.md show it).
+ * The real renderer, so that the picture is the rig's: the browser starts once the view has
+ * converged (bounded), or the frame would be a coarse preview. */
+static void test_http_browser(void **state)
+{
+    (void)state;
+    const int port = 18086;
+    char *dir = lr_test_tmpdir();
+    lr_test_log log = {0};
+    lr_rig *r = make_rig_at(dir, port, "", "passes", 320, 240, &log);
+    lr_rig_info info;
+    int64_t t0 = lr_now_ns();
+    do {
+        run_ms(r, 50);
+        lr_rig_get_info(r, &info);
+    } while (!info.idle && lr_now_ns() - t0 < 30000 * MS);
+    print_message("browser: the view converged in %.1f s%s\n", (double)(lr_now_ns() - t0) * 1e-9,
+                  info.idle ? "" : " (not: the 30 s bound)");
+    double base = scene_num(r, "light.intensity");
+    char url[64];
+    snprintf(url, sizeof url, "http://127.0.0.1:%d/", port);
+    const char *shot = LR_SOURCE_CONFIGS "/../build/test/http-page.png";
+    char *const argv[] = {"python3", LR_SOURCE_CONFIGS "/../tests/fw/http_browser.py", url,
+                          "18096", (char *)shot, NULL};
+    char *out;
+    int rc = run_client(r, argv, &out, 90);
+    if (rc != 0)
+        fail_msg("http_browser.py: exit %d: %s", rc, out);
+    print_message("browser: %s", out);
+    lr_json *j = parse(out);
+    lr_jnode root = lr_json_root(j);
+    char shown[32] = "";
+    double f0 = -1, f1 = -1;
+    lr_err e = {0};
+    assert_int_equal(lr_json_get_string(j, root, "shown_after", true, shown, sizeof shown, &e),
+                     LR_OK);
+    assert_string_equal(shown, "1.000");
+    assert_int_equal(lr_json_get_number(j, root, "frame_before", true, &f0, &e), LR_OK);
+    assert_int_equal(lr_json_get_number(j, root, "frame_after", true, &f1, &e), LR_OK);
+    assert_true(f1 > f0);
+    lr_json_destroy(j);
+    free(out);
+    /* The rig's own state: the slider's end is position 1, range [0, 2], linear, no fade:
+     * twice the candle's own light (initial 0.5 was once). */
+    run_ms(r, 30);
+    assert_true(fabs(scene_num(r, "light.intensity") - 2 * base) <= 1e-12 * base);
+    lr_rig_status *st = calloc(1, sizeof *st);
+    assert_non_null(st);
+    lr_rig_get_status(r, st);
+    assert_true(st->controls[0].position == 1.0);
+    free(st);
+    size_t n;
+    unsigned char *p = lr_test_read(shot, &n);
+    assert_true(n > 33);
+    assert_memory_equal(p, "\x89PNG\r\n\x1a\n", 8);
+    free(p);
+    lr_rig_destroy(r);
+    lr_test_rmtree(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -593,6 +665,7 @@ int main(void)
         cmocka_unit_test(test_http_api),
         cmocka_unit_test(test_http_bad_requests),
         cmocka_unit_test(test_http_token),
+        cmocka_unit_test(test_http_browser),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
