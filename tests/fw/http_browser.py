@@ -7,7 +7,8 @@ usage: http_browser.py RIG_URL DRIVER_PORT SCREENSHOT.png
 Loads the page, waits for its sliders and its first frame, moves the dimmer's slider to its
 end with the keyboard (End: a real input event, as a user's), then waits until the page
 shows the rig's new position (which comes back from the rig over the event stream, not from
-the slider) and a newer frame, and saves a screenshot. Prints one JSON line of what it saw;
+the slider) and a newer frame; then the material's slider (a cycle control) to its last
+value, until the page shows the rig's new material; and saves a screenshot. Prints one JSON line of what it saw;
 exit status 0 when every step happened within its timeout, 1 otherwise (the reason on
 stderr). tests/fw/test_fw_http.c runs it while the rig's loop runs, and checks the rig's own
 state afterwards.
@@ -98,13 +99,21 @@ def main():
                       lambda: (lambda f: f if f is not None and f > frame0 else None)(
                           js("const f=document.getElementById('frame');"
                              "return f.complete&&f.naturalWidth>0?+f.dataset.frame:null")), 15)
+        # A cycle control: the material slider's end is its last value (index n - 1).
+        el = call(base, "POST", s + "/element",
+                  {"using": "css selector", "value": "#c-material"})[W3C_ELEMENT]
+        call(base, "POST", s + f"/element/{el}/click", {})
+        call(base, "POST", s + f"/element/{el}/value", {"text": "\ue010"})
+        material = wait("the rig's new material on the page",
+                        lambda: (lambda t: t if t == "marble" else None)(
+                            js("return document.getElementById('v-material').textContent")), 15)
         # The page settles (the image decoded, the status rows filled) before the picture.
         time.sleep(0.3)
         png = base64.b64decode(call(base, "GET", s + "/screenshot"))
         with open(shot, "wb") as f:
             f.write(png)
         print(json.dumps({"slider": slider, "shown_before": shown0, "shown_after": shown1,
-                          "frame_before": frame0, "frame_after": frame1,
+                          "frame_before": frame0, "frame_after": frame1, "material": material,
                           "screenshot_bytes": len(png)}))
         return 0
     except Exception as e:  # noqa: BLE001 - any failure is the test's failure, said once
