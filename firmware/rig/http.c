@@ -36,7 +36,6 @@ typedef struct req {
     char body[LR_HTTP_BODY_MAX + 1];
     size_t len;
     bool too_big;
-    bool started;
 } req;
 
 struct lr_http {
