@@ -461,6 +461,43 @@ static void test_http_bad_requests(void **state)
     lr_test_rmtree(dir);
 }
 
+/* Bytes that are not HTTP (tests/fw/http_garbage.py): libmicrohttpd answers them itself (400,
+ * 414, 431) or closes; the over-limit chunked body gets the rig's 413; the rig answers
+ * normally afterwards, and none of it reached the control map. */
+static void test_http_garbage(void **state)
+{
+    (void)state;
+    const int port = 18085;
+    char *dir = lr_test_tmpdir();
+    lr_test_log log = {0};
+    lr_rig *r = make_rig(dir, port, "", "preview", &log);
+    char ps[16];
+    snprintf(ps, sizeof ps, "%d", port);
+    char *const argv[] = {"python3", LR_SOURCE_CONFIGS "/../tests/fw/http_garbage.py", ps, "1",
+                          NULL};
+    char *out;
+    int rc = run_client(r, argv, &out, 60);
+    if (rc != 0)
+        fail_msg("http_garbage.py: exit %d: %s", rc, out);
+    print_message("garbage: %s", out);
+    assert_non_null(strstr(out, "\"HTTP/1.1 400\""));
+    assert_non_null(strstr(out, "\"HTTP/1.1 413\""));
+    assert_non_null(strstr(out, "\"HTTP/1.1 414\""));
+    assert_non_null(strstr(out, "\"HTTP/1.1 431\""));
+    free(out);
+    long code;
+    char *b = http(r, port, "GET", "/api/status", NULL, NULL, &code);
+    assert_int_equal(code, 200);
+    free(b);
+    lr_rig_info info;
+    lr_rig_get_info(r, &info);
+    assert_int_equal(info.events, 0);
+    /* MHD's own messages are rate-limited in the log: at most 5 in 10 s, plus the count. */
+    assert_true(lr_test_log_count(&log, "http: ") <= 1 + 5 + 1);
+    lr_rig_destroy(r);
+    lr_test_rmtree(dir);
+}
+
 /* With a token, a POST needs it (Bearer); reads do not. */
 static void test_http_token(void **state)
 {
@@ -673,6 +710,7 @@ int main(void)
         cmocka_unit_test(test_http_api),
         cmocka_unit_test(test_http_bad_requests),
         cmocka_unit_test(test_http_token),
+        cmocka_unit_test(test_http_garbage),
         cmocka_unit_test(test_http_browser),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
