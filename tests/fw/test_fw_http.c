@@ -461,6 +461,85 @@ static void test_http_bad_requests(void **state)
     lr_test_rmtree(dir);
 }
 
+/* Replaces every occurrence of `from` in s (malloc'd, at most 8 KB) by `to`; returns it. */
+static char *replace_all(const char *s, const char *from, const char *to)
+{
+    char *out = malloc(8192);
+    assert_non_null(out);
+    size_t o = 0, fl = strlen(from), tl = strlen(to);
+    for (const char *p = s; *p;) {
+        if (strncmp(p, from, fl) == 0) {
+            assert_true(o + tl < 8192);
+            memcpy(out + o, to, tl);
+            o += tl;
+            p += fl;
+        } else {
+            assert_true(o + 1 < 8192);
+            out[o++] = *p++;
+        }
+    }
+    out[o] = '\0';
+    return out;
+}
+
+/* The shipped sim rig (configs/rig/sim.json) serves the page and the API on 127.0.0.1:8080;
+ * run here on 18080 (its relative paths made absolute, the file copied to a scratch folder),
+ * with its script moving the controls: the status names its device, the page is served, and
+ * the stream carries the script's control moves. */
+static void test_http_shipped_sim_rig(void **state)
+{
+    (void)state;
+    lr_rig_config *c = NULL;
+    lr_err e = {0};
+    if (lr_rig_config_load(LR_SOURCE_CONFIGS "/rig/sim.json", &c, &e))
+        fail_msg("%s", e.msg);
+    assert_true(c->http.enabled && c->http.loopback);
+    assert_string_equal(c->http.host, "127.0.0.1");
+    assert_int_equal(c->http.port, 8080);
+    assert_string_equal(c->http.token, "");
+    lr_rig_config_destroy(c);
+    size_t n;
+    char *text = (char *)lr_test_read(LR_SOURCE_CONFIGS "/rig/sim.json", &n);
+    char *a = replace_all(text, "\"../", "\"" LR_SOURCE_CONFIGS "/");
+    char *b2 = replace_all(a, "\"sim-demo.sim\"", "\"" LR_SOURCE_CONFIGS "/rig/sim-demo.sim\"");
+    char *t2 = replace_all(b2, "127.0.0.1:8080", "127.0.0.1:18080");
+    assert_non_null(strstr(t2, "127.0.0.1:18080"));
+    char *dir = lr_test_tmpdir();
+    char *cfg = lr_test_write(dir, "sim.json", t2, (size_t)-1);
+    free(text);
+    free(a);
+    free(b2);
+    free(t2);
+    lr_test_log log = {0};
+    lr_rig_opts o = {.config = cfg, .no_signals = true, .log = {lr_test_log_fn, &log}};
+    lr_rig *r;
+    if (lr_rig_create(&o, &r, &e))
+        fail_msg("%s", e.msg);
+    assert_int_equal(lr_rig_http_port(r), 18080);
+    long code;
+    char *body = http(r, 18080, "GET", "/api/status", NULL, NULL, &code);
+    assert_int_equal(code, 200);
+    assert_non_null(strstr(body, "\"name\": \"sim\""));
+    assert_non_null(strstr(body, "\"state\": \"open\""));
+    free(body);
+    body = http(r, 18080, "GET", "/", NULL, NULL, &code);
+    assert_int_equal(code, 200);
+    assert_non_null(strstr(body, "<title>lamprig</title>"));
+    assert_non_null(strstr(body, "/api/events"));
+    free(body);
+    /* configs/rig/sim-demo.sim moves a control at least every 0.95 s (its longest gap, and
+     * it loops): 2 s of the stream hold at least one "controls" event. */
+    char *const argv[] = {"curl", "-sN", "-m", "2", "http://127.0.0.1:18080/api/events", NULL};
+    char *out;
+    run_client(r, argv, &out, 10);
+    assert_non_null(strstr(out, "event: status\n"));
+    assert_non_null(strstr(out, "event: controls\n"));
+    free(out);
+    lr_rig_destroy(r);
+    free(cfg);
+    lr_test_rmtree(dir);
+}
+
 /* Bytes that are not HTTP (tests/fw/http_garbage.py): libmicrohttpd answers them itself (400,
  * 414, 431) or closes; the over-limit chunked body gets the rig's 413; the rig answers
  * normally afterwards, and none of it reached the control map. */
@@ -711,6 +790,7 @@ int main(void)
         cmocka_unit_test(test_http_bad_requests),
         cmocka_unit_test(test_http_token),
         cmocka_unit_test(test_http_garbage),
+        cmocka_unit_test(test_http_shipped_sim_rig),
         cmocka_unit_test(test_http_browser),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
