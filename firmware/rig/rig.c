@@ -107,7 +107,7 @@ struct lr_rig {
     lr_log user_log;        /* the caller's log; r->log records warnings and errors first */
     lr_rig_status_line warnings[LR_STATUS_LOG_KEEP], errors[LR_STATUS_LOG_KEEP];
     int n_warnings, n_errors;
-    int64_t frame_t[FRAME_TIMES]; /* ring of frame end times */
+    int64_t frame_t[FRAME_TIMES]; /* ring of frame start times (the loop's clock) */
     int n_frame_t;
     uint64_t unmatched;
     bool planned;
@@ -666,7 +666,9 @@ static void frame(lr_rig *r, int64_t now)
     if (r->set.calib && r->ar_dirty)
         ar_frame(r);
     r->frame_errors = 0;
-    r->frame_t[r->frames % FRAME_TIMES] = lr_now_ns();
+    /* The start, as the loop paces it: headless frames start at least frame_interval_ns
+     * apart, so the status's fps is at most output.fps (its end times vary with the work). */
+    r->frame_t[r->frames % FRAME_TIMES] = now;
     r->frames++;
     if (r->kms && lr_gl_flip_pending(r->gl)) {
         /* On the projector a frame shows at its page flip: the latency ends there. */
@@ -1266,9 +1268,9 @@ void lr_rig_get_status(lr_rig *r, lr_rig_status *st)
     st->reloads = r->reloads;
     st->reload_failures = r->reload_failures;
     st->lamp_level = r->lamp_written;
-    /* fps: the frames that ended in the last 2 s, over the time between the first and the
+    /* fps: the frames that started in the last 2 s, over the time between the first and the
      * last of them (0 when fewer than two: an idle rig renders nothing). The interval p99 is
-     * the nearest-rank 99th percentile of the last FRAME_TIMES - 1 intervals. */
+     * the nearest-rank 99th percentile of the last FRAME_TIMES - 1 start-to-start intervals. */
     int n = r->frames < FRAME_TIMES ? (int)r->frames : FRAME_TIMES;
     int64_t t[FRAME_TIMES], iv[FRAME_TIMES];
     for (int i = 0; i < n; i++) /* oldest first */

@@ -12,8 +12,10 @@
  *  "output": "headless", "view": "passes", "uptime_s": 12.5, "idle": false,
  *  "frames": 321, "events": 40, "events_unmatched": 3, "garbage": 0,
  *  "reloads": 0, "reload_failures": 0, "lamp_level": 0.64 | null,
- *  "fps": 29.8 | 0,                       frames per second over the last 2 s (0: idle)
- *  "frame_interval_p99_ms": 35.1 | null,  p99 of the last 64 frame-to-frame intervals
+ *  "fps": 29.8 | 0,                       frames started in the last 2 s over their span
+ *                                         (0: idle; at most output.fps headless)
+ *  "frame_interval_p99_ms": 35.1 | null,  nearest-rank p99 of the last 63 start-to-start
+ *                                         frame intervals
  *  "latency_ms": {"n": 40, "median": 2.1 | null, "p99": 7.9 | null},  control event ->
  *                                         the first frame showing it (firmware/rig/stats.h)
  *  "devices": [{"name": "sim", "kind": "sim", "state": "open"}, ...],

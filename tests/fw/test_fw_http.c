@@ -461,6 +461,115 @@ static void test_http_bad_requests(void **state)
     lr_test_rmtree(dir);
 }
 
+/* The status producer alone (firmware/rig/status_json.h), as any publisher uses it: known
+ * values come back exactly, unmeasured ones (NaN, no lamp) as null, strings escaped. */
+static void test_status_json(void **state)
+{
+    (void)state;
+    lr_rig_status *st = calloc(1, sizeof *st);
+    assert_non_null(st);
+    lr_rig_status_line warn = {1.5, "a \"quoted\" line\nand a second"};
+    *st = (lr_rig_status){.version = "9.9", .config = "c.json", .scene = "candle.json",
+                          .output = "headless", .view = "preview", .uptime_s = 12.25,
+                          .frames = 7, .events = 3, .lamp_level = -1, .fps = 29.5,
+                          .frame_interval_p99_ms = NAN, .latency_n = 3,
+                          .latency_median_ms = 2.5, .latency_p99_ms = NAN, .n_devices = 1,
+                          .plan_text = "", .plan_error = NAN, .plan_frame_ms = NAN,
+                          .n_warnings = 1, .warnings = &warn, .n_controls = 2};
+    st->devices[0] = (lr_rig_status_dev){"sim", "sim", "open"};
+    st->controls[0] = (lr_rig_status_control){.name = "dimmer", .source = "", .control = "d",
+                                              .param = "light.level", .position = 0.25,
+                                              .level = 0.0625};
+    st->controls[1] = (lr_rig_status_control){.name = "m", .source = "panel", .control = "b",
+                                              .param = "objects[0].material", .cycle = true,
+                                              .index = 1, .n_values = 2,
+                                              .values = {"wax", "marble"}};
+    size_t len = 0;
+    char *doc = lr_status_json_string(st, false, &len);
+    assert_non_null(doc);
+    assert_int_equal(len, strlen(doc));
+    lr_json *j = parse(doc);
+    lr_jnode root = lr_json_root(j);
+    lr_err e = {0};
+    double v;
+    assert_int_equal(lr_json_get_number(j, root, "uptime_s", true, &v, &e), LR_OK);
+    assert_true(v == 12.25);
+    assert_int_equal(lr_json_get_number(j, root, "fps", true, &v, &e), LR_OK);
+    assert_true(v == 29.5);
+    assert_int_equal(lr_json_type(j, lr_json_get(j, root, "lamp_level")), LR_JSON_NULL);
+    assert_int_equal(lr_json_type(j, lr_json_get(j, root, "frame_interval_p99_ms")),
+                     LR_JSON_NULL);
+    lr_jnode lat = lr_json_get(j, root, "latency_ms");
+    assert_int_equal(lr_json_get_number(j, lat, "median", true, &v, &e), LR_OK);
+    assert_true(v == 2.5);
+    assert_int_equal(lr_json_type(j, lr_json_get(j, lat, "p99")), LR_JSON_NULL);
+    char msg[128];
+    lr_jnode w0 = lr_json_at(j, lr_json_get(j, root, "warnings"), 0);
+    assert_int_equal(lr_json_get_string(j, w0, "msg", true, msg, sizeof msg, &e), LR_OK);
+    assert_string_equal(msg, warn.msg);
+    lr_jnode ctl = lr_json_get(j, root, "controls");
+    assert_int_equal(lr_json_count(j, ctl), 2);
+    assert_int_equal(lr_json_get_number(j, lr_json_at(j, ctl, 0), "level", true, &v, &e),
+                     LR_OK);
+    assert_true(v == 0.0625);
+    lr_jnode vals = lr_json_get(j, lr_json_at(j, ctl, 1), "values");
+    assert_int_equal(lr_json_count(j, vals), 2);
+    assert_int_equal(lr_json_string(j, lr_json_at(j, vals, 1), "v", msg, sizeof msg, &e), LR_OK);
+    assert_string_equal(msg, "marble");
+    lr_json_destroy(j);
+    free(doc);
+    /* The controls alone: the same array. */
+    doc = lr_status_json_string(st, true, NULL);
+    assert_non_null(doc);
+    j = parse(doc);
+    assert_int_equal(lr_json_type(j, lr_json_root(j)), LR_JSON_ARRAY);
+    assert_int_equal(lr_json_count(j, lr_json_root(j)), 2);
+    lr_json_destroy(j);
+    free(doc);
+    free(st);
+}
+
+/* The status's frame figures on a rig that wants a frame at every slot: a looping sim
+ * script moves the dimmer every 10 ms, faster than the 20 ms slots of fps 50. Headless frames
+ * start at least 1/fps apart (the loop's pacing), so over any span the measured rate is at
+ * most fps, and every interval, the p99 included, is at least 1/fps = 20 ms. */
+static void test_status_frame_rate(void **state)
+{
+    (void)state;
+    char *dir = lr_test_tmpdir();
+    char text[1024];
+    snprintf(text, sizeof text,
+             "{\"scene\": \"%s/scenes/candle.json\",\n"
+             " \"devices\": [{\"type\": \"sim\", \"loop\": true, \"text\": "
+             "\"0.00 dimmer absolute 0.2\\n0.01 dimmer absolute 0.4\\n0.02 end\\n\"}],\n"
+             " \"controls\": [{\"control\": \"dimmer\", \"param\": \"light.level\", "
+             "\"range\": [0, 2]}],\n"
+             " \"output\": {\"width\": 16, \"height\": 16, \"fps\": 50, \"renderer\": \"preview\"},\n"
+             " \"http\": {\"listen\": \"127.0.0.1:18087\"}}\n",
+             LR_SOURCE_CONFIGS);
+    char *cfg = lr_test_write(dir, "rig.json", text, (size_t)-1);
+    lr_test_log log = {0};
+    lr_rig_opts o = {.config = cfg, .no_signals = true, .log = {lr_test_log_fn, &log},
+                     .no_plan = true};
+    lr_rig *r;
+    lr_err e = {0};
+    if (lr_rig_create(&o, &r, &e))
+        fail_msg("%s", e.msg);
+    run_ms(r, 1500);
+    lr_rig_status *st = calloc(1, sizeof *st);
+    assert_non_null(st);
+    lr_rig_get_status(r, st);
+    print_message("status: %.2f fps, interval p99 %.2f ms over %llu frames\n", st->fps,
+                  st->frame_interval_p99_ms, (unsigned long long)st->frames);
+    assert_true(st->frames >= 3);
+    assert_true(st->fps > 0 && st->fps <= 50.0);
+    assert_true(st->frame_interval_p99_ms >= 20.0);
+    free(st);
+    lr_rig_destroy(r);
+    free(cfg);
+    lr_test_rmtree(dir);
+}
+
 /* Replaces every occurrence of `from` in s (malloc'd, at most 8 KB) by `to`; returns it. */
 static char *replace_all(const char *s, const char *from, const char *to)
 {
@@ -785,6 +894,8 @@ static void test_http_browser(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_status_json),
+        cmocka_unit_test(test_status_frame_rate),
         cmocka_unit_test(test_http_config),
         cmocka_unit_test(test_http_api),
         cmocka_unit_test(test_http_bad_requests),
