@@ -73,6 +73,12 @@ static enum MHD_Result queue(struct MHD_Connection *c, unsigned status, char *bo
     MHD_add_response_header(r, MHD_HTTP_HEADER_CONTENT_TYPE, type);
     MHD_add_response_header(r, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
     MHD_add_response_header(r, "X-Content-Type-Options", "nosniff");
+    /* No other site may frame the page (a framed page could be clicked into moving the
+     * controls); its script and style are inline, everything else comes from the rig. */
+    MHD_add_response_header(r, "X-Frame-Options", "DENY");
+    MHD_add_response_header(r, "Content-Security-Policy",
+                            "default-src 'self'; script-src 'unsafe-inline'; "
+                            "style-src 'unsafe-inline'; frame-ancestors 'none'");
     if (status == MHD_HTTP_UNAUTHORIZED)
         MHD_add_response_header(r, MHD_HTTP_HEADER_WWW_AUTHENTICATE, "Bearer realm=\"lamprig\"");
     if (status == MHD_HTTP_TOO_MANY_REQUESTS)

@@ -631,8 +631,12 @@ static void test_http_shipped_sim_rig(void **state)
     assert_non_null(strstr(body, "\"name\": \"sim\""));
     assert_non_null(strstr(body, "\"state\": \"open\""));
     free(body);
-    body = http(r, 18080, "GET", "/", NULL, NULL, &code);
+    const char *const hdr[] = {"-D", "-", NULL};
+    body = http(r, 18080, "GET", "/", NULL, hdr, &code);
     assert_int_equal(code, 200);
+    assert_non_null(strstr(body, "Content-Type: text/html; charset=utf-8"));
+    assert_non_null(strstr(body, "X-Frame-Options: DENY"));
+    assert_non_null(strstr(body, "frame-ancestors 'none'"));
     assert_non_null(strstr(body, "<title>lamprig</title>"));
     assert_non_null(strstr(body, "/api/events"));
     free(body);
@@ -825,7 +829,7 @@ static void test_http_config(void **state)
  * control map (the scene's light changes), the page shows the rig's new position and a newer
  * frame; the screenshot is build/test/http-page.png (firmware/README.md, README.md show it).
  * The real renderer, so that the picture is the rig's: the browser starts once the view has
- * converged (within 10 s: under load the picture may then be a coarse preview, the checks
+ * converged (within 6 s: under load the picture may then be a coarse preview, the checks
  * are the same). */
 static void test_http_browser(void **state)
 {
@@ -839,9 +843,9 @@ static void test_http_browser(void **state)
     do {
         run_ms(r, 50);
         lr_rig_get_info(r, &info);
-    } while (!info.idle && lr_now_ns() - t0 < 10000 * MS);
+    } while (!info.idle && lr_now_ns() - t0 < 6000 * MS);
     print_message("browser: the view converged in %.1f s%s\n", (double)(lr_now_ns() - t0) * 1e-9,
-                  info.idle ? "" : " (not within the 10 s bound: the screenshot may show a preview)");
+                  info.idle ? "" : " (not within the 6 s bound: the screenshot may show a preview)");
     double base = scene_num(r, "light.intensity");
     char url[64];
     snprintf(url, sizeof url, "http://127.0.0.1:%d/", port);
