@@ -110,9 +110,14 @@ struct lr_rig {
     int64_t frame_t[FRAME_TIMES]; /* ring of frame start times (the loop's clock) */
     int n_frame_t;
     uint64_t unmatched;
-    bool planned;
-    char plan_text[512];
-    double plan_error, plan_frame_ms;
+    /* The plan the status shows (of the running scene), and the one plan_scene made last:
+     * it becomes the shown one only when its scene does (a failed reload or scene switch
+     * keeps the running scene's). */
+    struct rig_plan {
+        bool planned;
+        char text[512];
+        double error, frame_ms;
+    } plan, plan_new;
     char http_scene[LR_RIG_PATH_MAX]; /* a shipped scene POST /api/scene asked for */
     unsigned char *http_rgba;         /* lr_rig_frame_rgba's readback */
 };
@@ -287,9 +292,7 @@ static int plan_scene(lr_rig *r, const lr_rig_config *cfg, lr_scene *scene, bool
 {
     *no_vpl = false;
     *replan = NULL;
-    r->planned = false;
-    r->plan_text[0] = '\0';
-    r->plan_error = r->plan_frame_ms = NAN;
+    r->plan_new = (struct rig_plan){.planned = false, .error = NAN, .frame_ms = NAN};
     if (r->opts.no_plan)
         return LR_OK;
     lr_plan_scene_result *res = calloc(1, sizeof *res);
@@ -305,15 +308,16 @@ static int plan_scene(lr_rig *r, const lr_rig_config *cfg, lr_scene *scene, bool
         free(text);
         /* The status keeps the brief sentence and the worst predicted error and frame time. */
         if ((text = lr_plan_scene_text(res, false))) {
-            snprintf(r->plan_text, sizeof r->plan_text, "%s", text);
-            r->plan_text[strcspn(r->plan_text, "\n")] = '\0';
+            snprintf(r->plan_new.text, sizeof r->plan_new.text, "%s", text);
+            r->plan_new.text[strcspn(r->plan_new.text, "\n")] = '\0';
         }
         free(text);
-        r->planned = true;
-        r->plan_error = r->plan_frame_ms = 0;
+        r->plan_new.planned = true;
+        r->plan_new.error = r->plan_new.frame_ms = 0;
         for (int i = 0; i < res->plan.nobjects; i++) {
-            r->plan_error = fmax(r->plan_error, res->plan.objects[i].predicted_error);
-            r->plan_frame_ms = fmax(r->plan_frame_ms, res->plan.objects[i].predicted_frame_ms);
+            const lr_plan_choice *ch = &res->plan.objects[i];
+            r->plan_new.error = fmax(r->plan_new.error, ch->predicted_error);
+            r->plan_new.frame_ms = fmax(r->plan_new.frame_ms, ch->predicted_frame_ms);
         }
         *no_vpl = !res->vpl;
         rc = lr_rig_config_apply_sets(cfg, scene, e);
@@ -537,6 +541,7 @@ static void switch_scene(lr_rig *r, const char *path)
     r->view = view;
     r->set.scene = scene;
     r->set.replan = rp;
+    r->plan = r->plan_new;
     r->ar_dirty = true;
     lr_log_write(&r->log, LR_LOG_INFO, "scene: %s", path);
 }
@@ -830,6 +835,7 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
     if (!rc)
         rc = set_build(r, &r->set, false, e);
     if (!rc) {
+        r->plan = r->plan_new;
         if (opts->stats_path)
             snprintf(r->stats_path, sizeof r->stats_path, "%s", opts->stats_path);
         else
@@ -987,6 +993,7 @@ static int reload(lr_rig *r, lr_err *e)
     set_free(&r->set);
     r->set = s;
     r->view = view;
+    r->plan = r->plan_new;
     ensure_rgba(r);
     r->ar_dirty = true;
     r->lamp_written = -1;
@@ -1297,10 +1304,10 @@ void lr_rig_get_status(lr_rig *r, lr_rig_status *st)
         st->devices[i] = (lr_rig_status_dev){lr_dev_name(d), lr_dev_kind(d),
                                              lr_dev_state_name(lr_dev_get_state(d))};
     }
-    st->planned = r->planned;
-    st->plan_text = r->plan_text;
-    st->plan_error = r->plan_error;
-    st->plan_frame_ms = r->plan_frame_ms;
+    st->planned = r->plan.planned;
+    st->plan_text = r->plan.text;
+    st->plan_error = r->plan.error;
+    st->plan_frame_ms = r->plan.frame_ms;
     st->warnings = r->warnings;
     st->n_warnings = r->n_warnings;
     st->errors = r->errors;

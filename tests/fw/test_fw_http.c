@@ -618,7 +618,6 @@ static void test_http_shipped_sim_rig(void **state)
     free(text);
     free(a);
     free(b2);
-    free(t2);
     lr_test_log log = {0};
     lr_rig_opts o = {.config = cfg, .no_signals = true, .log = {lr_test_log_fn, &log}};
     lr_rig *r;
@@ -648,6 +647,47 @@ static void test_http_shipped_sim_rig(void **state)
     assert_non_null(strstr(out, "event: status\n"));
     assert_non_null(strstr(out, "event: controls\n"));
     free(out);
+    /* A reload that fails after its config loaded and its scene (the lamp shade) was
+     * planned: a required HID knob that is not there. 422 with the reason, the old config
+     * runs on, and the status still shows the running scene's plan, not the lamp shade's. */
+    body = http(r, 18080, "GET", "/api/status", NULL, NULL, &code);
+    lr_json *j = parse(body);
+    lr_jnode plan = lr_json_get(j, lr_json_root(j), "plan");
+    bool planned = false;
+    char plan_text[512] = "";
+    assert_int_equal(lr_json_get_bool(j, plan, "planned", true, &planned, &e), LR_OK);
+    assert_true(planned);
+    assert_int_equal(lr_json_get_string(j, plan, "text", true, plan_text, sizeof plan_text,
+                                        &e), LR_OK);
+    assert_true(strlen(plan_text) > 0);
+    lr_json_destroy(j);
+    free(body);
+    char *t3 = replace_all(t2, "scenes/candle.json", "scenes/lampshade.json");
+    char *t4 = replace_all(t3, "\"devices\": [",
+                           "\"devices\": [{\"type\": \"hid\", \"name\": \"knob\", "
+                           "\"vid\": \"dead\", \"pid\": \"beef\", \"required\": true},");
+    assert_non_null(strstr(t4, "lampshade.json"));
+    assert_non_null(strstr(t4, "\"required\": true"));
+    lr_test_put(cfg, t4, (size_t)-1);
+    free(t3);
+    free(t4);
+    free(t2);
+    body = post(r, 18080, "/api/reload", NULL, &code);
+    if (code != 422 || !strstr(body, "knob") || !strstr(body, "keeping the running config"))
+        fail_msg("reload with a missing required device: %ld %s", code, body);
+    free(body);
+    lr_rig_info info;
+    lr_rig_get_info(r, &info);
+    assert_int_equal(info.reload_failures, 1);
+    body = http(r, 18080, "GET", "/api/status", NULL, NULL, &code);
+    j = parse(body);
+    plan = lr_json_get(j, lr_json_root(j), "plan");
+    char text2[512] = "";
+    assert_int_equal(lr_json_get_string(j, plan, "text", true, text2, sizeof text2, &e), LR_OK);
+    assert_string_equal(text2, plan_text);
+    assert_non_null(strstr(text2, "candle"));
+    lr_json_destroy(j);
+    free(body);
     lr_rig_destroy(r);
     free(cfg);
     lr_test_rmtree(dir);
