@@ -46,7 +46,7 @@ else
 CC      ?= cc
 CXX     ?= c++
 PKGS    := egl glesv2 gbm libdrm libgpiod hidapi-libusb libusb-1.0 libmodbus libpng cairo lcms2 \
-           libsystemd liblo
+           libsystemd liblo libmicrohttpd
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS))
 PKG_LIBS   := $(shell pkg-config --libs $(PKGS))
 CV_CFLAGS  := $(shell pkg-config --cflags opencv4)
@@ -198,6 +198,10 @@ install: $(INSTALL_BINS:%=build/bin/%)
 	$(SUBST) tools/install/lamprig.service.in > $(DESTDIR)$(UNITDIR)/lamprig.service
 	install -m 0644 tools/install/60-lamprig.rules $(DESTDIR)$(UDEVDIR)/60-lamprig.rules
 	install -m 0644 tools/install/sysusers.conf $(DESTDIR)$(SYSUSERSDIR)/lamprig.conf
+	@# Discovery (_lamprig._tcp), announced only once linked into /etc/avahi/services.
+	install -d $(DESTDIR)$(DATADIR)/avahi
+	$(SUBST) tools/install/lamprig-avahi.service > $(DESTDIR)$(DATADIR)/avahi/lamprig.service
+	chmod 0644 $(DESTDIR)$(DATADIR)/avahi/lamprig.service
 	@# An existing rig config is the user's: never overwritten.
 	[ -e $(DESTDIR)$(SYSCONFDIR)/lamprig/rig.json ] || \
 	    $(SUBST) tools/install/rig.json.in > $(DESTDIR)$(SYSCONFDIR)/lamprig/rig.json

@@ -89,7 +89,12 @@ while [ $i -lt 100 ] && [ -z "$leader" ]; do
     i=$((i + 1))
 done
 [ -n "$leader" ] || { cat "$T/console.log"; echo "boot: the container did not start"; exit 1; }
-inside() { nsenter -t "$leader" -m -u -i -n -p -- "$@"; }
+# The first child seen may be a short-lived helper of nspawn's, gone once the container's
+# init runs (then every nsenter failed with "cannot open /proc/PID/ns/ipc"): look again.
+inside() {
+    kill -0 "$leader" 2>/dev/null || leader=$(pgrep -P "$nspawn_pid" | head -n 1 || true)
+    nsenter -t "$leader" -m -u -i -n -p -- "$@"
+}
 state=""
 i=0
 while [ $i -lt 120 ]; do
@@ -135,6 +140,24 @@ else
     inside journalctl -u lamprig --no-pager | tail -n 30
     fail "no frames: '$f0' -> '$f1' ($(prop StatusText))"
 fi
+
+# ---- the page, under the unit's sandbox (RestrictAddressFamilies, the system-call filter) ----
+# The container shares the host's network, so the service listens on 127.0.0.1:8080 there;
+# the container's bash speaks the request (a minbase root has no curl).
+i=0
+page=""
+while [ $i -lt 40 ]; do
+    page=$(inside bash -c 'exec 3<>/dev/tcp/127.0.0.1/8080 &&
+        printf "GET /api/status HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n" >&3 && cat <&3' 2>/dev/null || true)
+    case $page in *" 200 "*'"version"'*) break ;; esac
+    sleep 0.5
+    i=$((i + 1))
+done
+case $page in
+*" 200 "*'"version"'*) ok "serves GET /api/status on 127.0.0.1:8080 under the unit's sandbox" ;;
+*) inside journalctl -u lamprig --no-pager | grep -i http | tail -n 5
+   fail "no /api/status on 127.0.0.1:8080 ('$(echo "$page" | head -n 1)')" ;;
+esac
 
 # ---- reload ----
 if inside systemctl reload lamprig.service; then

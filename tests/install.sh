@@ -43,7 +43,7 @@ fi
 dpkg-deb -x "$deb" "$R"
 dpkg-deb -e "$deb" "$T/DEBIAN"
 depends=$(dpkg-deb -f "$deb" Depends)
-for lib in libsystemd0 libegl1 libgles2 libgpiod2 libhidapi-libusb0 libmodbus5 libegl-mesa0 adduser; do
+for lib in libsystemd0 libegl1 libgles2 libgpiod2 libhidapi-libusb0 libmodbus5 libmicrohttpd12 libegl-mesa0 adduser; do
     case "$depends" in *"$lib"*) ;; *) fail "Depends lacks $lib: $depends" ;; esac
 done
 ok "Depends names the linked libraries (dpkg-shlibdeps) and the GL drivers"
@@ -86,6 +86,16 @@ check "every shader of the source tree installed" \
 check "udev rules installed" test -f "$R/lib/udev/rules.d/60-lamprig.rules"
 check "sysusers.d entry" grep -q '^u lamprig ' "$R/usr/lib/sysusers.d/lamprig.conf"
 check "man page" test -f "$R/usr/share/man/man1/lamprig.1.gz"
+# Discovery: the Avahi service file announces _lamprig._tcp on the port of the shipped
+# config's "http.listen" (shipped, not linked into /etc/avahi/services: loopback by default).
+check "Avahi service file: _lamprig._tcp on the rig config's HTTP port" python3 -c '
+import json, sys, xml.etree.ElementTree as ET
+svc = {s.findtext("type"): s.findtext("port") for s in ET.parse(sys.argv[1]).getroot().iter("service")}
+port = json.load(open(sys.argv[2]))["http"]["listen"].rsplit(":", 1)[1]
+sys.exit(0 if svc.get("_lamprig._tcp") == port and svc.get("_http._tcp") == port else 1)
+' "$data/avahi/lamprig.service" "$R$cfg"
+check "RestrictAddressFamilies: exactly unix, IPv4, IPv6 (Modbus TCP, HTTP), netlink" \
+    grep -qx 'RestrictAddressFamilies=AF_UNIX AF_INET AF_INET6 AF_NETLINK' "$unit"
 
 # ---- systemd-analyze verify ----
 if command -v systemd-analyze >/dev/null; then
@@ -184,15 +194,27 @@ for scene in "$data/configs/scenes/candle.json" "$T/out/candle_marble.json"; do
         fail "installed plan of $(basename "$scene") differs from the source tree's"
     fi
 done
-# The shipped rig config, its /usr paths pointed into the root, stats into a scratch dir.
-sed -e "s|\"/usr/|\"$R/usr/|g" -e "s|\"/var/lib/lamprig/|\"$T/out/|g" "$R$cfg" >"$T/out/rig.json"
-if run_installed "$R$exe" run --config "$T/out/rig.json" --duration 1.5 >"$T/run.txt" 2>&1 &&
-    grep -q '"frames"' "$T/out/stats.json"; then
+# The shipped rig config, its /usr paths pointed into the root, stats into a scratch dir, its
+# HTTP endpoint on a port of the test plan (8080 may be anyone's on a build machine).
+sed -e "s|\"/usr/|\"$R/usr/|g" -e "s|\"/var/lib/lamprig/|\"$T/out/|g" \
+    -e 's|"127.0.0.1:8080"|"127.0.0.1:18087"|' "$R$cfg" >"$T/out/rig.json"
+run_installed "$R$exe" run --config "$T/out/rig.json" --duration 3 >"$T/run.txt" 2>&1 &
+rig=$!
+# The page and the status while it runs (the endpoint starts after the first frame).
+for _ in $(seq 1 300); do
+    curl -s -m 2 -o "$T/page.html" http://127.0.0.1:18087/ 2>/dev/null && break
+    sleep 0.1
+done
+curl -s -m 2 -o "$T/status.json" http://127.0.0.1:18087/api/status 2>/dev/null || true
+if wait "$rig" && grep -q '"frames"' "$T/out/stats.json"; then
     ok "installed binary runs the shipped rig config (sim devices, headless) and writes stats"
 else
     cat "$T/run.txt"
     fail "installed binary runs the shipped rig config"
 fi
+check "installed rig serves its page on the config's 127.0.0.1 port" grep -q '<title>lamprig</title>' "$T/page.html"
+check "installed rig serves /api/status with its version" \
+    grep -q "\"version\": \"$(cat "$src/VERSION")\"" "$T/status.json"
 
 # The suite's closing line: test binaries (tests/run.sh) and these checks together.
 echo "install: $passes passed, $fails failed"

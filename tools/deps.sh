@@ -7,6 +7,10 @@ set -eu
 # (examples/data/left*.jpg, left_intrinsics.yml): tests/calib/test_calib_camera.c checks against them.
 # libsystemd-dev: sd_notify from the rig loop. lintian and systemd (systemd-analyze verify)
 # check `make deb`'s package and unit in tests/install.sh; dpkg-dev comes with build-essential.
+# libmicrohttpd-dev: the rig's HTTP endpoint (firmware/rig/http.h); curl, chromium,
+# chromium-driver and python3: its tests (tests/fw/test_fw_http.c drives the API with curl,
+# the page in headless chromium through chromedriver's WebDriver protocol from
+# tests/fw/http_browser.py, python3's standard library only).
 # systemd-container (systemd-nspawn) and debootstrap boot the package under systemd in
 # tests/boot.sh (make test-boot).
 # liblo-dev: the OSC input (hal/osc.c). The console peers the tests start: liblo-tools
@@ -19,6 +23,7 @@ libopencv-dev libopencv-contrib-dev
 opencv-doc
 libpng-dev libcairo2-dev liblcms2-dev libcmocka-dev
 libsystemd-dev
+libmicrohttpd-dev curl chromium chromium-driver python3
 lintian systemd
 systemd-container debootstrap
 liblo-dev liblo-tools ola qlcplus iproute2"

@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <arpa/inet.h>
+#include <netinet/in.h>
 
 #include "firmware/control/curve.h"
 #include "hal/gpio.h"
@@ -892,6 +894,69 @@ static int bindings(ctx *x, lr_jnode arr, const lr_json *owner)
     return LR_OK;
 }
 
+/* ---- http ---- */
+
+/* "http": {"listen": "HOST:PORT", "token": "..."}. HOST is a numeric address (an IPv4
+ * literal, or an IPv6 literal in brackets): a name would need a resolver at start-up and
+ * could change what it means later. */
+static int parse_http(ctx *x, lr_jnode root)
+{
+    lr_jnode h = lr_json_get(x->j, root, "http");
+    if (h == LR_JNONE)
+        return LR_OK;
+    static const char *const ok[] = {"listen", "token", NULL};
+    lr_rig_config *c = x->c;
+    char listen[96] = "";
+    int rc;
+    if ((rc = keys(x, h, "http", ok)) ||
+        (rc = get_str(x, h, "http", "listen", true, listen, sizeof listen)) ||
+        (rc = get_str(x, h, "http", "token", false, c->http.token, sizeof c->http.token)))
+        return rc;
+    lr_jnode ln = lr_json_get(x->j, h, "listen");
+    const char *colon = strrchr(listen, ':');
+    const char *host = listen;
+    size_t hlen = colon ? (size_t)(colon - listen) : 0;
+    if (hlen >= 2 && listen[0] == '[' && listen[hlen - 1] == ']') {
+        host++;
+        hlen -= 2;
+    }
+    char *end = NULL;
+    long port = colon ? strtol(colon + 1, &end, 10) : 0;
+    if (!colon || !hlen || hlen >= sizeof c->http.host || !end || *end || end == colon + 1 ||
+        port < 1 || port > 65535)
+        return lr_json_fail(x->j, ln, "http.listen", x->e, LR_EPARSE,
+                            "expected \"ADDRESS:PORT\" (\"127.0.0.1:8080\", \"[::1]:8080\"), "
+                            "got \"%s\"", listen);
+    memcpy(c->http.host, host, hlen);
+    c->http.host[hlen] = '\0';
+    struct in_addr a4;
+    struct in6_addr a6;
+    if (inet_pton(AF_INET, c->http.host, &a4) == 1)
+        c->http.loopback = (ntohl(a4.s_addr) >> 24) == 127;
+    else if (inet_pton(AF_INET6, c->http.host, &a6) == 1 && listen[0] == '[')
+        c->http.loopback = IN6_IS_ADDR_LOOPBACK(&a6);
+    else
+        return lr_json_fail(x->j, ln, "http.listen", x->e, LR_EPARSE,
+                            "'%s' is not a numeric IPv4 address or [IPv6] address",
+                            c->http.host);
+    c->http.port = (int)port;
+    size_t tl = strlen(c->http.token);
+    lr_jnode tn = lr_json_get(x->j, h, "token");
+    if (tl && tl < LR_RIG_HTTP_TOKEN_MIN)
+        return lr_json_fail(x->j, tn, "http.token", x->e, LR_EPARSE,
+                            "at least %d characters, got %zu", LR_RIG_HTTP_TOKEN_MIN, tl);
+    for (size_t i = 0; i < tl; i++)
+        if (c->http.token[i] <= ' ' || c->http.token[i] > '~')
+            return lr_json_fail(x->j, tn, "http.token", x->e, LR_EPARSE,
+                                "printable ASCII without spaces (it goes in an HTTP header)");
+    if (!c->http.loopback && !tl)
+        return lr_json_fail(x->j, h, "http.token", x->e, LR_EPARSE,
+                            "required when http.listen (%s) is not a loopback address: "
+                            "anyone on the network could change the rig", listen);
+    c->http.enabled = true;
+    return LR_OK;
+}
+
 /* ---- top level ---- */
 
 static int parse_root(ctx *x)
@@ -900,7 +965,7 @@ static int parse_root(ctx *x)
     lr_jnode root = lr_json_root(j);
     lr_rig_config *c = x->c;
     static const char *const top[] = {"scene", "scene_set", "devices", "controls", "output",
-                                      "safe_level", "stats", "calib", "ar_samples", NULL};
+                                      "safe_level", "stats", "calib", "ar_samples", "http", NULL};
     int rc = keys(x, root, "", top);
     if (rc)
         return rc;
@@ -1091,6 +1156,8 @@ static int parse_root(ctx *x)
                 return lr_json_fail(j, st, "stats.path", x->e, LR_EPARSE, "path too long");
         }
     }
+    if ((rc = parse_http(x, root)))
+        return rc;
     /* Bindings name devices by source: a source that no device has (and no sim script could
      * speak for, i.e. there is no sim device) is a typo. */
     bool have_sim = false;

@@ -29,6 +29,13 @@
  *                                      (firmware/rig/ar_present.h), its clipping logged and
  *                                      counted in the stats
  *   "ar_samples": 16                   CPU reference samples per band and pixel for it
+ *   "http":     {"listen": "127.0.0.1:8080", "token": "..."}   the page and JSON API
+ *                                      (firmware/rig/http.h); "listen" is an IPv4 literal or
+ *                                      [IPv6] literal and a port. Any address outside
+ *                                      127.0.0.0/8 and ::1 needs a "token" (at least
+ *                                      LR_RIG_HTTP_TOKEN_MIN characters): without one the
+ *                                      config is refused, naming the field. No object: no
+ *                                      server, nothing listens.
  * }
  *
  * DEVICE: "type" (sim, modbus, gpio, hid, usb, sacn, artnet, osc) and the options of that hal
@@ -71,6 +78,8 @@
 #define LR_RIG_MAX_VALUES 32
 #define LR_RIG_MAX_ITEMS 16 /* inputs, encoders, buttons, watches per device */
 #define LR_RIG_MAX_SETS 32
+#define LR_RIG_HTTP_TOKEN_MAX 128
+#define LR_RIG_HTTP_TOKEN_MIN 16 /* characters: a guessable token protects nothing */
 /* The lamp driver's default Modbus unit: the rig's convention (the panel answers as unit 1, the
  * lamp driver as unit 2); hal/modbus.c's own default is 1 for both. */
 #define LR_RIG_LAMP_UNIT 2
@@ -201,6 +210,15 @@ typedef enum lr_rig_output_mode {
     LR_RIG_KMS,
 } lr_rig_output_mode;
 
+/* "http": the rig's page and JSON API (firmware/rig/http.h). */
+typedef struct lr_rig_http_config {
+    bool enabled;
+    char host[64];   /* an IPv4 or IPv6 literal, as written ("[::1]" without brackets) */
+    int port;        /* 1..65535 */
+    bool loopback;   /* 127.0.0.0/8 or ::1: only this machine can connect */
+    char token[LR_RIG_HTTP_TOKEN_MAX]; /* "": none; required unless loopback */
+} lr_rig_http_config;
+
 typedef struct lr_rig_config {
     char path[LR_RIG_PATH_MAX];  /* the file it came from */
     char scene[LR_RIG_PATH_MAX]; /* resolved */
@@ -227,6 +245,7 @@ typedef struct lr_rig_config {
     double stats_period_s;
     char calib[LR_RIG_PATH_MAX]; /* resolved calibration folder; "" = no spatial AR */
     int ar_samples;
+    lr_rig_http_config http; /* "http"; off without the object */
 } lr_rig_config;
 
 /* Loads and validates path completely (every device, binding and the output; file paths are

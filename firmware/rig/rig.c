@@ -17,8 +17,10 @@
 #include "firmware/rig/ar_present.h"
 #include "firmware/rig/config.h"
 #include "firmware/rig/control_map.h"
+#include "firmware/rig/http.h"
 #include "firmware/rig/notify.h"
 #include "firmware/rig/stats.h"
+#include "firmware/rig/status_json.h"
 #include "firmware/rig/view.h"
 #include "hal/artnet.h"
 #include "hal/artnet_packet.h"
@@ -33,17 +35,20 @@
 #include "hal/sim.h"
 #include "hal/usb.h"
 #include "render/base/out_dir.h"
+#include "render/base/paths.h"
 #include "render/gl/gl.h"
 #include "render/image/image.h"
 #include "render/plan/limits.h"
 #include "render/scene/scene.h"
 #include "firmware/plan_scene.h"
+#include "firmware/version.h"
 
 #define MAX_POLL 128
 #define RETIRED_MAX 8
 #define FLUSH_MS 1000
 /* The worker's first image at start-up; minutes only under the sanitizers. */
 #define FIRST_IMAGE_MS 600000
+#define FRAME_TIMES 64 /* frame end times kept for the status's fps and interval p99 */
 
 /* What a config builds; swapped whole on reload. */
 typedef struct rigset {
@@ -102,6 +107,27 @@ struct lr_rig {
     bool ar_size_logged;   /* the frame/mode size mismatch was logged */
     lr_notify *notify;     /* sd_notify: READY, watchdog pings, RELOADING, STOPPING */
     bool ready_sent;
+    /* The status others read (firmware/rig/status_json.h, the HTTP endpoint). */
+    lr_http *http;          /* "http" in the config; NULL: no server */
+    lr_rig_http_config http_cfg; /* what it was started with (a reload keeps it) */
+    int64_t http_retry_ns;       /* the next attempt to listen; INT64_MAX: none due */
+    bool http_failed;            /* a failure to listen was logged */
+    lr_log user_log;        /* the caller's log; r->log records warnings and errors first */
+    lr_rig_status_line warnings[LR_STATUS_LOG_KEEP], errors[LR_STATUS_LOG_KEEP];
+    int n_warnings, n_errors;
+    int64_t frame_t[FRAME_TIMES]; /* ring of frame start times (the loop's clock) */
+    int n_frame_t;
+    uint64_t unmatched;
+    /* The plan the status shows (of the running scene), and the one plan_scene made last:
+     * it becomes the shown one only when its scene does (a failed reload or scene switch
+     * keeps the running scene's). */
+    struct rig_plan {
+        bool planned;
+        char text[512];
+        double error, frame_ms;
+    } plan, plan_new;
+    char http_scene[LR_RIG_PATH_MAX]; /* a shipped scene POST /api/scene asked for */
+    unsigned char *http_rgba;         /* lr_rig_frame_rgba's readback */
 };
 
 /* A console input's counters for the stats file (names: static strings, or the parsers'
@@ -160,6 +186,27 @@ static int input_counters(const rigset *s, int i, lr_rig_stats_counter *out)
             out[n++] = (lr_rig_stats_counter){"bad_", osc_kind(k), oc.bad_kind[k]};
     return n;
 }
+
+/* Every line goes to the caller's log; warnings and errors are also kept (the last
+ * LR_STATUS_LOG_KEEP of each) for the status document. */
+static void rig_log(void *user, lr_log_level level, const char *msg)
+{
+    lr_rig *r = user;
+    lr_log_write(&r->user_log, level, "%s", msg);
+    if (level > LR_LOG_WARN)
+        return;
+    lr_rig_status_line *l = level == LR_LOG_ERROR ? r->errors : r->warnings;
+    int *n = level == LR_LOG_ERROR ? &r->n_errors : &r->n_warnings;
+    if (*n == LR_STATUS_LOG_KEEP) {
+        memmove(l, l + 1, (LR_STATUS_LOG_KEEP - 1) * sizeof *l);
+        (*n)--;
+    }
+    l[*n].t_s = (double)(lr_now_ns() - r->start_ns) * 1e-9;
+    snprintf(l[*n].msg, sizeof l[*n].msg, "%s", msg);
+    (*n)++;
+}
+
+static void http_start(lr_rig *r, int64_t now);
 
 static void set_free(rigset *s)
 {
@@ -376,6 +423,7 @@ static int plan_scene(lr_rig *r, const lr_rig_config *cfg, lr_scene *scene, bool
 {
     *no_vpl = false;
     *replan = NULL;
+    r->plan_new = (struct rig_plan){.planned = false, .error = NAN, .frame_ms = NAN};
     if (r->opts.no_plan)
         return LR_OK;
     lr_plan_scene_result *res = calloc(1, sizeof *res);
@@ -389,6 +437,19 @@ static int plan_scene(lr_rig *r, const lr_rig_config *cfg, lr_scene *scene, bool
         char *text = lr_plan_scene_text(res, true); /* the log keeps every reason */
         log_lines(r, text);
         free(text);
+        /* The status keeps the brief sentence and the worst predicted error and frame time. */
+        if ((text = lr_plan_scene_text(res, false))) {
+            snprintf(r->plan_new.text, sizeof r->plan_new.text, "%s", text);
+            r->plan_new.text[strcspn(r->plan_new.text, "\n")] = '\0';
+        }
+        free(text);
+        r->plan_new.planned = true;
+        r->plan_new.error = r->plan_new.frame_ms = 0;
+        for (int i = 0; i < res->plan.nobjects; i++) {
+            const lr_plan_choice *ch = &res->plan.objects[i];
+            r->plan_new.error = fmax(r->plan_new.error, ch->predicted_error);
+            r->plan_new.frame_ms = fmax(r->plan_new.frame_ms, ch->predicted_frame_ms);
+        }
         *no_vpl = !res->vpl;
         rc = lr_rig_config_apply_sets(cfg, scene, e);
         const lr_render_settings *now = lr_scene_render(scene), *p = &res->plan.settings;
@@ -611,6 +672,7 @@ static void switch_scene(lr_rig *r, const char *path)
     r->view = view;
     r->set.scene = scene;
     r->set.replan = rp;
+    r->plan = r->plan_new;
     r->ar_dirty = true;
     lr_log_write(&r->log, LR_LOG_INFO, "scene: %s", path);
 }
@@ -625,8 +687,10 @@ static void handle_event(lr_rig *r, const lr_event *ev, int64_t now)
                 lr_dev_retry_now(r->set.devs[i], now);
     int b = lr_control_map_event(r->set.map, ev, now);
     if (b < 0) {
-        if (isfinite(ev->value))
+        if (isfinite(ev->value)) {
             lr_rig_stats_unmatched(r->stats);
+            r->unmatched++;
+        }
         return;
     }
     r->events++;
@@ -738,6 +802,9 @@ static void frame(lr_rig *r, int64_t now)
     if (r->set.calib && r->ar_dirty)
         ar_frame(r);
     r->frame_errors = 0;
+    /* The start, as the loop paces it: headless frames start at least frame_interval_ns
+     * apart, so the status's fps is at most output.fps (its end times vary with the work). */
+    r->frame_t[r->frames % FRAME_TIMES] = now;
     r->frames++;
     if (r->kms && lr_gl_flip_pending(r->gl)) {
         /* On the projector a frame shows at its page flip: the latency ends there. */
@@ -861,7 +928,8 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
     if (!r)
         return lr_err_set(e, LR_ENOMEM, "out of memory");
     r->opts = *opts;
-    r->log = opts->log;
+    r->user_log = opts->log;
+    r->log = (lr_log){rig_log, r};
     r->sigfd = -1;
     r->lamp_written = -1;
     snprintf(r->config_path, sizeof r->config_path, "%s", opts->config);
@@ -901,6 +969,7 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
     if (!rc)
         rc = set_build(r, &r->set, false, e);
     if (!rc) {
+        r->plan = r->plan_new;
         if (opts->stats_path)
             snprintf(r->stats_path, sizeof r->stats_path, "%s", opts->stats_path);
         else
@@ -943,6 +1012,11 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
     int64_t devices_ns = lr_now_ns();
     r->end_ns = opts->duration_s > 0 ? devices_ns + (int64_t)(opts->duration_s * 1e9)
                                      : INT64_MAX;
+    /* The HTTP endpoint last: it answers once the rig shows an image and takes controls. */
+    r->http_cfg = c->http;
+    r->http_retry_ns = INT64_MAX;
+    if (c->http.enabled)
+        http_start(r, devices_ns);
     r->next_stats_ns = c->stats_period_s > 0 ? r->start_ns + (int64_t)(c->stats_period_s * 1e9)
                                              : INT64_MAX;
     lr_log_write(&r->log, LR_LOG_INFO, "config %s: scene %s, %d devices, %d controls, view %s",
@@ -951,6 +1025,30 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
     apply(r, r->start_ns);
     *out = r;
     return LR_OK;
+}
+
+/* Starts the HTTP endpoint. A failure (the port taken by another program) is logged once
+ * and retried every HTTP_RETRY_NS, as a missing device is: the controls and the lamp do not
+ * depend on the page, and a show box must not go dark because a port is busy. */
+#define HTTP_RETRY_NS 2000000000LL
+static void http_start(lr_rig *r, int64_t now)
+{
+    const lr_rig_http_config *c = &r->http_cfg;
+    lr_http_desc hd = {.host = c->host, .port = c->port, .loopback = c->loopback,
+                       .token = c->token, .rig = r, .log = r->log};
+    lr_err e = {0};
+    if (lr_http_create(&hd, &r->http, &e)) {
+        if (!r->http_failed)
+            lr_log_write(&r->log, LR_LOG_ERROR, "%s; retrying every %lld s", e.msg,
+                         HTTP_RETRY_NS / 1000000000LL);
+        r->http_failed = true;
+        r->http_retry_ns = now + HTTP_RETRY_NS;
+        return;
+    }
+    r->http_retry_ns = INT64_MAX;
+    lr_log_write(&r->log, LR_LOG_INFO, "http: listening on %s%s%s:%d%s",
+                 strchr(c->host, ':') ? "[" : "", c->host, strchr(c->host, ':') ? "]" : "",
+                 lr_http_port(r->http), c->token[0] ? ", token required for changes" : "");
 }
 
 /* One line for `systemctl status` (STATUS=). */
@@ -1029,6 +1127,7 @@ static int reload(lr_rig *r, lr_err *e)
     set_free(&r->set);
     r->set = s;
     r->view = view;
+    r->plan = r->plan_new;
     ensure_rgba(r);
     r->ar_dirty = true;
     r->lamp_written = -1;
@@ -1039,6 +1138,10 @@ static int reload(lr_rig *r, lr_err *e)
     r->frame_interval_ns = frame_interval(r);
     lr_log_write(&r->log, LR_LOG_INFO, "reloaded %s: scene %s, %d devices, %d controls",
                  r->config_path, c->scene, c->n_devices, c->n_bindings);
+    if (c->http.enabled != r->http_cfg.enabled || c->http.port != r->http_cfg.port ||
+        strcmp(c->http.host, r->http_cfg.host) || strcmp(c->http.token, r->http_cfg.token))
+        lr_log_write(&r->log, LR_LOG_WARN,
+                     "reload: the \"http\" block changed; it takes effect at the next start");
     apply(r, lr_now_ns());
     return LR_OK;
 }
@@ -1084,7 +1187,7 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             break;
         /* The poll set and the earliest deadline. */
         struct pollfd fds[MAX_POLL];
-        int owner[MAX_POLL]; /* -1 signalfd, -2 gl, -3 the view, else device index */
+        int owner[MAX_POLL]; /* -1 signalfd, -2 gl, -3 the view, -4 http, else device index */
         int nf = 0;
         int64_t t = r->end_ns < until_ns ? r->end_ns : until_ns;
         if (r->sigfd >= 0) {
@@ -1102,6 +1205,15 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
         if (r->kms && lr_gl_flip_pending(r->gl) && lr_gl_event_fd(r->gl) >= 0) {
             fds[nf] = (struct pollfd){lr_gl_event_fd(r->gl), POLLIN, 0};
             owner[nf++] = -2;
+        }
+        if (r->http_retry_ns < t)
+            t = r->http_retry_ns;
+        if (r->http && nf < MAX_POLL) {
+            fds[nf] = (struct pollfd){lr_http_pollfd(r->http), POLLIN, 0};
+            owner[nf++] = -4;
+            int64_t d = lr_http_deadline(r->http, now);
+            if (d < t)
+                t = d;
         }
         for (int i = 0; i < r->set.n_devs; i++) {
             int k = lr_dev_pollfds(r->set.devs[i], fds + nf, MAX_POLL - nf);
@@ -1159,6 +1271,12 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
          * above replaced the devices (owner[] then refers to the old set). */
         for (int i = 0; i < r->set.n_devs; i++)
             lr_dev_dispatch(r->set.devs[i], now);
+        /* The HTTP endpoint the same way (MHD_run reads only what is ready); its POSTs push
+         * events into the ring, drained just below with the devices' own. */
+        if (r->http)
+            lr_http_dispatch(r->http, now);
+        else if (now >= r->http_retry_ns)
+            http_start(r, now);
         lr_event ev;
         bool any = false;
         while (lr_event_ring_pop(r->ring, &ev)) {
@@ -1173,8 +1291,15 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
         const char *sw = lr_control_map_scene_request(r->set.map);
         if (sw)
             switch_scene(r, sw);
-        if (any || sw || r->fading)
+        if (r->http_scene[0]) {
+            switch_scene(r, r->http_scene);
+            r->http_scene[0] = '\0';
+            sw = "http";
+        }
+        if (any || sw || r->fading) {
             apply(r, now);
+            lr_http_controls_changed(r->http);
+        }
         if (frame_wanted(r, now) && now >= r->next_frame_ns &&
             !(r->kms && lr_gl_flip_pending(r->gl)))
             frame(r, now);
@@ -1194,6 +1319,9 @@ void lr_rig_destroy(lr_rig *r)
         return;
     if (r->ready_sent)
         lr_notify_stopping(r->notify);
+    /* Nothing answers for the rig once it is going. */
+    lr_http_destroy(r->http);
+    r->http = NULL;
     /* The lamp driver goes to its safe level first, and we wait for the acknowledgement. */
     if (r->set.cfg) {
         for (int i = 0; i < r->set.n_lamps; i++) {
@@ -1219,6 +1347,7 @@ void lr_rig_destroy(lr_rig *r)
     if (r->used_hid)
         lr_hid_library_exit();
     free(r->rgba);
+    free(r->http_rgba);
     lr_rig_stats_destroy(r->stats);
     lr_event_ring_destroy(r->ring);
     lr_notify_destroy(r->notify);
@@ -1242,3 +1371,176 @@ void lr_rig_get_info(const lr_rig *r, lr_rig_info *out)
 }
 
 struct lr_scene *lr_rig_scene(lr_rig *r) { return r->set.scene; }
+
+/* ---- the status and requests from outside (firmware/rig/http.h) ---- */
+
+static int cmp_i64(const void *a, const void *b)
+{
+    int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* A value of a cycle binding as the status shows it: a scene file by its file name. */
+static const char *value_name(const lr_rig_binding *b, int i)
+{
+    const char *v = b->values[i];
+    const char *sl = strcmp(b->param, "scene") == 0 ? strrchr(v, '/') : NULL;
+    return sl ? sl + 1 : v;
+}
+
+void lr_rig_get_status(lr_rig *r, lr_rig_status *st)
+{
+    int64_t now = lr_now_ns();
+    const lr_rig_config *c = r->set.cfg;
+    memset(st, 0, sizeof *st);
+    st->version = lr_version();
+    st->config = r->config_path;
+    const char *scene = r->set.scene ? lr_scene_path(r->set.scene) : c->scene;
+    const char *sl = strrchr(scene, '/');
+    st->scene = sl ? sl + 1 : scene;
+    st->output = r->kms ? "kms" : "headless";
+    st->view = r->view ? lr_rig_view_name(r->view) : "";
+    st->uptime_s = (double)(now - r->start_ns) * 1e-9;
+    st->idle = r->view && !frame_due(r) && !lr_rig_view_busy(r->view);
+    st->frames = r->frames;
+    st->events = r->events;
+    st->events_unmatched = r->unmatched;
+    st->garbage = lr_control_map_garbage(r->set.map);
+    st->reloads = r->reloads;
+    st->reload_failures = r->reload_failures;
+    st->lamp_level = r->lamp_written;
+    /* fps: the frames that started in the last 2 s, over the time between the first and the
+     * last of them (0 when fewer than two: an idle rig renders nothing). The interval p99 is
+     * the nearest-rank 99th percentile of the last FRAME_TIMES - 1 start-to-start intervals. */
+    int n = r->frames < FRAME_TIMES ? (int)r->frames : FRAME_TIMES;
+    int64_t t[FRAME_TIMES], iv[FRAME_TIMES];
+    for (int i = 0; i < n; i++) /* oldest first */
+        t[i] = r->frame_t[(r->frames - (uint64_t)n + (uint64_t)i) % FRAME_TIMES];
+    int recent = 0;
+    for (int i = 0; i < n; i++)
+        recent += t[i] >= now - 2000000000LL;
+    st->fps = recent >= 2 ? (recent - 1) / ((double)(t[n - 1] - t[n - recent]) * 1e-9) : 0;
+    for (int i = 1; i < n; i++)
+        iv[i - 1] = t[i] - t[i - 1];
+    if (n >= 2) {
+        qsort(iv, (size_t)(n - 1), sizeof iv[0], cmp_i64);
+        int k = (int)ceil(0.99 * (n - 1)) - 1;
+        st->frame_interval_p99_ms = (double)iv[k < 0 ? 0 : k] * 1e-6;
+    } else {
+        st->frame_interval_p99_ms = NAN;
+    }
+    st->latency_n = lr_rig_stats_events(r->stats);
+    st->latency_median_ms = lr_rig_stats_latency_ms(r->stats, 0.5);
+    st->latency_p99_ms = lr_rig_stats_latency_ms(r->stats, 0.99);
+    st->n_devices = r->set.n_devs;
+    for (int i = 0; i < r->set.n_devs; i++) {
+        lr_dev *d = r->set.devs[i];
+        st->devices[i] = (lr_rig_status_dev){lr_dev_name(d), lr_dev_kind(d),
+                                             lr_dev_state_name(lr_dev_get_state(d))};
+    }
+    st->planned = r->plan.planned;
+    st->plan_text = r->plan.text;
+    st->plan_error = r->plan.error;
+    st->plan_frame_ms = r->plan.frame_ms;
+    st->warnings = r->warnings;
+    st->n_warnings = r->n_warnings;
+    st->errors = r->errors;
+    st->n_errors = r->n_errors;
+    st->n_controls = c->n_bindings;
+    for (int i = 0; i < c->n_bindings; i++) {
+        const lr_rig_binding *b = &c->bindings[i];
+        lr_rig_status_control *o = &st->controls[i];
+        o->name = b->name;
+        o->source = b->source;
+        o->control = b->control;
+        o->param = b->param;
+        o->cycle = b->kind == LR_BIND_CYCLE;
+        o->position = lr_control_map_position(r->set.map, i);
+        o->level = lr_control_map_level(r->set.map, i, now);
+        o->index = lr_control_map_index(r->set.map, i);
+        o->n_values = o->cycle ? b->n_values : 0;
+        for (int k = 0; k < o->n_values; k++)
+            o->values[k] = value_name(b, k);
+    }
+}
+
+static void push_absolute(lr_rig *r, const lr_rig_binding *b, double x)
+{
+    lr_event ev;
+    lr_event_set(&ev, b->source[0] ? b->source : "http", b->control, LR_EV_ABSOLUTE, x,
+                 lr_now_ns());
+    lr_event_ring_push(r->ring, &ev);
+}
+
+int lr_rig_post_control(lr_rig *r, const char *name, double x, lr_err *e)
+{
+    if (!(x >= 0 && x <= 1))
+        return lr_err_set(e, LR_EINVAL, "value must be in 0..1, got %g", x);
+    const lr_rig_config *c = r->set.cfg;
+    for (int i = 0; i < c->n_bindings; i++)
+        if (strcmp(c->bindings[i].name, name) == 0) {
+            push_absolute(r, &c->bindings[i], x);
+            return LR_OK;
+        }
+    return lr_err_set(e, LR_ENODEV, "no control named '%s'", name);
+}
+
+int lr_rig_post_scene(lr_rig *r, const char *name, lr_err *e)
+{
+    const lr_rig_config *c = r->set.cfg;
+    size_t nl = strlen(name);
+    for (int i = 0; i < c->n_bindings; i++) {
+        const lr_rig_binding *b = &c->bindings[i];
+        if (b->kind != LR_BIND_CYCLE || strcmp(b->param, "scene") != 0)
+            continue;
+        for (int k = 0; k < b->n_values; k++) {
+            const char *v = value_name(b, k);
+            if (strcmp(v, name) == 0 ||
+                (strncmp(v, name, nl) == 0 && strcmp(v + nl, ".json") == 0)) {
+                /* The middle of the value's slot: floor(x * n) = k whatever rounding. */
+                push_absolute(r, b, (k + 0.5) / b->n_values);
+                return LR_OK;
+            }
+        }
+    }
+    /* A shipped scene, by a plain name only: no path reaches outside configs/scenes/. */
+    char base[LR_RIG_PATH_MAX];
+    snprintf(base, sizeof base, "%s", name);
+    if (nl > 5 && strcmp(base + nl - 5, ".json") == 0)
+        base[nl - 5] = '\0';
+    bool plain = base[0] && strlen(base) < 64;
+    for (const char *p = base; *p && plain; p++)
+        plain = (*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9') ||
+                *p == '_' || *p == '-';
+    char path[LR_RIG_PATH_MAX];
+    struct stat sb;
+    if (plain && snprintf(path, sizeof path, "%s/scenes/%s.json", lr_configs_dir(), base) <
+                     (int)sizeof path &&
+        stat(path, &sb) == 0 && S_ISREG(sb.st_mode)) {
+        snprintf(r->http_scene, sizeof r->http_scene, "%s", path);
+        return LR_OK;
+    }
+    return lr_err_set(e, LR_ENODEV,
+                      "no scene '%s' in the config's scene binding or in %s/scenes", name,
+                      lr_configs_dir());
+}
+
+const unsigned char *lr_rig_frame_rgba(lr_rig *r, int *w, int *h, uint64_t *frame, lr_err *e)
+{
+    if (!r->frames || !r->view) {
+        lr_err_set(e, LR_ENODEV, "the rig has not rendered a frame");
+        return NULL;
+    }
+    lr_rig_view_size(r->view, w, h);
+    free(r->http_rgba);
+    if (!(r->http_rgba = malloc((size_t)*w * (size_t)*h * 4))) {
+        lr_err_set(e, LR_ENOMEM, "out of memory");
+        return NULL;
+    }
+    if (lr_rig_view_read_rgba8(r->view, r->http_rgba, e))
+        return NULL;
+    *frame = r->frames - 1;
+    return r->http_rgba;
+}
+
+int lr_rig_http_port(const lr_rig *r) { return lr_http_port(r->http); }

@@ -70,4 +70,26 @@ void lr_rig_get_info(const lr_rig *r, lr_rig_info *out);
 /* The current scene (for tests: lr_scene_get on it). */
 struct lr_scene *lr_rig_scene(lr_rig *r);
 
+/* ---- for the HTTP endpoint (firmware/rig/http.h) and other publishers of the state ---- */
+
+struct lr_rig_status;
+/* The rig's status (firmware/rig/status_json.h); its pointers stay valid until the loop runs
+ * again or the rig is reloaded. */
+void lr_rig_get_status(lr_rig *r, struct lr_rig_status *out);
+/* Moves control NAME (a binding's name) to position x in 0..1: an absolute event from the
+ * binding's source (or "http" for a binding of any source) into the event ring, taken by
+ * the control map at the loop's next drain like a device's event. LR_ENODEV: no binding of
+ * that name; LR_EINVAL: x not in 0..1. */
+int lr_rig_post_control(lr_rig *r, const char *name, double x, lr_err *e);
+/* Switches to scene NAME: a value of the config's "scene" binding (by file name, with or
+ * without ".json"; as an event through the control map, so the binding's index follows) or
+ * else a shipped scene, configs/scenes/NAME.json (NAME: letters, digits, '_', '-'), loaded
+ * on the loop. LR_ENODEV: neither. */
+int lr_rig_post_scene(lr_rig *r, const char *name, lr_err *e);
+/* The latest frame as RGBA8, rows top to bottom, read back from the view (valid until the
+ * next call); *frame its number. NULL (e set) before the first frame. */
+const unsigned char *lr_rig_frame_rgba(lr_rig *r, int *w, int *h, uint64_t *frame, lr_err *e);
+/* The HTTP endpoint's port, 0 without one. */
+int lr_rig_http_port(const lr_rig *r);
+
 #endif
