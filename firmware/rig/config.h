@@ -29,6 +29,12 @@
  *                                      (firmware/rig/ar_present.h), its clipping logged and
  *                                      counted in the stats
  *   "ar_samples": 16                   CPU reference samples per band and pixel for it
+ *   "mqtt":     {"broker": "HOST:PORT" (required; a numeric address: see mqtt.h),
+ *                "rig": "NAME" (required; the topic lamprig/NAME/status),
+ *                "role": "follower" (applies lamprig/all/...) | "status" (publishes only),
+ *                "status_period_s": 5, "keepalive_s": 10,
+ *                "retry_min_ms": 250, "retry_max_ms": 10000}   several rigs in step
+ *                                      (firmware/rig/mqtt.h)
  * }
  *
  * DEVICE: "type" (sim, modbus, gpio, hid, usb) and the options of that hal back end, read
@@ -179,6 +185,24 @@ typedef enum lr_rig_output_mode {
     LR_RIG_KMS,
 } lr_rig_output_mode;
 
+/* "mqtt": the rig's MQTT link (firmware/rig/mqtt.h); enabled only when the field is given. */
+typedef enum lr_rig_mqtt_role {
+    LR_RIG_MQTT_FOLLOWER = 0, /* subscribes to lamprig/all/... and applies it */
+    LR_RIG_MQTT_STATUS,       /* publishes its status only */
+} lr_rig_mqtt_role;
+
+typedef struct lr_rig_mqtt {
+    bool enabled;
+    char host[128];
+    int port;
+    char rig[LR_RIG_NAME_MAX];
+    lr_rig_mqtt_role role;
+    double status_period_s;
+    int keepalive_s;
+    int retry_min_ms, retry_max_ms;
+    int line; /* of the "mqtt" object, for messages */
+} lr_rig_mqtt;
+
 typedef struct lr_rig_config {
     char path[LR_RIG_PATH_MAX];  /* the file it came from */
     char scene[LR_RIG_PATH_MAX]; /* resolved */
@@ -205,6 +229,7 @@ typedef struct lr_rig_config {
     double stats_period_s;
     char calib[LR_RIG_PATH_MAX]; /* resolved calibration folder; "" = no spatial AR */
     int ar_samples;
+    lr_rig_mqtt mqtt;
 } lr_rig_config;
 
 /* Loads and validates path completely (every device, binding and the output; file paths are
