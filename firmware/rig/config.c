@@ -794,8 +794,8 @@ static int parse_mqtt(ctx *x, lr_jnode root)
         (size_t)(colon - broker) >= sizeof m->host)
         return lr_json_fail(x->j, lr_json_get(x->j, o, "broker"), "mqtt.broker", x->e, LR_EPARSE,
                             "'%s': expected HOST:PORT (port 1..65535)", broker);
-    *colon = '\0';
-    snprintf(m->host, sizeof m->host, "%s", broker);
+    memcpy(m->host, broker, (size_t)(colon - broker));
+    m->host[colon - broker] = '\0';
     m->port = (int)port;
     m->line = lr_json_line(x->j, o);
     m->enabled = true;
