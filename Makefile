@@ -43,7 +43,7 @@ else
 CC      ?= cc
 CXX     ?= c++
 PKGS    := egl glesv2 gbm libdrm libgpiod hidapi-libusb libusb-1.0 libmodbus libpng cairo lcms2 \
-           libsystemd
+           libsystemd libmosquitto
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS))
 PKG_LIBS   := $(shell pkg-config --libs $(PKGS))
 CV_CFLAGS  := $(shell pkg-config --cflags opencv4)

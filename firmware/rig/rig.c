@@ -17,6 +17,7 @@
 #include "firmware/rig/ar_present.h"
 #include "firmware/rig/config.h"
 #include "firmware/rig/control_map.h"
+#include "firmware/rig/mqtt.h"
 #include "firmware/rig/notify.h"
 #include "firmware/rig/stats.h"
 #include "firmware/rig/view.h"
@@ -33,6 +34,8 @@
 #include "render/plan/limits.h"
 #include "render/scene/scene.h"
 #include "firmware/plan_scene.h"
+#include "firmware/version.h"
+#include "render/base/paths.h"
 
 #define MAX_POLL 128
 #define RETIRED_MAX 8
@@ -94,6 +97,8 @@ struct lr_rig {
     bool ar_size_logged;   /* the frame/mode size mismatch was logged */
     lr_notify *notify;     /* sd_notify: READY, watchdog pings, RELOADING, STOPPING */
     bool ready_sent;
+    lr_mqtt *mqtt;         /* "mqtt": several rigs in step (firmware/rig/mqtt.h); NULL without */
+    lr_rig_stats_dev mqtt_devs[LR_RIG_MAX_DEVICES]; /* the status document's devices */
 };
 
 static void set_free(rigset *s)
@@ -502,6 +507,117 @@ static void handle_event(lr_rig *r, const lr_event *ev, int64_t now)
     lr_rig_stats_event(r->stats, ev);
 }
 
+/* ---- MQTT (firmware/rig/mqtt.h) ---- */
+
+/* The rig's figures for its status document. */
+static void mqtt_status(void *user, lr_mqtt_status *st)
+{
+    lr_rig *r = user;
+    lr_rig_stats_dev *devs = r->mqtt_devs;
+    for (int i = 0; i < r->set.n_devs; i++)
+        devs[i] = (lr_rig_stats_dev){lr_dev_name(r->set.devs[i]), lr_dev_kind(r->set.devs[i]),
+                                     lr_dev_state_name(lr_dev_get_state(r->set.devs[i])), NULL};
+    lr_rig_info info;
+    lr_rig_get_info(r, &info);
+    *st = (lr_mqtt_status){
+        .version = lr_version(), .config = r->config_path,
+        .scene = r->set.scene ? lr_scene_path(r->set.scene) : NULL,
+        .output = info.output, .view = info.view,
+        .uptime_s = (double)(lr_now_ns() - r->start_ns) * 1e-9,
+        .frames = r->frames, .events = r->events, .reloads = r->reloads,
+        .reload_failures = r->reload_failures, .lamp_level = r->lamp_written,
+        .latency_median_ms = lr_rig_stats_latency_ms(r->stats, 0.5),
+        .latency_p99_ms = lr_rig_stats_latency_ms(r->stats, 0.99),
+        .idle = info.idle, .devs = devs, .n_devs = r->set.n_devs};
+}
+
+static int mqtt_open(lr_rig *r, lr_err *e)
+{
+    if (!r->set.cfg->mqtt.enabled)
+        return LR_OK;
+    lr_mqtt_desc d = {.cfg = r->set.cfg, .log = r->log, .status = mqtt_status, .user = r};
+    return lr_mqtt_create(&d, lr_now_ns(), &r->mqtt, e);
+}
+
+/* "candle", "candle.json" or a path: the config's scene cycle first (its binding then moves to
+ * that value, so a button goes on from there), else a shipped scene. *binding: the cycle
+ * binding and *index its value, or -1 with the shipped path in path. */
+static bool mqtt_scene(const lr_rig *r, const char *name, int *binding, int *index, char *path,
+                       size_t cap)
+{
+    const lr_rig_config *c = r->set.cfg;
+    size_t n = strlen(name);
+    for (int b = 0; b < c->n_bindings; b++) {
+        if (strcmp(c->bindings[b].param, "scene") != 0)
+            continue;
+        for (int i = 0; i < c->bindings[b].n_values; i++) {
+            const char *v = c->bindings[b].values[i];
+            const char *base = strrchr(v, '/') ? strrchr(v, '/') + 1 : v;
+            if (strcmp(v, name) == 0 || strcmp(base, name) == 0 ||
+                (strncmp(base, name, n) == 0 && strcmp(base + n, ".json") == 0)) {
+                *binding = b;
+                *index = i;
+                return true;
+            }
+        }
+    }
+    *binding = *index = -1;
+    if (strchr(name, '/') || !n)
+        return false;
+    bool ext = n > 5 && strcmp(name + n - 5, ".json") == 0;
+    char leaf[LR_MQTT_SCENE_MAX + 8];
+    snprintf(leaf, sizeof leaf, "%s%s", name, ext ? "" : ".json");
+    struct stat st;
+    return lr_path_join(path, cap, lr_configs_dir(), "scenes", leaf) == 0 &&
+           stat(path, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+/* The commands due now, each as the event of its binding (an absolute position, like a fader
+ * of that control); a scene outside the config's cycle is switched to directly. True when an
+ * event was taken. */
+static bool mqtt_apply(lr_rig *r, int64_t now)
+{
+    if (!r->mqtt)
+        return false;
+    bool any = false;
+    lr_mqtt_cmd c;
+    while (lr_mqtt_take(r->mqtt, lr_mqtt_realtime_ns(), &c)) {
+        const lr_rig_config *cfg = r->set.cfg;
+        int b = -1, idx = -1;
+        double x = c.value;
+        if (c.kind == LR_MQTT_SCENE) {
+            char path[LR_RIG_PATH_MAX];
+            if (!mqtt_scene(r, c.scene, &b, &idx, path, sizeof path)) {
+                lr_mqtt_refuse(r->mqtt, &c, "no such scene in the config's scene cycle or "
+                                            "configs/scenes");
+                continue;
+            }
+            if (b < 0) {
+                switch_scene(r, path);
+                any = true;
+                continue;
+            }
+            /* The middle of value idx's interval: floor(x * n) picks it. */
+            x = (idx + 0.5) / cfg->bindings[b].n_values;
+        } else {
+            for (int i = 0; i < cfg->n_bindings && b < 0; i++)
+                if (strcmp(cfg->bindings[i].name, c.name) == 0)
+                    b = i;
+            if (b < 0) {
+                lr_mqtt_refuse(r->mqtt, &c, "no binding of that name");
+                continue;
+            }
+        }
+        const lr_rig_binding *bd = &cfg->bindings[b];
+        lr_event ev;
+        lr_event_set(&ev, bd->source[0] ? bd->source : "mqtt", bd->control, LR_EV_ABSOLUTE, x,
+                     now);
+        handle_event(r, &ev, now);
+        any = true;
+    }
+    return any;
+}
+
 /* ---- frames ---- */
 
 /* Files are numbered by the rig's own frame count, never the view's accumulation index: that
@@ -608,6 +724,8 @@ static void frame(lr_rig *r, int64_t now)
         ar_frame(r);
     r->frame_errors = 0;
     r->frames++;
+    if (r->mqtt)
+        lr_mqtt_frame(r->mqtt, r->frames - 1, lr_mqtt_realtime_ns());
     if (r->kms && lr_gl_flip_pending(r->gl)) {
         /* On the projector a frame shows at its page flip: the latency ends there. */
         if (r->flip_stats_pending)
@@ -800,6 +918,8 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
      * above took, so a run plays the same part of the script. */
     if (!rc)
         rc = set_devices(r, &r->set, e);
+    if (!rc)
+        rc = mqtt_open(r, e);
     if (rc) {
         lr_rig_destroy(r);
         return rc;
@@ -892,8 +1012,19 @@ static int reload(lr_rig *r, lr_err *e)
         ;
     retire_view(r);
     r->used_hid |= r->set.has_hid;
+    /* The MQTT link stays when its block is the same (only the binding names are new). */
+    bool mqtt_new = !lr_mqtt_same(&r->set.cfg->mqtt, &s.cfg->mqtt);
+    if (mqtt_new) {
+        lr_mqtt_destroy(r->mqtt);
+        r->mqtt = NULL;
+    } else if (r->mqtt) {
+        lr_mqtt_set_config(r->mqtt, s.cfg);
+    }
     set_free(&r->set);
     r->set = s;
+    lr_err me = {0};
+    if (mqtt_new && mqtt_open(r, &me))
+        lr_log_write(&r->log, LR_LOG_ERROR, "reload: %s; running without MQTT", me.msg);
     r->view = view;
     ensure_rgba(r);
     r->ar_dirty = true;
@@ -950,7 +1081,7 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             break;
         /* The poll set and the earliest deadline. */
         struct pollfd fds[MAX_POLL];
-        int owner[MAX_POLL]; /* -1 signalfd, -2 gl, -3 the view, else device index */
+        int owner[MAX_POLL]; /* -1 signalfd, -2 gl, -3 the view, -4 mqtt, else device index */
         int nf = 0;
         int64_t t = r->end_ns < until_ns ? r->end_ns : until_ns;
         if (r->sigfd >= 0) {
@@ -964,6 +1095,13 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
         if (lr_rig_view_event_fd(r->view) >= 0 && !want) {
             fds[nf] = (struct pollfd){lr_rig_view_event_fd(r->view), POLLIN, 0};
             owner[nf++] = -3;
+        }
+        if (r->mqtt) {
+            if (lr_mqtt_pollfd(r->mqtt, &fds[nf]))
+                owner[nf++] = -4;
+            int64_t d = lr_mqtt_deadline(r->mqtt, now, lr_mqtt_realtime_ns());
+            if (d < t)
+                t = d;
         }
         if (r->kms && lr_gl_flip_pending(r->gl) && lr_gl_event_fd(r->gl) >= 0) {
             fds[nf] = (struct pollfd){lr_gl_event_fd(r->gl), POLLIN, 0};
@@ -1003,6 +1141,7 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             return lr_err_set(e, LR_EIO, "poll: %s", strerror(errno));
         }
         now = lr_now_ns();
+        short mqtt_ev = 0;
         for (int i = 0; i < nf && n > 0; i++) {
             if (!fds[i].revents)
                 continue;
@@ -1010,6 +1149,8 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
                 read_signals(r);
                 if (r->stop)
                     return LR_OK;
+            } else if (owner[i] == -4) {
+                mqtt_ev = fds[i].revents;
             } else if (owner[i] == -2) {
                 lr_err ge = {0};
                 if (lr_gl_dispatch(r->gl, &ge))
@@ -1025,12 +1166,15 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
          * above replaced the devices (owner[] then refers to the old set). */
         for (int i = 0; i < r->set.n_devs; i++)
             lr_dev_dispatch(r->set.devs[i], now);
+        if (r->mqtt)
+            lr_mqtt_dispatch(r->mqtt, mqtt_ev, now);
         lr_event ev;
         bool any = false;
         while (lr_event_ring_pop(r->ring, &ev)) {
             handle_event(r, &ev, now);
             any = true;
         }
+        any |= mqtt_apply(r, now);
         if (r->n_retired)
             reap_views(r);
         lr_err ve = {0};
@@ -1072,6 +1216,7 @@ void lr_rig_destroy(lr_rig *r)
                              r->set.cfg->safe_level, lr_modbus_output_raw(r->set.lamp[i]));
         }
     }
+    lr_mqtt_destroy(r->mqtt); /* "offline" on the status topic */
     if (r->stats && r->set.cfg)
         write_stats(r, lr_now_ns());
     lr_rig_view_destroy(r->view);
