@@ -5,6 +5,7 @@
 #   make test    build with -Werror + ASan + UBSan and run every test binary
 #   make run     render the default candle scene headless
 #   make bench   speed and error figures
+#   make fuzz    the libFuzzer harnesses (tests/fuzz/), FUZZ_S=60 seconds each on their corpus
 #   make soak    the rig's soak at full length (test_fw_loop with LAMPRIG_SOAK_S=120; make
 #                test runs it for 30 s)
 #   make install  PREFIX=/usr/local DESTDIR= (see tools/install/README.md)
@@ -17,7 +18,7 @@
 # tests/AREA/test_NAME.c (plus tests/support/*.c) builds one test binary per area,
 # build/test/test_NAME (the binary name has no sub-folder: make build/test/test_scene).
 
-PUBLIC_TARGETS := all build test soak run bench install deb test-install test-boot
+PUBLIC_TARGETS := all build test soak run bench install deb test-install test-boot fuzz
 
 ifndef LAMPRIG_INNER
 # Outer make: install dependencies first, then re-enter with pkg-config available.
@@ -144,6 +145,26 @@ test: $(TESTS:%=build/test/%) build/bin/lamprig $(TOOLS:%=build/bin/lamprig-%)
 # scale with the length). LAMPRIG_SOAK_S=N make soak for another length.
 soak: build/test/test_fw_loop build/bin/lamprig
 	@LAMPRIG_SOAK_S=$${LAMPRIG_SOAK_S:-120} sh tests/run.sh build/test/test_fw_loop
+
+# libFuzzer harnesses (tests/fuzz/fuzz_NAME.c; clang): build/fuzz/fuzz_NAME from the harness and
+# the few sources it parses with, listed per harness (FUZZ_SRC_NAME). `make fuzz` runs each for
+# FUZZ_S seconds (default 60) on its committed corpus, tests/fuzz/corpus/NAME/, new finds in
+# build/fuzz/NAME/; make test replays the corpus (tests/fw/test_fw_mqtt.c) without libFuzzer.
+FUZZ_CC     ?= clang
+FUZZ_S      ?= 60
+FUZZERS     := $(sort $(patsubst tests/fuzz/fuzz_%.c,%,$(wildcard tests/fuzz/fuzz_*.c)))
+FUZZ_BASE   := render/base/json.c render/base/json_scan.c render/base/err.c render/base/file.c
+FUZZ_SRC_mqtt_payload := firmware/rig/mqtt_payload.c $(FUZZ_BASE)
+build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c $$(FUZZ_SRC_$$*)
+	@mkdir -p $(@D)
+	@echo "  FUZZ    $@"
+	$(Q)$(FUZZ_CC) -std=c11 -D_GNU_SOURCE -I. -O1 -g -fsanitize=fuzzer,address,undefined \
+	    -fno-sanitize-recover=undefined $^ -lm -o $@
+.PHONY: fuzz
+fuzz: $(FUZZERS:%=build/fuzz/fuzz_%)
+	@for f in $(FUZZERS); do mkdir -p build/fuzz/$$f && \
+	    build/fuzz/fuzz_$$f build/fuzz/$$f tests/fuzz/corpus/$$f -max_total_time=$(FUZZ_S) \
+	    || exit 1; done
 
 # ---- install, package ----
 # The layout paths.h looks for: BINDIR/lamprig finds BINDIR/../share/lamprig/{configs,shaders}

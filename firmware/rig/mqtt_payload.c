@@ -101,11 +101,11 @@ int lr_mqtt_payload_parse(const char *topic, const void *payload, size_t len, lr
 
 int lr_mqtt_payload_format(const lr_mqtt_cmd *c, char *buf, size_t cap)
 {
-    char val[2 * LR_MQTT_SCENE_MAX + 8];
+    char val[6 * LR_MQTT_SCENE_MAX + 8]; /* every byte escaped as \u00XX at worst */
     if (c->kind == LR_MQTT_SCENE) {
         size_t k = 0;
         val[k++] = '"';
-        for (const char *s = c->scene; *s && k + 8 < sizeof val; s++) {
+        for (const char *s = c->scene; *s; s++) {
             unsigned char ch = (unsigned char)*s;
             if (ch == '"' || ch == '\\') {
                 val[k++] = '\\';
@@ -122,9 +122,15 @@ int lr_mqtt_payload_format(const lr_mqtt_cmd *c, char *buf, size_t cap)
         /* 17 significant digits read back to the same double. */
         snprintf(val, sizeof val, "%.17g", c->value);
     }
-    int w = c->has_apply_at
-                ? snprintf(buf, cap, "{\"value\": %s, \"apply_at\": %lld}", val,
-                           (long long)c->apply_at_ns)
-                : snprintf(buf, cap, "{\"value\": %s}", val);
+    int w;
+    if (!c->has_apply_at)
+        w = snprintf(buf, cap, "{\"value\": %s}", val);
+    else if (c->apply_at_ns >= LR_MQTT_NS_THRESHOLD)
+        w = snprintf(buf, cap, "{\"value\": %s, \"apply_at\": %lld}", val,
+                     (long long)c->apply_at_ns);
+    else /* below the threshold an integer would read as seconds: write seconds */
+        w = snprintf(buf, cap, "{\"value\": %s, \"apply_at\": %lld.%09lld}", val,
+                     (long long)(c->apply_at_ns / 1000000000LL),
+                     (long long)(c->apply_at_ns % 1000000000LL));
     return w < 0 || (size_t)w >= cap ? -1 : w;
 }

@@ -62,7 +62,9 @@ int lr_mqtt_payload_parse(const char *topic, const void *payload, size_t len, lr
                           lr_err *e);
 
 /* Writes a command's payload ({"value": ..., "apply_at": NS}) into buf; the length, or -1
- * when it does not fit. The scene name is JSON-escaped. */
+ * when it does not fit (6 * LR_MQTT_SCENE_MAX + 64 bytes always do). The scene name is
+ * JSON-escaped; an apply_at below LR_MQTT_NS_THRESHOLD ns is written in seconds, so that
+ * every command reads back the same. */
 int lr_mqtt_payload_format(const lr_mqtt_cmd *c, char *buf, size_t cap);
 
 #endif
