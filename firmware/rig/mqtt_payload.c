@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "render/base/json.h"
@@ -119,8 +120,11 @@ int lr_mqtt_payload_format(const lr_mqtt_cmd *c, char *buf, size_t cap)
         val[k++] = '"';
         val[k] = '\0';
     } else {
-        /* 17 significant digits read back to the same double. */
-        snprintf(val, sizeof val, "%.17g", c->value);
+        /* The shortest of 15 and 17 significant digits that reads back to the same double
+         * (17 always do): 0.4, not 0.40000000000000002. */
+        snprintf(val, sizeof val, "%.15g", c->value);
+        if (strtod(val, NULL) != c->value)
+            snprintf(val, sizeof val, "%.17g", c->value);
     }
     int w;
     if (!c->has_apply_at)
