@@ -9,6 +9,9 @@ set -eu
 # check `make deb`'s package and unit in tests/install.sh; dpkg-dev comes with build-essential.
 # systemd-container (systemd-nspawn) and debootstrap boot the package under systemd in
 # tests/boot.sh (make test-boot).
+# libmosquitto-dev: the rig's MQTT client (firmware/rig/mqtt.c, lamprig mqtt-send); mosquitto:
+# the broker test_fw_mqtt starts; iproute2: ip(8), its network namespaces and veth pair;
+# clang: `make fuzz` (libFuzzer harnesses in tests/fuzz/).
 PKGS="build-essential pkg-config
 libgpiod-dev libhidapi-dev libusb-1.0-0-dev libmodbus-dev
 libegl-dev libgles-dev libgbm-dev libdrm-dev libegl-mesa0 libgl1-mesa-dri libgbm1
@@ -16,6 +19,7 @@ libopencv-dev libopencv-contrib-dev
 opencv-doc
 libpng-dev libcairo2-dev liblcms2-dev libcmocka-dev
 libsystemd-dev
+libmosquitto-dev mosquitto iproute2 clang
 lintian systemd
 systemd-container debootstrap"
 
