@@ -432,6 +432,16 @@ bool lr_mqtt_take(lr_mqtt *m, int64_t now_rt_ns, lr_mqtt_cmd *out)
     return true;
 }
 
+bool lr_mqtt_pending_scene(const lr_mqtt *m, lr_mqtt_cmd *out)
+{
+    for (int i = 0; i < MAX_KEYS; i++)
+        if (m->pending[i].used && m->pending[i].cmd.kind == LR_MQTT_SCENE) {
+            *out = m->pending[i].cmd;
+            return true;
+        }
+    return false;
+}
+
 void lr_mqtt_frame(lr_mqtt *m, uint64_t index, int64_t now_rt_ns)
 {
     if (!m->last.valid || m->last.framed)

@@ -87,6 +87,9 @@ void lr_mqtt_dispatch(lr_mqtt *m, short revents, int64_t now_ns);
  * apply_at. false when none is due. The command counts as applied; its frame is recorded by
  * the next lr_mqtt_frame. */
 bool lr_mqtt_take(lr_mqtt *m, int64_t now_rt_ns, lr_mqtt_cmd *out);
+/* The scene command waiting for its apply_at, if any (not taken: the rig loads that scene
+ * ahead, so the switch at apply_at is a swap). */
+bool lr_mqtt_pending_scene(const lr_mqtt *m, lr_mqtt_cmd *out);
 /* The rig could not apply a command it took (a scene that does not load): logged, counted. */
 void lr_mqtt_refuse(lr_mqtt *m, const lr_mqtt_cmd *c, const char *why);
 /* A frame was drawn (index as in --out-dir's frame_NNNNNN, CLOCK_REALTIME at its end). */

@@ -99,6 +99,17 @@ struct lr_rig {
     bool ready_sent;
     lr_mqtt *mqtt;         /* "mqtt": several rigs in step (firmware/rig/mqtt.h); NULL without */
     lr_rig_stats_dev mqtt_devs[LR_RIG_MAX_DEVICES]; /* the status document's devices */
+    /* An MQTT scene command ahead of its apply_at: that scene loaded and planned and its view
+     * built in advance (mqtt_prepare), so that the switch at apply_at is a swap and the rigs
+     * do not differ by their load times. */
+    struct {
+        bool valid;
+        char path[LR_RIG_PATH_MAX];
+        lr_scene *scene;
+        lr_replan *replan;
+        lr_rig_view *view;
+    } pre;
+    char pre_key[LR_MQTT_SCENE_MAX + 24]; /* the command last prepared (tried once) */
 };
 
 static void set_free(rigset *s)
@@ -449,8 +460,89 @@ static void reap_views(lr_rig *r)
     r->n_retired = keep;
 }
 
+static void pre_drop(lr_rig *r)
+{
+    if (!r->pre.valid)
+        return;
+    lr_rig_view *cur = r->view;
+    r->view = r->pre.view;
+    retire_view(r); /* off the loop like any replaced view; its scene may go now */
+    r->view = cur;
+    lr_replan_destroy(r->pre.replan);
+    lr_scene_destroy(r->pre.scene);
+    memset(&r->pre, 0, sizeof r->pre);
+}
+
+/* Loads path, plans it and builds its view with the controls' values as they stand (a
+ * scratch map carrying the live one's positions: the live map keeps writing the scene shown).
+ * A failure is logged; the switch at apply_at then loads it as usual (and says why). */
+static void pre_load(lr_rig *r, const char *path)
+{
+    pre_drop(r);
+    lr_scene *scene = NULL;
+    lr_err e = {0};
+    lr_warn_sink warn = {scene_warn, r};
+    bool no_vpl = false;
+    lr_replan *rp = NULL;
+    if (lr_scene_load(path, &warn, &scene, &e) ||
+        lr_rig_config_apply_sets(r->set.cfg, scene, &e) ||
+        plan_scene(r, r->set.cfg, scene, &no_vpl, &rp, &e) || lr_plan_check_models(scene, &e)) {
+        lr_log_write(&r->log, LR_LOG_WARN, "mqtt: scene %s not loaded ahead: %s", path, e.msg);
+        lr_replan_destroy(rp);
+        lr_scene_destroy(scene);
+        return;
+    }
+    int64_t now = lr_now_ns();
+    lr_control_map *tmp = NULL;
+    unsigned dirty = 0;
+    if (lr_control_map_create(r->set.cfg, scene, false, now, &tmp, &e) == LR_OK) {
+        lr_control_map_carry(tmp, r->set.map, now);
+        lr_control_map_update(tmp, scene, now, &dirty, &e);
+    }
+    lr_control_map_destroy(tmp);
+    lr_rig_view *view;
+    if (view_build(r, scene, no_vpl, &view, &e)) {
+        lr_log_write(&r->log, LR_LOG_WARN, "mqtt: scene %s not loaded ahead: %s", path, e.msg);
+        lr_replan_destroy(rp);
+        lr_scene_destroy(scene);
+        return;
+    }
+    r->pre.valid = true;
+    snprintf(r->pre.path, sizeof r->pre.path, "%s", path);
+    r->pre.scene = scene;
+    r->pre.replan = rp;
+    r->pre.view = view;
+    lr_log_write(&r->log, LR_LOG_INFO, "mqtt: scene %s loaded ahead of its apply_at", path);
+}
+
+/* The switch to the scene loaded ahead: the controls are written into it again (what moved
+ * since it was loaded), then it and its view replace the shown ones. */
+static void pre_commit(lr_rig *r)
+{
+    lr_err e = {0};
+    lr_control_map_scene_replaced(r->set.map);
+    unsigned dirty = 0;
+    if (lr_control_map_update(r->set.map, r->pre.scene, lr_now_ns(), &dirty, &e))
+        lr_log_write(&r->log, LR_LOG_WARN, "control map: %s", e.msg);
+    if (dirty)
+        lr_rig_view_invalidate(r->pre.view, dirty);
+    retire_view(r);
+    lr_replan_destroy(r->set.replan);
+    lr_scene_destroy(r->set.scene);
+    r->view = r->pre.view;
+    r->set.scene = r->pre.scene;
+    r->set.replan = r->pre.replan;
+    r->ar_dirty = true;
+    lr_log_write(&r->log, LR_LOG_INFO, "scene: %s (loaded ahead)", r->pre.path);
+    memset(&r->pre, 0, sizeof r->pre);
+}
+
 static void switch_scene(lr_rig *r, const char *path)
 {
+    if (r->pre.valid && strcmp(r->pre.path, path) == 0) {
+        pre_commit(r);
+        return;
+    }
     lr_scene *scene = NULL;
     lr_err e = {0};
     lr_warn_sink warn = {scene_warn, r};
@@ -570,6 +662,28 @@ static bool mqtt_scene(const lr_rig *r, const char *name, int *binding, int *ind
     struct stat st;
     return lr_path_join(path, cap, lr_configs_dir(), "scenes", leaf) == 0 &&
            stat(path, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+/* A scene command ahead of its time: its scene loaded in advance (once per command). */
+static void mqtt_prepare(lr_rig *r)
+{
+    lr_mqtt_cmd c;
+    if (!lr_mqtt_pending_scene(r->mqtt, &c) || !c.has_apply_at ||
+        c.apply_at_ns <= lr_mqtt_realtime_ns())
+        return;
+    char key[sizeof r->pre_key];
+    snprintf(key, sizeof key, "%lld %s", (long long)c.apply_at_ns, c.scene);
+    if (strcmp(key, r->pre_key) == 0)
+        return;
+    snprintf(r->pre_key, sizeof r->pre_key, "%s", key);
+    int b, idx;
+    char path[LR_RIG_PATH_MAX];
+    if (!mqtt_scene(r, c.scene, &b, &idx, path, sizeof path))
+        return; /* refused when it is due */
+    if (b >= 0)
+        snprintf(path, sizeof path, "%s", r->set.cfg->bindings[b].values[idx]);
+    if (!(r->pre.valid && strcmp(r->pre.path, path) == 0))
+        pre_load(r, path);
 }
 
 /* The commands due now, each as the event of its binding (an absolute position, like a fader
@@ -1012,6 +1126,8 @@ static int reload(lr_rig *r, lr_err *e)
         ;
     retire_view(r);
     r->used_hid |= r->set.has_hid;
+    pre_drop(r); /* loaded for the old config's controls */
+    r->pre_key[0] = '\0';
     /* The MQTT link stays when its block is the same (only the binding names are new). */
     bool mqtt_new = !lr_mqtt_same(&r->set.cfg->mqtt, &s.cfg->mqtt);
     if (mqtt_new) {
@@ -1166,8 +1282,10 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
          * above replaced the devices (owner[] then refers to the old set). */
         for (int i = 0; i < r->set.n_devs; i++)
             lr_dev_dispatch(r->set.devs[i], now);
-        if (r->mqtt)
+        if (r->mqtt) {
             lr_mqtt_dispatch(r->mqtt, mqtt_ev, now);
+            mqtt_prepare(r);
+        }
         lr_event ev;
         bool any = false;
         while (lr_event_ring_pop(r->ring, &ev)) {
@@ -1220,6 +1338,9 @@ void lr_rig_destroy(lr_rig *r)
     if (r->stats && r->set.cfg)
         write_stats(r, lr_now_ns());
     lr_rig_view_destroy(r->view);
+    lr_rig_view_destroy(r->pre.view);
+    lr_replan_destroy(r->pre.replan);
+    lr_scene_destroy(r->pre.scene);
     for (int i = 0; i < r->n_retired; i++)
         lr_rig_view_destroy(r->retired[i]);
     lr_ar_present_destroy(r->ar_out);

@@ -7,8 +7,8 @@
  * same sanitizers) in two network namespaces joined by a veth pair; the broker and rig a in
  * one, rig b in the other. A change published once reaches both and shows in frames whose
  * times differ by at most one frame interval; the broker restarts and a rig restarts, and the
- * restarted rig picks up the retained state; a bad payload is counted, never applied; a
- * killed rig's last will says "offline".
+ * restarted rig picks up the retained state; a reload keeps the link; a bad payload is
+ * counted, never applied; a killed rig's last will says "offline".
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -25,6 +25,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -225,6 +226,7 @@ typedef struct world {
     pid_t broker, rig_a, rig_b;
     struct mosquitto *cli;
     rigview a, b;
+    bool lib; /* mosquitto_lib_init done */
 } world;
 
 static int64_t rt_ns(void) { return lr_mqtt_realtime_ns(); }
@@ -257,6 +259,7 @@ static pid_t spawn(world *w, const char *ns, const char *log, char *const argv[]
     pid_t pid = fork();
     assert_true(pid >= 0);
     if (pid == 0) {
+        prctl(PR_SET_PDEATHSIG, SIGKILL); /* a test that dies leaves no broker or rig behind */
         enter_ns(ns);
         int fd = open(out, O_WRONLY | O_CREAT | O_APPEND, 0644);
         if (fd >= 0) {
@@ -437,6 +440,12 @@ static bool b_bad(world *w, const void *arg)
     return ifield(w->b.doc, "mqtt", "bad") >= *(const int64_t *)arg;
 }
 
+static bool a_reloaded(world *w, const void *arg)
+{
+    (void)arg;
+    return ifield(w->a.doc, "reloads", NULL) == 1;
+}
+
 static bool a_offline(world *w, const void *arg)
 {
     (void)arg;
@@ -528,8 +537,10 @@ static void write_files(world *w)
     }
 }
 
-static void teardown_world(world *w)
+/* cmocka's teardown: runs after a failed assertion too, so nothing is left behind. */
+static int teardown_world(void **state)
 {
+    world *w = *state;
     if (w->cli)
         mosquitto_destroy(w->cli);
     stop(&w->rig_a, SIGKILL);
@@ -539,29 +550,43 @@ static void teardown_world(world *w)
         setns(w->home_ns, CLONE_NEWNET);
         close(w->home_ns);
     }
-    sh("ip netns del %s 2>/dev/null; ip netns del %s 2>/dev/null", w->ns_a, w->ns_b);
-    mosquitto_lib_cleanup();
-    lr_test_rmtree(w->dir);
+    if (w->ns_a[0])
+        sh("ip netns del %s 2>/dev/null; ip netns del %s 2>/dev/null", w->ns_a, w->ns_b);
+    if (w->lib)
+        mosquitto_lib_cleanup();
+    if (w->dir)
+        lr_test_rmtree(w->dir);
+    free(w);
+    return 0;
+}
+
+static int setup_world(void **state)
+{
+    world *w = calloc(1, sizeof *w);
+    if (!w)
+        return -1;
+    w->home_ns = -1;
+    *state = w;
+    return 0;
 }
 
 static void test_two_rigs(void **state)
 {
-    (void)state;
     if (geteuid() != 0 || access("/usr/sbin/mosquitto", X_OK) != 0 ||
         sh("command -v ip >/dev/null") != 0) {
         fprintf(stderr, "two rigs: needs root, ip(8) and mosquitto: skipped\n");
         skip();
     }
-    world w = {.home_ns = -1};
-    w.dir = lr_test_tmpdir();
+    world *w = *state;
+    w->dir = lr_test_tmpdir();
     int id = (int)(getpid() % 200) + 20;
-    snprintf(w.ns_a, sizeof w.ns_a, "lrmq-a-%d", (int)getpid());
-    snprintf(w.ns_b, sizeof w.ns_b, "lrmq-b-%d", (int)getpid());
-    snprintf(w.addr_a, sizeof w.addr_a, "10.231.%d.1", id);
-    snprintf(w.addr_b, sizeof w.addr_b, "10.231.%d.2", id);
-    ssize_t sl = readlink("/proc/self/exe", w.self, sizeof w.self - 1);
+    snprintf(w->ns_a, sizeof w->ns_a, "lrmq-a-%d", (int)getpid());
+    snprintf(w->ns_b, sizeof w->ns_b, "lrmq-b-%d", (int)getpid());
+    snprintf(w->addr_a, sizeof w->addr_a, "10.231.%d.1", id);
+    snprintf(w->addr_b, sizeof w->addr_b, "10.231.%d.2", id);
+    ssize_t sl = readlink("/proc/self/exe", w->self, sizeof w->self - 1);
     assert_true(sl > 0);
-    w.self[sl] = '\0';
+    w->self[sl] = '\0';
     char va[16], vb[16];
     snprintf(va, sizeof va, "lrmqa%d", (int)getpid() % 100000);
     snprintf(vb, sizeof vb, "lrmqb%d", (int)getpid() % 100000);
@@ -571,84 +596,92 @@ static void test_two_rigs(void **state)
                 "ip -n %s addr add %s/24 dev %s && ip -n %s addr add %s/24 dev %s && "
                 "ip -n %s link set %s up && ip -n %s link set %s up && "
                 "ip -n %s link set lo up && ip -n %s link set lo up",
-                w.ns_a, w.ns_b, va, vb, va, w.ns_a, vb, w.ns_b, w.ns_a, w.addr_a, va, w.ns_b,
-                w.addr_b, vb, w.ns_a, va, w.ns_b, vb, w.ns_a, w.ns_b);
+                w->ns_a, w->ns_b, va, vb, va, w->ns_a, vb, w->ns_b, w->ns_a, w->addr_a, va, w->ns_b,
+                w->addr_b, vb, w->ns_a, va, w->ns_b, vb, w->ns_a, w->ns_b);
     if (rc != 0) {
-        sh("ip netns del %s 2>/dev/null; ip netns del %s 2>/dev/null", w.ns_a, w.ns_b);
-        lr_test_rmtree(w.dir);
         fprintf(stderr, "two rigs: cannot create network namespaces here: skipped\n");
         skip();
     }
-    w.home_ns = open("/proc/self/ns/net", O_RDONLY | O_CLOEXEC);
-    enter_ns(w.ns_a); /* this process's client talks to the broker from its namespace */
+    w->home_ns = open("/proc/self/ns/net", O_RDONLY | O_CLOEXEC);
+    enter_ns(w->ns_a); /* this process's client talks to the broker from its namespace */
     mosquitto_lib_init();
-    write_files(&w);
+    w->lib = true;
+    write_files(w);
 
-    w.broker = start_broker(&w);
-    w.rig_a = start_rig(&w, "a", w.ns_a);
-    w.rig_b = start_rig(&w, "b", w.ns_b); /* across the veth pair */
-    client_connect(&w);
-    if (!wait_for(&w, both_online, NULL, 60000)) { /* start-up under the sanitizers */
-        dump(&w);
-        teardown_world(&w);
+    w->broker = start_broker(w);
+    w->rig_a = start_rig(w, "a", w->ns_a);
+    w->rig_b = start_rig(w, "b", w->ns_b); /* across the veth pair */
+    client_connect(w);
+    if (!wait_for(w, both_online, NULL, 60000)) { /* start-up under the sanitizers */
+        dump(w);
         fail_msg("the rigs did not come online");
     }
 
     /* 1. One change, published once, in step on both rigs. */
-    int64_t at = publish(&w, "control/dimmer", "0.8", rt_ns() + LEAD_NS);
-    check_in_step(&w, at, "dimmer 0.8");
-    assert_true(ifield(w.a.doc, "events", NULL) >= 1 && ifield(w.b.doc, "events", NULL) >= 1);
+    int64_t at = publish(w, "control/dimmer", "0.8", rt_ns() + LEAD_NS);
+    check_in_step(w, at, "dimmer 0.8");
+    assert_true(ifield(w->a.doc, "events", NULL) >= 1 && ifield(w->b.doc, "events", NULL) >= 1);
 
     /* 2. A bad payload: logged with its topic, counted, the rigs run on. */
     const char *junk = "{\"value\": \"loud\"}";
-    int64_t bad0 = ifield(w.b.doc, "mqtt", "bad") + 1;
-    assert_int_equal(mosquitto_publish(w.cli, NULL, "lamprig/all/control/dimmer",
+    int64_t bad0 = ifield(w->b.doc, "mqtt", "bad") + 1;
+    assert_int_equal(mosquitto_publish(w->cli, NULL, "lamprig/all/control/dimmer",
                                        (int)strlen(junk), junk, 1, false),
                      MOSQ_ERR_SUCCESS);
-    assert_true(wait_for(&w, b_bad, &bad0, 10000));
+    assert_true(wait_for(w, b_bad, &bad0, 10000));
 
     /* 3. The broker restarts (its retained messages persisted); both rigs reconnect and the
      * next change is in step again. */
-    stop(&w.broker, SIGTERM);
-    w.broker = start_broker(&w);
-    client_connect(&w);
+    stop(&w->broker, SIGTERM);
+    w->broker = start_broker(w);
+    client_connect(w);
     int64_t two = 2;
-    if (!wait_for(&w, connects_at_least, &two, 20000)) {
-        dump(&w);
-        teardown_world(&w);
+    if (!wait_for(w, connects_at_least, &two, 20000)) {
+        dump(w);
         fail_msg("the rigs did not reconnect after the broker restart");
     }
-    at = publish(&w, "control/dimmer", "0.3", rt_ns() + LEAD_NS);
-    check_in_step(&w, at, "dimmer 0.3 after a broker restart");
+    at = publish(w, "control/dimmer", "0.3", rt_ns() + LEAD_NS);
+    check_in_step(w, at, "dimmer 0.3 after a broker restart");
 
     /* 4. Rig b restarts: "offline" on a clean stop, then it takes the retained state. */
-    assert_clean_exit(&w, stop(&w.rig_b, SIGTERM));
-    assert_true(wait_for(&w, b_offline, NULL, 10000));
-    w.rig_b = start_rig(&w, "b", w.ns_b);
-    if (!wait_for(&w, b_framed, &at, 60000)) {
-        dump(&w);
-        teardown_world(&w);
+    assert_clean_exit(w, stop(&w->rig_b, SIGTERM));
+    assert_true(wait_for(w, b_offline, NULL, 10000));
+    w->rig_b = start_rig(w, "b", w->ns_b);
+    if (!wait_for(w, b_framed, &at, 60000)) {
+        dump(w);
         fail_msg("the restarted rig did not pick up the retained dimmer");
     }
     double v = NAN;
-    field(w.b.doc, "last_change", "value", NULL, &v);
+    field(w->b.doc, "last_change", "value", NULL, &v);
     assert_true(v == 0.3);
 
-    /* 5. A rig that dies: the broker publishes its last will. */
-    stop(&w.rig_a, SIGKILL);
-    assert_true(wait_for(&w, a_offline, NULL, 10000));
+    /* 5. Rig a reloads its config (SIGHUP, the same "mqtt" block): the link stays (no new
+     * connect) and the next change, a scene of the cycle, is in step on both. */
+    int64_t conn_a = ifield(w->a.doc, "mqtt", "connects");
+    kill(w->rig_a, SIGHUP);
+    if (!wait_for(w, a_reloaded, NULL, 30000)) { /* seconds under the sanitizers */
+        dump(w);
+        fail_msg("rig a did not reload");
+    }
+    at = publish(w, "scene", "\"votive\"", rt_ns() + LEAD_NS);
+    check_in_step(w, at, "scene votive after a reload of rig a");
+    assert_int_equal(ifield(w->a.doc, "mqtt", "connects"), conn_a);
+    assert_int_equal(ifield(w->a.doc, "reloads", NULL), 1);
 
-    assert_clean_exit(&w, stop(&w.rig_b, SIGTERM));
+    /* 6. A rig that dies: the broker publishes its last will. */
+    stop(&w->rig_a, SIGKILL);
+    assert_true(wait_for(w, a_offline, NULL, 10000));
+
+    assert_clean_exit(w, stop(&w->rig_b, SIGTERM));
     /* The bad payload was logged naming its topic. */
-    char *lb = lr_test_path(w.dir, "rig-b.log");
+    char *lb = lr_test_path(w->dir, "rig-b.log");
     size_t len;
     char *text = (char *)lr_test_read(lb, &len);
     free(lb);
     bool named = strstr(text, "mqtt: lamprig/all/control/dimmer:1: field 'value'") != NULL;
     free(text);
     if (!named)
-        dump(&w);
-    teardown_world(&w);
+        dump(w);
     assert_true(named);
 }
 
@@ -661,7 +694,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_payload_refusals),
         cmocka_unit_test(test_fuzz_corpus),
         cmocka_unit_test(test_config_mqtt),
-        cmocka_unit_test(test_two_rigs),
+        cmocka_unit_test_setup_teardown(test_two_rigs, setup_world, teardown_world),
     };
     if (getenv("LR_TEST_FILTER"))
         cmocka_set_test_filter(getenv("LR_TEST_FILTER"));
