@@ -10,7 +10,8 @@
  *     rig that joins late, restarts or reconnects gets the current state from the retained
  *     messages and applies it at once (apply_at in the past). A retained message already
  *     applied (the broker sends it again after a reconnect) is not applied twice, so a local
- *     knob moved since is not overridden.
+ *     knob moved since is not overridden. A scene command ahead of its apply_at is loaded in
+ *     advance by the rig (lr_mqtt_pending_scene), so its switch is a swap.
  *
  * Nothing blocks the loop: the client's socket is in the poll set (mosquitto_socket, read,
  * write when mosquitto_want_write, mosquitto_loop_misc for the keepalive), the connect is
