@@ -1197,7 +1197,7 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             break;
         /* The poll set and the earliest deadline. */
         struct pollfd fds[MAX_POLL];
-        int owner[MAX_POLL]; /* -1 signalfd, -2 gl, -3 the view, -4 mqtt, else device index */
+        int owner[MAX_POLL]; /* -1 signalfd, -2 gl, -3 the view, -5 mqtt, else device index */
         int nf = 0;
         int64_t t = r->end_ns < until_ns ? r->end_ns : until_ns;
         if (r->sigfd >= 0) {
@@ -1213,8 +1213,8 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             owner[nf++] = -3;
         }
         if (r->mqtt) {
-            if (lr_mqtt_pollfd(r->mqtt, &fds[nf]))
-                owner[nf++] = -4;
+            if (nf < MAX_POLL && lr_mqtt_pollfd(r->mqtt, &fds[nf]))
+                owner[nf++] = -5;
             int64_t d = lr_mqtt_deadline(r->mqtt, now, lr_mqtt_realtime_ns());
             if (d < t)
                 t = d;
@@ -1265,7 +1265,7 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
                 read_signals(r);
                 if (r->stop)
                     return LR_OK;
-            } else if (owner[i] == -4) {
+            } else if (owner[i] == -5) {
                 mqtt_ev = fds[i].revents;
             } else if (owner[i] == -2) {
                 lr_err ge = {0};
