@@ -5,7 +5,7 @@
  * System part (root: network namespaces): a real mosquitto broker with a config file of its
  * own and two `lamprig run --headless` rigs (this binary re-executed as lamprig, under the
  * same sanitizers) in two network namespaces joined by a veth pair; the broker and rig a in
- * one, rig b in the other. A change published once reaches both and shows in frames whose
+ * one, rig b in the other. The rigs start before the broker and connect when it appears. A change published once reaches both and shows in frames whose
  * times differ by at most one frame interval; the broker restarts and a rig restarts, and the
  * restarted rig picks up the retained state; a reload keeps the link; a bad payload is
  * counted, never applied; a killed rig's last will says "offline".
@@ -470,6 +470,25 @@ static int64_t publish(world *w, const char *topic_leaf, const char *value_json,
     return at;
 }
 
+/* Waits until dir/name holds needle. */
+static bool log_has(world *w, const char *name, const char *needle, int ms)
+{
+    char *p = lr_test_path(w->dir, name);
+    bool found = false;
+    for (int i = 0; i <= ms / 20 && !found; i++) {
+        FILE *f = fopen(p, "r");
+        char line[4096];
+        while (f && !found && fgets(line, sizeof line, f))
+            found = strstr(line, needle) != NULL;
+        if (f)
+            fclose(f);
+        if (!found)
+            usleep(20000);
+    }
+    free(p);
+    return found;
+}
+
 static void dump(world *w)
 {
     static const char *const logs[] = {"broker.log", "rig-a.log", "rig-b.log"};
@@ -608,9 +627,16 @@ static void test_two_rigs(void **state)
     w->lib = true;
     write_files(w);
 
-    w->broker = start_broker(w);
+    /* The rigs start before the broker: each says once that it is unreachable, runs on, and
+     * connects when it appears (the backoff's retries). */
     w->rig_a = start_rig(w, "a", w->ns_a);
     w->rig_b = start_rig(w, "b", w->ns_b); /* across the veth pair */
+    if (!log_has(w, "rig-a.log", "unreachable", 60000) ||
+        !log_has(w, "rig-b.log", "unreachable", 60000)) {
+        dump(w);
+        fail_msg("the rigs did not report the missing broker");
+    }
+    w->broker = start_broker(w);
     client_connect(w);
     if (!wait_for(w, both_online, NULL, 60000)) { /* start-up under the sanitizers */
         dump(w);
