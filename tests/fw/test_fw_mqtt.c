@@ -492,6 +492,35 @@ static bool log_has(world *w, const char *name, const char *needle, int ms)
     return found;
 }
 
+/* `lamprig mqtt-send --control NAME --value V --lead-ms LEAD_NS` from the broker's namespace:
+ * exit 0 and the line it prints; returns its apply_at. */
+static int64_t mqtt_send(world *w, const char *name, const char *value)
+{
+    char broker[64], lead[32];
+    snprintf(broker, sizeof broker, "%s:%d", w->addr_a, PORT);
+    snprintf(lead, sizeof lead, "%lld", LEAD_NS / 1000000LL);
+    char *argv[] = {w->self, CHILD_FLAG, "mqtt-send", "--broker", broker, "--control",
+                    (char *)name, "--value", (char *)value, "--lead-ms", lead, NULL};
+    int64_t before = rt_ns();
+    pid_t p = spawn(w, w->ns_a, "send.log", argv);
+    int st = stop(&p, 0);
+    char *path = lr_test_path(w->dir, "send.log");
+    size_t len;
+    char *text = (char *)lr_test_read(path, &len);
+    free(path);
+    char topic[64];
+    snprintf(topic, sizeof topic, "lamprig/all/control/%s {\"value\": %s, \"apply_at\": ", name,
+             value);
+    const char *at = strstr(text, topic);
+    int64_t t = at ? strtoll(at + strlen(topic), NULL, 10) : -1;
+    if (!WIFEXITED(st) || WEXITSTATUS(st) != 0 || t < before + LEAD_NS) {
+        dump(w);
+        fail_msg("mqtt-send: status %d, printed '%s'", st, text);
+    }
+    free(text);
+    return t;
+}
+
 static void dump(world *w)
 {
     static const char *const logs[] = {"broker.log", "rig-a.log", "rig-b.log"};
@@ -669,8 +698,8 @@ static void test_two_rigs(void **state)
         dump(w);
         fail_msg("the rigs did not reconnect after the broker restart");
     }
-    at = publish(w, "control/dimmer", "0.3", rt_ns() + LEAD_NS);
-    check_in_step(w, at, "dimmer 0.3 after a broker restart");
+    at = mqtt_send(w, "dimmer", "0.3");
+    check_in_step(w, at, "dimmer 0.3 (lamprig mqtt-send) after a broker restart");
 
     /* 4. Rig b restarts: "offline" on a clean stop, then it takes the retained state. */
     assert_clean_exit(w, stop(&w->rig_b, SIGTERM));
