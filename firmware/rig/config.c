@@ -759,11 +759,11 @@ static int parse_mqtt(ctx *x, lr_jnode root)
     lr_rig_mqtt *m = &x->c->mqtt;
     lr_jnode o = lr_json_get(x->j, root, "mqtt");
     *m = (lr_rig_mqtt){.status_period_s = 5, .keepalive_s = 10, .retry_min_ms = 250,
-                       .retry_max_ms = 10000};
+                       .retry_max_ms = 10000, .lead_ms = 250};
     if (o == LR_JNONE)
         return LR_OK;
     static const char *const ok[] = {"broker", "rig", "role", "status_period_s", "keepalive_s",
-                                     "retry_min_ms", "retry_max_ms", NULL};
+                                     "retry_min_ms", "retry_max_ms", "lead_ms", NULL};
     char broker[160] = "", role[16] = "follower";
     int rc;
     if ((rc = keys(x, o, "mqtt", ok)) ||
@@ -774,7 +774,8 @@ static int parse_mqtt(ctx *x, lr_jnode root)
                          &m->status_period_s)) ||
         (rc = get_int_in(x, o, "mqtt", "keepalive_s", false, 5, 3600, &m->keepalive_s)) ||
         (rc = get_int_in(x, o, "mqtt", "retry_min_ms", false, 1, 3600000, &m->retry_min_ms)) ||
-        (rc = get_int_in(x, o, "mqtt", "retry_max_ms", false, 1, 3600000, &m->retry_max_ms)))
+        (rc = get_int_in(x, o, "mqtt", "retry_max_ms", false, 1, 3600000, &m->retry_max_ms)) ||
+        (rc = get_int_in(x, o, "mqtt", "lead_ms", false, 0, 60000, &m->lead_ms)))
         return rc;
     if (strpbrk(m->rig, "/+#"))
         return lr_json_fail(x->j, lr_json_get(x->j, o, "rig"), "mqtt.rig", x->e, LR_EPARSE,
@@ -783,9 +784,11 @@ static int parse_mqtt(ctx *x, lr_jnode root)
         m->role = LR_RIG_MQTT_FOLLOWER;
     else if (strcmp(role, "status") == 0)
         m->role = LR_RIG_MQTT_STATUS;
+    else if (strcmp(role, "leader") == 0)
+        m->role = LR_RIG_MQTT_LEADER;
     else
         return lr_json_fail(x->j, lr_json_get(x->j, o, "role"), "mqtt.role", x->e, LR_EPARSE,
-                            "'%s': expected follower or status", role);
+                            "'%s': expected follower, leader or status", role);
     /* HOST:PORT, the port required (an MQTT broker's 1883 is not assumed silently). */
     char *colon = strrchr(broker, ':');
     char *end = NULL;

@@ -31,8 +31,9 @@
  *   "ar_samples": 16                   CPU reference samples per band and pixel for it
  *   "mqtt":     {"broker": "HOST:PORT" (required; a numeric address: see mqtt.h),
  *                "rig": "NAME" (required; the topic lamprig/NAME/status),
- *                "role": "follower" (applies lamprig/all/...) | "status" (publishes only),
- *                "status_period_s": 5, "keepalive_s": 10,
+ *                "role": "follower" (applies lamprig/all/...) | "status" (publishes only)
+ *                        | "leader" (a follower that publishes its own devices' controls),
+ *                "lead_ms": 250 (leader), "status_period_s": 5, "keepalive_s": 10,
  *                "retry_min_ms": 250, "retry_max_ms": 10000}   several rigs in step
  *                                      (firmware/rig/mqtt.h)
  * }
@@ -189,6 +190,7 @@ typedef enum lr_rig_output_mode {
 typedef enum lr_rig_mqtt_role {
     LR_RIG_MQTT_FOLLOWER = 0, /* subscribes to lamprig/all/... and applies it */
     LR_RIG_MQTT_STATUS,       /* publishes its status only */
+    LR_RIG_MQTT_LEADER,       /* a follower whose own devices' controls drive every rig */
 } lr_rig_mqtt_role;
 
 typedef struct lr_rig_mqtt {
@@ -200,6 +202,7 @@ typedef struct lr_rig_mqtt {
     double status_period_s;
     int keepalive_s;
     int retry_min_ms, retry_max_ms;
+    int lead_ms; /* leader: apply_at = now + lead_ms for what its devices send */
     int line; /* of the "mqtt" object, for messages */
 } lr_rig_mqtt;
 

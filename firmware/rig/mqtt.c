@@ -71,7 +71,8 @@ bool lr_mqtt_same(const lr_rig_mqtt *a, const lr_rig_mqtt *b)
     return a->enabled == b->enabled && strcmp(a->host, b->host) == 0 && a->port == b->port &&
            strcmp(a->rig, b->rig) == 0 && a->role == b->role &&
            a->status_period_s == b->status_period_s && a->keepalive_s == b->keepalive_s &&
-           a->retry_min_ms == b->retry_min_ms && a->retry_max_ms == b->retry_max_ms;
+           a->retry_min_ms == b->retry_min_ms && a->retry_max_ms == b->retry_max_ms &&
+           a->lead_ms == b->lead_ms;
 }
 
 static slot *find(slot *tab, const lr_mqtt_cmd *c, bool create)
@@ -191,8 +192,11 @@ static void on_connect(struct mosquitto *mosq, void *obj, int rc)
     m->outage_logged = false;
     lr_backoff_reset(&m->bo);
     lr_log_write(&m->log, LR_LOG_INFO, "mqtt: connected to %s as rig '%s'%s", m->where,
-                 m->cfg.rig, m->cfg.role == LR_RIG_MQTT_STATUS ? " (status only)" : "");
-    if (m->cfg.role == LR_RIG_MQTT_FOLLOWER)
+                 m->cfg.rig,
+                 m->cfg.role == LR_RIG_MQTT_STATUS   ? " (status only)"
+                 : m->cfg.role == LR_RIG_MQTT_LEADER ? " (leader: its controls go to every rig)"
+                                                     : "");
+    if (m->cfg.role != LR_RIG_MQTT_STATUS)
         subscribe(m);
     m->status_now = true;
 }
@@ -453,6 +457,27 @@ void lr_mqtt_frame(lr_mqtt *m, uint64_t index, int64_t now_rt_ns)
 }
 
 bool lr_mqtt_connected(const lr_mqtt *m) { return m->state == UP; }
+
+bool lr_mqtt_publish_cmd(lr_mqtt *m, const lr_mqtt_cmd *c)
+{
+    if (m->state != UP)
+        return false;
+    char topic[sizeof LR_MQTT_CONTROL_TOPIC + LR_MQTT_NAME_MAX];
+    if (c->kind == LR_MQTT_SCENE)
+        snprintf(topic, sizeof topic, "%s", LR_MQTT_SCENE_TOPIC);
+    else
+        snprintf(topic, sizeof topic, "%s%s", LR_MQTT_CONTROL_TOPIC, c->name);
+    char payload[6 * LR_MQTT_SCENE_MAX + 64];
+    int len = lr_mqtt_payload_format(c, payload, sizeof payload);
+    if (len < 0)
+        return false;
+    int rc = mosquitto_publish(m->mosq, NULL, topic, len, payload, 1, true);
+    if (rc != MOSQ_ERR_SUCCESS) {
+        lr_log_write(&m->log, LR_LOG_WARN, "mqtt: publish %s: %s", topic, mosquitto_strerror(rc));
+        return false;
+    }
+    return true;
+}
 
 void lr_mqtt_get_counters(const lr_mqtt *m, lr_mqtt_counters *out) { *out = m->cnt; }
 

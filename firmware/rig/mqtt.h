@@ -97,6 +97,9 @@ void lr_mqtt_refuse(lr_mqtt *m, const lr_mqtt_cmd *c, const char *why);
 void lr_mqtt_frame(lr_mqtt *m, uint64_t index, int64_t now_rt_ns);
 
 bool lr_mqtt_connected(const lr_mqtt *m);
+/* Publishes a command to every rig (retained, QoS 1), this one included; false when not
+ * connected or the publish failed (logged). The leader role's devices (rig.c). */
+bool lr_mqtt_publish_cmd(lr_mqtt *m, const lr_mqtt_cmd *c);
 void lr_mqtt_get_counters(const lr_mqtt *m, lr_mqtt_counters *out);
 
 int64_t lr_mqtt_realtime_ns(void);

@@ -110,6 +110,11 @@ struct lr_rig {
         lr_rig_view *view;
     } pre;
     char pre_key[LR_MQTT_SCENE_MAX + 24]; /* the command last prepared (tried once) */
+    /* Role "leader": the controls as its own devices have set them, ahead of what the rigs
+     * apply (a scratch map fed with the same commands, never written to a scene), and the
+     * apply_at of what it last published per binding (the scene at LR_RIG_MAX_BINDINGS). */
+    lr_control_map *lead_map;
+    int64_t lead_sent[LR_RIG_MAX_BINDINGS + 1];
 };
 
 static void set_free(rigset *s)
@@ -581,14 +586,11 @@ static void switch_scene(lr_rig *r, const char *path)
     lr_log_write(&r->log, LR_LOG_INFO, "scene: %s", path);
 }
 
-static void handle_event(lr_rig *r, const lr_event *ev, int64_t now)
+static bool lead_forward(lr_rig *r, const lr_event *ev, int64_t now);
+
+/* An event into the control map (a device's, or an MQTT command's). */
+static void take_event(lr_rig *r, const lr_event *ev, int64_t now)
 {
-    /* A knob's USB arrival: reopen the hid device of that name now, not at its next backoff. */
-    if (strcmp(ev->control, "present") == 0 && ev->value == 1)
-        for (int i = 0; i < r->set.n_devs; i++)
-            if (strcmp(lr_dev_kind(r->set.devs[i]), "hid") == 0 &&
-                strcmp(lr_dev_name(r->set.devs[i]), ev->source) == 0)
-                lr_dev_retry_now(r->set.devs[i], now);
     int b = lr_control_map_event(r->set.map, ev, now);
     if (b < 0) {
         if (isfinite(ev->value))
@@ -597,6 +599,19 @@ static void handle_event(lr_rig *r, const lr_event *ev, int64_t now)
     }
     r->events++;
     lr_rig_stats_event(r->stats, ev);
+}
+
+/* A device's event. */
+static void handle_event(lr_rig *r, const lr_event *ev, int64_t now)
+{
+    /* A knob's USB arrival: reopen the hid device of that name now, not at its next backoff. */
+    if (strcmp(ev->control, "present") == 0 && ev->value == 1)
+        for (int i = 0; i < r->set.n_devs; i++)
+            if (strcmp(lr_dev_kind(r->set.devs[i]), "hid") == 0 &&
+                strcmp(lr_dev_name(r->set.devs[i]), ev->source) == 0)
+                lr_dev_retry_now(r->set.devs[i], now);
+    if (!lead_forward(r, ev, now))
+        take_event(r, ev, now);
 }
 
 /* ---- MQTT (firmware/rig/mqtt.h) ---- */
@@ -623,12 +638,87 @@ static void mqtt_status(void *user, lr_mqtt_status *st)
         .idle = info.idle, .devs = devs, .n_devs = r->set.n_devs};
 }
 
+/* The leader's map, from the live one's positions (a reload, the link opened). */
+static void lead_reset(lr_rig *r)
+{
+    lr_control_map_destroy(r->lead_map);
+    r->lead_map = NULL;
+    memset(r->lead_sent, 0, sizeof r->lead_sent);
+    if (!r->mqtt || r->set.cfg->mqtt.role != LR_RIG_MQTT_LEADER)
+        return;
+    lr_err e = {0};
+    int64_t now = lr_now_ns();
+    if (lr_control_map_create(r->set.cfg, r->set.scene, false, now, &r->lead_map, &e)) {
+        lr_log_write(&r->log, LR_LOG_ERROR, "mqtt: leader: %s; its controls stay local", e.msg);
+        return;
+    }
+    lr_control_map_carry(r->lead_map, r->set.map, now);
+    /* The cycles (presets, the scene) where the live map has them: an absolute position in the
+     * middle of each one's value. */
+    for (int i = 0; i < r->set.cfg->n_bindings; i++) {
+        const lr_rig_binding *b = &r->set.cfg->bindings[i];
+        int idx = lr_control_map_index(r->set.map, i);
+        if (b->kind != LR_BIND_CYCLE || idx < 0)
+            continue;
+        lr_event ev;
+        lr_event_set(&ev, b->source[0] ? b->source : "mqtt", b->control, LR_EV_ABSOLUTE,
+                     (idx + 0.5) / b->n_values, now);
+        lr_control_map_event(r->lead_map, &ev, now);
+    }
+    lr_control_map_scene_request(r->lead_map); /* it loads nothing */
+}
+
 static int mqtt_open(lr_rig *r, lr_err *e)
 {
     if (!r->set.cfg->mqtt.enabled)
         return LR_OK;
     lr_mqtt_desc d = {.cfg = r->set.cfg, .log = r->log, .status = mqtt_status, .user = r};
-    return lr_mqtt_create(&d, lr_now_ns(), &r->mqtt, e);
+    int rc = lr_mqtt_create(&d, lr_now_ns(), &r->mqtt, e);
+    if (!rc)
+        lead_reset(r);
+    return rc;
+}
+
+/* Role "leader": a device's event moves the leader's map, and what it moved goes to every rig
+ * (this one too) at now + lead_ms, as the positions it gave; this rig applies it when it comes
+ * back, in step with the others. Not connected: false, and the event applies here at once
+ * (the leader's map follows, so the two agree). */
+static bool lead_forward(lr_rig *r, const lr_event *ev, int64_t now)
+{
+    if (!r->lead_map)
+        return false;
+    int moved = lr_control_map_event(r->lead_map, ev, now);
+    lr_control_map_scene_request(r->lead_map);
+    if (moved < 0 || !lr_mqtt_connected(r->mqtt))
+        return false;
+    const lr_rig_config *cfg = r->set.cfg;
+    int64_t at = lr_mqtt_realtime_ns() + (int64_t)cfg->mqtt.lead_ms * 1000000LL;
+    bool all = true;
+    for (int i = 0; i < cfg->n_bindings; i++) {
+        const lr_rig_binding *b = &cfg->bindings[i];
+        if ((b->source[0] && strcmp(b->source, ev->source) != 0) ||
+            strcmp(b->control, ev->control) != 0)
+            continue;
+        lr_mqtt_cmd c = {.kind = LR_MQTT_CONTROL, .has_apply_at = true, .apply_at_ns = at};
+        int key = i;
+        if (b->kind == LR_BIND_LEVEL) {
+            c.value = lr_control_map_position(r->lead_map, i);
+        } else if (strcmp(b->param, "scene") != 0) {
+            c.value = (lr_control_map_index(r->lead_map, i) + 0.5) / b->n_values;
+        } else {
+            /* The file name: the other rigs' configs name the same scene by their own paths. */
+            const char *v = b->values[lr_control_map_index(r->lead_map, i)];
+            c.kind = LR_MQTT_SCENE;
+            snprintf(c.scene, sizeof c.scene, "%s", strrchr(v, '/') ? strrchr(v, '/') + 1 : v);
+            key = LR_RIG_MAX_BINDINGS;
+        }
+        snprintf(c.name, sizeof c.name, "%s", b->name);
+        if (lr_mqtt_publish_cmd(r->mqtt, &c))
+            r->lead_sent[key] = at;
+        else
+            all = false;
+    }
+    return all;
 }
 
 /* "candle", "candle.json" or a path: the config's scene cycle first (its binding then moves to
@@ -726,7 +816,14 @@ static bool mqtt_apply(lr_rig *r, int64_t now)
         lr_event ev;
         lr_event_set(&ev, bd->source[0] ? bd->source : "mqtt", bd->control, LR_EV_ABSOLUTE, x,
                      now);
-        handle_event(r, &ev, now);
+        take_event(r, &ev, now);
+        /* A leader's map takes what others sent (its own sends are in it already, and an
+         * older one of its own must not undo a newer). */
+        int key = c.kind == LR_MQTT_SCENE ? LR_RIG_MAX_BINDINGS : b;
+        if (r->lead_map && !(c.has_apply_at && r->lead_sent[key] == c.apply_at_ns)) {
+            lr_control_map_event(r->lead_map, &ev, now);
+            lr_control_map_scene_request(r->lead_map);
+        }
         any = true;
     }
     return any;
@@ -1141,6 +1238,8 @@ static int reload(lr_rig *r, lr_err *e)
     lr_err me = {0};
     if (mqtt_new && mqtt_open(r, &me))
         lr_log_write(&r->log, LR_LOG_ERROR, "reload: %s; running without MQTT", me.msg);
+    if (!mqtt_new)
+        lead_reset(r); /* the new config's bindings */
     r->view = view;
     ensure_rgba(r);
     r->ar_dirty = true;
@@ -1335,6 +1434,7 @@ void lr_rig_destroy(lr_rig *r)
         }
     }
     lr_mqtt_destroy(r->mqtt); /* "offline" on the status topic */
+    lr_control_map_destroy(r->lead_map);
     if (r->stats && r->set.cfg)
         write_stats(r, lr_now_ns());
     lr_rig_view_destroy(r->view);

@@ -39,6 +39,7 @@
 #include "firmware/rig/mqtt_payload.h"
 #include "render/base/json.h"
 #include "tests/support/fs.h"
+#include "tests/support/modbus_server.h"
 
 #define CHILD_FLAG "--as-lamprig"
 #define PORT 18830
@@ -230,6 +231,7 @@ typedef struct world {
     struct mosquitto *cli;
     rigview a, b;
     bool lib; /* mosquitto_lib_init done */
+    lr_test_mb_server *panel; /* rig a's Modbus dimmer panel (rig a is the leader) */
 } world;
 
 static int64_t rt_ns(void) { return lr_mqtt_realtime_ns(); }
@@ -433,6 +435,18 @@ static bool both_framed(world *w, const void *arg)
     return framed(&w->a, at) && framed(&w->b, at);
 }
 
+/* Both rigs' last change is a dimmer at 0.55 with the same apply_at. */
+static bool both_leader_value(world *w, const void *arg)
+{
+    (void)arg;
+    double va = NAN, vb = NAN;
+    field(w->a.doc, "last_change", "value", NULL, &va);
+    field(w->b.doc, "last_change", "value", NULL, &vb);
+    int64_t at = ifield(w->a.doc, "last_change", "apply_at_ns");
+    return va == 0.55 && vb == 0.55 && at > 0 &&
+           at == ifield(w->b.doc, "last_change", "apply_at_ns");
+}
+
 static bool b_framed(world *w, const void *arg)
 {
     return framed(&w->b, *(const int64_t *)arg) && !w->b.offline;
@@ -574,16 +588,27 @@ static void write_files(world *w)
              PORT, w->addr_a, w->dir);
     free(lr_test_write(w->dir, "mosquitto.conf", text, (size_t)-1));
     for (int i = 0; i < 2; i++) {
+        /* Rig a is the leader, its dimmer a Modbus panel (this process serves it, in rig a's
+         * namespace); rig b has no device. */
+        char dev[256] = "";
+        if (i == 0)
+            snprintf(dev, sizeof dev,
+                     "{\"type\": \"modbus\", \"name\": \"panel\", \"url\": "
+                     "\"tcp://127.0.0.1:%d\", \"poll_ms\": 20, \"inputs\": [{\"control\": "
+                     "\"dimmer\", \"unit\": 1, \"reg\": 0, \"raw_max\": 1000}]}",
+                     lr_test_mb_server_port(w->panel));
         /* preview: a cheap CPU view; the flame steady, so an idle rig renders only changes. */
         snprintf(text, sizeof text,
                  "{\"scene\": \"%s/scenes/candle.json\",\n"
                  " \"scene_set\": {\"lights[0].flicker.amplitude\": 0},\n"
+                 " \"devices\": [%s],\n"
                  " \"controls\": \"%s/controls/candle.json\",\n"
                  " \"output\": {\"mode\": \"headless\", \"width\": 64, \"height\": 48, "
                  "\"fps\": %d, \"renderer\": \"preview\"},\n"
                  " \"mqtt\": {\"broker\": \"%s:%d\", \"rig\": \"%s\", \"status_period_s\": 1,\n"
-                 "          \"retry_min_ms\": 100, \"retry_max_ms\": 400}}\n",
-                 LR_SOURCE_CONFIGS, LR_SOURCE_CONFIGS, FPS, w->addr_a, PORT, i ? "b" : "a");
+                 "          \"retry_min_ms\": 100, \"retry_max_ms\": 400%s}}\n",
+                 LR_SOURCE_CONFIGS, dev, LR_SOURCE_CONFIGS, FPS, w->addr_a, PORT, i ? "b" : "a",
+                 i ? "" : ", \"role\": \"leader\", \"lead_ms\": 700");
         free(lr_test_write(w->dir, i ? "rig-b.json" : "rig-a.json", text, (size_t)-1));
     }
 }
@@ -605,6 +630,10 @@ static int teardown_world(void **state)
         sh("ip netns del %s 2>/dev/null; ip netns del %s 2>/dev/null", w->ns_a, w->ns_b);
     if (w->lib)
         mosquitto_lib_cleanup();
+    if (w->panel) {
+        lr_test_mb_server_stop(w->panel);
+        lr_test_mb_server_free(w->panel);
+    }
     if (w->dir)
         lr_test_rmtree(w->dir);
     free(w);
@@ -657,6 +686,7 @@ static void test_two_rigs(void **state)
     enter_ns(w->ns_a); /* this process's client talks to the broker from its namespace */
     mosquitto_lib_init();
     w->lib = true;
+    w->panel = lr_test_mb_server_start(); /* on 127.0.0.1 of this namespace */
     write_files(w);
 
     /* The rigs start before the broker: each says once that it is unreachable, runs on, and
@@ -670,13 +700,26 @@ static void test_two_rigs(void **state)
     }
     w->broker = start_broker(w);
     client_connect(w);
+    int64_t at;
     if (!wait_for(w, both_online, NULL, 60000)) { /* start-up under the sanitizers */
         dump(w);
         fail_msg("the rigs did not come online");
     }
 
+    /* 0. The leader's own panel moves (0 -> 0.55): rig a sends the position to every rig and
+     * applies it when it comes back, in step with rig b, and only then (one event, not two). */
+    int64_t ev_a = ifield(w->a.doc, "events", NULL);
+    lr_test_mb_server_set_reg(w->panel, 1, 0, 550);
+    if (!wait_for(w, both_leader_value, NULL, 15000)) {
+        dump(w);
+        fail_msg("the leader's panel did not reach both rigs");
+    }
+    at = ifield(w->a.doc, "last_change", "apply_at_ns");
+    check_in_step(w, at, "dimmer 0.55 from the leader's panel");
+    assert_int_equal(ifield(w->a.doc, "events", NULL), ev_a + 1);
+
     /* 1. One change, published once, in step on both rigs. */
-    int64_t at = publish(w, "control/dimmer", "0.8", rt_ns() + LEAD_NS);
+    at = publish(w, "control/dimmer", "0.8", rt_ns() + LEAD_NS);
     check_in_step(w, at, "dimmer 0.8");
     assert_true(ifield(w->a.doc, "events", NULL) >= 1 && ifield(w->b.doc, "events", NULL) >= 1);
 
