@@ -759,6 +759,11 @@ static void test_two_rigs(void **state)
     /* 5. Rig a reloads its config (SIGHUP, the same "mqtt" block): the link stays (no new
      * connect) and the next change, a scene of the cycle, is in step on both. */
     int64_t conn_a = ifield(w->a.doc, "mqtt", "connects");
+    /* The panel first where the dimmer is (0.3): the reloaded panel's first reading then moves
+     * nothing, so the leader sends nothing beside the scene below (a dimmer sent with about
+     * the same apply_at would be each rig's last change instead). */
+    lr_test_mb_server_set_reg(w->panel, 1, 0, 300);
+    usleep(300000); /* 15 polls */
     kill(w->rig_a, SIGHUP);
     if (!wait_for(w, a_reloaded, NULL, 30000)) { /* seconds under the sanitizers */
         dump(w);
