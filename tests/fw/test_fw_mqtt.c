@@ -329,7 +329,8 @@ static pid_t start_rig(world *w, const char *name, const char *ns)
     snprintf(cfg, sizeof cfg, "rig-%s.json", name);
     snprintf(log, sizeof log, "rig-%s.log", name);
     char *cp = lr_test_path(w->dir, cfg);
-    char *argv[] = {w->self, CHILD_FLAG, "run", "--config", cp, "--headless", NULL};
+    /* --no-plan: the preview view needs no render settings; start-up and reload are faster. */
+    char *argv[] = {w->self, CHILD_FLAG, "run", "--config", cp, "--headless", "--no-plan", NULL};
     pid_t p = spawn(w, ns, log, argv);
     free(cp);
     return p;
