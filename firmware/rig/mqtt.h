@@ -12,6 +12,8 @@
  *     applied (the broker sends it again after a reconnect) is not applied twice, so a local
  *     knob moved since is not overridden. A scene command ahead of its apply_at is loaded in
  *     advance by the rig (lr_mqtt_pending_scene), so its switch is a swap.
+ *   - leader: a follower whose own devices' controls go to every rig (lr_mqtt_publish_cmd,
+ *     apply_at = now + lead_ms) and are applied on it when they come back (rig.c).
  *
  * Nothing blocks the loop: the client's socket is in the poll set (mosquitto_socket, read,
  * write when mosquitto_want_write, mosquitto_loop_misc for the keepalive), the connect is
