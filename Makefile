@@ -5,12 +5,15 @@
 #   make test    build with -Werror + ASan + UBSan and run every test binary
 #   make run     render the default candle scene headless
 #   make bench   speed and error figures
-#   make fuzz    the libFuzzer harnesses (tests/fuzz/), FUZZ_S=60 seconds each on their corpus
 #   make soak    the rig's soak at full length (test_fw_loop with LAMPRIG_SOAK_S=120; make
 #                test runs it for 30 s)
 #   make install  PREFIX=/usr/local DESTDIR= (see tools/install/README.md)
 #   make deb      build/lamprig_VERSION_ARCH.deb from a staged install (tools/debian/)
 #   make test-install  the package, its lintian, unit, udev rules and installed binary
+#   make fuzz     libFuzzer binaries of the packet and MQTT payload parsers (clang),
+#                 build/fuzz/fuzz_NAME; run
+#                 one with a scratch folder first (libFuzzer writes new inputs into the first):
+#                 build/fuzz/fuzz_sacn_packet -max_total_time=60 NEW/ tests/fuzz/corpus/sacn
 #   make clean
 #
 # Sources are found by wildcard: every .c under render/ hal/ calib/ and firmware/ (except
@@ -44,7 +47,7 @@ else
 CC      ?= cc
 CXX     ?= c++
 PKGS    := egl glesv2 gbm libdrm libgpiod hidapi-libusb libusb-1.0 libmodbus libpng cairo lcms2 \
-           libsystemd libmosquitto
+           libsystemd liblo libmosquitto
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS))
 PKG_LIBS   := $(shell pkg-config --libs $(PKGS))
 CV_CFLAGS  := $(shell pkg-config --cflags opencv4)
@@ -146,25 +149,25 @@ test: $(TESTS:%=build/test/%) build/bin/lamprig $(TOOLS:%=build/bin/lamprig-%)
 soak: build/test/test_fw_loop build/bin/lamprig
 	@LAMPRIG_SOAK_S=$${LAMPRIG_SOAK_S:-120} sh tests/run.sh build/test/test_fw_loop
 
-# libFuzzer harnesses (tests/fuzz/fuzz_NAME.c; clang): build/fuzz/fuzz_NAME from the harness and
-# the few sources it parses with, listed per harness (FUZZ_SRC_NAME). `make fuzz` runs each for
-# FUZZ_S seconds (default 60) on its committed corpus, tests/fuzz/corpus/NAME/, new finds in
-# build/fuzz/NAME/; make test replays the corpus (tests/fw/test_fw_mqtt.c) without libFuzzer.
-FUZZ_CC     ?= clang
-FUZZ_S      ?= 60
-FUZZERS     := $(sort $(patsubst tests/fuzz/fuzz_%.c,%,$(wildcard tests/fuzz/fuzz_*.c)))
-FUZZ_BASE   := render/base/json.c render/base/json_scan.c render/base/err.c render/base/file.c
-FUZZ_SRC_mqtt_payload := firmware/rig/mqtt_payload.c $(FUZZ_BASE)
-build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c $$(FUZZ_SRC_$$*)
+# libFuzzer harnesses (tests/fuzz/fuzz_NAME.c) with the hal/ sources they name, built by clang
+# (GCC has no libFuzzer). make test runs the same harnesses on the corpus through cmocka.
+FUZZ := $(sort $(notdir $(basename $(wildcard tests/fuzz/fuzz_*.c))))
+.PHONY: fuzz
+fuzz: $(FUZZ:%=build/fuzz/%)
+build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c hal/%.c
 	@mkdir -p $(@D)
 	@echo "  FUZZ    $@"
-	$(Q)$(FUZZ_CC) -std=c11 -D_GNU_SOURCE -I. -O1 -g -fsanitize=fuzzer,address,undefined \
-	    -fno-sanitize-recover=undefined $^ -lm -o $@
-.PHONY: fuzz
-fuzz: $(FUZZERS:%=build/fuzz/fuzz_%)
-	@for f in $(FUZZERS); do mkdir -p build/fuzz/$$f && \
-	    build/fuzz/fuzz_$$f build/fuzz/$$f tests/fuzz/corpus/$$f -max_total_time=$(FUZZ_S) \
-	    || exit 1; done
+	$(Q)clang -std=c11 -D_GNU_SOURCE -I. -g -O1 -fsanitize=fuzzer,address,undefined -o $@ $^
+# The MQTT payload parser's harness (tests/fuzz/fuzz_mqtt_payload.c) is not one hal/ file: it
+# parses with the JSON reader. Run it: build/fuzz/fuzz_mqtt_payload build/fuzz/mqtt_payload
+# tests/fuzz/corpus/mqtt_payload -max_total_time=60 (new finds go to the first folder).
+build/fuzz/fuzz_mqtt_payload: tests/fuzz/fuzz_mqtt_payload.c firmware/rig/mqtt_payload.c \
+                              render/base/json.c render/base/json_scan.c render/base/err.c \
+                              render/base/file.c
+	@mkdir -p $(@D) build/fuzz/mqtt_payload
+	@echo "  FUZZ    $@"
+	$(Q)clang -std=c11 -D_GNU_SOURCE -I. -g -O1 -fsanitize=fuzzer,address,undefined \
+	    -fno-sanitize-recover=undefined -o $@ $^ -lm
 
 # ---- install, package ----
 # The layout paths.h looks for: BINDIR/lamprig finds BINDIR/../share/lamprig/{configs,shaders}

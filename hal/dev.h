@@ -85,7 +85,8 @@ void lr_dev_retry_now(lr_dev *d, int64_t now_ns);
 lr_dev_state lr_dev_get_state(const lr_dev *d);
 const char *lr_dev_state_name(lr_dev_state s); /* "open", "missing", "retrying", "done" */
 const char *lr_dev_name(const lr_dev *d);
-const char *lr_dev_kind(const lr_dev *d);      /* "gpio", "hid", "usb", "modbus", "sim" */
+/* "gpio", "hid", "usb", "modbus", "sim", "sacn", "artnet", "osc" */
+const char *lr_dev_kind(const lr_dev *d);
 /* The last state line logged, e.g. "gpio: gpiochip0: cannot open chip: No such file or
  * directory; retrying with backoff". Owned by the device, valid until the next dispatch. */
 const char *lr_dev_status(const lr_dev *d);

@@ -424,9 +424,8 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
      * the bound whatever u_n_lights says (a camera move's receivers cost 1.8x for one light
      * with the bound at 4, tools/bench/README.md "Camera move, profiled"). */
     for (int n = 1; n <= LR_MAX_LIGHTS; n++) {
-        lr_shader_defines d = r->defines;
-        for (int i = 0; i < d.n; i++)
-            d.list[i] = d.text[i]; /* the copy's own text */
+        lr_shader_defines d;
+        lr_shader_defines_copy(&d, &r->defines);
         if (!lr_shader_defines_add(&d, "LR_CACHE_LIGHTS", n) ||
             !lr_shader_defines_add(&d, "LR_RECV_LIGHTS", n)) {
             rc = lr_err_set(e, LR_EINVAL, "renderer: too many shader defines");

@@ -10,8 +10,11 @@ set -eu
 # systemd-container (systemd-nspawn) and debootstrap boot the package under systemd in
 # tests/boot.sh (make test-boot).
 # libmosquitto-dev: the rig's MQTT client (firmware/rig/mqtt.c, lamprig mqtt-send); mosquitto:
-# the broker test_fw_mqtt starts; iproute2: ip(8), its network namespaces and veth pair;
+# the broker test_fw_mqtt starts (its network namespaces and veth pair: iproute2, below);
 # clang: `make fuzz` (libFuzzer harnesses in tests/fuzz/).
+# liblo-dev: the OSC input (hal/osc.c). The console peers the tests start: liblo-tools
+# (oscsend), ola (olad, ola_set_dmx, ola_streaming_client), qlcplus; iproute2 (ip netns, veth)
+# for the namespace OLA's E1.31 output needs.
 PKGS="build-essential pkg-config
 libgpiod-dev libhidapi-dev libusb-1.0-0-dev libmodbus-dev
 libegl-dev libgles-dev libgbm-dev libdrm-dev libegl-mesa0 libgl1-mesa-dri libgbm1
@@ -19,9 +22,10 @@ libopencv-dev libopencv-contrib-dev
 opencv-doc
 libpng-dev libcairo2-dev liblcms2-dev libcmocka-dev
 libsystemd-dev
-libmosquitto-dev mosquitto iproute2 clang
+libmosquitto-dev mosquitto clang
 lintian systemd
-systemd-container debootstrap"
+systemd-container debootstrap
+liblo-dev liblo-tools ola qlcplus iproute2"
 
 missing=""
 for p in $PKGS; do

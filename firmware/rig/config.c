@@ -12,9 +12,12 @@
 #include "firmware/control/curve.h"
 #include "hal/gpio.h"
 #include "hal/hid.h"
+#include "hal/artnet.h"
 #include "hal/hid_report.h"
 #include "hal/modbus.h"
 #include "hal/opt.h"
+#include "hal/osc.h"
+#include "hal/sacn.h"
 #include "hal/sim.h"
 #include "hal/usb.h"
 #include "render/base/json.h"
@@ -294,6 +297,137 @@ static int modbus_reg(ctx *x, lr_jnode o, const char *where, bool lamp, lr_rig_m
     return LR_OK;
 }
 
+/* sacn and artnet: the receiver's options and its "channels" (hal/sacn.h, hal/artnet.h). */
+static int dmx_device(ctx *x, lr_jnode o, const char *where, lr_rig_device *d)
+{
+    bool sacn = d->type == LR_RIG_DEV_SACN;
+    const lr_opt *so = lr_sacn_opts, *ao = lr_artnet_opts;
+    const lr_opt *chopts = sacn ? lr_sacn_channel_opts : lr_artnet_channel_opts;
+    const lr_opt *bind = sacn ? &so[LR_SACN_OPT_BIND] : &ao[LR_ARTNET_OPT_BIND];
+    const lr_opt *port = sacn ? &so[LR_SACN_OPT_PORT] : &ao[LR_ARTNET_OPT_PORT];
+    const lr_opt *loss = sacn ? &so[LR_SACN_OPT_LOSS] : &ao[LR_ARTNET_OPT_LOSS];
+    const lr_opt *fade = sacn ? &so[LR_SACN_OPT_FADE_MS] : &ao[LR_ARTNET_OPT_FADE_MS];
+    const lr_opt *maxp = sacn ? &so[LR_SACN_OPT_MAX_PACKETS] : &ao[LR_ARTNET_OPT_MAX_PACKETS];
+    snprintf(d->bind, sizeof d->bind, "%s", bind->dflt_text);
+    d->port = (int)port->dflt;
+    d->fade_ms = (int)fade->dflt;
+    d->max_packets = (int)maxp->dflt;
+    int rc;
+    if ((rc = get_str(x, o, where, bind->key, false, d->bind, sizeof d->bind)) ||
+        (rc = opt_int(x, o, where, port, &d->port)) ||
+        (rc = opt_enum(x, o, where, loss, &d->loss)) ||
+        (rc = opt_int(x, o, where, fade, &d->fade_ms)) ||
+        (rc = opt_int(x, o, where, maxp, &d->max_packets)))
+        return rc;
+    if (sacn) {
+        d->max_sources = (int)so[LR_SACN_OPT_MAX_SOURCES].dflt;
+        d->loss_ms = (int)so[LR_SACN_OPT_LOSS_MS].dflt;
+        if ((rc = get_str(x, o, where, "interface", false, d->interface, sizeof d->interface)) ||
+            (rc = opt_bool(x, o, where, &so[LR_SACN_OPT_UNICAST_ONLY], &d->unicast_only)) ||
+            (rc = opt_bool(x, o, where, &so[LR_SACN_OPT_PREVIEW], &d->preview)) ||
+            (rc = opt_int(x, o, where, &so[LR_SACN_OPT_MAX_SOURCES], &d->max_sources)) ||
+            (rc = opt_int(x, o, where, &so[LR_SACN_OPT_LOSS_MS], &d->loss_ms)))
+            return rc;
+    } else {
+        d->merge_timeout_ms = (int)ao[LR_ARTNET_OPT_MERGE_TIMEOUT_MS].dflt;
+        snprintf(d->short_name, sizeof d->short_name, "%s",
+                 ao[LR_ARTNET_OPT_SHORT_NAME].dflt_text);
+        snprintf(d->announce, sizeof d->announce, "%s", ao[LR_ARTNET_OPT_ANNOUNCE].dflt_text);
+        if ((rc = get_str(x, o, where, "announce", false, d->announce, sizeof d->announce)) ||
+            (rc = get_str(x, o, where, "short_name", false, d->short_name,
+                          sizeof d->short_name)) ||
+            (rc = opt_enum(x, o, where, &ao[LR_ARTNET_OPT_MERGE], &d->merge)) ||
+            (rc = opt_int(x, o, where, &ao[LR_ARTNET_OPT_MERGE_TIMEOUT_MS],
+                          &d->merge_timeout_ms)))
+            return rc;
+    }
+    char f[192];
+    lr_jnode arr = lr_json_get(x->j, o, "channels");
+    field_name(f, sizeof f, where, "channels");
+    if (arr == LR_JNONE)
+        return missing(x, o, where, "channels");
+    if (lr_json_type(x->j, arr) != LR_JSON_ARRAY || lr_json_count(x->j, arr) < 1 ||
+        lr_json_count(x->j, arr) > LR_RIG_MAX_CHANNELS)
+        return lr_json_fail(x->j, arr, f, x->e, LR_EPARSE, "expected an array of 1..%d",
+                            LR_RIG_MAX_CHANNELS);
+    for (int i = 0; i < lr_json_count(x->j, arr); i++) {
+        lr_jnode it = lr_json_at(x->j, arr, i);
+        char w[96], wf[128];
+        snprintf(w, sizeof w, "%s.channels[%d]", where, i);
+        const lr_opt *const itables[] = {chopts, NULL};
+        const char *iallowed[16];
+        opt_keys(itables, NULL, iallowed, 16);
+        lr_rig_dmx_channel *c = &d->channels[i];
+        c->universe = (int)chopts[LR_DMX_CH_UNIVERSE].dflt;
+        if ((rc = keys(x, it, w, iallowed)) ||
+            (rc = get_str(x, it, w, "control", true, c->control, sizeof c->control)))
+            return rc;
+        field_name(wf, sizeof wf, w, "control");
+        if ((rc = check_name(x, it, wf, c->control)) ||
+            (rc = opt_int(x, it, w, &chopts[LR_DMX_CH_UNIVERSE], &c->universe)) ||
+            (rc = opt_int(x, it, w, &chopts[LR_DMX_CH_CHANNEL], &c->channel)) ||
+            (rc = opt_int(x, it, w, &chopts[LR_DMX_CH_FINE], &c->fine)))
+            return rc;
+        for (int k = 0; k < i; k++)
+            if (strcmp(d->channels[k].control, c->control) == 0)
+                return lr_json_fail(x->j, it, w, x->e, LR_EPARSE, "control '%s' appears twice",
+                                    c->control);
+        if (c->fine == c->channel) {
+            field_name(wf, sizeof wf, w, "fine");
+            return lr_json_fail(x->j, it, wf, x->e, LR_EPARSE,
+                                "the fine byte cannot be the channel itself (%d)", c->channel);
+        }
+        d->n_channels = i + 1;
+    }
+    return LR_OK;
+}
+
+static int osc_device(ctx *x, lr_jnode o, const char *where, lr_rig_device *d)
+{
+    const lr_opt *oo = lr_osc_opts;
+    d->port = (int)oo[LR_OSC_OPT_PORT].dflt;
+    d->max_packets = (int)oo[LR_OSC_OPT_MAX_PACKETS].dflt;
+    snprintf(d->prefix, sizeof d->prefix, "%s", oo[LR_OSC_OPT_PREFIX].dflt_text);
+    int rc;
+    if ((rc = opt_int(x, o, where, &oo[LR_OSC_OPT_PORT], &d->port)) ||
+        (rc = opt_int(x, o, where, &oo[LR_OSC_OPT_MAX_PACKETS], &d->max_packets)) ||
+        (rc = get_str(x, o, where, "prefix", false, d->prefix, sizeof d->prefix)))
+        return rc;
+    char f[192];
+    snprintf(d->scene_control, sizeof d->scene_control, "%s",
+             oo[LR_OSC_OPT_SCENE_CONTROL].dflt_text);
+    if ((rc = get_str(x, o, where, "scene_control", false, d->scene_control,
+                      sizeof d->scene_control)))
+        return rc;
+    field_name(f, sizeof f, where, "scene_control");
+    if ((rc = check_name(x, o, f, d->scene_control)))
+        return rc;
+    size_t pl = strlen(d->prefix);
+    if (pl < 2 || d->prefix[0] != '/' || d->prefix[pl - 1] == '/') {
+        field_name(f, sizeof f, where, "prefix");
+        return lr_json_fail(x->j, lr_json_get(x->j, o, "prefix"), f, x->e, LR_EPARSE,
+                            "'%s' is not /NAME[/NAME...] without a trailing '/'", d->prefix);
+    }
+    lr_jnode arr = lr_json_get(x->j, o, "scenes");
+    if (arr == LR_JNONE)
+        return LR_OK;
+    field_name(f, sizeof f, where, "scenes");
+    if (lr_json_type(x->j, arr) != LR_JSON_ARRAY ||
+        lr_json_count(x->j, arr) > LR_RIG_MAX_SCENE_NAMES)
+        return lr_json_fail(x->j, arr, f, x->e, LR_EPARSE,
+                            "expected an array of at most %d names", LR_RIG_MAX_SCENE_NAMES);
+    for (int i = 0; i < lr_json_count(x->j, arr); i++) {
+        char w[208];
+        snprintf(w, sizeof w, "%s[%d]", f, i);
+        lr_jnode it = lr_json_at(x->j, arr, i);
+        if ((rc = lr_json_string(x->j, it, w, d->scenes[i], sizeof d->scenes[i], x->e)) ||
+            (rc = check_name(x, it, w, d->scenes[i])))
+            return rc;
+        d->n_scenes = i + 1;
+    }
+    return LR_OK;
+}
+
 static int device(ctx *x, lr_jnode o, int index, lr_rig_device *d)
 {
     char where[64];
@@ -305,20 +439,23 @@ static int device(ctx *x, lr_jnode o, int index, lr_rig_device *d)
     int rc = get_str(x, o, where, "type", true, type, sizeof type);
     if (rc)
         return rc;
-    static const char *const types[] = {"sim", "modbus", "gpio", "hid", "usb"};
+    static const char *const types[] = {"sim", "modbus", "gpio", "hid", "usb",
+                                        "sacn", "artnet", "osc"};
     int t = -1;
-    for (int i = 0; i < 5; i++)
+    for (int i = 0; i < 8; i++)
         if (strcmp(type, types[i]) == 0)
             t = i;
     char f[192];
     field_name(f, sizeof f, where, "type");
     if (t < 0)
         return lr_json_fail(x->j, lr_json_get(x->j, o, "type"), f, x->e, LR_EPARSE,
-                            "unknown device type '%s' (sim, modbus, gpio, hid, usb)", type);
+                            "unknown device type '%s' (sim, modbus, gpio, hid, usb, sacn, "
+                            "artnet, osc)", type);
     d->type = (lr_rig_dev_type)t;
     /* The options of every device and of its back end (hal/opt.h), in lr_rig_dev_type order. */
     static const lr_opt *const backend[] = {lr_sim_opts, lr_modbus_opts, lr_gpio_opts,
-                                            lr_hid_opts, lr_usb_opts};
+                                            lr_hid_opts, lr_usb_opts, lr_sacn_opts,
+                                            lr_artnet_opts, lr_osc_opts};
     static const char *const type_key[] = {"type", NULL};
     const lr_opt *const tables[] = {lr_dev_opts, backend[t], NULL};
     const char *allowed[32];
@@ -525,6 +662,9 @@ static int device(ctx *x, lr_jnode o, int index, lr_rig_device *d)
         }
         return LR_OK;
     }
+    case LR_RIG_DEV_SACN:
+    case LR_RIG_DEV_ARTNET: return dmx_device(x, o, where, d);
+    case LR_RIG_DEV_OSC: return osc_device(x, o, where, d);
     }
     return LR_OK;
 }
@@ -1103,6 +1243,7 @@ int lr_rig_config_lamp_device(const lr_rig_config *c)
 
 const char *lr_rig_dev_type_name(lr_rig_dev_type t)
 {
-    static const char *const names[] = {"sim", "modbus", "gpio", "hid", "usb"};
-    return (unsigned)t < 5 ? names[t] : "?";
+    static const char *const names[] = {"sim", "modbus", "gpio", "hid", "usb",
+                                        "sacn", "artnet", "osc"};
+    return (unsigned)t < 8 ? names[t] : "?";
 }

@@ -38,12 +38,13 @@
  *                                      (firmware/rig/mqtt.h)
  * }
  *
- * DEVICE: "type" (sim, modbus, gpio, hid, usb) and the options of that hal back end, read
- * through its descriptors (hal/opt.h: key, type, range, default, one number in one place);
+ * DEVICE: "type" (sim, modbus, gpio, hid, usb, sacn, artnet, osc) and the options of that hal
+ * back end, read through its descriptors (hal/opt.h: key, type, range, default, one number in one place);
  * the reference is firmware/README.md's table, written from them by
  * lr_rig_config_fields_markdown. sim needs "script" (a file) or "text"; modbus "inputs",
  * "lamp" (the lamp driver, default unit LR_RIG_LAMP_UNIT) or both; gpio "encoders",
- * "buttons" or both; usb one or more "watch" entries.
+ * "buttons" or both; usb one or more "watch" entries; sacn and artnet one or more "channels"
+ * ({control, universe, channel, fine}: hal/dmx_in.h); osc optional "scenes" (names).
  *
  * BINDING (one control → one scene parameter; firmware/rig/control_map.h):
  *   "control": "SOURCE/CONTROL" | "CONTROL" (any source)      required
@@ -87,7 +88,18 @@ typedef enum lr_rig_dev_type {
     LR_RIG_DEV_GPIO,
     LR_RIG_DEV_HID,
     LR_RIG_DEV_USB,
+    LR_RIG_DEV_SACN,
+    LR_RIG_DEV_ARTNET,
+    LR_RIG_DEV_OSC,
 } lr_rig_dev_type;
+
+#define LR_RIG_MAX_CHANNELS 32 /* sacn/artnet channels per device */
+#define LR_RIG_MAX_SCENE_NAMES 32 /* osc scenes */
+
+typedef struct lr_rig_dmx_channel {
+    char control[LR_RIG_NAME_MAX];
+    int universe, channel, fine; /* fine 0: 8-bit */
+} lr_rig_dmx_channel;
 
 typedef struct lr_rig_modbus_reg {
     char control[LR_RIG_NAME_MAX];
@@ -148,6 +160,16 @@ typedef struct lr_rig_device {
     int n_watch;
     int rescan_ms;
     bool no_hotplug;
+    /* sacn, artnet, osc (port also osc; fade_ms, loss, max_packets all three or two) */
+    char bind[64], interface[64], announce[64], short_name[18], prefix[64];
+    char scene_control[LR_RIG_NAME_MAX];
+    int port, max_sources, loss_ms, fade_ms, max_packets, merge_timeout_ms;
+    int loss, merge; /* lr_dmx_loss, lr_dmx_merge_mode */
+    bool unicast_only, preview;
+    lr_rig_dmx_channel channels[LR_RIG_MAX_CHANNELS];
+    int n_channels;
+    char scenes[LR_RIG_MAX_SCENE_NAMES][LR_RIG_NAME_MAX];
+    int n_scenes;
 } lr_rig_device;
 
 typedef enum lr_binding_kind {
@@ -256,7 +278,7 @@ int lr_rig_config_lamp_device(const lr_rig_config *c);
  * "<!-- END rig-devices -->" (tests/fw/test_fw_config.c compares). */
 void lr_rig_config_fields_markdown(FILE *f);
 
-/* "sim", "modbus", "gpio", "hid", "usb". */
+/* "sim", "modbus", "gpio", "hid", "usb", "sacn", "artnet", "osc". */
 const char *lr_rig_dev_type_name(lr_rig_dev_type t);
 
 #endif

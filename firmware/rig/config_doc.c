@@ -4,11 +4,15 @@
 #include <string.h>
 
 #include "firmware/rig/config.h"
+#include "hal/artnet.h"
 #include "hal/dev.h"
+#include "hal/dmx_in.h"
 #include "hal/gpio.h"
 #include "hal/hid.h"
 #include "hal/modbus.h"
 #include "hal/opt.h"
+#include "hal/osc.h"
+#include "hal/sacn.h"
 #include "hal/sim.h"
 #include "hal/usb.h"
 
@@ -68,4 +72,9 @@ void lr_rig_config_fields_markdown(FILE *out)
     rows(out, "hid", lr_hid_opts);
     rows(out, "usb", lr_usb_opts);
     rows(out, "usb `watch[i]`", lr_usb_watch_opts);
+    rows(out, "sacn", lr_sacn_opts);
+    rows(out, "sacn `channels[i]`", lr_sacn_channel_opts);
+    rows(out, "artnet", lr_artnet_opts);
+    rows(out, "artnet `channels[i]`", lr_artnet_channel_opts);
+    rows(out, "osc", lr_osc_opts);
 }

@@ -21,11 +21,16 @@
 #include "firmware/rig/notify.h"
 #include "firmware/rig/stats.h"
 #include "firmware/rig/view.h"
+#include "hal/artnet.h"
+#include "hal/artnet_packet.h"
 #include "hal/dev.h"
 #include "hal/event.h"
 #include "hal/gpio.h"
 #include "hal/hid.h"
 #include "hal/modbus.h"
+#include "hal/osc.h"
+#include "hal/sacn.h"
+#include "hal/sacn_packet.h"
 #include "hal/sim.h"
 #include "hal/usb.h"
 #include "render/base/out_dir.h"
@@ -51,6 +56,9 @@ typedef struct rigset {
     lr_dev *devs[LR_RIG_MAX_DEVICES];
     lr_modbus *lamp[LR_RIG_MAX_DEVICES]; /* modbus devices with a lamp driver */
     lr_modbus *modbus[LR_RIG_MAX_DEVICES]; /* per devs[i]: its modbus link, or NULL */
+    lr_sacn *sacn[LR_RIG_MAX_DEVICES];     /* per devs[i], or NULL; the same for these: */
+    lr_artnet *artnet[LR_RIG_MAX_DEVICES];
+    lr_osc *osc[LR_RIG_MAX_DEVICES];
     int n_devs, n_lamps;
     bool has_hid;
     bool no_vpl; /* the planner found no receiver that sees any object */
@@ -117,6 +125,63 @@ struct lr_rig {
     int64_t lead_sent[LR_RIG_MAX_BINDINGS + 1];
 };
 
+/* A console input's counters for the stats file (names: static strings, or the parsers'
+ * result names behind "bad_"). */
+#define INPUT_COUNTERS_MAX (12 + LR_DMX_MAX_KINDS)
+static int dmx_counters(const lr_dmx_counters *c, const char *(*kind_name)(int), int n_kinds,
+                        lr_rig_stats_counter *out)
+{
+    const lr_rig_stats_counter fixed[] = {
+        {"", "packets", c->packets},       {"", "taken", c->taken},
+        {"", "other", c->other},           {"", "sequence", c->sequence},
+        {"", "full", c->full},             {"", "preview", c->preview},
+        {"", "terminated", c->terminated}, {"", "losses", c->losses},
+        {"", "polls", c->polls},           {"", "replies", c->replies},
+        {"", "events", c->events},         {"", "bad", c->bad},
+    };
+    int n = 0;
+    for (size_t k = 0; k < sizeof fixed / sizeof fixed[0]; k++)
+        out[n++] = fixed[k];
+    for (int k = 0; k < n_kinds && k < LR_DMX_MAX_KINDS; k++)
+        if (c->bad_kind[k])
+            out[n++] = (lr_rig_stats_counter){"bad_", kind_name(k), c->bad_kind[k]};
+    return n;
+}
+
+static const char *sacn_kind(int k) { return lr_sacn_result_name((lr_sacn_result)k); }
+static const char *artnet_kind(int k) { return lr_artnet_result_name((lr_artnet_result)k); }
+static const char *osc_kind(int k)
+{
+    static const char *const key[LR_OSC_N_BAD] = {"address", "types", "value", "scene",
+                                                  "packet"}; /* lr_osc_bad */
+    return (unsigned)k < LR_OSC_N_BAD ? key[k] : "?";
+}
+
+static int input_counters(const rigset *s, int i, lr_rig_stats_counter *out)
+{
+    lr_dmx_counters c;
+    if (s->sacn[i]) {
+        lr_sacn_get_counters(s->sacn[i], &c);
+        return dmx_counters(&c, sacn_kind, LR_SACN_N_RESULTS, out);
+    }
+    if (s->artnet[i]) {
+        lr_artnet_get_counters(s->artnet[i], &c);
+        return dmx_counters(&c, artnet_kind, LR_ARTNET_N_RESULTS, out);
+    }
+    if (!s->osc[i])
+        return 0;
+    lr_osc_counters oc;
+    lr_osc_get_counters(s->osc[i], &oc);
+    int n = 0;
+    out[n++] = (lr_rig_stats_counter){"", "messages", oc.messages};
+    out[n++] = (lr_rig_stats_counter){"", "events", oc.events};
+    out[n++] = (lr_rig_stats_counter){"", "bad", oc.bad};
+    for (int k = 0; k < LR_OSC_N_BAD; k++)
+        if (oc.bad_kind[k])
+            out[n++] = (lr_rig_stats_counter){"bad_", osc_kind(k), oc.bad_kind[k]};
+    return n;
+}
+
 static void set_free(rigset *s)
 {
     for (int i = 0; i < s->n_devs; i++)
@@ -135,6 +200,20 @@ static void scene_warn(void *user, const char *msg)
 {
     lr_rig *r = user;
     lr_log_write(&r->log, LR_LOG_WARN, "scene: %s", msg);
+}
+
+/* A console channel's home for a loss fade (hal/dmx_in.h): the position the control map took
+ * from the scene (or "initial") for the level binding of this device's control; NaN (hold)
+ * when no level binding takes it. */
+static double channel_home(const rigset *s, const lr_rig_device *d, const char *control)
+{
+    for (int i = 0; i < s->cfg->n_bindings; i++) {
+        const lr_rig_binding *b = &s->cfg->bindings[i];
+        if (b->kind == LR_BIND_LEVEL && strcmp(b->control, control) == 0 &&
+            (!b->source[0] || strcmp(b->source, d->name) == 0))
+            return lr_control_map_position(s->map, i);
+    }
+    return NAN;
 }
 
 static int create_device(lr_rig *r, rigset *s, const lr_rig_device *d, lr_err *e)
@@ -234,6 +313,58 @@ static int create_device(lr_rig *r, rigset *s, const lr_rig_device *d, lr_err *e
         lr_usb *u;
         if (!(rc = lr_usb_create(&ud, &u, e)))
             out = lr_usb_dev(u);
+        break;
+    }
+    case LR_RIG_DEV_SACN:
+    case LR_RIG_DEV_ARTNET: {
+        lr_dmx_channel ch[LR_RIG_MAX_CHANNELS];
+        for (int i = 0; i < d->n_channels; i++)
+            ch[i] = (lr_dmx_channel){.control = d->channels[i].control,
+                                     .universe = d->channels[i].universe,
+                                     .channel = d->channels[i].channel,
+                                     .fine = d->channels[i].fine,
+                                     .home = channel_home(s, d, d->channels[i].control)};
+        if (d->type == LR_RIG_DEV_SACN) {
+            lr_sacn_desc sd = {.dev = dev, .bind = d->bind, .interface = d->interface,
+                               .unicast_only = d->unicast_only, .channels = ch,
+                               .n_channels = d->n_channels, .loss = (lr_dmx_loss)d->loss,
+                               .preview = d->preview, .port = d->port,
+                               .max_sources = d->max_sources, .loss_ms = d->loss_ms,
+                               .fade_ms = d->fade_ms, .max_packets = d->max_packets};
+            lr_sacn *sa;
+            if (!(rc = lr_sacn_create(&sd, &sa, e))) {
+                out = lr_sacn_dev(sa);
+                s->sacn[s->n_devs] = sa;
+            }
+        } else {
+            lr_artnet_desc ad = {.dev = dev, .bind = d->bind, .announce = d->announce,
+                                 .short_name = d->short_name, .channels = ch,
+                                 .n_channels = d->n_channels,
+                                 .merge = (lr_dmx_merge_mode)d->merge,
+                                 .loss = (lr_dmx_loss)d->loss, .port = d->port,
+                                 .merge_timeout_ms = d->merge_timeout_ms,
+                                 .fade_ms = d->fade_ms, .max_packets = d->max_packets};
+            lr_artnet *an;
+            if (!(rc = lr_artnet_create(&ad, &an, e))) {
+                out = lr_artnet_dev(an);
+                s->artnet[s->n_devs] = an;
+            }
+        }
+        break;
+    }
+    case LR_RIG_DEV_OSC: {
+        const char *sc[LR_RIG_MAX_SCENE_NAMES];
+        for (int i = 0; i < d->n_scenes; i++)
+            sc[i] = d->scenes[i];
+        lr_osc_desc od = {.dev = dev, .prefix = d->prefix, .scene_control = d->scene_control,
+                          .scenes = sc,
+                          .n_scenes = d->n_scenes, .port = d->port,
+                          .max_packets = d->max_packets};
+        lr_osc *o;
+        if (!(rc = lr_osc_create(&od, &o, e))) {
+            out = lr_osc_dev(o);
+            s->osc[s->n_devs] = o;
+        }
         break;
     }
     }
@@ -622,8 +753,9 @@ static void mqtt_status(void *user, lr_mqtt_status *st)
     lr_rig *r = user;
     lr_rig_stats_dev *devs = r->mqtt_devs;
     for (int i = 0; i < r->set.n_devs; i++)
-        devs[i] = (lr_rig_stats_dev){lr_dev_name(r->set.devs[i]), lr_dev_kind(r->set.devs[i]),
-                                     lr_dev_state_name(lr_dev_get_state(r->set.devs[i])), NULL};
+        devs[i] = (lr_rig_stats_dev){
+            .name = lr_dev_name(r->set.devs[i]), .kind = lr_dev_kind(r->set.devs[i]),
+            .state = lr_dev_state_name(lr_dev_get_state(r->set.devs[i]))};
     lr_rig_info info;
     lr_rig_get_info(r, &info);
     *st = (lr_mqtt_status){
@@ -983,14 +1115,17 @@ static void write_stats(lr_rig *r, int64_t now)
     lr_err e = {0};
     lr_rig_stats_dev devs[LR_RIG_MAX_DEVICES];
     lr_modbus_counters mc[LR_RIG_MAX_DEVICES];
+    lr_rig_stats_counter in[LR_RIG_MAX_DEVICES][INPUT_COUNTERS_MAX];
     for (int i = 0; i < r->set.n_devs; i++) {
         lr_dev *d = r->set.devs[i];
         devs[i] = (lr_rig_stats_dev){lr_dev_name(d), lr_dev_kind(d),
-                                     lr_dev_state_name(lr_dev_get_state(d)), NULL};
+                                     lr_dev_state_name(lr_dev_get_state(d)), NULL, NULL, 0};
         if (r->set.modbus[i]) {
             lr_modbus_get_counters(r->set.modbus[i], &mc[i]);
             devs[i].modbus = &mc[i];
         }
+        devs[i].n_input = input_counters(&r->set, i, in[i]);
+        devs[i].input = in[i];
     }
     if (lr_rig_stats_write(r->stats, r->stats_path, r->config_path, now,
                            lr_control_map_garbage(r->set.map), devs, r->set.n_devs, &e))

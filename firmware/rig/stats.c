@@ -230,6 +230,15 @@ static void write_devices(lr_jw *w, const lr_rig_stats_dev *devs, int n)
             lr_jw_int(w, "writes", (long)c->writes);
             lr_jw_object_end(w);
         }
+        if (d->n_input > 0) {
+            lr_jw_object(w, "input");
+            for (int k = 0; k < d->n_input; k++) {
+                char key[96];
+                snprintf(key, sizeof key, "%s%s", d->input[k].prefix, d->input[k].name);
+                lr_jw_int(w, key, (long)d->input[k].value);
+            }
+            lr_jw_object_end(w);
+        }
         lr_jw_object_end(w);
     }
     lr_jw_array_end(w);

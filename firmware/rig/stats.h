@@ -6,7 +6,10 @@
  *   "config": "configs/rig/sim.json", "duration_s": 12.5,
  *   "frames": 321, "events": 40, "events_unmatched": 3, "garbage": 0,
  *   "devices": [{"name": "panel", "kind": "modbus", "state": "open",
- *                "modbus": {"requests": 812, "responses": 806, "timeouts": 2, "stale": 4, ...}}],
+ *                "modbus": {"requests": 812, "responses": 806, "timeouts": 2, "stale": 4, ...}},
+ *               {"name": "sacn", "kind": "sacn", "state": "open",
+ *                "input": {"packets": 9120, "taken": 9100, "bad": 3, "bad_acn-id": 3, ...}}],
+ *               (OSC, "input": {"messages": .., "events": .., "bad": .., "bad_address": ..})
  *   "latency_ms": {"n": 40, "min": 0.8, "median": 2.1, "p99": 7.9, "max": 8.3, "mean": 2.4},
  *   "converge_ms": {"n": 40, "median": 310, "p99": 2100, "max": 2300},
  *   "event_log": [{"source": "sim", "control": "dimmer", "kind": "absolute", "value": 0.5,
@@ -78,9 +81,18 @@ double lr_rig_stats_latency_ms(const lr_rig_stats *s, double q);
 
 /* One device as the stats file shows it ("devices"): its state and, for a Modbus link, every
  * counter of lr_modbus_counters (stale answers, timeouts, ...). */
+typedef struct lr_rig_stats_counter {
+    const char *prefix, *name; /* the key is prefix + name ("bad_" "acn-id") */
+    uint64_t value;
+} lr_rig_stats_counter;
+
 typedef struct lr_rig_stats_dev {
     const char *name, *kind, *state;
     const lr_modbus_counters *modbus; /* NULL: not a Modbus device */
+    /* A console input (sacn, artnet, osc): its counters as "input": {name: value}, the bad
+     * packets by kind among them ("bad_acn-id"); n_input 0: none. */
+    const lr_rig_stats_counter *input;
+    int n_input;
 } lr_rig_stats_dev;
 
 /* Writes the JSON above to path atomically. config may be NULL; garbage counts events with

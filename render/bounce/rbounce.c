@@ -54,7 +54,7 @@ bool lr_rbounce_needed(const lr_scene *s)
     if (lr_scene_render(s)->lpv > 0)
         return false;
     for (int i = 0; i < lr_scene_object_count(s); i++)
-        if (lr_scene_object_at(s, i)->sss_model == LR_SSS_TRANSLUCENT_RADIOSITY)
+        if (lr_sss_model_props_of(lr_scene_object_at(s, i)->sss_model)->patch_solve)
             return false; /* its solve has the receivers in F (render/transrad/tr_scene.h) */
     for (int i = 0; i < lr_scene_receiver_count(s); i++)
         if (lr_scene_receiver_at(s, i)->type == LR_RECEIVER_PLANE)

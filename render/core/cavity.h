@@ -60,7 +60,7 @@ typedef struct lr_cavity {
 
 /* B per unit intensity at surface point x, normal n, estimated with N samples per band from the
  * random stream `key` (the untruncated sampler of the profile models:
- * render/models/cavity_gains.c). */
+ * render/models/twin/cavity_gains.c). */
 typedef void (*lr_cavity_sample_fn)(const void *ctx, lr_vec3 x, lr_vec3 n, int N, uint64_t key,
                                     double B[3]);
 

@@ -8,7 +8,7 @@
 #include <time.h>
 
 #include "render/base/mat4.h"
-#include "render/models/cavity_gains.h"
+#include "render/models/twin/cavity_gains.h"
 #include "render/cpu/maps.h"
 #include "render/base/parallel.h"
 #include "render/bounce/objlight.h"
@@ -18,7 +18,7 @@
 #include "render/lpv/scene_lpv.h"
 #include "render/transrad/tr_scene.h"
 #include "render/base/rng.h"
-#include "render/models/sh.h"
+#include "render/models/twin/sh.h"
 #include "render/core/surface.h"
 #include "render/core/vpl.h"
 
@@ -636,7 +636,7 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
         lr_gb_camera cam;
         lr_gb_camera_scene(s, l, &cam);
         for (int o = 0; o < r.nobj; o++)
-            if (r.objs[o]->sss_model == LR_SSS_SH_TRANSLUCENCY)
+            if (lr_sss_model_props_of(r.objs[o]->sss_model)->light_env)
                 lr_cpu_sh_env(r.objs[o], lr_scene_light_at(s, l), &cam, rs->gbuffer_size, r.objs,
                               r.nobj, d->threads, &r.sh[o * r.nlight + l]);
     }
@@ -655,7 +655,7 @@ int lr_cpu_render(const lr_cpu_render_desc *d, lr_image *rgb, lr_image *var,
             goto fail;
     }
     for (int o = 0; o < r.nobj && !r.dscene; o++)
-        if (lr_scene_object_at(s, o)->sss_model == LR_SSS_DIFFUSION_GRID) {
+        if (lr_sss_model_props_of(lr_scene_object_at(s, o)->sss_model)->grid_field) {
             if ((rc = lr_dscene_create(&r.dscene, e)) || (rc = lr_dscene_update(r.dscene, s, e)))
                 goto fail;
         }

@@ -24,7 +24,7 @@
 
 #include "render/base/err.h"
 #include "render/base/progress.h"
-#include "render/models/radiosity.h"
+#include "render/models/twin/radiosity.h"
 #include "render/image/image.h"
 #include "render/scene/scene.h"
 

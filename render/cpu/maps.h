@@ -16,7 +16,7 @@
 #include <stdbool.h>
 
 #include "render/base/err.h"
-#include "render/models/radiosity.h"
+#include "render/models/twin/radiosity.h"
 #include "render/scene/scene.h"
 
 typedef struct lr_cpu_maps lr_cpu_maps;

@@ -345,7 +345,7 @@ int lr_dscene_update(lr_dscene *d, const lr_scene *s, lr_err *e)
             dobj_clear(D);
             continue;
         }
-        if (o->sss_model != LR_SSS_DIFFUSION_GRID) {
+        if (!lr_sss_model_props_of(o->sss_model)->grid_field) {
             /* Kept, not freed: the rig's preview frame renders the object with a profile
              * model and the refinement right after it comes back to the grid (render/async/);
              * a freed grid was built again at every change (its build is most of a 5 mm

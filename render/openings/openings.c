@@ -7,9 +7,9 @@
 #include <string.h>
 #include <time.h>
 
-#include "render/models/cavity_gains.h"
+#include "render/models/twin/cavity_gains.h"
 #include "render/base/parallel.h"
-#include "render/models/radiosity.h"
+#include "render/models/twin/radiosity.h"
 #include "render/core/recv_grid.h"
 #include "render/base/rng.h"
 #include "render/diffusion/dscene.h"
@@ -76,7 +76,7 @@ bool lr_openings_needed(const lr_scene *s)
     bool any = false;
     for (int i = 0; i < lr_scene_object_count(s); i++) {
         const lr_scene_object *o = lr_scene_object_at(s, i);
-        if (o->sss_model == LR_SSS_TRANSLUCENT_RADIOSITY)
+        if (lr_sss_model_props_of(o->sss_model)->patch_solve)
             return false; /* its receiver grid carries the inner faces' light (tr_scene.h) */
         any = any || eligible(o);
     }

@@ -20,7 +20,7 @@
  *
  * a, b, c the corners relative to p (exact; atan2 keeps the branch for Omega up to 2 pi).
  * Users: the diffusion grid's boundary source (render/diffusion/dscene.c), sh_translucency's
- * direct term (render/models/sh.c, render/shaders/lib/sh_translucency.glsl), translucent
+ * direct term (render/models/twin/sh.c, render/shaders/lib/sh_translucency.glsl), translucent
  * radiosity's direct term and its entering part (render/transrad/direct.c). */
 #ifndef LR_NEAR_LIGHT_H
 #define LR_NEAR_LIGHT_H

@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "render/base/mat4.h"
-#include "render/models/cavity_gains.h"
+#include "render/models/twin/cavity_gains.h"
 #include "render/passes/passes.h"
 
 int lr_passes_upload_arrays(lr_gpu_mesh *g, const float *pos, const float *nrm, size_t nv,

@@ -21,6 +21,19 @@ bool lr_shader_defines_add(lr_shader_defines *d, const char *name, int value)
     return true;
 }
 
+void lr_shader_defines_copy(lr_shader_defines *to, const lr_shader_defines *from)
+{
+    *to = *from;
+    const char *t0 = (const char *)from->text, *m0 = from->models;
+    for (int i = 0; i < from->n; i++) {
+        const char *p = from->list[i];
+        if (p >= t0 && p < t0 + sizeof from->text)
+            to->list[i] = (const char *)to->text + (p - t0);
+        else if (p >= m0 && p < m0 + sizeof from->models)
+            to->list[i] = to->models + (p - m0);
+    }
+}
+
 /* One entry: the constant's name as written in C, and its value. */
 #define DEF(x) {#x, (int)(x)}
 
@@ -41,12 +54,6 @@ const char *const *lr_passes_defines(lr_shader_defines *d)
         DEF(LR_GB_CUBE),
         DEF(LR_GB_PERSPECTIVE),
         DEF(LR_GB_ORTHO),
-        DEF(LR_SSS_DIRECTIONAL_DIPOLE),
-        DEF(LR_SSS_STANDARD_DIPOLE),
-        DEF(LR_SSS_MULTIPOLE),
-        DEF(LR_SSS_TRANSLUCENT_RADIOSITY),
-        DEF(LR_SSS_DIFFUSION_GRID),
-        DEF(LR_SSS_SH_TRANSLUCENCY),
         DEF(LR_TONEMAP_CLAMP),
         DEF(LR_TONEMAP_REINHARD),
         DEF(LR_TONEMAP_ACES),
@@ -56,5 +63,12 @@ const char *const *lr_passes_defines(lr_shader_defines *d)
     memset(d, 0, sizeof *d);
     for (size_t i = 0; i < sizeof defs / sizeof defs[0]; i++)
         lr_shader_defines_add(d, defs[i].name, defs[i].value); /* fits: asserted above */
+    /* The models' dispatch after the constants; the buffer holds the registry's text, which
+     * tests/optics/test_models.c checks fits (a shorter list here would fail every shader). */
+    int n = lr_models_glsl_defines(d->models, sizeof d->models, d->list + d->n,
+                                   LR_MODELS_GLSL_DEFINES);
+    if (n > 0)
+        d->n += n;
+    d->list[d->n] = NULL;
     return d->list;
 }

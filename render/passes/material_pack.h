@@ -4,6 +4,7 @@
 #ifndef LR_MATERIAL_PACK_H
 #define LR_MATERIAL_PACK_H
 
+#include "render/models/model.h"
 #include "render/optics/optics.h"
 
 /* Objects per scene the shaders' uniform arrays hold (material.glsl, gather.glsl). */

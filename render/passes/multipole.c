@@ -6,7 +6,7 @@
 void lr_passes_pack_multipole(const lr_coeffs *c, enum lr_sss_model model, double thickness_mm,
                               float b[12])
 {
-    bool on = model == LR_SSS_MULTIPOLE && thickness_mm > 0.0;
+    bool on = lr_sss_model_props_of(model)->slab && thickness_mm > 0.0;
     b[7] = on ? (float)thickness_mm : 0.0f;
     b[11] = on ? (float)lr_multipole_pairs(c, thickness_mm) : 0.0f;
 }

@@ -126,7 +126,7 @@ static int dgrid_update(lr_radiosity *rad, const lr_pass_ctx *c, lr_err *e)
     bool any = false;
     int n = lr_scene_object_count(c->scene), rc;
     for (int i = 0; i < n && i < LR_MAX_OBJECTS; i++)
-        any |= lr_scene_object_at(c->scene, i)->sss_model == LR_SSS_DIFFUSION_GRID;
+        any |= lr_sss_model_props_of(lr_scene_object_at(c->scene, i)->sss_model)->grid_field;
     if (!any && !rad->dscene)
         return LR_OK;
     if (!rad->dscene && (rc = lr_dscene_create(&rad->dscene, e)))

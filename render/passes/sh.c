@@ -25,7 +25,7 @@ static void project_view(const lr_gb_camera *cam, int view, int n, const lr_ligh
             if (id < 0 || id >= nobj || id >= LR_MAX_OBJECTS)
                 continue;
             const lr_scene_object *o = lr_scene_object_at(s, id);
-            if (o->sss_model != LR_SSS_SH_TRANSLUCENCY)
+            if (!lr_sss_model_props_of(o->sss_model)->light_env)
                 continue;
             lr_vec3 org, dir;
             double w;
@@ -58,7 +58,7 @@ int lr_radiosity_sh_project(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gb
     for (int o = 0; o < nobj && o < LR_MAX_OBJECTS; o++) {
         const lr_scene_object *ob = lr_scene_object_at(s, o);
         double sc[3] = {0, 0, 0}, rho[3] = {0, 0, 0}, lit = -1.0;
-        if (ob->sss_model == LR_SSS_SH_TRANSLUCENCY) {
+        if (lr_sss_model_props_of(ob->sss_model)->light_env) {
             rad->has_sh = true;
             lr_sh_object_scale(&ob->coeffs, ob->material.sh_scale, sc);
             lr_dipole_rd_total(&ob->coeffs, rho);

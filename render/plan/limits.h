@@ -4,22 +4,11 @@
  * another (a preset button, a translucency knob). Some models then leave the range in which
  * their measured error means anything, whatever the table says:
  *
- *   diffusion_grid   the grid (render/diffusion/dgrid.h, 7-point finite differences of seed 001
- *                    Eq. 1) must resolve the diffusion length 1/sigma_tr. Along a grid axis the
- *                    discrete solution of phi'' = sigma_tr^2 phi decays as e^{-lambda x} with
- *                    2 (cosh(lambda h) - 1) / h^2 = sigma_tr^2, i.e.
- *                    lambda h = acosh(1 + (sigma_tr h)^2 / 2): at sigma_tr h = 1 the decay rate
- *                    is 3.8 % low and the error grows as (sigma_tr h)^2 / 24 beyond. The limit
- *                    is LR_PLAN_GRID_MAX_SIGMA_H for the largest band's sigma_tr and the spacing
- *                    the object gets (lr_dscene_spacing). A wall (thickness_mm) thinner than
- *                    that spacing has cells with no interior node and is refused too.
- *   sh_translucency  seed 002 attenuates by the crossed thickness d through
- *                    a_c = exp(-sigma_tr max(d, 1/sigma_t')) (render/optics/sh_translucency.h: the
- *                    clamp at one transport mean free path). A wall (thickness_mm) thinner than
- *                    that mean free path in some band sits wholly in the clamp: the model cannot
- *                    tell that wall from a thicker one, so its figures do not carry over.
- *
- *   max_sigma_tr     a model whose row in render/optics/model.c has one (translucent
+ *   a model's own limit  its ops table's limit hook (render/models/model.h): the diffusion
+ *                    grid must resolve the diffusion length (render/models/diffusion_grid/
+ *                    diffusion_grid.h), SH translucency needs a wall thicker than one transport
+ *                    mean free path (render/models/sh_translucency/sh_translucency.c).
+ *   max_sigma_tr     a model whose properties (render/models/model.h) have one (translucent
  *                    radiosity: 500 /mm): beyond it (lr_sss_model_check_medium) its numerics
  *                    fail; the scene's loader and lr_scene_set refuse that material with that
  *                    model, and the planner leaves the model out.
@@ -34,8 +23,6 @@
 
 #include "render/base/err.h"
 #include "render/scene/scene.h"
-
-#define LR_PLAN_GRID_MAX_SIGMA_H 1.0
 
 /* Why model m is outside its validity limits for object o's current material (written to
  * buf, which is returned), or NULL when it is within them. */

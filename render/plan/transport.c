@@ -167,8 +167,9 @@ int lr_plan_transport_decide(const lr_scene *s, const enum lr_sss_model *models,
         plane |= lr_scene_receiver_at(s, r)->type == LR_RECEIVER_PLANE;
     const int no = lr_scene_object_count(s);
     for (int i = 0; i < no; i++)
-        transrad |= (models ? models[i] : lr_scene_object_at(s, i)->sss_model) ==
-                    LR_SSS_TRANSLUCENT_RADIOSITY;
+        transrad |= lr_sss_model_props_of(models ? models[i]
+                                                 : lr_scene_object_at(s, i)->sss_model)
+                        ->patch_solve;
 
     const char *none = lr_scene_light_count(s) < 1 ? "no light"
                        : !plane ? "no plane receiver"

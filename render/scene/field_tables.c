@@ -196,7 +196,7 @@ static const lr_field object_fields[] = {
              "Donner & Jensen 2005 slab, T across the wall, R on the same face; "
              "translucent_radiosity: seed 000's patch solve with the receivers, for materials "
              "of sigma_tr = sqrt(3 sigma_a (sigma_a + sigma_s_prime)) <= 500 /mm in every band "
-             "(render/optics/model.c's max_sigma_tr; a material beyond is refused); "
+             "(its properties' max_sigma_tr, render/models/translucent_radiosity/; a material beyond is refused); "
              "diffusion_grid: seed 001's grid solve, closed meshes; sh_translucency: seed 002, SH "
              "of the entering light times a thickness attenuation, the cheapest)"},
     /* The range is lr_multipole_thickness_validate's (LR_MULTIPOLE_D_MIN..MAX). */

@@ -302,9 +302,10 @@ static int parse_object(ctx *c, lr_jnode obj, int i, obj_rec *o)
     lr_err inner = {0};
     if ((rc = lr_fields_check(&lr_scene_object_desc, o, &field, &inner)))
         return fail_check(c, obj, where, field, rc, &inner);
-    if (o->pub.sss_model == LR_SSS_MULTIPOLE && !(o->pub.thickness_mm > 0.0))
+    if (lr_sss_model_props_of(o->pub.sss_model)->needs_thickness && !(o->pub.thickness_mm > 0.0))
         return lr_json_fail(c->j, obj, cat(f, sizeof f, where, "thickness_mm"), c->e, LR_EPARSE,
-                            "missing (required with model multipole)");
+                            "missing (required with model %s)",
+                            lr_sss_model_name(o->pub.sss_model));
     lr_jnode mat = lr_json_get(c->j, obj, "material"), mesh = lr_json_get(c->j, obj, "mesh");
     if (mat == LR_JNONE)
         return lr_json_fail(c->j, obj, cat(f, sizeof f, where, "material"), c->e, LR_EPARSE,

@@ -43,6 +43,7 @@
 #include "render/material/material.h"
 #include "render/mesh/bvh.h"
 #include "render/mesh/mesh.h"
+#include "render/models/model.h"
 #include "render/optics/optics.h"
 #include "render/scene/dirty.h"
 
@@ -103,17 +104,7 @@ const char *lr_scene_object_model_unmet(const lr_scene_object *o, enum lr_sss_mo
 
 static inline double lr_scene_object_sd_norm(const lr_scene_object *o, int c)
 {
-    if (o->sd_raw)
-        return 1.0;
-    switch (o->sss_model) {
-    case LR_SSS_DIRECTIONAL_DIPOLE:
-        return o->coeffs.sd_norm[c];
-    case LR_SSS_STANDARD_DIPOLE:
-    case LR_SSS_MULTIPOLE:
-        return 1.0 / o->coeffs.t_hem;
-    default:
-        return 1.0;
-    }
+    return lr_sss_sd_norm(o->sss_model, &o->coeffs, o->sd_raw, c);
 }
 
 /* ---- Lights ------------------------------------------------------------------------------- */

@@ -247,10 +247,12 @@ static int object_set(op *o, lr_scene *s, int i, const char *f, unsigned *d)
             return rc;
         if ((rc = lr_fields_check(&lr_scene_object_desc, &next, &bad, &inner)))
             return check_failed(o, f, bad, rc, &inner);
-        if (next.pub.sss_model == LR_SSS_MULTIPOLE && !(next.pub.thickness_mm > 0.0))
+        if (lr_sss_model_props_of(next.pub.sss_model)->needs_thickness &&
+            !(next.pub.thickness_mm > 0.0))
             return lr_field_fail(o, LR_EINVAL, strcmp(f, "model") == 0
-                                          ? "multipole needs the object's thickness_mm set first"
-                                          : "the multipole needs a thickness > 0 mm");
+                                          ? "%s needs the object's thickness_mm set first"
+                                          : "the %s needs a thickness > 0 mm",
+                                 lr_sss_model_name(next.pub.sss_model));
         if ((rc = lr_sss_model_check_medium(next.pub.sss_model, &next.pub.material.medium,
                                             &inner)))
             return lr_err_set(o->e, rc, "%s: the material's %s", o->key, inner.msg);

@@ -69,17 +69,12 @@ void main()
     }
     lr_coeffs_gl mat = lr_material(u_object);
     lr_sss_gl sss = lr_material_sss(u_object);
-    if (sss.model == LR_SSS_DIFFUSION_GRID) {
-        // Seed 001: B was solved on the CPU (render/diffusion/dscene.h); look it up.
-        o_B = vec4(min(lr_dgrid_B(xo) * u_map_scale, vec3(u_map_max)), 1.0);
-        o_pos = vec4(xo, 1.0);
-        o_nrm = vec4(no, float(u_object));
-        return;
-    }
-    if (sss.model == LR_SSS_SH_TRANSLUCENCY) {
-        // Seed 002: no samples, one evaluation per texel (Eq. 10-12).
-        vec3 Bsh = lr_sh_translucency_B(u_object, mat, xo, no);
-        o_B = vec4(min(Bsh * u_map_scale, vec3(u_map_max)), 1.0);
+    if (LR_MODEL_HAS_B(sss.model)) {
+        // A model with a B of its own (render/models/model.h glsl_B), drawn without samples:
+        // seed 001's grid solved on the CPU (lib/dgrid.glsl), seed 002's SH evaluated once
+        // per texel (Eq. 10-12, lib/sh_translucency.glsl).
+        vec3 Bown = LR_MODEL_B(sss.model, u_object, mat, xo, no);
+        o_B = vec4(min(Bown * u_map_scale, vec3(u_map_max)), 1.0);
         o_pos = vec4(xo, 1.0);
         o_nrm = vec4(no, float(u_object));
         return;

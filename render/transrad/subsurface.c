@@ -189,7 +189,8 @@ static int local_thickness(const lr_tr *t, int s, double **out, lr_err *e)
 {
     const lr_tr_surf *sf = &t->surf[s];
     *out = NULL;
-    bool slab = sf->d.model == LR_SSS_MULTIPOLE || sf->d.model == LR_SSS_TRANSLUCENT_RADIOSITY;
+    const lr_sss_model_props *p = lr_sss_model_props_of(sf->d.model);
+    bool slab = p->slab || p->measures_thickness;
     if (!slab)
         return LR_OK;
     double *th = calloc(sf->count ? sf->count : 1, sizeof *th);
@@ -204,7 +205,7 @@ static int local_thickness(const lr_tr *t, int s, double **out, lr_err *e)
             th[i] = sf->d.thickness_mm;
             continue;
         }
-        if (sf->d.model != LR_SSS_TRANSLUCENT_RADIOSITY)
+        if (!p->measures_thickness)
             continue;
         /* From points on the surface, not the centroid: a patch is a cluster of triangles,
          * and on a curved face its centroid lies off the surface (a candle's melt-pool dish:

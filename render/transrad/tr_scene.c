@@ -33,7 +33,7 @@ static double now_s(void)
 bool lr_tr_scene_needed(const lr_scene *s)
 {
     for (int i = 0; i < lr_scene_object_count(s); i++)
-        if (lr_scene_object_at(s, i)->sss_model == LR_SSS_TRANSLUCENT_RADIOSITY)
+        if (lr_sss_model_props_of(lr_scene_object_at(s, i)->sss_model)->patch_solve)
             return true;
     return false;
 }
@@ -190,7 +190,7 @@ static int receiver_values(lr_tr_scene *ts, const lr_scene *s, int ri, int l, lr
             continue;
         }
         const lr_scene_object *o = lr_scene_object_at(s, sq);
-        if (o->sss_model != LR_SSS_TRANSLUCENT_RADIOSITY)
+        if (!lr_sss_model_props_of(o->sss_model)->patch_solve)
             continue;
         lr_vec3 c, nq;
         lr_tr_patch_geometry(t, q, &c, &nq, NULL);
@@ -272,7 +272,7 @@ int lr_tr_scene_update(lr_tr_scene **tsp, const lr_scene *s, const lr_cancel *ca
             return rc;
         for (int o = 0; o < ts->n_obj; o++) {
             ts->mesh[o] = lr_scene_object_at(s, o)->mesh;
-            if (lr_scene_object_at(s, o)->sss_model == LR_SSS_TRANSLUCENT_RADIOSITY &&
+            if (lr_sss_model_props_of(lr_scene_object_at(s, o)->sss_model)->patch_solve &&
                 (rc = vertex_values(ts, lr_scene_object_at(s, o), o, l, e)))
                 return rc;
         }

@@ -25,10 +25,10 @@ static int check_surface(const lr_tr_surface_desc *d, int s, lr_err *e)
         if (!d->coeffs)
             return lr_err_set(e, LR_EINVAL, "transrad: surface %d: field 'coeffs': none given",
                               s);
-        if (d->model == LR_SSS_MULTIPOLE && !(d->thickness_mm > 0))
+        if (lr_sss_model_props_of(d->model)->needs_thickness && !(d->thickness_mm > 0))
             return lr_err_set(e, LR_EINVAL,
-                              "transrad: surface %d: field 'thickness_mm': the multipole "
-                              "needs the wall's thickness", s);
+                              "transrad: surface %d: field 'thickness_mm': the %s "
+                              "needs the wall's thickness", s, lr_sss_model_name(d->model));
     } else {
         for (int b = 0; b < 3; b++)
             if (!(d->albedo[b] >= 0 && d->albedo[b] <= 1))

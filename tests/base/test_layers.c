@@ -1,7 +1,7 @@
 /* The tree's include graph against docs/layers.txt: no include goes up a layer, no folder is
- * left out of the layers, no cycle between folders. The checker itself is first shown to
- * catch each kind of problem on a small tree made here, so a pass on the real tree means
- * something. */
+ * left out of the layers, no cycle between folders; and no model-id comparison outside
+ * render/models/ (render/models/model.h). Each checker is first shown to catch each kind of
+ * problem on a small tree made here, so a pass on the real tree means something. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -14,6 +14,7 @@
 
 #include "tests/support/fs.h"
 #include "tests/support/include_graph.h"
+#include "tests/support/model_ids.h"
 
 #define ROOT LR_SOURCE_CONFIGS "/.."
 #define REPORT_MAX 65536
@@ -118,6 +119,45 @@ static void test_tree_follows_its_layers(void **state)
     assert_int_equal(n, 0);
 }
 
+static void test_model_id_comparisons_are_named(void **state)
+{
+    (void)state;
+    char *dir = lr_test_tmpdir();
+    free(lr_test_write(dir, "render/a/x.c",
+                       "int f(int m) { return m == LR_SSS_MULTIPOLE; }\n"
+                       "int g(int m)\n{\n    return m !=\n        LR_SSS_SH_TRANSLUCENCY;\n}\n",
+                       (size_t)-1));
+    free(lr_test_write(dir, "render/shaders/y.frag",
+                       "\nswitch (m) { case LR_SSS_DIFFUSION_GRID: break; }\n"
+                       "bool h = LR_SSS_STANDARD_DIPOLE == m;\n", (size_t)-1));
+    /* Not comparisons: an id given as a value, a name in a comment or a define. */
+    free(lr_test_write(dir, "render/b/z.c",
+                       "int k = LR_SSS_MULTIPOLE; /* LR_SSS_MULTIPOLE */\n"
+                       "#define LR_SSS_X 1\nint n = LR_SSS_MODEL_COUNT;\n", (size_t)-1));
+    /* Inside render/models/ and tests/ they are allowed. */
+    free(lr_test_write(dir, "render/models/registry.c", "x == LR_SSS_MULTIPOLE\n", (size_t)-1));
+    free(lr_test_write(dir, "tests/t/test_q.c", "x == LR_SSS_MULTIPOLE\n", (size_t)-1));
+    assert_int_equal(lr_test_check_model_ids(dir, report, sizeof report), 4);
+    assert_non_null(strstr(report, "render/a/x.c:1: compares a model id: == LR_SSS_MULTIPOLE"));
+    assert_non_null(strstr(report, "render/a/x.c:4: compares a model id: !="));
+    assert_non_null(strstr(report, "render/shaders/y.frag:2: compares a model id: case "
+                                   "LR_SSS_DIFFUSION_GRID"));
+    assert_non_null(strstr(report, "render/shaders/y.frag:3: compares a model id: "
+                                   "LR_SSS_STANDARD_DIPOLE =="));
+    assert_null(strstr(report, "z.c"));
+    assert_null(strstr(report, "registry.c"));
+    lr_test_rmtree(dir);
+}
+
+static void test_no_model_id_comparison_outside_the_models(void **state)
+{
+    (void)state;
+    int n = lr_test_check_model_ids(ROOT, report, sizeof report);
+    if (n != 0)
+        fprintf(stderr, "%d model-id comparison(s) outside render/models/:\n%s", n, report);
+    assert_int_equal(n, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -128,6 +168,8 @@ int main(void)
         cmocka_unit_test(test_pattern_covers_folders_below),
         cmocka_unit_test(test_missing_layers_file_is_an_error),
         cmocka_unit_test(test_tree_follows_its_layers),
+        cmocka_unit_test(test_model_id_comparisons_are_named),
+        cmocka_unit_test(test_no_model_id_comparison_outside_the_models),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -22,6 +22,7 @@
 #include "firmware/rig/rig.h"
 #include "hal/dev.h"
 #include "render/diffusion/dscene.h"
+#include "render/models/diffusion_grid/diffusion_grid.h"
 #include "render/plan/limits.h"
 #include "render/plan/plan.h"
 #include "render/plan/replan.h"
@@ -66,7 +67,7 @@ static void test_limits(void **state)
     char buf[256];
     double h = lr_dscene_spacing(o);
     double x = h * fmax(o->coeffs.sigma_tr[0], fmax(o->coeffs.sigma_tr[1], o->coeffs.sigma_tr[2]));
-    assert_true(x < LR_PLAN_GRID_MAX_SIGMA_H); /* candle wax: about 0.32 (0.125 /mm x 2.52 mm) */
+    assert_true(x < LR_GRID_MAX_SIGMA_H); /* candle wax: about 0.32 (0.125 /mm x 2.52 mm) */
     assert_null(lr_plan_model_limit(o, LR_SSS_DIFFUSION_GRID, buf, sizeof buf));
     for (int m = 0; m < LR_SSS_MODEL_COUNT; m++)
         assert_null(lr_plan_model_limit(o, (enum lr_sss_model)m, buf, sizeof buf));
@@ -118,7 +119,7 @@ static void test_limits(void **state)
     o = lr_scene_object_at(shade, 0);
     h = lr_dscene_spacing(o);
     x = h * fmax(o->coeffs.sigma_tr[0], fmax(o->coeffs.sigma_tr[1], o->coeffs.sigma_tr[2]));
-    assert_true(x < LR_PLAN_GRID_MAX_SIGMA_H);
+    assert_true(x < LR_GRID_MAX_SIGMA_H);
     assert_true(h > 1.5);
     why = lr_plan_model_limit(o, LR_SSS_DIFFUSION_GRID, buf, sizeof buf);
     assert_non_null(why);

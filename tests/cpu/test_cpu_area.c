@@ -13,8 +13,8 @@
 #include <string.h>
 
 #include "render/area/frames.h"
-#include "render/models/cavity_gains.h"
-#include "render/models/radiosity.h"
+#include "render/models/twin/cavity_gains.h"
+#include "render/models/twin/radiosity.h"
 #include "render/base/rng.h"
 #include "render/core/vpl.h"
 #include "render/material/material.h"

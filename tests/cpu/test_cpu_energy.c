@@ -29,8 +29,8 @@
 #include <string.h>
 
 #include "render/base/paths.h"
-#include "render/models/cavity_gains.h"
-#include "render/models/radiosity.h"
+#include "render/models/twin/cavity_gains.h"
+#include "render/models/twin/radiosity.h"
 #include "render/base/rng.h"
 #include "render/material/material.h"
 #include "tests/support/near.h"

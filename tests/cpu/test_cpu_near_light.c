@@ -40,9 +40,9 @@
 #include <string.h>
 #include <time.h>
 
-#include "render/models/radiosity.h"
+#include "render/models/twin/radiosity.h"
 #include "render/base/rng.h"
-#include "render/models/sh.h"
+#include "render/models/twin/sh.h"
 #include "render/mesh/mesh.h"
 #include "render/optics/optics.h"
 #include "render/core/gbuffer_camera.h"

@@ -1,4 +1,4 @@
-/* CPU twin, pass 2 (render/models/radiosity.h): the stereographic Jacobian integrates to 4 pi over
+/* CPU twin, pass 2 (render/models/twin/radiosity.h): the stereographic Jacobian integrates to 4 pi over
  * the plane; the estimator is unbiased on a slab under a directional light (closed form by
  * quadrature of lr_dirpole_sd), per band for ketchup (no colour shift); its error falls like
  * 1/sqrt(N); pass and reference samplers agree; hard cases stay finite with asserted values.
@@ -18,7 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/models/radiosity.h"
+#include "render/models/twin/radiosity.h"
 #include "render/base/rng.h"
 #include "render/material/material.h"
 #include "render/mesh/shapes.h"

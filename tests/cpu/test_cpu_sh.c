@@ -1,4 +1,4 @@
-/* CPU twin of the sh_translucency model (render/models/sh.h): the thickness against ray casts
+/* CPU twin of the sh_translucency model (render/models/twin/sh.h): the thickness against ray casts
  * through a sphere (closed-form chords), the projection through the G-buffer cameras against
  * the closed-form power and lit area of a sphere, and the stored preset scales against the fit. */
 #include <setjmp.h>
@@ -11,8 +11,8 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "render/models/radiosity.h"
-#include "render/models/sh.h"
+#include "render/models/twin/radiosity.h"
+#include "render/models/twin/sh.h"
 #include "render/material/material.h"
 #include "tests/support/near.h"
 #include "tests/support/objects.h"

@@ -1,9 +1,11 @@
 /* lamprig fuzz — the MQTT command parser (firmware/rig/mqtt_payload.h) on arbitrary bytes.
  *
  * Input: a topic line, then the payload (the corpus files in corpus/mqtt_payload/ have this
- * form). Build and run with clang's libFuzzer (`make fuzz`, tests/fuzz/README.md):
- *   build/fuzz/fuzz_mqtt_payload tests/fuzz/corpus/mqtt_payload -max_total_time=60
- * tests/fw/test_fw_mqtt.c replays the corpus under ASan/UBSan in `make test`.
+ * form). Built with clang's libFuzzer by `make fuzz`; run it with a scratch folder first (new
+ * inputs go to the first folder):
+ *   build/fuzz/fuzz_mqtt_payload build/fuzz/mqtt_payload tests/fuzz/corpus/mqtt_payload \
+ *       -max_total_time=60
+ * tests/fw/test_fw_mqtt.c runs this same function on the corpus under ASan/UBSan in make test.
  * A refusal must name the topic; an accepted command must hold what the parser promises. */
 #include <math.h>
 #include <stdint.h>

@@ -61,7 +61,23 @@ static void test_bad_fields_named(void **state)
                                        "or directory"},
         {"{\"scene\": \"candle.json\",\n \"devices\": [\n  {\"type\": \"serial\"}]}",
          "rig.json:3: field 'devices[0].type': unknown device type 'serial' (sim, modbus, gpio, "
-         "hid, usb)"},
+         "hid, usb, sacn, artnet, osc)"},
+        {"{\"scene\": \"candle.json\",\n \"devices\": [\n  {\"type\": \"sacn\", \"channels\": "
+         "[\n   {\"control\": \"dimmer\", \"universe\": 0, \"channel\": 1}]}]}",
+         "rig.json:4: field 'devices[0].channels[0].universe': must be in 1..63999, got 0"},
+        {"{\"scene\": \"candle.json\",\n \"devices\": [\n  {\"type\": \"sacn\"}]}",
+         "rig.json:3: field 'devices[0].channels': required field is missing"},
+        {"{\"scene\": \"candle.json\",\n \"devices\": [\n  {\"type\": \"artnet\", \"channels\": "
+         "[\n   {\"control\": \"d\", \"channel\": 5, \"fine\": 5}]}]}",
+         "rig.json:4: field 'devices[0].channels[0].fine': the fine byte cannot be the channel "
+         "itself (5)"},
+        {"{\"scene\": \"candle.json\",\n \"devices\": [\n  {\"type\": \"artnet\", \"merge\": "
+         "\"max\", \"channels\": [{\"control\": \"d\", \"channel\": 1}]}]}",
+         "rig.json:3: field 'devices[0].merge': 'max' is not htp or ltp"},
+        {"{\"scene\": \"candle.json\",\n \"devices\": [\n  {\"type\": \"osc\", \"prefix\": "
+         "\"lamprig/\"}]}",
+         "rig.json:3: field 'devices[0].prefix': 'lamprig/' is not /NAME[/NAME...] without a "
+         "trailing '/'"},
         {"{\"scene\": \"candle.json\",\n \"devices\": [\n  {\"type\": \"sim\", \"script\": "
          "\"demo.sim\"},\n  {\"type\": \"sim\", \"text\": \"0 x press\"}]}",
          "rig.json:4: field 'devices[1].name': device name 'sim' is already used by devices[0]"},

@@ -41,6 +41,11 @@
 #include "tests/support/fs.h"
 #include "tests/support/modbus_server.h"
 
+/* The libFuzzer harness itself, renamed: the corpus test runs its checks (tests/fuzz/). */
+#define LLVMFuzzerTestOneInput fuzz_mqtt_payload
+#include "tests/fuzz/fuzz_mqtt_payload.c"
+#undef LLVMFuzzerTestOneInput
+
 #define CHILD_FLAG "--as-lamprig"
 #define PORT 18830
 /* 10 fps: one frame interval (the bound) is 100 ms, above the scheduling delays of a loaded
@@ -136,8 +141,9 @@ static void test_payload_refusals(void **state)
 }
 
 /* The fuzz corpus (tests/fuzz/corpus/mqtt_payload/, the harness's seeds and what it found):
- * every file parses or is refused with a message naming its topic, and nothing crashes under
- * ASan/UBSan. A file's first line is the topic, the rest the payload (the harness's format). */
+ * the harness's checks hold on every file (an accepted command in range and reading back the
+ * same when formatted), every file parses or is refused with a message naming its topic, and
+ * nothing trips ASan/UBSan. A file's first line is the topic, the rest the payload (the harness's format). */
 static void test_fuzz_corpus(void **state)
 {
     (void)state;
@@ -163,6 +169,7 @@ static void test_fuzz_corpus(void **state)
         size_t off = nl ? (size_t)(nl - b) + 1 : len;
         lr_mqtt_cmd c;
         lr_err e = {0};
+        fuzz_mqtt_payload(b, len); /* the harness's own checks: it aborts on a violation */
         int rc = lr_mqtt_payload_parse(topic, b + off, len - off, &c, &e);
         if (rc)
             assert_non_null(strstr(e.msg, topic[0] ? topic : "(null)") ? e.msg : NULL);

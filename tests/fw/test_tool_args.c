@@ -74,8 +74,9 @@ static void check_usage_error(const char *tool, const char *args, const char *co
 /* ---- lamprig-bench ------------------------------------------------------------------- */
 
 /* The sections tools/bench/README.md documents and `make bench` runs. */
-static const char *const bench_sections[] = {"optics", "cpu",   "render", "rig", "sweep",
-                                             "models", "dimmer", "camera", NULL};
+static const char *const bench_sections[] = {"optics", "cpu",    "render", "rig",
+                                             "sweep",  "models", "dimmer", "camera",
+                                             "console", NULL};
 
 static void test_bench(void **state)
 {
@@ -232,6 +233,45 @@ static void test_capsim(void **state)
     lr_test_rmtree(dir);
 }
 
+/* ---- lamprig-reference: two commands, each its own table ------------------------------ */
+
+static void test_reference(void **state)
+{
+    (void)state;
+    check_help("lamprig-reference render",
+               WORDS("--scene", "--out", "--variance", "--cache", "--cache-dir", "--width",
+                     "--height", "--spp", "--pass", "--threads", "--seed", "--progress",
+                     "--quiet"));
+    check_help("lamprig-reference validate", WORDS("--photons", "--threads", "--seed"));
+    check_usage_error("lamprig-reference render", "--scene a.json --width 0",
+                      WORDS("--width", "0", "1..16384"));
+    check_usage_error("lamprig-reference render", "--scene a.json --spp 1.5",
+                      WORDS("--spp", "1.5"));
+    check_usage_error("lamprig-reference render", "--out a.pfm", WORDS("--scene", "required"));
+    check_usage_error("lamprig-reference render", "--scene a.json --no-such-flag",
+                      WORDS("'--no-such-flag'"));
+    check_usage_error("lamprig-reference validate", "--seed -1", WORDS("--seed", "-1"));
+    check_usage_error("lamprig-reference", "bogus", WORDS("unknown command 'bogus'"));
+    /* The top-level help lists both commands; no command at all is a usage error. */
+    char *dir = lr_test_tmpdir();
+    assert_int_equal(lr_test_run_cli(dir, BIN "lamprig-reference --help"), 0);
+    char *out = lr_test_slurp(dir, "out");
+    assert_non_null(strstr(out, "  render "));
+    assert_non_null(strstr(out, "  validate "));
+    free(out);
+    assert_int_equal(lr_test_run_cli(dir, BIN "lamprig-reference"), 2);
+    /* An ordinary run: validate with few photons prints its table. */
+    int st = lr_test_run_cli(dir, BIN "lamprig-reference validate --photons 2000 --threads 1 "
+                                  "--seed 5");
+    if (st)
+        fail_msg("lamprig-reference validate: exit %d: %s", st, lr_test_slurp(dir, "err"));
+    out = lr_test_slurp(dir, "out");
+    assert_non_null(strstr(out, "| quantity |"));
+    assert_non_null(strstr(out, "2000 photons per problem"));
+    free(out);
+    lr_test_rmtree(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -240,6 +280,7 @@ int main(void)
         cmocka_unit_test(test_cpuref),
         cmocka_unit_test(test_transrad),
         cmocka_unit_test(test_capsim),
+        cmocka_unit_test(test_reference),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

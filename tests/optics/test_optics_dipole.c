@@ -13,6 +13,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "render/models/model.h"
 #include "render/optics/optics.h"
 #include "tests/support/near.h"
 #include "tests/support/quadrature.h"

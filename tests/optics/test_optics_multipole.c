@@ -28,6 +28,7 @@
 #include <string.h>
 
 #include "render/material/material.h"
+#include "render/models/model.h"
 #include "render/optics/optics.h"
 #include "render/reference/reference.h"
 #include "tests/support/near.h"

@@ -23,7 +23,7 @@
 #include <string.h>
 
 #include "render/cpu/frame.h"
-#include "render/models/radiosity.h"
+#include "render/models/twin/radiosity.h"
 #include "render/core/recv_grid.h"
 #include "render/lpv/scene_lpv.h"
 #include "render/mesh/bvh.h"

@@ -21,7 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/models/radiosity.h"
+#include "render/models/twin/radiosity.h"
 #include "render/diffusion/dscene.h"
 #include "render/renderer.h"
 #include "render/renderer_debug.h"

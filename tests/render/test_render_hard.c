@@ -263,7 +263,7 @@ static void test_fp16_accumulation(void **state)
  * and sigma_a 1e4 /mm): sigma_a in {1, 100, 1e4} x sigma_s' in {1, 1e6} /mm on a ball lit
  * from outside, over a table, each set on marble. Each combination is either refused with a
  * message that starts with the key that was set and says why in terms of sigma_tr
- * (lr_scene_set: the model's numerics, render/optics/model.c's max_sigma_tr;
+ * (lr_scene_set: the model's numerics, the model's max_sigma_tr, render/models/model.h;
  * lr_plan_check_models, which `lamprig render` and the rig run before rendering: the
  * planner's limits, the grid's spacing), or renders an image, maps and VPLs that are finite
  * and >= 0, with the emergent power within check_energy's bound (a finite 1e32 fails there: at

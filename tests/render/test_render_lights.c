@@ -27,7 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/models/cavity_gains.h"
+#include "render/models/twin/cavity_gains.h"
 #include "render/cpu/frame.h"
 #include "render/renderer.h"
 #include "render/renderer_debug.h"

@@ -25,7 +25,7 @@
 
 #include "render/base/mat4.h"
 #include "render/cpu/frame.h"
-#include "render/models/radiosity.h"
+#include "render/models/twin/radiosity.h"
 #include "render/base/rng.h"
 #include "render/core/vpl.h"
 #include "render/renderer.h"

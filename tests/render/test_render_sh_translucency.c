@@ -1,4 +1,4 @@
-/* sh_translucency (seed 002) on the GPU against its CPU twin (render/models/sh.h): the radiosity
+/* sh_translucency (seed 002) on the GPU against its CPU twin (render/models/twin/sh.h): the radiosity
  * maps of the GLSL pass (projection from the read-back light G-buffer, evaluation per texel in
  * render/shaders/lib/sh_translucency.glsl) at the GPU's own x_o, n_o against the twin's ray
  * casts through the same G-buffer texels. The model is deterministic (no samples), so the
@@ -21,8 +21,8 @@
 #include <string.h>
 
 #include "render/base/mat4.h"
-#include "render/models/radiosity.h"
-#include "render/models/sh.h"
+#include "render/models/twin/radiosity.h"
+#include "render/models/twin/sh.h"
 #include "render/renderer.h"
 #include "render/renderer_debug.h"
 #include "tests/support/gbuffer_snap.h"

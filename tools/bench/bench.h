@@ -30,6 +30,7 @@ extern const lrb_section lrb_sweep_section;
 extern const lrb_section lrb_models_section;
 extern const lrb_section lrb_dimmer_section;
 extern const lrb_section lrb_camera_section;
+extern const lrb_section lrb_console_section;
 
 /* Shared timing helpers (timing.c). */
 

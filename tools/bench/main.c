@@ -22,6 +22,7 @@ static const lrb_section *const sections[] = {
     &lrb_models_section,
     &lrb_dimmer_section,
     &lrb_camera_section,
+    &lrb_console_section,
 };
 #define NSECTIONS (sizeof sections / sizeof sections[0])
 

@@ -1,11 +1,10 @@
 /* lamprig-reference: the physical reference renderer (render/reference) on the command line.
  *
- *   lamprig-reference render --scene FILE [--out F.pfm] [--variance F.pfm] [--cache]
- *                            [--cache-dir DIR] [--width N] [--height N] [--spp N]
- *                            [--pass N] [--threads N] [--seed N] [--quiet]
+ *   lamprig-reference render --scene FILE [OPTIONS]
  *   lamprig-reference validate [--photons N] [--threads N] [--seed N]
  *
- * Exit status 0 on success, 1 on a runtime failure, 2 on bad arguments (one line on stderr).
+ * Each command's options are a table (firmware/tool.h): `COMMAND --help` is generated from it,
+ * and a bad argument is one line naming the flag with exit status 2.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,56 +12,97 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "firmware/args.h"
+#include "firmware/tool.h"
 #include "render/base/json.h"
 #include "render/base/progress.h"
 #include "render/reference/reference.h"
 #include "render/scene/scene.h"
 
+#define PROGRAM "lamprig-reference"
+
+static const lr_argspec render_opts[] = {
+    {.name = "--scene", .type = LR_ARG_PATH, .flags = LR_ARG_REQUIRED,
+     .help = "reference scene (configs/reference/) or project scene\n"
+             "(configs/scenes/: objects with meshes, receivers)"},
+    {.name = "--out", .type = LR_ARG_PATH, .metavar = "F.pfm",
+     .help = "mean image, PFM (default build/reference.pfm)"},
+    {.name = "--variance", .type = LR_ARG_PATH, .metavar = "F.pfm",
+     .help = "per-pixel variance of the mean, PFM (default: OUT with .var.pfm)"},
+    {.name = "--cache", .help = "reuse or fill build/reference-cache/<key>.pfm (+ .var.pfm, .json)"},
+    {.name = "--cache-dir", .type = LR_ARG_PATH, .metavar = "DIR",
+     .help = "the same with another directory"},
+    {.name = "--width", .type = LR_ARG_INT, .metavar = "N", .min = 1, .max = 16384,
+     .help = "image width (default: the scene file's render block)"},
+    {.name = "--height", .type = LR_ARG_INT, .metavar = "N", .min = 1, .max = 16384,
+     .help = "image height (default: the scene file's render block)"},
+    {.name = "--spp", .type = LR_ARG_INT, .metavar = "N", .min = 1, .max = 1 << 30,
+     .help = "samples per pixel (default: the scene file's render block)"},
+    {.name = "--pass", .type = LR_ARG_INT, .metavar = "N", .min = 1, .max = 1 << 30,
+     .help = "samples per pixel per progressive pass (default 4)"},
+    {.name = "--threads", .type = LR_ARG_INT, .metavar = "N", .min = 1, .max = 1024,
+     .help = "worker threads (default: all CPUs; the image does not depend on it)"},
+    {.name = "--seed", .type = LR_ARG_INT, .metavar = "N", .flags = LR_ARG_FLOOR,
+     .max = 9007199254740992.0, .help = "sample seed, 0..2^53 (default: the scene file's)"},
+    {.name = "--progress", .help = "progress lines on stderr (the default)"},
+    {.name = "--quiet", .help = "no progress lines on stderr (a line rewritten in place on a\n"
+                                "terminal, one a second otherwise)"},
+    {0},
+};
+
+static const lr_command render_cmd = {
+    .name = PROGRAM " render",
+    .about = "A volumetric Monte Carlo reference image of a scene file (README, \"Physical\n"
+             "reference\"): linear radiance as PFM, and the variance of each pixel's mean.",
+    .opts = render_opts,
+    .notes = "A summary line (time, samples, cache key) goes to stdout. Exit status 0, 1\n"
+             "(failure, message on stderr), 2 (bad arguments).",
+};
+
+static const lr_argspec validate_opts[] = {
+    {.name = "--photons", .type = LR_ARG_INT, .metavar = "N", .min = 2, .max = 1099511627776.0,
+     .help = "photons per problem (default 4000000)"},
+    {.name = "--threads", .type = LR_ARG_INT, .metavar = "N", .min = 1, .max = 1024,
+     .help = "worker threads (default: all CPUs)"},
+    {.name = "--seed", .type = LR_ARG_INT, .metavar = "N", .flags = LR_ARG_FLOOR,
+     .max = 9007199254740992.0, .help = "photon seed, 0..2^53 (default 1)"},
+    {0},
+};
+
+static const lr_command validate_cmd = {
+    .name = PROGRAM " validate",
+    .about = "The published slab benchmarks and the sphere energy balance, by counting photons\n"
+             "on the renderer's transport code.",
+    .opts = validate_opts,
+    .notes = "A markdown table goes to stdout. Exit status 0, 1 (failure), 2 (bad arguments).",
+};
+
 static const char usage[] =
-    "usage: lamprig-reference render --scene FILE [options]\n"
-    "       lamprig-reference validate [--photons N] [--threads N] [--seed N]\n"
+    "Usage: " PROGRAM " COMMAND [OPTIONS]\n"
     "\n"
-    "render: a volumetric Monte Carlo reference image of a scene file (README, \"Physical\n"
-    "reference\"): linear radiance as PFM, and the variance of each pixel's mean.\n"
-    "  --scene FILE       reference scene (configs/reference/) or project scene\n"
-    "                     (configs/scenes/: objects with meshes, receivers)\n"
-    "  --out FILE         mean image, PFM (default build/reference.pfm)\n"
-    "  --variance FILE    per-pixel variance of the mean, PFM (default: OUT with .var.pfm)\n"
-    "  --cache            reuse or fill build/reference-cache/<key>.pfm (+ .var.pfm, .json)\n"
-    "  --cache-dir DIR    the same with another directory\n"
-    "  --width N, --height N, --spp N, --seed N   override the scene file's render block\n"
-    "  --pass N           samples per pixel per progressive pass (default 4)\n"
-    "  --threads N        worker threads (default: all CPUs; the image does not depend on it)\n"
-    "  --quiet            no progress lines on stderr (a line rewritten in place on a\n"
-    "                     terminal, one a second otherwise; --progress: the default)\n"
+    "The physical reference renderer (render/reference) on the command line.\n"
     "\n"
-    "validate: the published slab benchmarks and the sphere energy balance, by counting\n"
-    "photons on the renderer's transport code (default 4000000 photons each).\n";
+    "Commands:\n"
+    "  render      a reference image of a scene file, PFM with its variance\n"
+    "  validate    the published slab benchmarks and the sphere energy balance\n"
+    "\n"
+    "`" PROGRAM " COMMAND --help` gives a command's options.\n";
+
+/* The value of a whole-number option given, or dflt. */
+static int int64_opt(const lr_command *cmd, const lr_args *a, const char *flag, long long dflt,
+                     long long *out)
+{
+    lr_err e = {0};
+    *out = dflt;
+    if (lr_args_has(a, flag) && lr_args_int64(a, flag, out, &e))
+        return lr_tool_usage(cmd->name, "%s", e.msg);
+    return 0;
+}
 
 static double now(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* An integer flag in [lo, hi]; returns 0 or prints the error and returns 2. */
-static int int_flag(const lr_args *a, const char *flag, long lo, long hi, long *out)
-{
-    const char *v = lr_args_get(a, flag);
-    if (!v)
-        return 0;
-    double x;
-    lr_err e = {0};
-    if (lr_args_number(flag, v, &x, &e) || x != (double)(long)x || x < (double)lo ||
-        x > (double)hi) {
-        fprintf(stderr, "lamprig-reference: %s: expected an integer in %ld..%ld, got '%s'\n",
-                flag, lo, hi, v);
-        return 2;
-    }
-    *out = (long)x;
-    return 0;
 }
 
 /* The passes' progress through the one printer (render/base/progress.h). */
@@ -88,39 +128,20 @@ static bool is_project_scene(const char *path)
 
 static int cmd_render(int argc, char **argv)
 {
-    static const lr_argspec specs[] = {
-        {.name = "--scene", .type = LR_ARG_STRING},
-        {.name = "--out", .type = LR_ARG_STRING},
-        {.name = "--variance", .type = LR_ARG_STRING},
-        {.name = "--cache"},
-        {.name = "--cache-dir", .type = LR_ARG_STRING},
-        {.name = "--width", .type = LR_ARG_STRING},
-        {.name = "--height", .type = LR_ARG_STRING},
-        {.name = "--spp", .type = LR_ARG_STRING},
-        {.name = "--pass", .type = LR_ARG_STRING},
-        {.name = "--threads", .type = LR_ARG_STRING},
-        {.name = "--seed", .type = LR_ARG_STRING},
-        {.name = "--progress"},
-        {.name = "--quiet"},
-        {0},
-    };
     lr_args a;
-    lr_err e = {0};
-    if (lr_args_parse(argc, argv, specs, 0, &a, &e)) {
-        fprintf(stderr, "lamprig-reference render: %s\n", e.msg);
-        return 2;
-    }
+    int status = lr_tool_args(&render_cmd, argc, argv, &a);
+    if (status >= 0)
+        return status;
     const char *scene = lr_args_get(&a, "--scene");
-    if (!scene) {
-        fprintf(stderr, "lamprig-reference render: --scene FILE is required\n");
-        return 2;
-    }
-    long w = -1, h = -1, spp = -1, pass = -1, threads = 0, seed = -1;
-    if (int_flag(&a, "--width", 1, 16384, &w) || int_flag(&a, "--height", 1, 16384, &h) ||
-        int_flag(&a, "--spp", 1, 1L << 30, &spp) || int_flag(&a, "--pass", 1, 1L << 30, &pass) ||
-        int_flag(&a, "--threads", 1, 1024, &threads) ||
-        int_flag(&a, "--seed", 0, 1L << 53, &seed))
-        return 2;
+    long long w, h, spp, pass, threads, seed;
+    if ((status = int64_opt(&render_cmd, &a, "--width", -1, &w)) ||
+        (status = int64_opt(&render_cmd, &a, "--height", -1, &h)) ||
+        (status = int64_opt(&render_cmd, &a, "--spp", -1, &spp)) ||
+        (status = int64_opt(&render_cmd, &a, "--pass", -1, &pass)) ||
+        (status = int64_opt(&render_cmd, &a, "--threads", 0, &threads)) ||
+        (status = int64_opt(&render_cmd, &a, "--seed", -1, &seed)))
+        return status;
+    lr_err e = {0};
     lr_ref_camera cam = {0};
     lr_ref_render_desc d = {0};
     lr_ref_scene *s = NULL;
@@ -171,7 +192,7 @@ static int cmd_render(int argc, char **argv)
     void *pr = (void *)lr_progress_meter_sink(pm);
     lr_ref_image mean = {0}, vimg = {0};
     lr_ref_stats stats = {0};
-    int status = 0;
+    status = 0;
     bool hit = false;
     const char *cache_dir = lr_args_get(&a, "--cache-dir");
     if (cache_dir || lr_args_has(&a, "--cache")) {
@@ -229,20 +250,16 @@ static void row(const char *name, lr_ref_estimate x, double published)
 
 static int cmd_validate(int argc, char **argv)
 {
-    static const lr_argspec specs[] = {{.name = "--photons", .type = LR_ARG_STRING},
-                                       {.name = "--threads", .type = LR_ARG_STRING},
-                                       {.name = "--seed", .type = LR_ARG_STRING},
-                                       {0}};
     lr_args a;
+    int status = lr_tool_args(&validate_cmd, argc, argv, &a);
+    if (status >= 0)
+        return status;
+    long long photons, threads, seed;
+    if ((status = int64_opt(&validate_cmd, &a, "--photons", 4000000, &photons)) ||
+        (status = int64_opt(&validate_cmd, &a, "--threads", 0, &threads)) ||
+        (status = int64_opt(&validate_cmd, &a, "--seed", 1, &seed)))
+        return status;
     lr_err e = {0};
-    if (lr_args_parse(argc, argv, specs, 0, &a, &e)) {
-        fprintf(stderr, "lamprig-reference validate: %s\n", e.msg);
-        return 2;
-    }
-    long photons = 4000000, threads = 0, seed = 1;
-    if (int_flag(&a, "--photons", 2, 1L << 40, &photons) ||
-        int_flag(&a, "--threads", 1, 1024, &threads) || int_flag(&a, "--seed", 0, 1L << 53, &seed))
-        return 2;
     double t0 = now();
     lr_ref_slab_problem gio = {.albedo = 0.9, .g = 0.0, .eta = 1.5, .optical_depth = INFINITY,
                                .photons = (uint64_t)photons, .seed = (uint64_t)seed,
@@ -271,7 +288,7 @@ static int cmd_validate(int argc, char **argv)
         rv.t_total, 0.66096);
     row("sphere, sigma_a = 0, n = 1.5, point light inside: escaping power / 4 pi I", esc.escaped,
         1.0);
-    printf("\n%ld photons per problem, %.1f s on %d threads (%.3g photons/s); specular part "
+    printf("\n%lld photons per problem, %.1f s on %d threads (%.3g photons/s); specular part "
            "of the first: %.5f (Fresnel at normal incidence 0.04); unscattered part of the "
            "transmittance: %.5f (exp(-2) = 0.13534)\n",
            photons, el, threads > 0 ? (int)threads : lr_ref_cpu_count(),
@@ -284,13 +301,12 @@ int main(int argc, char **argv)
     if (argc < 2 || !strcmp(argv[1], "help") || !strcmp(argv[1], "--help") ||
         !strcmp(argv[1], "-h")) {
         fputs(usage, argc < 2 ? stderr : stdout);
-        return argc < 2 ? 2 : 0;
+        return argc < 2 ? LR_EXIT_USAGE : LR_EXIT_OK;
     }
+    /* argv[1] stands in for the program name: lr_tool_args reads from argv[1] on. */
     if (!strcmp(argv[1], "render"))
-        return cmd_render(argc - 2, argv + 2);
+        return cmd_render(argc - 1, argv + 1);
     if (!strcmp(argv[1], "validate"))
-        return cmd_validate(argc - 2, argv + 2);
-    fprintf(stderr, "lamprig-reference: unknown command '%s' (render, validate, help)\n",
-            argv[1]);
-    return 2;
+        return cmd_validate(argc - 1, argv + 1);
+    return lr_tool_usage(PROGRAM, "unknown command '%s' (render, validate)", argv[1]);
 }

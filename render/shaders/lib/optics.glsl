@@ -162,8 +162,8 @@ vec3 lr_dirpole_sd_fresnel(lr_coeffs_gl c, vec3 xi, vec3 ni, vec3 wi, vec3 xo, v
 }
 
 // Standard dipole (render/optics/dipole.c): the coefficients lr_coeffs_gl lacks, per object,
-// and the model switch (render/optics/model.c; LR_SSS_DIRECTIONAL_DIPOLE, LR_SSS_STANDARD_DIPOLE,
-// LR_SSS_MULTIPOLE with the slab's thickness and pole-pair count).
+// and the model switch (LR_MODEL_SD_BAND, generated from render/models/registry.c; the
+// multipole with the slab's thickness and pole-pair count).
 struct lr_sss_gl {
     int model;
     vec3 albedo_prime;
@@ -234,11 +234,7 @@ float lr_multipole_sd_band(lr_coeffs_gl c, lr_sss_gl s, int j, vec3 xi, vec3 ni,
 float lr_sss_sd_band(lr_coeffs_gl c, lr_sss_gl s, int j, vec3 xi, vec3 ni, vec3 wi, vec3 xo,
                      vec3 no)
 {
-    if (s.model == LR_SSS_STANDARD_DIPOLE)
-        return lr_dipole_sd_band(c, s, j, xi, xo);
-    if (s.model == LR_SSS_MULTIPOLE)
-        return lr_multipole_sd_band(c, s, j, xi, ni, xo, no);
-    if (s.model == LR_SSS_DIFFUSION_GRID)
-        return 0.0; // no profile (lr_sss_sd_fresnel): radiosity.frag reads lib/dgrid.glsl
-    return lr_dirpole_sd_band(c, j, xi, ni, wi, xo, no);
+    // Each model's glsl_sd expression (render/models/*/); 0 for a model without a profile,
+    // whose B radiosity.frag takes from LR_MODEL_B instead.
+    return LR_MODEL_SD_BAND(c, s, j, xi, ni, wi, xo, no);
 }

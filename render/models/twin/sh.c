@@ -1,11 +1,11 @@
 /* CPU twin of the sh_translucency model; see sh.h. */
-#include "render/models/sh.h"
+#include "render/models/twin/sh.h"
 
 #include <math.h>
 #include <stdlib.h>
 
 #include "render/base/parallel.h"
-#include "render/models/radiosity.h"
+#include "render/models/twin/radiosity.h"
 #include "render/optics/near_light.h"
 
 /* The G-buffer's first surface along (org, dir), as render/models/radiosity.c's gbuffer_texel:

@@ -1,7 +1,7 @@
 /* The models' cavity closure: see cavity_gains.h. */
-#include "render/models/cavity_gains.h"
+#include "render/models/twin/cavity_gains.h"
 
-#include "render/models/radiosity.h"
+#include "render/models/twin/radiosity.h"
 #include "render/optics/optics.h"
 
 static void profile_b(const void *ctx, lr_vec3 x, lr_vec3 n, int N, uint64_t key, double B[3])
@@ -24,7 +24,7 @@ int lr_cavity_measure(const lr_scene_object *obj, const lr_light *l,
     /* Not for the raw directional dipole (its total exceeds 1); the standard dipole is the
      * normalisation's reference, so "normalize" does not change it (lr_scene_object_sd_norm). */
     bool applies = enclosure == LR_ENCLOSURE_HULL && l->type != LR_LIGHT_DIRECTIONAL &&
-                   !(obj->sd_raw && obj->sss_model == LR_SSS_DIRECTIONAL_DIPOLE) &&
+                   !(obj->sd_raw && lr_sss_model_props_of(obj->sss_model)->raw_no_closure) &&
                    /* the models that close the cavity themselves or are fitted
                     * (lr_sss_model_props: no_closure says why) */
                    !lr_sss_model_props_of(obj->sss_model)->no_closure;

@@ -1,12 +1,12 @@
 /* CPU twin of the scattered-radiosity pass (PIPELINE.md pass 2) and its untruncated reference.
  * See radiosity.h. */
-#include "render/models/radiosity.h"
+#include "render/models/twin/radiosity.h"
 
 #include <math.h>
 #include <stdint.h>
 
 #include "render/base/rng.h"
-#include "render/models/sh.h"
+#include "render/models/twin/sh.h"
 #include "render/optics/optics.h"
 
 /* A light closer to x_o than this many bounding radii is taken to sit on it: the lookup sphere
@@ -255,7 +255,7 @@ static double sample_ref(const ctx *k, int c, lr_rng *rng)
     return lit_point(k, vh, c) / p;
 }
 
-/* Seed 002's sh_translucency (render/models/sh.h): deterministic, so the variance is 0. Without a
+/* Seed 002's sh_translucency (render/models/twin/sh.h): deterministic, so the variance is 0. Without a
  * precomputed environment one is projected here through a cube of LR_CPU_SH_FALLBACK_SIZE^2
  * texels per face around the light (the caller's G-buffer cameras are unknown here). */
 #define LR_CPU_SH_FALLBACK_SIZE 32
@@ -306,7 +306,7 @@ void lr_cpu_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3
     }
 
     out->n = N;
-    if (obj->sss_model == LR_SSS_DIFFUSION_GRID) {
+    if (lr_sss_model_props_of(obj->sss_model)->grid_field) {
         double B[3] = {0.0, 0.0, 0.0};
         if (d && d->dfield.data)
             lr_dfield_eval(d->dfield.data, d->dfield.n, d->dfield.origin, d->dfield.h, xo, B);
@@ -316,7 +316,7 @@ void lr_cpu_radiosity(const lr_scene_object *obj, const lr_light *light, lr_vec3
         }
         return;
     }
-    if (obj->sss_model == LR_SSS_SH_TRANSLUCENCY) {
+    if (lr_sss_model_props_of(obj->sss_model)->light_env) {
         sh_radiosity(obj, light, xo, no, d, out);
         return;
     }

@@ -56,7 +56,7 @@ typedef struct lr_cpu_radiosity_desc {
     /* "model": "diffusion_grid" (seed 001): B is the solved field at x_o (lr_dfield_eval, the
      * pass's arithmetic; no samples, variance 0); data NULL gives 0. Both samplers. */
     lr_dfield_view dfield;
-    /* Objects with model sh_translucency: the light's projected environment (render/models/sh.h,
+    /* Objects with model sh_translucency: the light's projected environment (render/models/twin/sh.h,
      * lr_cpu_sh_env through the scene's G-buffer cameras). NULL: projected per call through a
      * small cube (slow). Their estimate is deterministic (variance 0, the sampler unused). */
     const struct lr_sh_env *sh_env;

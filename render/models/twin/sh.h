@@ -7,7 +7,7 @@
 
 #include <stdbool.h>
 
-#include "render/models/radiosity.h"
+#include "render/models/twin/radiosity.h"
 #include "render/optics/sh_translucency.h"
 #include "render/core/gbuffer_camera.h"
 #include "render/scene/scene.h"
