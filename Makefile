@@ -10,7 +10,8 @@
 #   make install  PREFIX=/usr/local DESTDIR= (see tools/install/README.md)
 #   make deb      build/lamprig_VERSION_ARCH.deb from a staged install (tools/debian/)
 #   make test-install  the package, its lintian, unit, udev rules and installed binary
-#   make fuzz     libFuzzer binaries of the packet parsers (clang), build/fuzz/fuzz_NAME; run
+#   make fuzz     libFuzzer binaries of the packet and MQTT payload parsers (clang),
+#                 build/fuzz/fuzz_NAME; run
 #                 one with a scratch folder first (libFuzzer writes new inputs into the first):
 #                 build/fuzz/fuzz_sacn_packet -max_total_time=60 NEW/ tests/fuzz/corpus/sacn
 #   make clean
@@ -46,7 +47,7 @@ else
 CC      ?= cc
 CXX     ?= c++
 PKGS    := egl glesv2 gbm libdrm libgpiod hidapi-libusb libusb-1.0 libmodbus libpng cairo lcms2 \
-           libsystemd liblo libmicrohttpd
+           libsystemd liblo libmicrohttpd libmosquitto
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS))
 PKG_LIBS   := $(shell pkg-config --libs $(PKGS))
 CV_CFLAGS  := $(shell pkg-config --cflags opencv4)
@@ -157,6 +158,16 @@ build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c hal/%.c
 	@mkdir -p $(@D)
 	@echo "  FUZZ    $@"
 	$(Q)clang -std=c11 -D_GNU_SOURCE -I. -g -O1 -fsanitize=fuzzer,address,undefined -o $@ $^
+# The MQTT payload parser's harness (tests/fuzz/fuzz_mqtt_payload.c) is not one hal/ file: it
+# parses with the JSON reader. Run it: build/fuzz/fuzz_mqtt_payload build/fuzz/mqtt_payload
+# tests/fuzz/corpus/mqtt_payload -max_total_time=60 (new finds go to the first folder).
+build/fuzz/fuzz_mqtt_payload: tests/fuzz/fuzz_mqtt_payload.c firmware/rig/mqtt_payload.c \
+                              render/base/json.c render/base/json_scan.c render/base/err.c \
+                              render/base/file.c
+	@mkdir -p $(@D) build/fuzz/mqtt_payload
+	@echo "  FUZZ    $@"
+	$(Q)clang -std=c11 -D_GNU_SOURCE -I. -g -O1 -fsanitize=fuzzer,address,undefined \
+	    -fno-sanitize-recover=undefined -o $@ $^ -lm
 
 # ---- install, package ----
 # The layout paths.h looks for: BINDIR/lamprig finds BINDIR/../share/lamprig/{configs,shaders}

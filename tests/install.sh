@@ -43,7 +43,7 @@ fi
 dpkg-deb -x "$deb" "$R"
 dpkg-deb -e "$deb" "$T/DEBIAN"
 depends=$(dpkg-deb -f "$deb" Depends)
-for lib in libsystemd0 libegl1 libgles2 libgpiod2 libhidapi-libusb0 libmodbus5 libmicrohttpd12 libegl-mesa0 adduser; do
+for lib in libsystemd0 libegl1 libgles2 libgpiod2 libhidapi-libusb0 libmodbus5 libmicrohttpd12 libmosquitto1 libegl-mesa0 adduser; do
     case "$depends" in *"$lib"*) ;; *) fail "Depends lacks $lib: $depends" ;; esac
 done
 ok "Depends names the linked libraries (dpkg-shlibdeps) and the GL drivers"

@@ -13,6 +13,9 @@ set -eu
 # tests/fw/http_browser.py, python3's standard library only).
 # systemd-container (systemd-nspawn) and debootstrap boot the package under systemd in
 # tests/boot.sh (make test-boot).
+# libmosquitto-dev: the rig's MQTT client (firmware/rig/mqtt.c, lamprig mqtt-send); mosquitto:
+# the broker test_fw_mqtt starts (its network namespaces and veth pair: iproute2, below);
+# clang: `make fuzz` (libFuzzer harnesses in tests/fuzz/).
 # liblo-dev: the OSC input (hal/osc.c). The console peers the tests start: liblo-tools
 # (oscsend), ola (olad, ola_set_dmx, ola_streaming_client), qlcplus; iproute2 (ip netns, veth)
 # for the namespace OLA's E1.31 output needs.
@@ -24,6 +27,7 @@ opencv-doc
 libpng-dev libcairo2-dev liblcms2-dev libcmocka-dev
 libsystemd-dev
 libmicrohttpd-dev curl chromium chromium-driver python3
+libmosquitto-dev mosquitto clang
 lintian systemd
 systemd-container debootstrap
 liblo-dev liblo-tools ola qlcplus iproute2"

@@ -12,6 +12,7 @@ extern const lr_command lr_compare_command;
 extern const lr_command lr_fit_command;
 extern const lr_command lr_render_command;
 extern const lr_command lr_run_command;
+extern const lr_command lr_mqtt_send_command;
 extern const lr_command lr_plan_command;
 
 /* `lamprig calib ...` and `lamprig compare ...` with argv[0] "calib" / "compare": the same

@@ -957,6 +957,59 @@ static int parse_http(ctx *x, lr_jnode root)
     return LR_OK;
 }
 
+/* "mqtt" (config.h; firmware/rig/mqtt.h). The rig name becomes a topic level, so it may not
+ * hold MQTT's separators or wildcards. */
+static int parse_mqtt(ctx *x, lr_jnode root)
+{
+    lr_rig_mqtt *m = &x->c->mqtt;
+    lr_jnode o = lr_json_get(x->j, root, "mqtt");
+    *m = (lr_rig_mqtt){.status_period_s = 5, .keepalive_s = 10, .retry_min_ms = 250,
+                       .retry_max_ms = 10000, .lead_ms = 250};
+    if (o == LR_JNONE)
+        return LR_OK;
+    static const char *const ok[] = {"broker", "rig", "role", "status_period_s", "keepalive_s",
+                                     "retry_min_ms", "retry_max_ms", "lead_ms", NULL};
+    char broker[160] = "", role[16] = "follower";
+    int rc;
+    if ((rc = keys(x, o, "mqtt", ok)) ||
+        (rc = get_str(x, o, "mqtt", "broker", true, broker, sizeof broker)) ||
+        (rc = get_str(x, o, "mqtt", "rig", true, m->rig, sizeof m->rig)) ||
+        (rc = get_str(x, o, "mqtt", "role", false, role, sizeof role)) ||
+        (rc = get_num_in(x, o, "mqtt", "status_period_s", false, 0.1, 86400,
+                         &m->status_period_s)) ||
+        (rc = get_int_in(x, o, "mqtt", "keepalive_s", false, 5, 3600, &m->keepalive_s)) ||
+        (rc = get_int_in(x, o, "mqtt", "retry_min_ms", false, 1, 3600000, &m->retry_min_ms)) ||
+        (rc = get_int_in(x, o, "mqtt", "retry_max_ms", false, 1, 3600000, &m->retry_max_ms)) ||
+        (rc = get_int_in(x, o, "mqtt", "lead_ms", false, 0, 60000, &m->lead_ms)))
+        return rc;
+    if (strpbrk(m->rig, "/+#"))
+        return lr_json_fail(x->j, lr_json_get(x->j, o, "rig"), "mqtt.rig", x->e, LR_EPARSE,
+                            "'%s': no '/', '+' or '#' (it is one topic level)", m->rig);
+    if (strcmp(role, "follower") == 0)
+        m->role = LR_RIG_MQTT_FOLLOWER;
+    else if (strcmp(role, "status") == 0)
+        m->role = LR_RIG_MQTT_STATUS;
+    else if (strcmp(role, "leader") == 0)
+        m->role = LR_RIG_MQTT_LEADER;
+    else
+        return lr_json_fail(x->j, lr_json_get(x->j, o, "role"), "mqtt.role", x->e, LR_EPARSE,
+                            "'%s': expected follower, leader or status", role);
+    /* HOST:PORT, the port required (an MQTT broker's 1883 is not assumed silently). */
+    char *colon = strrchr(broker, ':');
+    char *end = NULL;
+    long port = colon ? strtol(colon + 1, &end, 10) : 0;
+    if (!colon || colon == broker || !colon[1] || *end || port < 1 || port > 65535 ||
+        (size_t)(colon - broker) >= sizeof m->host)
+        return lr_json_fail(x->j, lr_json_get(x->j, o, "broker"), "mqtt.broker", x->e, LR_EPARSE,
+                            "'%s': expected HOST:PORT (port 1..65535)", broker);
+    memcpy(m->host, broker, (size_t)(colon - broker));
+    m->host[colon - broker] = '\0';
+    m->port = (int)port;
+    m->line = lr_json_line(x->j, o);
+    m->enabled = true;
+    return LR_OK;
+}
+
 /* ---- top level ---- */
 
 static int parse_root(ctx *x)
@@ -965,7 +1018,8 @@ static int parse_root(ctx *x)
     lr_jnode root = lr_json_root(j);
     lr_rig_config *c = x->c;
     static const char *const top[] = {"scene", "scene_set", "devices", "controls", "output",
-                                      "safe_level", "stats", "calib", "ar_samples", "http", NULL};
+                                      "safe_level", "stats", "calib", "ar_samples", "http",
+                                      "mqtt", NULL};
     int rc = keys(x, root, "", top);
     if (rc)
         return rc;
@@ -1156,7 +1210,7 @@ static int parse_root(ctx *x)
                 return lr_json_fail(j, st, "stats.path", x->e, LR_EPARSE, "path too long");
         }
     }
-    if ((rc = parse_http(x, root)))
+    if ((rc = parse_http(x, root)) || (rc = parse_mqtt(x, root)))
         return rc;
     /* Bindings name devices by source: a source that no device has (and no sim script could
      * speak for, i.e. there is no sim device) is a typo. */

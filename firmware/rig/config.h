@@ -36,6 +36,13 @@
  *                                      LR_RIG_HTTP_TOKEN_MIN characters): without one the
  *                                      config is refused, naming the field. No object: no
  *                                      server, nothing listens.
+ *   "mqtt":     {"broker": "HOST:PORT" (required; a numeric address: see mqtt.h),
+ *                "rig": "NAME" (required; the topic lamprig/NAME/status),
+ *                "role": "follower" (applies lamprig/all/...) | "status" (publishes only)
+ *                        | "leader" (a follower that publishes its own devices' controls),
+ *                "lead_ms": 250 (leader), "status_period_s": 5, "keepalive_s": 10,
+ *                "retry_min_ms": 250, "retry_max_ms": 10000}   several rigs in step
+ *                                      (firmware/rig/mqtt.h)
  * }
  *
  * DEVICE: "type" (sim, modbus, gpio, hid, usb, sacn, artnet, osc) and the options of that hal
@@ -218,6 +225,25 @@ typedef struct lr_rig_http_config {
     bool loopback;   /* 127.0.0.0/8 or ::1: only this machine can connect */
     char token[LR_RIG_HTTP_TOKEN_MAX]; /* "": none; required unless loopback */
 } lr_rig_http_config;
+/* "mqtt": the rig's MQTT link (firmware/rig/mqtt.h); enabled only when the field is given. */
+typedef enum lr_rig_mqtt_role {
+    LR_RIG_MQTT_FOLLOWER = 0, /* subscribes to lamprig/all/... and applies it */
+    LR_RIG_MQTT_STATUS,       /* publishes its status only */
+    LR_RIG_MQTT_LEADER,       /* a follower whose own devices' controls drive every rig */
+} lr_rig_mqtt_role;
+
+typedef struct lr_rig_mqtt {
+    bool enabled;
+    char host[128];
+    int port;
+    char rig[LR_RIG_NAME_MAX];
+    lr_rig_mqtt_role role;
+    double status_period_s;
+    int keepalive_s;
+    int retry_min_ms, retry_max_ms;
+    int lead_ms; /* leader: apply_at = now + lead_ms for what its devices send */
+    int line; /* of the "mqtt" object, for messages */
+} lr_rig_mqtt;
 
 typedef struct lr_rig_config {
     char path[LR_RIG_PATH_MAX];  /* the file it came from */
@@ -246,6 +272,7 @@ typedef struct lr_rig_config {
     char calib[LR_RIG_PATH_MAX]; /* resolved calibration folder; "" = no spatial AR */
     int ar_samples;
     lr_rig_http_config http; /* "http"; off without the object */
+    lr_rig_mqtt mqtt;
 } lr_rig_config;
 
 /* Loads and validates path completely (every device, binding and the output; file paths are

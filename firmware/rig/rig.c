@@ -18,6 +18,7 @@
 #include "firmware/rig/config.h"
 #include "firmware/rig/control_map.h"
 #include "firmware/rig/http.h"
+#include "firmware/rig/mqtt.h"
 #include "firmware/rig/notify.h"
 #include "firmware/rig/stats.h"
 #include "firmware/rig/status_json.h"
@@ -42,6 +43,7 @@
 #include "render/scene/scene.h"
 #include "firmware/plan_scene.h"
 #include "firmware/version.h"
+#include "render/base/paths.h"
 
 #define MAX_POLL 128
 #define RETIRED_MAX 8
@@ -128,6 +130,24 @@ struct lr_rig {
     } plan, plan_new;
     char http_scene[LR_RIG_PATH_MAX]; /* a shipped scene POST /api/scene asked for */
     unsigned char *http_rgba;         /* lr_rig_frame_rgba's readback */
+    lr_mqtt *mqtt;         /* "mqtt": several rigs in step (firmware/rig/mqtt.h); NULL without */
+    lr_rig_stats_dev mqtt_devs[LR_RIG_MAX_DEVICES]; /* the status document's devices */
+    /* An MQTT scene command ahead of its apply_at: that scene loaded and planned and its view
+     * built in advance (mqtt_prepare), so that the switch at apply_at is a swap and the rigs
+     * do not differ by their load times. */
+    struct {
+        bool valid;
+        char path[LR_RIG_PATH_MAX];
+        lr_scene *scene;
+        lr_replan *replan;
+        lr_rig_view *view;
+    } pre;
+    char pre_key[LR_MQTT_SCENE_MAX + 24]; /* the command last prepared (tried once) */
+    /* Role "leader": the controls as its own devices have set them, ahead of what the rigs
+     * apply (a scratch map fed with the same commands, never written to a scene), and the
+     * apply_at of what it last published per binding (the scene at LR_RIG_MAX_BINDINGS). */
+    lr_control_map *lead_map;
+    int64_t lead_sent[LR_RIG_MAX_BINDINGS + 1];
 };
 
 /* A console input's counters for the stats file (names: static strings, or the parsers'
@@ -636,8 +656,89 @@ static void reap_views(lr_rig *r)
     r->n_retired = keep;
 }
 
+static void pre_drop(lr_rig *r)
+{
+    if (!r->pre.valid)
+        return;
+    lr_rig_view *cur = r->view;
+    r->view = r->pre.view;
+    retire_view(r); /* off the loop like any replaced view; its scene may go now */
+    r->view = cur;
+    lr_replan_destroy(r->pre.replan);
+    lr_scene_destroy(r->pre.scene);
+    memset(&r->pre, 0, sizeof r->pre);
+}
+
+/* Loads path, plans it and builds its view with the controls' values as they stand (a
+ * scratch map carrying the live one's positions: the live map keeps writing the scene shown).
+ * A failure is logged; the switch at apply_at then loads it as usual (and says why). */
+static void pre_load(lr_rig *r, const char *path)
+{
+    pre_drop(r);
+    lr_scene *scene = NULL;
+    lr_err e = {0};
+    lr_warn_sink warn = {scene_warn, r};
+    bool no_vpl = false;
+    lr_replan *rp = NULL;
+    if (lr_scene_load(path, &warn, &scene, &e) ||
+        lr_rig_config_apply_sets(r->set.cfg, scene, &e) ||
+        plan_scene(r, r->set.cfg, scene, &no_vpl, &rp, &e) || lr_plan_check_models(scene, &e)) {
+        lr_log_write(&r->log, LR_LOG_WARN, "mqtt: scene %s not loaded ahead: %s", path, e.msg);
+        lr_replan_destroy(rp);
+        lr_scene_destroy(scene);
+        return;
+    }
+    int64_t now = lr_now_ns();
+    lr_control_map *tmp = NULL;
+    unsigned dirty = 0;
+    if (lr_control_map_create(r->set.cfg, scene, false, now, &tmp, &e) == LR_OK) {
+        lr_control_map_carry(tmp, r->set.map, now);
+        lr_control_map_update(tmp, scene, now, &dirty, &e);
+    }
+    lr_control_map_destroy(tmp);
+    lr_rig_view *view;
+    if (view_build(r, scene, no_vpl, &view, &e)) {
+        lr_log_write(&r->log, LR_LOG_WARN, "mqtt: scene %s not loaded ahead: %s", path, e.msg);
+        lr_replan_destroy(rp);
+        lr_scene_destroy(scene);
+        return;
+    }
+    r->pre.valid = true;
+    snprintf(r->pre.path, sizeof r->pre.path, "%s", path);
+    r->pre.scene = scene;
+    r->pre.replan = rp;
+    r->pre.view = view;
+    lr_log_write(&r->log, LR_LOG_INFO, "mqtt: scene %s loaded ahead of its apply_at", path);
+}
+
+/* The switch to the scene loaded ahead: the controls are written into it again (what moved
+ * since it was loaded), then it and its view replace the shown ones. */
+static void pre_commit(lr_rig *r)
+{
+    lr_err e = {0};
+    lr_control_map_scene_replaced(r->set.map);
+    unsigned dirty = 0;
+    if (lr_control_map_update(r->set.map, r->pre.scene, lr_now_ns(), &dirty, &e))
+        lr_log_write(&r->log, LR_LOG_WARN, "control map: %s", e.msg);
+    if (dirty)
+        lr_rig_view_invalidate(r->pre.view, dirty);
+    retire_view(r);
+    lr_replan_destroy(r->set.replan);
+    lr_scene_destroy(r->set.scene);
+    r->view = r->pre.view;
+    r->set.scene = r->pre.scene;
+    r->set.replan = r->pre.replan;
+    r->ar_dirty = true;
+    lr_log_write(&r->log, LR_LOG_INFO, "scene: %s (loaded ahead)", r->pre.path);
+    memset(&r->pre, 0, sizeof r->pre);
+}
+
 static void switch_scene(lr_rig *r, const char *path)
 {
+    if (r->pre.valid && strcmp(r->pre.path, path) == 0) {
+        pre_commit(r);
+        return;
+    }
     lr_scene *scene = NULL;
     lr_err e = {0};
     lr_warn_sink warn = {scene_warn, r};
@@ -677,14 +778,11 @@ static void switch_scene(lr_rig *r, const char *path)
     lr_log_write(&r->log, LR_LOG_INFO, "scene: %s", path);
 }
 
-static void handle_event(lr_rig *r, const lr_event *ev, int64_t now)
+static bool lead_forward(lr_rig *r, const lr_event *ev, int64_t now);
+
+/* An event into the control map (a device's, or an MQTT command's). */
+static void take_event(lr_rig *r, const lr_event *ev, int64_t now)
 {
-    /* A knob's USB arrival: reopen the hid device of that name now, not at its next backoff. */
-    if (strcmp(ev->control, "present") == 0 && ev->value == 1)
-        for (int i = 0; i < r->set.n_devs; i++)
-            if (strcmp(lr_dev_kind(r->set.devs[i]), "hid") == 0 &&
-                strcmp(lr_dev_name(r->set.devs[i]), ev->source) == 0)
-                lr_dev_retry_now(r->set.devs[i], now);
     int b = lr_control_map_event(r->set.map, ev, now);
     if (b < 0) {
         if (isfinite(ev->value)) {
@@ -695,6 +793,235 @@ static void handle_event(lr_rig *r, const lr_event *ev, int64_t now)
     }
     r->events++;
     lr_rig_stats_event(r->stats, ev);
+}
+
+/* A device's event. */
+static void handle_event(lr_rig *r, const lr_event *ev, int64_t now)
+{
+    /* A knob's USB arrival: reopen the hid device of that name now, not at its next backoff. */
+    if (strcmp(ev->control, "present") == 0 && ev->value == 1)
+        for (int i = 0; i < r->set.n_devs; i++)
+            if (strcmp(lr_dev_kind(r->set.devs[i]), "hid") == 0 &&
+                strcmp(lr_dev_name(r->set.devs[i]), ev->source) == 0)
+                lr_dev_retry_now(r->set.devs[i], now);
+    if (!lead_forward(r, ev, now))
+        take_event(r, ev, now);
+}
+
+/* ---- MQTT (firmware/rig/mqtt.h) ---- */
+
+/* The rig's figures for its status document. */
+static void mqtt_status(void *user, lr_mqtt_status *st)
+{
+    lr_rig *r = user;
+    lr_rig_stats_dev *devs = r->mqtt_devs;
+    for (int i = 0; i < r->set.n_devs; i++)
+        devs[i] = (lr_rig_stats_dev){
+            .name = lr_dev_name(r->set.devs[i]), .kind = lr_dev_kind(r->set.devs[i]),
+            .state = lr_dev_state_name(lr_dev_get_state(r->set.devs[i]))};
+    lr_rig_info info;
+    lr_rig_get_info(r, &info);
+    *st = (lr_mqtt_status){
+        .version = lr_version(), .config = r->config_path,
+        .scene = r->set.scene ? lr_scene_path(r->set.scene) : NULL,
+        .output = info.output, .view = info.view,
+        .uptime_s = (double)(lr_now_ns() - r->start_ns) * 1e-9,
+        .frames = r->frames, .events = r->events, .reloads = r->reloads,
+        .reload_failures = r->reload_failures, .lamp_level = r->lamp_written,
+        .latency_median_ms = lr_rig_stats_latency_ms(r->stats, 0.5),
+        .latency_p99_ms = lr_rig_stats_latency_ms(r->stats, 0.99),
+        .idle = info.idle, .devs = devs, .n_devs = r->set.n_devs};
+}
+
+/* The leader's map, from the live one's positions (a reload, the link opened). */
+static void lead_reset(lr_rig *r)
+{
+    lr_control_map_destroy(r->lead_map);
+    r->lead_map = NULL;
+    memset(r->lead_sent, 0, sizeof r->lead_sent);
+    if (!r->mqtt || r->set.cfg->mqtt.role != LR_RIG_MQTT_LEADER)
+        return;
+    lr_err e = {0};
+    int64_t now = lr_now_ns();
+    if (lr_control_map_create(r->set.cfg, r->set.scene, false, now, &r->lead_map, &e)) {
+        lr_log_write(&r->log, LR_LOG_ERROR, "mqtt: leader: %s; its controls stay local", e.msg);
+        return;
+    }
+    lr_control_map_carry(r->lead_map, r->set.map, now);
+    /* The cycles (presets, the scene) where the live map has them: an absolute position in the
+     * middle of each one's value. */
+    for (int i = 0; i < r->set.cfg->n_bindings; i++) {
+        const lr_rig_binding *b = &r->set.cfg->bindings[i];
+        int idx = lr_control_map_index(r->set.map, i);
+        if (b->kind != LR_BIND_CYCLE || idx < 0)
+            continue;
+        lr_event ev;
+        lr_event_set(&ev, b->source[0] ? b->source : "mqtt", b->control, LR_EV_ABSOLUTE,
+                     (idx + 0.5) / b->n_values, now);
+        lr_control_map_event(r->lead_map, &ev, now);
+    }
+    lr_control_map_scene_request(r->lead_map); /* it loads nothing */
+}
+
+static int mqtt_open(lr_rig *r, lr_err *e)
+{
+    if (!r->set.cfg->mqtt.enabled)
+        return LR_OK;
+    lr_mqtt_desc d = {.cfg = r->set.cfg, .log = r->log, .status = mqtt_status, .user = r};
+    int rc = lr_mqtt_create(&d, lr_now_ns(), &r->mqtt, e);
+    if (!rc)
+        lead_reset(r);
+    return rc;
+}
+
+/* Role "leader": a device's event moves the leader's map, and what it moved goes to every rig
+ * (this one too) at now + lead_ms, as the positions it gave; this rig applies it when it comes
+ * back, in step with the others. Not connected: false, and the event applies here at once
+ * (the leader's map follows, so the two agree). */
+static bool lead_forward(lr_rig *r, const lr_event *ev, int64_t now)
+{
+    if (!r->lead_map)
+        return false;
+    int moved = lr_control_map_event(r->lead_map, ev, now);
+    lr_control_map_scene_request(r->lead_map);
+    if (moved < 0 || !lr_mqtt_connected(r->mqtt))
+        return false;
+    const lr_rig_config *cfg = r->set.cfg;
+    int64_t at = lr_mqtt_realtime_ns() + (int64_t)cfg->mqtt.lead_ms * 1000000LL;
+    bool all = true;
+    for (int i = 0; i < cfg->n_bindings; i++) {
+        const lr_rig_binding *b = &cfg->bindings[i];
+        if ((b->source[0] && strcmp(b->source, ev->source) != 0) ||
+            strcmp(b->control, ev->control) != 0)
+            continue;
+        lr_mqtt_cmd c = {.kind = LR_MQTT_CONTROL, .has_apply_at = true, .apply_at_ns = at};
+        int key = i;
+        if (b->kind == LR_BIND_LEVEL) {
+            c.value = lr_control_map_position(r->lead_map, i);
+        } else if (strcmp(b->param, "scene") != 0) {
+            c.value = (lr_control_map_index(r->lead_map, i) + 0.5) / b->n_values;
+        } else {
+            /* The file name: the other rigs' configs name the same scene by their own paths. */
+            const char *v = b->values[lr_control_map_index(r->lead_map, i)];
+            c.kind = LR_MQTT_SCENE;
+            snprintf(c.scene, sizeof c.scene, "%s", strrchr(v, '/') ? strrchr(v, '/') + 1 : v);
+            key = LR_RIG_MAX_BINDINGS;
+        }
+        snprintf(c.name, sizeof c.name, "%s", b->name);
+        if (lr_mqtt_publish_cmd(r->mqtt, &c))
+            r->lead_sent[key] = at;
+        else
+            all = false;
+    }
+    return all;
+}
+
+/* "candle", "candle.json" or a path: the config's scene cycle first (its binding then moves to
+ * that value, so a button goes on from there), else a shipped scene. *binding: the cycle
+ * binding and *index its value, or -1 with the shipped path in path. */
+static bool mqtt_scene(const lr_rig *r, const char *name, int *binding, int *index, char *path,
+                       size_t cap)
+{
+    const lr_rig_config *c = r->set.cfg;
+    size_t n = strlen(name);
+    for (int b = 0; b < c->n_bindings; b++) {
+        if (strcmp(c->bindings[b].param, "scene") != 0)
+            continue;
+        for (int i = 0; i < c->bindings[b].n_values; i++) {
+            const char *v = c->bindings[b].values[i];
+            const char *base = strrchr(v, '/') ? strrchr(v, '/') + 1 : v;
+            if (strcmp(v, name) == 0 || strcmp(base, name) == 0 ||
+                (strncmp(base, name, n) == 0 && strcmp(base + n, ".json") == 0)) {
+                *binding = b;
+                *index = i;
+                return true;
+            }
+        }
+    }
+    *binding = *index = -1;
+    if (strchr(name, '/') || !n)
+        return false;
+    bool ext = n > 5 && strcmp(name + n - 5, ".json") == 0;
+    char leaf[LR_MQTT_SCENE_MAX + 8];
+    snprintf(leaf, sizeof leaf, "%s%s", name, ext ? "" : ".json");
+    struct stat st;
+    return lr_path_join(path, cap, lr_configs_dir(), "scenes", leaf) == 0 &&
+           stat(path, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+/* A scene command ahead of its time: its scene loaded in advance (once per command). */
+static void mqtt_prepare(lr_rig *r)
+{
+    lr_mqtt_cmd c;
+    if (!lr_mqtt_pending_scene(r->mqtt, &c) || !c.has_apply_at ||
+        c.apply_at_ns <= lr_mqtt_realtime_ns())
+        return;
+    char key[sizeof r->pre_key];
+    snprintf(key, sizeof key, "%lld %s", (long long)c.apply_at_ns, c.scene);
+    if (strcmp(key, r->pre_key) == 0)
+        return;
+    snprintf(r->pre_key, sizeof r->pre_key, "%s", key);
+    int b, idx;
+    char path[LR_RIG_PATH_MAX];
+    if (!mqtt_scene(r, c.scene, &b, &idx, path, sizeof path))
+        return; /* refused when it is due */
+    if (b >= 0)
+        snprintf(path, sizeof path, "%s", r->set.cfg->bindings[b].values[idx]);
+    if (!(r->pre.valid && strcmp(r->pre.path, path) == 0))
+        pre_load(r, path);
+}
+
+/* The commands due now, each as the event of its binding (an absolute position, like a fader
+ * of that control); a scene outside the config's cycle is switched to directly. True when an
+ * event was taken. */
+static bool mqtt_apply(lr_rig *r, int64_t now)
+{
+    if (!r->mqtt)
+        return false;
+    bool any = false;
+    lr_mqtt_cmd c;
+    while (lr_mqtt_take(r->mqtt, lr_mqtt_realtime_ns(), &c)) {
+        const lr_rig_config *cfg = r->set.cfg;
+        int b = -1, idx = -1;
+        double x = c.value;
+        if (c.kind == LR_MQTT_SCENE) {
+            char path[LR_RIG_PATH_MAX];
+            if (!mqtt_scene(r, c.scene, &b, &idx, path, sizeof path)) {
+                lr_mqtt_refuse(r->mqtt, &c, "no such scene in the config's scene cycle or "
+                                            "configs/scenes");
+                continue;
+            }
+            if (b < 0) {
+                switch_scene(r, path);
+                any = true;
+                continue;
+            }
+            /* The middle of value idx's interval: floor(x * n) picks it. */
+            x = (idx + 0.5) / cfg->bindings[b].n_values;
+        } else {
+            for (int i = 0; i < cfg->n_bindings && b < 0; i++)
+                if (strcmp(cfg->bindings[i].name, c.name) == 0)
+                    b = i;
+            if (b < 0) {
+                lr_mqtt_refuse(r->mqtt, &c, "no binding of that name");
+                continue;
+            }
+        }
+        const lr_rig_binding *bd = &cfg->bindings[b];
+        lr_event ev;
+        lr_event_set(&ev, bd->source[0] ? bd->source : "mqtt", bd->control, LR_EV_ABSOLUTE, x,
+                     now);
+        take_event(r, &ev, now);
+        /* A leader's map takes what others sent (its own sends are in it already, and an
+         * older one of its own must not undo a newer). */
+        int key = c.kind == LR_MQTT_SCENE ? LR_RIG_MAX_BINDINGS : b;
+        if (r->lead_map && !(c.has_apply_at && r->lead_sent[key] == c.apply_at_ns)) {
+            lr_control_map_event(r->lead_map, &ev, now);
+            lr_control_map_scene_request(r->lead_map);
+        }
+        any = true;
+    }
+    return any;
 }
 
 /* ---- frames ---- */
@@ -806,6 +1133,8 @@ static void frame(lr_rig *r, int64_t now)
      * apart, so the status's fps is at most output.fps (its end times vary with the work). */
     r->frame_t[r->frames % FRAME_TIMES] = now;
     r->frames++;
+    if (r->mqtt)
+        lr_mqtt_frame(r->mqtt, r->frames - 1, lr_mqtt_realtime_ns());
     if (r->kms && lr_gl_flip_pending(r->gl)) {
         /* On the projector a frame shows at its page flip: the latency ends there. */
         if (r->flip_stats_pending)
@@ -1003,6 +1332,8 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
      * above took, so a run plays the same part of the script. */
     if (!rc)
         rc = set_devices(r, &r->set, e);
+    if (!rc)
+        rc = mqtt_open(r, e);
     if (rc) {
         lr_rig_destroy(r);
         return rc;
@@ -1124,8 +1455,23 @@ static int reload(lr_rig *r, lr_err *e)
         ;
     retire_view(r);
     r->used_hid |= r->set.has_hid;
+    pre_drop(r); /* loaded for the old config's controls */
+    r->pre_key[0] = '\0';
+    /* The MQTT link stays when its block is the same (only the binding names are new). */
+    bool mqtt_new = !lr_mqtt_same(&r->set.cfg->mqtt, &s.cfg->mqtt);
+    if (mqtt_new) {
+        lr_mqtt_destroy(r->mqtt);
+        r->mqtt = NULL;
+    } else if (r->mqtt) {
+        lr_mqtt_set_config(r->mqtt, s.cfg);
+    }
     set_free(&r->set);
     r->set = s;
+    lr_err me = {0};
+    if (mqtt_new && mqtt_open(r, &me))
+        lr_log_write(&r->log, LR_LOG_ERROR, "reload: %s; running without MQTT", me.msg);
+    if (!mqtt_new)
+        lead_reset(r); /* the new config's bindings */
     r->view = view;
     r->plan = r->plan_new;
     ensure_rgba(r);
@@ -1187,7 +1533,7 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             break;
         /* The poll set and the earliest deadline. */
         struct pollfd fds[MAX_POLL];
-        int owner[MAX_POLL]; /* -1 signalfd, -2 gl, -3 the view, -4 http, else device index */
+        int owner[MAX_POLL]; /* -1 signalfd, -2 gl, -3 the view, -4 http, -5 mqtt, else device index */
         int nf = 0;
         int64_t t = r->end_ns < until_ns ? r->end_ns : until_ns;
         if (r->sigfd >= 0) {
@@ -1201,6 +1547,13 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
         if (lr_rig_view_event_fd(r->view) >= 0 && !want) {
             fds[nf] = (struct pollfd){lr_rig_view_event_fd(r->view), POLLIN, 0};
             owner[nf++] = -3;
+        }
+        if (r->mqtt) {
+            if (nf < MAX_POLL && lr_mqtt_pollfd(r->mqtt, &fds[nf]))
+                owner[nf++] = -5;
+            int64_t d = lr_mqtt_deadline(r->mqtt, now, lr_mqtt_realtime_ns());
+            if (d < t)
+                t = d;
         }
         if (r->kms && lr_gl_flip_pending(r->gl) && lr_gl_event_fd(r->gl) >= 0) {
             fds[nf] = (struct pollfd){lr_gl_event_fd(r->gl), POLLIN, 0};
@@ -1249,6 +1602,7 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             return lr_err_set(e, LR_EIO, "poll: %s", strerror(errno));
         }
         now = lr_now_ns();
+        short mqtt_ev = 0;
         for (int i = 0; i < nf && n > 0; i++) {
             if (!fds[i].revents)
                 continue;
@@ -1256,6 +1610,8 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
                 read_signals(r);
                 if (r->stop)
                     return LR_OK;
+            } else if (owner[i] == -5) {
+                mqtt_ev = fds[i].revents;
             } else if (owner[i] == -2) {
                 lr_err ge = {0};
                 if (lr_gl_dispatch(r->gl, &ge))
@@ -1277,12 +1633,17 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             lr_http_dispatch(r->http, now);
         else if (now >= r->http_retry_ns)
             http_start(r, now);
+        if (r->mqtt) {
+            lr_mqtt_dispatch(r->mqtt, mqtt_ev, now);
+            mqtt_prepare(r);
+        }
         lr_event ev;
         bool any = false;
         while (lr_event_ring_pop(r->ring, &ev)) {
             handle_event(r, &ev, now);
             any = true;
         }
+        any |= mqtt_apply(r, now);
         if (r->n_retired)
             reap_views(r);
         lr_err ve = {0};
@@ -1334,9 +1695,14 @@ void lr_rig_destroy(lr_rig *r)
                              r->set.cfg->safe_level, lr_modbus_output_raw(r->set.lamp[i]));
         }
     }
+    lr_mqtt_destroy(r->mqtt); /* "offline" on the status topic */
+    lr_control_map_destroy(r->lead_map);
     if (r->stats && r->set.cfg)
         write_stats(r, lr_now_ns());
     lr_rig_view_destroy(r->view);
+    lr_rig_view_destroy(r->pre.view);
+    lr_replan_destroy(r->pre.replan);
+    lr_scene_destroy(r->pre.scene);
     for (int i = 0; i < r->n_retired; i++)
         lr_rig_view_destroy(r->retired[i]);
     lr_ar_present_destroy(r->ar_out);
