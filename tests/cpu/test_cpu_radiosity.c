@@ -398,9 +398,12 @@ static void test_pass_blind_spot_facing_away(void **state)
  * incidence: B > 0 and finite at x_o 5 mm away, where the pass agrees with the reference.
  * At x_o = x_l itself the stereographic sphere through x_o has radius d = 0 (the light is
  * moved 1e-9 radii along n_o for the lookup): every plane sample at r >> d maps into a tiny cap
- * around the antipode (straight up out of the pool), so the pass sees no lit surface and
- * returns 0 (finite) -- a blind spot of the pass for texels much closer to the light than
- * 1/sigma_tr. The reference is finite, > 0 and continuous there (x_l against 1e-6 mm away). */
+ * around the antipode (straight up out of the pool), so the lookup alone sees no lit surface
+ * and returned 0 -- the blind spot of texels much closer to the light than 1/sigma_tr. The
+ * near-light direction samples (LR_PASS_NEAR_MIX, PIPELINE.md "Near lights") cover it: the
+ * pass now agrees with the reference there within 4 sigma of both (measured: 9.35e-5 against
+ * 8.91e-5 +- 1e-5 in red). The reference is finite, > 0 and continuous there (x_l against
+ * 1e-6 mm away). */
 static void test_light_on_surface(void **state)
 {
     (void)state;
@@ -442,7 +445,8 @@ static void test_light_on_surface(void **state)
         print_message("light on the pool, band %d: B(x_l): pass %.3g, reference %.6g +- %.2g\n",
                       c, pass.mean[c], at.mean[c], sqrt(at.var[c] / at.n));
         assert_true(isfinite(pass.mean[c]) && pass.mean[c] >= 0.0 && isfinite(pass.var[c]));
-        assert_true(pass.mean[c] < 0.01 * at.mean[c]);
+        assert_near(pass.mean[c], at.mean[c],
+                    4.0 * sqrt(pass.var[c] / pass.n + at.var[c] / at.n));
         assert_true(isfinite(at.mean[c]) && at.mean[c] > 0.0 && isfinite(at.var[c]));
         assert_near(at.mean[c], near.mean[c],
                     4.0 * sqrt(at.var[c] / at.n + near.var[c] / near.n));
