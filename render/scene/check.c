@@ -38,7 +38,9 @@ int lr_scene_check_light(lr_light *l, const char **field, lr_err *e)
                               l->edge_u.y, l->edge_u.z, l->edge_v.x, l->edge_v.y, l->edge_v.z);
         }
     }
-    return LR_OK;
+    /* Candela, lumens and colour temperature to the renderer's intensity and colour (last:
+     * the flux of a spot or an area light depends on its cone or its area). */
+    return lr_light_resolve_units(l, field, e);
 }
 
 void lr_scene_camera_defaults(lr_camera *c)
