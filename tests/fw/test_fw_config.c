@@ -165,7 +165,8 @@ static void test_control_map_file_errors(void **state)
     char text[600], msg[LR_ERR_MSG_MAX], want[1200];
     const struct { const char *file, *msg; } cases[] = {
         {"a.json", "controls/a.json:3: field 'controls[0].param': light.nope: a point light has "
-                   "no parameter 'nope' (known: intensity, color, position, flicker.{amplitude, "
+                   "no parameter 'nope' (known: intensity, intensity_cd, flux_lm, color, "
+                   "color_temperature_k, position, flicker.{amplitude, "
                    "frequency_hz, jitter_mm, seed})"},
         {"b.json", "controls/b.json:3: field 'controls[0].step': must be in 1e-06..1, got 0"},
         {"c.json", "controls/c.json:1: field 'bindings': unknown field"},
