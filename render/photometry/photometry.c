@@ -115,3 +115,19 @@ void lr_xy_to_uv1960(double x, double y, double *u, double *v)
     *u = 4.0 * x / d;
     *v = 6.0 * y / d;
 }
+
+/* photometry.h: the multiplier that shows the meter's luminance at mid grey. */
+static double ev0_exposure(void)
+{
+    return LR_EV_MID_GREY * LR_KM_LM_PER_W * 1e6 / (LR_METER_K_CD_M2 / 100.0);
+}
+
+double lr_ev_to_exposure(double ev100)
+{
+    return ev0_exposure() * exp2(-ev100);
+}
+
+double lr_exposure_to_ev(double exposure)
+{
+    return log2(ev0_exposure() / exposure);
+}

@@ -56,6 +56,17 @@ double lr_rgb_luminance(const double rgb[3]);
  * 0, then rescaled to keep Y. */
 void lr_cct_color(double t_k, double rgb[3]);
 
+/* Exposure as a camera's: EV100, as a reflected-light meter reads it (ISO 2720, calibration
+ * constant K = 12.5 cd/m^2). The luminance the meter reads at EV is L(EV) = K 2^EV / 100
+ * cd/m^2, and the exposure puts it at 18 % of full scale (mid grey) before the tone curve. A
+ * band value in W/(mm^2 sr) has the luminance K_m Y 1e6 cd/m^2, so the renderer's multiplier
+ * is exposure = 0.18 K_m 1e6 / L(EV) = 9.8352e8 / 2^EV: EV 0 (0.125 cd/m^2 at mid grey) up
+ * to EV 15 (sunlit snow). One EV more halves the image. */
+#define LR_METER_K_CD_M2 12.5
+#define LR_EV_MID_GREY 0.18
+double lr_ev_to_exposure(double ev100);
+double lr_exposure_to_ev(double exposure);
+
 /* CIE 1931 xy -> CIE 1960 uv (the space of correlated colour temperature). */
 void lr_xy_to_uv1960(double x, double y, double *u, double *v);
 

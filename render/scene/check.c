@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "render/base/mat4.h"
+#include "render/photometry/photometry.h"
 #include "render/scene/fields.h"
 #include "render/scene/scene_internal.h"
 
@@ -102,7 +103,21 @@ void lr_scene_render_defaults(lr_render_settings *r)
 
 int lr_scene_check_render(lr_render_settings *r, const char **field, lr_err *e)
 {
-    return lr_fields_check(&lr_scene_render_desc, r, field, e);
+    int rc = lr_fields_check(&lr_scene_render_desc, r, field, e);
+    if (rc)
+        return rc;
+    /* The exposure in the unit it was given, and the other derived (render/photometry). */
+    if (r->exposure_from_ev) {
+        double x = lr_ev_to_exposure(r->exposure_ev);
+        if (!(x > 0.0 && x < 1e30)) {
+            *field = "exposure_ev";
+            return lr_err_set(e, LR_EINVAL, "gives exposure %g, outside (0, 1e30)", x);
+        }
+        r->exposure = x;
+    } else {
+        r->exposure_ev = lr_exposure_to_ev(r->exposure);
+    }
+    return LR_OK;
 }
 
 int lr_scene_check_quality(const lr_quality *q, const char **field, lr_err *e)

@@ -344,6 +344,11 @@ static const lr_field render_fields[] = {
     {"exposure", LR_FT_NUM, 0, RS(exposure), 0, 1e30, Z | LR_FF_LO_OPEN | LR_FF_HI_OPEN |
      LR_FF_HI_QUIET, .dflt = {1}, .dirty = LR_DIRTY_DISPLAY,
      .help = "multiplies radiance in W/(mm^2 sr) before tone mapping"},
+    /* One of exposure and exposure_ev (load.c); the check derives the other. */
+    {"exposure_ev", LR_FT_NUM, 0, RS(exposure_ev), -60, 100, LR_FF_HI_QUIET,
+     .dflt_text = "from exposure", .dirty = LR_DIRTY_DISPLAY,
+     .help = "instead of exposure: a camera's EV100 (meter K = 12.5 cd/m^2 at 18 % grey; "
+             "exposure = 9.8352e8 / 2^EV; +1 EV halves the image)"},
     /* Only how composition gets B changes (render/passes/surface.h): a view-class change. Off
      * by default: its error is not yet shown to be under the converged noise (PIPELINE.md). */
     {"surface_cache", LR_FT_BOOL, 0, RS(surface_cache), .dflt = {0}, .dirty = LR_DIRTY_CAMERA,

@@ -392,6 +392,11 @@ static int parse_render(ctx *c, lr_jnode n, lr_scene *s)
     for (int i = 0; i < lr_scene_render_desc.n; i++)
         if (lr_json_get(c->j, n, lr_scene_render_desc.fields[i].key) != LR_JNONE)
             lr_scene_render_mark_given(s, lr_scene_render_desc.fields[i].key);
+    lr_jnode ev = lr_json_get(c->j, n, "exposure_ev");
+    if (ev != LR_JNONE && lr_json_get(c->j, n, "exposure") != LR_JNONE)
+        return lr_json_fail(c->j, ev, "render.exposure_ev", c->e, LR_EINVAL,
+                            "give one of exposure and exposure_ev, not both");
+    r->exposure_from_ev = ev != LR_JNONE;
     const char *field = NULL;
     lr_err inner = {0};
     if ((rc = lr_scene_check_render(r, &field, &inner)))

@@ -247,6 +247,11 @@ typedef struct lr_render_settings {
     int vpl_map_size; /* cube map of the outer surface that places the VPLs */
     int frames;       /* progressive frames until converged */
     double exposure;  /* multiplies radiance before tone mapping */
+    /* The same as a camera's EV100 (lr_ev_to_exposure); exposure_from_ev: the file or the
+     * last change gave exposure_ev, and the check derives exposure from it (else the other
+     * way round). */
+    double exposure_ev;
+    bool exposure_from_ev;
     /* Composition reads the objects' B from the view-independent surface cache
      * (render/passes/surface.h) instead of running Algorithm 1 per pixel (issue 11). */
     bool surface_cache;

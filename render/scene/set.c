@@ -442,6 +442,10 @@ int lr_scene_set(lr_scene *s, const char *key, const char *value, unsigned *dirt
         lr_render_settings r = s->render;
         if ((rc = table_field(&o, &lr_scene_render_desc, &r, k.field, &d)))
             return rc;
+        if (strcmp(k.field, "exposure_ev") == 0)
+            r.exposure_from_ev = true;
+        else if (strcmp(k.field, "exposure") == 0)
+            r.exposure_from_ev = false;
         if ((rc = lr_scene_check_render(&r, &bad, &inner)))
             return check_failed(&o, k.field, bad, rc, &inner);
         s->render = r;

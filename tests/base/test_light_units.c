@@ -193,6 +193,36 @@ static void test_set_units(void **state)
     lr_scene_destroy(s);
 }
 
+/* render.exposure_ev: the multiplier follows it (exposure read back = lr_ev_to_exposure),
+ * a set of exposure takes over again (exposure_ev read back = its EV), both in a file are
+ * refused. */
+static void test_exposure_ev_field(void **state)
+{
+    (void)state;
+    char t[512];
+    snprintf(t, sizeof t,
+             "{\"objects\": [{\"material\": \"candle_wax\", \"mesh\": {\"type\": \"sphere\"}}],\n"
+             " \"lights\": [{\"type\": \"point\", \"position\": [0,0,100], \"intensity\": 1}],\n"
+             " \"camera\": {\"position\": [0,-400,0], \"target\": [0,0,0]},\n"
+             " \"render\": {\"exposure_ev\": 8}}\n");
+    lr_scene *s;
+    lr_err e = {0};
+    if (lr_scene_parse(t, strlen(t), "t.json", NULL, &s, &e))
+        fail_msg("%s", e.msg);
+    assert_near_rel(lr_scene_render(s)->exposure, lr_ev_to_exposure(8.0), 1e-12);
+    set_ok(s, "render.exposure_ev", "9", LR_DIRTY_DISPLAY);
+    assert_near_rel(lr_scene_render(s)->exposure, 0.5 * lr_ev_to_exposure(8.0), 1e-12);
+    set_ok(s, "render.exposure", "3e6", LR_DIRTY_DISPLAY);
+    assert_near(lr_scene_render(s)->exposure_ev, lr_exposure_to_ev(3e6), 1e-12);
+    lr_scene_destroy(s);
+    char *p = strstr(t, "\"exposure_ev\": 8");
+    strcpy(p + 15, "8,\n\"exposure\": 1}}\n");
+    assert_int_equal(lr_scene_parse(t, strlen(t), "t.json", NULL, &s, &e), LR_EINVAL);
+    if (!strstr(e.msg, "t.json:4: field 'render.exposure_ev': give one of exposure and "
+                       "exposure_ev, not both"))
+        fail_msg("%s", e.msg);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -202,6 +232,7 @@ int main(void)
         cmocka_unit_test(test_area_lumens),
         cmocka_unit_test(test_refusals),
         cmocka_unit_test(test_set_units),
+        cmocka_unit_test(test_exposure_ev_field),
     };
     return cmocka_run_group_tests_name("light_units", tests, NULL, NULL);
 }

@@ -146,12 +146,27 @@ static void test_cct_color(void **state)
     assert_true(lr_planck_efficacy(1000.0) < 0.1 * LR_KM_LM_PER_W * 21.371327 / 81.0);
 }
 
+/* EV100: a white surface at the meter's luminance L = 12.5 2^EV / 100 cd/m^2 has radiance
+ * L / (683 lm/W x 1e6 mm^2/m^2) W/(mm^2 sr) (Y(1,1,1) = 1) and must come out at 0.18; one EV
+ * more halves the multiplier; the inverse returns the EV. All double arithmetic: 1e-12. */
+static void test_exposure_ev(void **state)
+{
+    (void)state;
+    for (double ev = -4.0; ev <= 16.0; ev += 2.5) {
+        double l = 12.5 * pow(2.0, ev) / 100.0;
+        double radiance = l / (LR_KM_LM_PER_W * 1e6);
+        assert_near_rel(lr_ev_to_exposure(ev) * radiance, 0.18, 1e-12);
+        assert_near_rel(lr_ev_to_exposure(ev + 1.0), 0.5 * lr_ev_to_exposure(ev), 1e-12);
+        assert_near(lr_exposure_to_ev(lr_ev_to_exposure(ev)), ev, 1e-12);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_table_sums),     cmocka_unit_test(test_primaries),
         cmocka_unit_test(test_illuminant_a),   cmocka_unit_test(test_d65_cct),
-        cmocka_unit_test(test_cct_color),
+        cmocka_unit_test(test_cct_color),      cmocka_unit_test(test_exposure_ev),
     };
     return cmocka_run_group_tests_name("photometry", tests, NULL, NULL);
 }
