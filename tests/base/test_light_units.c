@@ -223,6 +223,35 @@ static void test_exposure_ev_field(void **state)
         fail_msg("%s", e.msg);
 }
 
+/* The shipped candle's flame and the shade's bulb are given in candela and lumens: the
+ * numbers are the old W/sr times 683 lm/W x Y(color) (x 4 pi for the bulb's lumens), printed
+ * to the 17 digits that give back the old intensity bit for bit, so every renderer sees the
+ * same doubles and the images are unchanged, not only to 8-bit rounding:
+ *   flame 0.005 W/sr, color 1, 0.55, 0.2 (Y 0.620420): 2.1187351273381263 cd
+ *   bulb  0.25 W/sr, color 1, 0.78, 0.52 (Y 0.808011): 1733.754588262603 lm.
+ * The colours stay: the Planckian colours at 1900 K (1, 0.23, 0 in linear sRGB) and 2700 K
+ * (1, 0.42, 0.10) are far deeper than the scenes' tuned ones, so color_temperature_k would
+ * change the images. */
+static void test_shipped_scenes_map_exactly(void **state)
+{
+    (void)state;
+    static const struct { const char *file; double intensity, color[3]; } sc[] = {
+        {"candle.json", 0.005, {1.0, 0.55, 0.2}}, {"lampshade.json", 0.25, {1.0, 0.78, 0.52}}};
+    for (int i = 0; i < 2; i++) {
+        char path[512];
+        snprintf(path, sizeof path, "%s/scenes/%s", LR_SOURCE_CONFIGS, sc[i].file);
+        lr_scene *s;
+        lr_err e = {0};
+        if (lr_scene_load(path, NULL, &s, &e))
+            fail_msg("%s", e.msg);
+        const lr_light *l = lr_scene_light_at(s, 0);
+        assert_true(l->from != LR_STRENGTH_RADIOMETRIC);
+        assert_true(l->intensity == sc[i].intensity);
+        assert_memory_equal(l->color, sc[i].color, sizeof l->color);
+        lr_scene_destroy(s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -233,6 +262,7 @@ int main(void)
         cmocka_unit_test(test_refusals),
         cmocka_unit_test(test_set_units),
         cmocka_unit_test(test_exposure_ev_field),
+        cmocka_unit_test(test_shipped_scenes_map_exactly),
     };
     return cmocka_run_group_tests_name("light_units", tests, NULL, NULL);
 }
