@@ -92,7 +92,7 @@ static void test_bad_fields_named(void **state)
          "\"light.intensity\"},\n  {\"control\": \"knob\", \"param\": \"light.intensity\",\n   "
          "\"curve\": \"cubic\"}]}",
          "rig.json:5: field 'controls[1].curve': unknown curve 'cubic' (linear, square, "
-         "s-curve, log)"},
+         "s-curve, log, warm-dim)"},
         {"{\"scene\": \"candle.json\",\n \"controls\": [\n  {\"control\": \"dimmer\", \"param\": "
          "\"light.intensity\",\n   \"range\": [1, 1]}]}",
          "rig.json:4: field 'controls[0].range': range is empty: [1, 1]"},
