@@ -18,6 +18,15 @@ void lr_scene_light_defaults(lr_light *l, enum lr_light_type type)
 
 int lr_scene_check_light(lr_light *l, const char **field, lr_err *e)
 {
+    /* Only the strength the light was given is checked: the others are derived below, and a
+     * derived one may lie outside its field's range (a bright light in lumens over a large
+     * area) without being wrong. */
+    if (l->from != LR_STRENGTH_RADIOMETRIC)
+        l->intensity = 0.0;
+    if (l->from != LR_STRENGTH_CD)
+        l->intensity_cd = 0.0;
+    if (l->from != LR_STRENGTH_LM)
+        l->flux_lm = 0.0;
     int rc = lr_fields_check(&lr_scene_light_desc, l, field, e);
     if (rc)
         return rc;

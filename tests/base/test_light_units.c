@@ -184,6 +184,14 @@ static void test_set_units(void **state)
     assert_near(l->color_temperature_k, 0.0, 0.0);
     assert_near_rel(l->intensity, 0.5, 1e-12);
     assert_near_rel(l->intensity_cd, 0.5 * LR_KM_LM_PER_W, 1e-12);
+    /* A derived strength beyond its field's range is no error: 1e11 W/sr of a colour with
+     * Y = 1e5 is ~6.8e18 cd, past intensity_cd's 1e15, and the next change still passes. */
+    set_ok(s, "light.color", "1e5,1e5,1e5", LR_DIRTY_INTENSITY);
+    set_ok(s, "light.intensity", "1e11", LR_DIRTY_INTENSITY);
+    assert_true(l->intensity_cd > 1e18);
+    set_ok(s, "light.outer_deg", "50", LR_DIRTY_LIGHT_GEOMETRY);
+    set_ok(s, "light.color", "1,1,1", LR_DIRTY_INTENSITY);
+    set_ok(s, "light.intensity", "0.5", LR_DIRTY_INTENSITY);
     char buf[64];
     lr_err e = {0};
     assert_int_equal(lr_scene_get(s, "light.intensity_cd", buf, sizeof buf, &e), LR_OK);
