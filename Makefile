@@ -140,6 +140,16 @@ build/test/test_%: $$(addprefix build/obj/asan/,$$(addsuffix .o,$$(basename $$(w
 	@echo "  LD-SAN  $@"
 	$(Q)$(CXX) -fsanitize=address,undefined -o $@ $^ $(LDLIBS) $(CMOCKA_LIBS)
 
+# libFuzzer harnesses of the photometric file parsers (tests/fuzz/fuzz_ies.c, fuzz_ldt.c) with
+# the render/photometry sources they need, built by clang: make build/fuzz/fuzz_ies, then
+# build/fuzz/fuzz_ies -max_total_time=60 NEW/ tests/fuzz/corpus/ies (test_photometric_files
+# runs the same harnesses on the corpus).
+build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c render/photometry/%.c render/photometry/luminaire.c \
+                   render/base/err.c
+	@mkdir -p $(@D)
+	@echo "  FUZZ    $@"
+	$(Q)clang -std=c11 -D_GNU_SOURCE -I. -g -O1 -fsanitize=fuzzer,address,undefined -o $@ $^ -lm
+
 test: $(TESTS:%=build/test/%) build/bin/lamprig $(TOOLS:%=build/bin/lamprig-%)
 	@sh tests/run.sh $(TESTS:%=build/test/%)
 	@$(MAKE) --no-print-directory test-install

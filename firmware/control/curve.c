@@ -3,7 +3,7 @@
 #include <math.h>
 #include <string.h>
 
-static const char *const names[] = {"linear", "square", "s-curve", "log"};
+static const char *const names[] = {"linear", "square", "s-curve", "log", "warm-dim"};
 
 int lr_curve_parse(const char *name, enum lr_curve *out)
 {
@@ -35,6 +35,7 @@ double lr_curve_apply(enum lr_curve c, double x)
     case LR_CURVE_SQUARE: return x * x;
     case LR_CURVE_SCURVE: return x * x * (3.0 - 2.0 * x);
     case LR_CURVE_LOG: return log10(1.0 + 9.0 * x);
+    case LR_CURVE_WARM_DIM: return pow(x, LR_CURVE_WARM_DIM_EXP);
     case LR_CURVE_LINEAR:
     default: return x;
     }
@@ -49,6 +50,7 @@ double lr_curve_invert(enum lr_curve c, double y)
         /* The smoothstep's inverse in closed form: x = 1/2 - sin(asin(1 - 2y) / 3). */
         return 0.5 - sin(asin(1.0 - 2.0 * y) / 3.0);
     case LR_CURVE_LOG: return (pow(10.0, y) - 1.0) / 9.0;
+    case LR_CURVE_WARM_DIM: return pow(y, 1.0 / LR_CURVE_WARM_DIM_EXP);
     case LR_CURVE_LINEAR:
     default: return y;
     }

@@ -825,7 +825,7 @@ static int binding(ctx *x, lr_jnode o, const char *where, lr_rig_binding *b)
     if (lr_curve_parse(curve, &cv) != 0) {
         field_name(f, sizeof f, where, "curve");
         return lr_json_fail(x->j, lr_json_get(x->j, o, "curve"), f, x->e, LR_EPARSE,
-                            "unknown curve '%s' (linear, square, s-curve, log)", curve);
+                            "unknown curve '%s' (linear, square, s-curve, log, warm-dim)", curve);
     }
     b->curve = (int)cv;
     b->step = 0.02;

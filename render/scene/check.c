@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "render/base/mat4.h"
+#include "render/photometry/photometry.h"
 #include "render/scene/fields.h"
 #include "render/scene/scene_internal.h"
 
@@ -17,6 +18,15 @@ void lr_scene_light_defaults(lr_light *l, enum lr_light_type type)
 
 int lr_scene_check_light(lr_light *l, const char **field, lr_err *e)
 {
+    /* Only the strength the light was given is checked: the others are derived below, and a
+     * derived one may lie outside its field's range (a bright light in lumens over a large
+     * area) without being wrong. */
+    if (l->from != LR_STRENGTH_RADIOMETRIC)
+        l->intensity = 0.0;
+    if (l->from != LR_STRENGTH_CD)
+        l->intensity_cd = 0.0;
+    if (l->from != LR_STRENGTH_LM)
+        l->flux_lm = 0.0;
     int rc = lr_fields_check(&lr_scene_light_desc, l, field, e);
     if (rc)
         return rc;
@@ -38,7 +48,9 @@ int lr_scene_check_light(lr_light *l, const char **field, lr_err *e)
                               l->edge_u.y, l->edge_u.z, l->edge_v.x, l->edge_v.y, l->edge_v.z);
         }
     }
-    return LR_OK;
+    /* Candela, lumens and colour temperature to the renderer's intensity and colour (last:
+     * the flux of a spot or an area light depends on its cone or its area). */
+    return lr_light_resolve_units(l, field, e);
 }
 
 void lr_scene_camera_defaults(lr_camera *c)
@@ -100,7 +112,21 @@ void lr_scene_render_defaults(lr_render_settings *r)
 
 int lr_scene_check_render(lr_render_settings *r, const char **field, lr_err *e)
 {
-    return lr_fields_check(&lr_scene_render_desc, r, field, e);
+    int rc = lr_fields_check(&lr_scene_render_desc, r, field, e);
+    if (rc)
+        return rc;
+    /* The exposure in the unit it was given, and the other derived (render/photometry). */
+    if (r->exposure_from_ev) {
+        double x = lr_ev_to_exposure(r->exposure_ev);
+        if (!(x > 0.0 && x < 1e30)) {
+            *field = "exposure_ev";
+            return lr_err_set(e, LR_EINVAL, "gives exposure %g, outside (0, 1e30)", x);
+        }
+        r->exposure = x;
+    } else {
+        r->exposure_ev = lr_exposure_to_ev(r->exposure);
+    }
+    return LR_OK;
 }
 
 int lr_scene_check_quality(const lr_quality *q, const char **field, lr_err *e)

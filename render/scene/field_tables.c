@@ -3,6 +3,7 @@
  * relations between fields are in check.c. */
 #include <stddef.h>
 
+#include "render/photometry/photometry.h"
 #include "render/scene/fields.h"
 #include "render/scene/scene_internal.h"
 
@@ -28,17 +29,34 @@ static const lr_field light_fields[] = {
      .help = "point, spot, directional, quad or disk"},
     {"name", LR_FT_NAME, .dflt_text = "light0, light1, ...", .flags = LR_FF_NO_SET,
      .help = "unique; letters, digits, _ and - (not only digits)"},
-    {"intensity", LR_FT_NUM, P | S, L(intensity), 0, 1e12, LR_FF_REQUIRED | LR_FF_HI_OPEN |
-     LR_FF_HI_QUIET, .unit = "(W/sr)", .dirty = LR_DIRTY_INTENSITY,
-     .help = "radiant intensity (on axis for a spot): the dimmer"},
+    /* One of intensity, intensity_cd and flux_lm (radiance and flux_lm for area lights) is
+     * given: load.c; the record check derives the others (lr_light_resolve_units), so a get
+     * reads the present value in each unit and a set of any of them is the dimmer. */
+    {"intensity", LR_FT_NUM, P | S, L(intensity), 0, 1e12, LR_FF_HI_OPEN | LR_FF_HI_QUIET,
+     .dflt_text = "one of intensity, intensity_cd, flux_lm", .unit = "(W/sr)",
+     .dirty = LR_DIRTY_INTENSITY, .help = "radiant intensity (on axis for a spot): the dimmer"},
+    {"intensity_cd", LR_FT_NUM, P | S, L(intensity_cd), 0, 1e15, LR_FF_HI_OPEN | LR_FF_HI_QUIET,
+     .dflt_text = "one of intensity, intensity_cd, flux_lm", .unit = "(cd)",
+     .dirty = LR_DIRTY_INTENSITY,
+     .help = "luminous intensity (on axis for a spot): intensity = intensity_cd / (683 lm/W "
+             "x Y(color)); a candle flame ~1 cd"},
+    {"flux_lm", LR_FT_NUM, P | S | Q | K, L(flux_lm), 0, 1e15, LR_FF_HI_OPEN | LR_FF_HI_QUIET,
+     .dflt_text = "one of the strengths", .unit = "(lm)", .dirty = LR_DIRTY_INTENSITY,
+     .help = "luminous flux: over 4 pi sr (point), the cone's distribution (spot), pi x area "
+             "per side (quad, disk: a Lambertian emitter)"},
     {"radiance", LR_FT_NUM, D, L(intensity), 0, 1e12, LR_FF_REQUIRED | LR_FF_HI_OPEN |
      LR_FF_HI_QUIET, .unit = "(W/mm^2)", .dirty = LR_DIRTY_INTENSITY,
      .help = "irradiance on a surface facing the light (seed 003 Eq. 6)"},
-    {"radiance", LR_FT_NUM, Q | K, L(intensity), 0, 1e12, LR_FF_REQUIRED | LR_FF_HI_OPEN |
-     LR_FF_HI_QUIET, .unit = "(W/(mm^2 sr))", .dirty = LR_DIRTY_INTENSITY,
+    {"radiance", LR_FT_NUM, Q | K, L(intensity), 0, 1e12, LR_FF_HI_OPEN | LR_FF_HI_QUIET,
+     .dflt_text = "one of radiance, flux_lm", .unit = "(W/(mm^2 sr))",
+     .dirty = LR_DIRTY_INTENSITY,
      .help = "emitted radiance of the Lambertian area light: the dimmer"},
     {"color", LR_FT_RGB, 0, L(color), 0, 1e6, LR_FF_HI_OPEN | LR_FF_HI_QUIET, .dflt = {1, 1, 1},
      .dirty = LR_DIRTY_INTENSITY, .help = "per-band factor: band b gets intensity * color[b]"},
+    {"color_temperature_k", LR_FT_NUM, 0, L(color_temperature_k), LR_CCT_MIN_K, LR_CCT_MAX_K,
+     LR_FF_ZERO_ABSENT, .dflt_text = "none (color)", .unit = "K", .dirty = LR_DIRTY_INTENSITY,
+     .help = "instead of color: a Planckian radiator's colour (CIE 1931, linear sRGB), "
+             "intensity its visible watts (candle ~1900 K, warm lamp 2700 K)"},
     {"position", LR_FT_VEC3, P | S, L(position), NB, NB, LR_FF_REQUIRED | LR_FF_COORD,
      .unit = "mm", .dirty = LR_DIRTY_LIGHT_GEOMETRY, .help = "where the light is"},
     {"position", LR_FT_VEC3, Q | K, L(position), NB, NB, LR_FF_REQUIRED | LR_FF_COORD,
@@ -326,6 +344,11 @@ static const lr_field render_fields[] = {
     {"exposure", LR_FT_NUM, 0, RS(exposure), 0, 1e30, Z | LR_FF_LO_OPEN | LR_FF_HI_OPEN |
      LR_FF_HI_QUIET, .dflt = {1}, .dirty = LR_DIRTY_DISPLAY,
      .help = "multiplies radiance in W/(mm^2 sr) before tone mapping"},
+    /* One of exposure and exposure_ev (load.c); the check derives the other. */
+    {"exposure_ev", LR_FT_NUM, 0, RS(exposure_ev), -60, 100, LR_FF_HI_QUIET,
+     .dflt_text = "from exposure", .dirty = LR_DIRTY_DISPLAY,
+     .help = "instead of exposure: a camera's EV100 (meter K = 12.5 cd/m^2 at 18 % grey; "
+             "exposure = 9.8352e8 / 2^EV; +1 EV halves the image)"},
     /* Only how composition gets B changes (render/passes/surface.h): a view-class change. Off
      * by default: its error is not yet shown to be under the converged noise (PIPELINE.md). */
     {"surface_cache", LR_FT_BOOL, 0, RS(surface_cache), .dflt = {0}, .dirty = LR_DIRTY_CAMERA,

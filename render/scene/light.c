@@ -1,12 +1,58 @@
 /* Light shape and flicker: the parts of a light that are not its intensity. */
 #include <math.h>
 
+#include "render/photometry/photometry.h"
 #include "render/scene/scene.h"
 
 void lr_light_rgb(const lr_light *l, double out[3])
 {
     for (int b = 0; b < 3; b++)
         out[b] = l->intensity * l->color[b];
+}
+
+double lr_light_lm_per_unit(const lr_light *l)
+{
+    double kv = LR_KM_LM_PER_W * lr_rgb_luminance(l->color), omega = 0.0;
+    switch (l->type) {
+    case LR_LIGHT_POINT: omega = 4.0 * M_PI; break;
+    case LR_LIGHT_SPOT: {
+        /* The flux of I shape(cos) over the sphere: 2 pi times the integral over cos of the
+         * shape, 1 on [cos inner, 1], smoothstep between cos outer and cos inner (mean 1/2). */
+        double ci = cos(l->inner_deg * (M_PI / 180.0)), co = cos(l->outer_deg * (M_PI / 180.0));
+        omega = 2.0 * M_PI * ((1.0 - ci) + 0.5 * (ci - co));
+        break;
+    }
+    case LR_LIGHT_QUAD:
+    case LR_LIGHT_DISK:
+        /* A Lambertian emitter of radiance L sends pi L per unit area and side. */
+        omega = M_PI * lr_light_area(l) * (l->two_sided ? 2.0 : 1.0);
+        break;
+    case LR_LIGHT_DIRECTIONAL: omega = 0.0; break;
+    }
+    return kv * omega;
+}
+
+int lr_light_resolve_units(lr_light *l, const char **field, lr_err *e)
+{
+    if (l->color_temperature_k > 0.0)
+        lr_cct_color(l->color_temperature_k, l->color);
+    double kv = LR_KM_LM_PER_W * lr_rgb_luminance(l->color);
+    double per = lr_light_lm_per_unit(l);
+    if (l->from != LR_STRENGTH_RADIOMETRIC && !(kv > 0.0)) {
+        *field = l->from == LR_STRENGTH_CD ? "intensity_cd" : "flux_lm";
+        return lr_err_set(e, LR_EINVAL, "needs a colour with a luminous part (Y > 0), got color "
+                          "%g, %g, %g", l->color[0], l->color[1], l->color[2]);
+    }
+    if (l->from == LR_STRENGTH_CD)
+        l->intensity = l->intensity_cd / kv;
+    else if (l->from == LR_STRENGTH_LM)
+        l->intensity = per > 0.0 ? l->flux_lm / per : 0.0;
+    if (l->type == LR_LIGHT_POINT || l->type == LR_LIGHT_SPOT)
+        l->intensity_cd = kv * l->intensity;
+    else
+        l->intensity_cd = 0.0;
+    l->flux_lm = per * l->intensity;
+    return LR_OK;
 }
 
 lr_vec3 lr_light_area_normal(const lr_light *l)

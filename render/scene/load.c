@@ -121,6 +121,46 @@ static int type_of(ctx *c, lr_jnode obj, const char *where, const char *const *n
 
 /* ---- lights -------------------------------------------------------------------------------- */
 
+/* A light's strength is given once, in one unit (the others are derived from it: a file
+ * that gave two could disagree with itself), and its colour once: `color` or
+ * `color_temperature_k`. Directional lights have `radiance` only. */
+static int light_strength(ctx *c, lr_jnode obj, const char *where, lr_light *l)
+{
+    static const char *const keys[] = {"intensity", "radiance", "intensity_cd", "flux_lm"};
+    static const enum lr_light_strength from[] = {LR_STRENGTH_RADIOMETRIC,
+        LR_STRENGTH_RADIOMETRIC, LR_STRENGTH_CD, LR_STRENGTH_LM};
+    char f[96], list[96] = "";
+    int given = -1;
+    for (int k = 0; k < 4; k++)
+        if (lr_field_find(&lr_scene_light_desc, (int)l->type, keys[k]))
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s",
+                     list[0] ? ", " : "", keys[k]);
+    for (int k = 0; k < 4; k++) {
+        if (!lr_field_find(&lr_scene_light_desc, (int)l->type, keys[k]))
+            continue;
+        lr_jnode n = lr_json_get(c->j, obj, keys[k]);
+        if (n == LR_JNONE)
+            continue;
+        if (given >= 0) {
+            snprintf(f, sizeof f, "%s.%s", where, keys[k]);
+            return lr_json_fail(c->j, n, f, c->e, LR_EINVAL, "give one of %s, not both '%s' "
+                                "and '%s'", list, keys[given], keys[k]);
+        }
+        given = k;
+    }
+    if (given < 0)
+        return lr_json_fail(c->j, obj, where, c->e, LR_EPARSE, "missing its strength (required: "
+                            "one of %s)", list);
+    l->from = from[given];
+    lr_jnode t = lr_json_get(c->j, obj, "color_temperature_k");
+    if (t != LR_JNONE && lr_json_get(c->j, obj, "color") != LR_JNONE) {
+        snprintf(f, sizeof f, "%s.color_temperature_k", where);
+        return lr_json_fail(c->j, t, f, c->e, LR_EINVAL, "give one of color and "
+                            "color_temperature_k, not both");
+    }
+    return LR_OK;
+}
+
 static int parse_light(ctx *c, lr_jnode obj, int i, lr_light *l)
 {
     char where[64];
@@ -135,6 +175,8 @@ static int parse_light(ctx *c, lr_jnode obj, int i, lr_light *l)
     if ((rc = get_name(c, obj, where, "light", i, l->name)))
         return rc;
     if ((rc = lr_fields_read(c->j, obj, where, &lr_scene_light_desc, type, l, c->e)))
+        return rc;
+    if ((rc = light_strength(c, obj, where, l)))
         return rc;
     const char *field = NULL;
     lr_err inner = {0};
@@ -350,6 +392,11 @@ static int parse_render(ctx *c, lr_jnode n, lr_scene *s)
     for (int i = 0; i < lr_scene_render_desc.n; i++)
         if (lr_json_get(c->j, n, lr_scene_render_desc.fields[i].key) != LR_JNONE)
             lr_scene_render_mark_given(s, lr_scene_render_desc.fields[i].key);
+    lr_jnode ev = lr_json_get(c->j, n, "exposure_ev");
+    if (ev != LR_JNONE && lr_json_get(c->j, n, "exposure") != LR_JNONE)
+        return lr_json_fail(c->j, ev, "render.exposure_ev", c->e, LR_EINVAL,
+                            "give one of exposure and exposure_ev, not both");
+    r->exposure_from_ev = ev != LR_JNONE;
     const char *field = NULL;
     lr_err inner = {0};
     if ((rc = lr_scene_check_render(r, &field, &inner)))

@@ -121,6 +121,11 @@ typedef struct lr_flicker {
     unsigned seed;       /* phases */
 } lr_flicker;
 
+/* Which of a light's strength fields the others are derived from (the one the file gave, or
+ * the last one lr_scene_set changed): W/sr or W/(mm^2 sr) (`intensity` / `radiance`), candela
+ * (`intensity_cd`) or lumens (`flux_lm`). */
+enum lr_light_strength { LR_STRENGTH_RADIOMETRIC, LR_STRENGTH_CD, LR_STRENGTH_LM };
+
 typedef struct lr_light {
     char name[LR_SCENE_NAME_MAX];
     enum lr_light_type type;
@@ -140,11 +145,30 @@ typedef struct lr_light {
      * radiance L_e in W/(mm^2 sr) (render/area/emitter.h). */
     double intensity;
     double color[3]; /* relative per band (not normalised): band b gets intensity * color[b] */
+    /* The same strength in a lighting designer's units (render/photometry/photometry.h):
+     * point and spot: luminous intensity (cd, on axis for a spot); point, spot, quad, disk:
+     * luminous flux (lm). One of them or `intensity` is given (`from`); the record check
+     * derives the others, so each reads the light's present value. */
+    double intensity_cd, flux_lm;
+    enum lr_light_strength from;
+    /* > 0: `color` is the Planckian radiator's at this temperature (K), scaled so that
+     * `intensity` is its visible W/sr (lr_cct_color); 0: `color` as given. */
+    double color_temperature_k;
     lr_flicker flicker;
 } lr_light;
 
 /* intensity * color. */
 void lr_light_rgb(const lr_light *l, double out[3]);
+/* Lumens per unit of `intensity` (lm per W/sr; quad and disk: per W/(mm^2 sr)): K_m Y(color)
+ * (683 lm/W, render/photometry) times the solid angle the shape spreads the intensity over:
+ * 4 pi for a point, 2 pi ((1 - cos inner) + (cos inner - cos outer) / 2) for a spot (the
+ * smoothstep's mean over its band of cosines is 1/2), pi A for a Lambertian area light (2 pi A
+ * two-sided); 0 for a directional light (no flux). */
+double lr_light_lm_per_unit(const lr_light *l);
+/* Derives color from color_temperature_k (when > 0), then intensity from the field `from`
+ * names, then the other two strength fields. Fails (LR_EINVAL, *field set) when candela or
+ * lumens are asked of a colour without a luminous part. */
+int lr_light_resolve_units(lr_light *l, const char **field, lr_err *e);
 /* The light's angular shape in travel direction dir (unit): 1 for a point light; for a spot
  * 1 inside inner_deg, 0 outside outer_deg, smoothstep in the cosine between; for a
  * directional light 1; for an area light A cos(theta_e) (0 behind a one-sided one): the
@@ -223,6 +247,11 @@ typedef struct lr_render_settings {
     int vpl_map_size; /* cube map of the outer surface that places the VPLs */
     int frames;       /* progressive frames until converged */
     double exposure;  /* multiplies radiance before tone mapping */
+    /* The same as a camera's EV100 (lr_ev_to_exposure); exposure_from_ev: the file or the
+     * last change gave exposure_ev, and the check derives exposure from it (else the other
+     * way round). */
+    double exposure_ev;
+    bool exposure_from_ev;
     /* Composition reads the objects' B from the view-independent surface cache
      * (render/passes/surface.h) instead of running Algorithm 1 per pixel (issue 11). */
     bool surface_cache;

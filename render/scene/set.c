@@ -56,7 +56,20 @@ static int light_field(op *o, lr_light *l, const char *f, unsigned *d)
     if ((dir && strcmp(f, "intensity") == 0) || (!dir && strcmp(f, "radiance") == 0))
         return lr_field_fail(o, LR_EINVAL, "a %s light's strength is its '%s'",
                     lr_scene_light_desc.kind_names[l->type], dir ? "radiance" : "intensity");
-    return table_field(o, &lr_scene_light_desc, l, f, d);
+    int rc = table_field(o, &lr_scene_light_desc, l, f, d);
+    if (rc || o->get)
+        return rc;
+    /* The strength just set is the one the others follow (lr_light_resolve_units); a colour
+     * set replaces the colour temperature. */
+    if (strcmp(f, "intensity") == 0 || strcmp(f, "radiance") == 0)
+        l->from = LR_STRENGTH_RADIOMETRIC;
+    else if (strcmp(f, "intensity_cd") == 0)
+        l->from = LR_STRENGTH_CD;
+    else if (strcmp(f, "flux_lm") == 0)
+        l->from = LR_STRENGTH_LM;
+    else if (strcmp(f, "color") == 0)
+        l->color_temperature_k = 0.0;
+    return LR_OK;
 }
 
 /* ---- objects ---------------------------------------------------------------------------------- */
@@ -408,6 +421,11 @@ int lr_scene_set(lr_scene *s, const char *key, const char *value, unsigned *dirt
             return rc;
         if ((rc = lr_scene_check_light(&l, &bad, &inner)))
             return check_failed(&o, k.field, bad, rc, &inner);
+        /* A light given in lumens keeps its flux when its cone or area changes: its
+         * intensity moved too. */
+        const lr_light *was = &s->light[k.index];
+        if (l.intensity != was->intensity || memcmp(l.color, was->color, sizeof l.color) != 0)
+            d |= LR_DIRTY_INTENSITY;
         s->light[k.index] = l;
         break;
     }
@@ -424,6 +442,10 @@ int lr_scene_set(lr_scene *s, const char *key, const char *value, unsigned *dirt
         lr_render_settings r = s->render;
         if ((rc = table_field(&o, &lr_scene_render_desc, &r, k.field, &d)))
             return rc;
+        if (strcmp(k.field, "exposure_ev") == 0)
+            r.exposure_from_ev = true;
+        else if (strcmp(k.field, "exposure") == 0)
+            r.exposure_from_ev = false;
         if ((rc = lr_scene_check_render(&r, &bad, &inner)))
             return check_failed(&o, k.field, bad, rc, &inner);
         s->render = r;

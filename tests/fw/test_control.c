@@ -23,7 +23,7 @@ static void test_curve_values(void **state)
     assert_near(lr_curve_apply(LR_CURVE_SCURVE, 0.5), 0.5, 1e-15);
     assert_near(lr_curve_apply(LR_CURVE_SCURVE, 0.25), 0.15625, 1e-15);
     assert_near(lr_curve_apply(LR_CURVE_LOG, 0.5), log10(5.5), 1e-15);
-    for (int c = LR_CURVE_LINEAR; c <= LR_CURVE_LOG; c++) {
+    for (int c = LR_CURVE_LINEAR; c <= LR_CURVE_WARM_DIM; c++) {
         /* End points are exact: a dimmer at its stops is off / full whatever the curve. */
         assert_true(lr_curve_apply((enum lr_curve)c, 0.0) == 0.0);
         assert_near(lr_curve_apply((enum lr_curve)c, 1.0), 1.0, 1e-15);

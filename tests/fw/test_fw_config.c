@@ -108,7 +108,7 @@ static void test_bad_fields_named(void **state)
          "\"light.intensity\"},\n  {\"control\": \"knob\", \"param\": \"light.intensity\",\n   "
          "\"curve\": \"cubic\"}]}",
          "rig.json:5: field 'controls[1].curve': unknown curve 'cubic' (linear, square, "
-         "s-curve, log)"},
+         "s-curve, log, warm-dim)"},
         {"{\"scene\": \"candle.json\",\n \"controls\": [\n  {\"control\": \"dimmer\", \"param\": "
          "\"light.intensity\",\n   \"range\": [1, 1]}]}",
          "rig.json:4: field 'controls[0].range': range is empty: [1, 1]"},
@@ -181,7 +181,8 @@ static void test_control_map_file_errors(void **state)
     char text[600], msg[LR_ERR_MSG_MAX], want[1200];
     const struct { const char *file, *msg; } cases[] = {
         {"a.json", "controls/a.json:3: field 'controls[0].param': light.nope: a point light has "
-                   "no parameter 'nope' (known: intensity, color, position, flicker.{amplitude, "
+                   "no parameter 'nope' (known: intensity, intensity_cd, flux_lm, color, "
+                   "color_temperature_k, position, flicker.{amplitude, "
                    "frequency_hz, jitter_mm, seed})"},
         {"b.json", "controls/b.json:3: field 'controls[0].step': must be in 1e-06..1, got 0"},
         {"c.json", "controls/c.json:1: field 'bindings': unknown field"},

@@ -22,6 +22,7 @@
 #include "render/cpu/frame.h"
 #include "render/image/image.h"
 #include "render/passes/passes.h"
+#include "render/photometry/photometry.h"
 #include "render/scene/scene.h"
 #include "tests/support/near.h"
 
@@ -214,6 +215,31 @@ static void test_curves_and_reversed_range(void **state)
         assert_near(get(&f, "light.intensity"), 0.02 - 0.01 * y, 1e-9);
         fx_free(&f);
     }
+}
+
+/* One dimmer in a designer's units driving two parameters: the light's candela (linear) and
+ * its colour temperature (warm-dim, 1800..2700 K): at 0.5 the flame is 2 cd and
+ * 1800 + 900 x 0.5^(0.42/3.38) = 2624 K; the renderer's W/sr follow both (cd / K(T)). The
+ * values go through lr_scene_set's %.9g text: 1e-6 relative. */
+static void test_dimmer_in_candela_and_warm_dim(void **state)
+{
+    (void)state;
+    fx f;
+    fx_make(&f, "[{\"control\": \"dimmer\", \"param\": \"light.intensity_cd\", "
+                "\"range\": [0, 4], \"initial\": 1},\n"
+                " {\"control\": \"dimmer\", \"param\": \"light.color_temperature_k\", "
+                "\"range\": [1800, 2700], \"curve\": \"warm-dim\", \"initial\": 1}]");
+    update(&f, 0);
+    assert_near_rel(get(&f, "light.intensity_cd"), 4.0, 1e-6);
+    assert_near_rel(get(&f, "light.color_temperature_k"), 2700.0, 1e-6);
+    lr_event e = ev("sim", "dimmer", LR_EV_ABSOLUTE, 0.5, 10 * MS);
+    assert_int_equal(lr_control_map_event(f.map, &e, 10 * MS), 0);
+    update(&f, 10 * MS);
+    double t = 1800.0 + 900.0 * pow(0.5, 0.42 / 3.38);
+    assert_near_rel(get(&f, "light.intensity_cd"), 2.0, 1e-6);
+    assert_near_rel(get(&f, "light.color_temperature_k"), t, 1e-6);
+    assert_near_rel(get(&f, "light.intensity"), 2.0 / lr_planck_efficacy(t), 1e-5);
+    fx_free(&f);
 }
 
 /* Encoder detents move the position by step; slow turns are not accelerated, a fast spin is
@@ -588,6 +614,7 @@ int main(void)
         cmocka_unit_test(test_reload_carries_positions),
         cmocka_unit_test(test_dimmer_curve_range_fade),
         cmocka_unit_test(test_curves_and_reversed_range),
+        cmocka_unit_test(test_dimmer_in_candela_and_warm_dim),
         cmocka_unit_test(test_encoder_step_accel_clamp),
         cmocka_unit_test(test_material_cycle_keeps_scale),
         cmocka_unit_test(test_colour_times_scale),

@@ -860,7 +860,7 @@ static void test_sighup_reload(void **state)
     char want[700];
     snprintf(want, sizeof want,
              "reload: %s:8: field 'controls[0].curve': unknown curve 'cubic' (linear, square, "
-             "s-curve, log); keeping the running config",
+             "s-curve, log, warm-dim); keeping the running config",
              cfg);
     assert_true(file_has(err, want));
     usleep(200000);
