@@ -33,7 +33,7 @@ struct lr_mqtt {
     lr_rig_mqtt cfg;
     const lr_rig_config *rig_cfg;
     lr_log log;
-    void (*status_fn)(void *user, lr_mqtt_status *st);
+    void (*status_fn)(void *user, lr_rig_status *st);
     void *user;
     struct mosquitto *mosq;
     link_state state;
@@ -46,8 +46,6 @@ struct lr_mqtt {
     slot pending[MAX_KEYS], applied[MAX_KEYS];
     lr_mqtt_counters cnt;
     lr_mqtt_last last;
-    uint64_t frames_prev;
-    int64_t fps_t_prev;
     char status_topic[LR_RIG_NAME_MAX + 32];
     char where[160]; /* "HOST:PORT" for messages */
 };
@@ -285,7 +283,6 @@ int lr_mqtt_create(const lr_mqtt_desc *d, int64_t now_ns, lr_mqtt **out, lr_err 
     mosquitto_connect_callback_set(m->mosq, on_connect);
     mosquitto_disconnect_callback_set(m->mosq, on_disconnect);
     mosquitto_message_callback_set(m->mosq, on_message);
-    m->fps_t_prev = now_ns;
     m->next_status_ns = INT64_MAX;
     start_connect(m, now_ns);
     *out = m;
@@ -350,18 +347,14 @@ static void publish_status(lr_mqtt *m, int64_t now)
 {
     m->status_now = false;
     m->next_status_ns = now + (int64_t)(m->cfg.status_period_s * 1e9);
-    lr_mqtt_status st = {.lamp_level = -1, .latency_median_ms = NAN, .latency_p99_ms = NAN};
+    /* The rig's status is large (its controls): off the stack. */
+    lr_rig_status *st = calloc(1, sizeof *st);
+    if (!st)
+        return;
     if (m->status_fn)
-        m->status_fn(m->user, &st);
-    /* Frames per second since the previous status. */
-    double dt = (double)(now - m->fps_t_prev) * 1e-9;
-    double fps = dt > 0 && st.frames >= m->frames_prev
-                     ? (double)(st.frames - m->frames_prev) / dt
-                     : NAN;
-    m->frames_prev = st.frames;
-    m->fps_t_prev = now;
-    char *doc = lr_mqtt_status_json(m->cfg.rig, &st, fps, lr_mqtt_realtime_ns(), &m->cnt,
-                                    &m->last);
+        m->status_fn(m->user, st);
+    char *doc = lr_mqtt_status_json(m->cfg.rig, st, lr_mqtt_realtime_ns(), &m->cnt, &m->last);
+    free(st);
     if (!doc)
         return;
     int rc = mosquitto_publish(m->mosq, NULL, m->status_topic, (int)strlen(doc), doc, 1, true);

@@ -35,22 +35,13 @@
 #include "firmware/rig/config.h"
 #include "firmware/rig/mqtt_payload.h"
 #include "firmware/rig/stats.h"
+#include "firmware/rig/status_json.h"
 #include "hal/log.h"
 #include "render/base/err.h"
 
 typedef struct lr_mqtt lr_mqtt;
 
 /* The rig's figures for a status document (mqtt_status.c); strings may be NULL. */
-typedef struct lr_mqtt_status {
-    const char *version, *config, *scene, *output, *view;
-    double uptime_s;
-    uint64_t frames, events, reloads, reload_failures;
-    double lamp_level;                        /* -1: none written */
-    double latency_median_ms, latency_p99_ms; /* NaN: no event yet */
-    bool idle;
-    const lr_rig_stats_dev *devs;
-    int n_devs;
-} lr_mqtt_status;
 
 typedef struct lr_mqtt_counters {
     uint64_t received; /* command messages */
@@ -64,7 +55,7 @@ typedef struct lr_mqtt_desc {
                                * or is replaced with lr_mqtt_set_config */
     lr_log log;
     /* Fills the rig's figures when a status is to be published. */
-    void (*status)(void *user, lr_mqtt_status *st);
+    void (*status)(void *user, lr_rig_status *st); /* lr_rig_get_status */
     void *user;
 } lr_mqtt_desc;
 
@@ -106,8 +97,10 @@ void lr_mqtt_get_counters(const lr_mqtt *m, lr_mqtt_counters *out);
 
 int64_t lr_mqtt_realtime_ns(void);
 
-/* The status document (mqtt_status.c): the rig's figures, the link's counters and the last
- * command applied with its first frame. Returns a malloc'd string, NULL when out of memory. */
+/* The status document (mqtt_status.c): the rig's status (firmware/rig/status_json.h, the
+ * same members as GET /api/status) with the rig's name, its state, the time, the link's
+ * counters and the last command applied with its first frame. Returns a malloc'd string, NULL
+ * when out of memory. */
 typedef struct lr_mqtt_last {
     bool valid;
     lr_mqtt_cmd cmd;
@@ -116,8 +109,7 @@ typedef struct lr_mqtt_last {
     uint64_t frame;        /* the first frame after it */
     int64_t frame_rt_ns;   /* that frame's end */
 } lr_mqtt_last;
-char *lr_mqtt_status_json(const char *rig, const lr_mqtt_status *st, double fps,
-                          int64_t now_rt_ns, const lr_mqtt_counters *c,
-                          const lr_mqtt_last *last);
+char *lr_mqtt_status_json(const char *rig, const lr_rig_status *st, int64_t now_rt_ns,
+                          const lr_mqtt_counters *c, const lr_mqtt_last *last);
 
 #endif

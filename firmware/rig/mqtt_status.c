@@ -1,5 +1,6 @@
-/* lamprig firmware — the status document a rig publishes on lamprig/RIG/status (mqtt.h).
- * The figures are the rig's (rig.c, stats.h); the writer is render/base/json_write.h. */
+/* lamprig firmware — the status document a rig publishes on lamprig/RIG/status (mqtt.h): the
+ * rig's status as GET /api/status has it (firmware/rig/status_json.h, one producer) and the
+ * link's own members. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -7,17 +8,8 @@
 #include "firmware/rig/mqtt.h"
 #include "render/base/json_write.h"
 
-static void opt_string(lr_jw *w, const char *key, const char *s)
-{
-    if (s)
-        lr_jw_string(w, key, s);
-    else
-        lr_jw_null(w, key);
-}
-
-char *lr_mqtt_status_json(const char *rig, const lr_mqtt_status *st, double fps,
-                          int64_t now_rt_ns, const lr_mqtt_counters *c,
-                          const lr_mqtt_last *last)
+char *lr_mqtt_status_json(const char *rig, const lr_rig_status *st, int64_t now_rt_ns,
+                          const lr_mqtt_counters *c, const lr_mqtt_last *last)
 {
     char *buf = NULL;
     size_t len = 0;
@@ -35,35 +27,7 @@ char *lr_mqtt_status_json(const char *rig, const lr_mqtt_status *st, double fps,
     lr_jw_string(w, "state", "online");
     /* ns since 1970 as an integer: the receiver compares it with other rigs' times. */
     lr_jw_int(w, "time_ns", (long)now_rt_ns);
-    opt_string(w, "version", st->version);
-    opt_string(w, "config", st->config);
-    opt_string(w, "scene", st->scene);
-    opt_string(w, "output", st->output);
-    opt_string(w, "view", st->view);
-    lr_jw_number(w, "uptime_s", st->uptime_s);
-    lr_jw_int(w, "frames", (long)st->frames);
-    lr_jw_number_or_null(w, "fps", fps);
-    lr_jw_int(w, "events", (long)st->events);
-    lr_jw_int(w, "reloads", (long)st->reloads);
-    lr_jw_int(w, "reload_failures", (long)st->reload_failures);
-    if (st->lamp_level >= 0)
-        lr_jw_number(w, "lamp", st->lamp_level);
-    else
-        lr_jw_null(w, "lamp");
-    lr_jw_bool(w, "idle", st->idle);
-    lr_jw_object(w, "latency_ms");
-    lr_jw_number_or_null(w, "median", st->latency_median_ms);
-    lr_jw_number_or_null(w, "p99", st->latency_p99_ms);
-    lr_jw_object_end(w);
-    lr_jw_array(w, "devices");
-    for (int i = 0; i < st->n_devs; i++) {
-        lr_jw_object(w, NULL);
-        lr_jw_string(w, "name", st->devs[i].name);
-        lr_jw_string(w, "kind", st->devs[i].kind);
-        lr_jw_string(w, "state", st->devs[i].state);
-        lr_jw_object_end(w);
-    }
-    lr_jw_array_end(w);
+    lr_status_json_members(w, st); /* the members GET /api/status has */
     lr_jw_object(w, "mqtt");
     lr_jw_int(w, "received", (long)c->received);
     lr_jw_int(w, "applied", (long)c->applied);

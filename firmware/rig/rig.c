@@ -131,7 +131,6 @@ struct lr_rig {
     char http_scene[LR_RIG_PATH_MAX]; /* a shipped scene POST /api/scene asked for */
     unsigned char *http_rgba;         /* lr_rig_frame_rgba's readback */
     lr_mqtt *mqtt;         /* "mqtt": several rigs in step (firmware/rig/mqtt.h); NULL without */
-    lr_rig_stats_dev mqtt_devs[LR_RIG_MAX_DEVICES]; /* the status document's devices */
     /* An MQTT scene command ahead of its apply_at: that scene loaded and planned and its view
      * built in advance (mqtt_prepare), so that the switch at apply_at is a swap and the rigs
      * do not differ by their load times. */
@@ -810,27 +809,10 @@ static void handle_event(lr_rig *r, const lr_event *ev, int64_t now)
 
 /* ---- MQTT (firmware/rig/mqtt.h) ---- */
 
-/* The rig's figures for its status document. */
-static void mqtt_status(void *user, lr_mqtt_status *st)
+/* The rig's status for its MQTT document: the one GET /api/status shows. */
+static void mqtt_status(void *user, lr_rig_status *st)
 {
-    lr_rig *r = user;
-    lr_rig_stats_dev *devs = r->mqtt_devs;
-    for (int i = 0; i < r->set.n_devs; i++)
-        devs[i] = (lr_rig_stats_dev){
-            .name = lr_dev_name(r->set.devs[i]), .kind = lr_dev_kind(r->set.devs[i]),
-            .state = lr_dev_state_name(lr_dev_get_state(r->set.devs[i]))};
-    lr_rig_info info;
-    lr_rig_get_info(r, &info);
-    *st = (lr_mqtt_status){
-        .version = lr_version(), .config = r->config_path,
-        .scene = r->set.scene ? lr_scene_path(r->set.scene) : NULL,
-        .output = info.output, .view = info.view,
-        .uptime_s = (double)(lr_now_ns() - r->start_ns) * 1e-9,
-        .frames = r->frames, .events = r->events, .reloads = r->reloads,
-        .reload_failures = r->reload_failures, .lamp_level = r->lamp_written,
-        .latency_median_ms = lr_rig_stats_latency_ms(r->stats, 0.5),
-        .latency_p99_ms = lr_rig_stats_latency_ms(r->stats, 0.99),
-        .idle = info.idle, .devs = devs, .n_devs = r->set.n_devs};
+    lr_rig_get_status(user, st);
 }
 
 /* The leader's map, from the live one's positions (a reload, the link opened). */

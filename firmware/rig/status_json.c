@@ -49,6 +49,12 @@ static void lines(lr_jw *w, const char *key, const lr_rig_status_line *l, int n)
 void lr_status_json_write(lr_jw *w, const char *key, const lr_rig_status *st)
 {
     lr_jw_object(w, key);
+    lr_status_json_members(w, st);
+    lr_jw_object_end(w);
+}
+
+void lr_status_json_members(lr_jw *w, const lr_rig_status *st)
+{
     lr_jw_string(w, "version", st->version);
     lr_jw_string(w, "config", st->config);
     lr_jw_string(w, "scene", st->scene);
@@ -91,7 +97,6 @@ void lr_status_json_write(lr_jw *w, const char *key, const lr_rig_status *st)
     lines(w, "warnings", st->warnings, st->n_warnings);
     lines(w, "errors", st->errors, st->n_errors);
     lr_status_json_controls(w, "controls", st);
-    lr_jw_object_end(w);
 }
 
 char *lr_status_json_string(const lr_rig_status *st, bool controls_only, size_t *len)

@@ -85,6 +85,9 @@ typedef struct lr_rig_status {
 /* The status object (with its controls) as member `key` (NULL at the top level or in an
  * array). */
 void lr_status_json_write(lr_jw *w, const char *key, const lr_rig_status *st);
+/* Its members alone, into an object the caller opened (the MQTT status adds its own:
+ * firmware/rig/mqtt.h). */
+void lr_status_json_members(lr_jw *w, const lr_rig_status *st);
 /* The controls array alone. */
 void lr_status_json_controls(lr_jw *w, const char *key, const lr_rig_status *st);
 /* Either document as a malloc'd NUL-terminated string (*len its length, may be NULL);
