@@ -46,6 +46,10 @@ double lrb_thread_cpu_now(void);
  * the scheduler does not migrate it mid-run. Returns the CPU number, or -1 if pinning failed
  * (the figures are then still single-threaded, only noisier). */
 int lrb_pin_to_current_cpu(void);
+/* The folder of the running lamprig-bench (where build/bin/lamprig sits beside it) and the
+ * configs folder as an absolute path (the rig sections write rig configs into a scratch
+ * folder); nonzero with a line on stderr naming `section` when either cannot be found. */
+int lrb_rig_paths(const char *section, char *bindir, size_t bindir_cap, char *configs);
 /* One line naming the host CPU (from /proc/cpuinfo), for the record under each table. */
 void lrb_cpu_name(char *buf, size_t len);
 /* The rig section's per-control table (rig_controls.c): runs the shipped sim rig from bindir

@@ -213,17 +213,8 @@ static int read_stats(const char *stats, row rows[3], double *fi_med, double *fi
 static int run(FILE *out)
 {
     char bindir[PATH_MAX], configs[PATH_MAX];
-    ssize_t n = readlink("/proc/self/exe", bindir, sizeof bindir - 1);
-    if (n <= 0)
+    if (lrb_rig_paths("console", bindir, sizeof bindir, configs))
         return 1;
-    bindir[n] = '\0';
-    char *sl = strrchr(bindir, '/');
-    if (sl)
-        *sl = '\0';
-    if (!realpath(lr_configs_dir(), configs)) {
-        fprintf(stderr, "bench console: no configs directory '%s'\n", lr_configs_dir());
-        return 1;
-    }
     char dir[] = "/tmp/lamprig-bench-console-XXXXXX";
     if (!mkdtemp(dir))
         return 1;

@@ -325,17 +325,8 @@ static int free_port(void)
 
 static int run(FILE *out)
 {
-    ssize_t n = readlink("/proc/self/exe", bindir, sizeof bindir - 1);
-    if (n <= 0)
+    if (lrb_rig_paths("rig", bindir, sizeof bindir, configs))
         return 1;
-    bindir[n] = '\0';
-    char *sl = strrchr(bindir, '/');
-    if (sl)
-        *sl = '\0';
-    if (!realpath(lr_configs_dir(), configs)) {
-        fprintf(stderr, "bench rig: no configs directory '%s'\n", lr_configs_dir());
-        return 1;
-    }
     char dir[] = "/tmp/lamprig-bench-rig-XXXXXX";
     if (!mkdtemp(dir))
         return 1;

@@ -4,7 +4,11 @@
 #include <sched.h>
 #include <stdlib.h>
 #include <string.h>
+#include <stdio.h>
 #include <time.h>
+#include <unistd.h>
+
+#include "render/base/paths.h"
 
 volatile double lrb_sink;
 
@@ -126,4 +130,22 @@ double lrb_measure_rate(lrb_body body, void *ctx, double min_run_s, int runs, do
     }
     qsort(sorted, (size_t)runs, sizeof sorted[0], cmp_double);
     return runs % 2 ? sorted[runs / 2] : 0.5 * (sorted[runs / 2 - 1] + sorted[runs / 2]);
+}
+
+int lrb_rig_paths(const char *section, char *bindir, size_t bindir_cap, char *configs)
+{
+    ssize_t n = readlink("/proc/self/exe", bindir, bindir_cap - 1);
+    if (n <= 0) {
+        fprintf(stderr, "bench %s: /proc/self/exe cannot be read\n", section);
+        return 1;
+    }
+    bindir[n] = '\0';
+    char *sl = strrchr(bindir, '/');
+    if (sl)
+        *sl = '\0';
+    if (!realpath(lr_configs_dir(), configs)) {
+        fprintf(stderr, "bench %s: no configs directory '%s'\n", section, lr_configs_dir());
+        return 1;
+    }
+    return 0;
 }
