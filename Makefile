@@ -13,6 +13,8 @@
 #   make fuzz     libFuzzer binaries of the packet parsers (clang), build/fuzz/fuzz_NAME; run
 #                 one with a scratch folder first (libFuzzer writes new inputs into the first):
 #                 build/fuzz/fuzz_sacn_packet -max_total_time=60 NEW/ tests/fuzz/corpus/sacn
+#   make deb-arm64   build/lamprig_VERSION_arm64.deb, cross-compiled for the Pi (tools/cross/)
+#   make test-arm64  the GL-free unit tests built for arm64, run under qemu user mode
 #   make clean
 #
 # Sources are found by wildcard: every .c under render/ hal/ calib/ and firmware/ (except
@@ -21,6 +23,7 @@
 # build/test/test_NAME (the binary name has no sub-folder: make build/test/test_scene).
 
 PUBLIC_TARGETS := all build test soak run bench install deb test-install test-boot fuzz
+ARM64_TARGETS  := build-arm64 deb-arm64 test-arm64
 
 ifndef LAMPRIG_INNER
 # Outer make: install dependencies first, then re-enter with pkg-config available.
@@ -35,6 +38,13 @@ NPROC := $(shell nproc 2>/dev/null || echo 2)
 JOBS = $$(case " $$MAKEFLAGS " in *" -j"*) ;; *) echo -j$(NPROC) ;; esac)
 $(PUBLIC_TARGETS): deps
 	@$(MAKE) --no-print-directory $(JOBS) LAMPRIG_INNER=1 $@
+# The arm64 targets also install the cross toolchain and arm64 libraries (tools/deps.sh
+# arm64); a native make never does.
+.PHONY: $(ARM64_TARGETS) deps-arm64
+$(ARM64_TARGETS): deps-arm64
+	@$(MAKE) --no-print-directory $(JOBS) LAMPRIG_INNER=1 $@
+deps-arm64: deps
+	@sh tools/deps.sh arm64
 deps:
 	@sh tools/deps.sh
 clean:
@@ -184,11 +194,13 @@ SUBST = sed -e 's|@BINDIR@|$(BINDIR)|g' -e 's|@DATADIR@|$(DATADIR)|g' \
             -e 's|@SYSCONFDIR@|$(SYSCONFDIR)|g' -e 's|@STATEDIR@|$(STATEDIR)|g'
 
 .PHONY: install deb test-install test-boot
-install: $(INSTALL_BINS:%=build/bin/%)
+# INSTALL_FROM: where the binaries come from (deb-arm64 installs build/arm64/bin's).
+INSTALL_FROM ?= build/bin
+install: $(INSTALL_BINS:%=$(INSTALL_FROM)/%)
 	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(DATADIR) $(DESTDIR)$(MANDIR)/man1 \
 	    $(DESTDIR)$(SYSCONFDIR)/lamprig $(DESTDIR)$(UNITDIR) $(DESTDIR)$(UDEVDIR) \
 	    $(DESTDIR)$(SYSUSERSDIR)
-	install -m 0755 $(INSTALL_BINS:%=build/bin/%) $(DESTDIR)$(BINDIR)/
+	install -m 0755 $(INSTALL_BINS:%=$(INSTALL_FROM)/%) $(DESTDIR)$(BINDIR)/
 	@echo "  INSTALL configs, shaders -> $(DESTDIR)$(DATADIR)"
 	@for f in $(DATA_FILES); do \
 	    [ -f "$$f" ] && install -D -m 0644 "$$f" "$(DESTDIR)$(DATADIR)/$$f" || exit 1; done
@@ -231,5 +243,8 @@ run: build/bin/lamprig
 bench: build/bin/lamprig $(TOOLS:%=build/bin/lamprig-%)
 	./build/bin/lamprig-bench
 
--include $(shell find build/obj -name '*.d' 2>/dev/null)
+# arm64: make deb-arm64, make test-arm64 (tools/cross/arm64.mk).
+include tools/cross/arm64.mk
+
+-include $(shell find build/obj build/arm64/obj -name '*.d' 2>/dev/null)
 endif
