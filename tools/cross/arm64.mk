@@ -102,3 +102,47 @@ deb-arm64: $(ARM64_BINS)
 	LR_SHLIBDEPS_ARGS="$(foreach d,$(wildcard $(ARM64_CV)/pkg/*),-S$(CURDIR)/$(d))" \
 	    dpkg-architecture -aarm64 -c sh tools/debian/build-deb.sh build/arm64/deb build
 	sh tests/arm64/check-deb.sh build/lamprig_$(LR_VERSION)_arm64.deb
+
+# ---- tests on arm64, under qemu user mode ----
+# The GL-free unit tests of the areas the issue names, one or two binaries each, built for
+# aarch64 and run by tests/run.sh through qemu-aarch64-static (LR_TEST_EXEC; the arm64
+# dynamic loader and libraries are the multiarch ones under /usr/lib/aarch64-linux-gnu, so
+# no -L sysroot is needed). UBSan but no ASan: ASan's fixed shadow mapping needs the host's
+# 47-bit layout that qemu's guest address space does not give reliably, and it would cost
+# another 2-3x on an emulator already 5-10x slower than the host; make test runs the same
+# tests under ASan natively. UBSan (-fno-sanitize-recover) still stops on undefined
+# behaviour that only shows on arm64 (misaligned loads, shifts and overflow where arm64's
+# unsigned char or long double differ); the tests' own tolerances check the arithmetic.
+# Left out for time: test_optics_multipole and test_transrad ran over 10 minutes each under
+# qemu on the 2-core CI machine (15 s and 45 s natively under ASan). Left out because they
+# reach OpenCV: test_calib_files (its failed-calibration and `calib check` cases run the
+# Gray-code and camera calibration; they failed on cv_absent.c's error, as designed).
+ARM64_TESTS := test_optics_dipole test_json test_scene test_mesh \
+               test_hal_dmx_packet test_hal_sim test_control test_diffusion
+ARM64_TFLAGS = $(ARM64_COMMON) $(WARN) -Werror -O1 -g -fno-omit-frame-pointer \
+               -fsanitize=undefined -fno-sanitize-recover=undefined
+# calib/cv_shim.cpp is replaced by tests/arm64/cv_absent.c (it says why): the test binaries
+# link only the libraries installed for arm64, and libubsan statically (the cross runtime
+# lives under /usr/aarch64-linux-gnu/lib, outside the loader's multiarch paths).
+ARM64_TOBJ := $(LIB_C:%.c=build/arm64/tobj/%.o) build/arm64/tobj/tests/arm64/cv_absent.o
+build/arm64/tobj/firmware/version.o: VERSION
+build/arm64/tobj/firmware/version.o: ARM64_TFLAGS += -DLR_VERSION='"$(LR_VERSION)"'
+build/arm64/tobj/%.o: %.c
+	@mkdir -p $(@D)
+	@echo "  CC-A64T $<"
+	$(Q)$(ARM64_CC) $(ARM64_TFLAGS) -c $< -o $@
+build/arm64/lib/liblamprig-ubsan.a: $(ARM64_TOBJ)
+	@mkdir -p $(@D)
+	@echo "  AR-A64  $@"
+	$(Q)rm -f $@ && $(ARM64_AR) rcs $@ $^
+build/arm64/test/test_%: $$(addprefix build/arm64/tobj/,$$(addsuffix .o,$$(basename $$(wildcard tests/*/test_$$*.c)))) \
+                         $(SUPPORT:%.c=build/arm64/tobj/%.o) build/arm64/lib/liblamprig-ubsan.a
+	@mkdir -p $(@D)
+	@echo "  LD-A64T $@"
+	$(Q)$(ARM64_CXX) -fsanitize=undefined -static-libubsan -o $@ $^ -Wl,--as-needed $(ARM64_PKG_LIBS) \
+	    -lm -lpthread $(shell $(ARM64_PC) --libs cmocka)
+
+# Prints each binary's time and the total (tests/run.sh).
+test-arm64: $(ARM64_TESTS:%=build/arm64/test/%)
+	@start=$$(date +%s); LR_TEST_EXEC=qemu-aarch64-static sh tests/run.sh $^; rc=$$?; \
+	    echo "test-arm64: $(words $^) arm64 binaries under qemu in $$(( $$(date +%s) - start )) s"; exit $$rc
