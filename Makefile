@@ -22,7 +22,8 @@
 # tests/AREA/test_NAME.c (plus tests/support/*.c) builds one test binary per area,
 # build/test/test_NAME (the binary name has no sub-folder: make build/test/test_scene).
 
-PUBLIC_TARGETS := all build test soak run bench install deb test-install test-boot fuzz
+PUBLIC_TARGETS := all build test soak run bench install deb test-install test-boot fuzz \
+                  test-pi5-profile
 ARM64_TARGETS  := build-arm64 deb-arm64 test-arm64
 
 ifndef LAMPRIG_INNER
@@ -152,6 +153,17 @@ build/test/test_%: $$(addprefix build/obj/asan/,$$(addsuffix .o,$$(basename $$(w
 test: $(TESTS:%=build/test/%) build/bin/lamprig $(TOOLS:%=build/bin/lamprig-%)
 	@sh tests/run.sh $(TESTS:%=build/test/%)
 	@$(MAKE) --no-print-directory test-install
+
+# Render tests on llvmpipe restricted to the Raspberry Pi 5's GLES 3.1 profile
+# (docs/pi5-gles31-profile.md): ES 3.1, no float blending, no 32F linear filtering, no GPU
+# timers, so the renderer takes its RGBA16F maps and CPU timers. Not yet in `make test`: the
+# radiosity pass fails with GL_INVALID_OPERATION under it (README, "Install on a Raspberry Pi").
+PI5_PROFILE_ENV := MESA_GLES_VERSION_OVERRIDE=3.1 \
+    MESA_EXTENSION_OVERRIDE="-GL_EXT_float_blend -GL_OES_texture_float_linear -GL_EXT_disjoint_timer_query"
+PI5_PROFILE_TESTS := test_render_progressive
+.PHONY: test-pi5-profile
+test-pi5-profile: $(PI5_PROFILE_TESTS:%=build/test/%)
+	@$(PI5_PROFILE_ENV) sh tests/run.sh $^
 
 # The soak of test_fw_loop at the issue's two minutes (make test runs 30 s of it; the checks
 # scale with the length). LAMPRIG_SOAK_S=N make soak for another length.
