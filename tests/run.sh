@@ -90,7 +90,8 @@ launch() {
     mkdir -p "$run_dir/cache/$name"
     (
         export XDG_CACHE_HOME="$run_dir/cache/$name"
-        "$t" >"$run_dir/logs/$name.log" 2>&1
+        # LR_TEST_EXEC: a runner in front of each binary (make test-arm64: qemu-aarch64-static).
+        ${LR_TEST_EXEC:-} "$t" >"$run_dir/logs/$name.log" 2>&1
         echo $? >"$run_dir/logs/$name.rc"
     ) &
     pid_name[$!]=$name

@@ -32,11 +32,42 @@ lintian systemd
 systemd-container debootstrap
 liblo-dev liblo-tools ola qlcplus iproute2"
 
+# `tools/deps.sh arm64` (make deb-arm64, make test-arm64 only; a native make never installs
+# these): Debian's cross toolchain, the arm64 multiarch -dev packages of PKGS' libraries,
+# qemu-user-static (test-arm64 runs the arm64 tests under qemu-aarch64-static) and the arm64
+# Mesa drivers the arm64 binaries load. OpenCV: only the modules whose arm64 -dev package can
+# sit beside the native libopencv-dev (core, imgproc, flann, photo); the other five are
+# unpacked, not installed (tools/cross/arm64.mk says why). Needs `dpkg --add-architecture arm64`.
+ARM64_PKGS="crossbuild-essential-arm64 qemu-user-static
+libgpiod-dev:arm64 libhidapi-dev:arm64 libusb-1.0-0-dev:arm64 libmodbus-dev:arm64
+libegl-dev:arm64 libgles-dev:arm64 libgbm-dev:arm64 libdrm-dev:arm64
+libegl-mesa0:arm64 libgl1-mesa-dri:arm64 libgbm1:arm64
+libpng-dev:arm64 libcairo2-dev:arm64 liblcms2-dev:arm64 libcmocka-dev:arm64
+libsystemd-dev:arm64 liblo7:arm64
+libopencv-core-dev:arm64 libopencv-imgproc-dev:arm64 libopencv-flann-dev:arm64 libopencv-photo-dev:arm64"
+# liblo-dev is not Multi-Arch: same either: its headers are the native package's (the same on
+# both 64-bit little-endian ABIs) and tools/cross/arm64.mk links liblo.so.7 by name.
+if [ "${1:-}" = arm64 ]; then
+    PKGS=$ARM64_PKGS
+    if ! dpkg --print-foreign-architectures | grep -qx arm64; then
+        [ "$(id -u)" -eq 0 ] && dpkg --add-architecture arm64 || {
+            echo "lamprig deps: run 'dpkg --add-architecture arm64' as root first" >&2; exit 1; }
+    fi
+fi
+
+native=$(dpkg --print-architecture)
 missing=""
 for p in $PKGS; do
-    # dpkg-query prints "install ok installed" only for a fully installed package.
-    status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
-    [ "$status" = "install ok installed" ] || missing="$missing $p"
+    # dpkg-query prints "install ok installed" only for a fully installed package. With a
+    # foreign architecture added (make deb-arm64) an unqualified name matches every installed
+    # architecture: only the native one (or all) counts, so an arm64 copy never stands in
+    # for the native package and two copies never read as a missing one.
+    case $p in
+        *:*) ok=$(dpkg-query -W -f='${Status}\n' "$p" 2>/dev/null | grep -cx 'install ok installed' || true) ;;
+        *) ok=$(dpkg-query -W -f='${Architecture} ${Status}\n' "$p" 2>/dev/null |
+               grep -cE "^($native|all) install ok installed\$" || true) ;;
+    esac
+    [ "${ok:-0}" -gt 0 ] || missing="$missing $p"
 done
 [ -z "$missing" ] && exit 0
 

@@ -5,6 +5,9 @@
 #   dpkg-gencontrol DEBIAN/control from tools/debian/control + changelog, Installed-Size
 #   dpkg-deb        the package (root:root owned, without fakeroot)
 # usage: build-deb.sh STAGE OUTDIR
+# A cross package (make deb-arm64) runs it under `dpkg-architecture -aARCH -c` with STRIP set
+# to the cross strip and LR_SHLIBDEPS_ARGS to extra dpkg-shlibdeps options (-Sdir for the
+# libraries unpacked rather than installed; tools/cross/arm64.mk).
 set -eu
 stage=$1
 out=$2
@@ -23,7 +26,7 @@ fi
 
 # What dh_strip, dh_installman, dh_installchangelogs and dh_installdocs would do.
 for b in "$root"/usr/bin/*; do
-    strip --strip-unneeded --remove-section=.comment --remove-section=.note "$b"
+    ${STRIP:-strip} --strip-unneeded --remove-section=.comment --remove-section=.note "$b"
 done
 gzip -9n "$root"/usr/share/man/man1/*.1
 install -d "$root/usr/share/doc/lamprig"
@@ -43,7 +46,8 @@ cp "$here/control" "$here/changelog" "$src/debian/"
 abs_root=$(cd "$root" && pwd)
 (
     cd "$src"
-    dpkg-shlibdeps -Tdebian/substvars "$abs_root"/usr/bin/*
+    # shellcheck disable=SC2086
+    dpkg-shlibdeps ${LR_SHLIBDEPS_ARGS:-} -Tdebian/substvars "$abs_root"/usr/bin/*
     dpkg-gencontrol -plamprig -Vmisc:Depends= -Tdebian/substvars -fdebian/files -P"$abs_root"
 )
 
