@@ -43,7 +43,7 @@ libgpiod-dev:arm64 libhidapi-dev:arm64 libusb-1.0-0-dev:arm64 libmodbus-dev:arm6
 libegl-dev:arm64 libgles-dev:arm64 libgbm-dev:arm64 libdrm-dev:arm64
 libegl-mesa0:arm64 libgl1-mesa-dri:arm64 libgbm1:arm64
 libpng-dev:arm64 libcairo2-dev:arm64 liblcms2-dev:arm64 libcmocka-dev:arm64
-libsystemd-dev:arm64 liblo7:arm64
+libsystemd-dev:arm64 liblo7:arm64 libmicrohttpd-dev:arm64 libmosquitto-dev:arm64
 libopencv-core-dev:arm64 libopencv-imgproc-dev:arm64 libopencv-flann-dev:arm64 libopencv-photo-dev:arm64"
 # liblo-dev is not Multi-Arch: same either: its headers are the native package's (the same on
 # both 64-bit little-endian ABIs) and tools/cross/arm64.mk links liblo.so.7 by name.
