@@ -50,6 +50,13 @@ int lrb_pin_to_current_cpu(void);
  * configs folder as an absolute path (the rig sections write rig configs into a scratch
  * folder); nonzero with a line on stderr naming `section` when either cannot be found. */
 int lrb_rig_paths(const char *section, char *bindir, size_t bindir_cap, char *configs);
+/* A loopback port free now for sock_type (SOCK_STREAM, SOCK_DGRAM), or -1 (scratch.c). */
+int lrb_free_port(int sock_type);
+/* Writes text to path (a scratch file); 0, or nonzero when it could not be written. */
+int lrb_write_file(const char *path, const char *text);
+/* The shipped configs/rig/NAME (configs: lrb_rig_paths) as a malloc'd string, NULL when it
+ * cannot be read. */
+char *lrb_read_rig_file(const char *configs, const char *name);
 /* One line naming the host CPU (from /proc/cpuinfo), for the record under each table. */
 void lrb_cpu_name(char *buf, size_t len);
 /* The rig section's per-control table (rig_controls.c): runs the shipped sim rig from bindir

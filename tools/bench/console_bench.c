@@ -32,21 +32,6 @@
 
 static const char *const INPUTS[3] = {"sacn", "artnet", "osc"};
 
-static int udp_free_port(void)
-{
-    int fd = socket(AF_INET, SOCK_DGRAM, 0);
-    struct sockaddr_in a = {.sin_family = AF_INET};
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t al = sizeof a;
-    int port = -1;
-    if (fd >= 0 && bind(fd, (struct sockaddr *)&a, sizeof a) == 0 &&
-        getsockname(fd, (struct sockaddr *)&a, &al) == 0)
-        port = ntohs(a.sin_port);
-    if (fd >= 0)
-        close(fd);
-    return port;
-}
-
 static void put16(uint8_t *p, unsigned v)
 {
     p[0] = (uint8_t)(v >> 8);
@@ -103,15 +88,9 @@ static size_t osc_packet(uint8_t *b, float v)
 /* console.json with absolute paths, the given ports, unicast only, no Art-Net broadcast. */
 static int write_cfg(const char *configs, const char *path, const int port[3])
 {
-    char src[PATH_MAX + 32];
-    snprintf(src, sizeof src, "%s/rig/console.json", configs);
-    FILE *f = fopen(src, "r");
-    if (!f)
+    char *text = lrb_read_rig_file(configs, "console.json");
+    if (!text)
         return 1;
-    char text[8192];
-    size_t n = fread(text, 1, sizeof text - 1, f);
-    fclose(f);
-    text[n] = '\0';
     char out[16384];
     size_t o = 0;
     for (const char *p = text; *p && o < sizeof out - PATH_MAX - 128; p++) {
@@ -145,11 +124,8 @@ static int write_cfg(const char *configs, const char *path, const int port[3])
         out[o++] = *p;
     }
     out[o] = '\0';
-    FILE *w = fopen(path, "w");
-    if (!w)
-        return 1;
-    fputs(out, w);
-    return fclose(w) != 0;
+    free(text);
+    return lrb_write_file(path, out);
 }
 
 typedef struct row {
@@ -218,7 +194,7 @@ static int run(FILE *out)
     char dir[] = "/tmp/lamprig-bench-console-XXXXXX";
     if (!mkdtemp(dir))
         return 1;
-    int port[3] = {udp_free_port(), udp_free_port(), udp_free_port()};
+    int port[3] = {lrb_free_port(SOCK_DGRAM), lrb_free_port(SOCK_DGRAM), lrb_free_port(SOCK_DGRAM)};
     char cfg[PATH_MAX], stats[PATH_MAX], log[PATH_MAX], lamprig[PATH_MAX + 16], dur[32];
     snprintf(cfg, sizeof cfg, "%s/console.json", dir);
     snprintf(stats, sizeof stats, "%s/stats.json", dir);

@@ -60,15 +60,6 @@ static long cpu_ticks(pid_t pid)
     return (long)(ut + st);
 }
 
-static int write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    if (!f)
-        return -1;
-    fputs(text, f);
-    return fclose(f);
-}
-
 /* A rig config with the shipped sim rig's budget, output and control map, driven by script;
  * extra_set: more scene_set entries (", \"key\": value"), or "". */
 static int write_rig_set(const char *path, const char *script, const char *extra_set)
@@ -84,7 +75,7 @@ static int write_rig_set(const char *path, const char *script, const char *extra
              " \"output\": {\"mode\": \"headless\", \"width\": 320, \"height\": 240, \"fps\": 30},\n"
              " \"safe_level\": 0, \"stats\": {\"period_s\": 60}}\n",
              configs, extra_set, script, configs);
-    return write_file(path, text);
+    return lrb_write_file(path, text);
 }
 
 /* steady: the flame's flicker off (the candle flickers by default, and a flickering light
@@ -136,7 +127,7 @@ static int dimmer_latency(const char *dir, latency *l)
         len += (size_t)snprintf(text + len, sizeof text - len, "%.2f dimmer absolute %.3f\n",
                                 1.0 + TURN_SPACING_S * i, 0.2 + 0.8 * ((i * 5) % 9) / 8.0);
     snprintf(text + len, sizeof text - len, "%.2f end\n", 1.0 + TURN_SPACING_S * TURNS);
-    if (write_file(script, text) || write_rig(cfg, script, false))
+    if (lrb_write_file(script, text) || write_rig(cfg, script, false))
         return 1;
     char duration[32];
     snprintf(duration, sizeof duration, "%.1f", 1.0 + TURN_SPACING_S * TURNS + 1.0);
@@ -305,22 +296,7 @@ static int write_modbus_flicker(const char *src, const char *path, double amp)
                      configs, sc + strlen(scn), amp, k + strlen(key));
     if (m < 0 || (size_t)m >= sizeof out)
         return 1;
-    return write_file(path, out);
-}
-
-static int free_port(void)
-{
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {.sin_family = AF_INET};
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t al = sizeof a;
-    int port = -1;
-    if (fd >= 0 && bind(fd, (struct sockaddr *)&a, sizeof a) == 0 &&
-        getsockname(fd, (struct sockaddr *)&a, &al) == 0)
-        port = ntohs(a.sin_port);
-    if (fd >= 0)
-        close(fd);
-    return port;
+    return lrb_write_file(path, out);
 }
 
 static int run(FILE *out)
@@ -348,7 +324,7 @@ static int run(FILE *out)
     if (csv)
         fprintf(csv, "run,control,figure,value\n");
     rc |= lrb_rig_controls(out, csv, bindir, configs, dir);
-    int mb_port = free_port();
+    int mb_port = lrb_free_port(SOCK_STREAM);
     if (mb_port > 0)
         rc |= lrb_rig_modbus(out, csv, bindir, configs, dir, mb_port);
     else
@@ -363,14 +339,14 @@ static int run(FILE *out)
     idle_row idle_sim = {.pct = -1}, idle_mb = {.pct = -1};
     int real_error = 0;
     char *argv[] = {lamprig, "run", "--config", cfg, "--headless", NULL};
-    if (write_file(script, "0.0 dimmer absolute 0.6\n0.1 end\n") || write_rig(cfg, script, true)) {
+    if (lrb_write_file(script, "0.0 dimmer absolute 0.6\n0.1 end\n") || write_rig(cfg, script, true)) {
         snprintf(idle_sim.why, sizeof idle_sim.why, "cannot write the scratch rig config");
         real_error = 1;
     } else {
         real_error |= idle_cpu(argv, log, true, &idle_sim);
     }
     /* The Modbus demo rig against the simulator: a converged scene, the panel still polled. */
-    int port = free_port();
+    int port = lrb_free_port(SOCK_STREAM);
     char sim_bin[PATH_MAX + 32], port_s[16], url[64], mb_cfg[PATH_MAX + 32], sim_log[PATH_MAX + 32];
     snprintf(sim_bin, sizeof sim_bin, "%s/lamprig-modbus-sim", bindir);
     snprintf(port_s, sizeof port_s, "%d", port);

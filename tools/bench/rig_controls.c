@@ -101,15 +101,9 @@ static int read_run(const char *stats, run_row *r)
 /* The shipped rig, with `renderer` as its view ("" keeps the shipped one). */
 static int write_cfg(const char *configs, const char *path, const char *renderer)
 {
-    char src[PATH_MAX + 32];
-    snprintf(src, sizeof src, "%s/rig/sim.json", configs);
-    FILE *f = fopen(src, "r");
-    if (!f)
+    char *text = lrb_read_rig_file(configs, "sim.json");
+    if (!text)
         return 1;
-    char text[8192];
-    size_t n = fread(text, 1, sizeof text - 1, f);
-    fclose(f);
-    text[n] = '\0';
     /* Relative paths in the shipped file resolve against its folder: make them absolute. */
     char out[16384];
     size_t o = 0;
@@ -127,11 +121,8 @@ static int write_cfg(const char *configs, const char *path, const char *renderer
         out[o++] = *p;
     }
     out[o] = '\0';
-    FILE *w = fopen(path, "w");
-    if (!w)
-        return 1;
-    fputs(out, w);
-    return fclose(w) != 0;
+    free(text);
+    return lrb_write_file(path, out);
 }
 
 static int run_rig(const char *bindir, const char *cfg, const char *dir, int busy,
