@@ -10,7 +10,8 @@
 # divided by the jobs); binaries not listed start after them. Each binary gets a cache folder
 # of its own (XDG_CACHE_HOME) below this run's: no binary sees what another one cached, so a
 # result never depends on the order or on which binaries ran beside it, and a user's ~/.cache
-# never feeds a test. Each binary's output goes to a log of this run; a failure's last lines
+# never feeds a test (Mesa's shader cache alone is shared: compiled shaders, not results;
+# see launch). Each binary's output goes to a log of this run; a failure's last lines
 # are printed again above the summary (CI shows only the end of a long run). While binaries
 # run, a line every 60 s names the ones still running, so a long run is never silent.
 #
@@ -52,7 +53,7 @@ fi
 
 run_dir=$(mktemp -d "${TMPDIR:-/tmp}/lamprig-test-run.XXXXXX") || exit 1
 trap 'rm -rf "$run_dir"' EXIT
-mkdir -p "$run_dir/cache" "$run_dir/logs"
+mkdir -p "$run_dir/cache" "$run_dir/logs" "$run_dir/mesa_shader_cache"
 
 # Longest first: tests/durations.txt lists "NAME SECONDS" (measured; `sort -k2 -nr`).
 declare -A known=()
@@ -88,6 +89,11 @@ launch() {
     local t=$1 name
     name=$(basename "$t")
     mkdir -p "$run_dir/cache/$name"
+    # Mesa's shader cache alone is shared by the run's binaries (a link in each cache folder,
+    # so a test that points XDG_CACHE_HOME elsewhere still gets its own): it holds llvmpipe's
+    # compiled shaders, keyed by their source and the driver, never a result, and compiling
+    # the renderer's shaders again in every GL binary was about 2.5 s CPU each.
+    [ -n "${MESA_SHADER_CACHE_DIR:-}" ] || ln -s ../../mesa_shader_cache "$run_dir/cache/$name/mesa_shader_cache"
     (
         export XDG_CACHE_HOME="$run_dir/cache/$name"
         # LR_TEST_EXEC: a runner in front of each binary (make test-arm64: qemu-aarch64-static).
