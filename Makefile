@@ -170,7 +170,7 @@ test: $(TESTS:%=build/test/%) build/bin/lamprig $(TOOLS:%=build/bin/lamprig-%)
 # (docs/pi5-gles31-profile.md): ES 3.1, no float blending, no 32F linear filtering, no GPU
 # timers, so the renderer takes its RGBA16F maps and CPU timers. `make test` runs it after the
 # suite: a subset (test_render_progressive, the accumulation the fallback changes, and
-# test_render_passes, each pass on its own; about 37 s of CPU, 22 s wall on two cores);
+# test_render_passes, each pass on its own; about 42 s of CPU, 26 s wall on two cores);
 # tests/run.sh prints its time.
 PI5_PROFILE_ENV := MESA_GLES_VERSION_OVERRIDE=3.1 \
     MESA_EXTENSION_OVERRIDE="-GL_EXT_float_blend -GL_OES_texture_float_linear -GL_EXT_disjoint_timer_query"
