@@ -54,6 +54,10 @@ int lr_radiosity_alloc(lr_radiosity *rad, const lr_pass_ctx *c, lr_err *e)
                              .depth = {rad->depth, k}, .label = "radiosity map"};
             if ((rc = lr_fb_create(c->gl, &fd, &rad->fb[l * K + k], e)))
                 return rc;
+            lr_fb_desc ad = {.color = {{rad->B, l * K + k}}, .depth = {rad->depth, k},
+                             .label = "radiosity map accumulation"};
+            if ((rc = lr_fb_create(c->gl, &ad, &rad->acc[l * K + k], e)))
+                return rc;
         }
     rad->F = 0;
     return LR_OK;
@@ -63,7 +67,8 @@ void lr_radiosity_free(lr_radiosity *rad)
 {
     for (int k = 0; k < LR_MAX_LIGHTS * LR_MAX_K; k++) {
         lr_fb_destroy(rad->fb[k]);
-        rad->fb[k] = NULL;
+        lr_fb_destroy(rad->acc[k]);
+        rad->fb[k] = rad->acc[k] = NULL;
     }
     for (int i = 0; i < LR_MAX_OBJECTS; i++) {
         lr_tex_destroy(rad->trB[i]);
@@ -238,7 +243,6 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
                      lr_err *e)
 {
     static const GLenum all[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
-    static const GLenum first[3] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE};
     static const float zero[4] = {0, 0, 0, 0};
     if (restart || rad->F == 0) {
         place_maps(rad, c, gb);
@@ -267,8 +271,8 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
     glEnable(GL_DEPTH_TEST);
     for (int k = 0; k < K; k++)
         for (int l = 0; l < rad->n_lights; l++) {
-            lr_fb_bind(rad->fb[l * K + k]);
             if (F == 1 && l == 0) {
+                lr_fb_bind(rad->fb[l * K + k]);
                 glDrawBuffers(3, all);
                 glClearBufferfv(GL_COLOR, 0, zero);
                 glClearBufferfv(GL_COLOR, 1, zero);
@@ -287,11 +291,11 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
                 glDisable(GL_BLEND);
             } else if (F == 1) {
                 /* Further lights: x_o, n_o and depth are light 0's. */
-                glDrawBuffers(3, first);
+                lr_fb_bind(rad->acc[l * K + k]);
                 glClearBufferfv(GL_COLOR, 0, zero);
                 glDisable(GL_BLEND);
             } else {
-                glDrawBuffers(3, first);
+                lr_fb_bind(rad->acc[l * K + k]);
                 glEnable(GL_BLEND);
                 glBlendEquation(GL_FUNC_ADD);
                 glBlendColor(0.0f, 0.0f, 0.0f, lr_radiosity_blend_weight(c->map_format, F));

@@ -23,7 +23,14 @@ typedef struct lr_radiosity {
     /* B: K maps per light, layer l K + k for light l's map k (unit intensity); x_o, n_o and
      * depth: K layers shared by all lights (the map cameras do not depend on them). */
     lr_tex *B, *pos, *nrm, *depth;
-    lr_fb *fb[LR_MAX_LIGHTS * LR_MAX_K]; /* [l K + k] */
+    lr_fb *fb[LR_MAX_LIGHTS * LR_MAX_K]; /* [l K + k]: B, x_o, n_o and depth (restart) */
+    /* [l K + k]: B and depth only, for the frames that write B alone (every frame after a
+     * restart's first, and the first of further lights). glEnable(GL_BLEND) enables blending
+     * for every attachment, draw buffer NONE or not, and blending a 32-bit float attachment
+     * needs GL_EXT_float_blend: with x_o and n_o (RGBA32F) attached, a driver without it (the
+     * Pi 5's V3D) rejects the accumulating draw with GL_INVALID_OPERATION. This needs nothing
+     * beyond ES 3.0, unlike per-buffer glEnablei (ES 3.2 or OES_draw_buffers_indexed). */
+    lr_fb *acc[LR_MAX_LIGHTS * LR_MAX_K];
     float scale[LR_MAX_LIGHTS]; /* light l's maps store B * scale[l] */
     int F; /* frames accumulated */
     /* Whether a frame's estimate differs from the last one's: some object's B is sampled by
