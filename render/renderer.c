@@ -155,9 +155,11 @@ static int radiosity_alloc(lr_renderer *r, lr_err *e)
     lr_pass_ctx c = pass_ctx(r);
     return lr_radiosity_alloc(&r->rad, &c, e);
 }
+/* New settings lay the GPU side out again; the CPU solvers' keyed states stay (a preview's
+ * settings and back cost no grid, patch or form-factor rebuild): freed at destroy. */
 static void radiosity_free(lr_renderer *r)
 {
-    lr_radiosity_free(&r->rad);
+    lr_radiosity_release(&r->rad);
     lr_area_direct_free(&r->area);
 }
 /* Accumulating: render.frames not reached (capped for half-float maps). */
@@ -188,7 +190,9 @@ static int vpl_run(lr_renderer *r, unsigned dirty, lr_err *e)
     return lr_vpl_run(&r->vpl, &c, &r->rad, geometry, e);
 }
 
-static void irradiance_free(lr_renderer *r) { lr_irradiance_free(&r->irr); }
+/* The grids alone: the receiver bounce's F and rows and the openings' kernel are keyed on the
+ * scene (about a second to rebuild on llvmpipe's machine): freed at destroy. */
+static void irradiance_free(lr_renderer *r) { lr_irradiance_free_grids(&r->irr); }
 static bool irradiance_due(const lr_renderer *r) { return !r->irr.valid && !r->no_vpl; }
 static int irradiance_run(lr_renderer *r, unsigned dirty, lr_err *e)
 {
@@ -463,6 +467,8 @@ void lr_renderer_destroy(lr_renderer *r)
     if (!r)
         return;
     free_resources(r);
+    lr_radiosity_free(&r->rad);
+    lr_irradiance_free(&r->irr);
     lr_pass_objects_free(&r->objs);
     const lr_pass_programs *pr = &r->prog;
     lr_program *ps[] = {pr->surface,       pr->depth,         pr->radiosity,     pr->vpl,
@@ -699,5 +705,5 @@ void lr_renderer_parts_get(const lr_renderer *r, lr_renderer_parts *out)
                                .width = r->width, .height = r->height, .seed = r->seed,
                                .rs = &r->rs, .objs = &r->objs, .gbuffer = &r->gbuffer,
                                .radiosity = &r->rad, .vpl = &r->vpl, .compose = &r->img,
-                               .surface = &r->surf, .blend = r->blend};
+                               .surface = &r->surf, .irradiance = &r->irr, .blend = r->blend};
 }

@@ -7,6 +7,7 @@
 #include <time.h>
 
 #include "render/base/median.h"
+#include "render/bounce/rbounce.h"
 #include "render/optics/optics.h"
 #include "render/renderer_parts.h"
 
@@ -359,4 +360,15 @@ int lr_renderer_debug_floor_ms(lr_renderer *r, int reps, double *wall_ms, double
     }
     lr_debug_floor_destroy(f);
     return rc;
+}
+
+bool lr_renderer_debug_bounce_build(const lr_renderer *r, double *build_s)
+{
+    *build_s = 0;
+    const lr_irradiance *irr = r ? parts(r).irradiance : NULL;
+    if (!irr || !irr->rb)
+        return false;
+    double direct_s, solve_s;
+    lr_rbounce_times(irr->rb, build_s, &direct_s, &solve_s);
+    return true;
 }

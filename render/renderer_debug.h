@@ -134,4 +134,9 @@ int lr_debug_floor_run(lr_debug_floor *f, double *wall_ms, double *timer_ms, dou
                        lr_err *e);
 void lr_debug_floor_destroy(lr_debug_floor *f);
 
+/* The receiver bounce's solver (render/bounce/rbounce.h) as the last frame left it: false when
+ * the scene has none; *build_s is what its last update spent rebuilding (0: nothing changed
+ * its key, F and the object rows kept). */
+bool lr_renderer_debug_bounce_build(const lr_renderer *r, double *build_s);
+
 #endif

@@ -8,6 +8,7 @@
 #include "render/passes/blend.h"
 #include "render/passes/compose.h"
 #include "render/passes/gbuffer.h"
+#include "render/passes/irradiance.h"
 #include "render/passes/radiosity.h"
 #include "render/passes/vpl.h"
 #include "render/renderer.h"
@@ -26,6 +27,7 @@ typedef struct lr_renderer_parts {
     const lr_vpl *vpl;
     const lr_compose *compose;
     const lr_surface *surface;
+    const lr_irradiance *irradiance;
     lr_blend *blend; /* NULL when resources failed to allocate */
 } lr_renderer_parts;
 

@@ -63,7 +63,7 @@ int lr_radiosity_alloc(lr_radiosity *rad, const lr_pass_ctx *c, lr_err *e)
     return LR_OK;
 }
 
-void lr_radiosity_free(lr_radiosity *rad)
+void lr_radiosity_release(lr_radiosity *rad)
 {
     for (int k = 0; k < LR_MAX_LIGHTS * LR_MAX_K; k++) {
         lr_fb_destroy(rad->fb[k]);
@@ -76,16 +76,21 @@ void lr_radiosity_free(lr_radiosity *rad)
         lr_tex_destroy(rad->dg_tex[i]);
         rad->dg_tex[i] = NULL;
     }
-    lr_tr_scene_destroy(rad->tr);
-    rad->tr = NULL;
-    lr_dscene_destroy(rad->dscene);
-    rad->dscene = NULL;
     lr_tex_destroy(rad->B);
     lr_tex_destroy(rad->pos);
     lr_tex_destroy(rad->nrm);
     lr_tex_destroy(rad->depth);
     rad->B = rad->pos = rad->nrm = rad->depth = NULL;
     rad->F = 0;
+}
+
+void lr_radiosity_free(lr_radiosity *rad)
+{
+    lr_radiosity_release(rad);
+    lr_tr_scene_destroy(rad->tr);
+    rad->tr = NULL;
+    lr_dscene_destroy(rad->dscene);
+    rad->dscene = NULL;
 }
 
 /* Map cameras from the current geometry: orthographic, looking at the bounding sphere's

@@ -62,6 +62,11 @@ typedef struct lr_radiosity {
 
 /* Maps for c->rs (K, map_size) and c->n_lights lights; accumulation restarts. */
 int lr_radiosity_alloc(lr_radiosity *rad, const lr_pass_ctx *c, lr_err *e);
+/* The maps' textures and framebuffers (laid out again by lr_radiosity_alloc for new settings);
+ * the CPU solvers' states (the diffusion grids, translucent radiosity) stay: they are keyed on
+ * the scene and rebuild only what changed, and every restart uploads their results again. */
+void lr_radiosity_release(lr_radiosity *rad);
+/* Everything, the solvers too. */
 void lr_radiosity_free(lr_radiosity *rad);
 /* Adds one frame to the running mean, or restarts it (restart, or nothing accumulated): the
  * map cameras from the current geometry, the scale per light from gb's light types. */

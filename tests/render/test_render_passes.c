@@ -2,7 +2,8 @@
  * map agrees with GL's cube-map lookup convention (what the radiosity shader's texture() on a
  * samplerCube reads is what the face draws put there), the radiosity maps' world -> texture
  * matrices P_k put each texel's x_o on that texel, and the VPLs sit on their fixed directions
- * and do not move when the material or the dimmer changes. */
+ * and do not move when the material or the dimmer changes; new settings (a preview's and back)
+ * keep the CPU solvers' keyed states. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -213,12 +214,50 @@ static void test_vpls_are_stable(void **state)
     lr_scene_destroy(s);
 }
 
+/* lr_async's preview stage sets render.K, the map sizes and receiver_bounce=false for one frame
+ * and restores them: each re-allocates the renderer's GPU resources. The receiver bounce's F and
+ * object rows depend on the geometry alone (keyed, render/bounce/rbounce.c): the settings'
+ * re-allocation must not throw them away, or the full frame after every preview rebuilt them
+ * (about 0.9 s on the sim rig's candle, not cut by a newer batch). */
+static void test_new_settings_keep_the_bounce(void **state)
+{
+    (void)state;
+    lr_scene *s = lr_test_scene("candle", lr_test_small_settings, NULL);
+    lr_renderer *r = lr_test_renderer(gl, s, 64, 48, false, 3);
+    lr_test_frame(r);
+    double build_s;
+    assert_true(lr_renderer_debug_bounce_build(r, &build_s));
+    assert_true(build_s > 0); /* built by the first frame */
+    lr_test_converge(r, 4);
+    const char *preview[][2] = {{"render.K", "1"}, {"render.map_size", "32"},
+                                {"render.receiver_bounce", "false"}};
+    const char *back[][2] = {{"render.receiver_bounce", "true"}, {"render.map_size", "48"},
+                             {"render.K", "6"}};
+    for (int i = 0; i < 3; i++)
+        lr_test_set(s, r, preview[i][0], preview[i][1]);
+    lr_test_frame(r);
+    assert_false(lr_renderer_debug_bounce_build(r, &build_s)); /* parked */
+    for (int i = 0; i < 3; i++)
+        lr_test_set(s, r, back[i][0], back[i][1]);
+    lr_test_frame(r);
+    assert_true(lr_renderer_debug_bounce_build(r, &build_s));
+    printf("bounce rebuild after the settings and back: %.3f s\n", build_s);
+    assert_true(build_s == 0); /* kept: nothing in its key changed */
+    /* A material change keeps F too (the objects' albedo is set at each update). */
+    lr_test_set(s, r, "objects[pillar].material.scale", "0.7");
+    lr_test_frame(r);
+    assert_true(lr_renderer_debug_bounce_build(r, &build_s) && build_s == 0);
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_gbuffer_cube_matches_gl_lookup),
         cmocka_unit_test(test_map_matrices_put_x_o_on_its_texel),
         cmocka_unit_test(test_vpls_are_stable),
+        cmocka_unit_test(test_new_settings_keep_the_bounce),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
