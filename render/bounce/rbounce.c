@@ -12,7 +12,7 @@
 #include "render/transrad/tr_scene.h"
 
 #define KEY_MAX (3 + LR_TR_MAX_SURFACES * (LR_TR_KEY_MESH + 5))
-#define LKEY 20 /* doubles per light shape */
+#define LKEY LR_LIGHT_KEY_N /* doubles per light shape */
 #define MAX_LIGHTS 8
 /* Object patches: the receivers' light they reflect back varies over a body as the receivers'
  * does over their 30 mm cells. */
@@ -88,12 +88,7 @@ static int scene_key(const lr_scene *s, double *k)
  * flicker: those scale it). */
 static void light_key(const lr_light *l, double *k)
 {
-    double v[LKEY] = {l->type,        l->position.x,  l->position.y,  l->position.z,
-                      l->direction.x, l->direction.y, l->direction.z, l->edge_u.x,
-                      l->edge_u.y,    l->edge_u.z,    l->edge_v.x,    l->edge_v.y,
-                      l->edge_v.z,    l->radius,      l->two_sided,   l->inner_deg,
-                      l->outer_deg,   0,              0,              0};
-    memcpy(k, v, sizeof v);
+    lr_light_geometry_key(l, k);
 }
 
 static void free_solver(lr_rbounce *rb)

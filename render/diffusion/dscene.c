@@ -101,14 +101,9 @@ double lr_dscene_irradiance(const lr_scene_object *obj, const lr_light *light, l
     double c = lr_v3_dot(n, w);
     if (!(c > 0.0) || lr_bvh_occluded(obj->bvh, o, w, 0.0, fmax(0.0, r - 2.0 * eps)))
         return 0.0;
-    double shape = 1.0;
-    if (light->type == LR_LIGHT_SPOT) {
-        /* The pass's spot_shape: smoothstep(cos outer, cos inner, v . axis). */
-        double e0 = cos(light->outer_deg * M_PI / 180.0), e1 = cos(light->inner_deg * M_PI / 180.0);
-        double x = -lr_v3_dot(w, light->direction);
-        double t = e1 > e0 ? fmin(1.0, fmax(0.0, (x - e0) / (e1 - e0))) : (x >= e0 ? 1.0 : 0.0);
-        shape = t * t * (3.0 - 2.0 * t);
-    }
+    /* The spot's cone and a profile (lr_light_shape); an area light stays the point at its
+     * centre here. */
+    double shape = lr_light_is_area(light) ? 1.0 : lr_light_shape(light, lr_v3_scale(w, -1.0));
     /* The light over the patch the sample stands for (near_light.h), not at its centre: the
      * point sample cos / r^2 diverges as the light nears the surface (the flame 0.1 mm above
      * the pool's floor gave 1e5 times the object's normal light), the patch's mean is at most

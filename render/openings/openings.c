@@ -26,7 +26,7 @@
  * mesh key and its frame. */
 #define GKEY (2 + MAXO * (LR_TR_KEY_MESH + 3) + MAXR * (LR_TR_KEY_MESH + 10))
 /* Light key: the light's shape and every object's material and model. */
-#define LKEY (20 + MAXO * (sizeof(lr_coeffs) / sizeof(double) + 4))
+#define LKEY (LR_LIGHT_KEY_N + MAXO * (sizeof(lr_coeffs) / sizeof(double) + 4))
 
 typedef struct emitter {
     int obj;
@@ -115,13 +115,8 @@ static void light_key(const lr_scene *s, int l, double *k)
 {
     memset(k, 0, LKEY * sizeof *k);
     const lr_light *L = lr_scene_light_at(s, l);
-    double v[20] = {L->type,        L->position.x,  L->position.y,  L->position.z,
-                    L->direction.x, L->direction.y, L->direction.z, L->inner_deg,
-                    L->outer_deg,   L->radius,      L->two_sided,   L->edge_u.x,
-                    L->edge_u.y,    L->edge_u.z,    L->edge_v.x,    L->edge_v.y,
-                    L->edge_v.z,    0,              0,              0};
-    memcpy(k, v, sizeof v);
-    size_t n = 20, nc = sizeof(lr_coeffs) / sizeof(double);
+    lr_light_geometry_key(L, k);
+    size_t n = LR_LIGHT_KEY_N, nc = sizeof(lr_coeffs) / sizeof(double);
     for (int i = 0; i < lr_scene_object_count(s) && i < MAXO; i++) {
         const lr_scene_object *o = lr_scene_object_at(s, i);
         memcpy(k + n, &o->coeffs, nc * sizeof(double));

@@ -51,6 +51,8 @@ const char *const *lr_passes_defines(lr_shader_defines *d)
         DEF(LR_LIGHT_DIRECTIONAL),
         DEF(LR_LIGHT_QUAD),
         DEF(LR_LIGHT_DISK),
+        DEF(LR_PROFILE_NG),
+        DEF(LR_PROFILE_NC),
         DEF(LR_GB_CUBE),
         DEF(LR_GB_PERSPECTIVE),
         DEF(LR_GB_ORTHO),

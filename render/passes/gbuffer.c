@@ -8,6 +8,7 @@
  * plus 2 x gbuffer_size^2 for the 2D map (14.7 MB at 256^2). */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "render/area/frames.h"
@@ -30,6 +31,11 @@ int lr_gbuffer_alloc(lr_gbuffer *gb, const lr_pass_ctx *c, lr_err *e)
                         .label = "light G-buffer cube"};
     lr_tex_desc flat = {.type = LR_TEX_2D, .format = LR_TEX_RGBA32F, .width = n, .height = n,
                         .label = "light G-buffer 2D"};
+    lr_tex_desc prof = {.type = LR_TEX_2D, .format = LR_TEX_R32F, .width = LR_PROFILE_NG,
+                        .height = LR_PROFILE_NC * LR_MAX_LIGHTS, .label = "light profiles"};
+    if ((rc = lr_tex_create(c->gl, &prof, &gb->profiles, e)))
+        return rc;
+    gb->profiles_valid = false;
     for (int l = 0; l < nl; l++) {
         lr_light_gbuffer *g = &gb->light[l];
         g->size = n;
@@ -49,6 +55,9 @@ int lr_gbuffer_alloc(lr_gbuffer *gb, const lr_pass_ctx *c, lr_err *e)
 
 void lr_gbuffer_free(lr_gbuffer *gb)
 {
+    lr_tex_destroy(gb->profiles);
+    gb->profiles = NULL;
+    gb->profiles_valid = false;
     for (int l = 0; l < LR_MAX_LIGHTS; l++) {
         lr_light_gbuffer *g = &gb->light[l];
         for (int f = 0; f < 6; f++) {
@@ -86,6 +95,37 @@ static void clear_surface(void)
     glClear(GL_DEPTH_BUFFER_BIT);
 }
 
+/* The lights' profile tables into the texture when one changed (a scene's tables are fixed
+ * at load, so this runs once per scene). Rows without a profile stay 0: never read. */
+static int upload_profiles(lr_gbuffer *g, const lr_pass_ctx *c, lr_err *e)
+{
+    bool same = g->profiles_valid;
+    uint64_t key[LR_MAX_LIGHTS] = {0};
+    for (int l = 0; l < g->n_lights; l++) {
+        const lr_light *light = lr_scene_light_at(c->scene, l);
+        key[l] = light->profile.on ? light->profile.hash | 1u : 0;
+        same = same && key[l] == g->profile_key[l];
+    }
+    if (same)
+        return LR_OK;
+    const size_t per = (size_t)LR_PROFILE_NG * LR_PROFILE_NC;
+    float *t = calloc(per * LR_MAX_LIGHTS, sizeof *t);
+    if (!t)
+        return lr_err_set(e, LR_ENOMEM, "light profiles: out of memory");
+    for (int l = 0; l < g->n_lights; l++) {
+        const lr_light *light = lr_scene_light_at(c->scene, l);
+        if (light->profile.on)
+            memcpy(t + per * (size_t)l, light->profile.rel, per * sizeof *t);
+    }
+    int rc = lr_tex_upload(g->profiles, 0, t, e);
+    free(t);
+    if (rc)
+        return rc;
+    memcpy(g->profile_key, key, sizeof key);
+    g->profiles_valid = true;
+    return LR_OK;
+}
+
 /* Light l's G-buffer. */
 static void draw_light(lr_light_gbuffer *g, const lr_pass_ctx *ctx, int l, long frame)
 {
@@ -103,6 +143,9 @@ static void draw_light(lr_light_gbuffer *g, const lr_pass_ctx *ctx, int l, long 
     g->dir = lr_v3_normalize(light->direction);
     g->spot_cos[0] = (float)cos(light->outer_deg * M_PI / 180.0);
     g->spot_cos[1] = (float)cos(light->inner_deg * M_PI / 180.0);
+    g->profile_on = light->profile.on;
+    if (g->profile_on)
+        lr_light_profile_axes(light, &g->prof_x, &g->prof_y, &g->prof_z);
 
     lr_gb_camera cam;
     lr_gb_camera_scene_frame(ctx->scene, l, frame, &cam);
@@ -134,6 +177,9 @@ int lr_gbuffer_run(lr_gbuffer *g, const lr_pass_ctx *c, long frame, lr_err *e)
     glDisable(GL_CULL_FACE);
     for (int l = 0; l < g->n_lights; l++)
         draw_light(&g->light[l], c, l, frame);
+    int rc = upload_profiles(g, c, e);
+    if (rc)
+        return rc;
     return lr_gl_check("gbuffer pass", e);
 }
 
@@ -169,6 +215,13 @@ void lr_gbuffer_bind(const lr_gbuffer *gb, lr_program *p, int l)
         glUniform1f(loc, g->area);
     if ((loc = lr_program_uniform(p, "u_area_two_sided")) >= 0)
         glUniform1i(loc, g->two_sided);
+    if (lr_program_uniform(p, "u_profiles") >= 0)
+        lr_passes_bind_tex(p, "u_profiles", LR_PROFILE_TEX_UNIT, gb->profiles);
+    lr_passes_uniform_i(p, "u_profile_on", g->profile_on);
+    lr_passes_uniform_i(p, "u_profile_light", l);
+    lr_passes_uniform_v3(p, "u_prof_x", g->prof_x);
+    lr_passes_uniform_v3(p, "u_prof_y", g->prof_y);
+    lr_passes_uniform_v3(p, "u_prof_z", g->prof_z);
 }
 
 /* Element i of uniform array `name` ("u_x[2]"). */
@@ -215,8 +268,18 @@ void lr_gbuffer_bind_lights(const lr_gbuffer *gb, const lr_pass_ctx *c, lr_progr
             glUniform1f(loc, g->area);
         if ((loc = array_loc(p, "u_lights_two_sided", l)) >= 0)
             glUniform1i(loc, g->two_sided);
+        if ((loc = array_loc(p, "u_lights_profile", l)) >= 0)
+            glUniform1i(loc, g->profile_on);
+        const lr_vec3 *ax[3] = {&g->prof_x, &g->prof_y, &g->prof_z};
+        static const char *const axn[3] = {"u_lights_prof_x", "u_lights_prof_y",
+                                           "u_lights_prof_z"};
+        for (int k = 0; k < 3; k++)
+            if ((loc = array_loc(p, axn[k], l)) >= 0)
+                glUniform3f(loc, (float)ax[k]->x, (float)ax[k]->y, (float)ax[k]->z);
         if ((loc = array_loc(p, "u_lights_I", l)) >= 0)
             glUniform3f(loc, (float)c->I[l][0], (float)c->I[l][1], (float)c->I[l][2]);
     }
     lr_passes_uniform_i(p, "u_n_lights", gb->n_lights);
+    if (lr_program_uniform(p, "u_profiles") >= 0)
+        lr_passes_bind_tex(p, "u_profiles", LR_PROFILE_TEX_UNIT, gb->profiles);
 }

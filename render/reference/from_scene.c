@@ -25,6 +25,10 @@ static int add_light(lr_ref_scene *s, const lr_light *l, lr_err *e)
                             .position = l->position, .direction = l->direction,
                             .inner_deg = l->inner_deg, .outer_deg = l->outer_deg};
     lr_light_rgb(l, ld.emission);
+    if (l->profile.on) {
+        ld.profile = &l->profile;
+        lr_light_profile_axes(l, &ld.prof_x, &ld.prof_y, &ld.prof_z);
+    }
     if (l->type == LR_LIGHT_QUAD) {
         /* The reference's quad is a corner and full edges; it emits on edge1 x edge2's side,
          * which is edge_u x edge_v's. */
@@ -51,6 +55,8 @@ static int add_light(lr_ref_scene *s, const lr_light *l, lr_err *e)
     } else {
         ld.direction = lr_v3_scale(l->direction, -1.0);
     }
+    /* The back face's pattern is the front's mirrored in the emitter's plane: nadir turned. */
+    ld.prof_z = lr_v3_scale(ld.prof_z, -1.0);
     return lr_ref_scene_add_light(s, &ld, e);
 }
 

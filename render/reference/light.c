@@ -13,6 +13,14 @@ static double spot_profile(const lr_ref_light *l, double c)
     return x * x * (3.0 - 2.0 * x);
 }
 
+/* rel of light l's profile along world direction w (the desc's frame). */
+static double profile_rel(const lr_ref_light *l, lr_vec3 w)
+{
+    return lr_light_profile_eval(l->profile, lr_v3(lr_v3_dot(w, l->d.prof_x),
+                                                   lr_v3_dot(w, l->d.prof_y),
+                                                   lr_v3_dot(w, l->d.prof_z)));
+}
+
 double lr_ref_emitter_intensity(const lr_ref_emitter *em, lr_vec3 w, int b)
 {
     const lr_ref_light *l = em->light;
@@ -23,11 +31,15 @@ double lr_ref_emitter_intensity(const lr_ref_emitter *em, lr_vec3 w, int b)
     }
     switch (l->d.kind) {
     case LR_REF_LIGHT_POINT:
-        return l->d.emission[b];
-    case LR_REF_LIGHT_SPOT:
-        return l->d.emission[b] * spot_profile(l, lr_v3_dot(w, l->normal));
-    default: { /* Lambertian area element: I = L_e cos theta dA */
+        return l->d.emission[b] * (l->profile ? profile_rel(l, w) : 1.0);
+    case LR_REF_LIGHT_SPOT: {
+        double s = spot_profile(l, lr_v3_dot(w, l->normal));
+        return l->d.emission[b] * (l->profile && s > 0.0 ? s * profile_rel(l, w) : s);
+    }
+    default: { /* Lambertian area element: I = L_e cos theta dA (a profile: L_e rel dA) */
         double c = lr_v3_dot(w, l->normal);
+        if (c > 0.0 && l->profile)
+            c = profile_rel(l, w);
         return c > 0.0 ? l->d.emission[b] * c * em->area_weight : 0.0;
     }
     }
@@ -94,6 +106,24 @@ void lr_ref_light_emit_all(const lr_ref_light *l, lr_ref_rng *rng, lr_vec3 *orig
         c = sqrt(u1);
         k = LR_REF_PI * l->area;
         break;
+    }
+    if (l->profile) {
+        /* By the profile's distribution (profile.h sampler), weight shape / pdf: a point's
+         * rel, a spot's cone times rel, an area element's A rel (gamma < 90 only). */
+        double pdf, u3 = lr_ref_rng_uniform(rng);
+        lr_vec3 d = lr_profile_sample(l->sampler, u1, u2, u3, &pdf);
+        *dir = lr_v3_normalize(lr_v3_add(lr_v3_scale(l->d.prof_x, d.x),
+                                         lr_v3_add(lr_v3_scale(l->d.prof_y, d.y),
+                                                   lr_v3_scale(l->d.prof_z, d.z))));
+        double rel = profile_rel(l, *dir);
+        if (l->d.kind == LR_REF_LIGHT_SPOT)
+            rel *= spot_profile(l, lr_v3_dot(*dir, l->normal));
+        else if (l->object >= 0)
+            rel *= l->area;
+        k = pdf > 0.0 ? rel / pdf : 0.0;
+        for (int b = 0; b < 3; b++)
+            power[b] = k * l->d.emission[b];
+        return;
     }
     for (int b = 0; b < 3; b++)
         power[b] = k * l->d.emission[b];

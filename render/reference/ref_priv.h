@@ -47,6 +47,8 @@ typedef struct lr_ref_light {
     double power[3];             /* W per band */
     int medium;                  /* the medium the light emits into */
     int object;                  /* area lights: its object index, else -1 */
+    lr_light_profile *profile;   /* the desc's, owned; NULL none */
+    lr_profile_sampler *sampler; /* emission directions by the profile */
 } lr_ref_light;
 
 struct lr_ref_scene {

@@ -49,6 +49,7 @@
 #include "render/base/err.h"
 #include "render/base/vec3.h"
 #include "render/base/warn.h"
+#include "render/photometry/profile.h"
 #include "render/image/image.h"
 #include "render/reference/rng.h"
 
@@ -181,6 +182,12 @@ typedef struct lr_ref_light_desc {
     /* point, spot: radiant intensity on the axis, W/sr; quad, disk: radiance, W/(mm^2 sr),
      * emitted on the front side only (Lambertian). */
     double emission[3];
+    /* A photometric profile (render/photometry/profile.h; NULL none), copied: point and spot
+     * intensity emission rel(w) (a spot's times its cone), an area element's emission rel(w)
+     * dA in place of cos theta dA (gamma from the emitting side's normal, 0 behind it). Its
+     * frame: prof_x = C0, prof_y = C90, prof_z = nadir (a spot's axis, an area's normal). */
+    const lr_light_profile *profile;
+    lr_vec3 prof_x, prof_y, prof_z;
 } lr_ref_light_desc;
 
 typedef struct lr_ref_scene_desc {

@@ -60,6 +60,10 @@ void lr_ref_scene_destroy(lr_ref_scene *s)
         lr_ref_shape_destroy(s->objects[i].shape);
     free(s->objects);
     free(s->media);
+    for (int i = 0; i < s->n_lights; i++) {
+        free(s->lights[i].profile);
+        free(s->lights[i].sampler);
+    }
     free(s->lights);
     free(s->light_pick);
     free(s->delta_pick);
@@ -250,17 +254,48 @@ int lr_ref_scene_add_light(lr_ref_scene *s, const lr_ref_light_desc *d, lr_err *
         return lr_err_set(e, LR_EINVAL, "reference: light %d: unknown kind %d", idx,
                           (int)d->kind);
     }
+    if (d->profile && d->profile->on) {
+        /* The profile's flux in place of the uniform or Lambertian one (profile.h omega). */
+        bool area = d->kind == LR_REF_LIGHT_QUAD || d->kind == LR_REF_LIGHT_DISK;
+        l.profile = malloc(sizeof *l.profile);
+        l.sampler = malloc(sizeof *l.sampler);
+        lr_err inner = {0};
+        if (!l.profile || !l.sampler) {
+            rc = lr_err_set(e, LR_ENOMEM, "reference: light %d: out of memory", idx);
+        } else {
+            *l.profile = *d->profile;
+            rc = lr_profile_sampler_init(l.profile, area, l.sampler, &inner);
+            if (rc)
+                lr_err_set(e, rc, "reference: light %d: %s", idx, inner.msg);
+        }
+        if (rc) {
+            free(l.profile);
+            free(l.sampler);
+            lr_ref_shape_destroy(shape);
+            return rc;
+        }
+        factor = d->kind == LR_REF_LIGHT_POINT ? l.profile->omega
+               : d->kind == LR_REF_LIGHT_SPOT
+                   ? lr_light_profile_cone_omega(l.profile, l.d.inner_deg, l.d.outer_deg)
+                   : l.profile->omega_down * l.area;
+        l.d.profile = NULL; /* l.profile is the copy */
+    }
     for (int b = 0; b < 3; b++)
         l.power[b] = factor * d->emission[b];
     if ((rc = grow((void **)&s->lights, &s->cap_lights, s->n_lights, sizeof l, e))) {
+        free(l.profile);
+        free(l.sampler);
         lr_ref_shape_destroy(shape);
         return rc;
     }
     if (shape) {
         lr_ref_object o = {.kind = LR_REF_SURF_LIGHT, .shape = shape, .light = idx};
         copy_name(o.name, NULL, "light", idx);
-        if ((rc = push_object(s, &o, e)))
+        if ((rc = push_object(s, &o, e))) {
+            free(l.profile);
+            free(l.sampler);
             return rc;
+        }
         l.object = s->n_objects - 1;
     }
     lr_ref_hash_str(&s->hash, "light");
@@ -274,6 +309,12 @@ int lr_ref_scene_add_light(lr_ref_scene *s, const lr_ref_light_desc *d, lr_err *
     lr_ref_hash_double(&s->hash, l.d.outer_deg);
     for (int b = 0; b < 3; b++)
         lr_ref_hash_double(&s->hash, d->emission[b]);
+    if (l.profile) {
+        lr_ref_hash_u64(&s->hash, l.profile->hash);
+        lr_ref_hash_vec3(&s->hash, d->prof_x);
+        lr_ref_hash_vec3(&s->hash, d->prof_y);
+        lr_ref_hash_vec3(&s->hash, d->prof_z);
+    }
     s->lights[s->n_lights++] = l;
     return LR_OK;
 }

@@ -78,6 +78,18 @@ static const lr_field light_fields[] = {
     {"direction", LR_FT_VEC3, S | D, L(direction), NB, NB, LR_FF_REQUIRED | LR_FF_UNIT,
      .dflt = {0, 0, -1}, .dirty = LR_DIRTY_LIGHT_GEOMETRY,
      .help = "the way the light travels (normalised)"},
+    {"direction", LR_FT_VEC3, P, L(direction), NB, NB, LR_FF_UNIT, .dflt = {0, 0, -1},
+     .dirty = LR_DIRTY_LIGHT_GEOMETRY,
+     .help = "with a profile: the luminaire's nadir (gamma 0; normalised)"},
+    /* Loaded with the scene (load.c), so not settable at run time. */
+    {"profile", LR_FT_PATH, P | S | Q | K, L(profile_path), .flags = LR_FF_NO_SET,
+     .dflt_text = "none",
+     .help = "photometric file (.ies LM-63, .ldt EULUMDAT), relative to the scene: the "
+             "intensity per direction (render/photometry/profile.h); without a strength, the "
+             "file's flux (or its candela)"},
+    {"profile_c0", LR_FT_VEC3, P | S | Q | K, L(profile_c0), -1e6, 1e6, 0,
+     .dflt_text = "a quad's edge_u, else +x", .dirty = LR_DIRTY_LIGHT_GEOMETRY,
+     .help = "with a profile: the direction of its C0 plane (the luminaire's length)"},
     /* inner_deg's upper bound is outer_deg: check.c. */
     {"inner_deg", LR_FT_NUM, S, L(inner_deg), NB, NB, 0, .dflt = {20}, .unit = "degrees",
      .dirty = LR_DIRTY_LIGHT_GEOMETRY, .help = "half-angle of full intensity, (0, outer_deg]"},

@@ -14,8 +14,12 @@ double lr_light_lm_per_unit(const lr_light *l)
 {
     double kv = LR_KM_LM_PER_W * lr_rgb_luminance(l->color), omega = 0.0;
     switch (l->type) {
-    case LR_LIGHT_POINT: omega = 4.0 * M_PI; break;
+    case LR_LIGHT_POINT: omega = l->profile.on ? l->profile.omega : 4.0 * M_PI; break;
     case LR_LIGHT_SPOT: {
+        if (l->profile.on) {
+            omega = lr_light_profile_cone_omega(&l->profile, l->inner_deg, l->outer_deg);
+            break;
+        }
         /* The flux of I shape(cos) over the sphere: 2 pi times the integral over cos of the
          * shape, 1 on [cos inner, 1], smoothstep between cos outer and cos inner (mean 1/2). */
         double ci = cos(l->inner_deg * (M_PI / 180.0)), co = cos(l->outer_deg * (M_PI / 180.0));
@@ -25,7 +29,8 @@ double lr_light_lm_per_unit(const lr_light *l)
     case LR_LIGHT_QUAD:
     case LR_LIGHT_DISK:
         /* A Lambertian emitter of radiance L sends pi L per unit area and side. */
-        omega = M_PI * lr_light_area(l) * (l->two_sided ? 2.0 : 1.0);
+        omega = (l->profile.on ? l->profile.omega_down : M_PI) * lr_light_area(l) *
+                (l->two_sided ? 2.0 : 1.0);
         break;
     case LR_LIGHT_DIRECTIONAL: omega = 0.0; break;
     }
@@ -71,17 +76,26 @@ double lr_light_area(const lr_light *l)
     return 0.0;
 }
 
-double lr_light_shape(const lr_light *l, lr_vec3 dir)
+void lr_light_profile_axes(const lr_light *l, lr_vec3 *x, lr_vec3 *y, lr_vec3 *z)
 {
-    if (lr_light_is_area(l)) {
-        /* The whole emitter as a point (render/area/emitter.h): I = L_e A cos(theta_e). */
-        double c = lr_v3_dot(dir, lr_light_area_normal(l));
-        if (l->two_sided)
-            c = fabs(c);
-        return c > 0.0 ? lr_light_area(l) * c : 0.0;
-    }
-    if (l->type != LR_LIGHT_SPOT)
-        return 1.0;
+    lr_vec3 n = lr_light_is_area(l) ? lr_light_area_normal(l) : lr_v3_normalize(l->direction);
+    lr_vec3 hint = l->profile_c0;
+    if (!(lr_v3_len(hint) > 0.0))
+        hint = l->type == LR_LIGHT_QUAD ? l->edge_u : lr_v3(1.0, 0.0, 0.0);
+    lr_light_profile_frame(n, hint, x, y, z);
+}
+
+/* rel of the light's profile along world direction dir. */
+static double profile_rel(const lr_light *l, lr_vec3 dir)
+{
+    lr_vec3 x, y, z;
+    lr_light_profile_axes(l, &x, &y, &z);
+    return lr_light_profile_eval(&l->profile,
+                                 lr_v3(lr_v3_dot(dir, x), lr_v3_dot(dir, y), lr_v3_dot(dir, z)));
+}
+
+static double spot_cone(const lr_light *l, lr_vec3 dir)
+{
     double c = lr_v3_dot(dir, l->direction);
     double ci = cos(l->inner_deg * (M_PI / 180.0)), co = cos(l->outer_deg * (M_PI / 180.0));
     if (c >= ci)
@@ -90,6 +104,44 @@ double lr_light_shape(const lr_light *l, lr_vec3 dir)
         return 0.0;
     double t = (c - co) / (ci - co);
     return t * t * (3.0 - 2.0 * t);
+}
+
+double lr_light_shape(const lr_light *l, lr_vec3 dir)
+{
+    if (lr_light_is_area(l)) {
+        /* The whole emitter as a point (render/area/emitter.h): I = L_e A cos(theta_e), or
+         * L_e A rel(w) with a profile (the file's distribution in place of Lambert's). */
+        lr_vec3 n = lr_light_area_normal(l);
+        double c = lr_v3_dot(dir, n);
+        if (l->profile.on) {
+            if (c < 0.0 && l->two_sided) /* the back face: the front's pattern mirrored */
+                dir = lr_v3_sub(dir, lr_v3_scale(n, 2.0 * c)), c = -c;
+            return c > 0.0 ? lr_light_area(l) * profile_rel(l, dir) : 0.0;
+        }
+        if (l->two_sided)
+            c = fabs(c);
+        return c > 0.0 ? lr_light_area(l) * c : 0.0;
+    }
+    if (l->type == LR_LIGHT_DIRECTIONAL)
+        return 1.0;
+    double s = l->type == LR_LIGHT_SPOT ? spot_cone(l, dir) : 1.0;
+    return l->profile.on && s > 0.0 ? s * profile_rel(l, dir) : s;
+}
+
+void lr_light_geometry_key(const lr_light *l, double k[LR_LIGHT_KEY_N])
+{
+    lr_vec3 x = lr_v3(0, 0, 0), y, z;
+    if (l->profile.on)
+        lr_light_profile_axes(l, &x, &y, &z);
+    /* The table's hash in 48 bits: exact in a double. */
+    double ph = l->profile.on ? (double)(l->profile.hash >> 16) + 1.0 : 0.0;
+    double v[LR_LIGHT_KEY_N] = {l->type,      l->position.x,  l->position.y,  l->position.z,
+                                l->direction.x, l->direction.y, l->direction.z, l->edge_u.x,
+                                l->edge_u.y,  l->edge_u.z,    l->edge_v.x,    l->edge_v.y,
+                                l->edge_v.z,  l->radius,      l->two_sided,   l->inner_deg,
+                                l->outer_deg, ph,             x.x + 2.0 * x.y, x.z};
+    for (int i = 0; i < LR_LIGHT_KEY_N; i++)
+        k[i] = v[i];
 }
 
 /* A phase in [0, 2 pi) from the seed and a channel number (splitmix64 finaliser). */

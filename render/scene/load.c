@@ -148,10 +148,25 @@ static int light_strength(ctx *c, lr_jnode obj, const char *where, lr_light *l)
         }
         given = k;
     }
-    if (given < 0)
+    if (given < 0 && l->profile.on) {
+        /* The file's own strength: its stated flux, else (absolute photometry) its candela. */
+        if (l->profile.lumens > 0.0) {
+            l->from = LR_STRENGTH_LM;
+            l->flux_lm = l->profile.lumens;
+        } else if (!lr_light_is_area(l)) {
+            l->from = LR_STRENGTH_CD;
+            l->intensity_cd = l->profile.max_cd;
+        } else {
+            return lr_json_fail(c->j, obj, where, c->e, LR_EPARSE, "missing its strength: the "
+                                "profile states no flux (required: one of %s)", list);
+        }
+        given = 0;
+    } else if (given < 0) {
         return lr_json_fail(c->j, obj, where, c->e, LR_EPARSE, "missing its strength (required: "
                             "one of %s)", list);
-    l->from = from[given];
+    } else {
+        l->from = from[given];
+    }
     lr_jnode t = lr_json_get(c->j, obj, "color_temperature_k");
     if (t != LR_JNONE && lr_json_get(c->j, obj, "color") != LR_JNONE) {
         snprintf(f, sizeof f, "%s.color_temperature_k", where);
@@ -176,6 +191,17 @@ static int parse_light(ctx *c, lr_jnode obj, int i, lr_light *l)
         return rc;
     if ((rc = lr_fields_read(c->j, obj, where, &lr_scene_light_desc, type, l, c->e)))
         return rc;
+    if (l->profile_path[0]) {
+        /* The photometric file, relative to the scene; its errors name the file's line. */
+        char path[LR_SCENE_PATH_MAX], f[96];
+        lr_err inner = {0};
+        lr_jnode at = lr_json_get(c->j, obj, "profile");
+        snprintf(f, sizeof f, "%s.profile", where);
+        if (lr_scene_resolve_path(c->s, l->profile_path, path, sizeof path))
+            return lr_json_fail(c->j, at, f, c->e, LR_EINVAL, "path too long");
+        if ((rc = lr_light_profile_load(path, &l->profile, &inner)))
+            return lr_json_fail(c->j, at, f, c->e, rc, "%s", inner.msg);
+    }
     if ((rc = light_strength(c, obj, where, l)))
         return rc;
     const char *field = NULL;

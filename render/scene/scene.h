@@ -45,6 +45,7 @@
 #include "render/mesh/mesh.h"
 #include "render/models/model.h"
 #include "render/optics/optics.h"
+#include "render/photometry/profile.h"
 #include "render/scene/dirty.h"
 
 typedef struct lr_scene lr_scene;
@@ -155,6 +156,13 @@ typedef struct lr_light {
      * `intensity` is its visible W/sr (lr_cct_color); 0: `color` as given. */
     double color_temperature_k;
     lr_flicker flicker;
+    /* A photometric file's intensity per direction (render/photometry/profile.h), for point,
+     * spot, quad and disk lights: "profile" as written ("" none) and its table, loaded with
+     * the scene. Its nadir (gamma 0) is `direction` (point, spot, disk) or the quad's normal;
+     * its C0 plane the direction of profile_c0 (zero: a quad's edge_u, else +x). */
+    char profile_path[1024];
+    lr_vec3 profile_c0;
+    lr_light_profile profile;
 } lr_light;
 
 /* intensity * color. */
@@ -173,8 +181,18 @@ int lr_light_resolve_units(lr_light *l, const char **field, lr_err *e);
  * 1 inside inner_deg, 0 outside outer_deg, smoothstep in the cosine between; for a
  * directional light 1; for an area light A cos(theta_e) (0 behind a one-sided one): the
  * intensity per unit radiance of the emitter seen as a point, which a renderer places at one
- * sample point of the emitter per accumulation frame (render/area/frames.h). */
+ * sample point of the emitter per accumulation frame (render/area/frames.h).
+ * With a profile: a point light's shape is the profile's rel (intensity / its largest), a
+ * spot's rel times its cone, an area light's A rel in place of A cos(theta_e) (gamma measured
+ * from the emitting side's normal; behind a one-sided emitter 0, a two-sided one mirrored). */
 double lr_light_shape(const lr_light *l, lr_vec3 dir);
+/* The profile's frame in world space (lr_light_profile_frame): x = C0, y = C90, z = nadir. */
+void lr_light_profile_axes(const lr_light *l, lr_vec3 *x, lr_vec3 *y, lr_vec3 *z);
+/* What the direct light per unit intensity depends on (not intensity, colour or flicker,
+ * which scale it): type, position, direction, edges, radius, sidedness, cone, and the
+ * profile's table and frame. The solvers' cache keys (receiver bounce, openings). */
+#define LR_LIGHT_KEY_N 20
+void lr_light_geometry_key(const lr_light *l, double k[LR_LIGHT_KEY_N]);
 /* Flicker at time t seconds: the factor on intensity (>= 0, mean 1) and the position offset
  * (mm). Deterministic in (seed, t): a sum of three sines at incommensurate multiples of
  * frequency_hz with seed-derived phases, so that replays and tests see the same flame. */

@@ -5,6 +5,7 @@
 #include "lib/material.glsl"
 #include "lib/random.glsl"
 #include "lib/gbuffer.glsl"
+#include "lib/profile.glsl"
 #include "lib/dgrid.glsl"
 
 in vec3 v_pos;
@@ -37,19 +38,34 @@ layout(location = 0) out vec4 o_B;
 layout(location = 1) out vec4 o_pos;
 layout(location = 2) out vec4 o_nrm;
 
+// A photometric profile (lib/profile.glsl): this light's planes at u_profile_light's rows,
+// in the frame (C0, C90, nadir).
+uniform bool u_profile_on;
+uniform int u_profile_light;
+uniform vec3 u_prof_x, u_prof_y, u_prof_z;
+
 // The light's angular profile along `dir` (from the light): lr_light_shape.
 float light_shape(vec3 dir)
 {
+    vec3 w = normalize(dir);
     if (u_light_type == LR_LIGHT_QUAD || u_light_type == LR_LIGHT_DISK) {
-        float c = dot(normalize(dir), u_area_n);
-        if (u_area_two_sided)
+        float c = dot(w, u_area_n);
+        if (u_profile_on) {
+            if (c < 0.0 && u_area_two_sided) { // the back face: the front's pattern mirrored
+                w -= 2.0 * c * u_area_n;
+                c = -c;
+            }
+            c = c > 0.0 ? lr_profile_rel_world(u_profile_light, w, u_prof_x, u_prof_y, u_prof_z)
+                        : 0.0;
+        } else if (u_area_two_sided)
             c = abs(c);
         return c > 0.0 ? u_area * c : 0.0;
     }
-    if (u_light_type != LR_LIGHT_SPOT)
-        return 1.0;
-    float c = dot(normalize(dir), u_light_dir);
-    return smoothstep(u_spot_cos.x, u_spot_cos.y, c);
+    float s = u_light_type == LR_LIGHT_SPOT ? smoothstep(u_spot_cos.x, u_spot_cos.y,
+                                                         dot(w, u_light_dir)) : 1.0;
+    if (u_profile_on && s > 0.0)
+        s *= lr_profile_rel_world(u_profile_light, w, u_prof_x, u_prof_y, u_prof_z);
+    return s;
 }
 
 #include "lib/sh_translucency.glsl"

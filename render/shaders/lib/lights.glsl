@@ -3,6 +3,7 @@
 // indexes sampler arrays with constant expressions only, so the per-light lookups below are
 // unrolled for LR_MAX_LIGHTS = 4 (render/passes/passes.h).
 #include "gbuffer_texel.glsl"
+#include "profile.glsl"
 
 #ifndef LR_MAX_LIGHTS
 #define LR_MAX_LIGHTS 4
@@ -25,6 +26,11 @@ uniform vec3 u_lights_I[LR_MAX_LIGHTS];                 // intensity per band (w
 uniform vec3 u_lights_area_n[LR_MAX_LIGHTS];
 uniform float u_lights_area[LR_MAX_LIGHTS];
 uniform bool u_lights_two_sided[LR_MAX_LIGHTS];
+// A photometric profile (lib/profile.glsl) in the frame (C0, C90, nadir): lr_light_shape.
+uniform bool u_lights_profile[LR_MAX_LIGHTS];
+uniform vec3 u_lights_prof_x[LR_MAX_LIGHTS];
+uniform vec3 u_lights_prof_y[LR_MAX_LIGHTS];
+uniform vec3 u_lights_prof_z[LR_MAX_LIGHTS];
 uniform int u_n_lights;
 
 vec4 lr_lights_cube_pos(int l, vec3 v)
@@ -103,13 +109,26 @@ float lr_lights_direct(int l, vec3 x, vec3 nx)
     if (!(c > 0.0) || !lr_lights_lit(l, x))
         return 0.0;
     float shape = 1.0;
+    vec3 w = -to_l * inversesqrt(d2); // the way the light travels to x
     if (lr_lights_is_area(l)) {
-        float ce = dot(-to_l, u_lights_area_n[l]) * inversesqrt(d2);
-        if (u_lights_two_sided[l])
+        float ce = dot(w, u_lights_area_n[l]);
+        if (u_lights_profile[l]) {
+            if (ce < 0.0 && u_lights_two_sided[l]) { // the back face: the front's pattern mirrored
+                w -= 2.0 * ce * u_lights_area_n[l];
+                ce = -ce;
+            }
+            ce = ce > 0.0 ? lr_profile_rel_world(l, w, u_lights_prof_x[l], u_lights_prof_y[l],
+                                                 u_lights_prof_z[l]) : 0.0;
+        } else if (u_lights_two_sided[l])
             ce = abs(ce);
         shape = ce > 0.0 ? u_lights_area[l] * ce : 0.0;
-    } else if (u_lights_type[l] == LR_LIGHT_SPOT)
-        shape = smoothstep(u_lights_spot_cos[l].x, u_lights_spot_cos[l].y,
-                           dot(-to_l, u_lights_dir[l]) * inversesqrt(d2));
+    } else {
+        if (u_lights_type[l] == LR_LIGHT_SPOT)
+            shape = smoothstep(u_lights_spot_cos[l].x, u_lights_spot_cos[l].y,
+                               dot(w, u_lights_dir[l]));
+        if (u_lights_profile[l] && shape > 0.0)
+            shape *= lr_profile_rel_world(l, w, u_lights_prof_x[l], u_lights_prof_y[l],
+                                          u_lights_prof_z[l]);
+    }
     return shape * c / d2;
 }
