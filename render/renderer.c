@@ -30,6 +30,7 @@ struct lr_renderer {
     lr_scene *scene;
     int width, height;
     bool no_vpl;
+    bool images_only; /* desc: no blend pass, the caller blends the per-light images */
     bool vpl_visibility;
     unsigned seed;
     const lr_gl_caps *caps;
@@ -254,6 +255,7 @@ static void blend_free(lr_renderer *r)
     lr_blend_destroy(r->blend);
     r->blend = NULL;
 }
+static bool blend_on(const lr_renderer *r) { return !r->images_only; }
 /* The per-light images weighted by intensity x colour x flicker (PIPELINE.md "Blend"). */
 static int blend_run(lr_renderer *r, unsigned dirty, lr_err *e)
 {
@@ -291,7 +293,8 @@ static const lr_pass_desc pass_table[LR_PASS_COUNT] = {
      surface_due, surface_run, cache_now},
     {"compose", LR_PASS_COMPOSE, D_VIEW, LR_PASS_BLEND, false, compose_alloc, compose_free,
      compose_due, compose_run, NULL},
-    {"blend", LR_PASS_BLEND, D_OUTPUT, 0, false, blend_alloc, blend_free, NULL, blend_run, NULL},
+    {"blend", LR_PASS_BLEND, D_OUTPUT, 0, false, blend_alloc, blend_free, NULL, blend_run,
+     blend_on},
 };
 
 const lr_pass_desc *lr_pass_table(void)
@@ -392,6 +395,7 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
     r->width = w;
     r->height = h;
     r->no_vpl = desc->no_vpl;
+    r->images_only = desc->images_only;
     r->vpl_visibility = desc->vpl_visibility;
     r->seed = desc->seed ? desc->seed : 1;
     r->caps = caps;
@@ -535,7 +539,9 @@ static int frames_target(const lr_renderer *r)
 
 bool lr_renderer_needs_frame(const lr_renderer *r)
 {
-    return r->dirty != 0 || r->rad.F < frames_target(r) || r->coarse;
+    /* images_only: what only the blend reads (D_OUTPUT over D_VIEW) is the caller's. */
+    unsigned d = r->images_only ? r->dirty & ~(unsigned)(D_OUTPUT & ~D_VIEW) : r->dirty;
+    return d != 0 || r->rad.F < frames_target(r) || r->coarse;
 }
 
 static bool resources_stale(const lr_renderer *r)
@@ -646,6 +652,9 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
 
 int lr_renderer_read_hdr(lr_renderer *r, float *rgb, lr_err *e)
 {
+    if (r->images_only)
+        return lr_err_set(e, LR_EINVAL, "renderer: made images_only (the caller blends "
+                          "lr_renderer_images): no output image of its own");
     if (!r->blend)
         return lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
     return lr_blend_read_hdr(r->blend, rgb, e);
@@ -653,6 +662,9 @@ int lr_renderer_read_hdr(lr_renderer *r, float *rgb, lr_err *e)
 
 int lr_renderer_read_rgba8(lr_renderer *r, unsigned char *out, lr_err *e)
 {
+    if (r->images_only)
+        return lr_err_set(e, LR_EINVAL, "renderer: made images_only (the caller blends "
+                          "lr_renderer_images): no output image of its own");
     if (!r->blend)
         return lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
     return lr_blend_read_rgba8(r->blend, out, e);
@@ -660,6 +672,9 @@ int lr_renderer_read_rgba8(lr_renderer *r, unsigned char *out, lr_err *e)
 
 int lr_renderer_present(lr_renderer *r, lr_err *e)
 {
+    if (r->images_only)
+        return lr_err_set(e, LR_EINVAL, "renderer: made images_only (the caller blends "
+                          "lr_renderer_images): no output image of its own");
     if (!r->blend)
         return lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
     return lr_blend_present(r->blend, e);

@@ -46,6 +46,9 @@ typedef struct lr_renderer_desc {
     unsigned seed;         /* base of the per-texel/map/frame sample seeds; 0 = 1 */
     bool half_maps;        /* RGBA16F radiosity maps even where RGBA32F blending exists (the
                             * fallback for drivers without EXT_float_blend; for its tests) */
+    bool images_only;      /* the caller blends lr_renderer_images itself (render/async): the
+                            * renderer never runs its own blend pass (the output image, 10-70 ms
+                            * a preview on the proxy), and read_hdr / read_rgba8 / present fail */
 } lr_renderer_desc;
 
 

@@ -378,7 +378,9 @@ static void *worker_main(void *arg)
         return NULL;
 
     lr_renderer_desc rd = {.gl = a->wgl, .scene = a->wscene, .width = a->width,
-                           .height = a->height, .no_vpl = a->no_vpl};
+                           .height = a->height, .no_vpl = a->no_vpl,
+                           /* The caller blends the published images (lr_async_blend). */
+                           .images_only = true};
     if ((rc = lr_renderer_create(&rd, &a->r, &e)))
         worker_fail(a, rc, &e);
     else

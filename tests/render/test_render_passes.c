@@ -251,6 +251,68 @@ static void test_new_settings_keep_the_bounce(void **state)
     lr_scene_destroy(s);
 }
 
+/* images_only (render/async's renderer): no frame runs the blend pass, the per-light images
+ * are the same numbers as a plain renderer's (same scene, size and seed: the passes before
+ * the blend are the same code; compared bit for bit), and the output readers refuse. */
+static void test_images_only_skips_the_blend(void **state)
+{
+    (void)state;
+    lr_scene *s = lr_test_scene("candle", lr_test_small_settings, NULL);
+    enum { W = 32, H = 24 };
+    lr_renderer_desc d = {.gl = gl, .scene = s, .width = W, .height = H, .seed = 5};
+    lr_renderer *plain = lr_test_renderer_desc(&d);
+    d.images_only = true;
+    lr_renderer *only = lr_test_renderer_desc(&d);
+    /* The tests' small settings converge in two frames (a restart, one accumulation). */
+    for (int f = 0; f < 2; f++) {
+        lr_frame_stats a = lr_test_frame(plain), b = lr_test_frame(only);
+        assert_true(a.passes & LR_PASS_BLEND);
+        assert_false(b.passes & LR_PASS_BLEND);
+        assert_int_equal(a.passes & ~(unsigned)LR_PASS_BLEND, b.passes);
+    }
+    /* A dimmer change is the caller's blend: nothing left for the renderer to do. */
+    lr_test_set(s, only, "light.intensity_cd", "1.5");
+    lr_test_set(s, plain, "light.intensity_cd", "1.5");
+    assert_true(lr_renderer_needs_frame(plain));
+    assert_false(lr_renderer_needs_frame(only));
+    float sc_a[LR_SCENE_MAX_LIGHTS], sc_b[LR_SCENE_MAX_LIGHTS];
+    int na = 0, nb = 0;
+    const lr_tex *ia = lr_renderer_images(plain, &na, sc_a);
+    const lr_tex *ib = lr_renderer_images(only, &nb, sc_b);
+    assert_non_null(ia);
+    assert_non_null(ib);
+    assert_int_equal(na, nb);
+    float *pa = malloc(sizeof(float) * 4 * W * H), *pb = malloc(sizeof(float) * 4 * W * H);
+    assert_non_null(pa);
+    assert_non_null(pb);
+    lr_err e = {0};
+    for (int l = 0; l < na; l++) {
+        assert_true(sc_a[l] == sc_b[l]);
+        lr_fb *fa, *fb;
+        lr_fb_desc da = {.color = {{(lr_tex *)ia, l}}}, db = {.color = {{(lr_tex *)ib, l}}};
+        assert_int_equal(lr_fb_create(gl, &da, &fa, &e), LR_OK);
+        assert_int_equal(lr_fb_create(gl, &db, &fb, &e), LR_OK);
+        assert_int_equal(lr_fb_read(fa, 0, 0, 0, W, H, pa, &e), LR_OK);
+        assert_int_equal(lr_fb_read(fb, 0, 0, 0, W, H, pb, &e), LR_OK);
+        double sum = 0.0;
+        for (int i = 0; i < 4 * W * H; i++) {
+            assert_true(pa[i] == pb[i]);
+            sum += pa[i];
+        }
+        assert_true(sum > 0.0);
+        lr_fb_destroy(fa);
+        lr_fb_destroy(fb);
+    }
+    free(pa);
+    free(pb);
+    float rgb[3 * W * H];
+    assert_int_equal(lr_renderer_read_hdr(only, rgb, &e), LR_EINVAL);
+    assert_non_null(strstr(e.msg, "images_only"));
+    lr_renderer_destroy(plain);
+    lr_renderer_destroy(only);
+    lr_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -258,6 +320,7 @@ int main(void)
         cmocka_unit_test(test_map_matrices_put_x_o_on_its_texel),
         cmocka_unit_test(test_vpls_are_stable),
         cmocka_unit_test(test_new_settings_keep_the_bounce),
+        cmocka_unit_test(test_images_only_skips_the_blend),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
