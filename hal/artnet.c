@@ -12,6 +12,7 @@
 
 #include "hal/artnet_packet.h"
 #include "hal/dmx_core.h"
+#include "hal/reply_limit.h"
 
 #define MS 1000000LL
 
@@ -50,6 +51,7 @@ struct lr_artnet {
     bool more;
     bool send_logged;
     uint64_t send_failures;
+    lr_reply_limit limit; /* ArtPollReply per poller and overall (reply_limit.h) */
 };
 
 static const char *const *result_names(void)
@@ -173,10 +175,18 @@ static void handle(lr_artnet *a, const uint8_t *buf, size_t len, const struct so
         dmx_core_put(&a->core, u, key, 0, -1, p.slots, p.n_slots, now_ns);
         return;
     }
-    case LR_ARTNET_POLL:
+    case LR_ARTNET_POLL: {
+        uint8_t key[LR_REPLY_LIMIT_KEY];
+        memcpy(key, &from->sin_addr, 4);
+        memcpy(key + 4, &from->sin_port, 2);
+        if (!lr_reply_limit_take(&a->limit, key, now_ns)) {
+            a->core.c.polls_limited++;
+            return;
+        }
         a->core.c.polls++;
         send_replies(a, from);
         return;
+    }
     case LR_ARTNET_OTHER:
         a->core.c.other++;
         return;
@@ -299,6 +309,7 @@ int lr_artnet_create(const lr_artnet_desc *desc, lr_artnet **out, lr_err *e)
     if (!a)
         return lr_err_set(e, LR_ENOMEM, "artnet: out of memory");
     a->fd = -1;
+    lr_reply_limit_init(&a->limit, 1000, 20.0, 20.0);
     int rc = lr_dev_init(&a->base, &ARTNET_OPS, &desc->dev, e);
     if (rc == LR_OK)
         rc = configure(a, desc, e);

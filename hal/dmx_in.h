@@ -61,6 +61,8 @@ typedef struct lr_dmx_counters {
     uint64_t losses;       /* universes that lost their last source */
     uint64_t polls;        /* Art-Net: ArtPoll answered */
     uint64_t replies;      /* Art-Net: ArtPollReply sent */
+    uint64_t polls_limited;/* Art-Net: ArtPoll left unanswered by the reply limit (a poller
+                            * answered under 1 s ago, or over 20 replies a second) */
     uint64_t bad;          /* malformed, all kinds */
     uint64_t bad_kind[LR_DMX_MAX_KINDS]; /* per parser result (lr_sacn_result, lr_artnet_result) */
     uint64_t events;       /* channel events emitted */

@@ -151,7 +151,7 @@ struct lr_rig {
 
 /* A console input's counters for the stats file (names: static strings, or the parsers'
  * result names behind "bad_"). */
-#define INPUT_COUNTERS_MAX (12 + LR_DMX_MAX_KINDS)
+#define INPUT_COUNTERS_MAX (13 + LR_DMX_MAX_KINDS)
 static int dmx_counters(const lr_dmx_counters *c, const char *(*kind_name)(int), int n_kinds,
                         lr_rig_stats_counter *out)
 {
@@ -161,6 +161,7 @@ static int dmx_counters(const lr_dmx_counters *c, const char *(*kind_name)(int),
         {"", "full", c->full},             {"", "preview", c->preview},
         {"", "terminated", c->terminated}, {"", "losses", c->losses},
         {"", "polls", c->polls},           {"", "replies", c->replies},
+        {"", "polls_limited", c->polls_limited},
         {"", "events", c->events},         {"", "bad", c->bad},
     };
     int n = 0;

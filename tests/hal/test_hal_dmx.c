@@ -459,6 +459,34 @@ static void artnet_merge_and_poll(void **state)
     lr_artnet_get_counters(a, &c);
     assert_int_equal(c.polls, 1);
     assert_int_equal(c.replies, 2);
+    /* A flood of ArtPolls from the same poller within a second: left unanswered (the reply
+     * limit, hal/reply_limit.h), counted; another poller is still answered; the first one
+     * again a second later. */
+    n = lr_test_artpoll_build(b);
+    for (int k = 0; k < 50; k++)
+        lr_test_udp_send(tx3, 15510, b, n);
+    sent += 50;
+    pump(d, T0 + 3 * S + S / 2, sent);
+    lr_test_udp_send(tx2, 15510, b, n);
+    pump(d, T0 + 3 * S + S / 2, ++sent);
+    lr_artnet_get_counters(a, &c);
+    assert_int_equal(c.polls_limited, 50);
+    assert_int_equal(c.polls, 2);
+    assert_int_equal(c.replies, 4);
+    lr_test_udp_send(tx3, 15510, b, n);
+    pump(d, T0 + 4 * S + S / 10, ++sent);
+    lr_artnet_get_counters(a, &c);
+    assert_int_equal(c.polls, 3);
+    assert_int_equal(c.polls_limited, 50);
+    for (int k = 0; k < 2; k++) { /* drain tx2's and tx3's replies */
+        int fd = k ? tx3 : tx2;
+        struct pollfd p = {.fd = fd, .events = POLLIN};
+        while (poll(&p, 1, 50) == 1) {
+            uint8_t rep[600];
+            if (recv(fd, rep, sizeof rep, 0) <= 0)
+                break;
+        }
+    }
     /* The 10 s merge timeout: both senders of port-address 0 gone at 12 s, hold. */
     lr_dev_dispatch(d, T0 + 12 * S);
     lr_artnet_get_counters(a, &c);

@@ -10,6 +10,7 @@
 #include <cmocka.h>
 
 #include "hal/dmx_merge.h"
+#include "hal/reply_limit.h"
 
 #define MS 1000000LL
 #define S (1000 * MS)
@@ -156,6 +157,50 @@ static void artnet_htp_ltp(void **state)
     assert_int_equal(slot(&m, 1), 60);
 }
 
+/* The ArtPollReply limit (hal/reply_limit.h): one reply per poller per second; over all
+ * pollers a bucket of 20 refilled at 20 a second, so 40 distinct pollers at once get 20
+ * replies, half a second later 10 more. */
+static void reply_limit(void **state)
+{
+    (void)state;
+    lr_reply_limit l;
+    lr_reply_limit_init(&l, 1000, 20.0, 20.0);
+    uint8_t k[LR_REPLY_LIMIT_KEY] = {127, 0, 0, 1, 0, 0};
+    int64_t t = 100 * S;
+    assert_true(lr_reply_limit_take(&l, k, t));
+    assert_false(lr_reply_limit_take(&l, k, t + S / 2));
+    assert_false(lr_reply_limit_take(&l, k, t + S - 1));
+    assert_true(lr_reply_limit_take(&l, k, t + S));
+    t += 10 * S; /* the bucket full again */
+    int answered = 0;
+    for (int i = 0; i < 40; i++) {
+        k[5] = (uint8_t)(i + 1);
+        answered += lr_reply_limit_take(&l, k, t);
+    }
+    assert_int_equal(answered, 20);
+    answered = 0;
+    for (int i = 20; i < 40; i++) {
+        k[5] = (uint8_t)(i + 1);
+        answered += lr_reply_limit_take(&l, k, t + S / 2);
+    }
+    assert_int_equal(answered, 10);
+    /* 16 pollers are remembered: the 17th replaces the least recently answered, which is
+     * then answered again inside its second (a reply more, never a controller lost). */
+    t += 20 * S;
+    for (int j = 0; j < 16; j++) {
+        k[5] = (uint8_t)(101 + j);
+        assert_true(lr_reply_limit_take(&l, k, t + j * MS));
+    }
+    k[5] = 101;
+    assert_false(lr_reply_limit_take(&l, k, t + 20 * MS));
+    k[5] = 117;
+    assert_true(lr_reply_limit_take(&l, k, t + 21 * MS));
+    k[5] = 101;
+    assert_true(lr_reply_limit_take(&l, k, t + 22 * MS));
+    k[5] = 103;
+    assert_false(lr_reply_limit_take(&l, k, t + 23 * MS));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -163,6 +208,7 @@ int main(void)
         cmocka_unit_test(sequence_window),
         cmocka_unit_test(loss_and_termination),
         cmocka_unit_test(artnet_htp_ltp),
+        cmocka_unit_test(reply_limit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
