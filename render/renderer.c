@@ -31,6 +31,9 @@ struct lr_renderer {
     int width, height;
     bool no_vpl;
     bool images_only; /* desc: no blend pass, the caller blends the per-light images */
+    /* GPU memory (lr_gl_memory): the context's count when the renderer was made, what it has
+     * gained since (the renderer's textures and renderbuffers), and the desc's budget. */
+    size_t gpu_base, gpu_bytes, gpu_budget;
     bool vpl_visibility;
     unsigned seed;
     const lr_gl_caps *caps;
@@ -343,6 +346,23 @@ static int settings_check(const lr_renderer *r, const lr_render_settings *rs, lr
     return LR_OK;
 }
 
+/* The renderer's GPU memory now, against the budget: a board's GPU shares its RAM, so settings
+ * that would take more than the rig allows are refused with what they need. */
+static int check_memory(lr_renderer *r, lr_err *e)
+{
+    size_t now;
+    lr_gl_memory(r->gl, &now, NULL);
+    r->gpu_bytes = now > r->gpu_base ? now - r->gpu_base : 0;
+    if (!r->gpu_budget || r->gpu_bytes <= r->gpu_budget)
+        return LR_OK;
+    return lr_err_set(e, LR_ENOMEM, "renderer: the settings need %.1f MB of GPU memory (render.K "
+                      "%d maps of %d^2 per light, G-buffers %d^2, VPL maps %d^2, %d lights, "
+                      "%dx%d output), over the budget of %.1f MB (gpu_memory_mb)",
+                      r->gpu_bytes / 1048576.0, r->rs.K, r->rs.map_size, r->rs.gbuffer_size,
+                      r->rs.vpl_map_size, r->n_lights, r->width, r->height,
+                      r->gpu_budget / 1048576.0);
+}
+
 static int alloc_resources(lr_renderer *r, lr_err *e)
 {
     free_resources(r);
@@ -358,6 +378,8 @@ static int alloc_resources(lr_renderer *r, lr_err *e)
     for (int i = 0; i < LR_PASS_COUNT && !rc; i++)
         if (pass_table[i].alloc)
             rc = pass_table[i].alloc(r, e);
+    if (!rc)
+        rc = check_memory(r, e);
     if (rc) {
         free_resources(r);
         return rc;
@@ -396,6 +418,8 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
     r->height = h;
     r->no_vpl = desc->no_vpl;
     r->images_only = desc->images_only;
+    lr_gl_memory(desc->gl, &r->gpu_base, NULL);
+    r->gpu_budget = (size_t)(desc->gpu_budget_mb * 1048576.0);
     r->vpl_visibility = desc->vpl_visibility;
     r->seed = desc->seed ? desc->seed : 1;
     r->caps = caps;
@@ -639,6 +663,10 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e)
     r->dirty = 0;
     /* A restart this frame may have found the maps deterministic: the target after it. */
     r->rs.frames = frames_target(r);
+    /* Passes that make their textures at their first run (grids, LPV) count too. */
+    if ((rc = check_memory(r, e)))
+        return rc;
+    st.gpu_bytes = r->gpu_bytes;
     st.index = r->frame_index++;
     st.passes = passes;
     st.samples = r->rad.F;
@@ -679,6 +707,8 @@ int lr_renderer_present(lr_renderer *r, lr_err *e)
         return lr_err_set(e, LR_EINVAL, "renderer: no image (resources failed to allocate)");
     return lr_blend_present(r->blend, e);
 }
+
+size_t lr_renderer_gpu_bytes(const lr_renderer *r) { return r->gpu_bytes; }
 
 const lr_tex *lr_renderer_images(const lr_renderer *r, int *n, float *scale)
 {

@@ -49,6 +49,10 @@ typedef struct lr_renderer_desc {
     bool images_only;      /* the caller blends lr_renderer_images itself (render/async): the
                             * renderer never runs its own blend pass (the output image, 10-70 ms
                             * a preview on the proxy), and read_hdr / read_rgba8 / present fail */
+    /* > 0: the most GPU memory (MB: textures and renderbuffers, lr_gl_memory) the renderer
+     * may take; settings that need more are refused at create or at the frame that applies
+     * them (LR_ENOMEM, naming what they need). 0: no limit. */
+    double gpu_budget_mb;
 } lr_renderer_desc;
 
 
@@ -64,6 +68,7 @@ typedef struct lr_frame_stats {
      * cannot change the image (render/README.md, "When accumulation stops"). */
     bool deterministic;
     double time_s;               /* the clock the frame was composed at (0 without one) */
+    size_t gpu_bytes;            /* lr_renderer_gpu_bytes after the frame */
 } lr_frame_stats;
 
 int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *e);
@@ -109,6 +114,10 @@ int lr_renderer_read_hdr(lr_renderer *r, float *rgb, lr_err *e);
 int lr_renderer_read_rgba8(lr_renderer *r, unsigned char *rgba, lr_err *e);
 /* Draws the last frame to the context's default framebuffer (projector) and presents it. */
 int lr_renderer_present(lr_renderer *r, lr_err *e);
+
+/* The GPU memory (bytes) the renderer holds: what its context's textures and renderbuffers
+ * (lr_gl_memory) gained since it was made, measured at each allocation and frame. */
+size_t lr_renderer_gpu_bytes(const lr_renderer *r);
 
 /* The per-light images of the last composition (render/passes/compose.h): a 2D array of
  * *n layers, layer l holding scale[l] times light l's unit-intensity linear radiance (the

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 
 #include "firmware/commands/commands.h"
 #include "firmware/plan_scene.h"
@@ -38,6 +39,7 @@ static const lr_argspec opts[] = {
      .help = "linear RGB radiance, W/(mm^2 sr), PFM"},
     {.name = "--stats", .type = LR_ARG_PATH, .metavar = "F.json", .flags = LR_ARG_OUTPUT,
      .help = "{\"scene\",\"width\",\"height\",\"uncovered_pixels\",\"renderer\",\n"
+             "\"gpu_mb\",\"peak_rss_mb\",\n"
              "\"settings\",\"frames\":[{\"index\",\n"
              "\"passes\":[...],\"ms\":{pass:ms},\"total_ms\",\"samples\",\n"
              "\"converged\",\"time_s\"},...]}"},
@@ -222,6 +224,12 @@ static int write_stats(const char *path, const lr_scene *scene, lr_renderer *r,
     lr_jw_int(jw, "height", h);
     lr_jw_int(jw, "uncovered_pixels", uncovered);
     lr_jw_string(jw, "renderer", lr_renderer_info(r));
+    /* Memory: the renderer's textures and renderbuffers (lr_renderer_gpu_bytes) and the
+     * process's peak resident set (getrusage: the CPU solvers, meshes, BVHs, llvmpipe). */
+    struct rusage ru;
+    lr_jw_number(jw, "gpu_mb", lr_renderer_gpu_bytes(r) / 1048576.0);
+    if (getrusage(RUSAGE_SELF, &ru) == 0)
+        lr_jw_number(jw, "peak_rss_mb", ru.ru_maxrss / 1024.0);
     lr_jw_object(jw, "settings");
     lr_jw_int(jw, "K", rs->K);
     lr_jw_int(jw, "N", rs->N);

@@ -1129,11 +1129,13 @@ static int parse_root(ctx *x)
     c->output.width = 640;
     c->output.height = 480;
     c->output.fps = 30;
+    /* A quarter of a 4 GB board, whose GPU shares the RAM: the shipped rigs need 10-60 MB. */
+    c->output.gpu_memory_mb = 1024;
     lr_jnode out = lr_json_get(j, root, "output");
     if (out != LR_JNONE) {
         static const char *const ok[] = {"mode", "connector", "drm_device", "mode_size",
                                          "refresh_hz", "width", "height", "fps", "renderer",
-                                         NULL};
+                                         "gpu_memory_mb", NULL};
         /* "mode" is headless|kms; the display mode size is "mode_size": [W, H]. */
         if ((rc = keys(x, out, "output", ok)))
             return rc;
@@ -1168,6 +1170,8 @@ static int parse_root(ctx *x)
             (rc = get_int_in(x, out, "output", "width", false, 16, 8192, &c->output.width)) ||
             (rc = get_int_in(x, out, "output", "height", false, 16, 8192, &c->output.height)) ||
             (rc = get_num_in(x, out, "output", "fps", false, 0.1, 1000, &c->output.fps)) ||
+            (rc = get_num_in(x, out, "output", "gpu_memory_mb", false, 0, 1048576,
+                             &c->output.gpu_memory_mb)) ||
             (rc = get_str(x, out, "output", "renderer", false, c->output.renderer,
                           sizeof c->output.renderer)))
             return rc;

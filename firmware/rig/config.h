@@ -16,7 +16,9 @@
  *                "mode_size": [W, H] (kms; default the preferred mode), "refresh_hz": 0,
  *                "width": 640, "height": 480 (headless image size),
  *                "fps": 30 (headless frame rate cap; kms follows vsync),
- *                "renderer": "passes" | "preview" (default: the first one built in)}
+ *                "renderer": "passes" | "preview" (default: the first one built in),
+ *                "gpu_memory_mb": 1024 (the renderer's textures at most: settings that need
+ *                more are refused with what they need; 0: no limit)}
  *   "safe_level": 0                    lamp-driver level (0..1, as written to the driver,
  *                                      after any curve) set at shutdown
  *   "stats":    {"path": "PATH" (default none), "period_s": 10 (0: only at exit)}
@@ -265,6 +267,7 @@ typedef struct lr_rig_config {
         int width, height;
         double fps;
         char renderer[LR_RIG_NAME_MAX]; /* "" = default */
+        double gpu_memory_mb;           /* the renderer's GPU memory budget; 0: none */
     } output;
     double safe_level;
     char stats_path[LR_RIG_PATH_MAX];

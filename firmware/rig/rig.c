@@ -562,7 +562,7 @@ static int view_build(lr_rig *r, lr_scene *scene, bool no_vpl, lr_rig_view **out
     const lr_rig_config *c = r->set.cfg;
     lr_rig_view_desc vd = {.name = c->output.renderer, .gl = r->gl, .scene = scene,
                            .width = c->output.width, .height = c->output.height,
-                           .no_vpl = no_vpl};
+                           .no_vpl = no_vpl, .gpu_budget_mb = c->output.gpu_memory_mb};
     if (r->kms)
         lr_gl_size(r->gl, &vd.width, &vd.height);
     return lr_rig_view_create(&vd, out, e);

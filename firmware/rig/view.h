@@ -37,6 +37,7 @@ typedef struct lr_rig_view_desc {
     int width, height;
     bool no_vpl;      /* "passes": skip the VPL pass (the planner found no receiver in sight) */
     bool no_preview;  /* "passes": no coarse preview stage after a change */
+    double gpu_budget_mb; /* the renderer's GPU memory budget (output.gpu_memory_mb); 0: none */
 } lr_rig_view_desc;
 
 /* Comma-separated names of the back ends built in, default first. */

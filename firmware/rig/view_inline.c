@@ -9,7 +9,8 @@ static int v_create(const lr_rig_view_desc *d, void **impl, lr_err *e)
     if (!d->gl)
         return lr_err_set(e, LR_EINVAL, "renderer 'passes' needs a GL context");
     lr_renderer_desc rd = {.gl = d->gl, .scene = d->scene, .width = d->width,
-                           .height = d->height, .no_vpl = d->no_vpl};
+                           .height = d->height, .no_vpl = d->no_vpl,
+                           .gpu_budget_mb = d->gpu_budget_mb};
     lr_renderer *r;
     int rc = lr_renderer_create(&rd, &r, e);
     if (rc)

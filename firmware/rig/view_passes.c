@@ -30,7 +30,8 @@ static int v_create(const lr_rig_view_desc *d, void **impl, lr_err *e)
     if (!d->gl)
         return lr_err_set(e, LR_EINVAL, "renderer 'passes' needs a GL context");
     lr_async_desc ad = {.gl = d->gl, .scene = d->scene, .width = d->width,
-                        .height = d->height, .no_vpl = d->no_vpl};
+                        .height = d->height, .no_vpl = d->no_vpl,
+                        .gpu_budget_mb = d->gpu_budget_mb};
     char model_sets[LR_ASYNC_MAX_PREVIEW - N_PREVIEW][128];
     if (!d->no_preview) {
         for (int i = 0; i < N_PREVIEW; i++)

@@ -76,6 +76,7 @@ struct lr_async {
     int n_preview;
     unsigned no_preview_dirty;
     bool preview_always;
+    double gpu_budget_mb;
 
     /* ---- shared, under mu ---- */
     pthread_mutex_t mu;
@@ -380,7 +381,7 @@ static void *worker_main(void *arg)
     lr_renderer_desc rd = {.gl = a->wgl, .scene = a->wscene, .width = a->width,
                            .height = a->height, .no_vpl = a->no_vpl,
                            /* The caller blends the published images (lr_async_blend). */
-                           .images_only = true};
+                           .images_only = true, .gpu_budget_mb = a->gpu_budget_mb};
     if ((rc = lr_renderer_create(&rd, &a->r, &e)))
         worker_fail(a, rc, &e);
     else
@@ -594,6 +595,7 @@ int lr_async_create(const lr_async_desc *d, lr_async **out, lr_err *e)
     a->no_vpl = d->no_vpl;
     a->no_preview_dirty = d->no_preview_dirty;
     a->preview_always = d->preview_always;
+    a->gpu_budget_mb = d->gpu_budget_mb;
     a->shown = a->ready = -1;
     a->efd = -1;
     pthread_mutex_init(&a->mu, NULL);

@@ -87,6 +87,7 @@ typedef struct lr_async_desc {
      * (both dominated by a CPU solve the preview settings do not shrink) only delays the
      * image: it is skipped until a full frame gets dearer again. true: always drawn. */
     bool preview_always;
+    double gpu_budget_mb; /* the worker's renderer's (lr_renderer_desc); 0: no limit */
 } lr_async_desc;
 
 typedef struct lr_async_frame_stats {

@@ -107,6 +107,24 @@ void lr_gl_destroy(lr_gl *gl)
 }
 
 const lr_gl_caps *lr_gl_caps_get(const lr_gl *gl) { return &gl->caps; }
+
+void lr_gl__mem_add(lr_gl *gl, long long delta)
+{
+    if (delta < 0 && (size_t)-delta > gl->mem_bytes)
+        gl->mem_bytes = 0; /* not reached: every free follows its own make */
+    else
+        gl->mem_bytes = (size_t)((long long)gl->mem_bytes + delta);
+    if (gl->mem_bytes > gl->mem_peak)
+        gl->mem_peak = gl->mem_bytes;
+}
+
+void lr_gl_memory(const lr_gl *gl, size_t *bytes, size_t *peak)
+{
+    if (bytes)
+        *bytes = gl->mem_bytes;
+    if (peak)
+        *peak = gl->mem_peak;
+}
 lr_gl_backend lr_gl_backend_of(const lr_gl *gl) { return gl->backend; }
 const char *lr_gl_backend_name(const lr_gl *gl) { return gl->ops->name; }
 

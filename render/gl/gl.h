@@ -32,6 +32,7 @@
 #define LR_GL_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "render/base/err.h"
@@ -107,6 +108,10 @@ int lr_gl_create_shared(lr_gl *parent, lr_gl **out, lr_err *e);
 void lr_gl_destroy(lr_gl *gl);
 
 const lr_gl_caps *lr_gl_caps_get(const lr_gl *gl);
+/* The storage (bytes) of the textures and renderbuffers made through render/gl/tex.h on this
+ * context, now and at its most: what the renderer's settings cost in GPU memory (a driver
+ * adds its own alignment and bookkeeping; shader code and vertex buffers are not counted). */
+void lr_gl_memory(const lr_gl *gl, size_t *bytes, size_t *peak);
 lr_gl_backend lr_gl_backend_of(const lr_gl *gl);
 /* "surfaceless" or "kms". */
 const char *lr_gl_backend_name(const lr_gl *gl);

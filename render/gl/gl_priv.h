@@ -35,7 +35,13 @@ struct lr_gl {
     /* lr_gl_create_shared: a second context on the parent's display; destroying it leaves
      * the display and the back end to the parent. */
     bool shared;
+    /* Storage of the textures and renderbuffers made through tex.h on this context
+     * (lr_gl_memory), now and at its most. */
+    size_t mem_bytes, mem_peak;
 };
+
+/* tex.c: a texture's or renderbuffer's storage made (delta > 0) or freed. */
+void lr_gl__mem_add(lr_gl *gl, long long delta);
 
 /* Back-end constructors: fill gl->ops, gl->be, gl->dpy/config/surface/size and create the
  * context with lr_gl__egl_context. On failure they leave what they made for lr_gl_destroy. */

@@ -1,10 +1,14 @@
 /* lamprig — textures, framebuffers and float readback. */
 #include "render/gl/tex.h"
 
+#include "render/gl/gl_priv.h"
+
 #include <stdio.h>
 #include <stdlib.h>
 
 struct lr_tex {
+    lr_gl *gl;    /* whose memory count holds `bytes` (lr_gl_memory) */
+    size_t bytes; /* storage: width x height x layers x the format's texel size */
     GLuint id;
     GLenum target;
     lr_tex_format format;
@@ -13,6 +17,8 @@ struct lr_tex {
 };
 
 struct lr_fb {
+    lr_gl *gl;
+    size_t rb_bytes; /* the depth renderbuffer of our own (4 bytes a pixel) */
     GLuint id, depth_rb;
     int width, height;
     int ncolor;
@@ -27,21 +33,22 @@ struct lr_fb {
 static const struct format_info {
     GLenum internal, format, type; /* internal format; upload format/type */
     int channels;
+    int texel_bytes; /* storage per texel (what lr_gl_memory counts) */
     bool is_float, is_depth, is_32f;
     unsigned need;                 /* enum lr_gl_need to render into it */
     const char *name;
 } formats[] = {
-    [LR_TEX_RGBA32F] = {GL_RGBA32F, GL_RGBA, GL_FLOAT, 4, true, false, true, LR_GL_NEED_FLOAT_RT,
+    [LR_TEX_RGBA32F] = {GL_RGBA32F, GL_RGBA, GL_FLOAT, 4, 16, true, false, true, LR_GL_NEED_FLOAT_RT,
                         "RGBA32F"},
-    [LR_TEX_RGBA16F] = {GL_RGBA16F, GL_RGBA, GL_FLOAT, 4, true, false, false,
+    [LR_TEX_RGBA16F] = {GL_RGBA16F, GL_RGBA, GL_FLOAT, 4, 8, true, false, false,
                         LR_GL_NEED_HALF_FLOAT_RT, "RGBA16F"},
-    [LR_TEX_R32F] = {GL_R32F, GL_RED, GL_FLOAT, 1, true, false, true, LR_GL_NEED_FLOAT_RT, "R32F"},
-    [LR_TEX_RGBA8] = {GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, 4, false, false, false, 0, "RGBA8"},
-    [LR_TEX_DEPTH32F] = {GL_DEPTH_COMPONENT32F, GL_DEPTH_COMPONENT, GL_FLOAT, 1, false, true, true, 0,
+    [LR_TEX_R32F] = {GL_R32F, GL_RED, GL_FLOAT, 1, 4, true, false, true, LR_GL_NEED_FLOAT_RT, "R32F"},
+    [LR_TEX_RGBA8] = {GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, 4, 4, false, false, false, 0, "RGBA8"},
+    [LR_TEX_DEPTH32F] = {GL_DEPTH_COMPONENT32F, GL_DEPTH_COMPONENT, GL_FLOAT, 1, 4, false, true, true, 0,
                          "DEPTH32F"},
-    [LR_TEX_DEPTH24] = {GL_DEPTH_COMPONENT24, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, 1, false, true,
+    [LR_TEX_DEPTH24] = {GL_DEPTH_COMPONENT24, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, 1, 4, false, true,
                         false, 0, "DEPTH24"},
-    [LR_TEX_SRGB8_ALPHA8] = {GL_SRGB8_ALPHA8, GL_RGBA, GL_UNSIGNED_BYTE, 4, false, false, false,
+    [LR_TEX_SRGB8_ALPHA8] = {GL_SRGB8_ALPHA8, GL_RGBA, GL_UNSIGNED_BYTE, 4, 4, false, false, false,
                              LR_GL_NEED_SRGB_DECODE, "SRGB8_ALPHA8"},
 };
 
@@ -109,6 +116,9 @@ int lr_tex_create(lr_gl *gl, const lr_tex_desc *d, lr_tex **out, lr_err *e)
         lr_tex_destroy(t);
         return rc;
     }
+    t->gl = gl;
+    t->bytes = (size_t)w * (size_t)h * (size_t)layers * (size_t)f->texel_bytes;
+    lr_gl__mem_add(gl, (long long)t->bytes);
     *out = t;
     return LR_OK;
 }
@@ -118,6 +128,8 @@ void lr_tex_destroy(lr_tex *t)
     if (!t)
         return;
     glDeleteTextures(1, &t->id);
+    if (t->gl)
+        lr_gl__mem_add(t->gl, -(long long)t->bytes);
     free(t);
 }
 
@@ -256,6 +268,9 @@ int lr_fb_create(lr_gl *gl, const lr_fb_desc *d, lr_fb **out, lr_err *e)
         glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
         glBindRenderbuffer(GL_RENDERBUFFER, 0);
         glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, fb->depth_rb);
+        fb->gl = gl;
+        fb->rb_bytes = (size_t)w * (size_t)h * 4;
+        lr_gl__mem_add(gl, (long long)fb->rb_bytes);
     }
     GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -277,6 +292,8 @@ void lr_fb_destroy(lr_fb *fb)
     glDeleteFramebuffers(1, &fb->id);
     if (fb->depth_rb)
         glDeleteRenderbuffers(1, &fb->depth_rb);
+    if (fb->gl)
+        lr_gl__mem_add(fb->gl, -(long long)fb->rb_bytes);
     free(fb);
 }
 

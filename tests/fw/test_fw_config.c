@@ -57,6 +57,8 @@ static void test_bad_fields_named(void **state)
         {"{\"scene\": \"candle.json\",\n \"sceen\": 1}",
          "rig.json:2: field 'sceen': unknown field"},
         {"{\"devices\": []}", "rig.json:1: field 'scene': required field is missing"},
+        {"{\"scene\": \"candle.json\",\n \"output\": {\"gpu_memory_mb\": -5}}",
+         "rig.json:2: field 'output.gpu_memory_mb': must be in 0..1.04858e+06, got -5"},
         {"{\"scene\": \"nope.json\"}", "rig.json:1: field 'scene': '%D/nope.json': No such file "
                                        "or directory"},
         {"{\"scene\": \"candle.json\",\n \"devices\": [\n  {\"type\": \"serial\"}]}",
@@ -182,7 +184,7 @@ static void test_control_map_file_errors(void **state)
     const struct { const char *file, *msg; } cases[] = {
         {"a.json", "controls/a.json:3: field 'controls[0].param': light.nope: a point light has "
                    "no parameter 'nope' (known: intensity, intensity_cd, flux_lm, color, "
-                   "color_temperature_k, position, flicker.{amplitude, "
+                   "color_temperature_k, position, direction, profile_c0, flicker.{amplitude, "
                    "frequency_hz, jitter_mm, seed})"},
         {"b.json", "controls/b.json:3: field 'controls[0].step': must be in 1e-06..1, got 0"},
         {"c.json", "controls/c.json:1: field 'bindings': unknown field"},
@@ -267,6 +269,7 @@ static void test_shipped_rigs(void **state)
     assert_true(c->devices[0].loop);
     assert_int_equal(c->n_bindings, 6);
     assert_int_equal(c->output.mode, LR_RIG_HEADLESS);
+    assert_true(c->output.gpu_memory_mb == 1024); /* the default: a quarter of a 4 GB board */
     lr_scene *s;
     if (lr_scene_load(c->scene, NULL, &s, &e))
         fail_msg("%s", e.msg);

@@ -76,7 +76,7 @@ static void check_usage_error(const char *tool, const char *args, const char *co
 /* The sections tools/bench/README.md documents and `make bench` runs. */
 static const char *const bench_sections[] = {"optics", "cpu",    "render", "rig",
                                              "sweep",  "models", "dimmer", "camera",
-                                             "console", NULL};
+                                             "console", "memory", NULL};
 
 static void test_bench(void **state)
 {

@@ -313,6 +313,57 @@ static void test_images_only_skips_the_blend(void **state)
     lr_scene_destroy(s);
 }
 
+/* GPU memory (lr_renderer_gpu_bytes, lr_gl_memory; the renderer's budget): what the renderer
+ * holds is what its context's count gained, at least the light G-buffer's storage (per
+ * light: two RGBA32F cube maps and two 2D maps of gbuffer_size^2, and seven 4-byte depth
+ * renderbuffers), and all of it is given back at destroy (the count returns exactly). A
+ * budget under the need refuses the renderer naming the need and gpu_memory_mb; a budget
+ * above it lets it run, and a settings change that passes it fails the frame that applies it. */
+static void test_gpu_memory_budget(void **state)
+{
+    (void)state;
+    lr_scene *s = lr_test_scene("candle", lr_test_small_settings, NULL);
+    size_t before, after, peak;
+    lr_gl_memory(gl, &before, NULL);
+    lr_renderer_desc d = {.gl = gl, .scene = s, .width = 32, .height = 24};
+    lr_renderer *r = lr_test_renderer_desc(&d);
+    lr_frame_stats st = lr_test_frame(r);
+    size_t need = lr_renderer_gpu_bytes(r), n = 64;
+    lr_gl_memory(gl, &after, &peak);
+    assert_int_equal(need, after - before);
+    assert_int_equal(st.gpu_bytes, need);
+    size_t gbuffer = 2 * 6 * n * n * 16 + 2 * n * n * 16 + 7 * n * n * 4;
+    assert_true(need >= gbuffer);
+    printf("candle at the tests' settings: %.2f MB (G-buffer %.2f MB), context peak %.2f MB\n",
+           need / 1048576.0, gbuffer / 1048576.0, peak / 1048576.0);
+    lr_renderer_destroy(r);
+    lr_gl_memory(gl, &after, NULL);
+    assert_int_equal(after, before);
+
+    lr_renderer *no = NULL;
+    lr_err e = {0};
+    /* Under what create itself allocates (the G-buffer; grids come at the first frame). */
+    d.gpu_budget_mb = gbuffer / 1048576.0 * 0.5;
+    assert_int_equal(lr_renderer_create(&d, &no, &e), LR_ENOMEM);
+    assert_null(no);
+    assert_non_null(strstr(e.msg, "gpu_memory_mb"));
+    assert_non_null(strstr(e.msg, "MB of GPU memory"));
+    lr_gl_memory(gl, &after, NULL);
+    assert_int_equal(after, before);
+
+    d.gpu_budget_mb = need / 1048576.0 * 1.5;
+    r = lr_test_renderer_desc(&d);
+    lr_test_frame(r);
+    lr_test_set(s, r, "render.gbuffer_size", "256"); /* 16 x the G-buffer: over 1.5 x */
+    e = (lr_err){0};
+    assert_int_equal(lr_renderer_frame(r, NULL, &e), LR_ENOMEM);
+    assert_non_null(strstr(e.msg, "G-buffers 256^2"));
+    lr_renderer_destroy(r);
+    lr_gl_memory(gl, &after, NULL);
+    assert_int_equal(after, before);
+    lr_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -321,6 +372,7 @@ int main(void)
         cmocka_unit_test(test_vpls_are_stable),
         cmocka_unit_test(test_new_settings_keep_the_bounce),
         cmocka_unit_test(test_images_only_skips_the_blend),
+        cmocka_unit_test(test_gpu_memory_budget),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

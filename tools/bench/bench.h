@@ -31,6 +31,7 @@ extern const lrb_section lrb_models_section;
 extern const lrb_section lrb_dimmer_section;
 extern const lrb_section lrb_camera_section;
 extern const lrb_section lrb_console_section;
+extern const lrb_section lrb_memory_section;
 
 /* Shared timing helpers (timing.c). */
 

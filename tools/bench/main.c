@@ -23,6 +23,7 @@ static const lrb_section *const sections[] = {
     &lrb_dimmer_section,
     &lrb_camera_section,
     &lrb_console_section,
+    &lrb_memory_section,
 };
 #define NSECTIONS (sizeof sections / sizeof sections[0])
 
