@@ -131,8 +131,9 @@ static int write_cfg(const char *configs, const char *path, const int port[3])
 
 /* Whether the rig's log has the line it writes once every device is open ("config PATH: scene
  * .., N devices, .."): before it the inputs' sockets are not bound, and a packet sent then is
- * lost without a trace. A fixed start-up wait (4 s) lost the first move of each input beside
- * two busy loops, where the start-up took longer. */
+ * lost without a trace. The start-up (plan, first view) takes 4-5 s idle and half a minute
+ * beside two busy loops; a fixed 4 s wait lost the first moves of every input, and all of
+ * them when the start-up ran past the 24 s run. */
 static bool rig_ready(const char *log)
 {
     FILE *f = fopen(log, "r");
@@ -224,6 +225,9 @@ static int measure(const char *lamprig, const char *cfg, const char *stats, cons
             busy);
     char *argv[] = {(char *)lamprig, "run", "--config", (char *)cfg, "--headless",
                     "--duration", dur, "--stats", (char *)stats, NULL};
+    /* The log of the run before would read as ready at once. */
+    unlink(log);
+    unlink(stats);
     pid_t pid = lrb_spawn(argv, log);
     double waited = 0;
     for (; pid > 0 && waited < READY_S && !rig_ready(log); waited += 0.05)
