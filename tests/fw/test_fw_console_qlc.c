@@ -158,16 +158,20 @@ static int peer_teardown(void **state)
 }
 
 /* Runs the rig until the dimmer's intensity is `want` and the lamp's register `raw`, or
- * guard_ms; the times (ms from t0) of the first reaching each, -1 when not reached. */
+ * guard_ms; the times (ms from t0) of the intensity's first change (the fade's first step:
+ * the control latency itself) and of reaching each, -1 when not reached. */
 static void run_to(lr_rig *r, lr_test_mb_server *mb, double want, int raw, int64_t t0,
-                   int guard_ms, double *t_render, double *t_lamp)
+                   int guard_ms, double *t_first, double *t_render, double *t_lamp)
 {
-    *t_render = *t_lamp = -1;
+    *t_first = *t_render = *t_lamp = -1;
+    double before = scene_num(r, "light.intensity");
     lr_err e = {0};
     while ((*t_render < 0 || *t_lamp < 0) && lr_now_ns() - t0 < guard_ms * MS) {
         if (lr_rig_run_until(r, lr_now_ns() + 5 * MS, &e))
             fail_msg("%s", e.msg);
         double ms = (double)(lr_now_ns() - t0) * 1e-6;
+        if (*t_first < 0 && scene_num(r, "light.intensity") != before)
+            *t_first = ms;
         if (*t_render < 0 && fabs(scene_num(r, "light.intensity") - want) < 1e-12)
             *t_render = ms;
         if (*t_lamp < 0 && lr_test_mb_server_reg(mb, 2, 0) == raw)
@@ -264,11 +268,12 @@ static void qlcplus_drives_the_rig(void **state)
     for (size_t i = 0; i < sizeof steps / sizeof steps[0]; i++) {
         int64_t t0 = lr_now_ns();
         ws_text(fd, steps[i].cmd);
-        double tr, tl;
-        run_to(r, mb, steps[i].intensity, steps[i].raw, t0, 5000, &tr, &tl);
-        print_message("QLC+ %s: rendered intensity %.6g after %.0f ms, lamp raw %d after %.0f "
-                      "ms (web socket frame to the rig's state; the 0.25 s fade included)\n",
-                      steps[i].cmd, steps[i].intensity, tr, steps[i].raw, tl);
+        double t1, tr, tl;
+        run_to(r, mb, steps[i].intensity, steps[i].raw, t0, 5000, &t1, &tr, &tl);
+        print_message("QLC+ %s: intensity first changed after %.0f ms, reached %.6g after %.0f "
+                      "ms (the 0.25 s fade), lamp raw %d after %.0f ms (web socket frame to the "
+                      "rig's state, QLC+'s output cadence included)\n",
+                      steps[i].cmd, t1, steps[i].intensity, tr, steps[i].raw, tl);
         assert_true(tr >= 0);
         assert_true(tl >= 0);
         assert_near(scene_num(r, "light.intensity"), steps[i].intensity, 1e-12);
