@@ -130,16 +130,17 @@ double lr_light_shape(const lr_light *l, lr_vec3 dir)
 
 void lr_light_geometry_key(const lr_light *l, double k[LR_LIGHT_KEY_N])
 {
-    lr_vec3 x = lr_v3(0, 0, 0), y, z;
-    if (l->profile.on)
-        lr_light_profile_axes(l, &x, &y, &z);
-    /* The table's hash in 48 bits: exact in a double. */
-    double ph = l->profile.on ? (double)(l->profile.hash >> 16) + 1.0 : 0.0;
+    /* The table's hash in 48 bits (exact in a double) and the C0 hint as given: with the
+     * fields above they fix the profile's frame (lr_light_profile_axes). */
+    bool on = l->profile.on;
+    double ph = on ? (double)(l->profile.hash >> 16) + 1.0 : 0.0;
+    lr_vec3 c0 = on ? l->profile_c0 : lr_v3(0, 0, 0);
     double v[LR_LIGHT_KEY_N] = {l->type,      l->position.x,  l->position.y,  l->position.z,
                                 l->direction.x, l->direction.y, l->direction.z, l->edge_u.x,
                                 l->edge_u.y,  l->edge_u.z,    l->edge_v.x,    l->edge_v.y,
                                 l->edge_v.z,  l->radius,      l->two_sided,   l->inner_deg,
-                                l->outer_deg, ph,             x.x + 2.0 * x.y, x.z};
+                                l->outer_deg, ph,             c0.x,           c0.y,
+                                c0.z};
     for (int i = 0; i < LR_LIGHT_KEY_N; i++)
         k[i] = v[i];
 }

@@ -160,7 +160,6 @@ static int light_strength(ctx *c, lr_jnode obj, const char *where, lr_light *l)
             return lr_json_fail(c->j, obj, where, c->e, LR_EPARSE, "missing its strength: the "
                                 "profile states no flux (required: one of %s)", list);
         }
-        given = 0;
     } else if (given < 0) {
         return lr_json_fail(c->j, obj, where, c->e, LR_EPARSE, "missing its strength (required: "
                             "one of %s)", list);

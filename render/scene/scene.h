@@ -191,7 +191,7 @@ void lr_light_profile_axes(const lr_light *l, lr_vec3 *x, lr_vec3 *y, lr_vec3 *z
 /* What the direct light per unit intensity depends on (not intensity, colour or flicker,
  * which scale it): type, position, direction, edges, radius, sidedness, cone, and the
  * profile's table and frame. The solvers' cache keys (receiver bounce, openings). */
-#define LR_LIGHT_KEY_N 20
+#define LR_LIGHT_KEY_N 21
 void lr_light_geometry_key(const lr_light *l, double k[LR_LIGHT_KEY_N]);
 /* Flicker at time t seconds: the factor on intensity (>= 0, mean 1) and the position offset
  * (mm). Deterministic in (seed, t): a sum of three sines at incommensurate multiples of

@@ -108,7 +108,7 @@ static int run(FILE *out)
         fprintf(out, "\nLargest GPU need: %.0f MB, under the rig's default budget of 1024 MB "
                      "(`output.gpu_memory_mb`).\n", worst);
     char cmd[PATH_MAX + 16];
-    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     if (system(cmd) != 0)
         fprintf(stderr, "bench memory: could not remove %s\n", dir);
     return rc;
