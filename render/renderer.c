@@ -42,6 +42,7 @@ struct lr_renderer {
     char shader_dir[512];
     lr_shader_defines defines; /* lr_passes_defines: every program is built with them */
     const lr_cancel *cancel;   /* lr_renderer_set_cancel; NULL: never */
+    lr_slicer *slicer;         /* the long passes' slice ends (render/passes/slice.h) */
     lr_timer *timer;
     lr_pass_programs prog;
 
@@ -89,7 +90,7 @@ static lr_pass_ctx pass_ctx(const lr_renderer *r)
                      .width = r->width, .height = r->height, .n_lights = r->n_lights,
                      .map_format = r->map_format, .seed = r->seed, .no_vpl = r->no_vpl,
                      .vpl_visibility = r->vpl_visibility || r->rs.vpl_visibility,
-                     .cancel = r->cancel};
+                     .cancel = r->cancel, .slicer = r->slicer};
     for (int l = 0; l < r->n_lights && l < LR_MAX_LIGHTS; l++) {
         lr_light_rgb(lr_scene_light_at(r->scene, l), c.I[l]);
         double f = lr_renderer_flicker(r, l);
@@ -437,7 +438,7 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
     lr_passes_defines(&r->defines);
     if ((rc = find_shaders(r, e)))
         goto fail;
-    if ((rc = lr_timer_create(r->gl, NULL, &r->timer, e)))
+    if ((rc = lr_timer_create(r->gl, NULL, &r->timer, e)) || (rc = lr_slicer_create(&r->slicer, e)))
         goto fail;
     snprintf(r->info, sizeof r->info, "%s; %s; %s timers", caps->renderer, maps,
              lr_timer_is_gpu(r->timer) ? "GPU" : "CPU+glFinish");
@@ -507,6 +508,7 @@ void lr_renderer_destroy(lr_renderer *r)
     for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
         lr_program_destroy(ps[i]);
     lr_timer_destroy(r->timer);
+    lr_slicer_destroy(r->slicer);
     free(r);
 }
 
@@ -722,7 +724,11 @@ const lr_tex *lr_renderer_images(const lr_renderer *r, int *n, float *scale)
     return r->img.images;
 }
 
-void lr_renderer_set_cancel(lr_renderer *r, const lr_cancel *cancel) { r->cancel = cancel; }
+void lr_renderer_set_cancel(lr_renderer *r, const lr_cancel *cancel)
+{
+    r->cancel = cancel;
+    lr_slicer_set_cancel(r->slicer, cancel);
+}
 
 const char *lr_renderer_info(const lr_renderer *r)
 {
@@ -745,7 +751,8 @@ void lr_renderer_tonemap(const lr_renderer *r, lr_tonemap *tm)
 
 void lr_renderer_parts_get(const lr_renderer *r, lr_renderer_parts *out)
 {
-    *out = (lr_renderer_parts){.gl = r->gl, .timer = r->timer, .shader_dir = r->shader_dir,
+    *out = (lr_renderer_parts){.gl = r->gl, .timer = r->timer, .slicer = r->slicer,
+                               .shader_dir = r->shader_dir,
                                .defines = r->defines.list,
                                .width = r->width, .height = r->height, .seed = r->seed,
                                .rs = &r->rs, .objs = &r->objs, .gbuffer = &r->gbuffer,

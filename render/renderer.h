@@ -99,13 +99,18 @@ bool lr_renderer_needs_frame(const lr_renderer *r);
 /* Runs the passes that are due and leaves the image in the renderer's output target. */
 int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e);
 /* A token lr_renderer_frame polls (NULL: never cancelled; render/base/cancel.h): between
- * passes and inside the CPU solves they run (the diffusion grid's iterations, translucent
- * radiosity's and the receiver bounce's builds and sweeps). Once it is requested the frame
- * returns LR_ECANCELED with nothing composed and everything it would have done still due:
- * the next frame (after the owner resets the token) redoes it, and its image is the one an
- * uninterrupted frame would have given (to the solvers' tolerances: a cut solve's partial
- * iterate is the next one's warm start). The pointer must stay valid until the renderer is destroyed or it is
- * set again. For a caller that runs the renderer on a thread of its own (render/async). */
+ * passes, between the slices of the long GPU passes (render/passes/slice.h: each map and light
+ * of the radiosity pass, each band of the irradiance grids; with a token set every slice end
+ * waits for its GPU work, so a cut leaves at most one slice queued) and inside the CPU solves
+ * they run (the diffusion grid's iterations, translucent radiosity's and the receiver bounce's
+ * builds and sweeps). Once it is requested the frame returns LR_ECANCELED with nothing
+ * composed and everything it would have done still due: the next frame (after the owner
+ * resets the token) redoes it, and its image is the one an uninterrupted frame would have
+ * given (to the solvers' tolerances: a cut solve's partial iterate is the next one's warm
+ * start). A cut inside the radiosity pass (LR_CANCEL_RESTART or above only) restarts the
+ * maps' accumulation instead: the image then converges to a fresh renderer's. The pointer
+ * must stay valid until the renderer is destroyed or it is set again. For a caller that runs
+ * the renderer on a thread of its own (render/async). */
 void lr_renderer_set_cancel(lr_renderer *r, const lr_cancel *cancel);
 
 /* Linear RGB radiance of the last frame, width*height*3 floats, rows bottom to top (PFM order). */

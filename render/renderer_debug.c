@@ -236,6 +236,13 @@ bool lr_renderer_debug_compose_gathered(const lr_renderer *r)
     return parts(r).compose->gathered;
 }
 
+long lr_renderer_debug_slices(const lr_renderer *r) { return lr_slicer_count(parts(r).slicer); }
+
+void lr_renderer_debug_on_slice(lr_renderer *r, lr_slice_fn fn, void *ctx)
+{
+    lr_slicer_set_hook(parts(r).slicer, fn, ctx);
+}
+
 void lr_renderer_debug_surface_info(const lr_renderer *r, lr_debug_surface_info *out)
 {
     const lr_surface *sc = parts(r).surface;

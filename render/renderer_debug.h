@@ -9,6 +9,7 @@
 
 #include "render/base/err.h"
 #include "render/base/vec3.h"
+#include "render/passes/slice.h"
 #include "render/renderer.h"
 
 /* ---- scattered-radiosity maps (pass 2) ---------------------------------------------------- */
@@ -95,6 +96,12 @@ int lr_renderer_debug_uncovered(lr_renderer *r, int *count, lr_err *e);
 /* Whether the last composition ran Algorithm 1 per object pixel (render.surface_cache off)
  * rather than reading the surface cache (render/passes/surface.h). */
 bool lr_renderer_debug_compose_gathered(const lr_renderer *r);
+
+/* The long passes' slices (render/passes/slice.h): how many have ended since the renderer was
+ * made, and a hook called at each slice end before its poll (NULL: none), from which a test
+ * requests its token to cut a frame at a chosen slice. */
+long lr_renderer_debug_slices(const lr_renderer *r);
+void lr_renderer_debug_on_slice(lr_renderer *r, lr_slice_fn fn, void *ctx);
 
 /* The surface cache: entries (lattice points, render/mesh/lattice.h, both sides of open
  * objects), and object i's lattice point count and edge bound in mm (0 when the cache is not

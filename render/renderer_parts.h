@@ -16,6 +16,7 @@
 typedef struct lr_renderer_parts {
     lr_gl *gl;
     lr_timer *timer;
+    lr_slicer *slicer;
     const char *shader_dir;
     const char *const *defines; /* the renderer's lr_passes_defines */
     int width, height;

@@ -698,10 +698,14 @@ uint64_t lr_async_commit(lr_async *a, unsigned dirty)
     a->queue_batch = b;
     a->busy = true;
     /* The worker's frame solves a state this batch replaces: cut it (render/base/cancel.h),
-     * so that the new state's first image does not wait for the stale one's. */
+     * so that the new state's first image does not wait for the stale one's. A batch that
+     * restarts the maps cuts inside their accumulation too (render/passes/slice.h); one that
+     * does not (a camera move, a receiver) cuts between the radiosity pass's slices only
+     * after them, and a later batch that restarts them may still raise the request. */
     if ((dirty & TRANSPORT_DIRTY) && a->cancellable) {
-        lr_cancel_request(&a->cancel, LR_CANCEL_STALE);
-        a->cancellable = false;
+        bool restarts = (lr_dirty_passes(dirty) & LR_PASS_RADIOSITY) != 0;
+        lr_cancel_request(&a->cancel, restarts ? LR_CANCEL_RESTART : LR_CANCEL_STALE);
+        a->cancellable = !restarts;
     }
     pthread_cond_broadcast(&a->cv);
     pthread_mutex_unlock(&a->mu);

@@ -27,8 +27,11 @@
  * so that a knob turned every second does not throw the same seconds-long build away again
  * and again. */
 enum lr_cancel_level {
-    LR_CANCEL_STALE = 1, /* the result is no longer wanted: cut solves and passes */
-    LR_CANCEL_STOP = 2,  /* the owner ends: cut everything, builds too */
+    LR_CANCEL_STALE = 1,   /* the result is no longer wanted: cut solves and passes */
+    LR_CANCEL_RESTART = 2, /* ... and the new state restarts the maps' running mean: cut
+                            * inside their accumulation too (a partial frame there is only
+                            * thrown away by the restart; render/passes/slice.h) */
+    LR_CANCEL_STOP = 3,    /* the owner ends: cut everything, builds too */
 };
 
 typedef struct lr_cancel {

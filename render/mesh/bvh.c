@@ -22,6 +22,10 @@ struct lr_bvh {
     size_t nnodes;
     uint32_t *order;
     double *cent; /* 3 per triangle */
+    /* The triangles' corners in leaf order (tri[3 i + k]: corner k of triangle order[i]), as
+     * lr_mesh_triangle gives them (float to double is exact): the leaves read them in one
+     * sweep instead of three index lookups and conversions per triangle. */
+    lr_vec3 *tri;
 };
 
 const lr_mesh *lr_bvh_mesh(const lr_bvh *b) { return b->mesh; }
@@ -33,6 +37,7 @@ void lr_bvh_destroy(lr_bvh *b)
     free(b->nodes);
     free(b->order);
     free(b->cent);
+    free(b->tri);
     free(b);
 }
 
@@ -152,8 +157,36 @@ int lr_bvh_create(const lr_mesh *m, lr_bvh **out, lr_err *e)
         b->order[t] = (uint32_t)t;
     }
     build(b, 0, nt);
+    b->tri = malloc((nt ? 3 * nt : 1) * sizeof *b->tri);
+    if (!b->tri) {
+        lr_bvh_destroy(b);
+        return lr_err_set(e, LR_ENOMEM, "%s: out of memory for the BVH", lr_mesh_name(m));
+    }
+    for (size_t i = 0; i < nt; i++)
+        lr_mesh_triangle(m, b->order[i], &b->tri[3 * i]);
     *out = b;
     return LR_OK;
+}
+
+/* One axis of the slab test: narrows [*t0, *t1] to the ray's span inside the box's slab along
+ * that axis; false when it leaves nothing. A zero direction component: inside the slab or not
+ * (no division). Scalars in and out, so the sanitizers' checks stay on the node's six loads. */
+static inline bool slab_axis(double lo, double hi, double o, double inv, bool zero, double *t0,
+                             double *t1)
+{
+    if (zero)
+        return !(o < lo || o > hi);
+    double ta = (lo - o) * inv, tb = (hi - o) * inv;
+    if (ta > tb) {
+        double s = ta;
+        ta = tb;
+        tb = s;
+    }
+    /* Ize 2013: widening the exit by 2 gamma(3) makes the test conservative. */
+    tb *= 1.0 + 2.0 * (3.0 * 1.1102230246251565e-16);
+    *t0 = ta > *t0 ? ta : *t0;
+    *t1 = tb < *t1 ? tb : *t1;
+    return !(*t0 > *t1);
 }
 
 /* Ray-box slab test; false when the ray misses the box or leaves it before tmin or enters
@@ -162,25 +195,10 @@ static bool slab(const node *n, const double o[3], const double inv[3], const bo
                  double tmin, double tmax, double *tenter)
 {
     double t0 = tmin, t1 = tmax;
-    for (int a = 0; a < 3; a++) {
-        if (zero[a]) {
-            if (o[a] < n->lo[a] || o[a] > n->hi[a])
-                return false;
-            continue;
-        }
-        double ta = (n->lo[a] - o[a]) * inv[a], tb = (n->hi[a] - o[a]) * inv[a];
-        if (ta > tb) {
-            double s = ta;
-            ta = tb;
-            tb = s;
-        }
-        /* Ize 2013: widening the exit by 2 gamma(3) makes the test conservative. */
-        tb *= 1.0 + 2.0 * (3.0 * 1.1102230246251565e-16);
-        t0 = ta > t0 ? ta : t0;
-        t1 = tb < t1 ? tb : t1;
-        if (t0 > t1)
-            return false;
-    }
+    if (!slab_axis(n->lo[0], n->hi[0], o[0], inv[0], zero[0], &t0, &t1) ||
+        !slab_axis(n->lo[1], n->hi[1], o[1], inv[1], zero[1], &t0, &t1) ||
+        !slab_axis(n->lo[2], n->hi[2], o[2], inv[2], zero[2], &t0, &t1))
+        return false;
     *tenter = t0;
     return true;
 }
@@ -203,6 +221,12 @@ static bool better(const lr_hit *a, const lr_hit *b)
     return a->t < b->t || (a->t == b->t && a->triangle < b->triangle);
 }
 
+/* Each stack entry carries the node's entry parameter from the slab test made when it was
+ * pushed: on pop, a node entered beyond the nearest hit found since is skipped without a
+ * second box test (the slab test against the smaller tmax would reject exactly such nodes, and
+ * a node entered at or before it may still hold a hit as near with a lower index). Leaves clip
+ * the triangle test at the nearest hit so far: the test is inclusive (t <= tmax), so a tie is
+ * still found and settled by better(). */
 static bool traverse(const lr_bvh *b, lr_vec3 o, lr_vec3 d, double tmin, double tmax,
                      lr_hit *hit, bool any)
 {
@@ -213,22 +237,33 @@ static bool traverse(const lr_bvh *b, lr_vec3 o, lr_vec3 d, double tmin, double 
         inv[a] = zero[a] ? 0.0 : 1.0 / dd[a];
     }
     uint32_t stack[STACK_MAX];
+    double enter[STACK_MAX];
     int sp = 0;
-    stack[sp++] = 0;
+    double te;
+    if (!b->nnodes || !slab(&b->nodes[0], oo, inv, zero, tmin, tmax, &te))
+        return false;
+    stack[sp] = 0;
+    enter[sp++] = te;
     bool found = false;
     lr_hit best = {INFINITY, SIZE_MAX, 0, 0};
     while (sp > 0) {
-        const node *n = &b->nodes[stack[--sp]];
-        double te;
-        if (!slab(n, oo, inv, zero, tmin, found ? best.t : tmax, &te))
+        --sp;
+        if (found && enter[sp] > best.t)
             continue;
+        const node *n = &b->nodes[stack[sp]];
+        double bound = found ? best.t : tmax;
         if (n->count) {
             for (uint32_t i = 0; i < n->count; i++) {
-                lr_hit h;
-                if (tri_hit(b->mesh, b->order[n->first + i], o, d, tmin, tmax, &h) &&
-                    (!found || better(&h, &best))) {
+                uint32_t k = n->first + i;
+                const lr_vec3 *p = &b->tri[3 * (size_t)k];
+                double tt, u, v;
+                if (!lr_ray_triangle(o, d, p[0], p[1], p[2], tmin, bound, &tt, &u, &v))
+                    continue;
+                lr_hit h = {tt, b->order[k], u, v};
+                if (!found || better(&h, &best)) {
                     best = h;
                     found = true;
+                    bound = best.t;
                     if (any) {
                         *hit = best;
                         return true;
@@ -240,15 +275,20 @@ static bool traverse(const lr_bvh *b, lr_vec3 o, lr_vec3 d, double tmin, double 
         /* Push the farther child first so that the nearer one is searched first. */
         uint32_t l = (uint32_t)(n - b->nodes) + 1, r = n->right;
         double tl = INFINITY, tr = INFINITY;
-        bool hl = slab(&b->nodes[l], oo, inv, zero, tmin, found ? best.t : tmax, &tl);
-        bool hr = slab(&b->nodes[r], oo, inv, zero, tmin, found ? best.t : tmax, &tr);
+        bool hl = slab(&b->nodes[l], oo, inv, zero, tmin, bound, &tl);
+        bool hr = slab(&b->nodes[r], oo, inv, zero, tmin, bound, &tr);
         if (hl && hr) {
-            stack[sp++] = tl <= tr ? r : l;
-            stack[sp++] = tl <= tr ? l : r;
+            bool lfirst = tl <= tr;
+            stack[sp] = lfirst ? r : l;
+            enter[sp++] = lfirst ? tr : tl;
+            stack[sp] = lfirst ? l : r;
+            enter[sp++] = lfirst ? tl : tr;
         } else if (hl) {
-            stack[sp++] = l;
+            stack[sp] = l;
+            enter[sp++] = tl;
         } else if (hr) {
-            stack[sp++] = r;
+            stack[sp] = r;
+            enter[sp++] = tr;
         }
     }
     if (found)
@@ -314,22 +354,33 @@ static double box_distance(const node *n, lr_vec3 p)
     return sqrt(s);
 }
 
+/* As traverse: each stack entry carries its box distance from the push, so a pop compares it
+ * with the closest point found since instead of measuring the box again. */
 bool lr_bvh_closest(const lr_bvh *b, lr_vec3 p, double max_dist, lr_closest *out)
 {
     uint32_t stack[STACK_MAX];
+    double dist[STACK_MAX];
     int sp = 0;
-    stack[sp++] = 0;
+    if (!b->nnodes)
+        return false;
+    stack[sp] = 0;
+    dist[sp++] = box_distance(&b->nodes[0], p);
     bool found = false;
     lr_closest best = {.distance = INFINITY, .triangle = SIZE_MAX};
     while (sp > 0) {
-        const node *n = &b->nodes[stack[--sp]];
+        --sp;
         double bound = found ? best.distance : max_dist;
-        if (box_distance(n, p) > bound)
+        if (dist[sp] > bound)
             continue;
+        const node *n = &b->nodes[stack[sp]];
         if (n->count) {
             for (uint32_t i = 0; i < n->count; i++) {
+                uint32_t k = n->first + i;
+                const lr_vec3 *q = &b->tri[3 * (size_t)k];
                 lr_closest c;
-                tri_closest(b->mesh, b->order[n->first + i], p, &c);
+                c.point = lr_closest_on_triangle(p, q[0], q[1], q[2], c.w);
+                c.distance = lr_v3_len(lr_v3_sub(p, c.point));
+                c.triangle = b->order[k];
                 if (c.distance <= max_dist && (!found || closer(&c, &best))) {
                     best = c;
                     found = true;
@@ -339,8 +390,11 @@ bool lr_bvh_closest(const lr_bvh *b, lr_vec3 p, double max_dist, lr_closest *out
         }
         uint32_t l = (uint32_t)(n - b->nodes) + 1, r = n->right;
         double dl = box_distance(&b->nodes[l], p), dr = box_distance(&b->nodes[r], p);
-        stack[sp++] = dl <= dr ? r : l;
-        stack[sp++] = dl <= dr ? l : r;
+        bool lfirst = dl <= dr;
+        stack[sp] = lfirst ? r : l;
+        dist[sp++] = lfirst ? dr : dl;
+        stack[sp] = lfirst ? l : r;
+        dist[sp++] = lfirst ? dl : dr;
     }
     if (found && out)
         *out = best;

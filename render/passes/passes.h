@@ -20,6 +20,7 @@
 #include "render/image/image.h"
 #include "render/passes/defines.h"
 #include "render/passes/material_pack.h"
+#include "render/passes/slice.h"
 #include "render/scene/scene.h"
 
 /* The scene loader refuses more (render.K). */
@@ -104,6 +105,9 @@ typedef struct lr_pass_ctx {
     /* The renderer's (lr_renderer_set_cancel), handed to the CPU solves a pass runs (the
      * diffusion grid, translucent radiosity, the receiver bounce); NULL: never cancelled. */
     const lr_cancel *cancel;
+    /* The renderer's slice ends (render/passes/slice.h): the long GPU passes end each piece of
+     * their work with lr_slice_end, which waits and polls `cancel` when it is set. */
+    lr_slicer *slicer;
 } lr_pass_ctx;
 
 /* common.c */

@@ -347,6 +347,18 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
                 lr_passes_uniform_i(p, "u_tr_row0", tr ? l * rad->tr_rows[i] : 0);
                 lr_passes_draw(radiosity_mesh(c, rad, i));
             }
+            /* A slice per map and light (slice.h): a cut here leaves some maps one sample
+             * ahead of the others, so the maps restart at the next frame (frame count 0),
+             * as the change that cuts at this level makes them do anyway. */
+            int rc = lr_slice_end(c->slicer, LR_CANCEL_RESTART, "radiosity pass", e);
+            if (rc) {
+                glDisable(GL_BLEND);
+                glDepthMask(GL_TRUE);
+                glDepthFunc(GL_LESS);
+                rad->F = 0;
+                rad->gen++;
+                return rc;
+            }
         }
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);
