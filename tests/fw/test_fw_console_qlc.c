@@ -1,5 +1,5 @@
 /* firmware/: QLC+ (headless, in a network namespace of its own, driven through its web socket
- * as tests/hal/test_hal_dmx_peers.c drives it) through the shipped console rig
+ * as tests/hal/test_hal_dmx_peers.c drives it; tests/support/console_peer.h) through the shipped console rig
  * (configs/rig/console.json, in-process) to both the rendered dimmer and the Modbus lamp. The
  * file is used as shipped except for absolute paths, a 16x16 preview output, the lamp on a
  * libmodbus server's free port and sACN's interface (the veth end: this namespace has no
@@ -7,25 +7,21 @@
  * the test's own. Skipped without qlcplus, ip or root. The latency from the web socket frame
  * to the rendered change and to the lamp's register is printed, not asserted (it includes
  * QLC+'s own output cadence). */
-#include <errno.h>
 #include <math.h>
-#include <poll.h>
-#include <sched.h>
 #include <setjmp.h>
-#include <signal.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmocka.h>
 
 #include "firmware/rig/rig.h"
 #include "render/scene/scene.h"
+#include "tests/support/console_peer.h"
 #include "tests/support/dmx_build.h"
 #include "tests/support/fs.h"
 #include "tests/support/hal_test.h"
@@ -35,22 +31,6 @@
 #define MS 1000000LL
 #define CFG LR_SOURCE_CONFIGS
 #define NS_NET "10.157.0"
-
-static int sh(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static int sh(const char *fmt, ...)
-{
-    char cmd[1024];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(cmd, sizeof cmd, fmt, ap);
-    va_end(ap);
-    return system(cmd);
-}
-
-static bool have(const char *prog)
-{
-    return sh("command -v %s >/dev/null 2>&1", prog) == 0;
-}
 
 static void replace(char *s, size_t cap, const char *from, const char *to)
 {
@@ -84,76 +64,17 @@ static const char WORKSPACE[] =
     "   <Universe Name=\"Universe 2\" ID=\"1\"><Output Plugin=\"ArtNet\" Line=\"0\"/></Universe>\n"
     "  </InputOutputMap>\n </Engine>\n</Workspace>\n";
 
-/* RFC 6455, the smallest client: the upgrade, then masked text frames. */
-static int ws_open(const char *host, int port)
-{
-    int fd = lr_test_tcp_connect(host, port);
-    if (fd < 0)
-        return -1;
-    char req[256];
-    int n = snprintf(req, sizeof req,
-                     "GET /qlcplusWS HTTP/1.1\r\nHost: %s:%d\r\nUpgrade: websocket\r\n"
-                     "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
-                     "Sec-WebSocket-Version: 13\r\n\r\n", host, port);
-    char resp[512] = "";
-    size_t got = 0;
-    if (write(fd, req, (size_t)n) != n)
-        goto fail;
-    while (got < sizeof resp - 1 && !strstr(resp, "\r\n\r\n")) {
-        struct pollfd pf = {.fd = fd, .events = POLLIN};
-        if (poll(&pf, 1, 2000) != 1)
-            goto fail;
-        ssize_t k = read(fd, resp + got, sizeof resp - 1 - got);
-        if (k <= 0)
-            goto fail;
-        got += (size_t)k;
-        resp[got] = '\0';
-    }
-    if (strncmp(resp, "HTTP/1.1 101", 12) == 0)
-        return fd;
-fail:
-    close(fd);
-    return -1;
-}
-
-static void ws_text(int fd, const char *text)
-{
-    size_t n = strlen(text);
-    assert_true(n < 126);
-    uint8_t f[140];
-    const uint8_t mask[4] = {0x12, 0x34, 0x56, 0x78};
-    f[0] = 0x81;
-    f[1] = 0x80 | (uint8_t)n;
-    memcpy(f + 2, mask, 4);
-    for (size_t i = 0; i < n; i++)
-        f[6 + i] = (uint8_t)text[i] ^ mask[i % 4];
-    assert_int_equal(write(fd, f, 6 + n), (ssize_t)(6 + n));
-}
-
-typedef struct peer {
-    char ns[64], dir[64];
-    pid_t qlc;
-} peer;
-
 static int peer_setup(void **state)
 {
-    *state = calloc(1, sizeof(peer));
+    *state = calloc(1, sizeof(lr_test_peer));
     return *state ? 0 : -1;
 }
 
 /* Runs after a failed assertion too: no console or namespace is left behind. */
 static int peer_teardown(void **state)
 {
-    peer *p = *state;
-    if (p->qlc > 0) {
-        kill(p->qlc, SIGTERM);
-        waitpid(p->qlc, NULL, 0);
-    }
-    if (p->ns[0])
-        sh("ip netns del %s 2>/dev/null", p->ns);
-    if (p->dir[0])
-        sh("rm -rf %s", p->dir);
-    free(p);
+    lr_test_peer_stop(*state);
+    free(*state);
     return 0;
 }
 
@@ -181,45 +102,17 @@ static void run_to(lr_rig *r, lr_test_mb_server *mb, double want, int raw, int64
 
 static void qlcplus_drives_the_rig(void **state)
 {
-    peer *p = *state;
-    if (!have("qlcplus") || !have("ip")) {
-        print_message("qlcplus or ip not installed (Debian qlcplus, iproute2): skipped\n");
+    lr_test_peer *p = *state;
+    char why[160];
+    if (!lr_test_have("qlcplus")) {
+        print_message("qlcplus not installed (Debian qlcplus): skipped\n");
         skip();
     }
-    if (geteuid() != 0 || unshare(CLONE_NEWNET) != 0 || sh("ip link set lo up") != 0) {
-        print_message("no network namespace of our own (root needed): skipped\n");
+    if (!lr_test_netns_ok(why, sizeof why) || !lr_test_peer_ns(p, "qlcrig", NS_NET, why, sizeof why)) {
+        print_message("%s\n", why);
         skip();
     }
-    snprintf(p->ns, sizeof p->ns, "lamprig-qlcrig-%d", (int)getpid());
-    if (sh("ip netns add %s && ip link add veth-lqr type veth peer name veth-qr netns %s && "
-           "ip addr add " NS_NET ".1/24 brd + dev veth-lqr && ip link set veth-lqr up && "
-           "ip -n %s addr add " NS_NET ".2/24 brd + dev veth-qr && ip -n %s link set veth-qr up",
-           p->ns, p->ns, p->ns, p->ns) != 0) {
-        print_message("could not set up the veth pair: skipped\n");
-        skip();
-    }
-    snprintf(p->dir, sizeof p->dir, "/tmp/lamprig-qlcrig.XXXXXX");
-    assert_non_null(mkdtemp(p->dir));
-    char ws[128];
-    snprintf(ws, sizeof ws, "%s/console.qxw", p->dir);
-    FILE *f = fopen(ws, "w");
-    assert_non_null(f);
-    fputs(WORKSPACE, f);
-    fclose(f);
-    p->qlc = fork();
-    assert_true(p->qlc >= 0);
-    if (p->qlc == 0) {
-        char log[128], env_home[128];
-        snprintf(log, sizeof log, "%s/qlcplus.log", p->dir);
-        snprintf(env_home, sizeof env_home, "HOME=%s", p->dir);
-        if (!freopen(log, "w", stdout) || !freopen(log, "a", stderr))
-            _exit(127);
-        /* Its loopback left down (test_hal_dmx_peers.c says why): Art-Net on the veth. */
-        execlp("ip", "ip", "netns", "exec", p->ns, "env", "QT_QPA_PLATFORM=offscreen", env_home,
-               "XDG_RUNTIME_DIR=/tmp", "qlcplus", "--nowm", "--nogui", "--web", "--open", ws,
-               (char *)NULL);
-        _exit(127);
-    }
+    lr_test_qlc_start(p, WORKSPACE);
     /* The rig: the shipped console.json. */
     lr_test_mb_server *mb = lr_test_mb_server_start();
     char text[8192];
@@ -250,10 +143,10 @@ static void qlcplus_drives_the_rig(void **state)
     for (int i = 0; i < 150 && fd < 0; i++) {
         if (lr_rig_run_until(r, lr_now_ns() + 100 * MS, &e))
             fail_msg("%s", e.msg);
-        fd = ws_open(NS_NET ".2", 9999);
+        fd = lr_test_qlc_ws_open(NS_NET ".2");
     }
     if (fd < 0) {
-        sh("cat %s/qlcplus.log >&2", p->dir);
+        lr_test_sh("cat %s/qlcplus.log >&2", p->dir);
         fail_msg("QLC+'s web socket did not answer in 15 s (its log above)");
     }
     /* The dimmer binding (configs/controls/candle.json): light.level over [0, 2], square
@@ -267,7 +160,7 @@ static void qlcplus_drives_the_rig(void **state)
     } steps[] = {{"CH|513|255", 0.01, 255}, {"CH|513|51", 0.005 * 2 * 0.04, 10}};
     for (size_t i = 0; i < sizeof steps / sizeof steps[0]; i++) {
         int64_t t0 = lr_now_ns();
-        ws_text(fd, steps[i].cmd);
+        lr_test_qlc_ws_text(fd, steps[i].cmd);
         double t1, tr, tl;
         run_to(r, mb, steps[i].intensity, steps[i].raw, t0, 5000, &t1, &tr, &tl);
         print_message("QLC+ %s: intensity first changed after %.0f ms, reached %.6g after %.0f "

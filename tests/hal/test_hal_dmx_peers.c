@@ -31,16 +31,15 @@
 
 #include "hal/artnet.h"
 #include "hal/sacn.h"
+#include "tests/support/console_peer.h"
 #include "tests/support/dmx_build.h"
 #include "tests/support/hal_test.h"
 
 #define MS 1000000LL
 
 typedef struct peer {
-    char ns[64];
-    char dir[64];
-    pid_t olad; /* or qlcplus */
-    bool ready;
+    lr_test_peer c; /* the console: olad or qlcplus (tests/support/console_peer.h) */
+    bool ready;     /* olad's RPC answered */
 } peer;
 
 typedef struct rec {
@@ -61,23 +60,6 @@ static const lr_event *last_of(const rec *r, const char *source, const char *con
         if (strcmp(r->ev[i].source, source) == 0 && strcmp(r->ev[i].control, control) == 0)
             return &r->ev[i];
     return NULL;
-}
-
-static int sh(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static int sh(const char *fmt, ...)
-{
-    char cmd[1024];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(cmd, sizeof cmd, fmt, ap);
-    va_end(ap);
-    int st = system(cmd);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-static bool have(const char *prog)
-{
-    return sh("command -v %s >/dev/null 2>&1", prog) == 0;
 }
 
 /* OLA's plugins: all off but E1.31 and Art-Net, bound to the veth address (a plugin probing
@@ -108,86 +90,28 @@ static void write_ola_config(const char *dir)
     fclose(f);
 }
 
-/* Root, ip and a network namespace of our own: the common part. */
-static bool common_ok(char *why, size_t n)
-{
-    static int state; /* 0 not tried, 1 ok, -1 failed (why kept) */
-    static char reason[160];
-    if (state == 0) {
-        state = -1;
-        if (!have("ip") || !have("setpriv"))
-            snprintf(reason, sizeof reason, "ip or setpriv not installed (Debian iproute2, "
-                     "util-linux): skipped");
-        else if (geteuid() != 0)
-            snprintf(reason, sizeof reason,
-                     "not root: network namespaces and the consoles' users need it: skipped");
-        else if (unshare(CLONE_NEWNET) != 0)
-            snprintf(reason, sizeof reason, "unshare(CLONE_NEWNET): %s: skipped",
-                     strerror(errno));
-        else if (sh("ip link set lo up") != 0)
-            snprintf(reason, sizeof reason, "ip link set lo up failed: skipped");
-        else
-            state = 1;
-    }
-    snprintf(why, n, "%s", reason);
-    return state == 1;
-}
-
-/* A namespace for the console and the veth pair to it: NET.1 here, NET.2 there. */
-static bool make_peer_ns(peer *p, const char *name, const char *net, char *why, size_t n)
-{
-    snprintf(p->ns, sizeof p->ns, "lamprig-%s-%d", name, (int)getpid());
-    if (sh("ip netns add %s && "
-           "ip link add veth-l%s type veth peer name veth-%s netns %s && "
-           "ip addr add %s.1/24 brd + dev veth-l%s && ip link set veth-l%s up && "
-           "ip -n %s link set lo up && ip -n %s addr add %s.2/24 brd + dev veth-%s && "
-           "ip -n %s link set veth-%s up && ip -n %s route add 224.0.0.0/4 dev veth-%s",
-           p->ns, name, name, p->ns, net, name, name, p->ns, p->ns, net, name, p->ns, name,
-           p->ns, name) != 0) {
-        snprintf(why, n, "could not set up the veth pair to %s: skipped", p->ns);
-        return false;
-    }
-    snprintf(p->dir, sizeof p->dir, "/tmp/lamprig-%s.XXXXXX", name);
-    assert_non_null(mkdtemp(p->dir));
-    return true;
-}
-
-static void stop_peer(peer *p)
-{
-    if (p->olad > 0) {
-        kill(p->olad, SIGTERM);
-        waitpid(p->olad, NULL, 0);
-        p->olad = 0;
-    }
-    if (p->ns[0])
-        sh("ip netns del %s 2>/dev/null", p->ns);
-    if (p->dir[0])
-        sh("rm -rf %s", p->dir);
-    memset(p, 0, sizeof *p);
-}
-
 static void start_olad(peer *p)
 {
-    write_ola_config(p->dir);
-    assert_int_equal(sh("chown -R olad %s", p->dir), 0);
-    p->olad = fork();
-    assert_true(p->olad >= 0);
-    if (p->olad == 0) {
+    write_ola_config(p->c.dir);
+    assert_int_equal(lr_test_sh("chown -R olad %s", p->c.dir), 0);
+    p->c.pid = fork();
+    assert_true(p->c.pid >= 0);
+    if (p->c.pid == 0) {
         char log[128];
-        snprintf(log, sizeof log, "%s/olad.log", p->dir);
+        snprintf(log, sizeof log, "%s/olad.log", p->c.dir);
         if (!freopen(log, "w", stdout) || !freopen(log, "a", stderr))
             _exit(127);
         /* setpriv execs olad itself (no forking wrapper): the pid is olad's. */
-        execlp("ip", "ip", "netns", "exec", p->ns, "setpriv", "--reuid=olad", "--regid=nogroup",
-               "--clear-groups", "olad", "-c", p->dir, "--no-http", "--no-register-with-dns-sd",
+        execlp("ip", "ip", "netns", "exec", p->c.ns, "setpriv", "--reuid=olad", "--regid=nogroup",
+               "--clear-groups", "olad", "-c", p->c.dir, "--no-http", "--no-register-with-dns-sd",
                "-l", "3", (char *)NULL);
         _exit(127);
     }
     /* Ready when its RPC answers (about a second). */
     for (int i = 0; i < 100 && !p->ready; i++) {
         usleep(100000);
-        p->ready = sh("ip netns exec %s ola_dev_info >%s/devs 2>/dev/null", p->ns, p->dir) == 0 &&
-                   sh("grep -q E1.31 %s/devs && grep -q ArtNet %s/devs", p->dir, p->dir) == 0;
+        p->ready = lr_test_sh("ip netns exec %s ola_dev_info >%s/devs 2>/dev/null", p->c.ns, p->c.dir) == 0 &&
+                   lr_test_sh("grep -q E1.31 %s/devs && grep -q ArtNet %s/devs", p->c.dir, p->c.dir) == 0;
     }
 }
 
@@ -195,7 +119,7 @@ static void start_olad(peer *p)
 static int device_number(const peer *p, const char *kind)
 {
     char path[128], line[256];
-    snprintf(path, sizeof path, "%s/devs", p->dir);
+    snprintf(path, sizeof path, "%s/devs", p->c.dir);
     FILE *f = fopen(path, "r");
     assert_non_null(f);
     int n = -1;
@@ -229,7 +153,7 @@ static int peer_setup(void **state)
 /* Runs after a failed assertion too: no console or namespace is left behind. */
 static int peer_teardown(void **state)
 {
-    stop_peer(*state);
+    lr_test_peer_stop(&((peer *)*state)->c);
     free(*state);
     return 0;
 }
@@ -241,17 +165,17 @@ static void ola_drives_both(void **state)
     const char *need[] = {"olad", "ola_patch", "ola_set_dmx", "ola_streaming_client",
                           "ola_dev_info", NULL};
     for (int i = 0; need[i]; i++)
-        if (!have(need[i])) {
+        if (!lr_test_have(need[i])) {
             print_message("%s not installed (Debian ola): skipped\n", need[i]);
             skip();
         }
-    if (!common_ok(why, sizeof why) || !make_peer_ns(p, "ola", "10.155.0", why, sizeof why)) {
+    if (!lr_test_netns_ok(why, sizeof why) || !lr_test_peer_ns(&p->c, "ola", "10.155.0", why, sizeof why)) {
         print_message("%s\n", why);
         skip();
     }
     start_olad(p);
     if (!p->ready) {
-        sh("cat %s/olad.log >&2", p->dir);
+        lr_test_sh("cat %s/olad.log >&2", p->c.dir);
         fail_msg("olad did not come up in 10 s (its log above)");
     }
     rec r = {0};
@@ -275,8 +199,8 @@ static void ola_drives_both(void **state)
      * node answers, listing port-address 1, and OLA then sends that universe to us. */
     int de = device_number(p, "E1.31"), da = device_number(p, "ArtNet");
     assert_true(de > 0 && da > 0);
-    assert_int_equal(sh("ip netns exec %s ola_patch -d %d -p 0 -u 1", p->ns, de), 0);
-    assert_int_equal(sh("ip netns exec %s ola_patch -d %d -p 0 -u 1", p->ns, da), 0);
+    assert_int_equal(lr_test_sh("ip netns exec %s ola_patch -d %d -p 0 -u 1", p->c.ns, de), 0);
+    assert_int_equal(lr_test_sh("ip netns exec %s ola_patch -d %d -p 0 -u 1", p->c.ns, da), 0);
     lr_dev *devs[2] = {lr_sacn_dev(s), lr_artnet_dev(a)};
     lr_test_run(devs, 2, 300, NULL, NULL); /* OLA's poll and our reply */
 
@@ -289,7 +213,7 @@ static void ola_drives_both(void **state)
     want w = {&r, 51 / 255.0, 1 / 65535.0};
     bool seen = false;
     for (int k = 0; k < 5 && !seen; k++) {
-        assert_int_equal(sh("ip netns exec %s ola_streaming_client -u 1 -d 51,0,0,1", p->ns),
+        assert_int_equal(lr_test_sh("ip netns exec %s ola_streaming_client -u 1 -d 51,0,0,1", p->c.ns),
                          0);
         seen = lr_test_run(devs, 2, 1000, both_at, &w);
     }
@@ -298,7 +222,7 @@ static void ola_drives_both(void **state)
             print_message("event %s/%s %.9f\n", r.ev[i].source, r.ev[i].control, r.ev[i].value);
         fail_msg("ola_streaming_client did not reach both receivers in 5 tries (%d events)", r.n);
     }
-    assert_int_equal(sh("ip netns exec %s ola_set_dmx -u 1 -d 255,0,128,64", p->ns), 0);
+    assert_int_equal(lr_test_sh("ip netns exec %s ola_set_dmx -u 1 -d 255,0,128,64", p->c.ns), 0);
     w = (want){&r, 1.0, (128 * 256 + 64) / 65535.0};
     if (!lr_test_run(devs, 2, 5000, both_at, &w))
         fail_msg("ola_set_dmx did not reach both receivers in 5 s");
@@ -329,89 +253,19 @@ static const char WORKSPACE[] =
     "   <Universe Name=\"Universe 2\" ID=\"1\"><Output Plugin=\"ArtNet\" Line=\"0\"/></Universe>\n"
     "  </InputOutputMap>\n </Engine>\n</Workspace>\n";
 
-/* A web socket client of the smallest kind (RFC 6455): the upgrade, then masked text
- * frames. Returns the connected descriptor, -1 when QLC+ is not (yet) there. */
-static int ws_open(const char *host, int port)
-{
-    int fd = lr_test_tcp_connect(host, port);
-    if (fd < 0)
-        return -1;
-    char req[256];
-    int n = snprintf(req, sizeof req,
-                     "GET /qlcplusWS HTTP/1.1\r\nHost: %s:%d\r\nUpgrade: websocket\r\n"
-                     "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
-                     "Sec-WebSocket-Version: 13\r\n\r\n", host, port);
-    char resp[512] = "";
-    size_t got = 0;
-    if (write(fd, req, (size_t)n) != n)
-        goto fail;
-    /* The answer's head, up to its blank line (QLC+ sends nothing after it unasked). */
-    while (got < sizeof resp - 1 && !strstr(resp, "\r\n\r\n")) {
-        struct pollfd pf = {.fd = fd, .events = POLLIN};
-        if (poll(&pf, 1, 2000) != 1)
-            goto fail;
-        ssize_t k = read(fd, resp + got, sizeof resp - 1 - got);
-        if (k <= 0)
-            goto fail;
-        got += (size_t)k;
-        resp[got] = '\0';
-    }
-    if (strncmp(resp, "HTTP/1.1 101", 12) == 0)
-        return fd;
-fail:
-    close(fd);
-    return -1;
-}
-
-static void ws_text(int fd, const char *text)
-{
-    size_t n = strlen(text);
-    assert_true(n < 126);
-    uint8_t f[140];
-    const uint8_t mask[4] = {0x12, 0x34, 0x56, 0x78};
-    f[0] = 0x81;              /* FIN, text */
-    f[1] = 0x80 | (uint8_t)n; /* masked (a client must), length */
-    memcpy(f + 2, mask, 4);
-    for (size_t i = 0; i < n; i++)
-        f[6 + i] = (uint8_t)text[i] ^ mask[i % 4];
-    assert_int_equal(write(fd, f, 6 + n), (ssize_t)(6 + n));
-}
-
 static void qlcplus_drives_both(void **state)
 {
     char why[160];
     peer *p = *state;
-    if (!have("qlcplus")) {
+    if (!lr_test_have("qlcplus")) {
         print_message("qlcplus not installed (Debian qlcplus): skipped\n");
         skip();
     }
-    if (!common_ok(why, sizeof why) || !make_peer_ns(p, "qlc", "10.156.0", why, sizeof why)) {
+    if (!lr_test_netns_ok(why, sizeof why) || !lr_test_peer_ns(&p->c, "qlc", "10.156.0", why, sizeof why)) {
         print_message("%s\n", why);
         skip();
     }
-    /* Its loopback down: see WORKSPACE. */
-    assert_int_equal(sh("ip -n %s link set lo down", p->ns), 0);
-    char ws[128];
-    snprintf(ws, sizeof ws, "%s/console.qxw", p->dir);
-    FILE *f = fopen(ws, "w");
-    assert_non_null(f);
-    fputs(WORKSPACE, f);
-    fclose(f);
-    p->olad = fork();
-    assert_true(p->olad >= 0);
-    if (p->olad == 0) {
-        char log[128], home[96], env_home[128];
-        snprintf(log, sizeof log, "%s/qlcplus.log", p->dir);
-        snprintf(home, sizeof home, "%s", p->dir);
-        snprintf(env_home, sizeof env_home, "HOME=%s", home);
-        if (!freopen(log, "w", stdout) || !freopen(log, "a", stderr))
-            _exit(127);
-        /* A fresh HOME: QLC+ reads and writes its settings there, never the user's. */
-        execlp("ip", "ip", "netns", "exec", p->ns, "env", "QT_QPA_PLATFORM=offscreen", env_home,
-               "XDG_RUNTIME_DIR=/tmp", "qlcplus", "--nowm", "--nogui", "--web", "--open", ws,
-               (char *)NULL);
-        _exit(127);
-    }
+    lr_test_qlc_start(&p->c, WORKSPACE);
     rec r = {0};
     lr_test_log log = {0};
     const lr_dmx_channel ch[] = {
@@ -431,17 +285,17 @@ static void qlcplus_drives_both(void **state)
     int fd = -1;
     for (int i = 0; i < 150 && fd < 0; i++) {
         usleep(100000);
-        fd = ws_open("10.156.0.2", 9999);
+        fd = lr_test_qlc_ws_open("10.156.0.2");
     }
     if (fd < 0) {
-        sh("cat %s/qlcplus.log >&2", p->dir);
+        lr_test_sh("cat %s/qlcplus.log >&2", p->c.dir);
         fail_msg("QLC+'s web socket did not answer in 15 s (its log above)");
     }
     /* Simple Desk absolute addresses: universe 1 is 1..512, universe 2 is 513..1024. */
-    ws_text(fd, "CH|1|255");
-    ws_text(fd, "CH|3|128");
-    ws_text(fd, "CH|4|64");
-    ws_text(fd, "CH|513|255");
+    lr_test_qlc_ws_text(fd, "CH|1|255");
+    lr_test_qlc_ws_text(fd, "CH|3|128");
+    lr_test_qlc_ws_text(fd, "CH|4|64");
+    lr_test_qlc_ws_text(fd, "CH|513|255");
     lr_dev *devs[2] = {lr_sacn_dev(s), lr_artnet_dev(a)};
     want w = {&r, 1.0, (128 * 256 + 64) / 65535.0};
     if (!lr_test_run(devs, 2, 5000, both_at, &w)) {
@@ -451,8 +305,8 @@ static void qlcplus_drives_both(void **state)
     }
     /* A fader down: the second look replaces the first (QLC+ streams its universes
      * continuously, about 50 packets a second measured here, so sACN sees it at once). */
-    ws_text(fd, "CH|1|51");
-    ws_text(fd, "CH|513|51");
+    lr_test_qlc_ws_text(fd, "CH|1|51");
+    lr_test_qlc_ws_text(fd, "CH|513|51");
     w.dimmer = 51 / 255.0;
     if (!lr_test_run(devs, 2, 5000, both_at, &w))
         fail_msg("QLC+'s second look did not reach both receivers in 5 s");
@@ -474,11 +328,11 @@ static void multicast_join_retry(void **state)
 {
     (void)state;
     char why[160];
-    if (!common_ok(why, sizeof why)) {
+    if (!lr_test_netns_ok(why, sizeof why)) {
         print_message("%s\n", why);
         skip();
     }
-    sh("ip route del 224.0.0.0/4 2>/dev/null; ip link del lrv0 2>/dev/null");
+    lr_test_sh("ip route del 224.0.0.0/4 2>/dev/null; ip link del lrv0 2>/dev/null");
     rec r = {0};
     lr_test_log log = {0};
     const lr_dmx_channel ch[] = {{.control = "dimmer", .universe = 7, .channel = 1, .home = NAN}};
@@ -498,14 +352,14 @@ static void multicast_join_retry(void **state)
     lr_dev_dispatch(d, retry - 1);
     assert_int_equal(lr_test_log_count(&log, "multicast groups"), 1); /* no retry yet */
     /* The network comes up: a veth pair (no dummy module in every kernel) with a route. */
-    assert_int_equal(sh("ip link add lrv0 type veth peer name lrv1 && "
+    assert_int_equal(lr_test_sh("ip link add lrv0 type veth peer name lrv1 && "
                         "ip addr add 10.157.0.1/24 dev lrv0 && ip link set lrv0 up && "
                         "ip link set lrv1 up && ip route add 224.0.0.0/4 dev lrv0"), 0);
     lr_dev_dispatch(d, retry);
     assert_int_equal(lr_test_log_count(&log, "joined all 1 multicast groups"), 1);
     assert_int_equal(lr_dev_next_deadline(d), LR_NO_DEADLINE);
     lr_sacn_destroy(s);
-    sh("ip link del lrv0");
+    lr_test_sh("ip link del lrv0");
 }
 
 int main(void)
