@@ -11,6 +11,7 @@
 
 #include "render/base/paths.h"
 #include "render/gl/timer.h"
+#include "render/models/model.h"
 #include "render/passes/area_direct.h"
 #include "render/passes/blend.h"
 #include "render/passes/compose.h"
@@ -198,6 +199,17 @@ static int vpl_run(lr_renderer *r, unsigned dirty, lr_err *e)
 /* The grids alone: the receiver bounce's F and rows and the openings' kernel are keyed on the
  * scene (about a second to rebuild on llvmpipe's machine): freed at destroy. */
 static void irradiance_free(lr_renderer *r) { lr_irradiance_free_grids(&r->irr); }
+/* render.irradiance_grid, or what only the grid carries: the receiver bounce, the opening
+ * light, a patch-solve model's receiver light. */
+static bool irradiance_on(const lr_renderer *r)
+{
+    if (r->rs.irradiance_grid || r->rs.receiver_bounce || r->rs.opening_light)
+        return true;
+    for (int i = 0; i < lr_scene_object_count(r->scene); i++)
+        if (lr_sss_model_props_of(lr_scene_object_at(r->scene, i)->sss_model)->patch_solve)
+            return true;
+    return false;
+}
 static bool irradiance_due(const lr_renderer *r) { return !r->irr.valid && !r->no_vpl; }
 static int irradiance_run(lr_renderer *r, unsigned dirty, lr_err *e)
 {
@@ -240,6 +252,10 @@ static int compose_run(lr_renderer *r, unsigned dirty, lr_err *e)
 {
     (void)dirty;
     lr_pass_ctx c = pass_ctx(r);
+    /* The grid off: what it holds is of an earlier state, and composition gathers the VPLs
+     * per receiver pixel (u_cached false); drawn again when it comes back on (due). */
+    if (!irradiance_on(r))
+        r->irr.valid = false;
     lr_compose_inputs in = {.gbuffer = &r->gbuffer, .radiosity = &r->rad, .vpl = &r->vpl,
                             .irradiance = &r->irr, .area = &r->area, .lpv = lpv_live(r),
                             .surface = cache_now(r) && r->surf.valid ? &r->surf : NULL};
@@ -292,7 +308,7 @@ static const lr_pass_desc pass_table[LR_PASS_COUNT] = {
      false, radiosity_alloc, radiosity_free, radiosity_due, radiosity_run, NULL},
     {"vpl", LR_PASS_VPL, D_MAPS, LR_PASS_IRRADIANCE, true, vpl_alloc, vpl_free, NULL, vpl_run, NULL},
     {"irradiance", LR_PASS_IRRADIANCE, D_GRIDS, LR_PASS_COMPOSE, true, NULL, irradiance_free,
-     irradiance_due, irradiance_run, NULL},
+     irradiance_due, irradiance_run, irradiance_on},
     {"surface", LR_PASS_SURFACE, D_MAPS, LR_PASS_COMPOSE, false, NULL, surface_free,
      surface_due, surface_run, cache_now},
     {"compose", LR_PASS_COMPOSE, D_VIEW, LR_PASS_BLEND, false, compose_alloc, compose_free,

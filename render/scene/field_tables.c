@@ -393,6 +393,12 @@ static const lr_field render_fields[] = {
     {"opening_light", LR_FT_BOOL, 0, RS(opening_light), .dflt = {0}, .dirty = SET,
      .help = "light a shade's or cup's inner face sends to the plane receivers through its "
              "openings (issue 12)"},
+    /* Where composition reads the VPLs' light on the receivers from (render/passes/PIPELINE.md
+     * "Receiver irradiance cache"): the grid's pass runs or not, so a settings change. */
+    {"irradiance_grid", LR_FT_BOOL, 0, RS(irradiance_grid), .dflt = {1}, .dirty = SET,
+     .help = "the VPLs' light on the plane receivers from the irradiance grid (false: gathered "
+             "per pixel at composition; kept on while receiver_bounce, opening_light or "
+             "translucent_radiosity needs the grid)"},
 };
 
 const lr_record_desc lr_scene_render_desc = {"render", "render", NULL, NULL, NULL, NULL,

@@ -293,6 +293,11 @@ typedef struct lr_render_settings {
     /* The light the objects' inner faces send to the plane receivers through their openings
      * (render/openings/, issue 12 part 3), added to the receiver irradiance grid. */
     bool opening_light;
+    /* The VPLs' light on the plane receivers from the view-independent irradiance grid (the
+     * irradiance pass; default true), or, false, gathered per receiver pixel at composition:
+     * cheaper for a small image and few VPLs (the rig's preview). The grid stays on while the
+     * receiver bounce, the opening light or a patch-solve model needs it. */
+    bool irradiance_grid;
 } lr_render_settings;
 
 typedef struct lr_quality {
