@@ -105,6 +105,31 @@ static void assert_same_image(const float *a, const float *b)
     assert_true(worst <= 1e-6 * p);
 }
 
+/* A renderer with `token` set, two frames accumulated (sample 2). */
+static lr_renderer *tokened(lr_scene *s, lr_cancel *token)
+{
+    lr_renderer *r = lr_test_renderer(gl, s, W, H, false, 3);
+    lr_cancel_init(token);
+    lr_renderer_set_cancel(r, token);
+    lr_test_frame(r);
+    lr_frame_stats st = lr_test_frame(r);
+    assert_int_equal(st.samples, 2);
+    return r;
+}
+
+/* Converges r after its cuts and compares it with the uncut renderer's image; frees both and
+ * the scene. */
+static void converges_as_uncut(lr_renderer *r, lr_scene *s, float *want)
+{
+    lr_test_converge(r, 20);
+    float *got = lr_test_hdr(r);
+    assert_same_image(got, want);
+    free(got);
+    free(want);
+    lr_renderer_destroy(r);
+    lr_scene_destroy(s);
+}
+
 static void test_slices_per_frame(void **state)
 {
     (void)state;
@@ -128,13 +153,9 @@ static void test_restart_cuts_inside_the_maps(void **state)
     (void)state;
     lr_scene *s = lr_test_scene("candle", settings, NULL);
     float *want = uncut_image(s);
-    lr_renderer *r = lr_test_renderer(gl, s, W, H, false, 3);
     lr_cancel token;
-    lr_cancel_init(&token);
-    lr_renderer_set_cancel(r, &token);
-    lr_test_frame(r);
-    lr_frame_stats st = lr_test_frame(r);
-    assert_int_equal(st.samples, 2);
+    lr_renderer *r = tokened(s, &token);
+    lr_frame_stats st;
     /* Third frame: cut after its second map, mid-pass. */
     cutter c = {&token, LR_CANCEL_RESTART, lr_renderer_debug_slices(r) + 2};
     lr_renderer_debug_on_slice(r, cut_at, &c);
@@ -147,13 +168,7 @@ static void test_restart_cuts_inside_the_maps(void **state)
     lr_cancel_reset(&token);
     st = lr_test_frame(r);
     assert_int_equal(st.samples, 1); /* restarted */
-    lr_test_converge(r, 20);
-    float *got = lr_test_hdr(r);
-    assert_same_image(got, want);
-    free(got);
-    free(want);
-    lr_renderer_destroy(r);
-    lr_scene_destroy(s);
+    converges_as_uncut(r, s, want);
 }
 
 static void test_stale_cut_keeps_the_maps(void **state)
@@ -161,13 +176,9 @@ static void test_stale_cut_keeps_the_maps(void **state)
     (void)state;
     lr_scene *s = lr_test_scene("candle", settings, NULL);
     float *want = uncut_image(s);
-    lr_renderer *r = lr_test_renderer(gl, s, W, H, false, 3);
     lr_cancel token;
-    lr_cancel_init(&token);
-    lr_renderer_set_cancel(r, &token);
-    lr_test_frame(r);
-    lr_frame_stats st = lr_test_frame(r);
-    assert_int_equal(st.samples, 2);
+    lr_renderer *r = tokened(s, &token);
+    lr_frame_stats st;
     /* Requested during the radiosity pass's first slice: the maps end their frame, the cut
      * comes at the poll after the pass. */
     int maps = K * lr_scene_light_count(s);
@@ -194,13 +205,7 @@ static void test_stale_cut_keeps_the_maps(void **state)
     assert_int_equal(st.samples, FRAMES);
     assert_true(st.passes & LR_PASS_IRRADIANCE);
     assert_false(st.passes & LR_PASS_RADIOSITY);
-    lr_test_converge(r, 20);
-    float *got = lr_test_hdr(r);
-    assert_same_image(got, want);
-    free(got);
-    free(want);
-    lr_renderer_destroy(r);
-    lr_scene_destroy(s);
+    converges_as_uncut(r, s, want);
 }
 
 static void test_no_token_no_cut(void **state)
