@@ -42,8 +42,8 @@ export CMOCKA_MESSAGE_OUTPUT=stdout
 
 # One more than the CPUs: the rig's binaries (test_fw_loop, _modbus, _http, test_async) wait on
 # their clocks and peers for about half their time (test_fw_loop: 39 s of CPU in 72 s), and a
-# third binary fills that. On the 2-core machine the 125 binaries took 734 s at 3 against 767 s
-# at 2 (each CPU-bound binary is slower, the whole run shorter).
+# third binary fills that. On the 2-core machine the 125 binaries took 732-734 s at 3 against
+# 767 s at 2 (each CPU-bound binary is slower, the whole run shorter).
 jobs=${LR_TEST_JOBS:-$(( $(nproc 2>/dev/null || echo 2) + 1 ))}
 case $jobs in '' | *[!0-9]* | 0) echo "run.sh: LR_TEST_JOBS must be a positive integer" >&2; exit 2 ;; esac
 [ "$jobs" -lt 3 ] && [ -z "${LR_TEST_JOBS:-}" ] && jobs=3
