@@ -294,15 +294,14 @@ int lr_irradiance_run(lr_irradiance *irr, const lr_pass_ctx *c, const lr_vpl *v,
         /* In bands of LR_SLICE_ROWS rows (slice.h): a cut leaves the grids invalid, and the
          * pass, still due, draws them whole at the next frame. */
         glEnable(GL_SCISSOR_TEST);
-        for (int y = 0; y < LR_RECV_GRID; y += LR_SLICE_ROWS) {
+        for (int y = 0; y < LR_RECV_GRID && !rc; y += LR_SLICE_ROWS) {
             glScissor(0, y, LR_RECV_GRID, LR_SLICE_ROWS);
             lr_gl_draw_fullscreen(c->gl);
-            if ((rc = lr_slice_end(c->slicer, LR_CANCEL_STALE, "receiver irradiance pass", e))) {
-                glDisable(GL_SCISSOR_TEST);
-                return rc;
-            }
+            rc = lr_slice_end(c->slicer, LR_CANCEL_STALE, "receiver irradiance pass", e);
         }
         glDisable(GL_SCISSOR_TEST);
+        if (rc)
+            return rc;
     }
     if ((rc = lr_gl_check("receiver irradiance pass", e)) || (rc = bounce(irr, c, rad, e)) ||
         (rc = lr_gl_check("receiver irradiance pass (bounce)", e)))

@@ -271,7 +271,7 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
         }
     }
     int F = rad->F + 1;
-    int K = rad->K;
+    int K = rad->K, cut = LR_OK;
     glDisable(GL_CULL_FACE);
     glEnable(GL_DEPTH_TEST);
     for (int k = 0; k < K; k++)
@@ -350,19 +350,18 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
             /* A slice per map and light (slice.h): a cut here leaves some maps one sample
              * ahead of the others, so the maps restart at the next frame (frame count 0),
              * as the change that cuts at this level makes them do anyway. */
-            int rc = lr_slice_end(c->slicer, LR_CANCEL_RESTART, "radiosity pass", e);
-            if (rc) {
-                glDisable(GL_BLEND);
-                glDepthMask(GL_TRUE);
-                glDepthFunc(GL_LESS);
-                rad->F = 0;
-                rad->gen++;
-                return rc;
-            }
+            if ((cut = lr_slice_end(c->slicer, LR_CANCEL_RESTART, "radiosity pass", e)))
+                goto done;
         }
+done:
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);
+    if (cut) {
+        rad->F = 0;
+        rad->gen++;
+        return cut;
+    }
     rad->F = F;
     rad->gen++;
     return lr_gl_check("radiosity pass", e);
