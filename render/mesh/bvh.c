@@ -203,11 +203,10 @@ static bool slab(const node *n, const double o[3], const double inv[3], const bo
     return true;
 }
 
-static bool tri_hit(const lr_mesh *m, size_t t, lr_vec3 o, lr_vec3 d, double tmin, double tmax,
+/* Triangle t with corners p (the brute-force loops' from the mesh, the leaves' from b->tri). */
+static bool tri_hit(const lr_vec3 p[3], size_t t, lr_vec3 o, lr_vec3 d, double tmin, double tmax,
                     lr_hit *h)
 {
-    lr_vec3 p[3];
-    lr_mesh_triangle(m, t, p);
     double tt, u, v;
     if (!lr_ray_triangle(o, d, p[0], p[1], p[2], tmin, tmax, &tt, &u, &v))
         return false;
@@ -255,11 +254,9 @@ static bool traverse(const lr_bvh *b, lr_vec3 o, lr_vec3 d, double tmin, double 
         if (n->count) {
             for (uint32_t i = 0; i < n->count; i++) {
                 uint32_t k = n->first + i;
-                const lr_vec3 *p = &b->tri[3 * (size_t)k];
-                double tt, u, v;
-                if (!lr_ray_triangle(o, d, p[0], p[1], p[2], tmin, bound, &tt, &u, &v))
+                lr_hit h;
+                if (!tri_hit(&b->tri[3 * (size_t)k], b->order[k], o, d, tmin, bound, &h))
                     continue;
-                lr_hit h = {tt, b->order[k], u, v};
                 if (!found || better(&h, &best)) {
                     best = h;
                     found = true;
@@ -319,7 +316,9 @@ bool lr_mesh_intersect(const lr_mesh *m, lr_vec3 o, lr_vec3 d, double tmin, doub
     lr_hit best = {INFINITY, SIZE_MAX, 0, 0};
     for (size_t t = 0; t < lr_mesh_triangle_count(m); t++) {
         lr_hit h;
-        if (tri_hit(m, t, o, d, tmin, tmax, &h) && (!found || better(&h, &best))) {
+        lr_vec3 p[3];
+        lr_mesh_triangle(m, t, p);
+        if (tri_hit(p, t, o, d, tmin, tmax, &h) && (!found || better(&h, &best))) {
             best = h;
             found = true;
         }
@@ -329,14 +328,11 @@ bool lr_mesh_intersect(const lr_mesh *m, lr_vec3 o, lr_vec3 d, double tmin, doub
     return found;
 }
 
-static bool tri_closest(const lr_mesh *m, size_t t, lr_vec3 p, lr_closest *c)
+static void tri_closest(const lr_vec3 q[3], size_t t, lr_vec3 p, lr_closest *c)
 {
-    lr_vec3 q[3];
-    lr_mesh_triangle(m, t, q);
     c->point = lr_closest_on_triangle(p, q[0], q[1], q[2], c->w);
     c->distance = lr_v3_len(lr_v3_sub(p, c->point));
     c->triangle = t;
-    return true;
 }
 
 static bool closer(const lr_closest *a, const lr_closest *b)
@@ -376,11 +372,8 @@ bool lr_bvh_closest(const lr_bvh *b, lr_vec3 p, double max_dist, lr_closest *out
         if (n->count) {
             for (uint32_t i = 0; i < n->count; i++) {
                 uint32_t k = n->first + i;
-                const lr_vec3 *q = &b->tri[3 * (size_t)k];
                 lr_closest c;
-                c.point = lr_closest_on_triangle(p, q[0], q[1], q[2], c.w);
-                c.distance = lr_v3_len(lr_v3_sub(p, c.point));
-                c.triangle = b->order[k];
+                tri_closest(&b->tri[3 * (size_t)k], b->order[k], p, &c);
                 if (c.distance <= max_dist && (!found || closer(&c, &best))) {
                     best = c;
                     found = true;
@@ -407,7 +400,9 @@ bool lr_mesh_closest(const lr_mesh *m, lr_vec3 p, double max_dist, lr_closest *o
     lr_closest best = {.distance = INFINITY, .triangle = SIZE_MAX};
     for (size_t t = 0; t < lr_mesh_triangle_count(m); t++) {
         lr_closest c;
-        tri_closest(m, t, p, &c);
+        lr_vec3 q[3];
+        lr_mesh_triangle(m, t, q);
+        tri_closest(q, t, p, &c);
         if (c.distance <= max_dist && (!found || closer(&c, &best))) {
             best = c;
             found = true;
