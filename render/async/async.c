@@ -19,6 +19,7 @@
 #include "render/gl/tex.h"
 #include "render/passes/blend.h"
 #include "render/passes/defines.h"
+#include "render/passes/mix.h"
 #include "render/passes/passes.h"
 
 /* The worker runs at a lower priority than the caller (nice +3 relative: about half the CPU share of a nice-0 thread, so two busy loops beside the rig slow the transport but do not starve it): its threads (the
@@ -77,6 +78,17 @@ struct lr_async {
     unsigned no_preview_dirty;
     bool preview_always;
     double gpu_budget_mb;
+    /* The control-space cache (render/async/cache.h): the entries are under mu; the display
+     * of one (or of a mix drawn into `mixed`) is the caller's. */
+    bool rec_outside;    /* the batch being recorded changes transport outside the keys */
+    lr_mix *mix;
+    lr_tex *mixed;       /* the interpolated state's images */
+    int mixed_n;
+    struct {
+        bool on, exact, drawn;
+        uint64_t batch;  /* the batch whose state it shows */
+        lr_cache_mix mix;
+    } cached;
 
     /* ---- shared, under mu ---- */
     pthread_mutex_t mu;
@@ -87,7 +99,12 @@ struct lr_async {
     int shown, ready;    /* slot indices; -1: none */
     slot slots[2];
     uint64_t published;
-    uint64_t n_stage[LR_ASYNC_FINAL + 1]; /* publications per stage */
+    uint64_t n_stage[LR_ASYNC_STAGES]; /* publications per stage (cache ones: shown) */
+    lr_state_cache *cache; /* NULL: none */
+    uint64_t cache_epoch;  /* counts flushes: a state built across one is not stored */
+    uint64_t served_exact, served_interp; /* the last batches the cache answered */
+    lr_async_state *wishes; /* lr_async_anticipate's list */
+    int n_wishes, next_wish;
     int err_rc;
     lr_err err;
     /* The renderer's token (lr_renderer_set_cancel): requested by a stop, and by a transport
@@ -113,10 +130,17 @@ const char *lr_async_stage_name(lr_async_stage s)
 {
     switch (s) {
     case LR_ASYNC_PREVIEW: return "preview";
+    case LR_ASYNC_CACHED: return "cached";
+    case LR_ASYNC_INTERPOLATED: return "interpolated";
     case LR_ASYNC_REFINING: return "refining";
     case LR_ASYNC_FINAL: return "final";
     default: return "none";
     }
+}
+
+bool lr_async_stage_converged(lr_async_stage s)
+{
+    return s == LR_ASYNC_FINAL || s == LR_ASYNC_CACHED;
 }
 
 static double now_ms(void)
@@ -188,6 +212,8 @@ static void journal(void *user, const char *key, const char *value, unsigned dir
         pthread_mutex_unlock(&a->mu);
     }
     a->rec.dirty |= dirty;
+    if (a->cache && (dirty & TRANSPORT_DIRTY) && !lr_state_cache_has_key(a->cache, key))
+        a->rec_outside = true; /* the cache's keys are fixed at create: read without the lock */
 }
 
 /* ---- the worker ---- */
@@ -206,6 +232,23 @@ static void notify(lr_async *a)
     if (write(a->efd, &one, sizeof one) < 0) {
         /* EAGAIN: the counter is already non-zero, the caller will wake. */
     }
+}
+
+/* Copies n layers of src into dst (both the view's size) on the worker's context. */
+static void copy_layers(lr_async *a, const lr_tex *src, lr_tex *dst, int n)
+{
+    for (int l = 0; l < n; l++) {
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, a->read_fb);
+        glFramebufferTextureLayer(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, lr_tex_id(src), 0, l);
+        glReadBuffer(GL_COLOR_ATTACHMENT0);
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, a->draw_fb);
+        glFramebufferTextureLayer(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, lr_tex_id(dst), 0, l);
+        GLenum att = GL_COLOR_ATTACHMENT0;
+        glDrawBuffers(1, &att);
+        glBlitFramebuffer(0, 0, a->width, a->height, 0, 0, a->width, a->height,
+                          GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
 /* Copies the renderer's images into the slot the caller is not reading and publishes it. */
@@ -242,19 +285,7 @@ static int publish(lr_async *a, const lr_frame_stats *st, lr_async_stage stage, 
         s->w = a->width;
         s->h = a->height;
     }
-    for (int l = 0; l < n; l++) {
-        glBindFramebuffer(GL_READ_FRAMEBUFFER, a->read_fb);
-        glFramebufferTextureLayer(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, lr_tex_id(src), 0, l);
-        glReadBuffer(GL_COLOR_ATTACHMENT0);
-        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, a->draw_fb);
-        glFramebufferTextureLayer(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, lr_tex_id(s->tex), 0,
-                                  l);
-        GLenum att = GL_COLOR_ATTACHMENT0;
-        glDrawBuffers(1, &att);
-        glBlitFramebuffer(0, 0, a->width, a->height, 0, 0, a->width, a->height,
-                          GL_COLOR_BUFFER_BIT, GL_NEAREST);
-    }
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    copy_layers(a, src, s->tex, n);
     int rc = lr_gl_check("async: publishing the images", e);
     if (rc)
         return rc;
@@ -324,6 +355,125 @@ static int preview_frame(lr_async *a, uint64_t batch, unsigned *dirty, lr_err *e
         }
     }
     *dirty = back;
+    return rc;
+}
+
+/* Starts a frame of a state built ahead: false when it must not (a stop, or a batch that
+ * changes transport waits: the loop takes it first; a dimmer's batch waits for the end). */
+static bool ahead_begin(lr_async *a)
+{
+    pthread_mutex_lock(&a->mu);
+    bool go = !a->stop && !(a->queue.n > 0 && (a->queue.dirty & TRANSPORT_DIRTY));
+    if (go) {
+        lr_cancel_reset(&a->cancel);
+        a->cancellable = true;
+    }
+    pthread_mutex_unlock(&a->mu);
+    return go;
+}
+
+static void frame_end(lr_async *a);
+
+/* Builds the next state of the anticipation list that is not cached yet: its assignments on
+ * the copy, frames to convergence, its images into a new cache entry, the copy's values back
+ * (their flags left in the renderer for the next frame that renders: the images shown stay
+ * those of the scene's own state). Returns LR_OK with *did false when the list is done, and
+ * LR_ECANCELED when a change or a stop cut it (the state is visited again later). */
+static int build_ahead(lr_async *a, bool *did, lr_err *e)
+{
+    *did = false;
+    pthread_mutex_lock(&a->mu);
+    if (!a->cache || a->next_wish >= a->n_wishes || a->stop ||
+        (a->queue.n > 0 && (a->queue.dirty & TRANSPORT_DIRTY))) {
+        pthread_mutex_unlock(&a->mu);
+        return LR_OK;
+    }
+    lr_async_state w = a->wishes[a->next_wish];
+    uint64_t epoch = a->cache_epoch;
+    int nkeys;
+    const lr_cache_key *keys = lr_state_cache_keys(a->cache, &nkeys);
+    pthread_mutex_unlock(&a->mu);
+    *did = true;
+
+    char old[LR_ASYNC_STATE_SETS][LR_CACHE_VALUE_MAX];
+    int rc = LR_OK, applied = 0;
+    unsigned d = 0;
+    for (int i = 0; i < w.n && !rc; i++)
+        if (!(rc = lr_scene_get(a->wscene, w.key[i], old[i], sizeof old[i], e)) &&
+            !(rc = lr_scene_set(a->wscene, w.key[i], w.value[i], &d, e)))
+            applied = i + 1;
+    lr_state_tag tag;
+    bool held = false;
+    if (!rc && !(rc = lr_state_tag_of(a->wscene, keys, nkeys, &tag, e))) {
+        pthread_mutex_lock(&a->mu);
+        held = lr_state_cache_holds(a->cache, &tag);
+        pthread_mutex_unlock(&a->mu);
+    }
+    /* A state the copy refuses (a value outside what the material allows): passed over, not
+     * an error of the view. */
+    bool skip = rc != LR_OK, rendered = false;
+    rc = LR_OK;
+    int n = 0;
+    float scale[LR_SCENE_MAX_LIGHTS] = {0};
+    if (!skip && !held) {
+        lr_renderer_invalidate(a->r, d);
+        do {
+            if (!ahead_begin(a)) {
+                rc = LR_ECANCELED;
+                break;
+            }
+            lr_frame_stats st;
+            rc = lr_renderer_frame(a->r, &st, e);
+            frame_end(a);
+            rendered = true;
+        } while (!rc && lr_renderer_needs_frame(a->r));
+        const lr_tex *src = rc ? NULL : lr_renderer_images(a->r, &n, scale);
+        size_t bytes = (size_t)a->width * (size_t)a->height * 16u * (size_t)n;
+        pthread_mutex_lock(&a->mu);
+        bool fits = src && n > 0 && lr_state_cache_fits(a->cache, bytes);
+        pthread_mutex_unlock(&a->mu);
+        if (src && n > 0 && !fits) {
+            /* Full of pinned entries or too small: the rest of the list would not fit either. */
+            pthread_mutex_lock(&a->mu);
+            a->next_wish = a->n_wishes;
+            pthread_mutex_unlock(&a->mu);
+        } else if (src && n > 0) {
+            lr_tex *t = NULL;
+            lr_tex_desc td = {.type = LR_TEX_2D_ARRAY, .format = LR_TEX_RGBA32F,
+                              .width = a->width, .height = a->height, .layers = n,
+                              .label = "cached state's images"};
+            if (!(rc = lr_tex_create(a->wgl, &td, &t, e))) {
+                copy_layers(a, src, t, n);
+                rc = lr_gl_check("async: caching a state's images", e);
+                glFinish(); /* complete before the caller may read it */
+            }
+            pthread_mutex_lock(&a->mu);
+            if (!rc && a->cache_epoch == epoch)
+                lr_state_cache_store(a->cache, &tag, t, n, scale, bytes);
+            else
+                lr_tex_destroy(t);
+            lr_state_cache_reap(a->cache);
+            pthread_mutex_unlock(&a->mu);
+        }
+    }
+    unsigned back = 0;
+    for (int i = applied - 1; i >= 0; i--) {
+        lr_err re = {0};
+        int rrc = lr_scene_set(a->wscene, w.key[i], old[i], &back, &re);
+        if (rrc && (!rc || rc == LR_ECANCELED)) {
+            rc = rrc;
+            *e = re;
+        }
+    }
+    /* Nothing rendered: the renderer still holds the scene's own state. */
+    if (rendered)
+        lr_renderer_invalidate(a->r, back | d);
+    if (rc == LR_OK) {
+        pthread_mutex_lock(&a->mu);
+        if (a->next_wish < a->n_wishes && a->cache_epoch == epoch)
+            a->next_wish++;
+        pthread_mutex_unlock(&a->mu);
+    }
     return rc;
 }
 
@@ -397,18 +547,37 @@ static void *worker_main(void *arg)
     while (a->r) {
         pthread_mutex_lock(&a->mu);
         bool work = (dirty & TRANSPORT_DIRTY) || !converged;
-        while (!a->stop && !a->queue.n && !work) {
+        bool ahead = a->cache && a->next_wish < a->n_wishes;
+        while (!a->stop && !a->queue.n && !work && !ahead) {
             a->busy = false;
             pthread_cond_broadcast(&a->cv);
             pthread_cond_wait(&a->cv, &a->mu);
+            ahead = a->cache && a->next_wish < a->n_wishes;
         }
         if (a->stop) {
             pthread_mutex_unlock(&a->mu);
             break;
         }
+        if (!a->queue.n && !work) {
+            /* Nothing of the shown state left to do: build a state ahead (not "busy": the
+             * view has converged; a change cuts it). */
+            a->busy = false;
+            pthread_cond_broadcast(&a->cv);
+            pthread_mutex_unlock(&a->mu);
+            bool did;
+            rc = build_ahead(a, &did, &e);
+            if (rc && rc != LR_ECANCELED) {
+                worker_fail(a, rc, &e);
+                pthread_mutex_lock(&a->mu);
+                a->next_wish = a->n_wishes; /* not again until a new list */
+                pthread_mutex_unlock(&a->mu);
+            }
+            continue;
+        }
         a->busy = true;
         bool fresh = a->queue.n > 0;
         uint64_t b = a->queue_batch;
+        uint64_t exact_b = a->served_exact, interp_b = a->served_interp;
         set_list tmp = a->queue;
         a->queue = batch; /* empty */
         batch = tmp;
@@ -424,6 +593,18 @@ static void *worker_main(void *arg)
             }
             dirty |= got;
             lr_renderer_invalidate(a->r, got);
+            if (applied == exact_b) {
+                /* The caller shows this state's cached images: nothing to render (the
+                 * renderer keeps the flags for the next state that needs it). */
+                dirty = 0;
+                converged = true;
+                pthread_mutex_lock(&a->mu);
+                if (applied > a->published)
+                    a->published = applied;
+                pthread_cond_broadcast(&a->cv);
+                pthread_mutex_unlock(&a->mu);
+                continue;
+            }
             if (!(got & TRANSPORT_DIRTY) && converged) {
                 /* The published images stand for this batch too. */
                 pthread_mutex_lock(&a->mu);
@@ -436,7 +617,9 @@ static void *worker_main(void *arg)
         }
         bool heavy = first || (fresh && (got & HEAVY_DIRTY));
         bool worth = a->preview_always || !(a->preview_ms > 0.5 * a->full_ms && a->full_ms > 0);
-        if (a->n_preview && worth &&
+        /* An interpolation of cached states shows until this state converges: no preview. */
+        bool interpolated = fresh && applied == interp_b;
+        if (a->n_preview && worth && !interpolated &&
             (first || (heavy && (got & ~a->no_preview_dirty & TRANSPORT_DIRTY)))) {
             unsigned back = dirty;
             if (!frame_begin(a, false))
@@ -522,6 +705,12 @@ static void *worker_main(void *arg)
     list_free(&batch);
     lr_renderer_destroy(a->r);
     a->r = NULL;
+    /* The cache's textures were made on this context: freed with it (the caller no longer
+     * draws: a stop, or lr_async_destroy, which finished its own GL work first). */
+    pthread_mutex_lock(&a->mu);
+    if (a->cache)
+        lr_state_cache_drop_all(a->cache);
+    pthread_mutex_unlock(&a->mu);
     /* The caller no longer reads the slots (lr_async_destroy freed its side first). */
     for (int i = 0; i < 2; i++) {
         lr_tex_destroy(a->slots[i].tex);
@@ -554,7 +743,23 @@ static int caller_programs(lr_async *a, lr_err *e)
     lr_passes_defines(&a->defines);
     lr_blend_desc bd = {.gl = a->gl, .width = a->width, .height = a->height,
                         .shader_dir = a->shader_dir, .defines = a->defines.list};
-    return lr_blend_create(&bd, &a->blend, e);
+    int rc = lr_blend_create(&bd, &a->blend, e);
+    if (!rc && a->cache)
+        rc = lr_mix_create(a->gl, a->shader_dir, &a->mix, e);
+    return rc;
+}
+
+/* The cache over desc's keys, each checked against the scene. */
+static int cache_create(lr_async *a, const lr_async_desc *d, lr_err *e)
+{
+    if (!d->cache_keys || d->n_cache_keys <= 0 || !(d->cache_mb > 0.0))
+        return LR_OK;
+    lr_state_tag tag;
+    int rc = lr_state_tag_of(d->scene, d->cache_keys, d->n_cache_keys, &tag, e);
+    if (rc)
+        return lr_err_prefix(e, "async");
+    return lr_state_cache_create(d->cache_keys, d->n_cache_keys,
+                                 (size_t)(d->cache_mb * 1024.0 * 1024.0), &a->cache, e);
 }
 
 static int check_preview(lr_async *a, const lr_async_desc *d, lr_err *e)
@@ -602,6 +807,8 @@ int lr_async_create(const lr_async_desc *d, lr_async **out, lr_err *e)
     pthread_cond_init(&a->cv, NULL);
     lr_cancel_init(&a->cancel);
     int rc = check_preview(a, d, e);
+    if (!rc)
+        rc = cache_create(a, d, e);
     if (!rc && (a->efd = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) < 0)
         rc = lr_err_set(e, LR_EIO, "async: eventfd: %s", strerror(errno));
     if (!rc)
@@ -675,6 +882,11 @@ void lr_async_destroy(lr_async *a)
         pthread_mutex_unlock(&a->mu);
         pthread_join(a->th, NULL);
     }
+    /* The worker freed the entries' textures as it exited (they are its context's). */
+    lr_state_cache_destroy(a->cache);
+    lr_tex_destroy(a->mixed);
+    lr_mix_destroy(a->mix);
+    free(a->wishes);
     lr_scene_destroy(a->wscene);
     list_free(&a->rec);
     list_free(&a->queue);
@@ -691,8 +903,41 @@ uint64_t lr_async_commit(lr_async *a, unsigned dirty)
         a->blend_due = true;
     if (!a->rec.n)
         return 0;
+    /* The committed state's tag, read before the lock (the caller's scene is this thread's). */
+    lr_state_tag tag;
+    int nkeys = 0;
+    const lr_cache_key *keys = a->cache ? lr_state_cache_keys(a->cache, &nkeys) : NULL;
+    lr_err te = {0};
+    bool tagged = a->cache && (dirty & TRANSPORT_DIRTY) &&
+                  lr_state_tag_of(a->scene, keys, nkeys, &tag, &te) == LR_OK;
     pthread_mutex_lock(&a->mu);
     uint64_t b = ++a->batches;
+    if (a->cache && a->rec_outside) {
+        /* A change outside the keys: every entry was built on a scene that no longer is. */
+        lr_state_cache_flush(a->cache);
+        a->cache_epoch++;
+    }
+    a->rec_outside = false;
+    if (a->cache && (dirty & TRANSPORT_DIRTY)) {
+        lr_cache_mix mix;
+        /* A miss leaves a cached image shown until the worker publishes this state (a
+         * newer batch): an older state's image would step back. */
+        bool hit = tagged && lr_state_cache_find(a->cache, &tag, &mix);
+        if (hit) {
+            if (a->cached.on)
+                lr_state_cache_unpin(a->cache, &a->cached.mix);
+            a->cached.on = true;
+            lr_state_cache_pin(a->cache, &mix);
+            a->cached.mix = mix;
+            a->cached.exact = mix.exact;
+            a->cached.drawn = false;
+            a->cached.batch = b;
+            if (mix.exact)
+                a->served_exact = b;
+            else
+                a->served_interp = b;
+        }
+    }
     if (!list_append(&a->queue, &a->rec) && !a->err_rc)
         a->err_rc = lr_err_set(&a->err, LR_ENOMEM, "async: a batch of changes: out of memory");
     a->queue_batch = b;
@@ -730,9 +975,9 @@ bool lr_async_needs_frame(const lr_async *a)
     lr_async *m = (lr_async *)a; /* the mutex only */
     pthread_mutex_lock(&m->mu);
     bool ready = a->ready >= 0;
-    bool shown = a->shown >= 0;
+    bool shown = a->shown >= 0 || a->cached.on;
     pthread_mutex_unlock(&m->mu);
-    return ready || (a->blend_due && shown);
+    return ready || (a->cached.on && !a->cached.drawn) || (a->blend_due && shown);
 }
 
 bool lr_async_busy(const lr_async *a)
@@ -756,7 +1001,9 @@ static uint64_t locked_u64(const lr_async *a, const uint64_t *field)
 
 uint64_t lr_async_published(const lr_async *a) { return locked_u64(a, &a->published); }
 
-/* Takes the ready publication once the worker's copy has finished on the GPU. */
+/* Takes the ready publication once the worker's copy has finished on the GPU. While a
+ * cached state shows, only a publication of a newer state replaces it, or the converged image
+ * of the interpolated state itself; an older state's is dropped. */
 static bool take_ready(lr_async *a)
 {
     bool took = false;
@@ -765,13 +1012,74 @@ static bool take_ready(lr_async *a)
         slot *s = &a->slots[a->ready];
         GLenum w = s->written ? glClientWaitSync(s->written, 0, 0) : GL_ALREADY_SIGNALED;
         if (w == GL_ALREADY_SIGNALED || w == GL_CONDITION_SATISFIED) {
-            a->shown = a->ready;
+            bool replaces = !a->cached.on || s->batch > a->cached.batch ||
+                            (s->batch == a->cached.batch && !a->cached.exact &&
+                             s->stage == LR_ASYNC_FINAL);
+            if (replaces) {
+                a->shown = a->ready;
+                took = true;
+                if (a->cached.on) {
+                    lr_state_cache_unpin(a->cache, &a->cached.mix);
+                    a->cached.on = false;
+                }
+            }
             a->ready = -1;
-            took = true;
         }
     }
     pthread_mutex_unlock(&a->mu);
     return took;
+}
+
+/* The shown cached state's images: an exact entry's own, or its mix drawn once into `mixed`
+ * (scale 1). Under mu for the entries. */
+static int cached_images(lr_async *a, const lr_tex **images, int *n, float *scale, lr_err *e)
+{
+    pthread_mutex_lock(&a->mu);
+    const lr_cache_mix *m = &a->cached.mix;
+    const float *sc = NULL;
+    const lr_tex *t0 = lr_state_cache_images(a->cache, m->entry[0], n, &sc);
+    if (!t0) {
+        pthread_mutex_unlock(&a->mu);
+        return lr_err_set(e, LR_EINVAL, "async: a pinned cache entry is gone");
+    }
+    if (m->exact) {
+        memcpy(scale, sc, (size_t)*n * sizeof *scale);
+        *images = t0;
+        pthread_mutex_unlock(&a->mu);
+        return LR_OK;
+    }
+    lr_mix_input in = {.n = m->n, .layers = *n};
+    for (int k = 0; k < m->n; k++) {
+        int nk = 0;
+        const float *sk = NULL;
+        in.sets[k] = lr_state_cache_images(a->cache, m->entry[k], &nk, &sk);
+        if (!in.sets[k] || nk != *n) {
+            pthread_mutex_unlock(&a->mu);
+            return lr_err_set(e, LR_EINVAL, "async: cached states differ in their lights");
+        }
+        for (int b = 0; b < 3; b++)
+            in.a[k][b] = m->w[k][b];
+        for (int l = 0; l < *n; l++)
+            in.d[k][l] = sk[l] > 0.0f ? sk[l] : 1.0;
+    }
+    pthread_mutex_unlock(&a->mu);
+    for (int l = 0; l < *n; l++)
+        scale[l] = 1.0f;
+    *images = a->mixed;
+    if (a->cached.drawn)
+        return LR_OK;
+    if (!a->mixed || a->mixed_n != *n) {
+        lr_tex_destroy(a->mixed);
+        a->mixed = NULL;
+        lr_tex_desc td = {.type = LR_TEX_2D_ARRAY, .format = LR_TEX_RGBA32F, .width = a->width,
+                          .height = a->height, .layers = *n, .label = "interpolated images"};
+        int rc = lr_tex_create(a->gl, &td, &a->mixed, e);
+        if (rc)
+            return rc;
+        a->mixed_n = *n;
+    }
+    *images = a->mixed;
+    return lr_mix_run(a->mix, &in, a->mixed, e);
 }
 
 int lr_async_frame(lr_async *a, lr_async_frame_stats *st, lr_err *e)
@@ -783,13 +1091,29 @@ int lr_async_frame(lr_async *a, lr_async_frame_stats *st, lr_err *e)
     double t0 = now_ms();
     lr_async_frame_stats out = {0};
     out.new_images = take_ready(a);
-    if (a->shown < 0) {
+    if (a->shown < 0 && !a->cached.on) {
         if (st)
             *st = out;
         return LR_OK; /* nothing published yet: nothing to draw */
     }
-    slot *s = &a->slots[a->shown]; /* the worker does not touch the shown slot */
-    lr_blend_input in = {.images = s->tex, .n = s->n, .exposure =
+    slot *s = a->cached.on ? NULL : &a->slots[a->shown]; /* the worker leaves it alone */
+    const lr_tex *images = s ? s->tex : NULL;
+    int n_images = s ? s->n : 0;
+    float cscale[LR_SCENE_MAX_LIGHTS];
+    const float *scale = s ? s->scale : cscale;
+    if (!s) {
+        int rc = cached_images(a, &images, &n_images, cscale, e);
+        if (rc)
+            return rc;
+        if (!a->cached.drawn) {
+            a->cached.drawn = true;
+            out.new_images = true;
+            pthread_mutex_lock(&a->mu);
+            a->n_stage[a->cached.exact ? LR_ASYNC_CACHED : LR_ASYNC_INTERPOLATED]++;
+            pthread_mutex_unlock(&a->mu);
+        }
+    }
+    lr_blend_input in = {.images = images, .n = n_images, .exposure =
                          (float)lr_scene_render(a->scene)->exposure,
                          .tonemap_op = LR_RENDER_TONEMAP};
     int nl = lr_scene_light_count(a->scene);
@@ -804,7 +1128,7 @@ int lr_async_frame(lr_async *a, lr_async_frame_stats *st, lr_err *e)
         if (a->clock_set && light->flicker.amplitude > 0.0)
             lr_light_flicker_at(light, a->time_s, &f, NULL);
         for (int b = 0; b < 3; b++)
-            in.w[l][b] = I[b] * f / s->scale[l];
+            in.w[l][b] = I[b] * f / scale[l];
     }
     int rc = lr_blend_run(a->blend, &in, e);
     if (rc)
@@ -812,12 +1136,21 @@ int lr_async_frame(lr_async *a, lr_async_frame_stats *st, lr_err *e)
     GLsync read = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
     glFlush();
     pthread_mutex_lock(&a->mu);
-    if (s->read)
-        glDeleteSync(s->read);
-    s->read = read;
-    out.worker = s->st;
-    out.stage = s->stage;
-    out.batch = s->batch;
+    if (s) {
+        if (s->read)
+            glDeleteSync(s->read);
+        s->read = read;
+        out.worker = s->st;
+        out.stage = s->stage;
+        out.batch = s->batch;
+    } else {
+        /* The cache's textures are only ever dropped by the worker once unpinned; its
+         * deletion waits for the GL's own use of them. */
+        glDeleteSync(read);
+        out.worker.converged = a->cached.exact;
+        out.stage = a->cached.exact ? LR_ASYNC_CACHED : LR_ASYNC_INTERPOLATED;
+        out.batch = a->cached.batch;
+    }
     pthread_mutex_unlock(&a->mu);
     a->blend_due = false;
     out.blend_ms = now_ms() - t0;
@@ -839,7 +1172,7 @@ int lr_async_wait(lr_async *a, uint64_t batch, bool final, int timeout_ms, lr_er
     int rc = LR_OK;
     pthread_mutex_lock(&a->mu);
     for (;;) {
-        bool have = (a->ready >= 0 || a->shown >= 0) && a->published >= batch;
+        bool have = (a->ready >= 0 || a->shown >= 0 || a->cached.on) && a->published >= batch;
         if (have && (!final || (!a->busy && !a->queue.n)))
             break;
         if (a->err_rc) {
@@ -872,7 +1205,7 @@ int lr_async_error(lr_async *a, lr_err *e)
 
 uint64_t lr_async_publications(const lr_async *a, lr_async_stage stage)
 {
-    return (unsigned)stage <= LR_ASYNC_FINAL ? locked_u64(a, &a->n_stage[stage]) : 0;
+    return (unsigned)stage < LR_ASYNC_STAGES ? locked_u64(a, &a->n_stage[stage]) : 0;
 }
 
 bool lr_async_cuttable(const lr_async *a)
@@ -888,6 +1221,42 @@ uint64_t lr_async_cancelled(const lr_async *a) { return locked_u64(a, &a->n_canc
 
 int lr_async_event_fd(const lr_async *a) { return a->efd; }
 
+int lr_async_anticipate(lr_async *a, const lr_async_state *states, int n, lr_err *e)
+{
+    if (n < 0 || n > LR_ASYNC_MAX_STATES)
+        return lr_err_set(e, LR_EINVAL, "async: %d states to build ahead; at most %d", n,
+                          LR_ASYNC_MAX_STATES);
+    if (!a->cache)
+        return LR_OK;
+    lr_async_state *w = NULL;
+    if (n > 0) {
+        w = malloc((size_t)n * sizeof *w);
+        if (!w)
+            return lr_err_set(e, LR_ENOMEM, "async: out of memory");
+        memcpy(w, states, (size_t)n * sizeof *w);
+    }
+    pthread_mutex_lock(&a->mu);
+    free(a->wishes);
+    a->wishes = w;
+    a->n_wishes = n;
+    a->next_wish = 0;
+    pthread_cond_broadcast(&a->cv);
+    pthread_mutex_unlock(&a->mu);
+    return LR_OK;
+}
+
+void lr_async_cache_stats(const lr_async *a, lr_state_cache_stats *st, int *pending)
+{
+    lr_async *m = (lr_async *)a;
+    *st = (lr_state_cache_stats){0};
+    pthread_mutex_lock(&m->mu);
+    if (a->cache)
+        lr_state_cache_get_stats(a->cache, st);
+    if (pending)
+        *pending = a->n_wishes - a->next_wish;
+    pthread_mutex_unlock(&m->mu);
+}
+
 int lr_async_read_rgba8(lr_async *a, unsigned char *out, lr_err *e)
 {
     return lr_blend_read_rgba8(a->blend, out, e);
@@ -895,7 +1264,7 @@ int lr_async_read_rgba8(lr_async *a, unsigned char *out, lr_err *e)
 
 int lr_async_read_hdr(lr_async *a, float *rgb, lr_err *e)
 {
-    if (a->shown < 0)
+    if (a->shown < 0 && !a->cached.on)
         return lr_err_set(e, LR_EINVAL, "async: no image yet");
     return lr_blend_read_hdr(a->blend, rgb, e);
 }

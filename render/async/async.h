@@ -51,6 +51,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "render/async/cache.h"
 #include "render/base/err.h"
 #include "render/gl/gl.h"
 #include "render/renderer.h"
@@ -65,7 +66,13 @@ typedef enum lr_async_stage {
     LR_ASYNC_PREVIEW,   /* the preview settings, first frame after a transport change */
     LR_ASYNC_REFINING,  /* the scene's own settings, still accumulating */
     LR_ASYNC_FINAL,     /* the scene's own settings, converged */
+    LR_ASYNC_CACHED,    /* the state's converged images, built ahead (render/async/cache.h) */
+    LR_ASYNC_INTERPOLATED, /* interpolated between cached states around it */
 } lr_async_stage;
+#define LR_ASYNC_STAGES (LR_ASYNC_INTERPOLATED + 1)
+
+/* Whether a stage shows the state converged (final or cached). */
+bool lr_async_stage_converged(lr_async_stage s);
 
 const char *lr_async_stage_name(lr_async_stage s);
 
@@ -88,7 +95,21 @@ typedef struct lr_async_desc {
      * image: it is skipped until a full frame gets dearer again. true: always drawn. */
     bool preview_always;
     double gpu_budget_mb; /* the worker's renderer's (lr_renderer_desc); 0: no limit */
+    /* The control-space cache (render/async/cache.h): the keys whose values name a state,
+     * and the memory its images may take. None, or cache_mb 0: no cache. */
+    const lr_cache_key *cache_keys;
+    int n_cache_keys;
+    double cache_mb;
 } lr_async_desc;
+
+/* A state the caller may ask for next: assignments on top of the scene as last committed. */
+#define LR_ASYNC_STATE_SETS 16
+typedef struct lr_async_state {
+    int n;
+    char key[LR_ASYNC_STATE_SETS][LR_CACHE_KEY_MAX];
+    char value[LR_ASYNC_STATE_SETS][LR_CACHE_VALUE_MAX];
+} lr_async_state;
+#define LR_ASYNC_MAX_STATES 48
 
 typedef struct lr_async_frame_stats {
     lr_frame_stats worker;   /* the worker frame whose images are shown */
@@ -119,6 +140,28 @@ bool lr_async_stopped(const lr_async *a);
  * returned (intensity and display changes only mark the caller's next blend due). Returns
  * the batch number (counting from 1), or 0 when there was nothing to hand over. */
 uint64_t lr_async_commit(lr_async *a, unsigned dirty);
+
+/* The control-space cache.
+ *
+ * lr_async_commit looks the committed state up (its tag over desc.cache_keys): an entry of
+ * its own shows at the next frame as LR_ASYNC_CACHED and the worker renders nothing for it;
+ * an interpolation of cached states around it shows as LR_ASYNC_INTERPOLATED (its images
+ * mixed once, render/passes/mix.h) until the worker's converged image of the exact state
+ * replaces it (the worker skips the preview stage for it). A committed change to any key
+ * outside the cache's keys that changes light transport drops every entry: they were built
+ * on a scene that no longer is.
+ *
+ * lr_async_anticipate replaces the list of states to build ahead: whenever the worker has
+ * nothing else to do (no batch queued, the shown state converged) it renders the next one
+ * not yet cached to convergence (each frame cut by a transport batch, as a full frame is),
+ * stores its images, and restores its copy of the scene. A state that does not fit the
+ * budget (after evicting the least recently used) ends the list. The states are read when
+ * built, so they are relative to the scene as committed then. Errors: more than
+ * LR_ASYNC_MAX_STATES states. */
+int lr_async_anticipate(lr_async *a, const lr_async_state *states, int n, lr_err *e);
+/* The cache's counters (zeroes without a cache); *pending: states of the list not yet
+ * visited. */
+void lr_async_cache_stats(const lr_async *a, lr_state_cache_stats *st, int *pending);
 
 /* The renderer's clock (lr_renderer_set_time): flicker enters the blend. */
 void lr_async_set_time(lr_async *a, double t_seconds);
