@@ -1131,11 +1131,16 @@ static int parse_root(ctx *x)
     c->output.fps = 30;
     /* A quarter of a 4 GB board, whose GPU shares the RAM: the shipped rigs need 10-60 MB. */
     c->output.gpu_memory_mb = 1024;
+    /* Converged images of the controls' next states (render/async/cache.h): a 640x480 state of
+     * one light is 4.7 MB, so 256 MB holds every preset and sample of the shipped maps with
+     * room, a sixteenth of a 4 GB board. */
+    c->output.cache_mb = 256;
+    c->output.cache_samples = 9;
     lr_jnode out = lr_json_get(j, root, "output");
     if (out != LR_JNONE) {
         static const char *const ok[] = {"mode", "connector", "drm_device", "mode_size",
                                          "refresh_hz", "width", "height", "fps", "renderer",
-                                         "gpu_memory_mb", NULL};
+                                         "gpu_memory_mb", "cache_mb", "cache_samples", NULL};
         /* "mode" is headless|kms; the display mode size is "mode_size": [W, H]. */
         if ((rc = keys(x, out, "output", ok)))
             return rc;
@@ -1172,6 +1177,10 @@ static int parse_root(ctx *x)
             (rc = get_num_in(x, out, "output", "fps", false, 0.1, 1000, &c->output.fps)) ||
             (rc = get_num_in(x, out, "output", "gpu_memory_mb", false, 0, 1048576,
                              &c->output.gpu_memory_mb)) ||
+            (rc = get_num_in(x, out, "output", "cache_mb", false, 0, 1048576,
+                             &c->output.cache_mb)) ||
+            (rc = get_int_in(x, out, "output", "cache_samples", false, 2, 48,
+                             &c->output.cache_samples)) ||
             (rc = get_str(x, out, "output", "renderer", false, c->output.renderer,
                           sizeof c->output.renderer)))
             return rc;

@@ -18,7 +18,10 @@
  *                "fps": 30 (headless frame rate cap; kms follows vsync),
  *                "renderer": "passes" | "preview" (default: the first one built in),
  *                "gpu_memory_mb": 1024 (the renderer's textures at most: settings that need
- *                more are refused with what they need; 0: no limit)}
+ *                more are refused with what they need; 0: no limit),
+ *                "cache_mb": 256 ("passes": converged images of the states the controls
+ *                reach next, built ahead while the rig is idle, firmware/rig/ahead.h; 0: none),
+ *                "cache_samples": 9 (states along each continuous material control: 2..48)}
  *   "safe_level": 0                    lamp-driver level (0..1, as written to the driver,
  *                                      after any curve) set at shutdown
  *   "stats":    {"path": "PATH" (default none), "period_s": 10 (0: only at exit)}
@@ -268,6 +271,8 @@ typedef struct lr_rig_config {
         double fps;
         char renderer[LR_RIG_NAME_MAX]; /* "" = default */
         double gpu_memory_mb;           /* the renderer's GPU memory budget; 0: none */
+        double cache_mb;                /* the control-space cache's images; 0: none */
+        int cache_samples;              /* states per continuous control built ahead */
     } output;
     double safe_level;
     char stats_path[LR_RIG_PATH_MAX];

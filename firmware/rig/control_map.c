@@ -503,6 +503,58 @@ const char *lr_control_map_scene_request(lr_control_map *m)
     return m->scene_request;
 }
 
+const char *lr_control_map_key(const lr_control_map *m, int i)
+{
+    if (i < 0 || i >= m->n)
+        return NULL;
+    const bstate *s = &m->st[i];
+    if (s->group >= 0 && m->groups[s->group].relative)
+        return m->groups[s->group].target;
+    return s->b->param;
+}
+
+bool lr_control_map_is_cycle(const lr_control_map *m, int i)
+{
+    return i >= 0 && i < m->n && m->st[i].b->kind == LR_BIND_CYCLE;
+}
+
+int lr_control_map_values(const lr_control_map *m, int i)
+{
+    return lr_control_map_is_cycle(m, i) ? m->st[i].b->n_values : 0;
+}
+
+int lr_control_map_what_if(const lr_control_map *m, int i, double pos, lr_scene *scene,
+                           int64_t now_ns, unsigned *dirty, lr_err *e)
+{
+    if (i < 0 || i >= m->n)
+        return lr_err_set(e, LR_EINVAL, "control map: no binding %d", i);
+    lr_control_map *t = malloc(sizeof *t);
+    if (!t)
+        return lr_err_set(e, LR_ENOMEM, "out of memory");
+    *t = *m;
+    for (int k = 0; k < t->n; k++) {
+        bstate *s = &t->st[k];
+        if (s->b->kind == LR_BIND_LEVEL)
+            lr_fade_init(&s->fade, lr_fade_value(&s->fade, lr_fade_end_ns(&s->fade)));
+        s->cycle_pending = false;
+    }
+    bstate *s = &t->st[i];
+    if (s->b->kind == LR_BIND_LEVEL) {
+        double x = pos < 0 ? 0 : pos > 1 ? 1 : pos;
+        s->x = x;
+        lr_fade_init(&s->fade, level_of(s->b, x));
+    } else if (strcmp(s->b->param, "scene") != 0) {
+        int n = s->b->n_values;
+        s->index = n > 0 ? ((int)pos % n + n) % n : 0;
+        s->cycle_pending = true;
+    }
+    for (int g = 0; g < t->n_groups; g++)
+        t->groups[g].need_base = false; /* the live map's base stands */
+    int rc = lr_control_map_update(t, scene, now_ns, dirty, e);
+    free(t);
+    return rc;
+}
+
 int lr_control_map_count(const lr_control_map *m) { return m->n; }
 
 double lr_control_map_position(const lr_control_map *m, int i)

@@ -72,6 +72,20 @@ bool lr_control_map_lamp_level(const lr_control_map *m, int64_t now_ns, double *
 /* A scene switch waiting to be loaded (a path from the binding's values), or NULL. Clears it. */
 const char *lr_control_map_scene_request(lr_control_map *m);
 
+/* ---- the control space, for states built ahead (firmware/rig/ahead.h) ---- */
+/* The scene key binding i writes: its param (a light's level: the light's intensity or
+ * radiance key; "scene": "scene"). */
+const char *lr_control_map_key(const lr_control_map *m, int binding);
+bool lr_control_map_is_cycle(const lr_control_map *m, int binding);
+/* A cycle binding's number of values (0 for a level binding). */
+int lr_control_map_values(const lr_control_map *m, int binding);
+/* Writes into `scene` (a copy of the one the map drives) what the map would write with
+ * binding i at `pos` -- a level binding's position x in [0, 1], a cycle binding's value index
+ * -- and every other binding where its fade ends, ORing the flags into *dirty. The map itself
+ * is left as it is. Errors: the scene's refusal, i out of range. */
+int lr_control_map_what_if(const lr_control_map *m, int binding, double pos, lr_scene *scene,
+                           int64_t now_ns, unsigned *dirty, lr_err *e);
+
 /* For tests and logs. */
 int lr_control_map_count(const lr_control_map *m);
 double lr_control_map_position(const lr_control_map *m, int binding);   /* level: x */

@@ -14,6 +14,7 @@
 
 #include "calib/albedo.h"
 #include "calib/ar_frame.h"
+#include "firmware/rig/ahead.h"
 #include "firmware/rig/ar_present.h"
 #include "firmware/rig/config.h"
 #include "firmware/rig/control_map.h"
@@ -84,6 +85,8 @@ struct lr_rig {
     lr_gl *gl;
     bool kms;
     lr_rig_view *view;
+    /* The states the controls reach next, built ahead by the view (firmware/rig/ahead.h). */
+    lr_rig_ahead *ahead;
     /* Views replaced by a scene switch or reload whose work off the loop is still finishing
      * (lr_rig_view_retire): destroyed once done, so the loop never waits for them. */
     lr_rig_view *retired[RETIRED_MAX];
@@ -563,8 +566,18 @@ static int view_build(lr_rig *r, lr_scene *scene, bool no_vpl, lr_rig_view **out
     lr_rig_view_desc vd = {.name = c->output.renderer, .gl = r->gl, .scene = scene,
                            .width = c->output.width, .height = c->output.height,
                            .no_vpl = no_vpl, .gpu_budget_mb = c->output.gpu_memory_mb};
+    lr_cache_key keys[LR_CACHE_MAX_KEYS];
+    int nk = 0;
+    if (r->set.map && c->output.cache_mb > 0 &&
+        lr_rig_ahead_keys(r->set.map, scene, keys, LR_CACHE_MAX_KEYS, &nk, e))
+        return lr_err_prefix(e, "output.cache_mb");
+    vd.cache_keys = keys;
+    vd.n_cache_keys = nk;
+    vd.cache_mb = nk > 0 ? c->output.cache_mb : 0;
     if (r->kms)
         lr_gl_size(r->gl, &vd.width, &vd.height);
+    if (r->ahead)
+        lr_rig_ahead_changed(r->ahead, lr_now_ns()); /* a new view: its cache is empty */
     return lr_rig_view_create(&vd, out, e);
 }
 
@@ -609,6 +622,8 @@ static void apply(lr_rig *r, int64_t now)
     if (r->set.replan && (dirty & LR_DIRTY_MATERIAL))
         replan(r, &dirty);
     uint64_t batch = 0;
+    if (r->ahead && (dirty & ~(unsigned)(LR_DIRTY_INTENSITY | LR_DIRTY_DISPLAY)))
+        lr_rig_ahead_changed(r->ahead, now); /* the states ahead are relative to this one */
     if (dirty) {
         /* No view yet at start-up and in a scene switch: the view is built on the scene as
          * the controls have set it. */
@@ -626,6 +641,24 @@ static void apply(lr_rig *r, int64_t now)
      * apply that does. */
     if (dirty || !r->fading)
         lr_rig_stats_tag(r->stats, batch);
+}
+
+/* Makes one more state of the list ahead and hands the list so far to the view. */
+static void ahead_step(lr_rig *r, int64_t now)
+{
+    const lr_async_state *states;
+    int n;
+    bool done;
+    lr_err e = {0};
+    if (lr_rig_ahead_step(r->ahead, r->set.map, r->set.scene, r->set.replan, now, &states, &n,
+                          &done, &e) ||
+        lr_rig_view_anticipate(r->view, states, n, &e)) {
+        lr_log_write(&r->log, LR_LOG_WARN, "states ahead: %s", e.msg);
+        lr_rig_ahead_changed(r->ahead, INT64_MAX / 2); /* not again until a change */
+        return;
+    }
+    if (done && n > 0)
+        lr_log_write(&r->log, LR_LOG_INFO, "cache: %d states of the controls to build ahead", n);
 }
 
 /* Hands the current view to the retired list (the oldest is destroyed, waiting, when the list
@@ -1280,6 +1313,9 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e)
         lr_err_prefix(e, "--out-dir");
     if (!rc)
         rc = set_build(r, &r->set, false, e);
+    /* The samples are the starting config's (a reload keeps them). */
+    if (!rc && r->set.cfg->output.cache_mb > 0)
+        rc = lr_rig_ahead_create(r->set.cfg->output.cache_samples, &r->ahead, e);
     if (!rc) {
         r->plan = r->plan_new;
         if (opts->stats_path)
@@ -1570,6 +1606,11 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             t = r->next_stats_ns;
         if (lr_notify_deadline(r->notify) < t)
             t = lr_notify_deadline(r->notify);
+        if (r->ahead && r->view && !lr_rig_view_busy(r->view)) {
+            int64_t d = lr_rig_ahead_wake_ns(r->ahead);
+            if (d < t)
+                t = d < now ? now : d;
+        }
         int timeout;
         if (t == INT64_MAX)
             timeout = -1;
@@ -1647,6 +1688,9 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
         if (frame_wanted(r, now) && now >= r->next_frame_ns &&
             !(r->kms && lr_gl_flip_pending(r->gl)))
             frame(r, now);
+        /* One state ahead per turn once the controls rest and the view has converged. */
+        if (r->ahead && r->view && lr_rig_ahead_due(r->ahead, now) && !lr_rig_view_busy(r->view))
+            ahead_step(r, now);
         if (r->stats_path[0] && now >= r->next_stats_ns) {
             write_stats(r, now);
             r->next_stats_ns = now + (int64_t)(r->set.cfg->stats_period_s * 1e9);
@@ -1684,6 +1728,7 @@ void lr_rig_destroy(lr_rig *r)
         write_stats(r, lr_now_ns());
     lr_rig_view_destroy(r->view);
     lr_rig_view_destroy(r->pre.view);
+    lr_rig_ahead_destroy(r->ahead);
     lr_replan_destroy(r->pre.replan);
     lr_scene_destroy(r->pre.scene);
     for (int i = 0; i < r->n_retired; i++)

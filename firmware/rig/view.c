@@ -121,6 +121,20 @@ int lr_rig_view_wait_first(lr_rig_view *v, int timeout_ms, lr_err *e)
     return v->ops->wait_first ? v->ops->wait_first(v->impl, timeout_ms, e) : LR_OK;
 }
 
+int lr_rig_view_anticipate(lr_rig_view *v, const lr_async_state *states, int n, lr_err *e)
+{
+    return v->ops->anticipate ? v->ops->anticipate(v->impl, states, n, e) : LR_OK;
+}
+
+void lr_rig_view_cache_stats(const lr_rig_view *v, lr_state_cache_stats *st, int *pending)
+{
+    *st = (lr_state_cache_stats){0};
+    if (pending)
+        *pending = 0;
+    if (v->ops->cache_stats)
+        v->ops->cache_stats(v->impl, st, pending);
+}
+
 int lr_rig_view_read_rgba8(lr_rig_view *v, unsigned char *rgba, lr_err *e)
 {
     return v->ops->read_rgba8(v->impl, rgba, e);

@@ -38,6 +38,11 @@ typedef struct lr_rig_view_desc {
     bool no_vpl;      /* "passes": skip the VPL pass (the planner found no receiver in sight) */
     bool no_preview;  /* "passes": no coarse preview stage after a change */
     double gpu_budget_mb; /* the renderer's GPU memory budget (output.gpu_memory_mb); 0: none */
+    /* "passes": the control-space cache (render/async/cache.h, firmware/rig/ahead.h): the
+     * keys naming a state and its memory (output.cache_mb); none or 0: no cache. */
+    const lr_cache_key *cache_keys;
+    int n_cache_keys;
+    double cache_mb;
 } lr_rig_view_desc;
 
 /* Comma-separated names of the back ends built in, default first. */
@@ -64,6 +69,11 @@ int lr_rig_view_frame(lr_rig_view *v, lr_frame_stats *stats, lr_rig_frame_info *
 int lr_rig_view_event_fd(const lr_rig_view *v);
 /* True while the back end has transport work in hand (off the loop). */
 bool lr_rig_view_busy(const lr_rig_view *v);
+/* The states to build ahead (render/async/async.h lr_async_anticipate); back ends without a
+ * cache ignore them. */
+int lr_rig_view_anticipate(lr_rig_view *v, const lr_async_state *states, int n, lr_err *e);
+/* The cache's counters (zeroes without one). */
+void lr_rig_view_cache_stats(const lr_rig_view *v, lr_state_cache_stats *st, int *pending);
 /* An error of work done off the loop (once), LR_OK when none. */
 int lr_rig_view_error(lr_rig_view *v, lr_err *e);
 /* Retires a view without waiting for work under way off the loop (a scene switch): it stops
@@ -98,6 +108,8 @@ typedef struct lr_rig_view_ops {
     int (*wait_first)(void *impl, int timeout_ms, lr_err *e);
     void (*retire)(void *impl);
     bool (*retired)(const void *impl);
+    int (*anticipate)(void *impl, const lr_async_state *states, int n, lr_err *e);
+    void (*cache_stats)(const void *impl, lr_state_cache_stats *st, int *pending);
 } lr_rig_view_ops;
 
 extern const lr_rig_view_ops lr_rig_view_passes;

@@ -34,7 +34,8 @@ static int v_create(const lr_rig_view_desc *d, void **impl, lr_err *e)
         return lr_err_set(e, LR_EINVAL, "renderer 'passes' needs a GL context");
     lr_async_desc ad = {.gl = d->gl, .scene = d->scene, .width = d->width,
                         .height = d->height, .no_vpl = d->no_vpl,
-                        .gpu_budget_mb = d->gpu_budget_mb};
+                        .gpu_budget_mb = d->gpu_budget_mb, .cache_keys = d->cache_keys,
+                        .n_cache_keys = d->n_cache_keys, .cache_mb = d->cache_mb};
     char model_sets[LR_ASYNC_MAX_PREVIEW - N_PREVIEW][128];
     if (!d->no_preview) {
         for (int i = 0; i < N_PREVIEW; i++)
@@ -75,7 +76,7 @@ static int v_frame(void *impl, lr_frame_stats *st, lr_rig_frame_info *info, lr_e
     st->passes = as.stage == LR_ASYNC_NONE ? 0u : (unsigned)LR_PASS_BLEND;
     st->total_ms = as.blend_ms;
     *info = (lr_rig_frame_info){.batch = as.batch, .stage = as.stage,
-                                .converged = as.stage == LR_ASYNC_FINAL};
+                                .converged = lr_async_stage_converged(as.stage)};
     return LR_OK;
 }
 
@@ -90,6 +91,14 @@ static bool v_busy(const void *impl) { return lr_async_busy(impl); }
 static int v_error(void *impl, lr_err *e) { return lr_async_error(impl, e); }
 
 static void v_retire(void *impl) { lr_async_stop(impl); }
+static int v_anticipate(void *impl, const lr_async_state *s, int n, lr_err *e)
+{
+    return lr_async_anticipate(impl, s, n, e);
+}
+static void v_cache_stats(const void *impl, lr_state_cache_stats *st, int *pending)
+{
+    lr_async_cache_stats(impl, st, pending);
+}
 static bool v_retired(const void *impl) { return lr_async_stopped(impl); }
 
 static int v_wait(void *impl, int timeout_ms, lr_err *e)
@@ -114,4 +123,6 @@ const lr_rig_view_ops lr_rig_view_passes = {
     .wait_first = v_wait,
     .retire = v_retire,
     .retired = v_retired,
+    .anticipate = v_anticipate,
+    .cache_stats = v_cache_stats,
 };

@@ -358,3 +358,16 @@ int lr_replan_update(lr_replan *r, lr_scene *s, unsigned changed, unsigned *dirt
         free(t.buf);
     return LR_OK;
 }
+
+int lr_replan_what_if(const lr_replan *r, lr_scene *s, unsigned changed, unsigned *dirty,
+                      lr_err *e)
+{
+    /* A copy takes the choices, snapshots and pins; the table is only read. */
+    lr_replan *t = malloc(sizeof *t);
+    if (!t)
+        return lr_err_set(e, LR_ENOMEM, "re-plan: out of memory");
+    *t = *r;
+    int rc = lr_replan_update(t, s, changed, dirty, NULL, NULL, e);
+    free(t);
+    return rc;
+}

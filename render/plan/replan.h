@@ -67,6 +67,12 @@ void lr_replan_destroy(lr_replan *r);
 int lr_replan_update(lr_replan *r, lr_scene *s, unsigned changed, unsigned *dirty, char **text,
                      int *replanned, lr_err *e);
 
+/* What lr_replan_update would write into s after changes `changed`, written into s (a copy
+ * of the planned scene with a state to come: render/async/'s states built ahead), r itself
+ * left as it is. */
+int lr_replan_what_if(const lr_replan *r, lr_scene *s, unsigned changed, unsigned *dirty,
+                      lr_err *e);
+
 /* The plan as it stands after the last re-plan. */
 const lr_plan *lr_replan_plan(const lr_replan *r);
 /* Whether object i is left to its own model (see the top of this file). */

@@ -17,6 +17,7 @@
 
 #include "firmware/control/accel.h"
 #include "firmware/control/curve.h"
+#include "firmware/rig/ahead.h"
 #include "firmware/rig/config.h"
 #include "firmware/rig/control_map.h"
 #include "render/cpu/frame.h"
@@ -608,6 +609,105 @@ static void test_shipped_cycles_are_visible(void **state)
     globfree(&maps);
 }
 
+/* The control space built ahead (firmware/rig/ahead.h) of the candle's map: the keys are the
+ * controls that change transport (the preset, the scale both knob and tint write) and the
+ * re-planner's, not the dimmer's or the flicker's; a what-if moves one control in a copy and
+ * leaves the map and the live scene as they were; the list is the state shown, the other
+ * presets (next first) and the samples of each continuous control, one state per step, all
+ * different states. */
+static void test_states_ahead(void **state)
+{
+    (void)state;
+    fx f;
+    fx_make(&f, "[{\"control\": \"dimmer\", \"param\": \"light.level\", \"range\": [0, 2]},"
+                " {\"control\": \"knob1\", \"param\": \"lights[0].flicker.amplitude\", "
+                "\"range\": [0, 0.5]},"
+                " {\"control\": \"button1\", \"param\": \"objects[0].material\", "
+                "\"values\": [\"candle_wax\", \"marble\", \"porcelain\"]},"
+                " {\"control\": \"knob2\", \"param\": \"objects[0].material.scale\", "
+                "\"range\": [0.25, 4], \"curve\": \"log\", \"initial\": 0.5},"
+                " {\"control\": \"tint\", \"param\": \"objects[0].material.scale\", "
+                "\"colors\": [[1, 1, 1], [0.7, 1, 1.6]], \"initial\": 0}]");
+    update(&f, 0);
+    lr_cache_key keys[LR_CACHE_MAX_KEYS];
+    int nk = 0;
+    lr_err e = {0};
+    assert_int_equal(lr_rig_ahead_keys(f.map, f.scene, keys, LR_CACHE_MAX_KEYS, &nk, &e), LR_OK);
+    bool mat = false, scale = false, model = false, settings = false;
+    for (int k = 0; k < nk; k++) {
+        mat |= !strcmp(keys[k].name, "objects[0].material") && keys[k].interp == LR_CACHE_EXACT;
+        scale |= !strcmp(keys[k].name, "objects[0].material.scale") &&
+                 keys[k].interp == LR_CACHE_LINEAR;
+        model |= !strcmp(keys[k].name, "objects[0].model");
+        settings |= !strcmp(keys[k].name, "render.map_size");
+        assert_null(strstr(keys[k].name, "intensity"));
+        assert_null(strstr(keys[k].name, "flicker"));
+    }
+    assert_true(mat && scale && model && settings);
+    assert_int_equal(nk, 3 + 6);
+
+    /* A what-if on a copy: the preset moves there, the map and the live scene stay. */
+    lr_scene *copy = NULL;
+    assert_int_equal(lr_scene_clone(f.scene, NULL, &copy, &e), LR_OK);
+    double s0 = get(&f, "objects[0].material.scale");
+    unsigned d = 0;
+    assert_int_equal(lr_control_map_what_if(f.map, 2, 1, copy, 0, &d, &e), LR_OK);
+    assert_true(d & LR_DIRTY_MATERIAL);
+    char buf[64];
+    lr_scene_get(copy, "objects[0].material", buf, sizeof buf, NULL);
+    assert_string_equal(buf, "marble");
+    lr_scene_get(copy, "objects[0].material.scale", buf, sizeof buf, NULL);
+    assert_near(strtod(buf, NULL), s0, 1e-6); /* the knob's scale written again after it */
+    lr_scene_get(f.scene, "objects[0].material", buf, sizeof buf, NULL);
+    assert_string_equal(buf, "candle_wax");
+    assert_int_equal(lr_control_map_index(f.map, 2), 0);
+    lr_scene_destroy(copy);
+
+    lr_rig_ahead *h;
+    assert_int_equal(lr_rig_ahead_create(5, &h, &e), LR_OK);
+    lr_rig_ahead_changed(h, 0);
+    assert_false(lr_rig_ahead_due(h, 100 * MS)); /* resting */
+    assert_true(lr_rig_ahead_due(h, 400 * MS));
+    const lr_async_state *st = NULL;
+    int n = 0, steps = 0;
+    bool done = false;
+    while (!done) {
+        int before = n;
+        assert_int_equal(lr_rig_ahead_step(h, f.map, f.scene, NULL, 400 * MS, &st, &n, &done, &e),
+                         LR_OK);
+        assert_true(n <= before + 1);
+        steps++;
+        assert_true(steps < 100);
+    }
+    /* The state shown, 2 other presets, 5 knob samples and 5 tint samples, less the knob's
+     * and the tint's sample at their current positions (0.5 and 0): a what-if that writes
+     * nothing is the state shown, listed once, first. */
+    assert_int_equal(n, 1 + 2 + 4 + 4);
+    assert_int_equal(st[0].n, 0);
+    assert_string_equal(st[1].key[0], "objects[0].material");
+    assert_string_equal(st[1].value[0], "marble"); /* the next one first */
+    assert_string_equal(st[2].value[0], "porcelain");
+    /* Every state applied on a copy gives a state the copy takes, with the scale in range. */
+    for (int i = 0; i < n; i++) {
+        lr_scene *c = NULL;
+        assert_int_equal(lr_scene_clone(f.scene, NULL, &c, &e), LR_OK);
+        for (int k = 0; k < st[i].n; k++)
+            if (lr_scene_set(c, st[i].key[k], st[i].value[k], NULL, &e))
+                fail_msg("state %d: %s", i, e.msg);
+        double v[3];
+        lr_scene_get(c, "objects[0].material.scale", buf, sizeof buf, NULL);
+        int nv = sscanf(buf, "%lf,%lf,%lf", &v[0], &v[1], &v[2]);
+        assert_true(nv >= 1);
+        assert_true(v[0] >= 0.25 * 0.7 - 1e-9 && v[0] <= 4 * 1.6 + 1e-9);
+        lr_scene_destroy(c);
+    }
+    assert_false(lr_rig_ahead_due(h, 500 * MS)); /* done until the next change */
+    lr_rig_ahead_changed(h, 600 * MS);
+    assert_true(lr_rig_ahead_due(h, 1000 * MS));
+    lr_rig_ahead_destroy(h);
+    fx_free(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -623,6 +723,7 @@ int main(void)
         cmocka_unit_test(test_light_level_follows_each_scene),
         cmocka_unit_test(test_light_level_errors),
         cmocka_unit_test(test_shipped_cycles_are_visible),
+        cmocka_unit_test(test_states_ahead),
     };
     if (getenv("LR_TEST_FILTER")) /* e.g. LR_TEST_FILTER='test_soak*' to run one test */
         cmocka_set_test_filter(getenv("LR_TEST_FILTER"));
