@@ -87,6 +87,7 @@ struct lr_rig {
     lr_rig_view *view;
     /* The states the controls reach next, built ahead by the view (firmware/rig/ahead.h). */
     lr_rig_ahead *ahead;
+    bool ahead_building; /* a list was handed over and the view has not finished it */
     /* Views replaced by a scene switch or reload whose work off the loop is still finishing
      * (lr_rig_view_retire): destroyed once done, so the loop never waits for them. */
     lr_rig_view *retired[RETIRED_MAX];
@@ -657,8 +658,13 @@ static void ahead_step(lr_rig *r, int64_t now)
         lr_rig_ahead_changed(r->ahead, INT64_MAX / 2); /* not again until a change */
         return;
     }
-    if (done && n > 0)
+    if (done && n > 0) {
         lr_log_write(&r->log, LR_LOG_INFO, "cache: %d states of the controls to build ahead", n);
+        r->ahead_building = true;
+    } else if (done) {
+        lr_log_write(&r->log, LR_LOG_INFO, "cache: states built ahead: none (no control "
+                                           "changes light transport)");
+    }
 }
 
 /* Hands the current view to the retired list (the oldest is destroyed, waiting, when the list
@@ -1691,6 +1697,18 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
         /* One state ahead per turn once the controls rest and the view has converged. */
         if (r->ahead && r->view && lr_rig_ahead_due(r->ahead, now) && !lr_rig_view_busy(r->view))
             ahead_step(r, now);
+        if (r->ahead_building && r->view && !lr_rig_view_busy(r->view) &&
+            !lr_rig_ahead_due(r->ahead, now)) {
+            lr_state_cache_stats cs;
+            int pending = 0;
+            lr_rig_view_cache_stats(r->view, &cs, &pending);
+            if (pending == 0) {
+                r->ahead_building = false;
+                lr_log_write(&r->log, LR_LOG_INFO,
+                             "cache: states built ahead: %d held, %.1f of %.0f MB", cs.entries,
+                             (double)cs.bytes / 1048576.0, (double)cs.budget / 1048576.0);
+            }
+        }
         if (r->stats_path[0] && now >= r->next_stats_ns) {
             write_stats(r, now);
             r->next_stats_ns = now + (int64_t)(r->set.cfg->stats_period_s * 1e9);

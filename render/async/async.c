@@ -593,20 +593,15 @@ static void *worker_main(void *arg)
             }
             dirty |= got;
             lr_renderer_invalidate(a->r, got);
-            if (applied == exact_b) {
-                /* The caller shows this state's cached images: nothing to render (the
-                 * renderer keeps the flags for the next state that needs it). */
-                dirty = 0;
-                converged = true;
-                pthread_mutex_lock(&a->mu);
-                if (applied > a->published)
-                    a->published = applied;
-                pthread_cond_broadcast(&a->cv);
-                pthread_mutex_unlock(&a->mu);
-                continue;
-            }
-            if (!(got & TRANSPORT_DIRTY) && converged) {
-                /* The published images stand for this batch too. */
+            /* The caller shows this state's cached images: nothing to render (the renderer
+             * keeps the flags for the next state that needs it). Or the batch changes no
+             * transport: the published images stand for it too. */
+            bool cached = applied == exact_b;
+            if (cached || (!(got & TRANSPORT_DIRTY) && converged)) {
+                if (cached) {
+                    dirty = 0;
+                    converged = true;
+                }
                 pthread_mutex_lock(&a->mu);
                 if (applied > a->published)
                     a->published = applied;

@@ -165,6 +165,23 @@ static int idle_cpu(char *const argv[], const char *log, bool wait_quiet, idle_r
     return idle_cpu_after(argv, log, wait_quiet, wait_quiet ? 30.0 : 3.0, row);
 }
 
+#define AHEAD_MAX_S 150.0
+
+/* 0 when the log file holds `what`, else 1 (not yet, or unreadable). */
+static int log_has(const char *log, const char *what)
+{
+    FILE *f = fopen(log, "r");
+    if (!f)
+        return 1;
+    char line[1024];
+    int found = 1;
+    while (found && fgets(line, sizeof line, f))
+        if (strstr(line, what))
+            found = 0;
+    fclose(f);
+    return found;
+}
+
 /* As idle_cpu, with the longest wait for quiet (wait_quiet) or the fixed warm-up given. */
 static int idle_cpu_after(char *const argv[], const char *log, bool wait_quiet, double warm_s,
                           idle_row *row)
@@ -177,6 +194,11 @@ static int idle_cpu_after(char *const argv[], const char *log, bool wait_quiet, 
     }
     long prev = -1;
     bool alive = true;
+    /* Idle means after the states ahead are built (firmware/rig/ahead.h: the rig's background
+     * work once its controls rest, 40 s on the proxy): wait for its log line, AHEAD_MAX_S at
+     * most (a rig without a cache never writes it). */
+    for (double w = 0; w < AHEAD_MAX_S && log_has(log, "cache: states built ahead"); w += 0.5)
+        lrb_sleep_s(0.5);
     for (int i = 0; i < (int)(warm_s / 0.5 + 0.5); i++) {
         lrb_sleep_s(0.5);
         long t = cpu_ticks(pid);

@@ -19,6 +19,11 @@
 #include "render/base/json.h"
 
 #define RUN_S 22.0
+/* The warm runs: the rig rests this long before the demo plays once (its control-space cache
+ * builds the states the controls reach next meanwhile, firmware/rig/ahead.h), then WARM_TAIL_S
+ * for the demo's 10 s and its last image. */
+#define WARM_S 45.0
+#define WARM_TAIL_S 12.0
 #define MAX_CONTROLS 8
 #define MAX_EVENTS 4096
 
@@ -98,8 +103,36 @@ static int read_run(const char *stats, run_row *r)
     return rc;
 }
 
-/* The shipped rig, with `renderer` as its view ("" keeps the shipped one). */
-static int write_cfg(const char *configs, const char *path, const char *renderer)
+/* The shipped demo script with every event WARM_S later, played once. */
+static int write_warm_script(const char *configs, const char *path)
+{
+    char *text = lrb_read_rig_file(configs, "sim-demo.sim");
+    if (!text)
+        return 1;
+    size_t cap = strlen(text) * 2 + 256, o = 0;
+    char *out = malloc(cap);
+    if (!out) {
+        free(text);
+        return 1;
+    }
+    for (char *line = strtok(text, "\n"); line; line = strtok(NULL, "\n")) {
+        char *end;
+        double t = strtod(line, &end);
+        if (line[0] != '#' && end != line)
+            o += (size_t)snprintf(out + o, cap - o, "%.2f%s\n", t + WARM_S, end);
+        else
+            o += (size_t)snprintf(out + o, cap - o, "%s\n", line);
+    }
+    free(text);
+    int rc = lrb_write_file(path, out);
+    free(out);
+    return rc;
+}
+
+/* The shipped rig, with `renderer` as its view ("" keeps the shipped one) and, with `script`,
+ * that script played once instead of the shipped demo looping. */
+static int write_cfg(const char *configs, const char *path, const char *renderer,
+                     const char *script)
 {
     char *text = lrb_read_rig_file(configs, "sim.json");
     if (!text)
@@ -108,6 +141,12 @@ static int write_cfg(const char *configs, const char *path, const char *renderer
     char out[16384];
     size_t o = 0;
     for (const char *p = text; *p && o < sizeof out - PATH_MAX - 64; p++) {
+        static const char demo[] = "\"sim-demo.sim\", \"loop\": true";
+        if (script && !strncmp(p, demo, sizeof demo - 1)) {
+            o += (size_t)snprintf(out + o, sizeof out - o, "\"%s\", \"loop\": false", script);
+            p += sizeof demo - 2;
+            continue;
+        }
         if (!strncmp(p, "\"../", 4) || !strncmp(p, "\"sim-demo.sim\"", 14)) {
             o += (size_t)snprintf(out + o, sizeof out - o, "\"%s/rig/", configs);
             continue;
@@ -126,20 +165,20 @@ static int write_cfg(const char *configs, const char *path, const char *renderer
 }
 
 static int run_rig(const char *bindir, const char *cfg, const char *dir, int busy,
-                   const char *tag, run_row *r)
+                   const char *tag, double run_s, run_row *r)
 {
     char lamprig[PATH_MAX + 16], stats[PATH_MAX + 64], log[PATH_MAX + 64], dur[32];
     snprintf(lamprig, sizeof lamprig, "%s/lamprig", bindir);
     snprintf(stats, sizeof stats, "%s/controls-%s.json", dir, tag);
     snprintf(log, sizeof log, "%s/controls-%s.log", dir, tag);
-    snprintf(dur, sizeof dur, "%.1f", RUN_S);
+    snprintf(dur, sizeof dur, "%.1f", run_s);
     pid_t loops[2];
     if (busy && lrb_busy_start(busy, loops))
         return 1;
-    fprintf(stderr, "bench rig: the shipped sim rig (%s), %.0f s...\n", tag, RUN_S);
+    fprintf(stderr, "bench rig: the shipped sim rig (%s), %.0f s...\n", tag, run_s);
     char *argv[] = {lamprig, "run", "--config", (char *)cfg, "--headless", "--duration", dur,
                     "--stats", stats, NULL};
-    int st = lrb_reap(lrb_spawn(argv, log), RUN_S + 300);
+    int st = lrb_reap(lrb_spawn(argv, log), run_s + 300);
     if (busy)
         lrb_busy_stop(busy, loops);
     if (st < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
@@ -184,17 +223,25 @@ static void print_run(FILE *out, FILE *csv, const char *label, const char *key, 
 int lrb_rig_controls(FILE *out, FILE *csv, const char *bindir, const char *configs,
                      const char *dir)
 {
-    char cfg_async[PATH_MAX + 32], cfg_inline[PATH_MAX + 32];
+    char cfg_async[PATH_MAX + 32], cfg_inline[PATH_MAX + 32], cfg_warm[PATH_MAX + 32],
+        script[PATH_MAX + 32];
     snprintf(cfg_async, sizeof cfg_async, "%s/sim-shipped.json", dir);
     snprintf(cfg_inline, sizeof cfg_inline, "%s/sim-inline.json", dir);
-    if (write_cfg(configs, cfg_async, "") || write_cfg(configs, cfg_inline, "passes_inline")) {
+    snprintf(cfg_warm, sizeof cfg_warm, "%s/sim-warm.json", dir);
+    snprintf(script, sizeof script, "%s/sim-warm.sim", dir);
+    if (write_cfg(configs, cfg_async, "", NULL) ||
+        write_cfg(configs, cfg_inline, "passes_inline", NULL) || write_warm_script(configs, script) ||
+        write_cfg(configs, cfg_warm, "", script)) {
         fprintf(stderr, "bench rig: cannot write the scratch rig configs\n");
         return 1;
     }
-    static run_row idle, busy, inl;
-    int rc = run_rig(bindir, cfg_async, dir, 0, "idle", &idle);
-    rc |= run_rig(bindir, cfg_async, dir, 2, "two busy loops", &busy);
-    rc |= run_rig(bindir, cfg_inline, dir, 0, "passes_inline, idle", &inl);
+    static run_row idle, busy, inl, warm, warm_busy;
+    int rc = run_rig(bindir, cfg_async, dir, 0, "idle", RUN_S, &idle);
+    rc |= run_rig(bindir, cfg_async, dir, 2, "two busy loops", RUN_S, &busy);
+    rc |= run_rig(bindir, cfg_inline, dir, 0, "passes_inline, idle", RUN_S, &inl);
+    rc |= run_rig(bindir, cfg_warm, dir, 0, "warm, idle", WARM_S + WARM_TAIL_S, &warm);
+    rc |= run_rig(bindir, cfg_warm, dir, 2, "warm, two busy loops", WARM_S + WARM_TAIL_S,
+                  &warm_busy);
     fprintf(out,
             "Every control of the shipped sim rig (`configs/rig/sim.json`, its demo script "
             "looping, %.0f s per run) as shipped (the transport on a worker thread, "
@@ -202,13 +249,19 @@ int lrb_rig_controls(FILE *out, FILE *csv, const char *bindir, const char *confi
             "transport on the loop (`passes_inline`) for comparison. First change: event to "
             "the end of the first frame showing it, at any stage (a coarse preview counts); "
             "converged: to the first frame showing it at the rig's own settings, converged; "
-            "frame interval: between presented frames over the run (30 fps cap: 33 ms).\n\n"
+            "frame interval: between presented frames over the run (30 fps cap: 33 ms). "
+            "Warm: the rig rests %.0f s after start, while its control-space cache builds the "
+            "states the controls reach next (`firmware/rig/ahead.h`), then plays the demo once; "
+            "a state found there shows converged at once, so its first change is its "
+            "converged one.\n\n"
             "| run | control | events | first change median / p99 | converged median / p99 "
             "(events) | frame interval median / p99 |\n|---|---|---|---|---|---|\n",
-            RUN_S);
+            RUN_S, WARM_S);
     print_run(out, csv, "as shipped, idle", "idle", &idle);
     print_run(out, csv, "as shipped, two busy loops", "busy", &busy);
     print_run(out, csv, "passes_inline, idle", "inline", &inl);
+    print_run(out, csv, "warm, idle", "warm", &warm);
+    print_run(out, csv, "warm, two busy loops", "warm_busy", &warm_busy);
     fprintf(out, "\nFirst frame after start: %.2f s as shipped (idle), %.2f s beside two busy "
                  "loops, %.2f s with the transport on the loop.\n\n",
             idle.first_frame_s, busy.first_frame_s, inl.first_frame_s);
