@@ -187,6 +187,9 @@ static int idle_cpu_after(char *const argv[], const char *log, bool wait_quiet, 
                           idle_row *row)
 {
     *row = (idle_row){.pct = -1};
+    /* The child truncates the log once started: an earlier run's lines must not be read as
+     * this one's before that (the wait for the states ahead below reads it). */
+    unlink(log);
     pid_t pid = lrb_spawn(argv, log);
     if (pid < 0) {
         snprintf(row->why, sizeof row->why, "could not start %s", argv[0]);
