@@ -913,6 +913,16 @@ uint64_t lr_async_commit(lr_async *a, unsigned dirty)
         a->cache_epoch++;
     }
     a->rec_outside = false;
+    /* A dimmer's batch right after one the cache answered is the same state: answered too
+     * (else the worker would render the cached state because the batches merged). */
+    if (!(dirty & TRANSPORT_DIRTY) && b > 1) {
+        if (a->served_exact && a->served_exact == b - 1)
+            a->served_exact = b;
+        if (a->served_interp && a->served_interp == b - 1)
+            a->served_interp = b;
+        if (a->cached.on && a->cached.batch == b - 1)
+            a->cached.batch = b; /* what replaces it is the worker's image of this batch */
+    }
     if (a->cache && (dirty & TRANSPORT_DIRTY)) {
         lr_cache_mix mix;
         /* A miss leaves a cached image shown until the worker publishes this state (a
