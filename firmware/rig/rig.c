@@ -88,6 +88,7 @@ struct lr_rig {
     /* The states the controls reach next, built ahead by the view (firmware/rig/ahead.h). */
     lr_rig_ahead *ahead;
     bool ahead_building; /* a list was handed over and the view has not finished it */
+    double ahead_step_max_ms; /* the longest list step on the loop, for the log */
     /* Views replaced by a scene switch or reload whose work off the loop is still finishing
      * (lr_rig_view_retire): destroyed once done, so the loop never waits for them. */
     lr_rig_view *retired[RETIRED_MAX];
@@ -651,9 +652,13 @@ static void ahead_step(lr_rig *r, int64_t now)
     int n;
     bool done;
     lr_err e = {0};
-    if (lr_rig_ahead_step(r->ahead, r->set.map, r->set.scene, r->set.replan, now, &states, &n,
-                          &done, &e) ||
-        lr_rig_view_anticipate(r->view, states, n, &e)) {
+    int64_t t0 = lr_now_ns();
+    int rc = lr_rig_ahead_step(r->ahead, r->set.map, r->set.scene, r->set.replan, now, &states,
+                               &n, &done, &e);
+    double ms = (double)(lr_now_ns() - t0) * 1e-6;
+    if (ms > r->ahead_step_max_ms)
+        r->ahead_step_max_ms = ms;
+    if (rc || lr_rig_view_anticipate(r->view, states, n, &e)) {
         lr_log_write(&r->log, LR_LOG_WARN, "states ahead: %s", e.msg);
         lr_rig_ahead_changed(r->ahead, INT64_MAX / 2); /* not again until a change */
         return;
@@ -1705,8 +1710,10 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
             if (pending == 0) {
                 r->ahead_building = false;
                 lr_log_write(&r->log, LR_LOG_INFO,
-                             "cache: states built ahead: %d held, %.1f of %.0f MB", cs.entries,
-                             (double)cs.bytes / 1048576.0, (double)cs.budget / 1048576.0);
+                             "cache: states built ahead: %d held, %.1f of %.0f MB (the longest "
+                             "step of the list on the loop: %.1f ms)", cs.entries,
+                             (double)cs.bytes / 1048576.0, (double)cs.budget / 1048576.0,
+                             r->ahead_step_max_ms);
             }
         }
         if (r->stats_path[0] && now >= r->next_stats_ns) {
