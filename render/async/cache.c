@@ -143,14 +143,6 @@ static bool bands(const char *text, double v[3])
     return n == 3 && isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
 }
 
-/* The interpolation coordinate of value v; NAN where it has none (ln of v <= 0). */
-static double coord(lr_cache_interp m, double v)
-{
-    if (m == LR_CACHE_LOG)
-        return v > 0.0 ? log(v) : NAN;
-    return v;
-}
-
 /* The entries equal to tag in every key but `axis`: per band the nearest at or below and at
  * or above the tag's value. */
 static bool interpolate(lr_state_cache *c, const lr_state_tag *tag, int axis, lr_cache_mix *mix)
@@ -161,9 +153,7 @@ static bool interpolate(lr_state_cache *c, const lr_state_tag *tag, int axis, lr
     int lo[3] = {-1, -1, -1}, hi[3] = {-1, -1, -1};
     double ulo[3], uhi[3], u[3];
     for (int b = 0; b < 3; b++) {
-        u[b] = coord(c->keys[axis].interp, want[b]);
-        if (!isfinite(u[b]))
-            return false;
+        u[b] = want[b];
         ulo[b] = -INFINITY;
         uhi[b] = INFINITY;
     }
@@ -178,9 +168,7 @@ static bool interpolate(lr_state_cache *c, const lr_state_tag *tag, int axis, lr
         if (!same || !bands(x->tag.value[axis], v))
             continue;
         for (int b = 0; b < 3; b++) {
-            double ub = coord(c->keys[axis].interp, v[b]);
-            if (!isfinite(ub))
-                continue;
+            double ub = v[b];
             if (ub <= u[b] && ub > ulo[b]) {
                 ulo[b] = ub;
                 lo[b] = i;

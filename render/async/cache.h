@@ -9,11 +9,11 @@
  *
  * Lookup (lr_state_cache_find) for the tag of the state the caller shows now:
  *   exact         an entry with the same tag: its images are that state's converged images;
- *   interpolated  entries equal in every key but one marked LR_CACHE_LOG or LR_CACHE_LINEAR
+ *   interpolated  entries equal in every key but one marked LR_CACHE_LINEAR
  *                 (a material's scale), numbers per band (one number: the same in every band):
  *                 for each band separately, the two entries whose value in that band brackets
- *                 the state's, weighted by the position t between them (in the value for
- *                 LR_CACHE_LINEAR, in its ln for LR_CACHE_LOG), their images combined
+ *                 the state's, weighted by the position t between them in the value, their
+ *                 images combined
  *                 geometrically, lo^(1-t) hi^t per pixel (render/passes/mix.h): light through
  *                 an absorbing, scattering medium is a sum over paths of exponentials in the
  *                 coefficients' scale s, A_p exp(-c_p s), so ln(image) is convex and close to
@@ -55,8 +55,7 @@
 
 typedef enum lr_cache_interp {
     LR_CACHE_EXACT = 0, /* matched as text only */
-    LR_CACHE_LINEAR,    /* numbers per band, interpolated linearly in the value */
-    LR_CACHE_LOG,       /* numbers per band (> 0), interpolated linearly in ln(value) */
+    LR_CACHE_LINEAR,    /* numbers per band, interpolated by position in the value */
 } lr_cache_interp;
 
 typedef struct lr_cache_key {
