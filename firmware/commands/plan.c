@@ -14,10 +14,12 @@ static const lr_argspec opts[] = {
     {.name = "--scene", .type = LR_ARG_PATH, .flags = LR_ARG_REQUIRED,
      .help = "the scene (configs/scenes/*.json); its \"quality\" block is the budget"},
     {.name = "--max-error", .type = LR_ARG_NUMBER, .metavar = "E", .flags = LR_ARG_ABOVE_MIN,
-     .help = "error budget (alone or with --frame-ms, replaces the scene's max_error\n"
-             "and frame_ms)"},
+     .help = "error budget (alone or with --frame-ms and --converge-ms, replaces the\n"
+             "scene's max_error, frame_ms and converge_ms)"},
     {.name = "--frame-ms", .type = LR_ARG_NUMBER, .metavar = "T", .flags = LR_ARG_ABOVE_MIN,
      .help = "milliseconds per accumulation frame (the same)"},
+    {.name = "--converge-ms", .type = LR_ARG_NUMBER, .metavar = "T", .flags = LR_ARG_ABOVE_MIN,
+     .help = "milliseconds from a change to the converged image (the same)"},
     {.name = "--change-ms", .type = LR_ARG_NUMBER, .metavar = "T", .flags = LR_ARG_ABOVE_MIN,
      .help = "longest wait after a material change: models measured slower\n"
              "(configs/bench/models.csv) are left out (default: the scene's\n"
@@ -92,6 +94,7 @@ static int run_plan(const lr_cli *c)
     int st;
     if ((st = lr_cli_check(c, lr_args_double(a, "--max-error", &given.max_error, &e) ||
                                   lr_args_double(a, "--frame-ms", &given.frame_ms, &e) ||
+                                  lr_args_double(a, "--converge-ms", &given.converge_ms, &e) ||
                                   lr_args_double(a, "--change-ms", &given.change_ms, &e),
                            &e)) ||
         (st = models_arg(c, lr_args_get(a, "--models"), &models)))
@@ -106,8 +109,9 @@ static int run_plan(const lr_cli *c)
     }
     if (!lr_plan_budget_resolve(scene, &given, &b)) {
         lr_scene_destroy(scene);
-        return lr_cli_usage(c->path, "the scene has no quality budget (quality.max_error or "
-                           "quality.frame_ms): give --max-error or --frame-ms");
+        return lr_cli_usage(c->path, "the scene has no quality budget (quality.max_error, "
+                           "quality.frame_ms or quality.converge_ms): give --max-error, "
+                           "--frame-ms or --converge-ms");
     }
     char table[1024];
     const char *why = "given";

@@ -1012,12 +1012,36 @@ static int parse_mqtt(ctx *x, lr_jnode root)
 
 /* ---- top level ---- */
 
+/* "budget": the quality block the rig plans every scene for (config.h). */
+static int parse_budget(ctx *x, lr_jnode root)
+{
+    lr_jnode b = lr_json_get(x->j, root, "budget");
+    if (b == LR_JNONE)
+        return LR_OK;
+    static const char *const ok[] = {"max_error", "frame_ms", "converge_ms", "change_ms", NULL};
+    int rc = keys(x, b, "budget", ok);
+    if (rc)
+        return rc;
+    lr_rig_budget *bu = &x->c->budget;
+    if ((rc = get_num_in(x, b, "budget", "max_error", false, 0, 1e6, &bu->max_error)) ||
+        (rc = get_num_in(x, b, "budget", "frame_ms", false, 0, 1e9, &bu->frame_ms)) ||
+        (rc = get_num_in(x, b, "budget", "converge_ms", false, 0, 1e9, &bu->converge_ms)) ||
+        (rc = get_num_in(x, b, "budget", "change_ms", false, 0, 1e9, &bu->change_ms)))
+        return rc;
+    if (!(bu->max_error > 0) && !(bu->frame_ms > 0) && !(bu->converge_ms > 0))
+        return lr_json_fail(x->j, b, "budget", x->e, LR_EPARSE,
+                            "no budget: give max_error, frame_ms or converge_ms (> 0)");
+    bu->given = true;
+    bu->line = lr_json_line(x->j, b);
+    return LR_OK;
+}
+
 static int parse_root(ctx *x)
 {
     const lr_json *j = x->j;
     lr_jnode root = lr_json_root(j);
     lr_rig_config *c = x->c;
-    static const char *const top[] = {"scene", "scene_set", "devices", "controls", "output",
+    static const char *const top[] = {"scene", "scene_set", "budget", "devices", "controls", "output",
                                       "safe_level", "stats", "calib", "ar_samples", "http",
                                       "mqtt", NULL};
     int rc = keys(x, root, "", top);
@@ -1028,6 +1052,8 @@ static int parse_root(ctx *x)
         (rc = resolve(x, lr_json_get(j, root, "scene"), "scene", rel, c->scene, sizeof c->scene)))
         return rc;
 
+    if ((rc = parse_budget(x, root)))
+        return rc;
     lr_jnode sets = lr_json_get(j, root, "scene_set");
     if (sets != LR_JNONE) {
         if (lr_json_type(j, sets) != LR_JSON_OBJECT)
@@ -1302,6 +1328,28 @@ void lr_rig_config_destroy(lr_rig_config *c)
 
 int lr_rig_config_apply_sets(const lr_rig_config *c, lr_scene *scene, lr_err *e)
 {
+    /* The budget replaces the scene's max_error, frame_ms and converge_ms together (one kind
+     * of budget, as `lamprig plan --max-error` does), change_ms only when given. */
+    if (c->budget.given) {
+        const struct {
+            const char *key;
+            double v;
+            bool always;
+        } q[] = {{"quality.max_error", c->budget.max_error, true},
+                 {"quality.frame_ms", c->budget.frame_ms, true},
+                 {"quality.converge_ms", c->budget.converge_ms, true},
+                 {"quality.change_ms", c->budget.change_ms, false}};
+        for (size_t i = 0; i < sizeof q / sizeof q[0]; i++) {
+            if (!q[i].always && !(q[i].v > 0))
+                continue;
+            char v[64];
+            lr_err le = {0};
+            snprintf(v, sizeof v, "%.17g", q[i].v);
+            if (lr_scene_set(scene, q[i].key, v, NULL, &le))
+                return lr_err_set(e, LR_EPARSE, "%s:%d: field 'budget': %s", c->path,
+                                  c->budget.line, le.msg);
+        }
+    }
     for (int i = 0; i < c->n_sets; i++) {
         lr_err le = {0};
         if (lr_scene_set(scene, c->sets[i].key, c->sets[i].value, NULL, &le))

@@ -7,6 +7,18 @@
  *   "scene_set": {"render.K": 4, "light.color": [1, 0.6, 0.3], ...}   scene parameters set
  *                                      after every load of the scene (the rig's render budget:
  *                                      a small GPU needs smaller maps than the scene file's)
+ *   "budget":   {"max_error": 0.2, "converge_ms": 2000, "frame_ms": 0, "change_ms": 3000}
+ *                                      what the rig must meet, for every scene it loads: the
+ *                                      planner (render/plan/plan.h) picks each scene's models
+ *                                      and render settings from the measured table for it,
+ *                                      and re-plans on material changes against it. It
+ *                                      replaces the scene's quality block (max_error,
+ *                                      frame_ms and converge_ms together; change_ms when
+ *                                      given). At least one of max_error, frame_ms and
+ *                                      converge_ms > 0. The presented frame interval is
+ *                                      output.fps's, whatever the transport costs (the view
+ *                                      runs it on a worker, render/async/); render.* in
+ *                                      scene_set still win over the plan
  *   "devices":  [ DEVICE, ... ]        zero or more (names unique)
  *   "controls": [ BINDING, ... ] | "PATH"   the control map, inline or a file holding
  *                                      {"controls": [ ... ]} (configs/controls/NAME.json)
@@ -250,6 +262,13 @@ typedef struct lr_rig_mqtt {
     int line; /* of the "mqtt" object, for messages */
 } lr_rig_mqtt;
 
+/* "budget": the quality block every scene the rig loads is planned for. */
+typedef struct lr_rig_budget {
+    bool given;
+    double max_error, frame_ms, converge_ms, change_ms; /* 0: not given */
+    int line;
+} lr_rig_budget;
+
 typedef struct lr_rig_config {
     char path[LR_RIG_PATH_MAX];  /* the file it came from */
     char scene[LR_RIG_PATH_MAX]; /* resolved */
@@ -258,6 +277,7 @@ typedef struct lr_rig_config {
         int line;
     } sets[LR_RIG_MAX_SETS];
     int n_sets;
+    lr_rig_budget budget;
     lr_rig_device devices[LR_RIG_MAX_DEVICES];
     int n_devices;
     lr_rig_binding bindings[LR_RIG_MAX_BINDINGS];
@@ -291,7 +311,8 @@ int lr_rig_config_load(const char *path, lr_rig_config **out, lr_err *e);
 int lr_rig_config_parse(const char *text, const char *name, lr_rig_config **out, lr_err *e);
 void lr_rig_config_destroy(lr_rig_config *c);
 
-/* Applies "scene_set" to a freshly loaded scene; errors name the config file, line and field. */
+/* Applies "budget" (as the scene's quality block) and then "scene_set" to a freshly loaded
+ * scene; errors name the config file, line and field. */
 struct lr_scene;
 int lr_rig_config_apply_sets(const lr_rig_config *c, struct lr_scene *scene, lr_err *e);
 

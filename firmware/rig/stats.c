@@ -21,6 +21,7 @@ typedef struct ev_rec {
     double latency_ms;
     int stage; /* lr_rig_frame_info.stage of the frame that first showed it */
     double converge_ms; /* to the first converged frame showing it; NaN: not yet */
+    bool rested;        /* the newest event that converged frame shows: the controls rested */
 } ev_rec;
 
 typedef struct fr_rec {
@@ -57,6 +58,7 @@ struct lr_rig_stats {
     /* Every latency, for quantiles, in constant memory: a rig runs for months. */
     lr_lat_hist *lat;
     lr_lat_hist *conv; /* event -> first converged frame showing it */
+    lr_lat_hist *settle; /* the same for the newest event each converged frame shows */
 };
 
 int lr_rig_stats_create(int64_t start_ns, lr_rig_stats **out, lr_err *e)
@@ -67,8 +69,9 @@ int lr_rig_stats_create(int64_t start_ns, lr_rig_stats **out, lr_err *e)
         s->frames = calloc(LOG_MAX, sizeof *s->frames);
         s->lat = lr_lat_hist_create();
         s->conv = lr_lat_hist_create();
+        s->settle = lr_lat_hist_create();
     }
-    if (!s || !s->events || !s->frames || !s->lat || !s->conv) {
+    if (!s || !s->events || !s->frames || !s->lat || !s->conv || !s->settle) {
         lr_rig_stats_destroy(s);
         return lr_err_set(e, LR_ENOMEM, "out of memory");
     }
@@ -85,6 +88,7 @@ void lr_rig_stats_destroy(lr_rig_stats *s)
     free(s->frames);
     lr_lat_hist_destroy(s->lat);
     lr_lat_hist_destroy(s->conv);
+    lr_lat_hist_destroy(s->settle);
     free(s);
 }
 
@@ -147,6 +151,15 @@ void lr_rig_stats_frame_shown(lr_rig_stats *s, const lr_frame_stats *f,
      * first frame of a fade, still at the old level, is one). */
     if (!f->passes)
         return;
+    /* The newest event a converged frame shows: from it on the controls rested until that
+     * image, so its time is the time to converge after a rest (stats.h: settle_ms). */
+    int newest = -1;
+    for (int i = 0; info->converged && i < s->n_pending; i++) {
+        const pend_rec *p = pending_at(s, i);
+        if (p->batch != UNTAGGED && p->batch <= info->batch &&
+            (newest < 0 || p->ev.t_ns >= pending_at(s, newest)->ev.t_ns))
+            newest = i;
+    }
     int keep = 0;
     for (int i = 0; i < s->n_pending; i++) {
         pend_rec *p = pending_at(s, i);
@@ -164,6 +177,7 @@ void lr_rig_stats_frame_shown(lr_rig_stats *s, const lr_frame_stats *f,
             er->latency_ms = ms;
             er->stage = info->stage;
             er->converge_ms = NAN;
+            er->rested = false;
             p->ev_index = s->n_events;
             s->n_events++;
             lr_lat_hist_add(s->lat, ms);
@@ -171,8 +185,14 @@ void lr_rig_stats_frame_shown(lr_rig_stats *s, const lr_frame_stats *f,
         }
         if (shows && info->converged) {
             lr_lat_hist_add(s->conv, ms);
-            if (s->n_events - p->ev_index <= LOG_MAX)
+            bool last = LOG_MAX >= s->n_events - p->ev_index;
+            if (last)
                 s->events[p->ev_index % LOG_MAX].converge_ms = ms;
+            if (i == newest) {
+                lr_lat_hist_add(s->settle, ms);
+                if (last)
+                    s->events[p->ev_index % LOG_MAX].rested = true;
+            }
             continue; /* done with */
         }
         /* Kept in order; keep <= i, so this never overwrites one not yet read. */
@@ -203,6 +223,11 @@ double lr_rig_stats_latency_ms(const lr_rig_stats *s, double q)
 double lr_rig_stats_converge_ms(const lr_rig_stats *s, double q)
 {
     return lr_lat_hist_quantile(s->conv, q);
+}
+
+double lr_rig_stats_settle_ms(const lr_rig_stats *s, double q)
+{
+    return lr_lat_hist_quantile(s->settle, q);
 }
 
 static void write_devices(lr_jw *w, const lr_rig_stats_dev *devs, int n)
@@ -296,6 +321,13 @@ int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *conf
     lr_jw_number_or_null(w, "p99", lr_lat_hist_quantile(h, 0.99));
     lr_jw_number_or_null(w, "max", lr_lat_hist_max(h));
     lr_jw_object_end(w);
+    h = s->settle;
+    lr_jw_object(w, "settle_ms");
+    lr_jw_int(w, "n", (long)lr_lat_hist_n(h));
+    lr_jw_number_or_null(w, "median", lr_lat_hist_quantile(h, 0.5));
+    lr_jw_number_or_null(w, "p99", lr_lat_hist_quantile(h, 0.99));
+    lr_jw_number_or_null(w, "max", lr_lat_hist_max(h));
+    lr_jw_object_end(w);
     lr_jw_array(w, "event_log");
     uint64_t first = s->n_events > LOG_MAX ? s->n_events - LOG_MAX : 0;
     for (uint64_t i = first; i < s->n_events; i++) {
@@ -310,6 +342,7 @@ int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *conf
         lr_jw_number_or_null(w, "latency_ms", r->latency_ms);
         lr_jw_string(w, "stage", lr_async_stage_name((lr_async_stage)r->stage));
         lr_jw_number_or_null(w, "converge_ms", r->converge_ms);
+        lr_jw_bool(w, "rested", r->rested);
         lr_jw_object_end(w);
     }
     lr_jw_array_end(w);

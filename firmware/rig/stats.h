@@ -12,8 +12,10 @@
  *               (OSC, "input": {"messages": .., "events": .., "bad": .., "bad_address": ..})
  *   "latency_ms": {"n": 40, "min": 0.8, "median": 2.1, "p99": 7.9, "max": 8.3, "mean": 2.4},
  *   "converge_ms": {"n": 40, "median": 310, "p99": 2100, "max": 2300},
+ *   "settle_ms": {"n": 6, "median": 1200, "p99": 1900, "max": 1900},
  *   "event_log": [{"source": "sim", "control": "dimmer", "kind": "absolute", "value": 0.5,
- *                  "t_s": 1.25, "frame": 38, "latency_ms": 2.1, "stage": "final"}, ...],
+ *                  "t_s": 1.25, "frame": 38, "latency_ms": 2.1, "stage": "final",
+ *                  "converge_ms": 310, "rested": true}, ...],
  *                                                                            (last 4096)
  *   "frame_log": [{"index": 38, "t_s": 1.252, "passes": ["compose"], "ms": [0,0,0,0.4],
  *                  "total_ms": 0.4, "samples": 64, "converged": true,
@@ -22,7 +24,11 @@
  * latency_ms: event -> the end of the first frame that shows it, at whatever stage
  * (render/async/async.h: a preview, refining or final image); converge_ms: event -> the first
  * frame that shows it converged (the renderer's own settings, accumulation done). An event's
- * "stage" is that of the frame that first showed it.
+ * "stage" is that of the frame that first showed it. settle_ms: the same for the newest event
+ * each converged frame shows (its "rested" is true): from the controls' last change to the
+ * converged image, what a designer waits after letting go of a control (an event that a
+ * later one supersedes before convergence waits for that one as well: converge_ms counts it,
+ * settle_ms does not).
  * t_s are seconds since the stats were created (CLOCK_MONOTONIC). The summary covers every
  * event in constant memory: n, min, max, mean exact, median and p99 from a histogram within
  * 0.5 % (firmware/rig/lat_hist.h). Nothing here grows with the number of events or frames.
@@ -67,6 +73,8 @@ void lr_rig_stats_frame_shown(lr_rig_stats *s, const lr_frame_stats *f,
 void lr_rig_stats_frame(lr_rig_stats *s, const lr_frame_stats *f, int64_t done_ns);
 /* Event -> converged image quantile, ms; NaN when none. */
 double lr_rig_stats_converge_ms(const lr_rig_stats *s, double q);
+/* Controls' rest -> converged image quantile, ms (settle_ms above); NaN when none. */
+double lr_rig_stats_settle_ms(const lr_rig_stats *s, double q);
 
 /* A spatial-AR projector frame (calib/ar_frame.h): its clipping, kept for the stats file
  * ("ar": frames, last and worst clipped fraction of pixels and of the light). */

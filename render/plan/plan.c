@@ -52,23 +52,25 @@ bool lr_plan_budget_from_scene(const lr_scene *s, lr_plan_budget *out)
     const lr_quality *q = lr_scene_quality(s);
     out->max_error = q->max_error;
     out->frame_ms = q->frame_ms;
+    out->converge_ms = q->converge_ms;
     out->change_ms = q->change_ms;
-    return q->max_error > 0 || q->frame_ms > 0;
+    return q->max_error > 0 || q->frame_ms > 0 || q->converge_ms > 0;
 }
 
 bool lr_plan_budget_resolve(const lr_scene *s, const lr_plan_budget *given, lr_plan_budget *out)
 {
     lr_plan_budget_from_scene(s, out);
-    /* An error or frame budget given is the budget's kind: it replaces the scene's pair (a
-     * frame-only budget is frame-only), while change_ms, no budget by itself, is kept unless
-     * given. */
-    if (given->max_error > 0 || given->frame_ms > 0) {
+    /* An error, frame or converge budget given is the budget's kind: it replaces the scene's
+     * three (a frame-only budget is frame-only), while change_ms, no budget by itself, is kept
+     * unless given. */
+    if (given->max_error > 0 || given->frame_ms > 0 || given->converge_ms > 0) {
         out->max_error = given->max_error > 0 ? given->max_error : 0.0;
         out->frame_ms = given->frame_ms > 0 ? given->frame_ms : 0.0;
+        out->converge_ms = given->converge_ms > 0 ? given->converge_ms : 0.0;
     }
     if (given->change_ms > 0)
         out->change_ms = given->change_ms;
-    return out->max_error > 0 || out->frame_ms > 0;
+    return out->max_error > 0 || out->frame_ms > 0 || out->converge_ms > 0;
 }
 
 /* The scene file's base name without extension: what the bench writes in `scene`. */
@@ -171,7 +173,7 @@ static bool better(const cand *a, const cand *b, const lr_plan_budget *bu)
             return a->err < b->err;
         return a->fms < b->fms;
     }
-    if (a->err != b->err) /* frame_ms only: lowest error */
+    if (a->err != b->err) /* a time budget only: lowest error */
         return a->err < b->err;
     if (a->conv != b->conv)
         return a->conv < b->conv;
@@ -185,6 +187,8 @@ static double shortfall(const cand *c, const lr_plan_budget *b)
         r = fmax(r, c->err / b->max_error);
     if (b->frame_ms > 0)
         r = fmax(r, c->fms / b->frame_ms);
+    if (b->converge_ms > 0)
+        r = fmax(r, c->conv / b->converge_ms);
     return r;
 }
 
@@ -247,12 +251,37 @@ static int plan_object(const lr_scene *s, int index, const lr_plan_table *t,
     else
         reason(c, "not convex (vertices up to %.1f mm outside a face plane): %d maps to cover %.1f %%",
                a->convex_violation_mm, a->K_cover, 100.0 * a->coverage[a->K_cover - 1]);
-    return lr_plan_choose(s, index, t, b, models, -1, c, e);
+    return lr_plan_choose(s, index, t, b, models, -1, NULL, c, e);
+}
+
+/* The row of scene `scene` with r's model and settings (any frames: a frame's cost does not
+ * depend on how many are accumulated), the slowest when measured more than once; NULL when
+ * none. */
+static const lr_plan_row *timing_row(const lr_plan_table *t, const char *scene,
+                                     const lr_plan_row *r)
+{
+    const lr_plan_row *best = NULL;
+    for (int i = 0; i < lr_plan_table_count(t); i++) {
+        const lr_plan_row *q = lr_plan_table_row(t, i);
+        if (strcmp(q->scene, scene) || strcmp(q->model, r->model) || q->K != r->K ||
+            q->N != r->N || q->N_vpl != r->N_vpl || q->map_size != r->map_size ||
+            q->gbuffer_size != r->gbuffer_size || q->vpl != r->vpl || q->lpv != r->lpv ||
+            !isfinite(q->frame_ms))
+            continue;
+        if (!best || q->frame_ms > best->frame_ms)
+            best = q;
+    }
+    return best;
 }
 
 int lr_plan_choose(const lr_scene *s, int index, const lr_plan_table *t, const lr_plan_budget *b,
-                   unsigned models, int vpl_rows, lr_plan_choice *c, lr_err *e)
+                   unsigned models, int vpl_rows, const char *time_scene, lr_plan_choice *c,
+                   lr_err *e)
 {
+    /* Times from another scene than the errors (the re-plan: time_scene is the object's own). */
+    bool other_times = time_scene && strcmp(time_scene, c->table_scene);
+    const char *cost_scene = other_times ? time_scene : c->table_scene;
+    int n_timed = 0;
     const lr_scene_object *o = lr_scene_object_at(s, index);
     const lr_plan_analysis *a = &c->analysis;
     bool need_vpl = a->receivers_seeing != 0;
@@ -278,7 +307,7 @@ int lr_plan_choose(const lr_scene *s, int index, const lr_plan_table *t, const l
             const lr_plan_row *r = lr_plan_table_row(t, i);
             if (strcmp(r->model, name) || !isfinite(r->ms_change))
                 continue;
-            if (!strcmp(r->scene, c->table_scene))
+            if (!strcmp(r->scene, cost_scene))
                 here = r;
             if (!worst || r->ms_change > worst->ms_change)
                 worst = r;
@@ -318,13 +347,17 @@ retry:
             /* pass 0: K >= K_cover; pass 1 (none had that many maps): the most maps measured */
             if (pass == 0 ? r->K < a->K_cover : r->K < kmax)
                 continue;
-            cand x = {.row = r, .err = lr_plan_row_error(r), .fms = r->frame_ms};
-            if (!need_vpl && r->vpl && isfinite(r->ms_vpl))
-                x.fms = fmax(r->frame_ms - r->ms_vpl, 0.0);
-            x.conv = (isfinite(r->ms_gbuffer) ? r->ms_gbuffer : 0.0) + r->frames * x.fms;
+            const lr_plan_row *tr = other_times ? timing_row(t, time_scene, r) : NULL;
+            n_timed += !pass && tr;
+            if (!tr)
+                tr = r;
+            cand x = {.row = r, .err = lr_plan_row_error(r), .fms = tr->frame_ms};
+            if (!need_vpl && tr->vpl && isfinite(tr->ms_vpl))
+                x.fms = fmax(tr->frame_ms - tr->ms_vpl, 0.0);
+            x.conv = (isfinite(tr->ms_gbuffer) ? tr->ms_gbuffer : 0.0) + r->frames * x.fms;
             /* render.lpv: the volume is built once, on the first frame (its own pass). */
-            if (r->lpv > 0 && isfinite(r->ms_lpv))
-                x.conv += r->ms_lpv;
+            if (r->lpv > 0 && isfinite(tr->ms_lpv))
+                x.conv += tr->ms_lpv;
             cs[ncand++] = x;
         }
         if (!pass && ndark)
@@ -352,6 +385,11 @@ retry:
                                   "one dark)" : "");
     }
 
+    if (other_times)
+        reason(c, "times from '%s' itself at the same settings for %d of %d rows (a frame's "
+                  "cost follows the geometry, receivers and image, not the material)%s%s%s",
+               time_scene, n_timed, nscene, n_timed < nscene ? "; the others from '" : "",
+               n_timed < nscene ? c->table_scene : "", n_timed < nscene ? "'" : "");
     const cand *best = NULL;
     int nfeas = 0;
     for (int i = 0; i < ncand; i++) {
@@ -361,7 +399,8 @@ retry:
          * (no receiver in sight, so still a candidate) meets nothing. */
         bool ok = isfinite(x->err) && !lr_plan_row_dark(x->row) &&
                   (b->max_error <= 0 || x->err <= b->max_error) &&
-                  (b->frame_ms <= 0 || x->fms <= b->frame_ms);
+                  (b->frame_ms <= 0 || x->fms <= b->frame_ms) &&
+                  (b->converge_ms <= 0 || x->conv <= b->converge_ms);
         if (!ok)
             continue;
         nfeas++;
@@ -393,10 +432,11 @@ int lr_plan_create(const lr_scene *s, const lr_plan_table *t, const lr_plan_budg
                    const lr_plan_options *opt, lr_plan *out, lr_err *e)
 {
     memset(out, 0, sizeof *out);
-    if (!(b->max_error > 0) && !(b->frame_ms > 0))
-        return lr_err_set(e, LR_EINVAL, "planner: no budget (quality.max_error or "
-                                        "quality.frame_ms, > 0)");
-    if (!isfinite(b->max_error) || !isfinite(b->frame_ms) || b->max_error < 0 || b->frame_ms < 0)
+    if (!(b->max_error > 0) && !(b->frame_ms > 0) && !(b->converge_ms > 0))
+        return lr_err_set(e, LR_EINVAL, "planner: no budget (quality.max_error, "
+                                        "quality.frame_ms or quality.converge_ms, > 0)");
+    if (!isfinite(b->max_error) || !isfinite(b->frame_ms) || !isfinite(b->converge_ms) ||
+        b->max_error < 0 || b->frame_ms < 0 || b->converge_ms < 0)
         return lr_err_set(e, LR_EINVAL, "planner: budget must be finite and >= 0");
     int no = lr_scene_object_count(s);
     if (no > LR_PLAN_MAX_OBJECTS)
@@ -511,12 +551,17 @@ static void put(out *o, const char *fmt, ...)
 
 static void put_budget(out *o, const lr_plan_budget *b)
 {
-    if (b->max_error > 0 && b->frame_ms > 0)
-        put(o, "error <= %g and <= %g ms/frame", b->max_error, b->frame_ms);
-    else if (b->max_error > 0)
+    const char *sep = "";
+    if (b->max_error > 0) {
         put(o, "error <= %g", b->max_error);
-    else
-        put(o, "<= %g ms/frame", b->frame_ms);
+        sep = " and ";
+    }
+    if (b->frame_ms > 0) {
+        put(o, "%s<= %g ms/frame", sep, b->frame_ms);
+        sep = " and ";
+    }
+    if (b->converge_ms > 0)
+        put(o, "%sconverged in <= %g s", sep, b->converge_ms * 1e-3);
 }
 
 /* Whether the predicted error (the largest part) is the RMSE part's noise floor: the row's
@@ -582,10 +627,17 @@ size_t lr_plan_format(const lr_plan *p, char *buf, size_t cap)
 /* The budget as a reader says it: "error <= 0.05, <= 100 ms a frame". */
 static void put_budget_words(out *o, const lr_plan_budget *b)
 {
-    if (b->max_error > 0)
-        put(o, "error <= %g%s", b->max_error, b->frame_ms > 0 ? ", " : "");
-    if (b->frame_ms > 0)
-        put(o, "<= %g ms a frame", b->frame_ms);
+    const char *sep = "";
+    if (b->max_error > 0) {
+        put(o, "error <= %g", b->max_error);
+        sep = ", ";
+    }
+    if (b->frame_ms > 0) {
+        put(o, "%s<= %g ms a frame", sep, b->frame_ms);
+        sep = ", ";
+    }
+    if (b->converge_ms > 0)
+        put(o, "%sconverged in <= %g s", sep, b->converge_ms * 1e-3);
 }
 
 size_t lr_plan_format_brief(const lr_plan *p, char *buf, size_t cap)
@@ -594,7 +646,7 @@ size_t lr_plan_format_brief(const lr_plan *p, char *buf, size_t cap)
     if (cap)
         buf[0] = '\0';
     /* The scene's figures are its worst object's: one settings block renders them all. */
-    double err = 0.0, fms = 0.0, over = 0.0;
+    double err = 0.0, fms = 0.0, conv = 0.0, over = 0.0;
     bool at_most = false; /* the worst error is a noise floor (error_at_most) */
     bool dark = false;    /* a chosen row leaves a region dark (lr_plan_row_dark) */
     put(&o, "plan: %s: ", p->scene);
@@ -610,9 +662,11 @@ size_t lr_plan_format_brief(const lr_plan *p, char *buf, size_t cap)
         err = isfinite(c->predicted_error) && isfinite(err) ? fmax(err, c->predicted_error)
                                                             : INFINITY;
         fms = fmax(fms, c->predicted_frame_ms);
+        conv = fmax(conv, c->predicted_converge_ms);
         dark |= lr_plan_row_dark(&c->row);
         over = fmax(over, shortfall(&(cand){.err = c->predicted_error,
-                                            .fms = c->predicted_frame_ms},
+                                            .fms = c->predicted_frame_ms,
+                                            .conv = c->predicted_converge_ms},
                                     &p->budget));
     }
     if (isfinite(err))
@@ -620,7 +674,11 @@ size_t lr_plan_format_brief(const lr_plan *p, char *buf, size_t cap)
             dark ? " (a region left dark)" : "");
     else
         put(&o, ", no finite predicted error (a region left dark)");
-    put(&o, ", %.0f ms a frame on this table; the budget (", fms);
+    if (p->budget.converge_ms > 0) /* the budget's own figure, said where it is judged */
+        put(&o, ", %.0f ms a frame, converged in %.1f s on this table; the budget (", fms,
+            conv * 1e-3);
+    else
+        put(&o, ", %.0f ms a frame on this table; the budget (", fms);
     put_budget_words(&o, &p->budget);
     if (p->feasible)
         put(&o, ") holds\n");
@@ -654,9 +712,9 @@ size_t lr_plan_format_json(const lr_plan *p, char *buf, size_t cap)
         buf[0] = '\0';
     put(&o, "{\"scene\":");
     put_json_string(&o, p->scene);
-    put(&o, ",\"budget\":{\"max_error\":%.17g,\"frame_ms\":%.17g,\"change_ms\":%.17g},"
-            "\"feasible\":%s,\"objects\":[",
-        p->budget.max_error, p->budget.frame_ms, p->budget.change_ms,
+    put(&o, ",\"budget\":{\"max_error\":%.17g,\"frame_ms\":%.17g,\"converge_ms\":%.17g,"
+            "\"change_ms\":%.17g},\"feasible\":%s,\"objects\":[",
+        p->budget.max_error, p->budget.frame_ms, p->budget.converge_ms, p->budget.change_ms,
         p->feasible ? "true" : "false");
     for (int i = 0; i < p->nobjects; i++) {
         const lr_plan_choice *c = &p->objects[i];

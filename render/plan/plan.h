@@ -255,6 +255,10 @@ typedef struct lr_plan_budget {
      * next frame: models whose measured change cost (lr_plan_row.ms_change) is over it are
      * left out while any other model remains; 0: none. Not a budget by itself. */
     double change_ms;
+    /* ms from a change to the converged image: the row's ms_gbuffer + frames x frame_ms
+     * (lr_plan_choice.predicted_converge_ms), what a designer waits after turning a control in
+     * the rig; 0: none. */
+    double converge_ms;
 } lr_plan_budget;
 
 
@@ -310,24 +314,26 @@ typedef struct lr_plan_options {
  * features when the table has no row for it):
  *   max_error only: the row with error <= max_error that converges soonest
  *                   (ms_gbuffer + frames x frame_ms), ties to the lower error;
- *   frame_ms only:  the lowest error with frame_ms <= budget, ties to the sooner converging;
- *   both:           the soonest converging row meeting both; none: infeasible, the row
- *                   nearest to both (smallest max(error / max_error, frame_ms / budget)),
- *                   said in the reasons;
- *   neither:        LR_EINVAL (no budget to plan for).
+ *   frame_ms or converge_ms only (or both, no max_error): the lowest error with frame_ms
+ *                   and time to converge within the budget, ties to the sooner converging;
+ *   max_error and a time: the soonest converging row meeting all; none: infeasible, the row
+ *                   nearest to all (smallest max(error / max_error, frame_ms / frame budget,
+ *                   converge / converge budget)), said in the reasons;
+ *   none:           LR_EINVAL (no budget to plan for).
  * Rows with fewer maps than the object's K_cover are left out (the bench measures one view;
  * coverage must hold for every view). VPLs are cut for an object no receiver sees.
  * LR_EINVAL when no row is usable. */
 int lr_plan_create(const lr_scene *s, const lr_plan_table *t, const lr_plan_budget *b,
                    const lr_plan_options *opt, lr_plan *out, lr_err *e);
 
-/* The budget of a scene's "quality" block; false when it sets none. */
+/* The budget of a scene's "quality" block; false when it sets none (no max_error, frame_ms
+ * or converge_ms). */
 bool lr_plan_budget_from_scene(const lr_scene *s, lr_plan_budget *out);
-/* The budget of a command line (`lamprig plan --max-error/--frame-ms/--change-ms`: fields
- * > 0 given, 0 not) over the scene's: a max_error or frame_ms given replaces the scene's
- * pair of them (the budget's kind is the one given), change_ms given replaces the scene's,
- * and what is not given is the scene's. False when the result has neither max_error nor
- * frame_ms. */
+/* The budget of a command line (`lamprig plan --max-error/--frame-ms/--converge-ms/
+ * --change-ms`: fields > 0 given, 0 not) or a rig config's `budget` over the scene's: a
+ * max_error, frame_ms or converge_ms given replaces the scene's three (the budget's kind is
+ * the one given), change_ms given replaces the scene's, and what is not given is the scene's.
+ * False when the result has none of max_error, frame_ms and converge_ms. */
 bool lr_plan_budget_resolve(const lr_scene *s, const lr_plan_budget *given, lr_plan_budget *out);
 
 /* Applies plan->settings to the scene through lr_scene_set (render.K, N, N_vpl, map_size,

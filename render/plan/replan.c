@@ -176,7 +176,7 @@ static int replan_object(lr_replan *r, const lr_scene *s, int i, lr_plan_choice 
                                                         : INFINITY;
         reason(c, "re-planned for material '%s' (%s): the table has no rows for it; rows of "
                   "'%s', measured with its own material at %.1f diffusion lengths (|ln| of the "
-                  "size ratio %.2f): errors and times are that material's",
+                  "size ratio %.2f): errors are that material's",
                o->material.name, mine, m->name, m->f.size_tr, lr);
         if (strcmp(m->name, r->key))
             reason(c, "'%s' is nearer by features than '%s' itself (%s)", m->name, r->key,
@@ -190,7 +190,8 @@ static int replan_object(lr_replan *r, const lr_scene *s, int i, lr_plan_choice 
         reason(c, "rows with the VPL pass %s only (the view's, fixed at load)",
                r->plan.vpl ? "on" : "off");
     return lr_plan_choose(s, i, r->table, &r->plan.budget, r->models,
-                          need_vpl ? (r->plan.vpl ? 1 : 0) : -1, c, e);
+                          need_vpl ? (r->plan.vpl ? 1 : 0) : -1,
+                          lr_plan_table_has_scene(r->table, r->key) ? r->key : NULL, c, e);
 }
 
 /* The scene-wide settings from the choices, as lr_plan_create merges them. */

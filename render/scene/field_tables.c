@@ -412,6 +412,10 @@ static const lr_field quality_fields[] = {
      .help = "relative RMS error against the converged reference"},
     {"frame_ms", LR_FT_NUM, 0, Q(frame_ms), 0, 1e9, LR_FF_HI_OPEN | LR_FF_HI_QUIET,
      .unit = "ms (0: no budget)", .dirty = SET, .help = "time budget per frame"},
+    {"converge_ms", LR_FT_NUM, 0, Q(converge_ms), 0, 1e9, LR_FF_HI_OPEN | LR_FF_HI_QUIET,
+     .unit = "ms (0: no budget)", .dirty = SET,
+     .help = "time budget from a change to the converged image (the light G-buffer and every "
+             "accumulation frame, as measured): what a designer waits after turning a control"},
     {"change_ms", LR_FT_NUM, 0, Q(change_ms), 0, 1e9, LR_FF_HI_OPEN | LR_FF_HI_QUIET,
      .unit = "ms (0: none)", .dirty = SET,
      .help = "longest wait from a material change to the next frame: the planner leaves out "

@@ -303,6 +303,7 @@ typedef struct lr_render_settings {
 typedef struct lr_quality {
     double max_error; /* relative RMS error budget; 0: none */
     double frame_ms;  /* time budget per frame; 0: none */
+    double converge_ms; /* time budget from a change to the converged image; 0: none */
     double change_ms; /* longest wait after a material change (the planner); 0: none */
 } lr_quality;
 

@@ -64,7 +64,7 @@ static lr_plan *plan_of(const lr_scene *s, double max_error, double frame_ms, un
 {
     lr_plan *p = calloc(1, sizeof *p);
     lr_err e = {0};
-    lr_plan_budget b = {max_error, frame_ms, 0};
+    lr_plan_budget b = {.max_error = max_error, .frame_ms = frame_ms};
     if (lr_plan_create(s, table, &b, &(lr_plan_options){.models = models}, p, &e))
         fail_msg("plan: %s", e.msg);
     return p;
@@ -321,7 +321,7 @@ static void test_committed_front_both_scenes(void **state)
                 continue; /* a row that leaves a region dark meets no budget */
             assert_true(err >= fmax(r->bias_object, isnan(r->bias_receivers) ? 0.0 : r->bias_receivers));
             lr_plan p;
-            assert_int_equal(lr_plan_create(scenes[s], t, &(lr_plan_budget){err, 0, 0}, NULL, &p, &e),
+            assert_int_equal(lr_plan_create(scenes[s], t, &(lr_plan_budget){.max_error = err}, NULL, &p, &e),
                              LR_OK);
             assert_true(p.feasible);
             assert_true(p.objects[0].predicted_error <= err);
@@ -388,9 +388,58 @@ static void test_both_budgets_and_infeasible(void **state)
     /* No budget at all is an error, not a plan. */
     lr_plan q;
     lr_err e = {0};
-    assert_int_equal(lr_plan_create(candle, table, &(lr_plan_budget){0, 0, 0}, NULL, &q, &e),
+    assert_int_equal(lr_plan_create(candle, table, &(lr_plan_budget){0}, NULL, &q, &e),
                      LR_EINVAL);
     assert_non_null(strstr(e.msg, "no budget"));
+}
+
+/* quality.converge_ms (tests/fixtures/plan_front.csv, converged in = ms_gbuffer + frames x
+ * frame_ms): candle K4 340 ms (0.12), standard K8 1630 ms (0.11), K8 1950 ms (0.07), K12
+ * 4830 ms (0.05), ... Alone: the lowest error converging in time; with max_error: the soonest
+ * converged meeting both; none: the closest by max(error / E, converged / C). */
+static void test_converge_budget(void **state)
+{
+    (void)state;
+    lr_err e = {0};
+    lr_plan *p = calloc(1, sizeof *p);
+    assert_non_null(p);
+    struct {
+        double max_error, converge_ms;
+        int K;
+        const char *model;
+        bool feasible;
+        double conv;
+    } cases[] = {
+        {0, 2000, 8, "directional_dipole", true, 1950},    /* 0.07 beats 0.11 and 0.12 */
+        {0, 1000, 4, "directional_dipole", true, 340},     /* only K4 in time */
+        {0.115, 2000, 8, "standard_dipole", true, 1630},   /* soonest of 0.11 and 0.07 */
+        {0.1, 1000, 4, "directional_dipole", false, 340},  /* 1.2x against K8's 1.95x */
+        {0, 100, 4, "directional_dipole", false, 340},     /* nothing converges in 0.1 s */
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        lr_plan_budget b = {.max_error = cases[i].max_error, .converge_ms = cases[i].converge_ms};
+        assert_int_equal(lr_plan_create(candle, table, &b, NULL, p, &e), LR_OK);
+        const lr_plan_choice *c = &p->objects[0];
+        assert_int_equal(c->row.K, cases[i].K);
+        assert_string_equal(c->row.model, cases[i].model);
+        assert_int_equal(p->feasible, cases[i].feasible);
+        assert_near(c->predicted_converge_ms, cases[i].conv, 1e-9);
+    }
+    char buf[4096];
+    lr_plan_format_brief(p, buf, sizeof buf); /* the last case */
+    assert_non_null(strstr(buf, "converged in 0.3 s on this table; the budget (converged in <= "
+                                "0.1 s) is not reachable here, the closest row shown (3.4x over"));
+    lr_plan_budget b = {.max_error = 0.1, .converge_ms = 1000};
+    assert_int_equal(lr_plan_create(candle, table, &b, NULL, p, &e), LR_OK);
+    assert_true(has_reason(&p->objects[0], "1.20x the budget"));
+    lr_plan_format(p, buf, sizeof buf);
+    assert_non_null(strstr(buf, "budget error <= 0.1 and converged in <= 1 s NOT MET"));
+    /* Negative or non-finite: refused. */
+    b = (lr_plan_budget){.converge_ms = -1};
+    assert_int_equal(lr_plan_create(candle, table, &b, NULL, p, &e), LR_EINVAL);
+    b = (lr_plan_budget){.max_error = 0.1, .converge_ms = INFINITY};
+    assert_int_equal(lr_plan_create(candle, table, &b, NULL, p, &e), LR_EINVAL);
+    free(p);
 }
 
 static void test_models_and_coverage_filter(void **state)
@@ -790,12 +839,18 @@ static void test_budget_resolve(void **state)
     assert_near(b.max_error, 0.0, 0.0);
     assert_near(b.frame_ms, 150, 0.0);
     assert_near(b.change_ms, 3000, 0.0);
-    assert_true(lr_plan_budget_resolve(candle, &(lr_plan_budget){0.2, 0, 500}, &b));
+    assert_true(lr_plan_budget_resolve(candle, &(lr_plan_budget){.max_error = 0.2, .change_ms = 500}, &b));
     assert_near(b.max_error, 0.2, 0.0);
     assert_near(b.frame_ms, 0.0, 0.0);
     assert_near(b.change_ms, 500, 0.0);
     assert_true(lr_plan_budget_resolve(candle, &(lr_plan_budget){0}, &b));
     assert_near(b.max_error, 0.05, 0.0);
+    assert_near(b.change_ms, 3000, 0.0);
+    /* converge_ms given (a rig's budget) replaces the scene's error and frame budgets too */
+    assert_true(lr_plan_budget_resolve(candle, &(lr_plan_budget){.converge_ms = 2000}, &b));
+    assert_near(b.max_error, 0.0, 0.0);
+    assert_near(b.frame_ms, 0.0, 0.0);
+    assert_near(b.converge_ms, 2000, 0.0);
     assert_near(b.change_ms, 3000, 0.0);
     /* A scene without a budget and only --change-ms given: still no budget. */
     lr_scene *sphere = NULL;
@@ -953,7 +1008,7 @@ static void test_sh_translucency_rows(void **state)
     for (int k = 0; k < 3; k++) {
         lr_plan *p = calloc(1, sizeof *p);
         assert_non_null(p);
-        lr_plan_budget b = {budgets[k], 0, 0};
+        lr_plan_budget b = {.max_error = budgets[k]};
         if (lr_plan_create(candle, t, &b, &(lr_plan_options){.models = models[k]}, p, &e))
             fail_msg("plan: %s", e.msg);
         assert_string_equal(p->objects[0].row.model, want[k]);
@@ -1066,7 +1121,7 @@ static void test_receivers_in_sight(void **state)
         "  \"normal\": [0, 1, 0], \"size\": [200, 200], \"albedo\": [0.5, 0.5, 0.5]}]";
     s = parse_scene("unseen_ball.json", ball, "[0, 0, 0]", unseen);
     lr_plan *p = calloc(1, sizeof *p);
-    assert_int_equal(lr_plan_create(s, table, &(lr_plan_budget){0.05, 0, 0}, NULL, p, &e), LR_OK);
+    assert_int_equal(lr_plan_create(s, table, &(lr_plan_budget){.max_error = 0.05}, NULL, p, &e), LR_OK);
     const lr_plan_choice *c = &p->objects[0];
     assert_int_equal(c->analysis.receivers_seeing, 0u);
     assert_false(c->vpl);
@@ -1403,7 +1458,7 @@ static void test_cli_plan(void **state)
     assert_int_equal(run("./build/bin/lamprig plan --scene tests/fixtures/tight/candle.json --table "
                          FIXTURE " --change-ms 100000 --json"), 0);
     expect_in("out", "\"budget\":{\"max_error\":0.050000000000000003,\"frame_ms\":100,"
-                     "\"change_ms\":100000}");
+                     "\"converge_ms\":0,\"change_ms\":100000}");
 
     assert_int_equal(run("./build/bin/lamprig plan --scene tests/fixtures/tight/candle.json --table "
                          FIXTURE " --max-error 0.05 --json"), 0);
@@ -1566,6 +1621,7 @@ int main(void)
         cmocka_unit_test(test_committed_front_both_scenes),
         cmocka_unit_test(test_frame_ms_budget),
         cmocka_unit_test(test_both_budgets_and_infeasible),
+        cmocka_unit_test(test_converge_budget),
         cmocka_unit_test(test_models_and_coverage_filter),
         cmocka_unit_test(test_multipole_where_the_object_takes_it),
         cmocka_unit_test(test_error_sees_regions),

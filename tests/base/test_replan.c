@@ -261,6 +261,62 @@ static void test_direct_changes(void **state)
     lr_scene_destroy(s);
 }
 
+/* The re-plan's times: errors from the scene nearest by material (the votive for porcelain),
+ * times from the candle's own row at the same settings (tests/fixtures/replan_times.csv: the
+ * candle costs 3x the votive there, as measured scenes do); a row the candle lacks keeps the
+ * votive's time. A converge budget then holds or not by the candle's time. */
+static void test_times_from_own_scene(void **state)
+{
+    (void)state;
+    lr_err e = {0};
+    for (int pass = 0; pass < 2; pass++) {
+        lr_scene *s = load("candle");
+        lr_plan_table *t;
+        if (lr_plan_table_load(LR_SOURCE_CONFIGS "/../tests/fixtures/replan_times.csv", &t, &e))
+            fail_msg("%s", e.msg);
+        lr_plan *p = calloc(1, sizeof *p);
+        assert_non_null(p);
+        /* pass 1 adds a converge budget of 2 s: the candle's 4830 ms misses it */
+        lr_plan_budget b = {.max_error = 0.25, .converge_ms = pass ? 2000 : 0};
+        if (lr_plan_create(s, t, &b, NULL, p, &e) || lr_plan_apply(p, s, NULL, &e))
+            fail_msg("%s", e.msg);
+        assert_string_equal(model_of(s), "diffusion_grid");
+        assert_near(p->objects[0].predicted_converge_ms, 500.0, 1e-9);
+        lr_replan *r;
+        if (lr_replan_create(s, t, p, NULL, &r, &e))
+            fail_msg("%s", e.msg);
+        free(p);
+        unsigned dirty = 0;
+        char *text = NULL;
+        int n = -1;
+        set(s, "objects[0].material", "porcelain", &dirty);
+        assert_int_equal(lr_replan_update(r, s, dirty, &dirty, &text, &n, &e), LR_OK);
+        assert_int_equal(n, 1);
+        const lr_plan_choice *c = &lr_replan_plan(r)->objects[0];
+        assert_string_equal(c->table_scene, "votive");
+        assert_non_null(text);
+        assert_non_null(strstr(text, "times from 'candle' itself at the same settings for 1 of 2 "
+                                     "rows"));
+        assert_non_null(strstr(text, "the others from 'votive'"));
+        if (pass == 0) {
+            assert_string_equal(model_of(s), "directional_dipole");
+            assert_near(c->predicted_error, 0.15, 1e-12);     /* the votive's */
+            assert_near(c->predicted_frame_ms, 300.0, 1e-12); /* the candle's */
+            assert_near(c->predicted_converge_ms, 30.0 + 16 * 300.0, 1e-9);
+            assert_true(lr_replan_plan(r)->feasible);
+        } else {
+            /* 4830 ms misses 2 s by 2.4x; the SH row (0.30, 55 ms) by 1.2x: the closest */
+            assert_string_equal(model_of(s), "sh_translucency");
+            assert_near(c->predicted_converge_ms, 5.0 + 50.0, 1e-9);
+            assert_false(lr_replan_plan(r)->feasible);
+            assert_non_null(strstr(text, "(1.20x the budget)"));
+        }
+        free(text);
+        lr_replan_destroy(r);
+        lr_scene_destroy(s);
+    }
+}
+
 /* Only the grid allowed: porcelain leaves no row; the object keeps its model, the text says
  * so, and the same material is not retried on every later change flag. A settings override
  * (render.frames set after the plan) is not written over. */
@@ -369,6 +425,7 @@ int main(void)
         cmocka_unit_test(test_limits),
         cmocka_unit_test(test_direct_changes),
         cmocka_unit_test(test_no_row_and_overrides),
+        cmocka_unit_test(test_times_from_own_scene),
         cmocka_unit_test(test_rig_control_stream),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

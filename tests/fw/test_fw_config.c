@@ -57,6 +57,12 @@ static void test_bad_fields_named(void **state)
         {"{\"scene\": \"candle.json\",\n \"sceen\": 1}",
          "rig.json:2: field 'sceen': unknown field"},
         {"{\"devices\": []}", "rig.json:1: field 'scene': required field is missing"},
+        {"{\"scene\": \"candle.json\",\n \"budget\": {\"change_ms\": 100}}",
+         "rig.json:2: field 'budget': no budget: give max_error, frame_ms or converge_ms (> 0)"},
+        {"{\"scene\": \"candle.json\",\n \"budget\": {\"max_error\": -0.1}}",
+         "rig.json:2: field 'budget.max_error': must be in 0..1e+06, got -0.1"},
+        {"{\"scene\": \"candle.json\",\n \"budget\": {\"converge_s\": 2}}",
+         "rig.json:2: field 'budget.converge_s': unknown field"},
         {"{\"scene\": \"candle.json\",\n \"output\": {\"gpu_memory_mb\": -5}}",
          "rig.json:2: field 'output.gpu_memory_mb': must be in 0..1.04858e+06, got -5"},
         {"{\"scene\": \"nope.json\"}", "rig.json:1: field 'scene': '%D/nope.json': No such file "
@@ -266,6 +272,11 @@ static void test_shipped_rigs(void **state)
     if (lr_rig_config_load(CFG "/rig/sim.json", &c, &e))
         fail_msg("%s", e.msg);
     assert_int_equal(c->devices[0].type, LR_RIG_DEV_SIM);
+    /* The shipped rigs state a budget, not render settings: the planner picks those. */
+    assert_true(c->budget.given);
+    assert_true(c->budget.max_error == 0.2 && c->budget.converge_ms == 2000);
+    for (int i = 0; i < c->n_sets; i++)
+        assert_null(strstr(c->sets[i].key, "render."));
     assert_true(c->devices[0].loop);
     assert_int_equal(c->n_bindings, 6);
     assert_int_equal(c->output.mode, LR_RIG_HEADLESS);
@@ -277,6 +288,13 @@ static void test_shipped_rigs(void **state)
     if (lr_control_map_create(c, s, true, 0, &m, &e))
         fail_msg("%s", e.msg);
     lr_control_map_destroy(m);
+    /* The budget replaces the scene's quality block (its 600 ms a frame goes), change_ms
+     * stays the scene's. */
+    if (lr_rig_config_apply_sets(c, s, &e))
+        fail_msg("%s", e.msg);
+    const lr_quality *q = lr_scene_quality(s);
+    assert_true(q->max_error == 0.2 && q->converge_ms == 2000 && q->frame_ms == 0);
+    assert_true(q->change_ms == 3000);
     lr_scene_destroy(s);
     lr_rig_config_destroy(c);
 }

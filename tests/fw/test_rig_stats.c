@@ -190,6 +190,75 @@ static void test_stats_latency_fields(void **state)
     free(path);
 }
 
+/* settle_ms and "rested" (stats.h): a transport batch (events at 0 and 100 ms, batch 1 and 2)
+ * refined, a dimmer event at 300 ms taking batch 0 (blend-only, applied with batch 2's images),
+ * converged at 1300 ms: every event there converges, only the newest, the dimmer, rested, with
+ * 1000 ms; a later press converged in the same frame that first shows it rests with its
+ * latency. The earlier events' converge_ms run from their own times. */
+static void test_stats_settle(void **state)
+{
+    (void)state;
+    lr_err e = {0};
+    lr_rig_stats *s;
+    assert_int_equal(lr_rig_stats_create(0, &s, &e), LR_OK);
+    const int64_t ms = 1000000;
+    lr_event ev;
+    lr_event_set(&ev, "sim", "button1", LR_EV_PRESS, 1, 0);
+    lr_rig_stats_event(s, &ev);
+    lr_rig_stats_tag(s, 1);
+    lr_event_set(&ev, "sim", "knob2", LR_EV_DELTA, 1, 100 * ms);
+    lr_rig_stats_event(s, &ev);
+    lr_rig_stats_tag(s, 2);
+    lr_frame_stats f = pass_frame(0);
+    lr_rig_stats_frame_shown(s, &f, &(lr_rig_frame_info){2, LR_ASYNC_PREVIEW, false}, 200 * ms);
+    lr_event_set(&ev, "sim", "dimmer", LR_EV_ABSOLUTE, 0.5, 300 * ms);
+    lr_rig_stats_event(s, &ev);
+    lr_rig_stats_tag(s, 0);
+    f = pass_frame(1);
+    lr_rig_stats_frame_shown(s, &f, &(lr_rig_frame_info){2, LR_ASYNC_REFINING, false}, 600 * ms);
+    f = pass_frame(2);
+    lr_rig_stats_frame_shown(s, &f, &(lr_rig_frame_info){2, LR_ASYNC_FINAL, true}, 1300 * ms);
+    lr_event_set(&ev, "sim", "button1", LR_EV_PRESS, 1, 2000 * ms);
+    lr_rig_stats_event(s, &ev);
+    lr_rig_stats_tag(s, 3);
+    f = pass_frame(3);
+    lr_rig_stats_frame_shown(s, &f, &(lr_rig_frame_info){3, LR_ASYNC_CACHED, true}, 2030 * ms);
+    assert_near(lr_rig_stats_settle_ms(s, 0.0), 30.0, 30.0 * LR_LAT_HIST_REL_ERR);
+    assert_near(lr_rig_stats_settle_ms(s, 1.0), 1000.0, 1000.0 * LR_LAT_HIST_REL_ERR);
+    assert_near(lr_rig_stats_converge_ms(s, 1.0), 1300.0, 1300.0 * LR_LAT_HIST_REL_ERR);
+
+    char *dir = lr_test_tmpdir();
+    char *path = lr_test_path(dir, "stats.json");
+    assert_int_equal(lr_rig_stats_write(s, path, NULL, 2100 * ms, 0, NULL, 0, &e), LR_OK);
+    lr_json *j;
+    assert_int_equal(lr_json_load(path, &j, &e), LR_OK);
+    lr_jnode root = lr_json_root(j), log = lr_json_get(j, root, "event_log");
+    long n = 0;
+    assert_int_equal(lr_json_get_int(j, lr_json_get(j, root, "settle_ms"), "n", true, &n, &e),
+                     LR_OK);
+    assert_int_equal(n, 2);
+    assert_int_equal(lr_json_count(j, log), 4);
+    static const char *const control[] = {"button1", "knob2", "dimmer", "button1"};
+    static const bool rested[] = {false, false, true, true};
+    static const double conv[] = {1300, 1200, 1000, 30};
+    for (int i = 0; i < 4; i++) {
+        lr_jnode x = lr_json_at(j, log, i);
+        char name[32];
+        bool r;
+        double c;
+        assert_int_equal(lr_json_get_string(j, x, "control", true, name, sizeof name, &e), LR_OK);
+        assert_string_equal(name, control[i]);
+        assert_int_equal(lr_json_get_bool(j, x, "rested", true, &r, &e), LR_OK);
+        assert_int_equal(r, rested[i]);
+        assert_int_equal(lr_json_get_number(j, x, "converge_ms", true, &c, &e), LR_OK);
+        assert_near(c, conv[i], 1e-9);
+    }
+    lr_json_destroy(j);
+    lr_rig_stats_destroy(s);
+    lr_test_rmtree(dir);
+    free(path);
+}
+
 /* 10^6 events (a knob spun for days), a stats write every 10^5: the resident size after a
  * warm-up that fills the two logs (4096 events, 4096 frames) and writes once stays within
  * 1 MiB, the slack of the allocator (the JSON writer's buffers, ASan's quarantine of them).
@@ -240,6 +309,7 @@ int main(void)
         cmocka_unit_test(test_hist_quantiles),
         cmocka_unit_test(test_hist_small),
         cmocka_unit_test(test_stats_latency_fields),
+        cmocka_unit_test(test_stats_settle),
         cmocka_unit_test(test_stats_memory_constant),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
