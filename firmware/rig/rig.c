@@ -19,6 +19,7 @@
 #include "firmware/rig/config.h"
 #include "firmware/rig/control_map.h"
 #include "firmware/rig/http.h"
+#include "firmware/rig/job.h"
 #include "firmware/rig/mqtt.h"
 #include "firmware/rig/notify.h"
 #include "firmware/rig/stats.h"
@@ -136,6 +137,13 @@ struct lr_rig {
     char http_scene[LR_RIG_PATH_MAX]; /* a shipped scene POST /api/scene asked for */
     unsigned char *http_rgba;         /* lr_rig_frame_rgba's readback */
     lr_mqtt *mqtt;         /* "mqtt": several rigs in step (firmware/rig/mqtt.h); NULL without */
+    /* A scene switch or reload loading in a job (firmware/rig/job.h: the loop never waits for
+     * a scene file, its plan and its control map); one at a time: a reload or a scene asked
+     * for meanwhile waits for it. */
+    struct loading *load;
+    lr_rig_job *load_job;
+    bool reload_pending;
+    char scene_pending[LR_RIG_PATH_MAX];
     /* An MQTT scene command ahead of its apply_at: that scene loaded and planned and its view
      * built in advance (mqtt_prepare), so that the switch at apply_at is a swap and the rigs
      * do not differ by their load times. */
@@ -247,10 +255,12 @@ static void set_free(rigset *s)
     memset(s, 0, sizeof *s);
 }
 
+/* A scene's warnings: into the log of the job loading it while on that job's thread (a scene
+ * keeps its sink for later changes, which come from the loop). */
 static void scene_warn(void *user, const char *msg)
 {
     lr_rig *r = user;
-    lr_log_write(&r->log, LR_LOG_WARN, "scene: %s", msg);
+    lr_log_write(lr_rig_job_log_here(r->load_job, &r->log), LR_LOG_WARN, "scene: %s", msg);
 }
 
 /* A console channel's home for a loss fade (hal/dmx_in.h): the position the control map took
@@ -426,29 +436,33 @@ static int create_device(lr_rig *r, rigset *s, const lr_rig_device *d, lr_err *e
 }
 
 /* The planner's text, one log line per line (it ends lines in '\n'; TEXT is cut in place). */
-static void log_lines(lr_rig *r, char *text)
+static void log_lines_to(const lr_log *log, char *text)
 {
     for (char *line = text, *nl; line && *line; line = nl + 1) {
         if ((nl = strchr(line, '\n')))
             *nl = '\0';
-        lr_log_write(&r->log, LR_LOG_INFO, "%s", line);
+        lr_log_write(log, LR_LOG_INFO, "%s", line);
         if (!nl)
             break;
     }
 }
+
+static void log_lines(lr_rig *r, char *text) { log_lines_to(&r->log, text); }
 
 /* The planner (firmware/plan_scene.h) for a scene with a quality budget (in the scene file
  * or the config's scene_set), unless --no-plan: its settings are applied, then the config's
  * scene_set once more so that an explicit render.* setting wins. A missing or unusable table
  * is logged and the scene's settings stay. *no_vpl: the plan cuts the VPL pass. *replan: the
  * re-planner for material changes (NULL when not planned, or when it could not be made:
- * logged, the plan stands without it). */
-static int plan_scene(lr_rig *r, const lr_rig_config *cfg, lr_scene *scene, bool *no_vpl,
+ * logged, the plan stands without it). Logs to `log`, the plan's summary into *out; reads
+ * only r->opts (so it runs in a job too). */
+static int plan_scene(const lr_rig *r, const lr_log *log, struct rig_plan *out,
+                      const lr_rig_config *cfg, lr_scene *scene, bool *no_vpl,
                       lr_replan **replan, lr_err *e)
 {
     *no_vpl = false;
     *replan = NULL;
-    r->plan_new = (struct rig_plan){.planned = false, .error = NAN, .frame_ms = NAN};
+    *out = (struct rig_plan){.planned = false, .error = NAN, .frame_ms = NAN};
     if (r->opts.no_plan)
         return LR_OK;
     lr_plan_scene_result *res = calloc(1, sizeof *res);
@@ -457,23 +471,23 @@ static int plan_scene(lr_rig *r, const lr_rig_config *cfg, lr_scene *scene, bool
     lr_err pe = {0};
     int rc = LR_OK;
     if (lr_plan_scene(scene, r->opts.plan_table, false, res, &pe)) {
-        lr_log_write(&r->log, LR_LOG_WARN, "plan: %s; running with the scene's settings", pe.msg);
+        lr_log_write(log, LR_LOG_WARN, "plan: %s; running with the scene's settings", pe.msg);
     } else if (res->planned) {
         char *text = lr_plan_scene_text(res, true); /* the log keeps every reason */
-        log_lines(r, text);
+        log_lines_to(log, text);
         free(text);
         /* The status keeps the brief sentence and the worst predicted error and frame time. */
         if ((text = lr_plan_scene_text(res, false))) {
-            snprintf(r->plan_new.text, sizeof r->plan_new.text, "%s", text);
-            r->plan_new.text[strcspn(r->plan_new.text, "\n")] = '\0';
+            snprintf(out->text, sizeof out->text, "%s", text);
+            out->text[strcspn(out->text, "\n")] = '\0';
         }
         free(text);
-        r->plan_new.planned = true;
-        r->plan_new.error = r->plan_new.frame_ms = 0;
+        out->planned = true;
+        out->error = out->frame_ms = 0;
         for (int i = 0; i < res->plan.nobjects; i++) {
             const lr_plan_choice *ch = &res->plan.objects[i];
-            r->plan_new.error = fmax(r->plan_new.error, ch->predicted_error);
-            r->plan_new.frame_ms = fmax(r->plan_new.frame_ms, ch->predicted_frame_ms);
+            out->error = fmax(out->error, ch->predicted_error);
+            out->frame_ms = fmax(out->frame_ms, ch->predicted_frame_ms);
         }
         *no_vpl = !res->vpl;
         rc = lr_rig_config_apply_sets(cfg, scene, e);
@@ -481,12 +495,12 @@ static int plan_scene(lr_rig *r, const lr_rig_config *cfg, lr_scene *scene, bool
         if (!rc && (now->K != p->K || now->N != p->N || now->N_vpl != p->N_vpl ||
                     now->map_size != p->map_size || now->gbuffer_size != p->gbuffer_size ||
                     now->frames != p->frames))
-            lr_log_write(&r->log, LR_LOG_INFO,
+            lr_log_write(log, LR_LOG_INFO,
                          "plan: the config's scene_set overrides it: render K=%d N=%d N_vpl=%d "
                          "map_size=%d gbuffer_size=%d frames=%d",
                          now->K, now->N, now->N_vpl, now->map_size, now->gbuffer_size, now->frames);
         if (!rc && lr_plan_scene_replanner(scene, res, replan, &pe))
-            lr_log_write(&r->log, LR_LOG_WARN, "plan: %s; no re-plan on material changes",
+            lr_log_write(log, LR_LOG_WARN, "plan: %s; no re-plan on material changes",
                          pe.msg);
     }
     free(res);
@@ -527,8 +541,11 @@ static int set_devices(lr_rig *r, rigset *s, lr_err *e)
     return rc;
 }
 
-/* Config, scene, control map and (with_devices) devices: all or nothing. */
-static int set_build(lr_rig *r, rigset *s, bool with_devices, lr_err *e)
+/* Config, scene, plan, control map and calibration: all or nothing; logs to `log`, the plan's
+ * summary into *plan. Reads only what the rig never changes after start (the config path,
+ * --modbus, the options), so a reload runs it in a job. */
+static int set_build_core(const lr_rig *r, const lr_log *log, struct rig_plan *plan, rigset *s,
+                          lr_err *e)
 {
     memset(s, 0, sizeof *s);
     int rc = lr_rig_config_load(r->config_path, &s->cfg, e);
@@ -537,27 +554,59 @@ static int set_build(lr_rig *r, rigset *s, bool with_devices, lr_err *e)
         for (int i = 0; i < s->cfg->n_devices; i++)
             any |= s->cfg->devices[i].type == LR_RIG_DEV_MODBUS;
         if (!any)
-            lr_log_write(&r->log, LR_LOG_WARN,
+            lr_log_write(log, LR_LOG_WARN,
                          "--modbus %s: the config has no modbus device; ignored", r->modbus_url);
     }
-    lr_warn_sink warn = {scene_warn, r};
+    lr_warn_sink warn = {scene_warn, (void *)r};
     if (!rc)
         rc = lr_scene_load(s->cfg->scene, &warn, &s->scene, e);
     if (!rc)
         rc = lr_rig_config_apply_sets(s->cfg, s->scene, e);
     if (!rc)
-        rc = plan_scene(r, s->cfg, s->scene, &s->no_vpl, &s->replan, e);
+        rc = plan_scene(r, log, plan, s->cfg, s->scene, &s->no_vpl, &s->replan, e);
     if (!rc) /* a model forced outside its validity limit (render/plan/limits.h) */
         rc = lr_plan_check_models(s->scene, e);
     if (!rc)
         rc = lr_control_map_create(s->cfg, s->scene, true, lr_now_ns(), &s->map, e);
     if (!rc && s->cfg->calib[0])
         rc = ar_load(s, e);
-    if (!rc && with_devices)
-        rc = set_devices(r, s, e);
-    if (rc) {
+    if (rc)
+        set_free(s);
+    return rc;
+}
+
+/* The same and (with_devices) the devices, on the loop. */
+static int set_build(lr_rig *r, rigset *s, bool with_devices, lr_err *e)
+{
+    int rc = set_build_core(r, &r->log, &r->plan_new, s, e);
+    if (!rc && with_devices && (rc = set_devices(r, s, e))) {
         r->used_hid |= s->has_hid;
         set_free(s);
+    }
+    return rc;
+}
+
+/* A scene file loaded, set as the config says and planned: what a scene switch needs before
+ * its view. Reads r->set.cfg, which the loop leaves alone while a scene loads in a job. */
+static int scene_build(const lr_rig *r, const lr_log *log, struct rig_plan *plan,
+                       const char *path, lr_scene **scene, bool *no_vpl, lr_replan **rp,
+                       lr_err *e)
+{
+    *scene = NULL;
+    *rp = NULL;
+    lr_warn_sink warn = {scene_warn, (void *)r};
+    int rc = lr_scene_load(path, &warn, scene, e);
+    if (!rc)
+        rc = lr_rig_config_apply_sets(r->set.cfg, *scene, e);
+    if (!rc)
+        rc = plan_scene(r, log, plan, r->set.cfg, *scene, no_vpl, rp, e);
+    if (!rc)
+        rc = lr_plan_check_models(*scene, e);
+    if (rc) {
+        lr_replan_destroy(*rp);
+        lr_scene_destroy(*scene);
+        *scene = NULL;
+        *rp = NULL;
     }
     return rc;
 }
@@ -721,15 +770,10 @@ static void pre_load(lr_rig *r, const char *path)
     pre_drop(r);
     lr_scene *scene = NULL;
     lr_err e = {0};
-    lr_warn_sink warn = {scene_warn, r};
     bool no_vpl = false;
     lr_replan *rp = NULL;
-    if (lr_scene_load(path, &warn, &scene, &e) ||
-        lr_rig_config_apply_sets(r->set.cfg, scene, &e) ||
-        plan_scene(r, r->set.cfg, scene, &no_vpl, &rp, &e) || lr_plan_check_models(scene, &e)) {
+    if (scene_build(r, &r->log, &r->plan_new, path, &scene, &no_vpl, &rp, &e)) {
         lr_log_write(&r->log, LR_LOG_WARN, "mqtt: scene %s not loaded ahead: %s", path, e.msg);
-        lr_replan_destroy(rp);
-        lr_scene_destroy(scene);
         return;
     }
     int64_t now = lr_now_ns();
@@ -777,37 +821,136 @@ static void pre_commit(lr_rig *r)
     memset(&r->pre, 0, sizeof r->pre);
 }
 
+/* A scene or a config loaded and planned in a job (firmware/rig/job.h): what it made, for the
+ * loop to take when the job is done (load_poll). */
+typedef struct loading {
+    lr_rig *r;
+    bool reload;                   /* the whole config (set), else the scene at path */
+    char path[LR_RIG_PATH_MAX];
+    int rc;
+    lr_err e;
+    rigset set;                    /* reload: without its devices (they open on the loop) */
+    lr_scene *scene;               /* a scene switch */
+    bool no_vpl;
+    lr_replan *replan;
+    struct rig_plan plan;
+    int64_t started_ns;
+} loading;
+
+static void load_run(void *arg, const lr_log *log)
+{
+    loading *l = arg;
+    if (l->reload)
+        l->rc = set_build_core(l->r, log, &l->plan, &l->set, &l->e);
+    else
+        l->rc = scene_build(l->r, log, &l->plan, l->path, &l->scene, &l->no_vpl, &l->replan,
+                            &l->e);
+}
+
+static void loading_free(loading *l)
+{
+    if (!l)
+        return;
+    set_free(&l->set);
+    lr_replan_destroy(l->replan);
+    lr_scene_destroy(l->scene);
+    free(l);
+}
+
+static void switch_commit(lr_rig *r, loading *l);
+static void reload_commit(lr_rig *r, loading *l);
+static void switch_scene(lr_rig *r, const char *path);
+
+/* Starts loading (a config when reload, else the scene at path) in a job; where no job can be
+ * started, loads it here and now. */
+static void load_start(lr_rig *r, bool reload, const char *path)
+{
+    loading *l = calloc(1, sizeof *l);
+    if (!l) {
+        lr_log_write(&r->log, LR_LOG_ERROR, "%s: out of memory", reload ? "reload" : "scene switch");
+        return;
+    }
+    l->r = r;
+    l->reload = reload;
+    l->started_ns = lr_now_ns();
+    if (path)
+        snprintf(l->path, sizeof l->path, "%s", path);
+    lr_err e = {0};
+    r->load = l;
+    if (lr_rig_job_start(load_run, l, &r->load_job, &e)) {
+        lr_log_write(&r->log, LR_LOG_WARN, "%s; loading on the loop", e.msg);
+        r->load_job = NULL;
+        load_run(l, &r->log);
+        r->load = NULL;
+        if (reload)
+            reload_commit(r, l);
+        else
+            switch_commit(r, l);
+        loading_free(l);
+    }
+}
+
+/* Takes what a finished job loaded (wait: also one still running, for callers that must have
+ * it now: the synchronous reload, shutdown), then a request that came meanwhile. */
+static void load_poll(lr_rig *r, bool wait)
+{
+    if (!r->load || !(wait || lr_rig_job_done(r->load_job)))
+        return;
+    loading *l = r->load;
+    lr_rig_job_finish(r->load_job, &r->log); /* its log lines, in order */
+    r->load_job = NULL;
+    r->load = NULL;
+    if (l->reload)
+        reload_commit(r, l);
+    else
+        switch_commit(r, l);
+    loading_free(l);
+    if (r->reload_pending) {
+        r->reload_pending = false;
+        load_start(r, true, NULL);
+    } else if (r->scene_pending[0]) {
+        char path[LR_RIG_PATH_MAX];
+        snprintf(path, sizeof path, "%s", r->scene_pending);
+        r->scene_pending[0] = '\0';
+        switch_scene(r, path);
+    }
+}
+
+/* A scene switch (button2, the page, MQTT): loaded and planned in a job while the loop goes on
+ * with the scene shown; one at a time, and a request made meanwhile waits for it (the latest
+ * wins). A scene loaded ahead (MQTT's apply_at) is a swap at once. */
 static void switch_scene(lr_rig *r, const char *path)
 {
     if (r->pre.valid && strcmp(r->pre.path, path) == 0) {
         pre_commit(r);
         return;
     }
-    lr_scene *scene = NULL;
-    lr_err e = {0};
-    lr_warn_sink warn = {scene_warn, r};
-    bool no_vpl = false;
-    lr_replan *rp = NULL;
-    if (lr_scene_load(path, &warn, &scene, &e) ||
-        lr_rig_config_apply_sets(r->set.cfg, scene, &e) ||
-        plan_scene(r, r->set.cfg, scene, &no_vpl, &rp, &e) ||
-        lr_plan_check_models(scene, &e)) {
-        lr_log_write(&r->log, LR_LOG_ERROR, "scene switch: %s; keeping %s", e.msg,
-                     lr_scene_path(r->set.scene));
-        lr_scene_destroy(scene);
+    if (r->load) {
+        snprintf(r->scene_pending, sizeof r->scene_pending, "%s", path);
         return;
     }
+    load_start(r, false, path);
+}
+
+/* The loaded scene replaces the shown one (on the loop, after its job). */
+static void switch_commit(lr_rig *r, loading *l)
+{
+    if (l->rc) {
+        lr_log_write(&r->log, LR_LOG_ERROR, "scene switch: %s; keeping %s", l->e.msg,
+                     lr_scene_path(r->set.scene));
+        return;
+    }
+    lr_scene *scene = l->scene;
     /* The controls' values go into the new scene before its view copies it, so that its first
      * image is the one the controls ask for. */
     lr_control_map_scene_replaced(r->set.map);
     unsigned dirty = 0;
+    lr_err e = {0};
     if (lr_control_map_update(r->set.map, scene, lr_now_ns(), &dirty, &e))
         lr_log_write(&r->log, LR_LOG_WARN, "control map: %s", e.msg);
     lr_rig_view *view;
-    if (view_build(r, scene, no_vpl, &view, &e)) {
+    if (view_build(r, scene, l->no_vpl, &view, &e)) {
         lr_log_write(&r->log, LR_LOG_ERROR, "scene switch: %s", e.msg);
-        lr_replan_destroy(rp);
-        lr_scene_destroy(scene);
         lr_control_map_scene_replaced(r->set.map); /* the old scene again, written in full */
         return;
     }
@@ -816,10 +959,14 @@ static void switch_scene(lr_rig *r, const char *path)
     lr_scene_destroy(r->set.scene);
     r->view = view;
     r->set.scene = scene;
-    r->set.replan = rp;
+    r->set.replan = l->replan;
+    l->scene = NULL;
+    l->replan = NULL;
+    r->plan_new = l->plan;
     r->plan = r->plan_new;
     r->ar_dirty = true;
-    lr_log_write(&r->log, LR_LOG_INFO, "scene: %s", path);
+    lr_log_write(&r->log, LR_LOG_INFO, "scene: %s (loaded in %.0f ms)", l->path,
+                 (double)(lr_now_ns() - l->started_ns) * 1e-6);
 }
 
 static bool lead_forward(lr_rig *r, const lr_event *ev, int64_t now);
@@ -1426,26 +1573,86 @@ static const char *status_line(const lr_rig *r, char *buf, size_t cap)
     return buf;
 }
 
-static int reload(lr_rig *r, lr_err *e);
+static int reload_finish(lr_rig *r, rigset *s, lr_err *e);
 
-int lr_rig_reload(lr_rig *r, lr_err *e)
+static int reload_failed(lr_rig *r, const lr_err *e)
 {
-    /* The service manager sees the reload start and end (a failed one too: the old config
-     * runs on, ready as before). */
-    if (r->ready_sent)
-        lr_notify_reloading(r->notify, lr_now_ns());
-    int rc = reload(r, e);
+    r->reload_failures++;
+    lr_log_write(&r->log, LR_LOG_ERROR, "reload: %s; keeping the running config", e->msg);
+    return e->code ? e->code : LR_EINVAL;
+}
+
+static void notify_ready(lr_rig *r)
+{
     if (r->ready_sent) {
         char st[256];
         lr_notify_ready(r->notify, status_line(r, st, sizeof st));
     }
+}
+
+/* The synchronous reload (in-process callers, POST /api/reload): what loads meanwhile is
+ * taken first, then the config is loaded here and now. */
+int lr_rig_reload(lr_rig *r, lr_err *e)
+{
+    r->reload_pending = false; /* this is it */
+    while (r->load)
+        load_poll(r, true);
+    /* The service manager sees the reload start and end (a failed one too: the old config
+     * runs on, ready as before). */
+    if (r->ready_sent)
+        lr_notify_reloading(r->notify, lr_now_ns());
+    rigset s;
+    int rc = set_build(r, &s, true, e);
+    rc = rc ? reload_failed(r, e) : reload_finish(r, &s, e);
+    notify_ready(r);
     return rc;
 }
 
-static int reload(lr_rig *r, lr_err *e)
+/* SIGHUP: the config loads and plans in a job; the loop goes on with the running one and
+ * takes the new one when it is ready (reload_commit). */
+static void reload_start(lr_rig *r)
 {
-    rigset s;
-    int rc = set_build(r, &s, true, e);
+    if (r->load) {
+        r->reload_pending = true;
+        return;
+    }
+    if (r->ready_sent)
+        lr_notify_reloading(r->notify, lr_now_ns());
+    load_start(r, true, NULL);
+}
+
+/* The config a job loaded: its devices open here, then it replaces the running one. */
+static void reload_commit(lr_rig *r, loading *l)
+{
+    lr_err e = {0};
+    int rc = l->rc;
+    if (rc) {
+        e = l->e;
+        reload_failed(r, &e);
+    } else {
+        rigset s = l->set;
+        memset(&l->set, 0, sizeof l->set);
+        r->plan_new = l->plan;
+        if ((rc = set_devices(r, &s, &e))) {
+            r->used_hid |= s.has_hid;
+            set_free(&s);
+            reload_failed(r, &e);
+        } else {
+            rc = reload_finish(r, &s, &e);
+        }
+    }
+    if (!rc)
+        lr_log_write(&r->log, LR_LOG_INFO, "reload: loaded and planned off the loop in %.0f ms",
+                     (double)(lr_now_ns() - l->started_ns) * 1e-6);
+    notify_ready(r);
+}
+
+/* s: a config built with its devices (taken: freed on failure). */
+static int reload_finish(lr_rig *r, rigset *sp, lr_err *e)
+{
+    rigset s = *sp;
+    memset(sp, 0, sizeof *sp);
+    int rc = LR_OK;
     /* The controls stay where they are (the dimmer, the knobs): the lamp does not jump back to
      * the config's initial level and fade to the panel again. */
     if (!rc)
@@ -1474,11 +1681,8 @@ static int reload(lr_rig *r, lr_err *e)
             set_free(&s);
         }
     }
-    if (rc) {
-        r->reload_failures++;
-        lr_log_write(&r->log, LR_LOG_ERROR, "reload: %s; keeping the running config", e->msg);
-        return rc;
-    }
+    if (rc)
+        return reload_failed(r, e);
     /* Events already queued by the old devices still apply to the old map: drop them. */
     lr_event ev;
     while (lr_event_ring_pop(r->ring, &ev))
@@ -1530,8 +1734,7 @@ static void read_signals(lr_rig *r)
     while (read(r->sigfd, &si, sizeof si) == (ssize_t)sizeof si) {
         if (si.ssi_signo == SIGHUP) {
             lr_log_write(&r->log, LR_LOG_INFO, "SIGHUP: reloading %s", r->config_path);
-            lr_err e = {0};
-            lr_rig_reload(r, &e);
+            reload_start(r);
         } else {
             lr_log_write(&r->log, LR_LOG_INFO, "%s: shutting down",
                          si.ssi_signo == SIGINT ? "SIGINT" : "SIGTERM");
@@ -1569,6 +1772,10 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
         if (r->sigfd >= 0) {
             fds[nf] = (struct pollfd){r->sigfd, POLLIN, 0};
             owner[nf++] = -1;
+        }
+        if (r->load_job) { /* readable once the scene or config it loads is ready */
+            fds[nf] = (struct pollfd){lr_rig_job_fd(r->load_job), POLLIN, 0};
+            owner[nf++] = -6;
         }
         /* The worker's publications wake the loop only while no frame is wanted: once one is,
          * the frame deadline below wakes it, and the descriptor (drained by the frame) would
@@ -1657,6 +1864,9 @@ int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e)
                 }
             }
         }
+        /* A scene or config loaded off the loop is taken here, before the devices: a reload
+         * replaces them. */
+        load_poll(r, false);
         /* Every device is dispatched on every wake: dispatch reads only what is ready and runs
          * only due timers, so this costs nothing when idle, and it stays right when a reload
          * above replaced the devices (owner[] then refers to the old set). */
@@ -1732,6 +1942,13 @@ void lr_rig_destroy(lr_rig *r)
         return;
     if (r->ready_sent)
         lr_notify_stopping(r->notify);
+    /* A load in flight is waited for and dropped (what it made is freed, never shown). */
+    if (r->load) {
+        lr_rig_job_finish(r->load_job, &r->log);
+        loading_free(r->load);
+        r->load = NULL;
+        r->load_job = NULL;
+    }
     /* Nothing answers for the rig once it is going. */
     lr_http_destroy(r->http);
     r->http = NULL;

@@ -151,8 +151,8 @@ static void test_sim_in_process(void **state)
     lr_test_rmtree(dir);
 }
 
-/* A scene switch (button2) loads the next scene file and writes every control's value into
- * it again: the dimmer's intensity, the material picked by button1 and the translucency
+/* A scene switch (button2) loads the next scene file (in a job, off the loop) and writes
+ * every control's value into it again: the dimmer's intensity, the material picked by button1 and the translucency
  * scale survive the switch (the votive's file says 0.004 W/sr and scale 1.5); --out-dir keeps
  * one file per frame across the switch. */
 static void test_scene_switch_keeps_controls(void **state)
@@ -177,13 +177,19 @@ static void test_scene_switch_keeps_controls(void **state)
     char *frames = lr_test_path(dir, "frames");
     assert_int_equal(mkdir(frames, 0755), 0);
     lr_test_log log = {0};
-    lr_rig_opts o = {.config = cfg, .duration_s = 0.6, .no_signals = true, .out_dir = frames,
+    lr_rig_opts o = {.config = cfg, .duration_s = 120, .no_signals = true, .out_dir = frames,
                      .log = {lr_test_log_fn, &log}};
     lr_rig *r;
     lr_err e = {0};
     if (lr_rig_create(&o, &r, &e))
         fail_msg("%s", e.msg);
-    assert_int_equal(lr_rig_run(r, &e), LR_OK);
+    /* The script's 0.25 s, then the switch: its scene loads and plans in a job (firmware/rig/
+     * job.h), a few turns later; a minute's guard. */
+    int64_t t0 = lr_now_ns();
+    assert_int_equal(lr_rig_run_until(r, t0 + 600 * 1000000LL, &e), LR_OK);
+    while (strcmp(lr_scene_name(lr_rig_scene(r)), "votive") && lr_now_ns() < t0 + 60 * 1000000000LL)
+        assert_int_equal(lr_rig_run_until(r, lr_now_ns() + 20 * 1000000LL, &e), LR_OK);
+    
     assert_string_equal(lr_scene_name(lr_rig_scene(r)), "votive");
     assert_near(scene_num(r, "light.intensity"), 0.003, 1e-12);
     assert_near(scene_num(r, "objects[0].material.scale"), 3.0, 1e-9);
@@ -839,7 +845,7 @@ static void test_sigterm_clean_exit(void **state)
 }
 
 /* SIGHUP: a broken config is reported (file, line, field) and the old one runs on; a good one
- * is applied (its safe level is the one written at exit). */
+ * is loaded off the loop and applied (its safe level is the one written at exit). */
 static void test_sighup_reload(void **state)
 {
     (void)state;
@@ -869,6 +875,8 @@ static void test_sighup_reload(void **state)
     write_rig(dir, port, 0.5, ", \"curve\": \"s-curve\"");
     assert_int_equal(kill(pid, SIGHUP), 0);
     assert_true(wait_file_has(err, "reloaded ", 10000));
+    /* Loaded and planned in a job while the loop went on (firmware/rig/job.h). */
+    assert_true(wait_file_has(err, "reload: loaded and planned off the loop in ", 10000));
     /* The new config drives the lamp: s-curve(0.2) = 0.104 → 27; s-curve(0.9) = 0.972 → 248. */
     bool seen = false;
     for (int i = 0; i < 1000 && !seen; i++) {

@@ -143,6 +143,30 @@ static void block(FILE *out, const figs *f, const char *models_csv)
                  get(f, "warm", "button1", "first_p99_ms"), "%.0f", "ms"),
             pair(b, sizeof b, get(f, "warm_busy", "button1", "first_median_ms"),
                  get(f, "warm_busy", "button1", "first_p99_ms"), "%.0f", "ms"));
+    /* After a rest (rig_controls.c's rest runs): the controls' last change to the converged
+     * image at the settings the planner chose for the rig's budget. */
+    for (size_t i = 0; i < sizeof controls / sizeof controls[0]; i++) {
+        const char *k = controls[i].control;
+        if (!strcmp(k, "dimmer") || !strcmp(k, "knob1"))
+            continue; /* blend-only: converged in their first frame */
+        char cell[2][128];
+        const char *run[2] = {"rest", "rest_busy"};
+        for (int r = 0; r < 2; r++) {
+            double n = get(f, run[r], k, "rests"), m = get(f, run[r], k, "rests_converged");
+            pair(cell[r], sizeof cell[r], get(f, run[r], k, "settled_median_ms") / 1e3,
+                 get(f, run[r], k, "settled_max_ms") / 1e3, "%.1f", "s");
+            if (isfinite(n) && isfinite(m) && m < n) {
+                size_t len = strlen(cell[r]);
+                if (!(m > 0))
+                    len = (size_t)snprintf(cell[r], sizeof cell[r], "none converged");
+                snprintf(cell[r] + len, sizeof cell[r] - len, " (%.0f of %.0f rests converged)",
+                         m, n);
+            }
+        }
+        fprintf(out, "| %s → converged after a rest (the rig's budget), median / max | %s | %s "
+                     "| – | ≤ 2 s |\n",
+                controls[i].what, cell[0], cell[1]);
+    }
     fprintf(out, "| presented frame interval, p99 | %s | %s | %s | ≤ 67 ms |\n",
             one(a, sizeof a, get(f, "idle", "", "frame_interval_p99_ms"), "%.0f", "ms"),
             one(b, sizeof b, get(f, "busy", "", "frame_interval_p99_ms"), "%.0f", "ms"),

@@ -1,8 +1,8 @@
 /* Section "rig": the firmware, `lamprig run`, measured from outside as a child process (the
  * release build/bin/lamprig next to this binary).
- * (1) Control-to-frame latency of a dimmer turn, headless: the shipped sim rig's render budget
- *     and control map (configs/rig/sim.json: K = 4, N = 4, 64² maps, 8 frames, 320×240, 30 fps
- *     cap, the candle's dimmer with its square curve and 0.25 s fade), driven by a sim script of
+ * (1) Control-to-frame latency of a dimmer turn, headless: the shipped sim rig's budget and
+ *     control map (configs/rig/sim.json: the settings its planner picks for the budget, 320×240,
+ *     30 fps cap, the candle's dimmer with its square curve and 0.25 s fade), driven by a sim script of
  *     60 dimmer turns over 30 s; median and p99 of the per-event latencies in its --stats file.
  * (2) Idle CPU when nothing changes: utime + stime from /proc/PID/stat over 10 s, once the
  *     scene has converged (one scripted dimmer move, then no events) with the flame steady;
@@ -60,21 +60,31 @@ static long cpu_ticks(pid_t pid)
     return (long)(ut + st);
 }
 
-/* A rig config with the shipped sim rig's budget, output and control map, driven by script;
- * extra_set: more scene_set entries (", \"key\": value"), or "". */
+/* A rig config with the shipped sim rig's budget (its "budget" object, copied from
+ * configs/rig/sim.json), output and control map, driven by script; extra_set: scene_set
+ * entries (", \"key\": value"), or "". */
 static int write_rig_set(const char *path, const char *script, const char *extra_set)
 {
+    char *shipped = lrb_read_rig_file(configs, "sim.json");
+    const char *b = shipped ? strstr(shipped, "\"budget\"") : NULL;
+    const char *end = b ? strchr(b, '}') : NULL;
+    if (!end) {
+        fprintf(stderr, "bench rig: configs/rig/sim.json has no \"budget\" object\n");
+        free(shipped);
+        return 1;
+    }
     char text[3 * PATH_MAX + 1024];
     snprintf(text, sizeof text,
              "{\"scene\": \"%s/scenes/candle.json\",\n"
-             " \"scene_set\": {\"render.K\": 4, \"render.N\": 4, \"render.map_size\": 64,\n"
-             "   \"render.gbuffer_size\": 64, \"render.vpl_map_size\": 32, \"render.N_vpl\": 16,\n"
-             "   \"render.frames\": 8%s},\n"
+             " %.*s,\n"
+             " \"scene_set\": {%s},\n"
              " \"devices\": [{\"type\": \"sim\", \"name\": \"sim\", \"script\": \"%s\"}],\n"
              " \"controls\": \"%s/controls/candle.json\",\n"
              " \"output\": {\"mode\": \"headless\", \"width\": 320, \"height\": 240, \"fps\": 30},\n"
              " \"safe_level\": 0, \"stats\": {\"period_s\": 60}}\n",
-             configs, extra_set, script, configs);
+             configs, (int)(end + 1 - b), b, extra_set[0] ? extra_set + 2 : "", script,
+             configs);
+    free(shipped);
     return lrb_write_file(path, text);
 }
 
@@ -448,8 +458,9 @@ static int run(FILE *out)
     if (rc == 0) {
         fprintf(out, "Control-to-frame latency of a dimmer turn: %d absolute dimmer moves, one "
                      "every %.1f s, through the candle's control map (square curve, 0.25 s fade) "
-                     "with the shipped sim rig's render budget (K = 4, N = 4, 64² maps, "
-                     "8 frames, 320×240, 30 fps cap); per-event latency from the stats "
+                     "with the shipped sim rig's budget (`budget` in configs/rig/sim.json: "
+                     "the settings its planner picks, 320×240, 30 fps cap); per-event "
+                     "latency from the stats "
                      "(event timestamp to the end of the first frame after it that runs a "
                      "pass: the fade's first frame, still at the old level, does not "
                      "count).\n\n",

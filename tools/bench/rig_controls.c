@@ -112,14 +112,17 @@ static int read_run(const char *stats, run_row *r)
             row->first[row->n_first++] = first;
         if (row && isfinite(conv) && row->n_conv < MAX_EVENTS / 4)
             row->conv[row->n_conv++] = conv;
-        if (row && rested && isfinite(conv) && row->n_settle < MAX_EVENTS / 4)
-            row->settle[row->n_settle++] = conv;
+        /* A rest: no event for REST_GAP_S / 2 after this one; its time, when the converged
+         * frame's newest event was this one (stats.h: "rested"). */
         double gap = duration - ts[i];
         for (int k = 0; k < n_ev; k++)
             if (ts[k] > ts[i])
                 gap = fmin(gap, ts[k] - ts[i]);
-        if (row && gap >= REST_GAP_S / 2)
+        bool rest = gap >= REST_GAP_S / 2;
+        if (row && rest)
             row->n_rests++;
+        if (row && rest && rested && isfinite(conv) && row->n_settle < MAX_EVENTS / 4)
+            row->settle[row->n_settle++] = conv;
     }
     int nf = lr_json_count(j, frs);
     double *iv = nf > 1 ? calloc((size_t)nf, sizeof *iv) : NULL;
