@@ -154,7 +154,7 @@ static void block(FILE *out, const figs *f, const char *models_csv)
         for (int r = 0; r < 2; r++) {
             double n = get(f, run[r], k, "rests"), m = get(f, run[r], k, "rests_converged");
             pair(cell[r], sizeof cell[r], get(f, run[r], k, "settled_median_ms") / 1e3,
-                 get(f, run[r], k, "settled_max_ms") / 1e3, "%.1f", "s");
+                 get(f, run[r], k, "settled_max_ms") / 1e3, "%.2f", "s");
             if (isfinite(n) && isfinite(m) && m < n) {
                 size_t len = strlen(cell[r]);
                 if (!(m > 0))
