@@ -81,13 +81,16 @@ int lr_rig_job_start(lr_rig_job_fn fn, void *arg, lr_rig_job **out, lr_err *e)
         free(j);
         return lr_err_set(e, LR_EIO, "job: eventfd: %s", strerror(err));
     }
+    /* *out before the thread starts: the work may look itself up through the caller's
+     * pointer (lr_rig_job_log_here) from its first instruction. */
+    *out = j;
     int rc = pthread_create(&j->thread, NULL, run, j);
     if (rc) {
+        *out = NULL;
         close(j->efd);
         free(j);
         return lr_err_set(e, LR_EIO, "job: no thread: %s", strerror(rc));
     }
-    *out = j;
     return LR_OK;
 }
 

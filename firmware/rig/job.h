@@ -28,8 +28,8 @@ typedef struct lr_rig_job lr_rig_job;
 /* The work: runs once on the job's thread; `log` keeps its lines for the loop. */
 typedef void (*lr_rig_job_fn)(void *arg, const lr_log *log);
 
-/* Starts fn(arg) on a new thread. LR_ENOMEM, or LR_EIO when no thread or eventfd can be
- * made (then nothing runs). */
+/* Starts fn(arg) on a new thread; *out is set before the thread starts (NULL again on
+ * failure). LR_ENOMEM, or LR_EIO when no thread or eventfd can be made (then nothing runs). */
 int lr_rig_job_start(lr_rig_job_fn fn, void *arg, lr_rig_job **out, lr_err *e);
 /* Whether fn has returned (never blocks). */
 bool lr_rig_job_done(const lr_rig_job *j);
