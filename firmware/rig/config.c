@@ -1041,9 +1041,9 @@ static int parse_root(ctx *x)
     const lr_json *j = x->j;
     lr_jnode root = lr_json_root(j);
     lr_rig_config *c = x->c;
-    static const char *const top[] = {"scene", "scene_set", "budget", "devices", "controls", "output",
-                                      "safe_level", "stats", "calib", "ar_samples", "http",
-                                      "mqtt", NULL};
+    static const char *const top[] = {"scene",      "scene_set", "budget", "devices",
+                                      "controls",   "output",    "safe_level", "stats",
+                                      "calib",      "ar_samples", "http",    "mqtt", NULL};
     int rc = keys(x, root, "", top);
     if (rc)
         return rc;

@@ -867,7 +867,8 @@ static void load_start(lr_rig *r, bool reload, const char *path)
 {
     loading *l = calloc(1, sizeof *l);
     if (!l) {
-        lr_log_write(&r->log, LR_LOG_ERROR, "%s: out of memory", reload ? "reload" : "scene switch");
+        lr_log_write(&r->log, LR_LOG_ERROR, "%s: out of memory",
+                     reload ? "reload" : "scene switch");
         return;
     }
     l->r = r;

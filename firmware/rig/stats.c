@@ -230,6 +230,17 @@ double lr_rig_stats_settle_ms(const lr_rig_stats *s, double q)
     return lr_lat_hist_quantile(s->settle, q);
 }
 
+/* "NAME": {"n", "median", "p99", "max"} of a histogram. */
+static void write_summary(lr_jw *w, const char *name, const lr_lat_hist *h)
+{
+    lr_jw_object(w, name);
+    lr_jw_int(w, "n", (long)lr_lat_hist_n(h));
+    lr_jw_number_or_null(w, "median", lr_lat_hist_quantile(h, 0.5));
+    lr_jw_number_or_null(w, "p99", lr_lat_hist_quantile(h, 0.99));
+    lr_jw_number_or_null(w, "max", lr_lat_hist_max(h));
+    lr_jw_object_end(w);
+}
+
 static void write_devices(lr_jw *w, const lr_rig_stats_dev *devs, int n)
 {
     lr_jw_array(w, "devices");
@@ -314,20 +325,8 @@ int lr_rig_stats_write(const lr_rig_stats *s, const char *path, const char *conf
     lr_jw_number_or_null(w, "max", lr_lat_hist_max(h));
     lr_jw_number_or_null(w, "mean", lr_lat_hist_mean(h));
     lr_jw_object_end(w);
-    h = s->conv;
-    lr_jw_object(w, "converge_ms");
-    lr_jw_int(w, "n", (long)lr_lat_hist_n(h));
-    lr_jw_number_or_null(w, "median", lr_lat_hist_quantile(h, 0.5));
-    lr_jw_number_or_null(w, "p99", lr_lat_hist_quantile(h, 0.99));
-    lr_jw_number_or_null(w, "max", lr_lat_hist_max(h));
-    lr_jw_object_end(w);
-    h = s->settle;
-    lr_jw_object(w, "settle_ms");
-    lr_jw_int(w, "n", (long)lr_lat_hist_n(h));
-    lr_jw_number_or_null(w, "median", lr_lat_hist_quantile(h, 0.5));
-    lr_jw_number_or_null(w, "p99", lr_lat_hist_quantile(h, 0.99));
-    lr_jw_number_or_null(w, "max", lr_lat_hist_max(h));
-    lr_jw_object_end(w);
+    write_summary(w, "converge_ms", s->conv);
+    write_summary(w, "settle_ms", s->settle);
     lr_jw_array(w, "event_log");
     uint64_t first = s->n_events > LOG_MAX ? s->n_events - LOG_MAX : 0;
     for (uint64_t i = first; i < s->n_events; i++) {

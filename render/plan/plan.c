@@ -549,19 +549,27 @@ static void put(out *o, const char *fmt, ...)
         o->len += (size_t)n;
 }
 
-static void put_budget(out *o, const lr_plan_budget *b)
+/* The budget's parts joined by `sep`, the frame budget as "<= T" + `per_frame`: the plan line
+ * says "error <= 0.05 and <= 100 ms/frame", the sentence "error <= 0.05, <= 100 ms a frame". */
+static void put_budget_as(out *o, const lr_plan_budget *b, const char *sep,
+                          const char *per_frame)
 {
-    const char *sep = "";
+    const char *s = "";
     if (b->max_error > 0) {
         put(o, "error <= %g", b->max_error);
-        sep = " and ";
+        s = sep;
     }
     if (b->frame_ms > 0) {
-        put(o, "%s<= %g ms/frame", sep, b->frame_ms);
-        sep = " and ";
+        put(o, "%s<= %g%s", s, b->frame_ms, per_frame);
+        s = sep;
     }
     if (b->converge_ms > 0)
-        put(o, "%sconverged in <= %g s", sep, b->converge_ms * 1e-3);
+        put(o, "%sconverged in <= %g s", s, b->converge_ms * 1e-3);
+}
+
+static void put_budget(out *o, const lr_plan_budget *b)
+{
+    put_budget_as(o, b, " and ", " ms/frame");
 }
 
 /* Whether the predicted error (the largest part) is the RMSE part's noise floor: the row's
@@ -627,17 +635,7 @@ size_t lr_plan_format(const lr_plan *p, char *buf, size_t cap)
 /* The budget as a reader says it: "error <= 0.05, <= 100 ms a frame". */
 static void put_budget_words(out *o, const lr_plan_budget *b)
 {
-    const char *sep = "";
-    if (b->max_error > 0) {
-        put(o, "error <= %g", b->max_error);
-        sep = ", ";
-    }
-    if (b->frame_ms > 0) {
-        put(o, "%s<= %g ms a frame", sep, b->frame_ms);
-        sep = ", ";
-    }
-    if (b->converge_ms > 0)
-        put(o, "%sconverged in <= %g s", sep, b->converge_ms * 1e-3);
+    put_budget_as(o, b, ", ", " ms a frame");
 }
 
 size_t lr_plan_format_brief(const lr_plan *p, char *buf, size_t cap)
