@@ -861,6 +861,16 @@ static void switch_commit(lr_rig *r, loading *l);
 static void reload_commit(lr_rig *r, loading *l);
 static void switch_scene(lr_rig *r, const char *path);
 
+/* What a load made replaces the running config or scene, then it is freed. */
+static void load_commit(lr_rig *r, loading *l)
+{
+    if (l->reload)
+        reload_commit(r, l);
+    else
+        switch_commit(r, l);
+    loading_free(l);
+}
+
 /* Starts loading (a config when reload, else the scene at path) in a job; where no job can be
  * started, loads it here and now. */
 static void load_start(lr_rig *r, bool reload, const char *path)
@@ -883,11 +893,7 @@ static void load_start(lr_rig *r, bool reload, const char *path)
         r->load_job = NULL;
         load_run(l, &r->log);
         r->load = NULL;
-        if (reload)
-            reload_commit(r, l);
-        else
-            switch_commit(r, l);
-        loading_free(l);
+        load_commit(r, l);
     }
 }
 
@@ -901,11 +907,7 @@ static void load_poll(lr_rig *r, bool wait)
     lr_rig_job_finish(r->load_job, &r->log); /* its log lines, in order */
     r->load_job = NULL;
     r->load = NULL;
-    if (l->reload)
-        reload_commit(r, l);
-    else
-        switch_commit(r, l);
-    loading_free(l);
+    load_commit(r, l);
     if (r->reload_pending) {
         r->reload_pending = false;
         load_start(r, true, NULL);
@@ -1656,8 +1658,7 @@ static int reload_finish(lr_rig *r, rigset *sp, lr_err *e)
     int rc = LR_OK;
     /* The controls stay where they are (the dimmer, the knobs): the lamp does not jump back to
      * the config's initial level and fade to the panel again. */
-    if (!rc)
-        lr_control_map_carry(s.map, r->set.map, lr_now_ns());
+    lr_control_map_carry(s.map, r->set.map, lr_now_ns());
     lr_rig_view *view = NULL;
     if (!rc && r->kms && s.calib && !r->ar_out && (rc = ar_output(r, e))) {
         r->used_hid |= s.has_hid;
