@@ -746,6 +746,8 @@ void lr_renderer_set_cancel(lr_renderer *r, const lr_cancel *cancel)
     lr_slicer_set_cancel(r->slicer, cancel);
 }
 
+void lr_renderer_set_slice_ms(lr_renderer *r, double ms) { lr_slicer_set_budget(r->slicer, ms); }
+
 const char *lr_renderer_info(const lr_renderer *r)
 {
     return r->info;

@@ -113,6 +113,11 @@ int lr_renderer_frame(lr_renderer *r, lr_frame_stats *stats, lr_err *e);
  * the renderer on a thread of its own (render/async). */
 void lr_renderer_set_cancel(lr_renderer *r, const lr_cancel *cancel);
 
+/* With a token: the longest GPU passes end a slice about every `ms` (> 0; the rows of a band
+ * sized from the last bands' times, render/passes/slice.h), so a change waits about that long
+ * for the cut; 0 (the default): fixed bands (a map, 64 grid rows). The image is the same. */
+void lr_renderer_set_slice_ms(lr_renderer *r, double ms);
+
 /* Linear RGB radiance of the last frame, width*height*3 floats, rows bottom to top (PFM order). */
 int lr_renderer_read_hdr(lr_renderer *r, float *rgb, lr_err *e);
 /* Tone-mapped sRGB, width*height*4 bytes, rows top to bottom (PNG order). */

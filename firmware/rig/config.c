@@ -1162,11 +1162,15 @@ static int parse_root(ctx *x)
      * room, a sixteenth of a 4 GB board. */
     c->output.cache_mb = 256;
     c->output.cache_samples = 9;
+    /* A quarter of the 30 fps frame interval: a change's first image (the cut, the preview,
+     * the next frame) within two intervals. */
+    c->output.slice_ms = 8;
     lr_jnode out = lr_json_get(j, root, "output");
     if (out != LR_JNONE) {
         static const char *const ok[] = {"mode", "connector", "drm_device", "mode_size",
                                          "refresh_hz", "width", "height", "fps", "renderer",
-                                         "gpu_memory_mb", "cache_mb", "cache_samples", NULL};
+                                         "gpu_memory_mb", "cache_mb", "cache_samples", "slice_ms",
+                                         NULL};
         /* "mode" is headless|kms; the display mode size is "mode_size": [W, H]. */
         if ((rc = keys(x, out, "output", ok)))
             return rc;
@@ -1207,6 +1211,8 @@ static int parse_root(ctx *x)
                              &c->output.cache_mb)) ||
             (rc = get_int_in(x, out, "output", "cache_samples", false, 2, 48,
                              &c->output.cache_samples)) ||
+            (rc = get_num_in(x, out, "output", "slice_ms", false, 0, 1000,
+                             &c->output.slice_ms)) ||
             (rc = get_str(x, out, "output", "renderer", false, c->output.renderer,
                           sizeof c->output.renderer)))
             return rc;

@@ -33,7 +33,10 @@
  *                more are refused with what they need; 0: no limit),
  *                "cache_mb": 256 ("passes": converged images of the states the controls
  *                reach next, built ahead while the rig is idle, firmware/rig/ahead.h; 0: none),
- *                "cache_samples": 9 (states along each continuous material control: 2..48)}
+ *                "cache_samples": 9 (states along each continuous material control: 2..48),
+ *                "slice_ms": 8 ("passes": the worker's long GPU passes end a slice about
+ *                this often, so a change waits about that long to cut a stale frame;
+ *                0..1000, 0: fixed slices of a map or 64 grid rows)}
  *   "safe_level": 0                    lamp-driver level (0..1, as written to the driver,
  *                                      after any curve) set at shutdown
  *   "stats":    {"path": "PATH" (default none), "period_s": 10 (0: only at exit)}
@@ -293,6 +296,7 @@ typedef struct lr_rig_config {
         double gpu_memory_mb;           /* the renderer's GPU memory budget; 0: none */
         double cache_mb;                /* the control-space cache's images; 0: none */
         int cache_samples;              /* states per continuous control built ahead */
+        double slice_ms;                /* the worker's GPU slices ("passes"); 0: fixed */
     } output;
     double safe_level;
     char stats_path[LR_RIG_PATH_MAX];

@@ -625,6 +625,7 @@ static int view_build(lr_rig *r, lr_scene *scene, bool no_vpl, lr_rig_view **out
     vd.cache_keys = keys;
     vd.n_cache_keys = nk;
     vd.cache_mb = nk > 0 ? c->output.cache_mb : 0;
+    vd.slice_ms = c->output.slice_ms;
     if (r->kms)
         lr_gl_size(r->gl, &vd.width, &vd.height);
     if (r->ahead)

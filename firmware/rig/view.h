@@ -43,6 +43,7 @@ typedef struct lr_rig_view_desc {
     const lr_cache_key *cache_keys;
     int n_cache_keys;
     double cache_mb;
+    double slice_ms; /* the worker's GPU slices (output.slice_ms); 0: fixed */
 } lr_rig_view_desc;
 
 /* Comma-separated names of the back ends built in, default first. */

@@ -78,6 +78,8 @@ struct lr_async {
     unsigned no_preview_dirty;
     bool preview_always;
     double gpu_budget_mb;
+    double slice_ms;
+    double preview_scale;
     /* The control-space cache (render/async/cache.h): the entries are under mu; the display
      * of one (or of a mix drawn into `mixed`) is the caller's. */
     bool rec_outside;    /* the batch being recorded changes transport outside the keys */
@@ -119,6 +121,10 @@ struct lr_async {
     lr_gl *wgl;
     lr_scene *wscene;
     lr_renderer *r;
+    /* The preview stage's renderer (NULL: no preview stage), at preview_scale of the view's
+     * size, and the scene's changes since its last frame. */
+    lr_renderer *pr;
+    unsigned pr_dirty;
     GLuint read_fb, draw_fb;
     /* Wall time of the last preview frame and of the last full frame that re-ran the maps:
      * a preview that costs more than half a full frame (a CPU solve dominates both) is not
@@ -235,7 +241,9 @@ static void notify(lr_async *a)
 }
 
 /* Copies n layers of src into dst (both the view's size) on the worker's context. */
-static void copy_layers(lr_async *a, const lr_tex *src, lr_tex *dst, int n)
+/* Copies n layers of src (sw x sh) into dst (the view's size), scaled by the nearest texel
+ * when the sizes differ (a preview's): float targets need not be filterable on the board. */
+static void copy_layers(lr_async *a, const lr_tex *src, int sw, int sh, lr_tex *dst, int n)
 {
     for (int l = 0; l < n; l++) {
         glBindFramebuffer(GL_READ_FRAMEBUFFER, a->read_fb);
@@ -245,19 +253,20 @@ static void copy_layers(lr_async *a, const lr_tex *src, lr_tex *dst, int n)
         glFramebufferTextureLayer(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, lr_tex_id(dst), 0, l);
         GLenum att = GL_COLOR_ATTACHMENT0;
         glDrawBuffers(1, &att);
-        glBlitFramebuffer(0, 0, a->width, a->height, 0, 0, a->width, a->height,
-                          GL_COLOR_BUFFER_BIT, GL_NEAREST);
+        glBlitFramebuffer(0, 0, sw, sh, 0, 0, a->width, a->height, GL_COLOR_BUFFER_BIT,
+                          GL_NEAREST);
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
-/* Copies the renderer's images into the slot the caller is not reading and publishes it. */
-static int publish(lr_async *a, const lr_frame_stats *st, lr_async_stage stage, uint64_t batch,
-                   lr_err *e)
+/* Copies renderer r's images into the slot the caller is not reading and publishes them. */
+static int publish(lr_async *a, lr_renderer *r, const lr_frame_stats *st, lr_async_stage stage,
+                   uint64_t batch, lr_err *e)
 {
-    int n;
+    int n, sw, sh;
     float scale[LR_SCENE_MAX_LIGHTS];
-    const lr_tex *src = lr_renderer_images(a->r, &n, scale);
+    const lr_tex *src = lr_renderer_images(r, &n, scale);
+    lr_renderer_size(r, &sw, &sh);
     if (!src || n < 1)
         return LR_OK;
     pthread_mutex_lock(&a->mu);
@@ -285,7 +294,7 @@ static int publish(lr_async *a, const lr_frame_stats *st, lr_async_stage stage, 
         s->w = a->width;
         s->h = a->height;
     }
-    copy_layers(a, src, s->tex, n);
+    copy_layers(a, src, sw, sh, s->tex, n);
     int rc = lr_gl_check("async: publishing the images", e);
     if (rc)
         return rc;
@@ -321,13 +330,15 @@ static int replay(lr_async *a, set_list *l, unsigned *dirty, lr_err *e)
     return LR_OK;
 }
 
-/* The preview stage: its assignments applied, one frame, published, the scene's own values
- * back (their flags joining `dirty` for the next frames). */
-static int preview_frame(lr_async *a, uint64_t batch, unsigned *dirty, lr_err *e)
+/* The preview stage: its assignments applied, one frame of the preview's own renderer (with
+ * the scene's changes since its last frame), published, the scene's own values back. The
+ * view's renderer never sees the preview's values: its maps, grids and solver states stay
+ * allocated for the scene's own settings. */
+static int preview_frame(lr_async *a, uint64_t batch, lr_err *e)
 {
     char old[LR_ASYNC_MAX_PREVIEW][256];
     int rc = LR_OK, applied = 0;
-    unsigned d = *dirty;
+    unsigned d = a->pr_dirty;
     for (int i = 0; i < a->n_preview && !rc; i++)
         if (!(rc = lr_scene_get(a->wscene, a->preview_key[i], old[i], sizeof old[i], e)) &&
             !(rc = lr_scene_set(a->wscene, a->preview_key[i], a->preview_value[i], &d, e)))
@@ -339,12 +350,16 @@ static int preview_frame(lr_async *a, uint64_t batch, unsigned *dirty, lr_err *e
     if (skip)
         rc = LR_OK;
     if (!rc && !skip) {
-        lr_renderer_invalidate(a->r, d);
-        rc = lr_renderer_frame(a->r, &st, e);
+        lr_renderer_invalidate(a->pr, d);
+        rc = lr_renderer_frame(a->pr, &st, e);
+        /* Its next frame redoes what this one did not finish (a cut: a stop). */
+        a->pr_dirty = rc ? d : 0;
     }
     if (!rc && !skip)
-        rc = publish(a, &st, LR_ASYNC_PREVIEW, batch, e);
-    /* Restored whatever happened: the copy must stay equal to the caller's scene. */
+        rc = publish(a, a->pr, &st, LR_ASYNC_PREVIEW, batch, e);
+    /* Restored whatever happened: the copy must stay equal to the caller's scene. Its flags
+     * are the preview renderer's at its next frame (the scene's values there are the
+     * preview's again, but a change in between may have been to one of these keys). */
     unsigned back = 0;
     for (int i = applied - 1; i >= 0; i--) {
         lr_err re = {0};
@@ -354,7 +369,7 @@ static int preview_frame(lr_async *a, uint64_t batch, unsigned *dirty, lr_err *e
             *e = re;
         }
     }
-    *dirty = back;
+    a->pr_dirty |= back;
     return rc;
 }
 
@@ -443,7 +458,7 @@ static int build_ahead(lr_async *a, bool *did, lr_err *e)
                               .width = a->width, .height = a->height, .layers = n,
                               .label = "cached state's images"};
             if (!(rc = lr_tex_create(a->wgl, &td, &t, e))) {
-                copy_layers(a, src, t, n);
+                copy_layers(a, src, a->width, a->height, t, n);
                 rc = lr_gl_check("async: caching a state's images", e);
                 glFinish(); /* complete before the caller may read it */
             }
@@ -534,8 +549,24 @@ static void *worker_main(void *arg)
                            .images_only = true, .gpu_budget_mb = a->gpu_budget_mb};
     if ((rc = lr_renderer_create(&rd, &a->r, &e)))
         worker_fail(a, rc, &e);
-    else
+    else {
         lr_renderer_set_cancel(a->r, &a->cancel);
+        lr_renderer_set_slice_ms(a->r, a->slice_ms);
+    }
+    if (a->r && a->n_preview) {
+        double s = a->preview_scale > 0 && a->preview_scale < 1 ? a->preview_scale : 1.0;
+        lr_renderer_desc pd = rd;
+        pd.width = a->width * s < 1 ? 1 : (int)lround(a->width * s);
+        pd.height = a->height * s < 1 ? 1 : (int)lround(a->height * s);
+        if ((rc = lr_renderer_create(&pd, &a->pr, &e))) {
+            worker_fail(a, rc, &e);
+            lr_renderer_destroy(a->r);
+            a->r = NULL;
+        } else {
+            lr_renderer_set_cancel(a->pr, &a->cancel); /* a stop cuts it */
+        }
+    }
+    a->pr_dirty = LR_DIRTY_SETTINGS; /* its first frame: everything */
     set_list batch = {0};
     unsigned dirty = LR_DIRTY_SETTINGS; /* the first frame: everything */
     bool converged = false, first = true;
@@ -587,6 +618,7 @@ static void *worker_main(void *arg)
             rc = replay(a, &batch, &got, &e);
             list_clear(&batch);
             applied = b;
+            a->pr_dirty |= got;
             if (rc) {
                 worker_fail(a, rc, &e);
                 break;
@@ -616,11 +648,10 @@ static void *worker_main(void *arg)
         bool interpolated = fresh && applied == interp_b;
         if (a->n_preview && worth && !interpolated &&
             (first || (heavy && (got & ~a->no_preview_dirty & TRANSPORT_DIRTY)))) {
-            unsigned back = dirty;
             if (!frame_begin(a, false))
                 continue; /* a stop */
             double t0 = now_ms();
-            rc = preview_frame(a, applied, &back, &e);
+            rc = preview_frame(a, applied, &e);
             frame_end(a);
             a->preview_ms = now_ms() - t0;
             if (rc == LR_ECANCELED) {
@@ -628,8 +659,6 @@ static void *worker_main(void *arg)
                 a->n_cancelled++;
                 pthread_mutex_unlock(&a->mu);
                 converged = false; /* a stop: the loop's top ends it */
-                dirty = back;
-                lr_renderer_invalidate(a->r, back);
                 continue;
             }
             if (!rc)
@@ -640,8 +669,6 @@ static void *worker_main(void *arg)
                 dirty = 0;
                 continue;
             }
-            dirty = back;
-            lr_renderer_invalidate(a->r, back);
             /* A newer change already waits (a knob still turning): preview it next instead of
              * refining a state that is already stale; the refinement comes when the controls
              * rest. */
@@ -687,7 +714,8 @@ static void *worker_main(void *arg)
         if (st.passes & LR_PASS_COMPOSE)
             cut_unshown = false;
         if ((st.passes & LR_PASS_COMPOSE) &&
-            (rc = publish(a, &st, converged ? LR_ASYNC_FINAL : LR_ASYNC_REFINING, applied, &e))) {
+            (rc = publish(a, a->r, &st, converged ? LR_ASYNC_FINAL : LR_ASYNC_REFINING, applied,
+                          &e))) {
             worker_fail(a, rc, &e);
             converged = true;
         } else if (!(st.passes & LR_PASS_COMPOSE)) {
@@ -698,6 +726,8 @@ static void *worker_main(void *arg)
         }
     }
     list_free(&batch);
+    lr_renderer_destroy(a->pr);
+    a->pr = NULL;
     lr_renderer_destroy(a->r);
     a->r = NULL;
     /* The cache's textures were made on this context: freed with it (the caller no longer
@@ -796,6 +826,8 @@ int lr_async_create(const lr_async_desc *d, lr_async **out, lr_err *e)
     a->no_preview_dirty = d->no_preview_dirty;
     a->preview_always = d->preview_always;
     a->gpu_budget_mb = d->gpu_budget_mb;
+    a->slice_ms = d->slice_ms;
+    a->preview_scale = d->preview_scale;
     a->shown = a->ready = -1;
     a->efd = -1;
     pthread_mutex_init(&a->mu, NULL);

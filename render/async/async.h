@@ -100,6 +100,14 @@ typedef struct lr_async_desc {
     const lr_cache_key *cache_keys;
     int n_cache_keys;
     double cache_mb;
+    /* The worker's renderer ends a slice of its long GPU passes about every slice_ms, so a
+     * change cuts a stale frame after about that long (lr_renderer_set_slice_ms); 0: fixed
+     * slices. */
+    double slice_ms;
+    /* The preview's image side over the view's, 0 < s <= 1 (0: 1): the preview is drawn by a
+     * renderer of its own at that size (so the view's renderer keeps its maps and grids
+     * across previews) and shown scaled up to the view (nearest texel). */
+    double preview_scale;
 } lr_async_desc;
 
 /* A state the caller may ask for next: assignments on top of the scene as last committed. */

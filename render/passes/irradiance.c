@@ -291,11 +291,12 @@ int lr_irradiance_run(lr_irradiance *irr, const lr_pass_ctx *c, const lr_vpl *v,
         lr_passes_uniform_v3(p, "u_grid_hb", lr_v3_scale(f.b, f.h));
         lr_passes_uniform_v3(p, "u_grid_n", lr_scene_receiver_at(c->scene, i)->normal);
         lr_passes_uniform_i(p, "u_tr_layer", irr->layer[i]);
-        /* In bands of LR_SLICE_ROWS rows (slice.h): a cut leaves the grids invalid, and the
-         * pass, still due, draws them whole at the next frame. */
+        /* In bands of rows (slice.h): a cut leaves the grids invalid, and the pass, still
+         * due, draws them whole at the next frame. */
         glEnable(GL_SCISSOR_TEST);
-        for (int y = 0; y < LR_RECV_GRID && !rc; y += LR_SLICE_ROWS) {
-            glScissor(0, y, LR_RECV_GRID, LR_SLICE_ROWS);
+        for (int y = 0, rows; y < LR_RECV_GRID && !rc; y += rows) {
+            rows = lr_slice_band(c->slicer, LR_SLICE_IRRADIANCE, LR_RECV_GRID - y);
+            glScissor(0, y, LR_RECV_GRID, rows);
             lr_gl_draw_fullscreen(c->gl);
             rc = lr_slice_end(c->slicer, LR_CANCEL_STALE, "receiver irradiance pass", e);
         }

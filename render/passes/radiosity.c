@@ -244,6 +244,29 @@ static const lr_gpu_mesh *radiosity_mesh(const lr_pass_ctx *c, const lr_radiosit
     return !per_vertex && c->objs->built[i].vao ? &c->objs->built[i] : &c->objs->obj[i];
 }
 
+/* The objects into light l's map, with the program's per-map uniforms already set. */
+static void draw_objects(const lr_radiosity *rad, const lr_pass_ctx *c, lr_program *p, int l)
+{
+    for (int i = 0; i < c->objs->n_objects; i++) {
+        if (rad->dg_tex[i]) {
+            lr_dfield_view v;
+            lr_dscene_field(rad->dscene, i, l, &v);
+            lr_passes_bind_tex(p, "u_dg_field", LR_DGRID_TEX_UNIT, rad->dg_tex[i]);
+            lr_passes_uniform_v3(p, "u_dg_origin", v.origin);
+            lr_passes_uniform_f(p, "u_dg_h", (float)v.h);
+            glUniform3i(lr_program_uniform(p, "u_dg_dims"), v.n[0], v.n[1], v.n[2]);
+            lr_passes_uniform_i(p, "u_dg_layer0", l * v.n[2]);
+        }
+        lr_passes_uniform_i(p, "u_object", i);
+        lr_passes_uniform_i(p, "u_two_sided", c->objs->two_sided[i]);
+        bool tr = i < LR_MAX_OBJECTS && rad->trB[i];
+        lr_passes_uniform_i(p, "u_tr_on", tr);
+        lr_passes_bind_tex(p, "u_tr_B", 10, tr ? rad->trB[i] : NULL);
+        lr_passes_uniform_i(p, "u_tr_row0", tr ? l * rad->tr_rows[i] : 0);
+        lr_passes_draw(radiosity_mesh(c, rad, i));
+    }
+}
+
 int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *gb, bool restart,
                      lr_err *e)
 {
@@ -329,28 +352,19 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
             glUniform1ui(lr_program_uniform(p, "u_seed"), c->seed);
             glUniform1ui(lr_program_uniform(p, "u_map"), (GLuint)k);
             glUniform1ui(lr_program_uniform(p, "u_frame"), (GLuint)F);
-            for (int i = 0; i < c->objs->n_objects; i++) {
-                if (rad->dg_tex[i]) {
-                    lr_dfield_view v;
-                    lr_dscene_field(rad->dscene, i, l, &v);
-                    lr_passes_bind_tex(p, "u_dg_field", LR_DGRID_TEX_UNIT, rad->dg_tex[i]);
-                    lr_passes_uniform_v3(p, "u_dg_origin", v.origin);
-                    lr_passes_uniform_f(p, "u_dg_h", (float)v.h);
-                    glUniform3i(lr_program_uniform(p, "u_dg_dims"), v.n[0], v.n[1], v.n[2]);
-                    lr_passes_uniform_i(p, "u_dg_layer0", l * v.n[2]);
-                }
-                lr_passes_uniform_i(p, "u_object", i);
-                lr_passes_uniform_i(p, "u_two_sided", c->objs->two_sided[i]);
-                bool tr = i < LR_MAX_OBJECTS && rad->trB[i];
-                lr_passes_uniform_i(p, "u_tr_on", tr);
-                lr_passes_bind_tex(p, "u_tr_B", 10, tr ? rad->trB[i] : NULL);
-                lr_passes_uniform_i(p, "u_tr_row0", tr ? l * rad->tr_rows[i] : 0);
-                lr_passes_draw(radiosity_mesh(c, rad, i));
+            /* In bands of the map's rows (slice.h): each texel is drawn once a frame whatever
+             * the bands. A cut here leaves some maps one sample ahead of the others, so the
+             * maps restart at the next frame (frame count 0), as the change that cuts at
+             * this level makes them do anyway. */
+            glEnable(GL_SCISSOR_TEST);
+            for (int y = 0, rows; y < rad->size && !cut; y += rows) {
+                rows = lr_slice_band(c->slicer, LR_SLICE_RADIOSITY, rad->size - y);
+                glScissor(0, y, rad->size, rows);
+                draw_objects(rad, c, p, l);
+                cut = lr_slice_end(c->slicer, LR_CANCEL_RESTART, "radiosity pass", e);
             }
-            /* A slice per map and light (slice.h): a cut here leaves some maps one sample
-             * ahead of the others, so the maps restart at the next frame (frame count 0),
-             * as the change that cuts at this level makes them do anyway. */
-            if ((cut = lr_slice_end(c->slicer, LR_CANCEL_RESTART, "radiosity pass", e)))
+            glDisable(GL_SCISSOR_TEST);
+            if (cut)
                 goto done;
         }
 done:

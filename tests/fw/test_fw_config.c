@@ -65,6 +65,8 @@ static void test_bad_fields_named(void **state)
          "rig.json:2: field 'budget.converge_s': unknown field"},
         {"{\"scene\": \"candle.json\",\n \"output\": {\"gpu_memory_mb\": -5}}",
          "rig.json:2: field 'output.gpu_memory_mb': must be in 0..1.04858e+06, got -5"},
+        {"{\"scene\": \"candle.json\",\n \"output\": {\"slice_ms\": 2000}}",
+         "rig.json:2: field 'output.slice_ms': must be in 0..1000, got 2000"},
         {"{\"scene\": \"nope.json\"}", "rig.json:1: field 'scene': '%D/nope.json': No such file "
                                        "or directory"},
         {"{\"scene\": \"candle.json\",\n \"devices\": [\n  {\"type\": \"serial\"}]}",
@@ -281,6 +283,7 @@ static void test_shipped_rigs(void **state)
     assert_int_equal(c->n_bindings, 6);
     assert_int_equal(c->output.mode, LR_RIG_HEADLESS);
     assert_true(c->output.gpu_memory_mb == 1024); /* the default: a quarter of a 4 GB board */
+    assert_true(c->output.slice_ms == 8);         /* the default: a quarter of 1/30 s */
     lr_scene *s;
     if (lr_scene_load(c->scene, NULL, &s, &e))
         fail_msg("%s", e.msg);

@@ -1,7 +1,8 @@
 /* The renderer off the caller's loop (render/async/async.h): its converged image is the
  * renderer's own, a dimmer change during a solve is blended at once on the images already
  * published, the preview stage comes exactly once per change that re-runs the maps, and the
- * scene copy it renders is independent of the caller's scene (lr_scene_clone). */
+ * scene copy it renders is independent of the caller's scene (lr_scene_clone); a preview at
+ * half the size is a half-size renderer's image scaled up. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -246,6 +247,80 @@ static void test_preview_once_per_heavy_change(void **state)
     lr_scene_destroy(s);
 }
 
+/* The preview stage at preview_scale 0.5 is drawn by a renderer of its own at half the view's
+ * width and height and shown scaled up by the nearest texel: the first image shown is a fresh
+ * half-size renderer's image of the scene at the preview's assignments, each of its pixels
+ * covering 2 x 2 of the view's (to the same 1e-5 of the peak: the same sums). The full frame
+ * after it (a grid solve, a fraction of a second) is what the test races: when it was shown
+ * first, the test tries again with a new worker. */
+static void test_preview_at_scale(void **state)
+{
+    fixture *f = *state;
+    static const char *const pv[][2] = {{"render.K", "1"}, {"render.N", "1"},
+                                        {"render.map_size", "16"}, {"render.frames", "1"},
+                                        {"objects[0].model", "directional_dipole"}};
+    enum { NPV = sizeof pv / sizeof pv[0] };
+    char sets[NPV][64];
+    for (int attempt = 0; attempt < 5; attempt++) {
+        lr_scene *s = lr_test_scene("candle", lr_test_small_settings, grid_sets);
+        lr_async_desc d = {.gl = f->gl, .scene = s, .width = W, .height = H, .n_preview = NPV,
+                           .preview_always = true, .preview_scale = 0.5};
+        for (int i = 0; i < NPV; i++) {
+            snprintf(sets[i], sizeof sets[i], "%s=%s", pv[i][0], pv[i][1]);
+            d.preview[i] = sets[i];
+        }
+        lr_async *a = NULL;
+        lr_err e = {0};
+        if (lr_async_create(&d, &a, &e))
+            fail_msg("lr_async_create: %s", e.msg);
+        if (lr_async_wait(a, 0, false, WAIT_MS, &e))
+            fail_msg("lr_async_wait: %s", e.msg);
+        /* The publication is taken once its fence has signalled: a few frames. */
+        lr_async_frame_stats st = {0};
+        for (int i = 0; i < WAIT_MS / 5 && st.stage == LR_ASYNC_NONE; i++) {
+            if (lr_async_frame(a, &st, &e))
+                fail_msg("lr_async_frame: %s", e.msg);
+            struct timespec ts = {0, 5 * 1000 * 1000};
+            if (st.stage == LR_ASYNC_NONE)
+                nanosleep(&ts, NULL);
+        }
+        float *got = malloc((size_t)W * H * 3 * sizeof *got);
+        assert_non_null(got);
+        if (lr_async_read_hdr(a, got, &e))
+            fail_msg("lr_async_read_hdr: %s", e.msg);
+        lr_async_destroy(a);
+        if (st.stage != LR_ASYNC_PREVIEW) {
+            print_message("attempt %d: the first image shown was %s\n", attempt,
+                          lr_async_stage_name(st.stage));
+            free(got);
+            lr_scene_destroy(s);
+            continue;
+        }
+        unsigned dirty = 0;
+        for (int i = 0; i < NPV; i++)
+            set(s, pv[i][0], pv[i][1], &dirty);
+        lr_renderer_desc rd = {.gl = f->gl, .scene = s, .width = W / 2, .height = H / 2};
+        lr_renderer *r = lr_test_renderer_desc(&rd);
+        lr_test_converge(r, 1);
+        float *half = lr_test_hdr(r);
+        float *want = malloc((size_t)W * H * 3 * sizeof *want);
+        assert_non_null(want);
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++)
+                for (int b = 0; b < 3; b++)
+                    want[((size_t)y * W + x) * 3 + b] =
+                        half[((size_t)(y / 2) * (W / 2) + x / 2) * 3 + b];
+        assert_same_image(got, want, "half-size preview vs a half-size renderer, scaled up");
+        free(half);
+        free(want);
+        free(got);
+        lr_renderer_destroy(r);
+        lr_scene_destroy(s);
+        return;
+    }
+    fail_msg("the preview was never the first image shown in 5 tries");
+}
+
 /* Polls until the worker runs a full frame that a batch would cut (it takes a batch within
  * milliseconds of its commit; the hang guard only bounds a broken worker). */
 static void wait_cuttable(lr_async *a)
@@ -414,6 +489,7 @@ int main(void)
         cmocka_unit_test(test_final_is_the_renderers_image),
         cmocka_unit_test(test_dimmer_does_not_wait_for_a_solve),
         cmocka_unit_test(test_preview_once_per_heavy_change),
+        cmocka_unit_test(test_preview_at_scale),
         cmocka_unit_test(test_newer_change_cuts_a_stale_solve),
         cmocka_unit_test(test_stop_cuts_the_frame),
     };

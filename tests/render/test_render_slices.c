@@ -10,7 +10,11 @@
  *    radiosity pass end its slices and cuts at the irradiance pass's first band: the frame's
  *    map sample is kept (the next frame is the one after it), and the image converges to the
  *    uncut renderer's;
- *  - without a token nothing is cut, whatever the hook requests.
+ *  - without a token nothing is cut, whatever the hook requests;
+ *  - with a time budget (lr_renderer_set_slice_ms) the bands are sized from the pass's last
+ *    bands: a budget no row fits gives one row a band (MAP rows a map, LR_RECV_GRID a grid),
+ *    one every pass fits gives one band a map and a grid; a cut mid-map under a budget
+ *    restarts the maps, and every such frame converges to the uncut image.
  * The converged images are compared exactly (to 1e-6 of the peak): the same seed and the same
  * samples give the same sums. */
 #include <setjmp.h>
@@ -33,7 +37,7 @@
 
 LR_TEST_GL_FIXTURE(gl) /* tests/support/gl.h: setup(), teardown() */
 
-enum { W = 32, H = 24, K = 4, FRAMES = 4 };
+enum { W = 32, H = 24, K = 4, FRAMES = 4, MAP = 32 };
 
 /* The candle with its two plane receivers and VPLs (the irradiance pass runs), small maps;
  * no receiver bounce or opening light (CPU solves this test does not cut). */
@@ -284,6 +288,63 @@ static void test_irradiance_grid_off(void **state)
     lr_scene_destroy(s);
 }
 
+/* Slices in one accumulation frame of r. */
+static long frame_slices(lr_renderer *r)
+{
+    long before = lr_renderer_debug_slices(r);
+    lr_frame_stats st = lr_test_frame(r);
+    assert_true(st.passes & LR_PASS_RADIOSITY);
+    assert_true(st.passes & LR_PASS_IRRADIANCE);
+    return lr_renderer_debug_slices(r) - before;
+}
+
+static void test_budget_sizes_the_bands(void **state)
+{
+    (void)state;
+    lr_scene *s = lr_test_scene("candle", settings, NULL);
+    int lights = lr_scene_light_count(s), planes = plane_grids(s);
+    float *want = uncut_image(s);
+    lr_cancel token;
+    /* A budget under any row's time: after the first frame's estimates, one row a band. */
+    lr_renderer *r = tokened(s, &token);
+    lr_renderer_set_slice_ms(r, 1e-9);
+    (void)frame_slices(r); /* the estimates */
+    long n = frame_slices(r);
+    print_message("budget 1e-9 ms: %ld slices a frame\n", n);
+    assert_int_equal(n, (long)K * lights * MAP + (long)planes * LR_RECV_GRID);
+    converges_as_uncut(r, s, want);
+
+    /* A budget every pass fits in: one band a map and a grid. */
+    s = lr_test_scene("candle", settings, NULL);
+    want = uncut_image(s);
+    r = tokened(s, &token);
+    lr_renderer_set_slice_ms(r, 1e9);
+    (void)frame_slices(r);
+    n = frame_slices(r);
+    print_message("budget 1e9 ms: %ld slices a frame\n", n);
+    assert_int_equal(n, (long)K * lights + planes);
+    converges_as_uncut(r, s, want);
+
+    /* Cut at the fifth one-row band of the first map: the maps restart. */
+    s = lr_test_scene("candle", settings, NULL);
+    want = uncut_image(s);
+    r = tokened(s, &token);
+    lr_renderer_set_slice_ms(r, 1e-9);
+    (void)frame_slices(r);
+    cutter c = {&token, LR_CANCEL_RESTART, lr_renderer_debug_slices(r) + 5};
+    lr_renderer_debug_on_slice(r, cut_at, &c);
+    lr_frame_stats st;
+    lr_err e = {0};
+    assert_int_equal(lr_renderer_frame(r, &st, &e), LR_ECANCELED);
+    assert_non_null(strstr(e.msg, "radiosity pass: cancelled"));
+    assert_int_equal(lr_renderer_debug_slices(r), c.at);
+    lr_renderer_debug_on_slice(r, NULL, NULL);
+    lr_cancel_reset(&token);
+    st = lr_test_frame(r);
+    assert_int_equal(st.samples, 1); /* restarted */
+    converges_as_uncut(r, s, want);
+}
+
 int main(void)
 {
     if (getenv("LR_TEST_FILTER"))
@@ -294,6 +355,7 @@ int main(void)
         cmocka_unit_test(test_stale_cut_keeps_the_maps),
         cmocka_unit_test(test_no_token_no_cut),
         cmocka_unit_test(test_irradiance_grid_off),
+        cmocka_unit_test(test_budget_sizes_the_bands),
     };
     int failed = cmocka_run_group_tests(tests, setup, teardown);
     free(uncut);
