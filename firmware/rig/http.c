@@ -31,11 +31,18 @@ typedef struct sse {
     struct sse *next;
 } sse;
 
-/* A request in progress: its body, bounded. */
+/* A request in progress: its body, bounded; for POST /api/reload, the rig's answer it awaits
+ * with its connection suspended (lr_rig_reload_async). */
 typedef struct req {
     char body[LR_HTTP_BODY_MAX + 1];
     size_t len;
     bool too_big;
+    struct lr_http *h;
+    struct MHD_Connection *conn;
+    bool reload_wait, reload_done, suspended;
+    int reload_rc;
+    char reload_msg[LR_ERR_MSG_MAX];
+    struct req *next_wait;
 } req;
 
 struct lr_http {
@@ -48,6 +55,7 @@ struct lr_http {
     int port;
     sse *streams;
     int n_streams;
+    req *reloads; /* POST /api/reload requests awaiting the rig's answer */
     bool closing;
     bool controls_dirty;
     int64_t last_controls_ns, next_status_ns;
@@ -435,7 +443,45 @@ static enum MHD_Result post_scene(lr_http *h, struct MHD_Connection *c, const re
     return ok_reply(c, &a);
 }
 
-static enum MHD_Result post_reload(lr_http *h, struct MHD_Connection *c, const req *q)
+static void wait_unlink(lr_http *h, req *q)
+{
+    for (req **p = &h->reloads; *p; p = &(*p)->next_wait)
+        if (*p == q) {
+            *p = q->next_wait;
+            break;
+        }
+    q->next_wait = NULL;
+}
+
+/* The rig's answer to a reload (on the loop, or inside lr_rig_reload_async): kept for the
+ * handler, which MHD calls again once the connection is resumed. */
+static void reload_done(void *ctx, int rc, const lr_err *e)
+{
+    req *q = ctx;
+    q->reload_done = true;
+    q->reload_rc = rc;
+    snprintf(q->reload_msg, sizeof q->reload_msg, "%s", rc && e ? e->msg : "");
+    wait_unlink(q->h, q);
+    if (q->suspended) {
+        q->suspended = false;
+        MHD_resume_connection(q->conn);
+    }
+}
+
+static enum MHD_Result reload_reply(lr_http *h, struct MHD_Connection *c, const req *q)
+{
+    if (h->closing && q->reload_rc < 0)
+        return fail(c, MHD_HTTP_SERVICE_UNAVAILABLE, "reload: the rig is shutting down");
+    if (q->reload_rc)
+        return fail(c, MHD_HTTP_UNPROCESSABLE_CONTENT, "reload: %s; keeping the running config",
+                    q->reload_msg);
+    ok_arg a = {"reloaded", "config", 0, false};
+    return ok_reply(c, &a);
+}
+
+/* What SIGHUP does, answered when the new config runs or has failed: the config loads in a
+ * job off the loop meanwhile, the connection suspended, so the loop never waits for it. */
+static enum MHD_Result post_reload(lr_http *h, struct MHD_Connection *c, req *q)
 {
     if (q->len) {
         /* An empty body or {}: nothing else is defined. */
@@ -452,11 +498,21 @@ static enum MHD_Result post_reload(lr_http *h, struct MHD_Connection *c, const r
             return fail(c, MHD_HTTP_BAD_REQUEST, "%s", e.msg);
     }
     lr_err e = {0};
-    if (lr_rig_reload(h->rig, &e))
-        return fail(c, MHD_HTTP_UNPROCESSABLE_CONTENT, "reload: %s; keeping the running config",
-                    e.msg);
-    ok_arg a = {"reloaded", "config", 0, false};
-    return ok_reply(c, &a);
+    q->h = h;
+    q->conn = c;
+    q->reload_wait = true;
+    q->next_wait = h->reloads;
+    h->reloads = q;
+    if (lr_rig_reload_async(h->rig, reload_done, q, &e)) {
+        wait_unlink(h, q);
+        q->reload_wait = false;
+        return fail(c, MHD_HTTP_SERVICE_UNAVAILABLE, "%s", e.msg);
+    }
+    if (q->reload_done) /* answered at once: no job could be started */
+        return reload_reply(h, c, q);
+    q->suspended = true;
+    MHD_suspend_connection(c);
+    return MHD_YES;
 }
 
 /* ---- checks ---- */
@@ -606,6 +662,9 @@ static enum MHD_Result handler(void *cls, struct MHD_Connection *c, const char *
         *data_size = 0;
         return MHD_YES;
     }
+    /* A reload's request, called again once resumed: its answer (the checks were made). */
+    if (q->reload_wait)
+        return q->reload_done ? reload_reply(h, c, q) : MHD_YES;
     q->body[q->len] = '\0';
     return route(h, c, url, method, q);
 }
@@ -613,9 +672,14 @@ static enum MHD_Result handler(void *cls, struct MHD_Connection *c, const char *
 static void completed(void *cls, struct MHD_Connection *c, void **con_cls,
                       enum MHD_RequestTerminationCode why)
 {
-    (void)cls;
+    lr_http *h = cls;
     (void)c;
     (void)why;
+    req *q = *con_cls;
+    if (q && q->reload_wait && !q->reload_done) {
+        lr_rig_reload_forget(h->rig, q);
+        wait_unlink(h, q);
+    }
     free(*con_cls);
     *con_cls = NULL;
 }
@@ -707,6 +771,13 @@ void lr_http_destroy(lr_http *h)
             s->suspended = false;
             MHD_resume_connection(s->conn);
         }
+    /* Reloads still awaited are answered 503: the rig will not call them. */
+    while (h->reloads) {
+        req *q = h->reloads;
+        lr_rig_reload_forget(h->rig, q);
+        lr_err e = {0};
+        reload_done(q, -1, &e); /* unlinks it, resumes its connection */
+    }
     MHD_run(h->d);
     MHD_stop_daemon(h->d);
     free(h->png);

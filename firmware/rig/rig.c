@@ -54,6 +54,13 @@
 #define FIRST_IMAGE_MS 600000
 #define FRAME_TIMES 64 /* frame end times kept for the status's fps and interval p99 */
 
+/* A request for a reload's answer (lr_rig_reload_async). */
+typedef struct reload_waiter {
+    lr_rig_reload_fn fn;
+    void *ctx;
+    uint64_t gen; /* answered by reload number gen (lr_rig.reload_gen) or a later one */
+} reload_waiter;
+
 /* What a config builds; swapped whole on reload. */
 typedef struct rigset {
     lr_rig_config *cfg;
@@ -143,16 +150,22 @@ struct lr_rig {
     struct loading *load;
     lr_rig_job *load_job;
     bool reload_pending;
+    /* Reloads started (each job's number) and the answers awaited (lr_rig_reload_async), each
+     * by the first reload started after its request. */
+    uint64_t reload_gen;
+    reload_waiter waiter[LR_RIG_RELOAD_WAITERS];
+    int n_waiters;
     char scene_pending[LR_RIG_PATH_MAX];
-    /* An MQTT scene command ahead of its apply_at: that scene loaded and planned and its view
-     * built in advance (mqtt_prepare), so that the switch at apply_at is a swap and the rigs
-     * do not differ by their load times. */
+    /* An MQTT scene command ahead of its apply_at: that scene loaded and planned (in a job)
+     * and its view built in advance (mqtt_prepare), so that the switch at apply_at is a swap
+     * and the rigs do not differ by their load times. */
     struct {
         bool valid;
         char path[LR_RIG_PATH_MAX];
         lr_scene *scene;
         lr_replan *replan;
         lr_rig_view *view;
+        struct rig_plan plan;
     } pre;
     char pre_key[LR_MQTT_SCENE_MAX + 24]; /* the command last prepared (tried once) */
     /* Role "leader": the controls as its own devices have set them, ahead of what the rigs
@@ -763,42 +776,11 @@ static void pre_drop(lr_rig *r)
     memset(&r->pre, 0, sizeof r->pre);
 }
 
-/* Loads path, plans it and builds its view with the controls' values as they stand (a
- * scratch map carrying the live one's positions: the live map keeps writing the scene shown).
- * A failure is logged; the switch at apply_at then loads it as usual (and says why). */
-static void pre_load(lr_rig *r, const char *path)
-{
-    pre_drop(r);
-    lr_scene *scene = NULL;
-    lr_err e = {0};
-    bool no_vpl = false;
-    lr_replan *rp = NULL;
-    if (scene_build(r, &r->log, &r->plan_new, path, &scene, &no_vpl, &rp, &e)) {
-        lr_log_write(&r->log, LR_LOG_WARN, "mqtt: scene %s not loaded ahead: %s", path, e.msg);
-        return;
-    }
-    int64_t now = lr_now_ns();
-    lr_control_map *tmp = NULL;
-    unsigned dirty = 0;
-    if (lr_control_map_create(r->set.cfg, scene, false, now, &tmp, &e) == LR_OK) {
-        lr_control_map_carry(tmp, r->set.map, now);
-        lr_control_map_update(tmp, scene, now, &dirty, &e);
-    }
-    lr_control_map_destroy(tmp);
-    lr_rig_view *view;
-    if (view_build(r, scene, no_vpl, &view, &e)) {
-        lr_log_write(&r->log, LR_LOG_WARN, "mqtt: scene %s not loaded ahead: %s", path, e.msg);
-        lr_replan_destroy(rp);
-        lr_scene_destroy(scene);
-        return;
-    }
-    r->pre.valid = true;
-    snprintf(r->pre.path, sizeof r->pre.path, "%s", path);
-    r->pre.scene = scene;
-    r->pre.replan = rp;
-    r->pre.view = view;
-    lr_log_write(&r->log, LR_LOG_INFO, "mqtt: scene %s loaded ahead of its apply_at", path);
-}
+/* A scene loaded and planned ahead (a job, load_start's LOAD_AHEAD): its view is built here
+ * with the controls' values as they stand (a scratch map carrying the live one's positions:
+ * the live map keeps writing the scene shown). A failure is logged; the switch at apply_at
+ * then loads it as usual (and says why). */
+static void ahead_commit(lr_rig *r, struct loading *l);
 
 /* The switch to the scene loaded ahead: the controls are written into it again (what moved
  * since it was loaded), then it and its view replace the shown ones. */
@@ -817,6 +799,7 @@ static void pre_commit(lr_rig *r)
     r->view = r->pre.view;
     r->set.scene = r->pre.scene;
     r->set.replan = r->pre.replan;
+    r->plan_new = r->plan = r->pre.plan;
     r->ar_dirty = true;
     lr_log_write(&r->log, LR_LOG_INFO, "scene: %s (loaded ahead)", r->pre.path);
     memset(&r->pre, 0, sizeof r->pre);
@@ -824,9 +807,15 @@ static void pre_commit(lr_rig *r)
 
 /* A scene or a config loaded and planned in a job (firmware/rig/job.h): what it made, for the
  * loop to take when the job is done (load_poll). */
+typedef enum load_kind {
+    LOAD_RELOAD, /* the whole config (set) */
+    LOAD_SWITCH, /* the scene at path, shown when loaded */
+    LOAD_AHEAD,  /* the scene at path, kept for an MQTT command's apply_at (r->pre) */
+} load_kind;
+
 typedef struct loading {
     lr_rig *r;
-    bool reload;                   /* the whole config (set), else the scene at path */
+    load_kind kind;
     char path[LR_RIG_PATH_MAX];
     int rc;
     lr_err e;
@@ -836,12 +825,13 @@ typedef struct loading {
     lr_replan *replan;
     struct rig_plan plan;
     int64_t started_ns;
+    uint64_t gen;                  /* reload: its number (lr_rig.reload_gen) */
 } loading;
 
 static void load_run(void *arg, const lr_log *log)
 {
     loading *l = arg;
-    if (l->reload)
+    if (l->kind == LOAD_RELOAD)
         l->rc = set_build_core(l->r, log, &l->plan, &l->set, &l->e);
     else
         l->rc = scene_build(l->r, log, &l->plan, l->path, &l->scene, &l->no_vpl, &l->replan,
@@ -865,26 +855,30 @@ static void switch_scene(lr_rig *r, const char *path);
 /* What a load made replaces the running config or scene, then it is freed. */
 static void load_commit(lr_rig *r, loading *l)
 {
-    if (l->reload)
+    if (l->kind == LOAD_RELOAD)
         reload_commit(r, l);
+    else if (l->kind == LOAD_AHEAD)
+        ahead_commit(r, l);
     else
         switch_commit(r, l);
     loading_free(l);
 }
 
-/* Starts loading (a config when reload, else the scene at path) in a job; where no job can be
- * started, loads it here and now. */
-static void load_start(lr_rig *r, bool reload, const char *path)
+/* Starts loading (the config, or the scene at path) in a job; where no job can be started,
+ * loads it here and now. */
+static void load_start(lr_rig *r, load_kind kind, const char *path)
 {
+    static const char *const what[] = {"reload", "scene switch", "mqtt: scene ahead"};
     loading *l = calloc(1, sizeof *l);
     if (!l) {
-        lr_log_write(&r->log, LR_LOG_ERROR, "%s: out of memory",
-                     reload ? "reload" : "scene switch");
+        lr_log_write(&r->log, LR_LOG_ERROR, "%s: out of memory", what[kind]);
         return;
     }
     l->r = r;
-    l->reload = reload;
+    l->kind = kind;
     l->started_ns = lr_now_ns();
+    if (kind == LOAD_RELOAD)
+        l->gen = ++r->reload_gen;
     if (path)
         snprintf(l->path, sizeof l->path, "%s", path);
     lr_err e = {0};
@@ -911,7 +905,7 @@ static void load_poll(lr_rig *r, bool wait)
     load_commit(r, l);
     if (r->reload_pending) {
         r->reload_pending = false;
-        load_start(r, true, NULL);
+        load_start(r, LOAD_RELOAD, NULL);
     } else if (r->scene_pending[0]) {
         char path[LR_RIG_PATH_MAX];
         snprintf(path, sizeof path, "%s", r->scene_pending);
@@ -933,7 +927,43 @@ static void switch_scene(lr_rig *r, const char *path)
         snprintf(r->scene_pending, sizeof r->scene_pending, "%s", path);
         return;
     }
-    load_start(r, false, path);
+    load_start(r, LOAD_SWITCH, path);
+}
+
+static void ahead_commit(lr_rig *r, loading *l)
+{
+    if (l->rc) {
+        lr_log_write(&r->log, LR_LOG_WARN, "mqtt: scene %s not loaded ahead: %s", l->path,
+                     l->e.msg);
+        return;
+    }
+    pre_drop(r);
+    lr_err e = {0};
+    int64_t now = lr_now_ns();
+    lr_control_map *tmp = NULL;
+    unsigned dirty = 0;
+    if (lr_control_map_create(r->set.cfg, l->scene, false, now, &tmp, &e) == LR_OK) {
+        lr_control_map_carry(tmp, r->set.map, now);
+        lr_control_map_update(tmp, l->scene, now, &dirty, &e);
+    }
+    lr_control_map_destroy(tmp);
+    lr_rig_view *view;
+    if (view_build(r, l->scene, l->no_vpl, &view, &e)) {
+        lr_log_write(&r->log, LR_LOG_WARN, "mqtt: scene %s not loaded ahead: %s", l->path,
+                     e.msg);
+        return;
+    }
+    r->pre.valid = true;
+    snprintf(r->pre.path, sizeof r->pre.path, "%s", l->path);
+    r->pre.scene = l->scene;
+    r->pre.replan = l->replan;
+    r->pre.view = view;
+    r->pre.plan = l->plan;
+    l->scene = NULL;
+    l->replan = NULL;
+    lr_log_write(&r->log, LR_LOG_INFO,
+                 "mqtt: scene %s loaded ahead of its apply_at (off the loop in %.0f ms)",
+                 l->path, (double)(now - l->started_ns) * 1e-6);
 }
 
 /* The loaded scene replaces the shown one (on the loop, after its job). */
@@ -1138,6 +1168,8 @@ static void mqtt_prepare(lr_rig *r)
     snprintf(key, sizeof key, "%lld %s", (long long)c.apply_at_ns, c.scene);
     if (strcmp(key, r->pre_key) == 0)
         return;
+    if (r->load)
+        return; /* a load runs (one at a time): asked again at the next turn */
     snprintf(r->pre_key, sizeof r->pre_key, "%s", key);
     int b, idx;
     char path[LR_RIG_PATH_MAX];
@@ -1146,7 +1178,7 @@ static void mqtt_prepare(lr_rig *r)
     if (b >= 0)
         snprintf(path, sizeof path, "%s", r->set.cfg->bindings[b].values[idx]);
     if (!(r->pre.valid && strcmp(r->pre.path, path) == 0))
-        pre_load(r, path);
+        load_start(r, LOAD_AHEAD, path);
 }
 
 /* The commands due now, each as the event of its binding (an absolute position, like a fader
@@ -1578,6 +1610,27 @@ static const char *status_line(const lr_rig *r, char *buf, size_t cap)
 }
 
 static int reload_finish(lr_rig *r, rigset *s, lr_err *e);
+static void reload_start(lr_rig *r);
+
+/* Answers the requests that reload `gen` (or a later one) serves: those made before it
+ * started. */
+static void reload_answer(lr_rig *r, uint64_t gen, int rc, const lr_err *e)
+{
+    int k = 0;
+    for (int i = 0; i < r->n_waiters; i++) {
+        if (r->waiter[i].gen <= gen) {
+            /* Copied out first: the answer may ask again (a new entry) or forget. */
+            lr_rig_reload_fn fn = r->waiter[i].fn;
+            void *ctx = r->waiter[i].ctx;
+            r->waiter[i].fn = NULL;
+            fn(ctx, rc, e);
+        }
+    }
+    for (int i = 0; i < r->n_waiters; i++)
+        if (r->waiter[i].fn)
+            r->waiter[k++] = r->waiter[i];
+    r->n_waiters = k;
+}
 
 static int reload_failed(lr_rig *r, const lr_err *e)
 {
@@ -1609,7 +1662,31 @@ int lr_rig_reload(lr_rig *r, lr_err *e)
     int rc = set_build(r, &s, true, e);
     rc = rc ? reload_failed(r, e) : reload_finish(r, &s, e);
     notify_ready(r);
+    /* It started after every request awaiting one. */
+    reload_answer(r, UINT64_MAX, rc, e);
     return rc;
+}
+
+int lr_rig_reload_async(lr_rig *r, lr_rig_reload_fn done, void *ctx, lr_err *e)
+{
+    if (r->n_waiters >= LR_RIG_RELOAD_WAITERS)
+        return lr_err_set(e, LR_EUNSUPPORTED, "reload: %d reloads already waiting",
+                          LR_RIG_RELOAD_WAITERS);
+    /* The next reload to start: now, or the pending one after the job that runs. */
+    r->waiter[r->n_waiters++] = (reload_waiter){done, ctx, r->reload_gen + 1};
+    lr_log_write(&r->log, LR_LOG_INFO, "reload: asked for over HTTP: reloading %s",
+                 r->config_path);
+    reload_start(r);
+    return LR_OK;
+}
+
+void lr_rig_reload_forget(lr_rig *r, void *ctx)
+{
+    int k = 0;
+    for (int i = 0; i < r->n_waiters; i++)
+        if (r->waiter[i].ctx != ctx)
+            r->waiter[k++] = r->waiter[i];
+    r->n_waiters = k;
 }
 
 /* SIGHUP: the config loads and plans in a job; the loop goes on with the running one and
@@ -1622,7 +1699,7 @@ static void reload_start(lr_rig *r)
     }
     if (r->ready_sent)
         lr_notify_reloading(r->notify, lr_now_ns());
-    load_start(r, true, NULL);
+    load_start(r, LOAD_RELOAD, NULL);
 }
 
 /* The config a job loaded: its devices open here, then it replaces the running one. */
@@ -1649,6 +1726,7 @@ static void reload_commit(lr_rig *r, loading *l)
         lr_log_write(&r->log, LR_LOG_INFO, "reload: loaded and planned off the loop in %.0f ms",
                      (double)(lr_now_ns() - l->started_ns) * 1e-6);
     notify_ready(r);
+    reload_answer(r, l->gen, rc, &e);
 }
 
 /* s: a config built with its devices (taken: freed on failure). */

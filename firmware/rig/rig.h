@@ -60,9 +60,23 @@ int lr_rig_create(const lr_rig_opts *opts, lr_rig **out, lr_err *e);
 int lr_rig_run(lr_rig *r, lr_err *e);
 /* Runs the loop until now >= until_ns (or a stop); for tests that drive it in steps. */
 int lr_rig_run_until(lr_rig *r, int64_t until_ns, lr_err *e);
-/* What SIGTERM / SIGHUP do, for in-process callers. */
+/* What SIGTERM / SIGHUP do, for in-process callers. lr_rig_reload loads the config here and
+ * now and returns its result: the loop waits for it. */
 void lr_rig_stop(lr_rig *r);
 int lr_rig_reload(lr_rig *r, lr_err *e);
+
+/* The answer to lr_rig_reload_async: rc LR_OK when the new config runs, else the reason
+ * (e: file, line, field) while the old one runs on. Called on the loop. */
+typedef void (*lr_rig_reload_fn)(void *ctx, int rc, const lr_err *e);
+#define LR_RIG_RELOAD_WAITERS 8
+/* What SIGHUP does, answered: the config loads and plans in a job off the loop (after the one
+ * running, if any: the answer is a reload that started after this call), and `done` is called
+ * on the loop once it has been committed or has failed -- inside this call when no job could
+ * be started. LR_EUNSUPPORTED when LR_RIG_RELOAD_WAITERS answers are already awaited. A rig
+ * destroyed first never calls it: lr_rig_reload_forget is the caller's way out before that. */
+int lr_rig_reload_async(lr_rig *r, lr_rig_reload_fn done, void *ctx, lr_err *e);
+/* Drops the answers awaited with ctx (its connection closed). */
+void lr_rig_reload_forget(lr_rig *r, void *ctx);
 /* Safe level, device close, stats: the clean shutdown. NULL is a no-op. */
 void lr_rig_destroy(lr_rig *r);
 

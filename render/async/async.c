@@ -350,16 +350,17 @@ static int preview_frame(lr_async *a, uint64_t batch, lr_err *e)
     if (skip)
         rc = LR_OK;
     if (!rc && !skip) {
-        lr_renderer_invalidate(a->pr, d);
+        /* The preview's own assignments are not changes for its renderer: it sees them at
+         * every frame (and whatever the scene's own values of those keys do in between). */
+        lr_renderer_invalidate(a->pr, a->pr_dirty);
         rc = lr_renderer_frame(a->pr, &st, e);
         /* Its next frame redoes what this one did not finish (a cut: a stop). */
-        a->pr_dirty = rc ? d : 0;
+        if (!rc)
+            a->pr_dirty = 0;
     }
     if (!rc && !skip)
         rc = publish(a, a->pr, &st, LR_ASYNC_PREVIEW, batch, e);
-    /* Restored whatever happened: the copy must stay equal to the caller's scene. Its flags
-     * are the preview renderer's at its next frame (the scene's values there are the
-     * preview's again, but a change in between may have been to one of these keys). */
+    /* Restored whatever happened: the copy must stay equal to the caller's scene. */
     unsigned back = 0;
     for (int i = applied - 1; i >= 0; i--) {
         lr_err re = {0};
@@ -369,7 +370,6 @@ static int preview_frame(lr_async *a, uint64_t batch, lr_err *e)
             *e = re;
         }
     }
-    a->pr_dirty |= back;
     return rc;
 }
 

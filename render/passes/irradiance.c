@@ -295,7 +295,7 @@ int lr_irradiance_run(lr_irradiance *irr, const lr_pass_ctx *c, const lr_vpl *v,
          * due, draws them whole at the next frame. */
         glEnable(GL_SCISSOR_TEST);
         for (int y = 0, rows; y < LR_RECV_GRID && !rc; y += rows) {
-            rows = lr_slice_band(c->slicer, LR_SLICE_IRRADIANCE, LR_RECV_GRID - y);
+            rows = lr_slice_band(c->slicer, LR_SLICE_IRRADIANCE, y, LR_RECV_GRID);
             glScissor(0, y, LR_RECV_GRID, rows);
             lr_gl_draw_fullscreen(c->gl);
             rc = lr_slice_end(c->slicer, LR_CANCEL_STALE, "receiver irradiance pass", e);

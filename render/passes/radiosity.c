@@ -358,7 +358,7 @@ int lr_radiosity_run(lr_radiosity *rad, const lr_pass_ctx *c, const lr_gbuffer *
              * this level makes them do anyway. */
             glEnable(GL_SCISSOR_TEST);
             for (int y = 0, rows; y < rad->size && !cut; y += rows) {
-                rows = lr_slice_band(c->slicer, LR_SLICE_RADIOSITY, rad->size - y);
+                rows = lr_slice_band(c->slicer, LR_SLICE_RADIOSITY, y, rad->size);
                 glScissor(0, y, rad->size, rows);
                 draw_objects(rad, c, p, l);
                 cut = lr_slice_end(c->slicer, LR_CANCEL_RESTART, "radiosity pass", e);

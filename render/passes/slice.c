@@ -23,6 +23,7 @@ static double now_ms(void)
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
+/* Without a budget: a map whole, a grid in LR_SLICE_ROWS. */
 static int fixed_rows(enum lr_slice_pass pass, int total)
 {
     return pass == LR_SLICE_IRRADIANCE && total > LR_SLICE_ROWS ? LR_SLICE_ROWS : total;
@@ -48,19 +49,23 @@ void lr_slicer_set_budget(lr_slicer *s, double ms) { s->budget_ms = ms > 0 ? ms 
 
 long lr_slicer_count(const lr_slicer *s) { return s->count; }
 
-int lr_slice_band(lr_slicer *s, enum lr_slice_pass pass, int total)
+int lr_slice_band(lr_slicer *s, enum lr_slice_pass pass, int y, int size)
 {
+    int total = size - y;
     if (total < 1)
         return 0;
     if (!s || !s->cancel || !(s->budget_ms > 0))
         return fixed_rows(pass, total);
     double per_row = s->ms_per_row[pass];
+    int least = (size + LR_SLICE_MAX_BANDS - 1) / LR_SLICE_MAX_BANDS;
     /* No estimate yet (the pass's first band): a small one, which gives it. */
-    int rows = total < LR_SLICE_FIRST_ROWS ? total : LR_SLICE_FIRST_ROWS;
+    int rows = LR_SLICE_FIRST_ROWS > least ? LR_SLICE_FIRST_ROWS : least;
     if (per_row > 0) {
         double fit = s->budget_ms / per_row;
-        rows = fit >= total ? total : fit < 1 ? 1 : (int)fit;
+        rows = fit >= total ? total : fit < least ? least : (int)fit;
     }
+    if (rows > total)
+        rows = total;
     s->band_pass = (int)pass;
     s->band_rows = rows;
     s->band_t0 = now_ms();

@@ -21,7 +21,8 @@
  *
  * How many rows a band has: with a time budget (lr_slicer_set_budget, the rig's
  * output.slice_ms) and a token, as many as the pass's last bands say fit in the budget on this
- * GPU (a running estimate of ms per row, per pass), at least one; otherwise the fixed bands
+ * GPU (a running estimate of ms per row, per pass), at least size / LR_SLICE_MAX_BANDS;
+ * otherwise the fixed bands
  * below, whose count the tests rely on. The fixed bands were sized for the candle at 16 VPLs
  * (about 17 ms a band); at the planned 64 VPLs they took 40-70 ms, the wait of a change that
  * arrives during the pass.
@@ -39,6 +40,11 @@
 
 /* With a budget, the rows of a pass's first band, before any estimate. */
 #define LR_SLICE_FIRST_ROWS 4
+/* With a budget, at most this many bands to a map or a grid: a band costs a few ms beyond its
+ * rows on llvmpipe (the draw's set-up and the wait), so bands sized to a budget under that
+ * would shrink to one row and multiply the pass's time (the candle's irradiance pass: 1.9 s
+ * in 3-row bands against 0.63 s whole). */
+#define LR_SLICE_MAX_BANDS 32
 
 /* The passes drawn in bands (each has its own estimate of the time per row). */
 enum lr_slice_pass { LR_SLICE_RADIOSITY, LR_SLICE_IRRADIANCE, LR_SLICE_PASSES };
@@ -59,9 +65,9 @@ void lr_slicer_set_budget(lr_slicer *s, double ms);
 /* Slices ended since the slicer was made. */
 long lr_slicer_count(const lr_slicer *s);
 
-/* Starts a band of `pass`, of the `total` rows still to draw: returns its rows (1..total) and
- * notes the time, so that lr_slice_end measures it. s may be NULL: the fixed band. */
-int lr_slice_band(lr_slicer *s, enum lr_slice_pass pass, int total);
+/* Starts a band of `pass` at row y of `size` rows: returns its rows (1..size - y) and notes
+ * the time, so that lr_slice_end measures it. s may be NULL: the fixed band. */
+int lr_slice_band(lr_slicer *s, enum lr_slice_pass pass, int y, int size);
 
 /* Ends a slice of pass `what`: with a token, waits for the GPU work issued so far and returns
  * LR_ECANCELED ("WHAT: cancelled") when the token is requested at `level` or above; LR_OK

@@ -323,6 +323,8 @@ static void test_http_api(void **state)
     lr_rig_info info;
     lr_rig_get_info(r, &info);
     assert_int_equal(info.reloads, 1);
+    /* Loaded in a job while the loop served the connection (suspended) and the frames. */
+    assert_int_equal(lr_test_log_count(&log, "reload: loaded and planned off the loop in "), 1);
     assert_non_null(strstr(lr_scene_path(lr_rig_scene(r)), "candle.json"));
 
     /* The frame: a PNG of the output's size, numbered. */
@@ -943,6 +945,78 @@ static void test_http_browser(void **state)
     lr_test_rmtree(dir);
 }
 
+/* lr_rig_reload_async, POST /api/reload's way: each answer is a reload that started after its
+ * request (a request made while a reload runs waits for the next one), on the loop, with the
+ * loop turning meanwhile; a forgotten request is not answered; at most LR_RIG_RELOAD_WAITERS
+ * wait at once. */
+typedef struct answers {
+    int n, rc;
+    uint64_t reloads; /* the rig's count when answered */
+    lr_rig *r;
+} answers;
+
+static void answered(void *ctx, int rc, const lr_err *e)
+{
+    (void)e;
+    answers *a = ctx;
+    lr_rig_info info;
+    lr_rig_get_info(a->r, &info);
+    a->n++;
+    a->rc = rc;
+    a->reloads = info.reloads;
+}
+
+static void test_reload_answers(void **state)
+{
+    (void)state;
+    const int port = 18089;
+    char *dir = lr_test_tmpdir();
+    lr_test_log log = {0};
+    lr_rig *r = make_rig(dir, port, "", "preview", &log);
+    run_ms(r, 50);
+    lr_rig_info info;
+    lr_rig_get_info(r, &info);
+    uint64_t frames0 = info.frames;
+    answers a = {.r = r}, b = {.r = r}, c = {.r = r};
+    lr_err e = {0};
+    assert_int_equal(lr_rig_reload_async(r, answered, &a, &e), LR_OK);
+    assert_int_equal(lr_rig_reload_async(r, answered, &b, &e), LR_OK); /* during the first */
+    assert_int_equal(lr_rig_reload_async(r, answered, &c, &e), LR_OK);
+    lr_rig_reload_forget(r, &c);
+    assert_int_equal(a.n + b.n, 0); /* not inside the calls: a job runs */
+    int64_t guard = lr_now_ns() + 60000 * MS;
+    while (b.n == 0 && lr_now_ns() < guard)
+        run_ms(r, 10);
+    assert_int_equal(a.n, 1);
+    assert_int_equal(a.rc, LR_OK);
+    assert_int_equal(a.reloads, 1);
+    assert_int_equal(b.n, 1);
+    assert_int_equal(b.rc, LR_OK);
+    assert_int_equal(b.reloads, 2); /* the one after: its request came during the first */
+    assert_int_equal(c.n, 0);
+    lr_rig_get_info(r, &info);
+    assert_true(info.frames > frames0); /* the loop drew meanwhile */
+    assert_int_equal(lr_test_log_count(&log, "reload: loaded and planned off the loop in "), 2);
+
+    /* At most LR_RIG_RELOAD_WAITERS at once: the next is refused, naming why. */
+    answers w[LR_RIG_RELOAD_WAITERS];
+    for (int i = 0; i < LR_RIG_RELOAD_WAITERS; i++) {
+        w[i] = (answers){.r = r};
+        assert_int_equal(lr_rig_reload_async(r, answered, &w[i], &e), LR_OK);
+    }
+    assert_int_equal(lr_rig_reload_async(r, answered, &c, &e), LR_EUNSUPPORTED);
+    assert_non_null(strstr(e.msg, "reloads already waiting"));
+    while (w[LR_RIG_RELOAD_WAITERS - 1].n == 0 && lr_now_ns() < guard)
+        run_ms(r, 10);
+    /* The first started reload 3; the others came while it ran: one more answers them all. */
+    for (int i = 0; i < LR_RIG_RELOAD_WAITERS; i++) {
+        assert_int_equal(w[i].n, 1);
+        assert_int_equal(w[i].reloads, i == 0 ? 3 : 4);
+    }
+    lr_rig_destroy(r);
+    lr_test_rmtree(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -950,6 +1024,7 @@ int main(void)
         cmocka_unit_test(test_status_frame_rate),
         cmocka_unit_test(test_http_config),
         cmocka_unit_test(test_http_api),
+        cmocka_unit_test(test_reload_answers),
         cmocka_unit_test(test_http_bad_requests),
         cmocka_unit_test(test_http_token),
         cmocka_unit_test(test_http_garbage),

@@ -12,7 +12,8 @@
  *    uncut renderer's;
  *  - without a token nothing is cut, whatever the hook requests;
  *  - with a time budget (lr_renderer_set_slice_ms) the bands are sized from the pass's last
- *    bands: a budget no row fits gives one row a band (MAP rows a map, LR_RECV_GRID a grid),
+ *    bands: a budget no row fits gives the fewest rows a band may have (LR_SLICE_MAX_BANDS
+ *    bands a map and a grid),
  *    one every pass fits gives one band a map and a grid; a cut mid-map under a budget
  *    restarts the maps, and every such frame converges to the uncut image.
  * The converged images are compared exactly (to 1e-6 of the peak): the same seed and the same
@@ -37,7 +38,7 @@
 
 LR_TEST_GL_FIXTURE(gl) /* tests/support/gl.h: setup(), teardown() */
 
-enum { W = 32, H = 24, K = 4, FRAMES = 4, MAP = 32 };
+enum { W = 32, H = 24, K = 4, FRAMES = 4 };
 
 /* The candle with its two plane receivers and VPLs (the irradiance pass runs), small maps;
  * no receiver bounce or opening light (CPU solves this test does not cut). */
@@ -305,13 +306,14 @@ static void test_budget_sizes_the_bands(void **state)
     int lights = lr_scene_light_count(s), planes = plane_grids(s);
     float *want = uncut_image(s);
     lr_cancel token;
-    /* A budget under any row's time: after the first frame's estimates, one row a band. */
+    /* A budget under any row's time: after the first frame's estimates, the fewest rows a
+     * band may have (a 32-row map: one; the 256-row grid: 8). */
     lr_renderer *r = tokened(s, &token);
     lr_renderer_set_slice_ms(r, 1e-9);
     (void)frame_slices(r); /* the estimates */
     long n = frame_slices(r);
     print_message("budget 1e-9 ms: %ld slices a frame\n", n);
-    assert_int_equal(n, (long)K * lights * MAP + (long)planes * LR_RECV_GRID);
+    assert_int_equal(n, (long)(K * lights + planes) * LR_SLICE_MAX_BANDS);
     converges_as_uncut(r, s, want);
 
     /* A budget every pass fits in: one band a map and a grid. */
@@ -325,7 +327,7 @@ static void test_budget_sizes_the_bands(void **state)
     assert_int_equal(n, (long)K * lights + planes);
     converges_as_uncut(r, s, want);
 
-    /* Cut at the fifth one-row band of the first map: the maps restart. */
+    /* Cut at the fifth band of the first map: the maps restart. */
     s = lr_test_scene("candle", settings, NULL);
     want = uncut_image(s);
     r = tokened(s, &token);
