@@ -39,7 +39,6 @@
 
 typedef struct peer {
     lr_test_peer c; /* the console: olad or qlcplus (tests/support/console_peer.h) */
-    bool ready;     /* olad's RPC answered */
 } peer;
 
 typedef struct rec {
@@ -60,74 +59,6 @@ static const lr_event *last_of(const rec *r, const char *source, const char *con
         if (strcmp(r->ev[i].source, source) == 0 && strcmp(r->ev[i].control, control) == 0)
             return &r->ev[i];
     return NULL;
-}
-
-/* OLA's plugins: all off but E1.31 and Art-Net, bound to the veth address (a plugin probing
- * USB and serial devices would only slow the start). */
-static void write_ola_config(const char *dir)
-{
-    static const char *const off[] = {"dummy", "espnet", "ftdidmx", "gpio", "karate", "kinet",
-                                      "milinst", "opendmx", "openpixelcontrol", "osc",
-                                      "pathport", "renard", "sandnet", "shownet", "spi",
-                                      "stageprofi", "uartdmx", "usbdmx", "usbserial", NULL};
-    char path[256];
-    for (int i = 0; off[i]; i++) {
-        snprintf(path, sizeof path, "%s/ola-%s.conf", dir, off[i]);
-        FILE *f = fopen(path, "w");
-        assert_non_null(f);
-        fputs("enabled = false\n", f);
-        fclose(f);
-    }
-    snprintf(path, sizeof path, "%s/ola-e131.conf", dir);
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs("enabled = true\nip = 10.155.0.2\ninput_ports = 0\noutput_ports = 1\n", f);
-    fclose(f);
-    snprintf(path, sizeof path, "%s/ola-artnet.conf", dir);
-    f = fopen(path, "w");
-    assert_non_null(f);
-    fputs("enabled = true\nip = 10.155.0.2\noutput_ports = 1\n", f);
-    fclose(f);
-}
-
-static void start_olad(peer *p)
-{
-    write_ola_config(p->c.dir);
-    assert_int_equal(lr_test_sh("chown -R olad %s", p->c.dir), 0);
-    p->c.pid = fork();
-    assert_true(p->c.pid >= 0);
-    if (p->c.pid == 0) {
-        char log[128];
-        snprintf(log, sizeof log, "%s/olad.log", p->c.dir);
-        if (!freopen(log, "w", stdout) || !freopen(log, "a", stderr))
-            _exit(127);
-        /* setpriv execs olad itself (no forking wrapper): the pid is olad's. */
-        execlp("ip", "ip", "netns", "exec", p->c.ns, "setpriv", "--reuid=olad", "--regid=nogroup",
-               "--clear-groups", "olad", "-c", p->c.dir, "--no-http", "--no-register-with-dns-sd",
-               "-l", "3", (char *)NULL);
-        _exit(127);
-    }
-    /* Ready when its RPC answers (about a second). */
-    for (int i = 0; i < 100 && !p->ready; i++) {
-        usleep(100000);
-        p->ready = lr_test_sh("ip netns exec %s ola_dev_info >%s/devs 2>/dev/null", p->c.ns, p->c.dir) == 0 &&
-                   lr_test_sh("grep -q E1.31 %s/devs && grep -q ArtNet %s/devs", p->c.dir, p->c.dir) == 0;
-    }
-}
-
-/* The device number of the line naming kind in ola_dev_info's output ("Device 2: E1.31 ..."). */
-static int device_number(const peer *p, const char *kind)
-{
-    char path[128], line[256];
-    snprintf(path, sizeof path, "%s/devs", p->c.dir);
-    FILE *f = fopen(path, "r");
-    assert_non_null(f);
-    int n = -1;
-    while (fgets(line, sizeof line, f))
-        if (strstr(line, kind) && sscanf(line, "Device %d:", &n) == 1)
-            break;
-    fclose(f);
-    return n;
 }
 
 typedef struct want {
@@ -173,8 +104,7 @@ static void ola_drives_both(void **state)
         print_message("%s\n", why);
         skip();
     }
-    start_olad(p);
-    if (!p->ready) {
+    if (!lr_test_olad_start(&p->c, "10.155.0.2")) {
         lr_test_sh("cat %s/olad.log >&2", p->c.dir);
         fail_msg("olad did not come up in 10 s (its log above)");
     }
@@ -197,7 +127,7 @@ static void ola_drives_both(void **state)
     assert_int_equal(lr_test_log_count(&log, "multicast groups"), 0); /* joined */
     /* Patching enables OLA's ports, and the first enabled Art-Net port makes it poll: our
      * node answers, listing port-address 1, and OLA then sends that universe to us. */
-    int de = device_number(p, "E1.31"), da = device_number(p, "ArtNet");
+    int de = lr_test_olad_device(&p->c, "E1.31"), da = lr_test_olad_device(&p->c, "ArtNet");
     assert_true(de > 0 && da > 0);
     assert_int_equal(lr_test_sh("ip netns exec %s ola_patch -d %d -p 0 -u 1", p->c.ns, de), 0);
     assert_int_equal(lr_test_sh("ip netns exec %s ola_patch -d %d -p 0 -u 1", p->c.ns, da), 0);

@@ -160,3 +160,73 @@ void lr_test_qlc_ws_text(int fd, const char *text)
         f[6 + i] = (uint8_t)text[i] ^ mask[i % 4];
     assert_int_equal(write(fd, f, 6 + n), (ssize_t)(6 + n));
 }
+
+/* OLA's plugins: all off but E1.31 and Art-Net, bound to ip (a plugin probing USB and serial
+ * devices would only slow the start). */
+static void write_ola_config(const char *dir, const char *ip)
+{
+    static const char *const off[] = {"dummy", "espnet", "ftdidmx", "gpio", "karate", "kinet",
+                                      "milinst", "opendmx", "openpixelcontrol", "osc",
+                                      "pathport", "renard", "sandnet", "shownet", "spi",
+                                      "stageprofi", "uartdmx", "usbdmx", "usbserial", NULL};
+    char path[256];
+    for (int i = 0; off[i]; i++) {
+        snprintf(path, sizeof path, "%s/ola-%s.conf", dir, off[i]);
+        FILE *f = fopen(path, "w");
+        assert_non_null(f);
+        fputs("enabled = false\n", f);
+        fclose(f);
+    }
+    snprintf(path, sizeof path, "%s/ola-e131.conf", dir);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f, "enabled = true\nip = %s\ninput_ports = 0\noutput_ports = 1\n", ip);
+    fclose(f);
+    snprintf(path, sizeof path, "%s/ola-artnet.conf", dir);
+    f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f, "enabled = true\nip = %s\noutput_ports = 1\n", ip);
+    fclose(f);
+}
+
+bool lr_test_olad_start(lr_test_peer *p, const char *ip)
+{
+    write_ola_config(p->dir, ip);
+    assert_int_equal(lr_test_sh("chown -R olad %s", p->dir), 0);
+    p->pid = fork();
+    assert_true(p->pid >= 0);
+    if (p->pid == 0) {
+        char log[128];
+        snprintf(log, sizeof log, "%s/olad.log", p->dir);
+        if (!freopen(log, "w", stdout) || !freopen(log, "a", stderr))
+            _exit(127);
+        /* setpriv execs olad itself (no forking wrapper): the pid is olad's. */
+        execlp("ip", "ip", "netns", "exec", p->ns, "setpriv", "--reuid=olad", "--regid=nogroup",
+               "--clear-groups", "olad", "-c", p->dir, "--no-http", "--no-register-with-dns-sd",
+               "-l", "3", (char *)NULL);
+        _exit(127);
+    }
+    /* Ready when its RPC answers (about a second). */
+    bool ready = false;
+    for (int i = 0; i < 100 && !ready; i++) {
+        usleep(100000);
+        ready = lr_test_sh("ip netns exec %s ola_dev_info >%s/devs 2>/dev/null", p->ns, p->dir) ==
+                    0 &&
+                lr_test_sh("grep -q E1.31 %s/devs && grep -q ArtNet %s/devs", p->dir, p->dir) == 0;
+    }
+    return ready;
+}
+
+int lr_test_olad_device(const lr_test_peer *p, const char *kind)
+{
+    char path[128], line[256];
+    snprintf(path, sizeof path, "%s/devs", p->dir);
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    int n = -1;
+    while (fgets(line, sizeof line, f))
+        if (strstr(line, kind) && sscanf(line, "Device %d:", &n) == 1)
+            break;
+    fclose(f);
+    return n;
+}

@@ -37,6 +37,14 @@ bool lr_test_peer_ns(lr_test_peer *p, const char *name, const char *net, char *w
  * after a failed assertion (a teardown's). */
 void lr_test_peer_stop(lr_test_peer *p);
 
+/* OLA's daemon in p's namespace as its own user (setpriv, user olad), a fresh config folder
+ * p->dir with every plugin off but E1.31 and Art-Net (one output port each, bound to ip, the
+ * namespace's veth address), its log olad.log there. True once its RPC answers and lists both
+ * devices (ola_dev_info, written to p->dir/devs); false after 10 s. */
+bool lr_test_olad_start(lr_test_peer *p, const char *ip);
+/* The device number of the line naming `kind` ("E1.31", "ArtNet") in p->dir/devs; -1: none. */
+int lr_test_olad_device(const lr_test_peer *p, const char *kind);
+
 /* QLC+ headless (offscreen, --nogui --web) in p's namespace with `workspace` (a .qxw
  * document) written to p->dir/console.qxw, HOME and its log (qlcplus.log) in p->dir. Its
  * loopback goes down first: QLC+ sends its E1.31 and Art-Net output from the first address
