@@ -166,19 +166,26 @@ build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c render/photometry/%.c render/photometry/l
 	@echo "  FUZZ    $@"
 	$(Q)clang -std=c11 -D_GNU_SOURCE -I. -g -O1 -fsanitize=fuzzer,address,undefined -o $@ $^ -lm
 
+# The suite and the Pi 5 profile's binaries in one run (tests/run.sh's pi5: entries), the
+# package's install checks beside it (their output after the run's): 45-50 s less than one
+# after the other on the 2-core machine.
 test: $(TESTS:%=build/test/%) build/bin/lamprig $(TOOLS:%=build/bin/lamprig-%)
-	@sh tests/run.sh $(TESTS:%=build/test/%)
-	@$(MAKE) --no-print-directory test-pi5-profile
-	@$(MAKE) --no-print-directory test-install
+	@$(MAKE) --no-print-directory test-install >build/test-install.log 2>&1 & ipid=$$!; \
+	LR_PI5_GLES=$(PI5_GLES) LR_PI5_EXT="$(PI5_EXT)" sh tests/run.sh $(TESTS:%=build/test/%) \
+	    $(PI5_PROFILE_TESTS:%=pi5:build/test/%); rc=$$?; \
+	wait $$ipid; irc=$$?; cat build/test-install.log; \
+	[ $$irc = 0 ] || echo "make test: the install checks failed (above)"; \
+	[ $$rc = 0 ] && [ $$irc = 0 ]
 
 # Render tests on llvmpipe restricted to the Raspberry Pi 5's GLES 3.1 profile
 # (docs/pi5-gles31-profile.md): ES 3.1, no float blending, no 32F linear filtering, no GPU
-# timers, so the renderer takes its RGBA16F maps and CPU timers. `make test` runs it after the
-# suite: a subset (test_render_progressive, the accumulation the fallback changes, and
+# timers, so the renderer takes its RGBA16F maps and CPU timers. `make test` runs it in the
+# suite's run: a subset (test_render_progressive, the accumulation the fallback changes, and
 # test_render_passes, each pass on its own; about 42 s of CPU, 26 s wall on two cores);
 # tests/run.sh prints its time.
-PI5_PROFILE_ENV := MESA_GLES_VERSION_OVERRIDE=3.1 \
-    MESA_EXTENSION_OVERRIDE="-GL_EXT_float_blend -GL_OES_texture_float_linear -GL_EXT_disjoint_timer_query"
+PI5_GLES := 3.1
+PI5_EXT := -GL_EXT_float_blend -GL_OES_texture_float_linear -GL_EXT_disjoint_timer_query
+PI5_PROFILE_ENV := MESA_GLES_VERSION_OVERRIDE=$(PI5_GLES) MESA_EXTENSION_OVERRIDE="$(PI5_EXT)"
 PI5_PROFILE_TESTS := test_render_progressive test_render_passes
 .PHONY: test-pi5-profile
 test-pi5-profile: $(PI5_PROFILE_TESTS:%=build/test/%)

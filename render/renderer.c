@@ -46,6 +46,7 @@ struct lr_renderer {
     lr_slicer *slicer;         /* the long passes' slice ends (render/passes/slice.h) */
     lr_timer *timer;
     lr_pass_programs prog;
+    bool borrowed_programs; /* prog is desc.programs_of's: not destroyed here */
 
     /* Settings the resources were made for, and the scene's lights then. */
     lr_render_settings rs;
@@ -459,7 +460,10 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
     snprintf(r->info, sizeof r->info, "%s; %s; %s timers", caps->renderer, maps,
              lr_timer_is_gpu(r->timer) ? "GPU" : "CPU+glFinish");
     lr_pass_programs *pr = &r->prog;
-    if ((rc = program(r, "mesh.vert", "surface.frag", &pr->surface, e)) ||
+    if (desc->programs_of) {
+        *pr = desc->programs_of->prog;
+        r->borrowed_programs = true;
+    } else if ((rc = program(r, "mesh.vert", "surface.frag", &pr->surface, e)) ||
         (rc = program(r, "mesh.vert", "depth.frag", &pr->depth, e)) ||
         (rc = program(r, "radiosity.vert", "radiosity.frag", &pr->radiosity, e)) ||
         (rc = program(r, "fullscreen.vert", "vpl.frag", &pr->vpl, e)) ||
@@ -468,25 +472,28 @@ int lr_renderer_create(const lr_renderer_desc *desc, lr_renderer **out, lr_err *
         (rc = program(r, "fullscreen.vert", "area_direct.frag", &pr->area, e)) ||
         (rc = program(r, "fullscreen.vert", "surface_cache.frag", &pr->cache, e)))
         goto fail;
-    /* Composition from the surface cache and of the receivers, one program per light count
-     * (LR_CACHE_LIGHTS, LR_RECV_LIGHTS): llvmpipe runs a loop's body for every light up to
-     * the bound whatever u_n_lights says (a camera move's receivers cost 1.8x for one light
-     * with the bound at 4, tools/bench/README.md "Camera move, profiled"). */
-    for (int n = 1; n <= LR_MAX_LIGHTS; n++) {
-        lr_shader_defines d;
-        lr_shader_defines_copy(&d, &r->defines);
-        if (!lr_shader_defines_add(&d, "LR_CACHE_LIGHTS", n) ||
-            !lr_shader_defines_add(&d, "LR_RECV_LIGHTS", n)) {
-            rc = lr_err_set(e, LR_EINVAL, "renderer: too many shader defines");
-            goto fail;
+    if (!r->borrowed_programs) {
+        /* Composition from the surface cache and of the receivers, one program per light count
+         * (LR_CACHE_LIGHTS, LR_RECV_LIGHTS): llvmpipe runs a loop's body for every light up to
+         * the bound whatever u_n_lights says (a camera move's receivers cost 1.8x for one light
+         * with the bound at 4, tools/bench/README.md "Camera move, profiled"). */
+        for (int n = 1; n <= LR_MAX_LIGHTS; n++) {
+            lr_shader_defines d;
+            lr_shader_defines_copy(&d, &r->defines);
+            if (!lr_shader_defines_add(&d, "LR_CACHE_LIGHTS", n) ||
+                !lr_shader_defines_add(&d, "LR_RECV_LIGHTS", n)) {
+                rc = lr_err_set(e, LR_EINVAL, "renderer: too many shader defines");
+                goto fail;
+            }
+            lr_program_desc pd = {.vertex = "compose_cached.vert",
+                                  .fragment = "compose_cached.frag", .dir = r->shader_dir,
+                                  .defines = d.list};
+            lr_program_desc pr_d = {.vertex = "mesh.vert", .fragment = "compose_receiver.frag",
+                                    .dir = r->shader_dir, .defines = d.list};
+            if ((rc = lr_program_create(&pd, &pr->obj_cached[n - 1], e)) ||
+                (rc = lr_program_create(&pr_d, &pr->recv[n - 1], e)))
+                goto fail;
         }
-        lr_program_desc pd = {.vertex = "compose_cached.vert", .fragment = "compose_cached.frag",
-                              .dir = r->shader_dir, .defines = d.list};
-        lr_program_desc pr_d = {.vertex = "mesh.vert", .fragment = "compose_receiver.frag",
-                                .dir = r->shader_dir, .defines = d.list};
-        if ((rc = lr_program_create(&pd, &pr->obj_cached[n - 1], e)) ||
-            (rc = lr_program_create(&pr_d, &pr->recv[n - 1], e)))
-            goto fail;
     }
     if ((rc = alloc_resources(r, e)) || (rc = lr_pass_objects_upload(&r->objs, r->scene, e)))
         goto fail;
@@ -521,7 +528,7 @@ void lr_renderer_destroy(lr_renderer *r)
                         pr->cache,         pr->obj_cached[0], pr->obj_cached[1],
                         pr->obj_cached[2], pr->obj_cached[3], pr->area,
                         pr->recv[1],       pr->recv[2],       pr->recv[3]};
-    for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
+    for (size_t i = 0; i < sizeof ps / sizeof ps[0] && !r->borrowed_programs; i++)
         lr_program_destroy(ps[i]);
     lr_timer_destroy(r->timer);
     lr_slicer_destroy(r->slicer);

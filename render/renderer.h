@@ -53,6 +53,11 @@ typedef struct lr_renderer_desc {
      * may take; settings that need more are refused at create or at the frame that applies
      * them (LR_ENOMEM, naming what they need). 0: no limit. */
     double gpu_budget_mb;
+    /* Another renderer on the same context and thread whose GLSL programs this one uses
+     * instead of building its own (their defines do not depend on the scene or settings):
+     * render/async's preview renderer, which then costs no compile. It must outlive this one.
+     * NULL: its own. */
+    const struct lr_renderer *programs_of;
 } lr_renderer_desc;
 
 

@@ -4,6 +4,9 @@
 #
 #   sh tests/run.sh build/test/test_NAME ...       (or bash; `make test` runs them all)
 #   LR_TEST_JOBS=N   binaries at once (default: the number of CPUs plus one, at least 3)
+#   pi5:build/test/test_NAME   that binary again under the Raspberry Pi 5's GLES profile
+#                    (MESA_GLES_VERSION_OVERRIDE=$LR_PI5_GLES, MESA_EXTENSION_OVERRIDE=
+#                    $LR_PI5_EXT, both from the Makefile), shown as test_NAME@pi5
 #
 # Scheduling: the binaries named in tests/durations.txt start longest first (a fixed list of
 # measured CPU times, so a run's makespan is about the longest binary's time plus the rest
@@ -70,7 +73,7 @@ fi
 listed=()
 unlisted=()
 for t in "$@"; do
-    name=$(basename "$t")
+    name=$(basename "${t#pi5:}")
     if [ -n "${known[$name]:-}" ]; then listed+=("${known[$name]} $t"); else unlisted+=("$t"); fi
 done
 queue=()
@@ -90,8 +93,13 @@ run_start=$EPOCHREALTIME
 last_beat=${EPOCHREALTIME%.*}
 
 launch() {
-    local t=$1 name
-    name=$(basename "$t")
+    local t=$1 name pi5=
+    name=$(basename "${t#pi5:}")
+    if [ "${t#pi5:}" != "$t" ]; then
+        pi5=1
+        t=${t#pi5:}
+        name=$name@pi5
+    fi
     mkdir -p "$run_dir/cache/$name"
     # Mesa's shader cache alone is shared by the run's binaries (a link in each cache folder,
     # so a test that points XDG_CACHE_HOME elsewhere still gets its own): it holds llvmpipe's
@@ -101,6 +109,10 @@ launch() {
     (
         export XDG_CACHE_HOME="$run_dir/cache/$name"
         # LR_TEST_EXEC: a runner in front of each binary (make test-arm64: qemu-aarch64-static).
+        if [ -n "$pi5" ]; then
+            export MESA_GLES_VERSION_OVERRIDE="${LR_PI5_GLES:?pi5: entries need LR_PI5_GLES}"
+            export MESA_EXTENSION_OVERRIDE="${LR_PI5_EXT:?pi5: entries need LR_PI5_EXT}"
+        fi
         ${LR_TEST_EXEC:-} "$t" >"$run_dir/logs/$name.log" 2>&1
         echo $? >"$run_dir/logs/$name.rc"
     ) &

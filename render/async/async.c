@@ -556,6 +556,7 @@ static void *worker_main(void *arg)
     if (a->r && a->n_preview) {
         double s = a->preview_scale > 0 && a->preview_scale < 1 ? a->preview_scale : 1.0;
         lr_renderer_desc pd = rd;
+        pd.programs_of = a->r; /* destroyed after it */
         pd.width = a->width * s < 1 ? 1 : (int)lround(a->width * s);
         pd.height = a->height * s < 1 ? 1 : (int)lround(a->height * s);
         if ((rc = lr_renderer_create(&pd, &a->pr, &e))) {

@@ -11,6 +11,7 @@
 
 #include <sched.h>
 #include <stdbool.h>
+#include <stdio.h>
 #include <string.h>
 
 static const lrb_section *const sections[] = {
@@ -94,6 +95,9 @@ static int figures(const lr_args *a)
 
 int main(int argc, char **argv)
 {
+    /* The tables (stdout) a line at a time: with both streams in one file (`lamprig-bench rig
+     * > log 2>&1`) a fully buffered table was cut by the progress lines (stderr). */
+    setvbuf(stdout, NULL, _IOLBF, 0);
     /* The sections' list is the help's notes: built here from the table above. */
     char notes[2048];
     size_t n = (size_t)snprintf(notes, sizeof notes, "SECTION: the sections to run, in the "
