@@ -136,6 +136,21 @@ static void run_to(lr_rig *r, lr_test_mb_server *mb, double want, int raw, int64
     }
 }
 
+/* After a console's command at t0: the rig reaches the intensity and the lamp's raw level
+ * within 5 s; the times printed (what: the command; note: what they include). */
+static void reaches(lr_rig *r, lr_test_mb_server *mb, const char *what, int64_t t0,
+                    double intensity, int raw, const char *note)
+{
+    double t1, tr, tl;
+    run_to(r, mb, intensity, raw, t0, 5000, &t1, &tr, &tl);
+    print_message("%s: intensity first changed after %.0f ms, reached %.6g after %.0f ms (the "
+                  "0.25 s fade), lamp raw %d after %.0f ms (%s)\n",
+                  what, t1, intensity, tr, raw, tl, note);
+    assert_true(tr >= 0);
+    assert_true(tl >= 0);
+    assert_near(scene_num(r, "light.intensity"), intensity, 1e-12);
+}
+
 static void qlcplus_drives_the_rig(void **state)
 {
     lr_test_peer *p = *state;
@@ -176,15 +191,8 @@ static void qlcplus_drives_the_rig(void **state)
     for (size_t i = 0; i < sizeof steps / sizeof steps[0]; i++) {
         int64_t t0 = lr_now_ns();
         lr_test_qlc_ws_text(fd, steps[i].cmd);
-        double t1, tr, tl;
-        run_to(r, mb, steps[i].intensity, steps[i].raw, t0, 5000, &t1, &tr, &tl);
-        print_message("QLC+ %s: intensity first changed after %.0f ms, reached %.6g after %.0f "
-                      "ms (the 0.25 s fade), lamp raw %d after %.0f ms (web socket frame to the "
-                      "rig's state, QLC+'s output cadence included)\n",
-                      steps[i].cmd, t1, steps[i].intensity, tr, steps[i].raw, tl);
-        assert_true(tr >= 0);
-        assert_true(tl >= 0);
-        assert_near(scene_num(r, "light.intensity"), steps[i].intensity, 1e-12);
+        reaches(r, mb, steps[i].cmd, t0, steps[i].intensity, steps[i].raw,
+                "web socket frame to the rig's state, QLC+'s output cadence included");
     }
     close(fd);
     lr_rig_destroy(r);
@@ -243,15 +251,8 @@ static void ola_and_oscsend_drive_the_rig(void **state)
         int rc = steps[i].in_ns ? lr_test_sh("ip netns exec %s %s", p->ns, steps[i].cmd)
                                 : lr_test_sh("%s", steps[i].cmd);
         assert_int_equal(rc, 0);
-        double t1, tr, tl;
-        run_to(r, mb, steps[i].intensity, steps[i].raw, t0, 5000, &t1, &tr, &tl);
-        print_message("%s: intensity first changed after %.0f ms, reached %.6g after %.0f ms "
-                      "(the 0.25 s fade), lamp raw %d after %.0f ms (the command's own start "
-                      "included)\n",
-                      steps[i].cmd, t1, steps[i].intensity, tr, steps[i].raw, tl);
-        assert_true(tr >= 0);
-        assert_true(tl >= 0);
-        assert_near(scene_num(r, "light.intensity"), steps[i].intensity, 1e-12);
+        reaches(r, mb, steps[i].cmd, t0, steps[i].intensity, steps[i].raw,
+                "the command's own start included");
     }
     /* A scene of the OSC device's list: loaded off the loop, then shown. */
     assert_int_equal(lr_test_sh("oscsend 127.0.0.1 9000 /lamprig/scene s votive"), 0);
